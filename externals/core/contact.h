@@ -1,0 +1,94 @@
+/* contact.h -- nonlinear stick-membrane impact (Hunt-Crossley), plain C99.
+ *
+ * A stick of lumped mass m (kg) hits the membrane at (r/a, theta). With the
+ * compression x = stick position - membrane displacement at the contact point
+ * (positive into the membrane), the contact force is
+ *     F = k x^alpha + lambda x^alpha dx/dt   for x > 0,  else 0,  and F >= 0.
+ * The contact is solved jointly with the membrane's modes, sample by sample
+ * (Avanzini & Rocchesso), with an energy-consistent discretisation: the
+ * spring term is a discrete gradient of V(x) = k x^(alpha+1)/(alpha+1) and the
+ * modes and the stick advance with the midpoint rule, so the discrete energy
+ * of stick + membrane + spring never grows (docs/membrane.md). The stick
+ * therefore never rebounds faster than it came in, by construction.
+ *
+ * A contact does nothing on its own: attach it to a membrane
+ * (membrane_attach_contact), then contact_hit() starts a stroke.
+ */
+#ifndef ICTUS_CONTACT_H
+#define ICTUS_CONTACT_H
+
+#include "membrane.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define CONTACT_MASS_MIN      1.0e-4 /* kg */
+#define CONTACT_MASS_MAX      10.0
+#define CONTACT_STIFFNESS_MIN 1.0    /* N/m^alpha */
+#define CONTACT_STIFFNESS_MAX 1.0e12
+#define CONTACT_ALPHA_MIN     1.0
+#define CONTACT_ALPHA_MAX     4.0
+#define CONTACT_DAMPING_MIN   0.0    /* lambda, s/m */
+#define CONTACT_DAMPING_MAX   1.0e3
+#define CONTACT_VELOCITY_MAX  50.0   /* m/s, |hit velocity| */
+
+/* Defaults: a 50 g snare stick with a felt-free wooden tip on Mylar. */
+#define CONTACT_DEFAULT_MASS      0.05
+#define CONTACT_DEFAULT_STIFFNESS 1.0e7
+#define CONTACT_DEFAULT_ALPHA     1.5
+#define CONTACT_DEFAULT_DAMPING   0.5
+
+/* What a finished stroke reports (on release: the stick leaves the membrane). */
+typedef struct contact_report {
+    double duration_ms;         /* first touch to release */
+    double peak_force_n;        /* largest contact force */
+    double rebound_velocity_mps; /* stick velocity away from the membrane at release (>= 0) */
+    double impulse_ns;          /* integral of the force */
+} contact_report;
+
+/* Allocates. Returns NULL when memory cannot be had. */
+contact *contact_new(void);
+void contact_free(contact *c);
+
+ictus_status contact_set_mass(contact *c, double mass_kg);
+ictus_status contact_set_stiffness(contact *c, double k);
+ictus_status contact_set_alpha(contact *c, double alpha);
+ictus_status contact_set_damping(contact *c, double lambda);
+double contact_get_mass(const contact *c);
+double contact_get_stiffness(const contact *c);
+double contact_get_alpha(const contact *c);
+double contact_get_damping(const contact *c);
+
+/* Starts a stroke: the stick arrives at the membrane surface at (r/a, theta)
+ * moving into it at velocity_mps (> 0), `sample_offset` samples into the next
+ * membrane_process() call of the membrane it is attached to. Values out of
+ * range are clamped (status says so). A new hit replaces a stroke in progress. */
+ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, double theta_deg,
+                         int sample_offset);
+
+/* Force buffer: membrane_process() writes this contact's force (N), one value
+ * per sample, into the buffer given here (capacity in samples; the membrane
+ * writes min(n, capacity) values per call). NULL to stop writing. */
+void contact_set_force_output(contact *c, float *buffer, int capacity);
+
+/* 1 while the stick is in a stroke (touching, or away but not yet released). */
+int contact_is_active(const contact *c);
+/* Returns 1 and fills *report once per finished stroke (then clears the flag). */
+int contact_take_report(contact *c, contact_report *report);
+/* Stick state (m, m/s; positive into the membrane) and the last force (N). */
+double contact_stick_position(const contact *c);
+double contact_stick_velocity(const contact *c);
+double contact_last_force(const contact *c);
+
+/* Stick on a rigid, immovable target: the same contact law and discretisation
+ * with no membrane. Simulates one stroke at sample_rate_hz and fills *report.
+ * Returns 0 if it did not release within max_seconds. For tests against Hertz's
+ * contact time. */
+int contact_simulate_rigid(const contact *c, double velocity_mps, double sample_rate_hz,
+                           double max_seconds, contact_report *report);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

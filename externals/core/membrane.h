@@ -1,0 +1,151 @@
+/* membrane.h -- modal circular membrane (plain C99, no Pd).
+ *
+ * An ideal circular membrane of radius a (m), tension T (N/m) and areal density
+ * sigma (kg/m^2), fixed at its rim. Its modes (m, n) ring at
+ *     f_mn = j_mn * c / (2 pi a),  c = sqrt(T / sigma),
+ * where j_mn is the n-th positive zero of the Bessel function J_m. Modes with
+ * m >= 1 come in degenerate cos/sin pairs; each is a separate mode here, so the
+ * angles of the strike and of the pickups matter. Mode shapes:
+ *     phi(r, theta) = J_m(j_mn r / a) * {cos, sin}(m theta).
+ * Each mode is a damped oscillator driven by the force at the strike point and
+ * by every attached contact (see contact.h); the state of all of them advances
+ * together sample by sample in membrane_process().
+ *
+ * Damping law (documented in docs/membrane.md):
+ *     sigma_k = sigma0 + sigma1 * omega_k^2     (decay rate, 1/s; T60 = ln(1000)/sigma_k)
+ * set by the fundamental's T60 and a high-frequency damping control.
+ *
+ * Threading: one instance is used by one thread at a time. Setters may be
+ * called between membrane_process() calls while sounding; they never click,
+ * blow up or produce NaN. Only functions documented as "allocates" allocate;
+ * membrane_process() never allocates, locks or prints.
+ */
+#ifndef ICTUS_MEMBRANE_H
+#define ICTUS_MEMBRANE_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Result of a setter: the value was taken as given, clamped into range (the
+ * clamped value can be read back with the matching getter), or refused
+ * because memory could not be had (state unchanged). NaN counts as out of
+ * range and is replaced by the parameter's default. */
+typedef enum {
+    ICTUS_OK = 0,
+    ICTUS_CLAMPED = 1,
+    ICTUS_ENOMEM = 2
+} ictus_status;
+
+/* Legal ranges (SI units). Setters clamp into them. */
+#define MEMBRANE_RADIUS_MIN     0.01   /* m */
+#define MEMBRANE_RADIUS_MAX     2.0    /* m */
+#define MEMBRANE_TENSION_MIN    1.0    /* N/m */
+#define MEMBRANE_TENSION_MAX    1.0e5  /* N/m */
+#define MEMBRANE_DENSITY_MIN    0.01   /* kg/m^2 */
+#define MEMBRANE_DENSITY_MAX    20.0   /* kg/m^2 */
+#define MEMBRANE_MODES_MIN      1
+#define MEMBRANE_MODES_MAX      4096
+#define MEMBRANE_T60_MIN        0.005  /* s */
+#define MEMBRANE_T60_MAX        60.0   /* s */
+#define MEMBRANE_PICKUPS        2      /* pickups (outputs) per membrane */
+#define MEMBRANE_MAX_CONTACTS   4      /* contacts attached at once */
+#define MEMBRANE_SR_MIN         1000.0 /* Hz */
+#define MEMBRANE_SR_MAX         768000.0
+
+/* Defaults: a 14-inch Mylar head (radius 0.178 m, 0.262 kg/m^2) at 3000 N/m. */
+#define MEMBRANE_DEFAULT_RADIUS  0.178
+#define MEMBRANE_DEFAULT_TENSION 3000.0
+#define MEMBRANE_DEFAULT_DENSITY 0.262
+#define MEMBRANE_DEFAULT_MODES   128
+#define MEMBRANE_DEFAULT_T60     1.0
+
+typedef struct membrane membrane;
+typedef struct contact contact;
+
+/* Creates a membrane with the defaults above at the given sample rate (Hz).
+ * Allocates. Returns NULL when memory cannot be had. */
+membrane *membrane_new(double sample_rate_hz);
+void membrane_free(membrane *m);
+
+/* Sample rate of this instance (Hz); recomputes the coefficients, keeps the state. */
+ictus_status membrane_set_sample_rate(membrane *m, double sample_rate_hz);
+
+/* Physics. Mass sets the density as mass / (pi a^2); density wins if set later. */
+ictus_status membrane_set_radius(membrane *m, double radius_m);
+ictus_status membrane_set_tension(membrane *m, double tension_n_per_m);
+ictus_status membrane_set_density(membrane *m, double density_kg_per_m2);
+ictus_status membrane_set_mass(membrane *m, double mass_kg);
+
+/* Number of modes (sorted by frequency). Allocates when growing beyond the
+ * capacity reached so far; call from a message handler, never from audio.
+ * Modes above Nyquist*0.95 are kept silent (counted, not ringing). */
+ictus_status membrane_set_modes(membrane *m, int count);
+
+/* Damping: T60 of the fundamental (s), and the high-frequency damping control
+ * (documented in docs/membrane.md; 0 = every mode decays like the fundamental). */
+ictus_status membrane_set_t60(membrane *m, double t60_s);
+ictus_status membrane_set_hf_damping(membrane *m, double control);
+
+/* Pickup `index` (0 .. MEMBRANE_PICKUPS-1) at r/a in [0, 1], angle in degrees. */
+ictus_status membrane_set_pickup(membrane *m, int index, double r_over_a, double theta_deg);
+
+/* Point where the force input of membrane_process() is applied. */
+ictus_status membrane_set_strike_point(membrane *m, double r_over_a, double theta_deg);
+
+/* An ideal impulse (N s) at (r/a, theta), landing `sample_offset` samples into the
+ * next membrane_process() call (offsets past that block carry over to later
+ * blocks). Up to 64 pending strikes are queued; more are dropped and counted. */
+ictus_status membrane_strike(membrane *m, double r_over_a, double theta_deg, double impulse_ns,
+                             int sample_offset);
+
+/* Silences every mode and every attached contact at once. */
+void membrane_clear(membrane *m);
+
+/* Output gain applied to the pickups (see docs/membrane.md for the scale). */
+ictus_status membrane_set_output_gain(membrane *m, double gain);
+
+/* Attach / detach a contact (at most MEMBRANE_MAX_CONTACTS). A contact is
+ * solved jointly with the modes, sample by sample. Attaching an attached
+ * contact does nothing. Returns ICTUS_ENOMEM when the table is full. */
+ictus_status membrane_attach_contact(membrane *m, contact *c);
+void membrane_detach_contact(membrane *m, contact *c);
+
+/* Advances n samples. force_in (may be NULL) is a force (N) applied at the
+ * strike point; out[0..MEMBRANE_PICKUPS-1] receive the pickup signals
+ * (membrane velocity, see docs/membrane.md). force_in may alias an output. */
+void membrane_process(membrane *m, const float *force_in, float *const *out, int n);
+
+/* Read-back, for tests, help patches and the wrappers' error messages. */
+double membrane_get_sample_rate(const membrane *m);
+double membrane_get_radius(const membrane *m);
+double membrane_get_tension(const membrane *m);
+double membrane_get_density(const membrane *m);
+double membrane_get_mass(const membrane *m);
+int membrane_get_modes(const membrane *m);
+double membrane_get_t60(const membrane *m);
+double membrane_get_hf_damping(const membrane *m);
+double membrane_get_output_gain(const membrane *m);
+/* Mode k (0-based, sorted by frequency): frequency (Hz), T60 (s), indices (m, n)
+ * and which of the degenerate pair (0 = cos, 1 = sin). Return 0 on a bad k. */
+int membrane_get_mode(const membrane *m, int k, double *freq_hz, double *t60_s, int *bessel_m,
+                      int *bessel_n, int *sin_partner);
+/* Membrane transverse displacement (m) and velocity (m/s) at a point, from the
+ * current modal state (O(modes); not for the audio loop). */
+double membrane_displacement_at(const membrane *m, double r_over_a, double theta_deg);
+double membrane_velocity_at(const membrane *m, double r_over_a, double theta_deg);
+/* Total vibrational energy of the modes (J). */
+double membrane_energy(const membrane *m);
+/* Strikes dropped because the queue was full. */
+long membrane_dropped_strikes(const membrane *m);
+
+/* The n-th positive zero (n >= 1) of the Bessel function J_m (m >= 0), computed
+ * to about 1e-13 relative (not from a table). Exposed for tests and docs. */
+double ictus_bessel_zero(int m, int n);
+/* J_m(x) for integer m >= 0. */
+double ictus_bessel_j(int m, double x);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
