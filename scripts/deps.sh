@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
     build-essential cmake pkg-config
     puredata-core puredata-dev pd-cyclone
-    libode-dev libeigen3-dev liblo-dev liblo-tools
+    libode-dev libeigen3-dev liblo-dev liblo-tools nlohmann-json3-dev
     catch2
     python3 python3-numpy python3-scipy python3-matplotlib
     "$@"
