@@ -112,6 +112,11 @@ struct JointLimit {
 // The series of local rotations of one joint over all frames of a motion.
 std::vector<Eigen::Quaterniond> joint_series(const Motion &motion, int joint);
 
+// Learns both limits for every joint of a skeleton that is not an end site,
+// from that joint's local rotations over all frames of `motion`.
+std::vector<JointLimit> learn_limits(const Skeleton &skeleton, const Motion &motion,
+                                     const LimitOptions &options = {});
+
 // Learns both limits for every named series (names.size() == series.size();
 // each series non-empty, else MocapError).
 std::vector<JointLimit> learn_limits(const std::vector<std::string> &names,
