@@ -1,0 +1,509 @@
+// bvh.cpp -- Biovision Hierarchy reader.
+//
+// The hierarchy is read token by token (line numbers kept for messages), the
+// motion section line by line, so a wrong value count is reported on its line.
+#include "ictus/bvh.hpp"
+
+#include "text_lines.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+namespace ictus
+{
+
+namespace
+{
+
+using detail::quote;
+
+constexpr std::size_t kMaxFileBytes = std::size_t{512} << 20; // 512 MiB
+constexpr int kMaxJoints = 10000;
+constexpr int kMaxDepth = 500;          // nesting; guards the recursion
+constexpr double kMinFrameTimeS = 1e-5; // 100 kHz
+constexpr double kMaxFrameTimeS = 60.0;
+
+// Walks the tokens of the hierarchy section, line by line.
+class Cursor
+{
+  public:
+    Cursor(const std::vector<std::string> &lines, const std::string &source)
+        : lines_(lines), source_(source)
+    {
+    }
+
+    // The next token, or throws "expected <what>, got end of file".
+    std::string next(const std::string &what)
+    {
+        fill();
+        if (line_ >= lines_.size())
+            throw MocapError(source_, static_cast<int>(lines_.size()),
+                             "expected " + what + ", got end of file");
+        token_line_ = static_cast<int>(line_) + 1;
+        return tokens_[index_++];
+    }
+
+    const std::string *peek()
+    {
+        fill();
+        return line_ >= lines_.size() ? nullptr : &tokens_[index_];
+    }
+
+    void expect(const std::string &word)
+    {
+        const std::string got = next("'" + word + "'");
+        if (got != word)
+            fail("'" + word + "'", got);
+    }
+
+    double number(const std::string &what)
+    {
+        const std::string token = next(what);
+        double value = 0.0;
+        if (!detail::parse_double(token, value) || !std::isfinite(value))
+            fail(what + " (a finite number)", token);
+        return value;
+    }
+
+    // The rest of the current token's line, up to (not including) `stop`.
+    std::vector<std::string> rest_of_line(const std::string &stop)
+    {
+        std::vector<std::string> rest;
+        if (line_ >= lines_.size() || static_cast<int>(line_) + 1 != token_line_)
+            return rest;
+        while (index_ < tokens_.size() && tokens_[index_] != stop)
+            rest.push_back(tokens_[index_++]);
+        return rest;
+    }
+
+    [[noreturn]] void fail(const std::string &expected, const std::string &got) const
+    {
+        throw MocapError(source_, token_line_, "expected " + expected + ", got " + quote(got));
+    }
+
+    int token_line() const { return token_line_; }
+    // Index of the first line after the last token taken.
+    std::size_t line_after_token() const { return static_cast<std::size_t>(token_line_); }
+
+  private:
+    void fill()
+    {
+        while (line_ < lines_.size() && index_ >= tokens_.size()) {
+            if (loaded_)
+                ++line_;
+            if (line_ >= lines_.size())
+                break;
+            tokens_ = detail::split_blanks(lines_[line_]);
+            index_ = 0;
+            loaded_ = true;
+        }
+    }
+
+    const std::vector<std::string> &lines_;
+    const std::string &source_;
+    std::size_t line_ = 0;
+    bool loaded_ = false;
+    std::vector<std::string> tokens_;
+    std::size_t index_ = 0;
+    int token_line_ = 0;
+};
+
+bool channel_from_name(const std::string &name, BvhChannel &channel)
+{
+    static const struct {
+        const char *name;
+        BvhChannel channel;
+    } table[] = {{"Xposition", BvhChannel::Xposition}, {"Yposition", BvhChannel::Yposition},
+                 {"Zposition", BvhChannel::Zposition}, {"Xrotation", BvhChannel::Xrotation},
+                 {"Yrotation", BvhChannel::Yrotation}, {"Zrotation", BvhChannel::Zrotation}};
+    for (const auto &entry : table)
+        if (name == entry.name) {
+            channel = entry.channel;
+            return true;
+        }
+    return false;
+}
+
+bool is_position(BvhChannel c)
+{
+    return c == BvhChannel::Xposition || c == BvhChannel::Yposition || c == BvhChannel::Zposition;
+}
+
+int channel_axis(BvhChannel c)
+{
+    switch (c) {
+    case BvhChannel::Xposition:
+    case BvhChannel::Xrotation:
+        return 0;
+    case BvhChannel::Yposition:
+    case BvhChannel::Yrotation:
+        return 1;
+    default:
+        return 2;
+    }
+}
+
+class BvhParser
+{
+  public:
+    BvhParser(const std::vector<std::string> &lines, const std::string &source,
+              const BvhOptions &options, MocapWarnings *warnings)
+        : lines_(lines), source_(source), options_(options), warnings_(warnings),
+          cursor_(lines, source)
+    {
+    }
+
+    BvhFile parse()
+    {
+        if (!std::isfinite(options_.scale) || options_.scale <= 0.0)
+            throw MocapError(source_, 0,
+                             "expected BvhOptions::scale finite and > 0, got " +
+                                 std::to_string(options_.scale));
+        cursor_.expect("HIERARCHY");
+        cursor_.expect("ROOT");
+        parse_joint(-1, 0);
+        const std::string after = cursor_.next("MOTION");
+        if (after != "MOTION")
+            cursor_.fail("MOTION (one ROOT hierarchy, braces balanced)", after);
+        if (bvh_.channel_count == 0)
+            throw MocapError(source_, cursor_.token_line(),
+                             "expected at least one channel in the hierarchy, got none");
+        const long declared = parse_frames();
+        parse_frame_time();
+        parse_motion(declared);
+        return std::move(bvh_);
+    }
+
+  private:
+    void parse_joint(int parent, int depth)
+    {
+        const int keyword_line = cursor_.token_line();
+        if (depth > kMaxDepth)
+            throw MocapError(source_, keyword_line,
+                             "expected a hierarchy at most " + std::to_string(kMaxDepth) +
+                                 " joints deep, got deeper");
+        if (static_cast<int>(bvh_.skeleton.joints.size()) >= kMaxJoints)
+            throw MocapError(source_, keyword_line,
+                             "expected at most " + std::to_string(kMaxJoints) +
+                                 " joints, got more");
+        std::string name;
+        for (const std::string &part : cursor_.rest_of_line("{"))
+            name += (name.empty() ? "" : " ") + part;
+        if (name.empty())
+            throw MocapError(source_, keyword_line, "expected a joint name, got end of line");
+        cursor_.expect("{");
+        SkeletonJoint joint;
+        joint.name = name;
+        joint.parent = parent;
+        joint.offset_m = parse_offset() * options_.scale;
+        const int index = static_cast<int>(bvh_.skeleton.joints.size());
+        bvh_.skeleton.joints.push_back(joint);
+        bvh_.channels.emplace_back();
+        const std::string *ahead = cursor_.peek();
+        if (ahead && *ahead == "CHANNELS")
+            parse_channels(index, parent);
+        for (;;) {
+            const std::string token = cursor_.next("JOINT, End Site or '}'");
+            if (token == "JOINT") {
+                parse_joint(index, depth + 1);
+            } else if (token == "End") {
+                const std::string site = cursor_.next("Site");
+                if (site != "Site" && site != "site")
+                    cursor_.fail("Site", site);
+                parse_end_site(index);
+            } else if (token == "}") {
+                return;
+            } else {
+                cursor_.fail("JOINT, End Site or '}' (in joint " + name + ")", token);
+            }
+        }
+    }
+
+    Eigen::Vector3d parse_offset()
+    {
+        cursor_.expect("OFFSET");
+        Eigen::Vector3d offset;
+        for (int k = 0; k < 3; ++k)
+            offset[k] = cursor_.number("an OFFSET coordinate");
+        return offset;
+    }
+
+    void parse_channels(int index, int parent)
+    {
+        cursor_.expect("CHANNELS");
+        const std::string count_token = cursor_.next("a channel count");
+        double count = 0.0;
+        if (!detail::parse_double(count_token, count) || count != std::floor(count) ||
+            count < 0.0 || count > 6.0)
+            cursor_.fail("a channel count 0..6", count_token);
+        std::vector<BvhChannel> &channels = bvh_.channels[static_cast<std::size_t>(index)];
+        for (int c = 0; c < static_cast<int>(count); ++c) {
+            const std::string channel_name = cursor_.next("a channel name");
+            BvhChannel channel;
+            if (!channel_from_name(channel_name, channel))
+                cursor_.fail("a channel name (Xposition Yposition Zposition Xrotation "
+                             "Yrotation Zrotation)",
+                             channel_name);
+            for (BvhChannel seen : channels)
+                if (seen == channel)
+                    cursor_.fail("each channel once per joint", channel_name);
+            channels.push_back(channel);
+            if (is_position(channel) && parent >= 0)
+                has_joint_translation_ = true;
+        }
+        bvh_.channel_count += static_cast<int>(count);
+    }
+
+    void parse_end_site(int parent)
+    {
+        cursor_.expect("{");
+        SkeletonJoint site;
+        site.name = bvh_.skeleton.joints[static_cast<std::size_t>(parent)].name + "_End";
+        site.parent = parent;
+        site.end_site = true;
+        site.offset_m = parse_offset() * options_.scale;
+        cursor_.expect("}");
+        if (static_cast<int>(bvh_.skeleton.joints.size()) >= kMaxJoints)
+            throw MocapError(source_, cursor_.token_line(),
+                             "expected at most " + std::to_string(kMaxJoints) +
+                                 " joints, got more");
+        bvh_.skeleton.joints.push_back(site);
+        bvh_.channels.emplace_back();
+    }
+
+    // "Frames: N" (also "Frames:N").
+    long parse_frames()
+    {
+        std::string token = cursor_.next("Frames:");
+        std::string value_token;
+        if (token == "Frames:")
+            value_token = cursor_.next("a frame count");
+        else if (token.rfind("Frames:", 0) == 0)
+            value_token = token.substr(7);
+        else
+            cursor_.fail("Frames:", token);
+        double frames = 0.0;
+        const std::string range = "[1, " + std::to_string(options_.max_frames) + "]";
+        if (!detail::parse_double(value_token, frames) || !std::isfinite(frames) ||
+            frames != std::floor(frames) || frames < 1.0 ||
+            frames > static_cast<double>(options_.max_frames))
+            cursor_.fail("a whole frame count in " + range, value_token);
+        return static_cast<long>(frames);
+    }
+
+    // "Frame Time: T" (s). A rate that the printed T matches to its last
+    // printed digit is snapped to the integer (".0083333" -> 120 Hz).
+    void parse_frame_time()
+    {
+        const std::string frame = cursor_.next("Frame Time:");
+        if (frame != "Frame")
+            cursor_.fail("Frame Time:", frame);
+        std::string token = cursor_.next("Time:");
+        std::string value_token;
+        if (token == "Time:")
+            value_token = cursor_.next("a frame time");
+        else if (token.rfind("Time:", 0) == 0)
+            value_token = token.substr(5);
+        else
+            cursor_.fail("Time:", token);
+        double frame_time = 0.0;
+        if (!detail::parse_double(value_token, frame_time) || !std::isfinite(frame_time) ||
+            frame_time < kMinFrameTimeS || frame_time > kMaxFrameTimeS)
+            cursor_.fail("a frame time in [1e-05, 60] s", value_token);
+        const std::vector<std::string> extra = cursor_.rest_of_line("");
+        if (!extra.empty())
+            cursor_.fail("end of line after the frame time", extra.front());
+        double rate = 1.0 / frame_time;
+        const std::size_t dot = value_token.find('.');
+        if (dot != std::string::npos && value_token.find_first_of("eE") == std::string::npos) {
+            const int decimals = static_cast<int>(value_token.size() - dot - 1);
+            const double half_last_digit = 0.5 * std::pow(10.0, -decimals);
+            const double whole = std::round(rate);
+            if (whole >= 1.0 && std::fabs(1.0 / whole - frame_time) <= half_last_digit * 1.000001)
+                rate = whole;
+        }
+        bvh_.frame_time_s = 1.0 / rate;
+        bvh_.motion.frame_rate_hz = rate;
+        frame_time_line_ = cursor_.token_line();
+    }
+
+    void parse_motion(long declared)
+    {
+        const std::size_t joint_count = bvh_.skeleton.joints.size();
+        const auto channel_count = static_cast<std::size_t>(bvh_.channel_count);
+        if (options_.skip_frames < 0 || options_.skip_frames >= declared)
+            throw MocapError(source_, frame_time_line_ - 1,
+                             "expected BvhOptions::skip_frames in [0, " +
+                                 std::to_string(declared - 1) + "], got " +
+                                 std::to_string(options_.skip_frames));
+        std::vector<double> values(channel_count);
+        long read = 0;
+        long extra_lines = 0;
+        int first_extra_line = 0;
+        for (std::size_t l = static_cast<std::size_t>(frame_time_line_); l < lines_.size(); ++l) {
+            const int line_number = static_cast<int>(l) + 1;
+            const std::vector<std::string> tokens = detail::split_blanks(lines_[l]);
+            if (tokens.empty())
+                continue;
+            if (read == declared) {
+                if (extra_lines++ == 0)
+                    first_extra_line = line_number;
+                continue;
+            }
+            if (tokens.size() != channel_count)
+                throw MocapError(source_, line_number,
+                                 "expected " + std::to_string(channel_count) +
+                                     " values (one per channel) on motion line " +
+                                     std::to_string(read + 1) + ", got " +
+                                     std::to_string(tokens.size()));
+            for (std::size_t c = 0; c < channel_count; ++c) {
+                if (!detail::parse_double(tokens[c], values[c]) || !std::isfinite(values[c]))
+                    throw MocapError(source_, line_number,
+                                     "expected a finite number in column " + std::to_string(c) +
+                                         " (" + channel_label(c) + "), got " + quote(tokens[c]));
+            }
+            if (read >= options_.skip_frames)
+                add_frame(values, joint_count);
+            ++read;
+        }
+        if (read < declared)
+            throw MocapError(source_, static_cast<int>(lines_.size()),
+                             "expected " + std::to_string(declared) +
+                                 " motion lines (Frames: " + std::to_string(declared) + "), got " +
+                                 std::to_string(read) + " (truncated file?)");
+        if (extra_lines > 0 && warnings_)
+            warnings_->push_back(
+                source_ + ":" + std::to_string(first_extra_line) + ": ignored " +
+                std::to_string(extra_lines) +
+                " motion line(s) beyond the declared Frames: " + std::to_string(declared));
+        if (has_joint_translation_ && warnings_)
+            warnings_->push_back(source_ + ": non-root joints have position channels; "
+                                           "forward_kinematics(Skeleton, Motion) ignores them, use "
+                                           "bvh_forward_kinematics");
+    }
+
+    std::string channel_label(std::size_t column) const
+    {
+        std::size_t c = column;
+        for (std::size_t j = 0; j < bvh_.channels.size(); ++j) {
+            if (c < bvh_.channels[j].size())
+                return bvh_.skeleton.joints[j].name + " " + to_string(bvh_.channels[j][c]);
+            c -= bvh_.channels[j].size();
+        }
+        return "?";
+    }
+
+    void add_frame(const std::vector<double> &values, std::size_t joint_count)
+    {
+        constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+        std::vector<Eigen::Quaterniond> rotation(joint_count, Eigen::Quaterniond::Identity());
+        std::vector<Eigen::Vector3d> translation;
+        if (has_joint_translation_)
+            translation.resize(joint_count);
+        Eigen::Vector3d root_position = bvh_.skeleton.joints[0].offset_m;
+        std::size_t column = 0;
+        for (std::size_t j = 0; j < joint_count; ++j) {
+            Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+            Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+            for (BvhChannel channel : bvh_.channels[j]) {
+                const double value = values[column++];
+                if (is_position(channel))
+                    moved[channel_axis(channel)] = value * options_.scale;
+                else // intrinsic: each later channel rotates about the already-rotated axes
+                    q = q * axis_rotation(channel_axis(channel), value * kDegToRad);
+            }
+            rotation[j] = q.normalized();
+            const Eigen::Vector3d placed = bvh_.skeleton.joints[j].offset_m + moved;
+            if (j == 0)
+                root_position = placed;
+            if (has_joint_translation_)
+                translation[j] = placed;
+        }
+        bvh_.motion.root_position_m.push_back(root_position);
+        bvh_.motion.local_rotation.push_back(std::move(rotation));
+        if (has_joint_translation_)
+            bvh_.joint_translation_m.push_back(std::move(translation));
+    }
+
+    const std::vector<std::string> &lines_;
+    const std::string &source_;
+    const BvhOptions &options_;
+    MocapWarnings *warnings_;
+    Cursor cursor_;
+    BvhFile bvh_;
+    bool has_joint_translation_ = false;
+    int frame_time_line_ = 0;
+};
+
+} // namespace
+
+int BvhFile::channelled_joints() const
+{
+    int count = 0;
+    for (const auto &list : channels)
+        count += list.empty() ? 0 : 1;
+    return count;
+}
+
+Eigen::Quaterniond axis_rotation(int axis, double angle_rad)
+{
+    const Eigen::Vector3d axes[3] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                     Eigen::Vector3d::UnitZ()};
+    return Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, axes[axis < 0 || axis > 2 ? 0 : axis]));
+}
+
+const char *to_string(BvhChannel channel)
+{
+    switch (channel) {
+    case BvhChannel::Xposition:
+        return "Xposition";
+    case BvhChannel::Yposition:
+        return "Yposition";
+    case BvhChannel::Zposition:
+        return "Zposition";
+    case BvhChannel::Xrotation:
+        return "Xrotation";
+    case BvhChannel::Yrotation:
+        return "Yrotation";
+    case BvhChannel::Zrotation:
+        return "Zrotation";
+    }
+    return "?";
+}
+
+BvhFile parse_bvh(std::istream &in, const std::string &source_name, const BvhOptions &options,
+                  MocapWarnings *warnings)
+{
+    const std::vector<std::string> lines = detail::read_lines(in, source_name, kMaxFileBytes);
+    BvhParser parser(lines, source_name, options, warnings);
+    return parser.parse();
+}
+
+BvhFile read_bvh(const std::string &path, const BvhOptions &options, MocapWarnings *warnings)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw MocapError(path, 0, "expected a readable BVH file, got one that cannot be opened");
+    return parse_bvh(in, path, options, warnings);
+}
+
+std::vector<Eigen::Vector3d> bvh_forward_kinematics(const BvhFile &bvh, int frame)
+{
+    if (bvh.joint_translation_m.empty())
+        return forward_kinematics(bvh.skeleton, bvh.motion, frame);
+    const std::vector<Eigen::Quaterniond> world =
+        world_rotations(bvh.skeleton, bvh.motion, frame); // checks frame and sizes
+    const auto &translation = bvh.joint_translation_m[static_cast<std::size_t>(frame)];
+    std::vector<Eigen::Vector3d> position(bvh.skeleton.joints.size());
+    for (std::size_t j = 0; j < bvh.skeleton.joints.size(); ++j) {
+        const int parent = bvh.skeleton.joints[j].parent;
+        position[j] =
+            parent < 0 ? translation[j]
+                       : Eigen::Vector3d(position[static_cast<std::size_t>(parent)] +
+                                         world[static_cast<std::size_t>(parent)] * translation[j]);
+    }
+    return position;
+}
+
+} // namespace ictus

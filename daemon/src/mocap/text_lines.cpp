@@ -1,0 +1,122 @@
+// text_lines.cpp -- line splitting and number parsing shared by the readers.
+#include "text_lines.hpp"
+
+#include "ictus/mocap_error.hpp"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <system_error>
+
+namespace ictus::detail
+{
+
+std::vector<std::string> read_lines(std::istream &in, const std::string &source_name,
+                                    std::size_t max_bytes)
+{
+    std::vector<std::string> lines;
+    std::string current;
+    std::size_t total = 0;
+    char buffer[65536];
+    bool pending_cr = false;
+    while (in) {
+        in.read(buffer, sizeof buffer);
+        const std::streamsize got = in.gcount();
+        total += static_cast<std::size_t>(got);
+        if (total > max_bytes)
+            throw MocapError(source_name, 0,
+                             "expected at most " + std::to_string(max_bytes) +
+                                 " bytes, got more (file too large)");
+        for (std::streamsize i = 0; i < got; ++i) {
+            const char c = buffer[i];
+            if (pending_cr) {
+                pending_cr = false;
+                if (c == '\n')
+                    continue; // second half of CRLF
+            }
+            if (c == '\r' || c == '\n') {
+                lines.push_back(current);
+                current.clear();
+                pending_cr = (c == '\r');
+            } else {
+                current.push_back(c);
+            }
+        }
+    }
+    if (in.bad())
+        throw MocapError(source_name, 0, "expected a readable stream, got a read error");
+    if (!current.empty())
+        lines.push_back(current);
+    return lines;
+}
+
+std::vector<std::string> split_blanks(const std::string &line)
+{
+    std::vector<std::string> tokens;
+    std::size_t i = 0;
+    const std::size_t n = line.size();
+    while (i < n) {
+        while (i < n && std::isspace(static_cast<unsigned char>(line[i])))
+            ++i;
+        const std::size_t start = i;
+        while (i < n && !std::isspace(static_cast<unsigned char>(line[i])))
+            ++i;
+        if (i > start)
+            tokens.emplace_back(line, start, i - start);
+    }
+    return tokens;
+}
+
+bool parse_double(const std::string &token, double &value)
+{
+    // std::from_chars: locale-independent (strtod would follow a global locale
+    // that may use ',' as the decimal point) and it accepts "nan"/"inf", which
+    // the callers then reject or treat as gaps by name.
+    const char *first = token.data();
+    const char *last = token.data() + token.size();
+    if (first != last && *first == '+')
+        ++first;
+    if (first == last)
+        return false;
+    double parsed = 0.0;
+    const auto [end, error] = std::from_chars(first, last, parsed);
+    if (end != last)
+        return false;
+    if (error == std::errc::result_out_of_range) {
+        // Overflow: report as non-finite; underflow: zero is the right value.
+        const bool negative = (*first == '-');
+        double magnitude = 0.0;
+        for (const char *c = first; c != last; ++c)
+            if (*c == 'e' || *c == 'E') {
+                magnitude = std::atof(c + 1);
+                break;
+            }
+        parsed = magnitude > 0 ? (negative ? -HUGE_VAL : HUGE_VAL) : 0.0;
+    } else if (error != std::errc()) {
+        return false;
+    }
+    value = parsed;
+    return true;
+}
+
+std::string quote(const std::string &token)
+{
+    std::string shown = token.size() > 40 ? token.substr(0, 40) + "..." : token;
+    for (char &c : shown)
+        if (!std::isprint(static_cast<unsigned char>(c)))
+            c = '?';
+    return "'" + shown + "'";
+}
+
+std::string trim(const std::string &text)
+{
+    std::size_t begin = 0, end = text.size();
+    while (begin < end && std::isspace(static_cast<unsigned char>(text[begin])))
+        ++begin;
+    while (end > begin && std::isspace(static_cast<unsigned char>(text[end - 1])))
+        --end;
+    return text.substr(begin, end - begin);
+}
+
+} // namespace ictus::detail
