@@ -1,0 +1,230 @@
+/* contact~ -- a stick that hits a membrane~ (Hunt-Crossley contact,
+ * externals/core/contact.h), solved jointly with the membrane's modes.
+ *
+ * [contact~ NAME] plays the membrane~ named NAME. It finds it in its dsp
+ * method with pd_findbyclass(), as delread~ finds delwrite~, and attaches its
+ * core contact to the membrane's core. The membrane's perform computes the
+ * stroke and writes the contact force into a buffer owned here; contact~'s
+ * perform copies it to the signal outlet. If Pd happens to sort contact~ before
+ * membrane~, the force outlet lags one block; the sound (membrane~'s outlets)
+ * is exact either way, since the contact is solved inside membrane~'s perform.
+ *
+ * Outlets: contact force (N, signal); on release, a list
+ * duration_ms peak_force_N rebound_velocity_mps (from a clock, never from perform).
+ */
+#include <string.h>
+
+#include "ictus_pd.h"
+
+t_class *ictus_contact_tilde_class;
+
+/* ---------------- parameters ---------------- */
+
+typedef ictus_status (*t_csetter)(contact *, double);
+typedef double (*t_cgetter)(const contact *);
+
+typedef struct _cparam {
+    const char *p_name;
+    const char *p_unit;
+    double p_min, p_max;
+    t_csetter p_set;
+    t_cgetter p_get;
+} t_cparam;
+
+static const t_cparam contact_tilde_params[] = {
+    {"mass", "kg", CONTACT_MASS_MIN, CONTACT_MASS_MAX, contact_set_mass, contact_get_mass},
+    {"stiffness", "N/m^alpha", CONTACT_STIFFNESS_MIN, CONTACT_STIFFNESS_MAX, contact_set_stiffness,
+     contact_get_stiffness},
+    {"alpha", "", CONTACT_ALPHA_MIN, CONTACT_ALPHA_MAX, contact_set_alpha, contact_get_alpha},
+    {"damping", "s/m", CONTACT_DAMPING_MIN, CONTACT_DAMPING_MAX, contact_set_damping,
+     contact_get_damping},
+};
+#define NCPARAMS (int)(sizeof(contact_tilde_params) / sizeof(contact_tilde_params[0]))
+
+/* mass, stiffness, alpha, damping: one number each, clamped and reported. */
+static void contact_tilde_setparam(t_contact_tilde *x, t_symbol *s, int argc, t_atom *argv)
+{
+    int i;
+    double value;
+    const t_cparam *p;
+    for (i = 0; i < NCPARAMS; i++)
+        if (!strcmp(s->s_name, contact_tilde_params[i].p_name))
+            break;
+    if (i == NCPARAMS)
+        return;
+    p = &contact_tilde_params[i];
+    if (argc > 1)
+        pd_error(x, "contact~: %s takes one number; extra arguments ignored", s->s_name);
+    if (!ictus_getnumber(x, "contact~", s->s_name, "value", argc, argv, 0, &value))
+        return;
+    if (value < p->p_min || value > p->p_max) {
+        double used = value < p->p_min ? p->p_min : p->p_max;
+        pd_error(x, "contact~: %s must be in [%g, %g] %s, got %g; using %g", p->p_name, p->p_min,
+                 p->p_max, p->p_unit, value, used);
+        value = used;
+    }
+    if (p->p_set(x->x_core, value) == ICTUS_CLAMPED)
+        pd_error(x, "contact~: %s %g %s is out of range; using %g", p->p_name, value, p->p_unit,
+                 p->p_get(x->x_core));
+}
+
+/* The membrane~ whose sample clock times our messages: the attached one, else
+ * the one the name finds now (before DSP has attached us), else none. */
+static t_membrane_tilde *contact_tilde_timing_membrane(t_contact_tilde *x)
+{
+    if (x->x_membrane)
+        return x->x_membrane;
+    if (x->x_name == &s_)
+        return 0;
+    return (t_membrane_tilde *)pd_findbyclass(x->x_name, ictus_membrane_tilde_class);
+}
+
+/* hit <velocity m/s> <r/a> <theta deg>: the stick reaches the surface at this
+ * message's logical time, to the sample. */
+static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom *argv)
+{
+    double velocity, r, theta;
+    t_membrane_tilde *m;
+    (void)s;
+    if (!ictus_getnumber(x, "contact~", "hit", "velocity (m/s)", argc, argv, 0, &velocity) ||
+        !ictus_getpoint(x, "contact~", "hit", argc, argv, 1, &r, &theta))
+        return;
+    if (!(velocity > 0) || velocity > CONTACT_VELOCITY_MAX) {
+        double used = velocity > 0 ? CONTACT_VELOCITY_MAX : 0.001;
+        pd_error(x, "contact~: hit: velocity must be in (0, %g] m/s, got %g; using %g",
+                 CONTACT_VELOCITY_MAX, velocity, used);
+        velocity = used;
+    }
+    m = contact_tilde_timing_membrane(x);
+    contact_hit(x->x_core, velocity, r, theta, m ? ictus_clock_offset_now(&m->x_clock) : 0);
+}
+
+/* set NAME: play another membrane~ (takes effect at the next DSP sort, as delread~). */
+static void contact_tilde_set(t_contact_tilde *x, t_symbol *name)
+{
+    x->x_name = name;
+    canvas_update_dsp();
+}
+
+/* ---------------- report clock ---------------- */
+
+static void contact_tilde_report_tick(t_contact_tilde *x)
+{
+    t_atom list[3];
+    SETFLOAT(&list[0], (t_float)x->x_report.duration_ms);
+    SETFLOAT(&list[1], (t_float)x->x_report.peak_force_n);
+    SETFLOAT(&list[2], (t_float)x->x_report.rebound_velocity_mps);
+    outlet_list(x->x_report_out, &s_list, 3, list);
+}
+
+/* ---------------- DSP ---------------- */
+
+static t_int *contact_tilde_perform(t_int *w)
+{
+    t_contact_tilde *x = (t_contact_tilde *)(w[1]);
+    t_sample *out = (t_sample *)(w[2]);
+    int n = (int)(w[3]), i, have = n < x->x_force_size ? n : x->x_force_size;
+    float *force = x->x_force;
+    /* The membrane's perform filled the buffer (this block, or the last one if
+     * Pd sorted us first); zero it so a missing membrane gives silence. */
+    for (i = 0; i < have; i++) {
+        out[i] = force[i];
+        force[i] = 0;
+    }
+    for (; i < n; i++)
+        out[i] = 0;
+    if (contact_take_report(x->x_core, &x->x_report))
+        clock_delay(x->x_report_clock, 0);
+    return (w + 4);
+}
+
+static void contact_tilde_dsp(t_contact_tilde *x, t_signal **sp)
+{
+    int n = sp[0]->s_n;
+    t_membrane_tilde *m = 0;
+    if (x->x_name != &s_) {
+        m = (t_membrane_tilde *)pd_findbyclass(x->x_name, ictus_membrane_tilde_class);
+        if (!m)
+            pd_error(x, "contact~: no membrane~ named '%s'", x->x_name->s_name);
+    }
+    if (x->x_membrane && x->x_membrane != m)
+        ictus_membrane_tilde_detach(x->x_membrane, x);
+    /* The force buffer: allocated here (a dsp method, never in perform). */
+    if (x->x_force_size != n) {
+        float *grown =
+            (float *)resizebytes(x->x_force, sizeof(float) * x->x_force_size, sizeof(float) * n);
+        if (grown) {
+            x->x_force = grown;
+            x->x_force_size = n;
+        } else
+            pd_error(x, "contact~: out of memory for the force outlet");
+    }
+    if (x->x_force)
+        memset(x->x_force, 0, sizeof(float) * x->x_force_size);
+    contact_set_force_output(x->x_core, x->x_force, x->x_force_size);
+    if (m && !ictus_membrane_tilde_attach(m, x))
+        pd_error(x, "contact~: membrane~ '%s' already has %d contact~s; this one is silent",
+                 x->x_name->s_name, MEMBRANE_MAX_CONTACTS);
+    dsp_add(contact_tilde_perform, 3, x, sp[0]->s_vec, (t_int)n);
+}
+
+/* ---------------- life cycle ---------------- */
+
+static void *contact_tilde_new(t_symbol *s, int argc, t_atom *argv)
+{
+    t_contact_tilde *x;
+    contact *core = contact_new();
+    (void)s;
+    if (!core) {
+        pd_error(0, "contact~: out of memory");
+        return 0;
+    }
+    x = (t_contact_tilde *)pd_new(ictus_contact_tilde_class);
+    x->x_core = core;
+    x->x_f = 0;
+    x->x_membrane = 0;
+    x->x_force = 0;
+    x->x_force_size = 0;
+    memset(&x->x_report, 0, sizeof(x->x_report));
+    x->x_name = &s_;
+    if (argc > 0 && argv[0].a_type == A_SYMBOL)
+        x->x_name = atom_getsymbol(&argv[0]);
+    else
+        pd_error(x, "contact~: needs the name of a membrane~ as argument ([contact~ NAME]); "
+                    "silent until 'set NAME'");
+    if (argc > 1)
+        pd_error(x, "contact~: takes one argument, a membrane~ name; extra arguments ignored");
+    outlet_new(&x->x_obj, &s_signal);
+    x->x_report_out = outlet_new(&x->x_obj, &s_list);
+    x->x_report_clock = clock_new(x, (t_method)contact_tilde_report_tick);
+    return x;
+}
+
+static void contact_tilde_free(t_contact_tilde *x)
+{
+    /* Detach before the buffer goes: the membrane's perform writes into it. */
+    if (x->x_membrane)
+        ictus_membrane_tilde_detach(x->x_membrane, x);
+    contact_set_force_output(x->x_core, 0, 0);
+    clock_free(x->x_report_clock);
+    if (x->x_force)
+        freebytes(x->x_force, sizeof(float) * x->x_force_size);
+    contact_free(x->x_core);
+}
+
+void ictus_contact_tilde_setup(void)
+{
+    int i;
+    ictus_contact_tilde_class =
+        class_new(gensym("contact~"), (t_newmethod)contact_tilde_new, (t_method)contact_tilde_free,
+                  sizeof(t_contact_tilde), CLASS_DEFAULT, A_GIMME, 0);
+    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_dsp, gensym("dsp"), A_CANT,
+                    0);
+    for (i = 0; i < NCPARAMS; i++)
+        class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_setparam,
+                        gensym(contact_tilde_params[i].p_name), A_GIMME, 0);
+    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_hit, gensym("hit"), A_GIMME,
+                    0);
+    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_set, gensym("set"), A_SYMBOL,
+                    0);
+}
