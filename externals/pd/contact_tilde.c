@@ -59,13 +59,13 @@ static void contact_tilde_setparam(t_contact_tilde *x, t_symbol *s, int argc, t_
         return;
     if (value < p->p_min || value > p->p_max) {
         double used = value < p->p_min ? p->p_min : p->p_max;
-        pd_error(x, "contact~: %s must be in [%g, %g] %s, got %g; using %g", p->p_name, p->p_min,
-                 p->p_max, p->p_unit, value, used);
+        pd_error(x, "contact~: %s must be in [%g, %g]%s%s, got %g; using %g", p->p_name, p->p_min,
+                 p->p_max, *p->p_unit ? " " : "", p->p_unit, value, used);
         value = used;
     }
     if (p->p_set(x->x_core, value) == ICTUS_CLAMPED)
-        pd_error(x, "contact~: %s %g %s is out of range; using %g", p->p_name, value, p->p_unit,
-                 p->p_get(x->x_core));
+        pd_error(x, "contact~: %s %g%s%s is out of range; using %g", p->p_name, value,
+                 *p->p_unit ? " " : "", p->p_unit, p->p_get(x->x_core));
 }
 
 /* The membrane~ whose sample clock times our messages: the attached one, else
@@ -96,7 +96,12 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
         velocity = used;
     }
     m = contact_tilde_timing_membrane(x);
-    contact_hit(x->x_core, velocity, r, theta, m ? ictus_clock_offset_now(&m->x_clock) : 0);
+    if (!m) {
+        /* a stroke kept for a membrane~ that may come later would start at a random time */
+        pd_error(x, "contact~: hit: no membrane~ named '%s'; ignored", x->x_name->s_name);
+        return;
+    }
+    contact_hit(x->x_core, velocity, r, theta, ictus_clock_offset_now(&m->x_clock));
 }
 
 /* set NAME: play another membrane~ (takes effect at the next DSP sort, as delread~). */
@@ -104,6 +109,28 @@ static void contact_tilde_set(t_contact_tilde *x, t_symbol *name)
 {
     x->x_name = name;
     canvas_update_dsp();
+}
+
+/* The membrane~ went away mid-stroke: drop the stroke (a membrane~ created later
+ * must not be hit by it) by swapping in a fresh core contact with the same
+ * parameters. Called from membrane~'s free method, never from perform. */
+void ictus_contact_tilde_abandon_stroke(t_contact_tilde *x)
+{
+    contact *fresh;
+    if (!contact_is_active(x->x_core))
+        return;
+    fresh = contact_new();
+    if (!fresh) {
+        pd_error(x, "contact~: out of memory; the interrupted stroke is kept");
+        return;
+    }
+    contact_set_mass(fresh, contact_get_mass(x->x_core));
+    contact_set_stiffness(fresh, contact_get_stiffness(x->x_core));
+    contact_set_alpha(fresh, contact_get_alpha(x->x_core));
+    contact_set_damping(fresh, contact_get_damping(x->x_core));
+    contact_set_force_output(fresh, x->x_force, x->x_force_size);
+    contact_free(x->x_core);
+    x->x_core = fresh;
 }
 
 /* ---------------- report clock ---------------- */

@@ -79,5 +79,7 @@ void ictus_contact_tilde_setup(void);
 /* Called by contact~: attach to / detach from a membrane~ (both sides kept in step). */
 int ictus_membrane_tilde_attach(t_membrane_tilde *m, t_contact_tilde *c);
 void ictus_membrane_tilde_detach(t_membrane_tilde *m, t_contact_tilde *c);
+/* Drops a stroke in progress (the membrane~ it was hitting is being deleted). */
+void ictus_contact_tilde_abandon_stroke(t_contact_tilde *x);
 
 #endif

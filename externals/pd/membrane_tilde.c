@@ -26,6 +26,9 @@
 
 t_class *ictus_membrane_tilde_class;
 
+#define ICTUS_STRIKE_IMPULSE_MAX 10.0 /* N s */
+#define ICTUS_PI                 3.14159265358979323846
+
 /* ---------------- logical time -> sample offset ---------------- */
 
 int ictus_clock_offset_now(const t_ictus_clock *c)
@@ -134,23 +137,24 @@ int ictus_getnumber(void *x, const char *obj, const char *msg, const char *arg, 
 static void membrane_tilde_param(t_membrane_tilde *x, const t_param *p, double value)
 {
     ictus_status status;
-    if (!strcmp(p->p_name, "modes")) {
-        double rounded = floor(value + 0.5);
-        if (rounded < MEMBRANE_MODES_MIN || rounded > MEMBRANE_MODES_MAX) {
-            double used = rounded < MEMBRANE_MODES_MIN ? MEMBRANE_MODES_MIN : MEMBRANE_MODES_MAX;
-            pd_error(x, "membrane~: modes must be in [%d, %d], got %g; using %g",
-                     MEMBRANE_MODES_MIN, MEMBRANE_MODES_MAX, value, used);
-            rounded = used;
-        }
-        value = rounded;
-    } else if (value < p->p_min || value > p->p_max) {
-        double used = value < p->p_min ? p->p_min : p->p_max;
-        if (p->p_max == HUGE_VAL)
-            pd_error(x, "membrane~: %s must be >= %g %s, got %g; using %g", p->p_name, p->p_min,
+    const char *space = *p->p_unit ? " " : "";
+    double lo = p->p_min, hi = p->p_max;
+    if (!strcmp(p->p_name, "mass")) {
+        /* the mass is density times area: its range follows the radius */
+        double a = membrane_get_radius(x->x_core);
+        lo = MEMBRANE_DENSITY_MIN * ICTUS_PI * a * a;
+        hi = MEMBRANE_DENSITY_MAX * ICTUS_PI * a * a;
+    }
+    if (!strcmp(p->p_name, "modes"))
+        value = floor(value + 0.5);
+    if (value < lo || value > hi) {
+        double used = value < lo ? lo : hi;
+        if (hi == HUGE_VAL)
+            pd_error(x, "membrane~: %s must be >= %g%s%s, got %g; using %g", p->p_name, lo, space,
                      p->p_unit, value, used);
         else
-            pd_error(x, "membrane~: %s must be in [%g, %g] %s, got %g; using %g", p->p_name,
-                     p->p_min, p->p_max, p->p_unit, value, used);
+            pd_error(x, "membrane~: %s must be in [%g, %g]%s%s, got %g; using %g", p->p_name, lo,
+                     hi, space, p->p_unit, value, used);
         value = used;
     }
     status = p->p_set(x->x_core, value);
@@ -158,8 +162,8 @@ static void membrane_tilde_param(t_membrane_tilde *x, const t_param *p, double v
         pd_error(x, "membrane~: %s %g: out of memory; keeping %g", p->p_name, value,
                  p->p_get(x->x_core));
     else if (status == ICTUS_CLAMPED)
-        pd_error(x, "membrane~: %s %g %s is out of range; using %g", p->p_name, value, p->p_unit,
-                 p->p_get(x->x_core));
+        pd_error(x, "membrane~: %s %g%s%s is out of range; using %g", p->p_name, value, space,
+                 p->p_unit, p->p_get(x->x_core));
 }
 
 /* radius, tension, density, mass, modes, t60, hfdamp, gain: one number each. */
@@ -231,10 +235,11 @@ static void membrane_tilde_strike(t_membrane_tilde *x, t_symbol *s, int argc, t_
     if (!ictus_getpoint(x, "membrane~", "strike", argc, argv, 0, &r, &theta) ||
         !ictus_getnumber(x, "membrane~", "strike", "impulse (N s)", argc, argv, 2, &impulse))
         return;
-    if (fabs(impulse) > 1.0e3) {
-        double used = impulse > 0 ? 1.0e3 : -1.0e3;
-        pd_error(x, "membrane~: strike: impulse must be in [-1000, 1000] N s, got %g; using %g",
-                 impulse, used);
+    /* 10 N s is four times a 0.05 kg stick at the core's 50 m/s limit */
+    if (impulse < 0 || impulse > ICTUS_STRIKE_IMPULSE_MAX) {
+        double used = impulse < 0 ? 0 : ICTUS_STRIKE_IMPULSE_MAX;
+        pd_error(x, "membrane~: strike: impulse must be in [0, %g] N s, got %g; using %g",
+                 ICTUS_STRIKE_IMPULSE_MAX, impulse, used);
         impulse = used;
     }
     membrane_strike(x->x_core, r, theta, impulse, ictus_clock_offset_now(&x->x_clock));
@@ -370,8 +375,11 @@ static void membrane_tilde_free(t_membrane_tilde *x)
     int i;
     /* contact~ objects keep a pointer to us: detach them all so none dangles. */
     for (i = 0; i < MEMBRANE_MAX_CONTACTS; i++)
-        if (x->x_contacts[i])
-            ictus_membrane_tilde_detach(x, x->x_contacts[i]);
+        if (x->x_contacts[i]) {
+            t_contact_tilde *c = x->x_contacts[i];
+            ictus_membrane_tilde_detach(x, c);
+            ictus_contact_tilde_abandon_stroke(c);
+        }
     if (x->x_name != &s_)
         pd_unbind(&x->x_obj.ob_pd, x->x_name);
     membrane_free(x->x_core);

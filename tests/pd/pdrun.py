@@ -1,0 +1,145 @@
+"""Helpers for the tests that run the real pd binary in batch mode.
+
+A test builds a patch from a list of boxes and connections, runs
+`pd -nogui -nosound -batch -stderr`, and reads back what the patch wrote into a
+table (32-bit float WAV via soundfiler, see docs/externals.md)."""
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import wave
+
+import numpy as np
+
+PD = os.environ.get("ICTUS_PD", "pd")
+# Under the ASan build, the sanitizer runtime to preload into pd (which is not
+# instrumented itself); python is left alone.
+PD_ENV = dict(os.environ)
+if os.environ.get("ICTUS_PD_PRELOAD"):
+    PD_ENV["LD_PRELOAD"] = os.environ["ICTUS_PD_PRELOAD"]
+# What Pd prints when something went wrong while loading or running a patch.
+ERROR_RE = re.compile(r"error|couldn't|bad arguments|no method|not found|warning", re.I)
+
+
+class Patch:
+    """A flat Pd patch: add boxes (returns their index), connect them."""
+
+    def __init__(self, declare=None):
+        self.lines = ["#N canvas 0 0 800 600 12;"]
+        if declare:
+            self.lines.append("#X declare %s;" % declare)
+        self.count = 0
+
+    def obj(self, text):
+        self.lines.append("#X obj %d %d %s;" % (10 + 30 * self.count, 10 + 20 * self.count, text))
+        self.count += 1
+        return self.count - 1
+
+    def msg(self, text):
+        self.lines.append("#X msg %d %d %s;" % (10 + 30 * self.count, 10 + 20 * self.count, text))
+        self.count += 1
+        return self.count - 1
+
+    def table(self, name, size):
+        return self.obj("table %s %d" % (name, size))
+
+    def subpatch(self, name, sub):
+        """Inserts `sub` (a Patch) as [pd name]; returns its index."""
+        self.lines.append("#N canvas 0 0 600 400 %s 0;" % name)
+        self.lines.extend(sub.lines[1:])
+        self.lines.append("#X restore %d %d pd %s;" % (10 + 30 * self.count, 10 + 20 * self.count, name))
+        self.count += 1
+        return self.count - 1
+
+    def connect(self, a, outlet, b, inlet):
+        self.lines.append("#X connect %d %d %d %d;" % (a, outlet, b, inlet))
+
+    def text(self):
+        return "\n".join(self.lines) + "\n"
+
+
+def recorder(p, tables, seconds, sr, wav_path, quit_extra=None):
+    """Adds: loadbang -> dsp on, start every [tabwrite~ t] for `tables` (a list
+    of (source_index, outlet, table_name)), and after `seconds` write them all
+    into one multichannel WAV and quit. Recording starts with the first DSP block,
+    at logical time 0, so sample i of the WAV is logical time i / sr."""
+    n = int(round(seconds * sr))
+    lb = p.obj("loadbang")
+    trig = p.obj("t b b b")
+    p.connect(lb, 0, trig, 0)
+    dsp = p.msg("\\; pd dsp 1")
+    p.connect(trig, 2, dsp, 0)
+    names = []
+    for src, outlet, name in tables:
+        p.table(name, n)
+        tw = p.obj("tabwrite~ %s" % name)
+        p.connect(src, outlet, tw, 0)
+        p.connect(trig, 1, tw, 0)
+        names.append(name)
+    done = p.obj("delay %.17g" % (seconds * 1000.0 + 10.0))
+    p.connect(trig, 0, done, 0)
+    write = p.msg("write -wave -bytes 4 %s %s" % (wav_path, " ".join(names)))
+    sf = p.obj("soundfiler")
+    quit_msg = p.msg("\\; pd quit")
+    t2 = p.obj("t b b")
+    p.connect(done, 0, t2, 0)
+    p.connect(t2, 1, write, 0)
+    p.connect(write, 0, sf, 0)
+    p.connect(t2, 0, quit_msg, 0)
+    return trig
+
+
+def run_pd(patch_text, libdir, sr=48000, extra_args=(), workdir=None, name="test.pd",
+           timeout=120):
+    """Writes the patch into workdir and runs pd on it; returns (returncode, stderr)."""
+    workdir = workdir or tempfile.mkdtemp(prefix="ictus-pd-")
+    path = os.path.join(workdir, name)
+    with open(path, "w") as f:
+        f.write(patch_text)
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr), "-path", libdir]
+    cmd += list(extra_args) + ["-open", path]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=workdir,
+                          env=PD_ENV)
+    return proc.returncode, proc.stdout + proc.stderr
+
+
+def read_wav_float(path):
+    """Reads a 32-bit float WAV (what soundfiler writes) -> (samples [n, ch], sr)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] != b"RIFF" or data[8:12] != b"WAVE":
+        raise ValueError("%s: not a WAV file" % path)
+    pos, fmt, frames = 12, None, None
+    while pos + 8 <= len(data):
+        cid, size = data[pos:pos + 4], int.from_bytes(data[pos + 4:pos + 8], "little")
+        body = data[pos + 8:pos + 8 + size]
+        if cid == b"fmt ":
+            tag = int.from_bytes(body[0:2], "little")
+            channels = int.from_bytes(body[2:4], "little")
+            sr = int.from_bytes(body[4:8], "little")
+            bits = int.from_bytes(body[14:16], "little")
+            if tag == 0xFFFE:
+                tag = int.from_bytes(body[24:26], "little")
+            fmt = (tag, channels, sr, bits)
+        elif cid == b"data":
+            frames = body
+        pos += 8 + size + (size & 1)
+    if fmt is None or frames is None:
+        raise ValueError("%s: no fmt or data chunk" % path)
+    tag, channels, sr, bits = fmt
+    if tag != 3 or bits != 32:
+        raise ValueError("%s: expected 32-bit float, got tag %d, %d bits" % (path, tag, bits))
+    samples = np.frombuffer(frames, dtype="<f4").reshape(-1, channels)
+    return samples, sr
+
+
+def error_lines(log):
+    return [l for l in log.splitlines() if ERROR_RE.search(l)]
+
+
+def check(cond, message):
+    if not cond:
+        print("FAIL:", message)
+        sys.exit(1)
+    print("ok:", message)

@@ -1,0 +1,104 @@
+"""Bad input to membrane~ and contact~: every bad message gets an error line
+naming the object and the parameter, the value is clamped or refused, pd does
+not crash, and the output stays finite. Symbols such as 'nan' and 'inf' are how
+a NaN reaches a Pd message; huge and negative numbers, missing and wrong-typed
+arguments, modes 0 and 1000000, a contact~ without a name and one naming a
+membrane~ that does not exist are all tried."""
+import argparse
+import os
+import tempfile
+
+import numpy as np
+
+from pdrun import Patch, check, read_wav_float, recorder, run_pd
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", required=True)
+args = ap.parse_args()
+
+# (message to membrane~, a substring its error line must contain)
+membrane_cases = [
+    ("radius nan", "membrane~: radius: value must be a number, got 'nan'"),
+    ("radius -1", "membrane~: radius must be in [0.01, 2] m, got -1; using 0.01"),
+    ("radius 1e+30", "membrane~: radius must be in [0.01, 2] m, got 1e+30; using 2"),
+    ("radius 0.2", None),
+    ("tension foo", "membrane~: tension: value must be a number, got 'foo'"),
+    ("tension -5", "membrane~: tension must be in [1, 100000] N/m, got -5; using 1"),
+    ("tension 3000", None),
+    ("density inf", "membrane~: density: value must be a number, got 'inf'"),
+    ("density 0", "membrane~: density must be in [0.01, 20] kg/m^2, got 0; using 0.01"),
+    ("density 0.26", None),
+    ("mass -2", "membrane~: mass must be in [0.00125664, 2.51327] kg, got -2; using 0.00125664"),
+    ("modes 0", "membrane~: modes must be in [1, 4096], got 0; using 1"),
+    ("modes 1000000", "membrane~: modes must be in [1, 4096], got 1e+06; using 4096"),
+    ("modes 64", None),
+    ("t60", "membrane~: t60: missing value"),
+    ("t60 -1", "membrane~: t60 must be in [0.005, 60] s, got -1; using 0.005"),
+    ("t60 1", None),
+    ("hfdamp -3", "membrane~: hfdamp must be >= 0, got -3; using 0"),
+    ("gain -1", "membrane~: gain must be >= 0, got -1; using 0"),
+    ("gain 1", None),
+    ("pickup 3 0.5 0", "membrane~: pickup: index must be 1 or 2, got 3"),
+    ("pickup 1 2 0", "membrane~: pickup: r/a must be in [0, 1], got 2; using 1"),
+    ("pickup 1", "membrane~: pickup: missing r/a"),
+    ("position -0.5 0", "membrane~: position: r/a must be in [0, 1], got -0.5; using 0"),
+    ("position 0.3 nan", "membrane~: position: theta (deg) must be a number, got 'nan'"),
+    ("strike 0.5", "membrane~: strike: missing theta (deg)"),
+    ("strike 0.5 0 nan", "membrane~: strike: impulse (N s) must be a number, got 'nan'"),
+    ("strike 0.5 0 1e+09", "membrane~: strike: impulse must be in [0, 10] N s, got 1e+09; using 10"),
+    ("strike 0.5 0 -1", "membrane~: strike: impulse must be in [0, 10] N s, got -1; using 0"),
+    ("strike 0.4 0 0.01", None),
+]
+contact_cases = [
+    ("mass 0", "contact~: mass must be in [0.0001, 10] kg, got 0; using 0.0001"),
+    ("mass nan", "contact~: mass: value must be a number, got 'nan'"),
+    ("mass 0.05", None),
+    ("stiffness -1", "contact~: stiffness must be in [1, 1e+12] N/m^alpha, got -1; using 1"),
+    ("stiffness 1e+07", None),
+    ("alpha 10", "contact~: alpha must be in [1, 4], got 10; using 4"),
+    ("alpha 1.5", None),
+    ("damping -1", "contact~: damping must be in [0, 1000] s/m, got -1; using 0"),
+    ("hit -1 0.5 0", "contact~: hit: velocity must be in (0, 50] m/s, got -1"),
+    ("hit 1e+09 0.5 0", "contact~: hit: velocity must be in (0, 50] m/s, got 1e+09; using 50"),
+    ("hit 1 0.5", "contact~: hit: missing theta (deg)"),
+    ("hit foo 0.5 0", "contact~: hit: velocity (m/s) must be a number, got 'foo'"),
+    ("hit 2 0.3 0", None),
+]
+
+sr = 48000
+work = tempfile.mkdtemp(prefix="ictus-bad-")
+wav = os.path.join(work, "bad.wav")
+p = Patch(declare="-path %s/ictus" % args.build)
+mem = p.obj("membrane~ bad-drum 1e+30 -5 nan")
+con = p.obj("contact~ bad-drum")
+p.obj("contact~")                       # no name
+p.obj("contact~ no-such-drum")          # nothing to play
+trig = recorder(p, [(mem, 0, "left"), (mem, 1, "right"), (con, 0, "force")], 0.5, sr, wav)
+for k, (text, _) in enumerate(membrane_cases):
+    d = p.obj("delay %g" % (5 + 3 * k))
+    m = p.msg(text)
+    p.connect(trig, 0, d, 0)
+    p.connect(d, 0, m, 0)
+    p.connect(m, 0, mem, 0)
+for k, (text, _) in enumerate(contact_cases):
+    d = p.obj("delay %g" % (150 + 20 * k))
+    m = p.msg(text)
+    p.connect(trig, 0, d, 0)
+    p.connect(d, 0, m, 0)
+    p.connect(m, 0, con, 0)
+rc, log = run_pd(p.text(), args.build, sr=sr, workdir=work)
+print(log)
+check(rc == 0, "pd did not crash (exit %d)" % rc)
+for text, expect in membrane_cases + contact_cases:
+    if expect:
+        check(expect in log, "'%s' -> '%s'" % (text, expect))
+for expect in ["membrane~: radius must be in [0.01, 2] m, got 1e+30; using 2",
+               "membrane~: tension must be in [1, 100000] N/m, got -5; using 1",
+               "membrane~: creation argument: density must be a number, got 'nan'",
+               "contact~: needs the name of a membrane~",
+               "contact~: no membrane~ named 'no-such-drum'"]:
+    check(expect in log, "creation: '%s'" % expect)
+x, _ = read_wav_float(wav)
+check(np.all(np.isfinite(x)), "output finite (%d samples)" % x.shape[0])
+check(np.max(np.abs(x[:, 0])) > 0 and np.max(x[:, 2]) > 0,
+      "the good strike and hit still sound after the bad ones")
