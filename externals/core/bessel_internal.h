@@ -1,0 +1,17 @@
+/* bessel_internal.h -- helpers shared by membrane.c and contact.c (not public API). */
+#ifndef ICTUS_BESSEL_INTERNAL_H
+#define ICTUS_BESSEL_INTERNAL_H
+
+typedef struct ictus_bessel_zero_entry {
+    double j; /* zero of J_m */
+    int m, n;
+} ictus_bessel_zero_entry;
+
+/* {J_{m-1}(x), J_m(x), J_{m+1}(x)} for x >= 0 in one Miller recurrence. */
+void ictus_bessel_j3(int m, double x, double out[3]);
+
+/* All zeros j_{m,n} < x_max, sorted by (j, m, n), in a malloc'd array the caller
+ * frees. Returns the count, or -1 when memory cannot be had. Allocates. */
+int ictus_bessel_zeros_below(double x_max, ictus_bessel_zero_entry **out);
+
+#endif
