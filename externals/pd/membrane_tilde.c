@@ -93,8 +93,9 @@ static double membrane_tilde_get_modes(const membrane *m)
     return membrane_get_modes(m);
 }
 
-/* hfdamp and gain have no range macros in membrane.h: any finite value >= 0 is
- * handed to the core, which clamps and says so. */
+/* hfdamp and gain have no range macros in membrane.h; these are the ranges
+ * membrane.c clamps to (docs/membrane.md). Should they drift apart, the core's
+ * ICTUS_CLAMPED still produces an error line below. A negative gain inverts. */
 static const t_param membrane_tilde_params[] = {
     {"radius", "m", MEMBRANE_RADIUS_MIN, MEMBRANE_RADIUS_MAX, membrane_set_radius,
      membrane_get_radius},
@@ -106,8 +107,8 @@ static const t_param membrane_tilde_params[] = {
     {"modes", "", MEMBRANE_MODES_MIN, MEMBRANE_MODES_MAX, membrane_tilde_set_modes,
      membrane_tilde_get_modes},
     {"t60", "s", MEMBRANE_T60_MIN, MEMBRANE_T60_MAX, membrane_set_t60, membrane_get_t60},
-    {"hfdamp", "", 0, HUGE_VAL, membrane_set_hf_damping, membrane_get_hf_damping},
-    {"gain", "", 0, HUGE_VAL, membrane_set_output_gain, membrane_get_output_gain},
+    {"hfdamp", "", 0, 1000.0, membrane_set_hf_damping, membrane_get_hf_damping},
+    {"gain", "", -1.0e6, 1.0e6, membrane_set_output_gain, membrane_get_output_gain},
 };
 #define NPARAMS (int)(sizeof(membrane_tilde_params) / sizeof(membrane_tilde_params[0]))
 

@@ -15,6 +15,7 @@ from pdrun import Patch, check, read_wav_float, recorder, run_pd
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 args = ap.parse_args()
+args.build = os.path.abspath(args.build)
 
 # (message to membrane~, a substring its error line must contain)
 membrane_cases = [
@@ -35,8 +36,8 @@ membrane_cases = [
     ("t60", "membrane~: t60: missing value"),
     ("t60 -1", "membrane~: t60 must be in [0.005, 60] s, got -1; using 0.005"),
     ("t60 1", None),
-    ("hfdamp -3", "membrane~: hfdamp must be >= 0, got -3; using 0"),
-    ("gain -1", "membrane~: gain must be >= 0, got -1; using 0"),
+    ("hfdamp -3", "membrane~: hfdamp must be in [0, 1000], got -3; using 0"),
+    ("gain 1e+07", "membrane~: gain must be in [-1e+06, 1e+06], got 1e+07; using 1e+06"),
     ("gain 1", None),
     ("pickup 3 0.5 0", "membrane~: pickup: index must be 1 or 2, got 3"),
     ("pickup 1 2 0", "membrane~: pickup: r/a must be in [0, 1], got 2; using 1"),

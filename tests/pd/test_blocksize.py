@@ -16,6 +16,7 @@ from pdrun import Patch, check, error_lines, read_wav_float, recorder, run_pd
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 args = ap.parse_args()
+args.build = os.path.abspath(args.build)
 
 sr = 48000
 seconds = 0.6

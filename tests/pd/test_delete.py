@@ -15,6 +15,7 @@ from pdrun import Patch, check, read_wav_float, recorder, run_pd
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 args = ap.parse_args()
+args.build = os.path.abspath(args.build)
 
 MEM = ("obj 10 10 membrane~ del-drum \\, obj 10 40 throw~ del-bus \\, connect 0 0 1 0"
        " \\, obj 200 10 r del-strike \\, connect 2 0 0 0")

@@ -16,6 +16,7 @@ from pdrun import Patch, check, error_lines, read_wav_float, recorder, run_pd
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 args = ap.parse_args()
+args.build = os.path.abspath(args.build)
 
 delays_ms = [123.45, 1000.0 / 3.0, 7.0, 250.0]
 work = tempfile.mkdtemp(prefix="ictus-timing-")
