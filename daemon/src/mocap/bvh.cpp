@@ -320,7 +320,10 @@ class BvhParser
             const int decimals = static_cast<int>(value_token.size() - dot - 1);
             const double half_last_digit = 0.5 * std::pow(10.0, -decimals);
             const double whole = std::round(rate);
-            if (whole >= 1.0 && std::fabs(1.0 / whole - frame_time) <= half_last_digit * 1.000001)
+            // Both: within the printed precision, and a change of the rate below
+            // 1e-4 (so that "0.3" does not become 3 Hz).
+            if (whole >= 1.0 && std::fabs(1.0 / whole - frame_time) <= half_last_digit * 1.000001 &&
+                std::fabs(rate - whole) <= 1e-4 * whole)
                 rate = whole;
         }
         bvh_.frame_time_s = 1.0 / rate;

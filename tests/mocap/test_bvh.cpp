@@ -1,0 +1,476 @@
+// BVH reader and forward kinematics against hand-computed joint positions, the
+// CMU drumming file's documented facts (data README), and malformed files.
+#include "mocap_test_util.hpp"
+
+#include "ictus/bvh.hpp"
+
+#include <fstream>
+#include <sstream>
+
+using namespace ictus;
+using namespace mocap_test;
+
+namespace
+{
+
+// Three chained joints with three different rotation orders, mixed CRLF / LF
+// line endings, root OFFSET (0.5, 0, 0).
+const char *const kChainBvh = "HIERARCHY\r\n"
+                              "ROOT root\n"
+                              "{\r\n"
+                              "  OFFSET 0.5 0 0\r\n"
+                              "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+                              "Yrotation\r\n"
+                              "  JOINT a\r\n"
+                              "  {\n"
+                              "    OFFSET 1 2 3\r\n"
+                              "    CHANNELS 3 Yrotation Xrotation Zrotation\r\n"
+                              "    JOINT b\r\n"
+                              "    {\r\n"
+                              "      OFFSET 0 4 0\r\n"
+                              "      CHANNELS 3 Xrotation Zrotation Yrotation\r\n"
+                              "      End Site\r\n"
+                              "      {\r\n"
+                              "        OFFSET 2 0 0\r\n"
+                              "      }\r\n"
+                              "    }\r\n"
+                              "  }\r\n"
+                              "}\r\n"
+                              "MOTION\n"
+                              "Frames: 3\n"
+                              "Frame Time: 0.04\r\n"
+                              "0 0 0 0 0 0 0 0 0 0 0 0\r\n"
+                              "10 20 30 90 0 0 0 0 0 0 0 0\n"
+                              "1 2 3 30 -40 50 15 25 -35 60 -20 10\r\n";
+
+void require_near(const Eigen::Vector3d &got, const Eigen::Vector3d &want, double tol)
+{
+    INFO("got " << got.transpose() << ", want " << want.transpose());
+    REQUIRE((got - want).norm() < tol);
+}
+
+// The same minimal file for the error tests; line numbers in comments.
+std::string minimal_bvh_lines[] = {
+    "HIERARCHY",                                                                // 1
+    "ROOT Hips",                                                                // 2
+    "{",                                                                        // 3
+    "  OFFSET 0 0 0",                                                           // 4
+    "  CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation", // 5
+    "  JOINT Chest",                                                            // 6
+    "  {",                                                                      // 7
+    "    OFFSET 0 1 0",                                                         // 8
+    "    CHANNELS 3 Zrotation Yrotation Xrotation",                             // 9
+    "    End Site",                                                             // 10
+    "    {",                                                                    // 11
+    "      OFFSET 0 1 0",                                                       // 12
+    "    }",                                                                    // 13
+    "  }",                                                                      // 14
+    "}",                                                                        // 15
+    "MOTION",                                                                   // 16
+    "Frames: 2",                                                                // 17
+    "Frame Time: 0.01",                                                         // 18
+    "0 1 0 0 0 0 0 0 0",                                                        // 19
+    "0 1 0 10 0 0 0 0 5",                                                       // 20
+};
+
+// The minimal file with line `line` (1-based) replaced by `text` (or removed
+// when text is null), cut after `keep_lines` lines when > 0.
+std::string minimal_bvh(int line = 0, const char *text = "", int keep_lines = 0)
+{
+    std::string out;
+    int n = 0;
+    for (const std::string &original : minimal_bvh_lines) {
+        ++n;
+        if (keep_lines > 0 && n > keep_lines)
+            break;
+        if (n == line) {
+            if (text)
+                out += std::string(text) + "\n";
+        } else {
+            out += original + "\n";
+        }
+    }
+    return out;
+}
+
+// Parses and requires a MocapError whose what() starts with "src.bvh:LINE:"
+// (or "src.bvh: " for line 0) and contains `expected`.
+void require_error(const std::string &text, int line, const std::string &expected,
+                   const BvhOptions &options = {})
+{
+    std::istringstream in(text);
+    try {
+        parse_bvh(in, "src.bvh", options);
+    } catch (const MocapError &error) {
+        const std::string what = error.what();
+        INFO("what(): " << what);
+        const std::string prefix =
+            line > 0 ? "src.bvh:" + std::to_string(line) + ": " : std::string("src.bvh: ");
+        CHECK(what.rfind(prefix, 0) == 0);
+        CHECK(error.line() == line);
+        CHECK(error.file() == "src.bvh");
+        CHECK(what.find(expected) != std::string::npos);
+        return;
+    }
+    FAIL("no MocapError for a malformed file (expected '" << expected << "')");
+}
+
+} // namespace
+
+TEST_CASE("BVH: hierarchy, channels, rate and mixed line endings", "[mocap][bvh]")
+{
+    const TempFile file("chain.bvh", kChainBvh);
+    MocapWarnings warnings;
+    const BvhFile bvh = read_bvh(file.path(), {}, &warnings);
+    CHECK(warnings.empty());
+    REQUIRE(bvh.skeleton.joints.size() == 4);
+    CHECK(bvh.skeleton.find("root") == 0);
+    CHECK(bvh.skeleton.find("b") == 2);
+    CHECK(bvh.skeleton.find("nope") == -1);
+    CHECK(bvh.skeleton.joints[3].end_site);
+    CHECK(bvh.skeleton.joints[3].parent == 2);
+    CHECK(bvh.channelled_joints() == 3);
+    CHECK(bvh.channel_count == 12);
+    CHECK(bvh.channels[1][0] == BvhChannel::Yrotation);
+    CHECK(bvh.motion.frames() == 3);
+    CHECK(bvh.motion.frame_rate_hz == 25.0);
+    CHECK(bvh.frame_time_s == 0.04);
+}
+
+TEST_CASE("BVH: forward kinematics reproduces hand-computed joint positions", "[mocap][bvh]")
+{
+    std::istringstream in(kChainBvh);
+    const BvhFile bvh = parse_bvh(in, "chain.bvh");
+
+    // Frame 0, rest pose: cumulative offsets.
+    auto p = forward_kinematics(bvh.skeleton, bvh.motion, 0);
+    require_near(p[0], {0.5, 0, 0}, 1e-12);
+    require_near(p[1], {1.5, 2, 3}, 1e-12);
+    require_near(p[2], {1.5, 6, 3}, 1e-12);
+    require_near(p[3], {3.5, 6, 3}, 1e-12);
+
+    // Frame 1: root at offset + (10, 20, 30), turned 90 deg about z, which maps
+    // (x, y, z) to (-y, x, z): a = root + (-2, 1, 3), b = a + (-4, 0, 0),
+    // end = b + (0, 2, 0).
+    p = forward_kinematics(bvh.skeleton, bvh.motion, 1);
+    require_near(p[0], {10.5, 20, 30}, 1e-12);
+    require_near(p[1], {8.5, 21, 33}, 1e-12);
+    require_near(p[2], {4.5, 21, 33}, 1e-12);
+    require_near(p[3], {4.5, 23, 33}, 1e-12);
+
+    // Frame 2: every joint rotated, each in its own channel order, composed in
+    // listed order (intrinsic) with rotation matrices written out by hand.
+    const Eigen::Matrix3d r_root = rot_z(deg(30)) * rot_x(deg(-40)) * rot_y(deg(50));
+    const Eigen::Matrix3d r_a = r_root * rot_y(deg(15)) * rot_x(deg(25)) * rot_z(deg(-35));
+    const Eigen::Matrix3d r_b = r_a * rot_x(deg(60)) * rot_z(deg(-20)) * rot_y(deg(10));
+    const Eigen::Vector3d root(1.5, 2, 3);
+    const Eigen::Vector3d a = root + r_root * Eigen::Vector3d(1, 2, 3);
+    const Eigen::Vector3d b = a + r_a * Eigen::Vector3d(0, 4, 0);
+    const Eigen::Vector3d end = b + r_b * Eigen::Vector3d(2, 0, 0);
+    p = forward_kinematics(bvh.skeleton, bvh.motion, 2);
+    require_near(p[0], root, 1e-12);
+    require_near(p[1], a, 1e-12);
+    require_near(p[2], b, 1e-12);
+    require_near(p[3], end, 1e-12);
+    const auto world = world_rotations(bvh.skeleton, bvh.motion, 2);
+    CHECK((world[2].toRotationMatrix() - r_b).norm() < 1e-12);
+    CHECK((world[3].toRotationMatrix() - r_b).norm() < 1e-12); // end site: identity local
+
+    // Scale converts every length (offsets and root translation) to metres.
+    std::istringstream again(kChainBvh);
+    BvhOptions cm;
+    cm.scale = 0.01;
+    const BvhFile scaled = parse_bvh(again, "chain.bvh", cm);
+    const auto p_scaled = forward_kinematics(scaled.skeleton, scaled.motion, 2);
+    require_near(p_scaled[3], 0.01 * end, 1e-14);
+
+    CHECK_THROWS_AS(forward_kinematics(bvh.skeleton, bvh.motion, 3), MocapError);
+    CHECK_THROWS_AS(forward_kinematics(bvh.skeleton, bvh.motion, -1), MocapError);
+}
+
+TEST_CASE("BVH: the channel order decides the composition", "[mocap][bvh]")
+{
+    // Rz(90) Rx(90) (0, 1, 0) = Rz(90) (0, 0, 1) = (0, 0, 1), while
+    // Rx(90) Rz(90) (0, 1, 0) = Rx(90) (-1, 0, 0) = (-1, 0, 0).
+    auto tip = [](const std::string &channels) {
+        const std::string text = "HIERARCHY\nROOT r\n{\nOFFSET 0 0 0\nCHANNELS 2 " + channels +
+                                 "\nEnd Site\n{\nOFFSET 0 1 0\n}\n}\nMOTION\nFrames: 1\n"
+                                 "Frame Time: 0.01\n90 90\n";
+        std::istringstream in(text);
+        const BvhFile bvh = parse_bvh(in, "order.bvh");
+        return forward_kinematics(bvh.skeleton, bvh.motion, 0)[1];
+    };
+    require_near(tip("Zrotation Xrotation"), {0, 0, 1}, 1e-12);
+    require_near(tip("Xrotation Zrotation"), {-1, 0, 0}, 1e-12);
+}
+
+TEST_CASE("BVH: position channels on a non-root joint", "[mocap][bvh]")
+{
+    // Root turned 90 deg about y, which maps (x, y, z) to (z, y, -x). Joint a
+    // sits at OFFSET (1, 0, 0) + its channels (0.5, 0, 0) and turns 90 deg about
+    // z. a = Ry90 (1.5, 0, 0) = (0, 0, -1.5); its end site, (0, 1, 0) in a's
+    // frame, is Ry90 Rz90 (0, 1, 0) = Ry90 (-1, 0, 0) = (0, 0, 1) further.
+    const std::string text = "HIERARCHY\nROOT r\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation "
+                             "Yrotation Xrotation\nJOINT a\n{\nOFFSET 1 0 0\nCHANNELS 6 "
+                             "Xposition Yposition Zposition Zrotation Yrotation Xrotation\n"
+                             "End Site\n{\nOFFSET 0 1 0\n}\n}\n}\nMOTION\nFrames: 1\n"
+                             "Frame Time: 0.01\n0 90 0 0.5 0 0 90 0 0\n";
+    std::istringstream in(text);
+    MocapWarnings warnings;
+    const BvhFile bvh = parse_bvh(in, "nonroot.bvh", {}, &warnings);
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("bvh_forward_kinematics") != std::string::npos);
+    const auto p = bvh_forward_kinematics(bvh, 0);
+    require_near(p[1], {0, 0, -1.5}, 1e-12);
+    require_near(p[2], {0, 0, -0.5}, 1e-12);
+}
+
+TEST_CASE("BVH: frame time printed to few digits snaps to the integer rate", "[mocap][bvh]")
+{
+    auto rate = [](const std::string &frame_time) {
+        std::istringstream in(minimal_bvh(18, ("Frame Time: " + frame_time).c_str()));
+        return parse_bvh(in, "rate.bvh").motion.frame_rate_hz;
+    };
+    CHECK(rate(".0083333") == 120.0); // |1/120 - .0083333| < 0.5e-7
+    CHECK(rate("0.033333") == 30.0);
+    CHECK(rate("0.004") == 250.0);
+    CHECK(rate("0.0123") == Approx(1.0 / 0.0123).epsilon(1e-12));   // 81.3 Hz: not snapped
+    CHECK(rate("0.00833") == Approx(1.0 / 0.00833).epsilon(1e-12)); // 120.05 Hz: 4e-4 off
+    CHECK(rate("0.3") == Approx(1.0 / 0.3).epsilon(1e-12));         // not 3 Hz
+}
+
+TEST_CASE("BVH: malformed files give FILE:LINE errors", "[mocap][bvh][errors]")
+{
+    {
+        std::istringstream fine(minimal_bvh());
+        REQUIRE(parse_bvh(fine, "src.bvh").motion.frames() == 2);
+    }
+    SECTION("truncated in the hierarchy")
+    {
+        require_error(minimal_bvh(0, "", 12), 12, "expected '}', got end of file");
+    }
+    SECTION("truncated motion: fewer lines than Frames")
+    {
+        require_error(minimal_bvh(0, "", 19), 19, "expected 2 motion lines (Frames: 2), got 1");
+        require_error(minimal_bvh(17, "Frames: 3"), 20, "expected 3 motion lines");
+    }
+    SECTION("truncated in the middle of a motion line")
+    {
+        require_error(minimal_bvh(20, "0 1 0 10 0"), 20,
+                      "expected 9 values (one per channel) on motion line 2, got 5");
+    }
+    SECTION("too many values on a line")
+    {
+        require_error(minimal_bvh(19, "0 1 0 0 0 0 0 0 0 7"), 19, "expected 9 values");
+    }
+    SECTION("NaN and infinity in the motion")
+    {
+        require_error(minimal_bvh(20, "0 1 0 10 nan 0 0 0 5"), 20,
+                      "expected a finite number in column 4 (Hips Yrotation), got 'nan'");
+        require_error(minimal_bvh(19, "0 1 0 0 0 0 0 inf 0"), 19,
+                      "column 7 (Chest Yrotation), got 'inf'");
+        require_error(minimal_bvh(19, "0 1 0 0 0 0 0 1e999 0"), 19, "got '1e999'");
+        require_error(minimal_bvh(19, "0 1 0 0 0 0 0 x 0"), 19, "got 'x'");
+    }
+    SECTION("absurd frame counts and frame times")
+    {
+        require_error(minimal_bvh(17, "Frames: 1e12"), 17,
+                      "expected a whole frame count in [1, 10000000], got '1e12'");
+        require_error(minimal_bvh(17, "Frames: 0"), 17, "got '0'");
+        require_error(minimal_bvh(17, "Frames: -3"), 17, "got '-3'");
+        require_error(minimal_bvh(17, "Frames: 2.5"), 17, "got '2.5'");
+        require_error(minimal_bvh(18, "Frame Time: 0"), 18,
+                      "expected a frame time in [1e-05, 60] s, got '0'");
+        require_error(minimal_bvh(18, "Frame Time: -0.01"), 18, "got '-0.01'");
+        require_error(minimal_bvh(18, "Frame Time: nan"), 18, "got 'nan'");
+        require_error(minimal_bvh(17, "Frame: 2"), 17, "expected Frames:, got 'Frame:'");
+        BvhOptions cap;
+        cap.max_frames = 1;
+        require_error(minimal_bvh(), 17, "expected a whole frame count in [1, 1]", cap);
+    }
+    SECTION("bad channels")
+    {
+        require_error(minimal_bvh(9, "CHANNELS 3 Zrotation Wrotation Xrotation"), 9,
+                      "Yrotation Zrotation), got 'Wrotation'");
+        require_error(minimal_bvh(9, "CHANNELS 7 Zrotation Yrotation Xrotation"), 9,
+                      "expected a channel count 0..6, got '7'");
+        require_error(minimal_bvh(9, "CHANNELS 3 Zrotation Zrotation Xrotation"), 9,
+                      "expected each channel once per joint, got 'Zrotation'");
+    }
+    SECTION("unbalanced braces and bad keywords")
+    {
+        require_error(minimal_bvh(14, nullptr), 15,
+                      "expected JOINT, End Site or '}' (in joint Hips), got 'MOTION'");
+        require_error(minimal_bvh(16, "}\nMOTION"), 16,
+                      "expected MOTION (one ROOT hierarchy, braces balanced), got '}'");
+        require_error(minimal_bvh(1, "HIERARCHIE"), 1, "expected 'HIERARCHY', got 'HIERARCHIE'");
+        require_error(minimal_bvh(6, "  BONE Chest"), 6, "got 'BONE'");
+        require_error(minimal_bvh(8, "OFFSET 0 nan 0"), 8,
+                      "expected an OFFSET coordinate (a finite number), got 'nan'");
+        require_error(minimal_bvh(2, "ROOT"), 2, "expected a joint name, got end of line");
+        require_error("", 0, "expected 'HIERARCHY', got end of file");
+    }
+    SECTION("skip_frames outside the file")
+    {
+        BvhOptions skip;
+        skip.skip_frames = 2;
+        require_error(minimal_bvh(), 17, "expected BvhOptions::skip_frames in [0, 1], got 2", skip);
+    }
+    SECTION("extra motion lines are ignored with a warning")
+    {
+        std::istringstream in(minimal_bvh(20, "0 1 0 10 0 0 0 0 5\n1 1 1 1 1 1 1 1 1"));
+        MocapWarnings warnings;
+        CHECK(parse_bvh(in, "src.bvh", {}, &warnings).motion.frames() == 2);
+        REQUIRE(warnings.size() == 1);
+        CHECK(warnings[0] == "src.bvh:21: ignored 1 motion line(s) beyond the declared Frames: 2");
+    }
+    SECTION("a missing file")
+    {
+        try {
+            read_bvh("/nonexistent/x.bvh");
+            FAIL("no error");
+        } catch (const MocapError &error) {
+            CHECK(std::string(error.what()) ==
+                  "/nonexistent/x.bvh: expected a readable BVH file, got one that cannot be "
+                  "opened");
+        }
+    }
+}
+
+namespace
+{
+
+// The CMU file's motion columns, read with nothing but the README's facts
+// (motion lines start at line 188, 96 numbers each).
+std::vector<std::vector<double>> cmu_columns(const std::string &path)
+{
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    std::vector<std::vector<double>> rows;
+    for (int n = 1; std::getline(in, line); ++n) {
+        if (n < 188)
+            continue;
+        std::istringstream fields(line);
+        std::vector<double> row;
+        double value;
+        while (fields >> value)
+            row.push_back(value);
+        rows.push_back(row);
+    }
+    return rows;
+}
+
+} // namespace
+
+TEST_CASE("BVH: the CMU drumming file (80_13)", "[mocap][bvh][data]")
+{
+    const std::string path = data_file("cmu/80_13.bvh");
+    if (path.empty())
+        return;
+    MocapWarnings warnings;
+    const BvhFile bvh = read_bvh(path, {}, &warnings);
+    CHECK(warnings.empty());
+    CHECK(bvh.motion.frames() == 1015);
+    CHECK(bvh.motion.frame_rate_hz == 120.0);
+    CHECK(bvh.channelled_joints() == 31);
+    CHECK(bvh.channel_count == 96);
+    CHECK(bvh.skeleton.joints.size() == 31 + 7); // + 7 end sites
+    const Skeleton &skeleton = bvh.skeleton;
+
+    // Frame 1 is the converter's reference pose (README).
+    require_near(bvh.motion.root_position_m[0], {-0.4238, 17.5047, 7.9002}, 1e-12);
+    const int left_up_leg = skeleton.find("LeftUpLeg");
+    REQUIRE(left_up_leg > 0);
+    CHECK((bvh.motion.local_rotation[0][static_cast<std::size_t>(left_up_leg)].toRotationMatrix() -
+           rot_z(deg(-21)))
+              .norm() < 1e-12);
+
+    // Rest pose: forward kinematics equals the cumulative OFFSETs.
+    Motion rest;
+    rest.frame_rate_hz = 120;
+    rest.root_position_m.push_back(skeleton.joints[0].offset_m);
+    rest.local_rotation.emplace_back(skeleton.joints.size(), Eigen::Quaterniond::Identity());
+    const auto rest_positions = forward_kinematics(skeleton, rest, 0);
+    for (std::size_t j = 0; j < skeleton.joints.size(); ++j) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (int k = static_cast<int>(j); k >= 0;
+             k = skeleton.joints[static_cast<std::size_t>(k)].parent)
+            sum += skeleton.joints[static_cast<std::size_t>(k)].offset_m;
+        INFO(skeleton.joints[j].name);
+        require_near(rest_positions[j], sum, 1e-12);
+    }
+    const int left_arm = skeleton.find("LeftArm");
+    const int left_fore_arm = skeleton.find("LeftForeArm");
+    require_near(rest_positions[static_cast<std::size_t>(left_fore_arm)] -
+                     rest_positions[static_cast<std::size_t>(left_arm)],
+                 {5.11878, 0, 0}, 1e-12);
+
+    // Bone lengths stay the OFFSET norms (README table) in every frame.
+    const struct {
+        const char *joint;
+        double length;
+    } table[] = {{"LeftArm", 3.42227},        {"LeftForeArm", 5.11878}, {"LeftHand", 3.59971},
+                 {"LeftHandIndex1", 0.62877}, {"RightArm", 3.52737},    {"RightForeArm", 5.49020},
+                 {"RightHand", 3.20659},      {"LeftUpLeg", 2.60678},   {"LeftLeg", 6.63812},
+                 {"LeftFoot", 7.51179}};
+    for (const auto &row : table) {
+        const int j = skeleton.find(row.joint);
+        REQUIRE(j > 0);
+        CHECK(skeleton.joints[static_cast<std::size_t>(j)].offset_m.norm() ==
+              Approx(row.length).margin(0.5e-5)); // the README prints 5 decimals
+    }
+    double worst = 0.0;
+    for (int f = 0; f < bvh.motion.frames(); ++f) {
+        const auto p = forward_kinematics(skeleton, bvh.motion, f);
+        for (std::size_t j = 1; j < skeleton.joints.size(); ++j) {
+            const auto parent = static_cast<std::size_t>(skeleton.joints[j].parent);
+            worst = std::max(
+                worst, std::fabs((p[j] - p[parent]).norm() - skeleton.joints[j].offset_m.norm()));
+        }
+    }
+    CHECK(worst < 1e-9);
+
+    // Every joint at three frames against forward kinematics done here with
+    // hand-written matrices from the raw columns (root: position + Z Y X,
+    // every other joint: Z Y X, in degrees; README).
+    const auto columns = cmu_columns(path);
+    REQUIRE(columns.size() == 1015);
+    for (int f : {1, 500, 1014}) {
+        const auto &row = columns[static_cast<std::size_t>(f)];
+        REQUIRE(row.size() == 96);
+        std::vector<Eigen::Matrix3d> world(skeleton.joints.size());
+        std::vector<Eigen::Vector3d> position(skeleton.joints.size());
+        std::size_t column = 0;
+        for (std::size_t j = 0; j < skeleton.joints.size(); ++j) {
+            const SkeletonJoint &joint = skeleton.joints[j];
+            Eigen::Matrix3d local = Eigen::Matrix3d::Identity();
+            if (j == 0) {
+                position[0] = joint.offset_m + Eigen::Vector3d(row[0], row[1], row[2]);
+                column = 3;
+            } else {
+                const auto parent = static_cast<std::size_t>(joint.parent);
+                position[j] = position[parent] + world[parent] * joint.offset_m;
+            }
+            if (!joint.end_site) {
+                local = rot_z(deg(row[column])) * rot_y(deg(row[column + 1])) *
+                        rot_x(deg(row[column + 2]));
+                column += 3;
+            }
+            world[j] = j == 0 ? local : world[static_cast<std::size_t>(joint.parent)] * local;
+        }
+        CHECK(column == 96);
+        const auto p = forward_kinematics(skeleton, bvh.motion, f);
+        for (std::size_t j = 0; j < skeleton.joints.size(); ++j) {
+            INFO("frame " << f << " joint " << skeleton.joints[j].name);
+            require_near(p[j], position[j], 1e-9);
+        }
+    }
+
+    // skip_frames = 1 drops the reference pose.
+    BvhOptions skip;
+    skip.skip_frames = 1;
+    const BvhFile captured = read_bvh(path, skip);
+    CHECK(captured.motion.frames() == 1014);
+    require_near(captured.motion.root_position_m[0], {columns[1][0], columns[1][1], columns[1][2]},
+                 1e-12);
+}
