@@ -1,0 +1,454 @@
+// Damped-least-squares IK (paper eq. 2) on a human-like arm: convergence on reachable targets
+// made by forward kinematics, warm-started tracking at 1 kHz, graceful behaviour at and beyond
+// the workspace boundary and at singularities, joint limits, bad input, no heap allocation.
+#include <catch2/catch.hpp>
+
+#include "arm_fixture.hpp"
+#include "ictus/chain_ik_solver_pos_dls.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+using Eigen::Quaterniond;
+using Eigen::Vector3d;
+using ictus::ChainIkSolverPos_dls;
+using ictus::IkResult;
+using ictus::IkStatus;
+
+static const double kPi = std::acos(-1.0);
+
+// Tip of `chain` with `rotations` put in, by the chain's FK (checked against hand values in
+// test_kinematic_chain.cpp) -- so accuracy is judged independently of the solver's report.
+static Vector3d tip_with(ictus::KinematicChain chain, const Quaterniond *rotations)
+{
+    chain.set_rotations(rotations);
+    return chain.tip_position();
+}
+
+static bool all_finite(const Quaterniond *q, int n)
+{
+    for (int j = 0; j < n; ++j)
+        if (!q[j].coeffs().allFinite())
+            return false;
+    return true;
+}
+
+// Largest per-joint rotation between two configurations (rad).
+static double largest_joint_change(const Quaterniond *a, const Quaterniond *b, int n)
+{
+    double largest = 0.0;
+    for (int j = 0; j < n; ++j)
+        largest = std::max(largest, ictus::rotation_angle_between(a[j], b[j]));
+    return largest;
+}
+
+static void print_histogram(const char *title, const std::vector<int> &iterations)
+{
+    std::vector<int> count(*std::max_element(iterations.begin(), iterations.end()) + 1, 0);
+    double sum = 0.0;
+    for (int i : iterations) {
+        ++count[i];
+        sum += i;
+    }
+    std::printf("%s: %zu solves, mean %.2f iterations; histogram:", title, iterations.size(),
+                sum / iterations.size());
+    for (size_t i = 0; i < count.size(); ++i)
+        if (count[i])
+            std::printf(" %zu:%d", i, count[i]);
+    std::printf("\n");
+}
+
+TEST_CASE("IK converges on reachable targets from a cold start", "[ik]")
+{
+    std::mt19937 rng(42);
+    ictus::KinematicChain chain = arm::make();
+    ChainIkSolverPos_dls solver(4);
+    const int max_iterations = solver.params().max_iterations;
+    std::vector<int> from_rest, from_other;
+    for (int trial = 0; trial < 500; ++trial) {
+        Quaterniond truth[4], other[4], out[4];
+        arm::random_pose(rng, truth);
+        arm::random_pose(rng, other);
+        const Vector3d target = tip_with(chain, truth);
+
+        for (int start = 0; start < 2; ++start) {
+            ictus::KinematicChain warm = chain; // rest pose, or another random pose
+            if (start == 1)
+                warm.set_rotations(other);
+            const IkResult r = solver.solve(warm, target, out);
+            INFO("trial " << trial << " start " << start << " status " << to_string(r.status));
+            REQUIRE(r.status == IkStatus::converged);
+            CHECK(r.iterations <= max_iterations);
+            // Independent of the solver's own error report.
+            CHECK((tip_with(chain, out) - target).norm() < 1e-4);
+            CHECK(r.position_error_m < 1e-4);
+            (start == 0 ? from_rest : from_other).push_back(r.iterations);
+        }
+    }
+    print_histogram("cold start from the rest pose", from_rest);
+    print_histogram("cold start from another random pose", from_other);
+}
+
+// Drumming-like stick-tip path: strokes at 4 Hz that rebound off the drum head at y = 0.75 m
+// (|sin| has the velocity reversal of a stroke), drifting slowly left-right over the head.
+// Peak tip speed 0.15 m * 4 pi rad/s ~ 1.9 m/s: ~2 mm per 1 ms physics step.
+static Vector3d drum_tip(double t_s)
+{
+    return Vector3d(0.20 + 0.08 * std::sin(2 * kPi * 0.5 * t_s),
+                    0.75 + 0.15 * std::abs(std::sin(kPi * 4.0 * t_s)),
+                    0.45 + 0.03 * std::sin(2 * kPi * 0.25 * t_s));
+}
+
+TEST_CASE("warm-started IK along a smooth drumming trajectory at 1 kHz needs 1-3 iterations",
+          "[ik]")
+{
+    ictus::KinematicChain chain = arm::make();
+    ChainIkSolverPos_dls solver(4);
+    Quaterniond out[4];
+    // Reach the start of the path first (a cold start, not counted).
+    REQUIRE(solver.solve(chain, drum_tip(0.0), out).status == IkStatus::converged);
+    chain.set_rotations(out);
+
+    std::vector<int> iterations;
+    const double dt_s = 1e-3;
+    for (int step = 1; step <= 2000; ++step) {
+        const Vector3d target = drum_tip(step * dt_s);
+        // Warm start = previous output, as if the simulated arm tracked it perfectly.
+        const IkResult r = solver.solve(chain, target, out);
+        REQUIRE(r.status == IkStatus::converged);
+        CHECK((tip_with(chain, out) - target).norm() < 1e-4);
+        iterations.push_back(r.iterations);
+        chain.set_rotations(out);
+    }
+    print_histogram("warm-started drumming trajectory at 1 kHz", iterations);
+    CHECK(*std::max_element(iterations.begin(), iterations.end()) <= 3);
+}
+
+TEST_CASE("IK on unreachable targets stretches the arm along the ray at full reach", "[ik]")
+{
+    std::mt19937 rng(3);
+    std::normal_distribution<double> gauss;
+    ictus::KinematicChain chain = arm::make();
+    ChainIkSolverPos_dls solver(4);
+    ictus::ChainFrames frames;
+    chain.forward(&frames);
+    const Vector3d root = frames.joint_position_m[0];
+    const ictus::KinematicChain rest = chain;
+    std::vector<int> calls_needed;
+    for (int trial = 0; trial < 50; ++trial) {
+        const Vector3d ray = Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+        const Vector3d target = root + (arm::reach() + 0.3) * ray;
+        // The closest reachable point: full reach along the ray (triangle inequality).
+        const Vector3d closest = root + arm::reach() * ray;
+        chain = rest;
+        Quaterniond out[4], before[4];
+        IkResult r;
+        int calls = 0;
+        for (; calls < 20; ++calls) {
+            for (int j = 0; j < 4; ++j)
+                before[j] = chain.rotation(j);
+            r = solver.solve(chain, target, out);
+            REQUIRE(all_finite(out, 4));
+            CHECK(r.status == IkStatus::unreachable);
+            // One call moves a joint at most max_iterations times the per-iteration bound.
+            CHECK(largest_joint_change(before, out, 4) <=
+                  solver.params().max_iterations * solver.params().max_joint_step_rad + 1e-9);
+            chain.set_rotations(out);
+            if ((chain.tip_position() - closest).norm() < 1e-4)
+                break;
+        }
+        INFO("trial " << trial);
+        CHECK((chain.tip_position() - closest).norm() < 1e-4);
+        calls_needed.push_back(calls + 1);
+    }
+    print_histogram("calls to reach full stretch (16 iterations each)", calls_needed);
+}
+
+TEST_CASE("IK tracking a target that leaves and re-enters the workspace has no jumps", "[ik]")
+{
+    ictus::KinematicChain chain = arm::make();
+    ChainIkSolverPos_dls solver(4);
+    ictus::ChainFrames frames;
+    chain.forward(&frames);
+    const Vector3d root = frames.joint_position_m[0];
+    const Vector3d ray = Vector3d(0.6, -0.3, 0.75).normalized();
+    const double reach = arm::reach();
+    // Out from 0.85 reach to 0.3 m beyond reach and back, 1 m/s, at 1 kHz, with a sideways wobble.
+    const double speed_mps = 1.0, dt_s = 1e-3;
+    const double out_distance = reach + 0.3 - 0.85 * reach;
+    const int steps = static_cast<int>(2 * out_distance / (speed_mps * dt_s));
+    const Vector3d side = ray.unitOrthogonal();
+    auto target_at = [&](int step) {
+        const double s = step * speed_mps * dt_s;
+        const double radius = 0.85 * reach + (s < out_distance ? s : 2 * out_distance - s);
+        return Vector3d(root + radius * ray + 0.05 * std::sin(2 * kPi * s) * side);
+    };
+    Quaterniond out[4], before[4];
+    REQUIRE(solver.solve(chain, target_at(0), out).status == IkStatus::converged);
+    chain.set_rotations(out);
+    double largest_change = 0.0;
+    int unreachable_calls = 0;
+    for (int step = 1; step <= steps; ++step) {
+        for (int j = 0; j < 4; ++j)
+            before[j] = chain.rotation(j);
+        const Vector3d target = target_at(step);
+        const IkResult r = solver.solve(chain, target, out);
+        REQUIRE(all_finite(out, 4));
+        REQUIRE(std::isfinite(r.position_error_m));
+        if (r.status == IkStatus::unreachable)
+            ++unreachable_calls;
+        else
+            CHECK(r.status == IkStatus::converged);
+        largest_change = std::max(largest_change, largest_joint_change(before, out, 4));
+        chain.set_rotations(out);
+    }
+    std::printf("workspace boundary crossing: %d of %d calls unreachable, largest joint change "
+                "per 1 ms call %.4f rad\n",
+                unreachable_calls, steps, largest_change);
+    CHECK(unreachable_calls > 0);
+    // The target moves 1 mm per call (1.1 mm with the wobble) and the shortest lever that can
+    // move the tip across the ray is the stick+hand (0.41 m): joints need ~3 mrad per call.
+    // 20 mrad (20 rad/s) allows for the redundancy's internal motion; a jump would exceed it.
+    CHECK(largest_change < 0.02);
+    // Back inside, it tracks again.
+    CHECK((chain.tip_position() - target_at(steps)).norm() < 1e-4);
+}
+
+// A straight chain hanging down: 4 joints, tip along the last segment; reach 1.0 m.
+static ictus::KinematicChain straight_chain()
+{
+    ictus::KinematicChain chain;
+    for (int j = 0; j < 4; ++j)
+        chain.add_joint(Vector3d(0.0, j == 0 ? 0.0 : -0.25, 0.0));
+    chain.set_tip(Vector3d(0.0, -0.25, 0.0));
+    return chain;
+}
+
+TEST_CASE("IK at a singularity takes finite, bounded steps", "[ik]")
+{
+    ictus::KinematicChain chain = straight_chain();
+    ictus::IkParams one_step;
+    one_step.max_iterations = 1;
+    ChainIkSolverPos_dls step_solver(4, one_step);
+    ChainIkSolverPos_dls solver(4);
+    Quaterniond out[4], before[4];
+
+    SECTION("exactly stretched, target along the arm: no motion, status singular")
+    {
+        // J has no column along the arm, so J^T e = 0: the damped step is zero, not infinite.
+        const IkResult r = solver.solve(chain, Vector3d(0.0, -0.8, 0.0), out);
+        REQUIRE(all_finite(out, 4));
+        CHECK(r.status == IkStatus::singular);
+        CHECK(r.min_singular_value_m < 1e-12);
+        CHECK(r.position_error_m == Approx(0.2));
+    }
+    SECTION("nearly stretched: each damped step obeys |dtheta| <= |e| / (2 lambda)")
+    {
+        chain.set_rotation(2, Quaterniond(Eigen::AngleAxisd(1e-4, Vector3d::UnitX())));
+        const Vector3d target(0.0, -0.8, 0.0);
+        int calls = 0;
+        IkResult r;
+        for (; calls < 200; ++calls) {
+            for (int j = 0; j < 4; ++j)
+                before[j] = chain.rotation(j);
+            const Vector3d error = target - chain.tip_position();
+            const double clamped_error =
+                std::min(error.norm(), step_solver.params().max_error_step_m);
+            r = step_solver.solve(chain, target, out);
+            REQUIRE(all_finite(out, 4));
+            // Without limits the joints turn by exactly the step's blocks, so the step norm is
+            // the root sum of squares of the joint rotations (frame independent). Wampler:
+            // sigma / (sigma^2 + lambda^2) <= 1 / (2 lambda).
+            double step_norm2 = 0.0;
+            for (int j = 0; j < 4; ++j)
+                step_norm2 += std::pow(ictus::rotation_angle_between(before[j], out[j]), 2);
+            CHECK(std::sqrt(step_norm2) <=
+                  clamped_error / (2 * step_solver.params().damping_m) + 1e-12);
+            chain.set_rotations(out);
+            if (r.status == IkStatus::converged)
+                break;
+        }
+        std::printf("escape from a near-singular stretch: %d one-iteration calls\n", calls + 1);
+        // The arm bends and gets there.
+        CHECK(r.status == IkStatus::converged);
+        CHECK((chain.tip_position() - target).norm() < 1e-4);
+    }
+}
+
+TEST_CASE("IK respects joint limits", "[ik]")
+{
+    // Limits narrower than the poses the targets come from, so many targets need a limit.
+    const arm::AngleLimit limits[4] = {{0.2}, {1.2}, {1.3}, {0.8}};
+    ictus::JointLimitRef refs[4];
+    for (int j = 0; j < 4; ++j)
+        refs[j] = ictus::JointLimitRef::to(limits[j]);
+    ictus::KinematicChain chain = arm::make(refs);
+    ChainIkSolverPos_dls solver(4);
+    std::mt19937 rng(11);
+    int converged = 0, limited = 0, inside_trials = 0, inside_converged = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        Quaterniond truth[4], out[4];
+        // Half the targets come from poses inside the limits, half from wider poses.
+        const bool inside = trial % 2 == 0;
+        for (int j = 0; j < 4; ++j)
+            truth[j] = arm::random_rotation(rng, inside ? limits[j].max_angle_rad
+                                                        : 1.6 * limits[j].max_angle_rad);
+        const Vector3d target = tip_with(chain, truth);
+        ictus::KinematicChain warm = chain;
+        const IkResult r = solver.solve(warm, target, out);
+        for (int j = 0; j < 4; ++j)
+            CHECK(arm::AngleLimit::angle_of(out[j]) <= limits[j].max_angle_rad + 1e-9);
+        if (r.status == IkStatus::converged) {
+            ++converged;
+            CHECK((tip_with(chain, out) - target).norm() < 1e-4);
+        } else {
+            CHECK((r.status == IkStatus::joint_limited || r.status == IkStatus::max_iterations));
+            limited += r.status == IkStatus::joint_limited;
+        }
+        if (inside) {
+            ++inside_trials;
+            inside_converged += r.status == IkStatus::converged;
+        }
+    }
+    std::printf("limits: %d of 300 converged, %d joint_limited; targets from poses inside the "
+                "limits: %d of %d converged\n",
+                converged, limited, inside_converged, inside_trials);
+    CHECK(limited > 0);
+}
+
+TEST_CASE("stick direction as a secondary task does not cost tip accuracy", "[ik]")
+{
+    std::mt19937 rng(5);
+    ictus::KinematicChain chain = arm::make();
+    ChainIkSolverPos_dls solver(4);
+    double worst_direction = 0.0, worst_direction_without = 0.0;
+    for (int trial = 0; trial < 200; ++trial) {
+        Quaterniond truth[4], out[4], out_plain[4];
+        arm::random_pose(rng, truth);
+        ictus::KinematicChain posed = chain;
+        posed.set_rotations(truth);
+        ictus::ChainFrames frames;
+        posed.forward(&frames); // a compatible (tip, direction) pair
+        const IkResult r =
+            solver.solve(chain, frames.tip_position_m, frames.stick_direction, 1.0, out);
+        const IkResult plain = solver.solve(chain, frames.tip_position_m, out_plain);
+        REQUIRE(plain.status == IkStatus::converged);
+        INFO("trial " << trial << " status " << to_string(r.status));
+        CHECK(r.status == IkStatus::converged);
+        posed.set_rotations(out);
+        posed.forward(&frames);
+        CHECK((frames.tip_position_m - tip_with(chain, truth)).norm() < 1e-4);
+        const Vector3d wanted = tip_with(chain, truth);
+        (void)wanted;
+        ictus::KinematicChain truth_chain = chain;
+        truth_chain.set_rotations(truth);
+        ictus::ChainFrames truth_frames;
+        truth_chain.forward(&truth_frames);
+        worst_direction = std::max(
+            worst_direction,
+            std::acos(std::min(1.0, frames.stick_direction.dot(truth_frames.stick_direction))));
+        ictus::KinematicChain plain_chain = chain;
+        plain_chain.set_rotations(out_plain);
+        plain_chain.forward(&frames);
+        worst_direction_without = std::max(
+            worst_direction_without,
+            std::acos(std::min(1.0, frames.stick_direction.dot(truth_frames.stick_direction))));
+    }
+    std::printf("stick direction error: worst %.2e rad with the secondary task, %.2f rad "
+                "without\n",
+                worst_direction, worst_direction_without);
+    CHECK(worst_direction < 2e-3);
+    CHECK(worst_direction_without > 0.1);
+}
+
+TEST_CASE("IK refuses bad input and leaves the warm start", "[ik]")
+{
+    ictus::KinematicChain chain = arm::make();
+    std::mt19937 rng(9);
+    Quaterniond start[4];
+    arm::random_pose(rng, start);
+    chain.set_rotations(start);
+    ChainIkSolverPos_dls solver(4);
+    const double nan = std::nan(""), inf = HUGE_VAL;
+    Quaterniond out[4];
+    auto expect_unchanged = [&]() {
+        for (int j = 0; j < 4; ++j)
+            CHECK(out[j].coeffs() == start[j].coeffs());
+    };
+    for (const Vector3d &bad : {Vector3d(nan, 1, 0), Vector3d(0, inf, 0), Vector3d(0, 0, -inf)}) {
+        const IkResult r = solver.solve(chain, bad, out);
+        CHECK(r.status == IkStatus::invalid_input);
+        CHECK(r.iterations == 0);
+        expect_unchanged();
+    }
+    const Vector3d good = chain.tip_position() + Vector3d(0.05, 0, 0);
+    CHECK(solver.solve(chain, good, Vector3d(nan, 0, 1), 0.5, out).status ==
+          IkStatus::invalid_input);
+    expect_unchanged();
+    CHECK(solver.solve(chain, good, Vector3d::Zero(), 0.5, out).status == IkStatus::invalid_input);
+    CHECK(solver.solve(chain, good, Vector3d::UnitY(), nan, out).status == IkStatus::invalid_input);
+    CHECK(solver.solve(chain, good, Vector3d::UnitY(), 1.5, out).status == IkStatus::invalid_input);
+    expect_unchanged();
+
+    // A chain of the wrong size.
+    ChainIkSolverPos_dls three(3);
+    CHECK(three.solve(chain, good, out).status == IkStatus::invalid_input);
+    ChainIkSolverPos_dls none(0);
+    CHECK(none.joints() == 0);
+    CHECK(none.solve(chain, good, out).status == IkStatus::invalid_input);
+
+    // A NaN in the warm start: refused, and the outputs hold no NaN.
+    ictus::KinematicChain broken = chain;
+    broken.set_rotation(2, Quaterniond(nan, 0, 0, 0));
+    CHECK(solver.solve(broken, good, out).status == IkStatus::invalid_input);
+    CHECK(all_finite(out, 4));
+    CHECK(out[2].coeffs() == Quaterniond::Identity().coeffs());
+
+    // Bad parameters are refused and the old ones kept.
+    ictus::IkParams p = solver.params();
+    p.damping_m = -1.0;
+    CHECK_FALSE(solver.set_params(p));
+    p.damping_m = nan;
+    CHECK_FALSE(solver.set_params(p));
+    p = solver.params();
+    p.max_iterations = 0;
+    CHECK_FALSE(solver.set_params(p));
+    CHECK(solver.params().damping_m == ictus::IkParams().damping_m);
+
+    // A limit that returns garbage is ignored rather than propagated.
+    struct NanLimit {
+        Quaterniond clamp(const Quaterniond &) const
+        {
+            const double n = std::nan("");
+            return Quaterniond(n, n, n, n);
+        }
+    } nan_limit;
+    ictus::KinematicChain limited = chain;
+    limited.set_limit(1, ictus::JointLimitRef::to(nan_limit));
+    solver.solve(limited, good, out);
+    CHECK(all_finite(out, 4));
+}
+
+TEST_CASE("solve() makes no heap allocation", "[ik]")
+{
+    const arm::AngleLimit limits[4] = {{0.3}, {1.5}, {1.5}, {1.0}};
+    ictus::JointLimitRef refs[4];
+    for (int j = 0; j < 4; ++j)
+        refs[j] = ictus::JointLimitRef::to(limits[j]);
+    ictus::KinematicChain chain = arm::make(refs);
+    ChainIkSolverPos_dls solver(4);
+    Quaterniond out[4];
+    const Vector3d targets[] = {drum_tip(0.1), drum_tip(0.2), Vector3d(5, 5, 5),
+                                Vector3d(std::nan(""), 0, 0)};
+    const long before = g_operator_new_calls.load();
+    Eigen::internal::set_is_malloc_allowed(false); // Eigen asserts if it would allocate
+    for (const Vector3d &target : targets) {
+        solver.solve(chain, target, out);
+        solver.solve(chain, target, Vector3d(0, -1, 1), 0.5, out);
+        chain.set_rotations(out);
+    }
+    Eigen::internal::set_is_malloc_allowed(true);
+    CHECK(g_operator_new_calls.load() == before);
+}
