@@ -428,6 +428,11 @@ void membrane_free(membrane *m)
     free(m);
 }
 
+void membrane_use_generic_kernel_(membrane *m)
+{
+    m->kernel = membrane_kernel_generic;
+}
+
 const char *membrane_kernel_name(const membrane *m)
 {
     return m->kernel == membrane_kernel_avx2 ? "avx2+fma" : "generic";

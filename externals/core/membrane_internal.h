@@ -58,6 +58,9 @@ struct contact {
     int force_cap;
 };
 
+/* Benchmarks only: run the portable kernel even on an AVX2 machine. */
+void membrane_use_generic_kernel_(membrane *m);
+
 /* Internal membrane services used by contact.c. */
 int membrane_capacity_(const membrane *m);
 /* Fills psi[0 .. capacity) with the mass-normalised mode shapes at (r/a, theta). */
