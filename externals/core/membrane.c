@@ -785,7 +785,10 @@ static void solve_contacts(membrane *m, membrane_kernel_args *a, contact **act, 
         c->force_pending = Fi;
         c->stroke_samples++;
         double t_end = (double)c->stroke_samples, t_start = t_end - 1.0;
-        int now_touching = (Fi > 0.0 || xw > 0.0);
+        /* Touching = compressed at the end of the sample; the sample in which x
+         * crosses zero (force may still be > 0 in it) holds the interpolated
+         * touch or release instant. */
+        int now_touching = xw > 0.0;
         if (now_touching && !c->touching) {
             /* Touch: interpolate where the compression crossed zero. */
             double t = xprev < 0.0 && xw > 0.0 ? t_start + (-xprev) / (xw - xprev) : t_start;

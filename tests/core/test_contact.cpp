@@ -85,6 +85,7 @@ TEST_CASE("Rigid target: contact time approaches Hertz within 5 %", "[core][cont
         INFO("m " << cs.mass << " k " << cs.k << " a " << cs.alpha << " v " << cs.v0 << ": tau "
                   << tau * 1e3 << " ms, simulated " << r.duration_ms << " ms");
         CHECK(std::fabs(r.duration_ms / (tau * 1e3) - 1.0) < 0.05);
+        WARN("rigid Hertz ratio " << r.duration_ms / (tau * 1e3));
         // No damping: the discrete energy is conserved, the stick comes back as fast.
         CHECK(r.rebound_velocity_mps == Approx(cs.v0).epsilon(1e-9));
         // Impulse = 2 m v0 for an elastic bounce.
@@ -111,6 +112,7 @@ TEST_CASE("Stiff heavy membrane: contact time approaches Hertz within 5 %", "[co
     REQUIRE(h.finished);
     INFO("Hertz " << tau * 1e3 << " ms, on the membrane " << h.report.duration_ms << " ms");
     CHECK(std::fabs(h.report.duration_ms / (tau * 1e3) - 1.0) < 0.05);
+    WARN("membrane Hertz ratio " << h.report.duration_ms / (tau * 1e3));
     membrane_free(m);
     contact_free(c);
 }
@@ -134,7 +136,7 @@ TEST_CASE("Passivity over 10^4 random legal contacts", "[core][contact]")
         double tau =
             hertz_time(contact_get_mass(c), contact_get_stiffness(c), contact_get_alpha(c), v);
         double fs = std::min(std::max(20.0 / tau, 1000.0), 1e8);
-        if (!contact_simulate_rigid(c, v, fs, 200.0 * tau, &r))
+        if (!contact_simulate_rigid(c, v, fs, 50.0 * tau, &r))
             continue; // heavy damping can stop the stick (it then never leaves)
         // Everything runs in double; the energy error per step of the bracketed
         // solve is a few ulp of the stick's energy, so over < 10^4 steps the rebound
@@ -222,6 +224,8 @@ TEST_CASE("Harder hits are shorter and brighter", "[core][contact]")
                   << " Hz, peak force " << h.report.peak_force_n << " N");
         CHECK(h.report.duration_ms < prev_dur);
         CHECK(h.centroid_hz > prev_centroid);
+        WARN("T " << tension << " v " << v << ": " << h.report.duration_ms << " ms, centroid "
+                  << h.centroid_hz << " Hz");
         prev_dur = h.report.duration_ms;
         prev_centroid = h.centroid_hz;
     }
@@ -236,7 +240,7 @@ TEST_CASE("Default output gain: a forte hit peaks near 0.5", "[core][contact]")
     contact *c = contact_new();
     membrane_attach_contact(m, c);
     hit_result h = hit_membrane(m, c, 5.0, 0.3, 0.0, 48000 / 2);
-    INFO("peak " << h.peak_out);
+    WARN("forte peak " << h.peak_out);
     CHECK(h.peak_out > 0.3);
     CHECK(h.peak_out < 0.8);
     membrane_free(m);
