@@ -1,0 +1,522 @@
+// ictusd -- the ictus simulation daemon: a physically simulated percussionist.
+// Verbs: track (joint-space PD tracking of a mocap clip, paper eq. 1) and
+// limits (joint limits learned from a clip, paper Algorithm 1). See
+// docs/character.md. Exit status: 0 ok, 1 runtime error (file, data), 2 usage
+// error (unknown verb or option, bad value), 3 the simulation diverged (and
+// was reset) at least once, 130 interrupted.
+#include "ictus/bvh.hpp"
+#include "ictus/character.hpp"
+#include "ictus/joint_limits.hpp"
+#include "ictus/track.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+
+volatile std::sig_atomic_t g_interrupted = 0;
+void on_sigint(int)
+{
+    g_interrupted = 1;
+}
+
+constexpr double kCmuScale = 0.056444; // (1/0.45) inch per unit, cgspeed CMU BVH files
+
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+void usage(std::ostream &out)
+{
+    out << "ictusd -- the ictus simulation daemon (a physically simulated percussionist)\n"
+           "\n"
+           "usage: ictusd VERB [options]\n"
+           "       ictusd --help | VERB --help\n"
+           "\n"
+           "verbs:\n"
+           "  track    drive the character with a motion capture in joint space (PD, eq. 1)\n"
+           "           and report tracking errors and speed\n"
+           "  limits   learn joint limits from a motion capture (Euler statistics and\n"
+           "           Algorithm 1), print them and write them as JSON\n"
+           "\n"
+           "examples:\n"
+           "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n"
+           "  ictusd track --mode joint --mocap clip.bvh --duration 600 --grip german --quiet\n"
+           "  ictusd limits ../shared/data/cmu/80_13.bvh --out limits.json\n"
+           "\n"
+           "exit status: 0 ok, 1 error in a file or the data, 2 usage error,\n"
+           "             3 the simulation diverged (and was reset), 130 interrupted\n";
+}
+
+void track_usage(std::ostream &out)
+{
+    out << "usage: ictusd track --mode joint --mocap FILE [options]\n"
+           "\n"
+           "Tracks the clip's joint rotations with per-joint PD controllers (eq. 1) on the\n"
+           "57-DoF character, pelvis anchored, sticks in the hands, a drum in front.\n"
+           "\n"
+           "  --mode joint           control mode (joint space; the Cartesian mode comes later)\n"
+           "  --mocap FILE           BVH file with CMU joint names\n"
+           "  --out DIR              write DIR/track.csv and DIR/summary.json\n"
+           "  --scale M              metres per BVH unit (default 0.056444, the CMU files)\n"
+           "  --skip-frames N        frames dropped at the start (default 1: the CMU\n"
+           "                         converter's reference pose)\n"
+           "  --duration S           simulated seconds (default: the clip; longer runs play\n"
+           "                         it forwards and backwards)\n"
+           "  --step S               physics step, s (default 0.001)\n"
+           "  --stepper quick|direct dWorldQuickStep (default) or dWorldStep\n"
+           "  --iterations N         QuickStep iterations (default 20)\n"
+           "  --body-mass KG         body mass for de Leva's table (default 70)\n"
+           "  --grip french|german   hand-stick orientation (default french)\n"
+           "  --stick-length M       (default 0.406)   --stick-mass KG (default 0.05)\n"
+           "  --stick-tip-radius M   (default 0.007)\n"
+           "  --drum-pos X,Y,Z       membrane centre, m (default: under the lowest tips)\n"
+           "  --drum-radius M        (default 0.178)   --drum-tension N/m (default 3000)\n"
+           "  --gain-hz HZ           PD natural frequency (default 15)\n"
+           "  --damping-ratio Z      (default 1)       --torque-scale S (default 1)\n"
+           "  --limits none|euler|quaternion   limits enforced (default quaternion)\n"
+           "  --limit-k K            limit width in standard deviations (default 3)\n"
+           "  --no-stops             clamp targets only, no safety-net stops\n"
+           "  --ramp S               blend targets in over S seconds (default 0.25)\n"
+           "  --smooth-hz HZ         low-pass the reference (Gaussian, default 10; 0: off)\n"
+           "  --despike-deg DEG      replace one-frame spikes larger than DEG (default 5;\n"
+           "                         0: off)\n"
+           "  --quiet                no progress output\n"
+           "\n"
+           "example:\n"
+           "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n";
+}
+
+void limits_usage(std::ostream &out)
+{
+    out << "usage: ictusd limits FILE [options]\n"
+           "\n"
+           "Learns the limits of the character's 19 joints from a BVH clip: Euler angles\n"
+           "(ZYX, mean -/+ k std) and quaternions (Algorithm 1: mean, log map, SVD,\n"
+           "ellipsoid of k std). Prints a table and writes JSON.\n"
+           "\n"
+           "  --out FILE      JSON output (default limits.json; '-' prints JSON instead)\n"
+           "  --scale M       metres per BVH unit (default 0.056444)\n"
+           "  --skip-frames N frames dropped at the start (default 1)\n"
+           "  --k K           quaternion ellipsoid half-axes in std (default 3)\n"
+           "  --euler-k K     Euler limits in std (default 2.5)\n"
+           "  --smooth-hz HZ, --despike-deg DEG   reference clean-up as in track\n"
+           "\n"
+           "example:\n"
+           "  ictusd limits ../shared/data/cmu/80_13.bvh --out limits.json\n";
+}
+
+// Strict number parsing: the whole text must be a finite number.
+double parse_double(const std::string &option, const std::string &text)
+{
+    char *end = nullptr;
+    errno = 0;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+        throw UsageError(option + ": expected a number, got '" + text + "'");
+    return v;
+}
+
+double parse_positive(const std::string &option, const std::string &text)
+{
+    const double v = parse_double(option, text);
+    if (!(v > 0.0))
+        throw UsageError(option + ": expected a number > 0, got '" + text + "'");
+    return v;
+}
+
+int parse_int(const std::string &option, const std::string &text, int lo, int hi)
+{
+    char *end = nullptr;
+    errno = 0;
+    const long v = std::strtol(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0' || errno == ERANGE || v < lo || v > hi)
+        throw UsageError(option + ": expected an integer in [" + std::to_string(lo) + ", " +
+                         std::to_string(hi) + "], got '" + text + "'");
+    return static_cast<int>(v);
+}
+
+Eigen::Vector3d parse_vec3(const std::string &option, const std::string &text)
+{
+    Eigen::Vector3d v;
+    std::stringstream in(text);
+    std::string part;
+    int i = 0;
+    while (std::getline(in, part, ',')) {
+        if (i >= 3)
+            throw UsageError(option + ": expected X,Y,Z, got '" + text + "'");
+        v[i++] = parse_double(option, part);
+    }
+    if (i != 3)
+        throw UsageError(option + ": expected X,Y,Z, got '" + text + "'");
+    return v;
+}
+
+// argv walker: flags with one value, no value, or positional arguments.
+struct Args {
+    std::vector<std::string> items;
+    size_t at = 0;
+    bool done() const { return at >= items.size(); }
+    const std::string &next() { return items[at++]; }
+    std::string value(const std::string &option)
+    {
+        if (done())
+            throw UsageError(option + ": missing value");
+        return next();
+    }
+};
+
+ictus::BvhFile load_bvh(const std::string &path, double scale, int skip)
+{
+    ictus::BvhOptions o;
+    o.scale = scale;
+    o.skip_frames = skip;
+    ictus::MocapWarnings warnings;
+    ictus::BvhFile bvh = ictus::read_bvh(path, o, &warnings);
+    for (const std::string &w : warnings)
+        std::cerr << "ictusd: warning: " << w << "\n";
+    return bvh;
+}
+
+// The character's joint-space series, one per joint, from every reference frame.
+void character_series(const ictus::ReferenceMotion &reference, const ictus::CharacterModel &model,
+                      std::vector<std::string> &names,
+                      std::vector<std::vector<Eigen::Quaterniond>> &series)
+{
+    names.clear();
+    series.assign(ictus::CharacterModel::kJoints, {});
+    for (int j = 0; j < ictus::CharacterModel::kJoints; ++j) {
+        names.push_back(model.joint_name(j));
+        for (int f = 0; f < reference.frames(); ++f)
+            series[j].push_back(reference.frame(f).local[j]);
+    }
+}
+
+class Progress
+{
+  public:
+    explicit Progress(bool enabled) : enabled_(enabled), tty_(isatty(STDERR_FILENO) == 1) {}
+    void operator()(double fraction)
+    {
+        if (!enabled_)
+            return;
+        const int pct = static_cast<int>(fraction * 100.0 + 0.5);
+        if (tty_) {
+            const int width = 40, filled = pct * width / 100;
+            std::cerr << "\rtrack [" << std::string(filled, '#') << std::string(width - filled, ' ')
+                      << "] " << pct << "%" << std::flush;
+            if (pct >= 100)
+                std::cerr << "\n";
+        } else if (pct / 10 != last_decile_) {
+            last_decile_ = pct / 10;
+            std::cerr << "track: " << pct << "%\n";
+        }
+    }
+
+  private:
+    bool enabled_, tty_;
+    int last_decile_ = -1;
+};
+
+int run_track(Args &args)
+{
+    std::string mode, mocap, out_dir, limits_mode = "quaternion";
+    double scale = kCmuScale, limit_k = 3.0;
+    int skip = 1;
+    bool quiet = false;
+    ictus::CharacterOptions character;
+    ictus::TrackOptions options;
+    ictus::ReferenceFilter filter;
+    bool drum_pos_given = false;
+    while (!args.done()) {
+        const std::string a = args.next();
+        if (a == "--help" || a == "-h") {
+            track_usage(std::cout);
+            return 0;
+        } else if (a == "--mode") {
+            mode = args.value(a);
+            if (mode != "joint")
+                throw UsageError("--mode: expected 'joint' (the Cartesian mode is not in this "
+                                 "version), got '" +
+                                 mode + "'");
+        } else if (a == "--mocap") {
+            mocap = args.value(a);
+        } else if (a == "--out") {
+            out_dir = args.value(a);
+        } else if (a == "--scale") {
+            scale = parse_positive(a, args.value(a));
+        } else if (a == "--skip-frames") {
+            skip = parse_int(a, args.value(a), 0, 100000000);
+        } else if (a == "--duration") {
+            options.duration_s = parse_positive(a, args.value(a));
+        } else if (a == "--step") {
+            options.scene.step_s = parse_positive(a, args.value(a));
+        } else if (a == "--stepper") {
+            const std::string s = args.value(a);
+            if (s == "quick")
+                options.scene.stepper = ictus::Stepper::quick;
+            else if (s == "direct")
+                options.scene.stepper = ictus::Stepper::direct;
+            else
+                throw UsageError("--stepper: expected quick or direct, got '" + s + "'");
+        } else if (a == "--iterations") {
+            options.scene.quickstep_iterations = parse_int(a, args.value(a), 1, 1000);
+        } else if (a == "--body-mass") {
+            character.body_mass_kg = parse_positive(a, args.value(a));
+        } else if (a == "--grip") {
+            const std::string g = args.value(a);
+            try {
+                character.grip = ictus::grip_from_string(g);
+            } catch (const ictus::CharacterError &e) {
+                throw UsageError(std::string("--") + e.what());
+            }
+        } else if (a == "--stick-length") {
+            character.stick.length_m = parse_positive(a, args.value(a));
+        } else if (a == "--stick-mass") {
+            character.stick.mass_kg = parse_positive(a, args.value(a));
+        } else if (a == "--stick-tip-radius") {
+            character.stick.tip_radius_m = parse_positive(a, args.value(a));
+        } else if (a == "--drum-pos") {
+            options.scene.drum.center_m = parse_vec3(a, args.value(a));
+            drum_pos_given = true;
+        } else if (a == "--drum-radius") {
+            options.scene.drum.radius_m = parse_positive(a, args.value(a));
+        } else if (a == "--drum-tension") {
+            options.scene.drum.tension_n_per_m = parse_positive(a, args.value(a));
+        } else if (a == "--gain-hz") {
+            options.gains.natural_frequency_hz = parse_positive(a, args.value(a));
+        } else if (a == "--damping-ratio") {
+            options.gains.damping_ratio = parse_positive(a, args.value(a));
+        } else if (a == "--torque-scale") {
+            options.gains.torque_scale = parse_positive(a, args.value(a));
+        } else if (a == "--limits") {
+            limits_mode = args.value(a);
+            if (limits_mode != "none" && limits_mode != "euler" && limits_mode != "quaternion")
+                throw UsageError("--limits: expected none, euler or quaternion, got '" +
+                                 limits_mode + "'");
+        } else if (a == "--limit-k") {
+            limit_k = parse_positive(a, args.value(a));
+        } else if (a == "--no-stops") {
+            options.scene.limit_stops = false;
+        } else if (a == "--ramp") {
+            options.ramp_s = parse_double(a, args.value(a));
+            if (options.ramp_s < 0.0)
+                throw UsageError("--ramp: expected a number >= 0, got " +
+                                 std::to_string(options.ramp_s));
+        } else if (a == "--smooth-hz") {
+            filter.smooth_cutoff_hz = parse_double(a, args.value(a));
+            if (filter.smooth_cutoff_hz < 0.0)
+                throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
+        } else if (a == "--despike-deg") {
+            filter.spike_threshold_rad = parse_double(a, args.value(a)) * M_PI / 180.0;
+            if (filter.spike_threshold_rad < 0.0)
+                throw UsageError("--despike-deg: expected a number >= 0 (0: off)");
+        } else if (a == "--quiet" || a == "-q") {
+            quiet = true;
+        } else {
+            throw UsageError("track: unknown option '" + a + "' (see ictusd track --help)");
+        }
+    }
+    if (mode.empty())
+        throw UsageError("track: --mode is required (--mode joint)");
+    if (mocap.empty())
+        throw UsageError("track: --mocap FILE is required");
+    options.drum_auto = !drum_pos_given;
+    // Option values that only the model can judge (e.g. a too-long step) are
+    // usage errors too: check them before reading the file.
+    try {
+        ictus::validate(options);
+    } catch (const ictus::CharacterError &e) {
+        throw UsageError(std::string("track: ") + e.what());
+    }
+
+    const ictus::BvhFile bvh = load_bvh(mocap, scale, skip);
+    const ictus::CharacterModel model =
+        ictus::CharacterModel::from_skeleton(bvh.skeleton, character);
+    const ictus::ReferenceMotion raw(model, bvh.motion);
+    const ictus::ReferenceMotion reference(model, bvh.motion, filter);
+
+    std::vector<ictus::JointLimit> limits;
+    std::vector<ictus::JointLimitRef> refs;
+    if (limits_mode != "none") {
+        std::vector<std::string> names;
+        std::vector<std::vector<Eigen::Quaterniond>> series;
+        character_series(reference, model, names, series);
+        ictus::LimitOptions lo;
+        lo.quaternion.k = limit_k;
+        lo.euler.k = limit_k;
+        limits = ictus::learn_limits(names, series, lo);
+        for (const ictus::JointLimit &l : limits)
+            refs.push_back(limits_mode == "euler" ? ictus::JointLimitRef::to(l.euler)
+                                                  : ictus::JointLimitRef::to(l.quaternion));
+    }
+
+    std::ofstream csv;
+    if (!out_dir.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(out_dir, ec);
+        if (ec)
+            throw std::runtime_error("--out: cannot create directory '" + out_dir +
+                                     "': " + ec.message());
+        csv.open(out_dir + "/track.csv");
+        if (!csv)
+            throw std::runtime_error("--out: cannot write '" + out_dir + "/track.csv'");
+        csv.precision(9);
+    }
+    options.interrupt = &g_interrupted;
+    Progress progress(!quiet);
+    ictus::TrackSummary summary = ictus::track_joint_space(
+        model, reference, options, refs, out_dir.empty() ? nullptr : &csv,
+        [&](double f) { progress(f); }, nullptr, &raw);
+
+    nlohmann::json j = summary.to_json();
+    j["mocap"] = mocap;
+    j["scale_m_per_unit"] = scale;
+    j["skip_frames"] = skip;
+    j["step_s"] = options.scene.step_s;
+    j["stepper"] = options.scene.stepper == ictus::Stepper::quick ? "quick" : "direct";
+    j["quickstep_iterations"] = options.scene.quickstep_iterations;
+    j["grip"] = ictus::to_string(character.grip);
+    j["body_mass_kg"] = character.body_mass_kg;
+    j["limits"] = limits_mode;
+    j["limit_k"] = limit_k;
+    j["limit_stops"] = options.scene.limit_stops;
+    j["gain_hz"] = options.gains.natural_frequency_hz;
+    j["damping_ratio"] = options.gains.damping_ratio;
+    j["drum_radius_m"] = options.scene.drum.radius_m;
+    j["smooth_hz"] = filter.smooth_cutoff_hz;
+    j["despike_deg"] = filter.spike_threshold_rad * 180.0 / M_PI;
+    j["spikes_removed"] = reference.spikes_removed();
+    j["interrupted"] = summary.interrupted;
+    if (!out_dir.empty()) {
+        csv.close();
+        if (!csv)
+            throw std::runtime_error("--out: error writing '" + out_dir + "/track.csv'");
+        std::ofstream js(out_dir + "/summary.json");
+        js << j.dump(2) << "\n";
+        if (!js)
+            throw std::runtime_error("--out: cannot write '" + out_dir + "/summary.json'");
+    }
+    std::cout << "mode joint, " << summary.duration_s << " s simulated, realtime factor "
+              << summary.realtime_factor << "\n"
+              << "tip rms (mm): left " << summary.tip_rms_mm[0] << ", right "
+              << summary.tip_rms_mm[1] << "\n"
+              << "joint rms (deg), all joints: " << j["joint_rms_deg_all"].get<double>() << "\n"
+              << "divergences: " << summary.divergences << "\n";
+    if (summary.interrupted)
+        return 130;
+    return summary.diverged ? 3 : 0;
+}
+
+int run_limits(Args &args)
+{
+    std::string file, out = "limits.json";
+    double scale = kCmuScale;
+    int skip = 1;
+    ictus::LimitOptions lo;
+    ictus::ReferenceFilter filter;
+    while (!args.done()) {
+        const std::string a = args.next();
+        if (a == "--help" || a == "-h") {
+            limits_usage(std::cout);
+            return 0;
+        } else if (a == "--out") {
+            out = args.value(a);
+        } else if (a == "--scale") {
+            scale = parse_positive(a, args.value(a));
+        } else if (a == "--skip-frames") {
+            skip = parse_int(a, args.value(a), 0, 100000000);
+        } else if (a == "--k") {
+            lo.quaternion.k = parse_positive(a, args.value(a));
+        } else if (a == "--euler-k") {
+            lo.euler.k = parse_positive(a, args.value(a));
+        } else if (a == "--smooth-hz") {
+            filter.smooth_cutoff_hz = parse_double(a, args.value(a));
+            if (filter.smooth_cutoff_hz < 0.0)
+                throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
+        } else if (a == "--despike-deg") {
+            filter.spike_threshold_rad = parse_double(a, args.value(a)) * M_PI / 180.0;
+            if (filter.spike_threshold_rad < 0.0)
+                throw UsageError("--despike-deg: expected a number >= 0 (0: off)");
+        } else if (!a.empty() && a[0] == '-' && a != "-") {
+            throw UsageError("limits: unknown option '" + a + "' (see ictusd limits --help)");
+        } else if (file.empty()) {
+            file = a;
+        } else {
+            throw UsageError("limits: one FILE expected, got also '" + a + "'");
+        }
+    }
+    if (file.empty())
+        throw UsageError("limits: FILE is required (ictusd limits FILE)");
+    const ictus::BvhFile bvh = load_bvh(file, scale, skip);
+    const ictus::CharacterModel model = ictus::CharacterModel::from_skeleton(bvh.skeleton);
+    const ictus::ReferenceMotion reference(model, bvh.motion, filter);
+    std::vector<std::string> names;
+    std::vector<std::vector<Eigen::Quaterniond>> series;
+    character_series(reference, model, names, series);
+    const std::vector<ictus::JointLimit> limits = ictus::learn_limits(names, series, lo);
+    nlohmann::json report = ictus::limits_report(limits, lo);
+    report["mocap"] = file;
+    if (out == "-") {
+        std::cout << report.dump(2) << "\n";
+        return 0;
+    }
+    ictus::print_limits(std::cout, limits);
+    std::ofstream js(out);
+    js << report.dump(2) << "\n";
+    if (!js)
+        throw std::runtime_error("--out: cannot write '" + out + "'");
+    std::cout << "wrote " << out << "\n";
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+    std::signal(SIGINT, on_sigint);
+    Args args;
+    for (int i = 1; i < argc; ++i)
+        args.items.emplace_back(argv[i]);
+    if (args.done()) {
+        usage(std::cerr);
+        return 2;
+    }
+    const std::string verb = args.next();
+    try {
+        if (verb == "--help" || verb == "-h" || verb == "help") {
+            usage(std::cout);
+            return 0;
+        }
+        if (verb == "track")
+            return run_track(args);
+        if (verb == "limits")
+            return run_limits(args);
+        throw UsageError("unknown verb '" + verb + "' (verbs: track, limits; see ictusd --help)");
+    } catch (const UsageError &e) {
+        std::cerr << "ictusd: " << e.what() << "\n";
+        return 2;
+    } catch (const ictus::MocapError &e) {
+        std::cerr << "ictusd: " << e.what() << "\n";
+        return 1;
+    } catch (const ictus::CharacterError &e) {
+        std::cerr << "ictusd: " << e.what() << "\n";
+        return 1;
+    } catch (const std::exception &e) {
+        std::cerr << "ictusd: " << e.what() << "\n";
+        return 1;
+    }
+}

@@ -1,0 +1,99 @@
+// Joint-space PD (eq. 1) as ODE motor rows; default gains and torque limits.
+#include "ictus/joint_controller.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+namespace ictus
+{
+
+Eigen::Vector3d rotation_vector(const Eigen::Quaterniond &q_in)
+{
+    Eigen::Quaterniond q = q_in;
+    if (q.w() < 0.0)
+        q.coeffs() = -q.coeffs();
+    const double s = q.vec().norm();
+    if (s < 1e-12)
+        return 2.0 * q.vec(); // first order: angle ~ 2 |v|
+    const double angle = 2.0 * std::atan2(s, q.w());
+    return q.vec() * (angle / s);
+}
+
+namespace
+{
+struct TorqueRow {
+    const char *suffix; // joint name without the l_/r_ prefix
+    double nm;          // per axis, for a 70 kg adult
+};
+// Order-of-magnitude maximal voluntary isometric torques of an adult, rounded:
+// a lumbar spine holds the whole upper body, a wrist only a hand and a stick.
+// The clavicle is the exception: a short, light segment between thorax and
+// arm, it must react whatever the shoulder applies plus the arm's weight, so
+// its limit exceeds the shoulder's (at 60 N m it saturated a third of the
+// time on the CMU clip, limiting the arm).
+const TorqueRow kTorque[] = {
+    {"lumbar", 250.0}, {"thorax", 250.0},   {"neck", 40.0},     {"upper_neck", 30.0},
+    {"head", 20.0},    {"clavicle", 120.0}, {"shoulder", 90.0}, {"elbow", 70.0},
+    {"wrist", 15.0},   {"hip", 200.0},      {"knee", 200.0},    {"ankle", 150.0},
+};
+} // namespace
+
+double default_torque_limit_nm(const std::string &joint_name, double body_mass_kg)
+{
+    std::string base = joint_name;
+    if (base.rfind("l_", 0) == 0 || base.rfind("r_", 0) == 0)
+        base = base.substr(2);
+    for (const TorqueRow &row : kTorque)
+        if (base == row.suffix)
+            return row.nm * body_mass_kg / 70.0;
+    throw CharacterError("torque limit: unknown joint '" + joint_name + "'");
+}
+
+std::vector<JointGains> default_gains(const CharacterModel &model, const CharacterPose &pose,
+                                      const GainOptions &options)
+{
+    auto bad = [](const char *what, double v) {
+        std::ostringstream s;
+        s << what << ": expected a finite value > 0, got " << v;
+        return CharacterError(s.str());
+    };
+    if (!(std::isfinite(options.natural_frequency_hz) && options.natural_frequency_hz > 0.0))
+        throw bad("gain natural frequency (Hz)", options.natural_frequency_hz);
+    if (!(std::isfinite(options.damping_ratio) && options.damping_ratio > 0.0))
+        throw bad("damping ratio", options.damping_ratio);
+    if (!(std::isfinite(options.torque_scale) && options.torque_scale > 0.0))
+        throw bad("torque scale", options.torque_scale);
+    const double w = 2.0 * M_PI * options.natural_frequency_hz;
+    std::vector<JointGains> gains(CharacterModel::kJoints);
+    for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        const double inertia = model.subtree_inertia(j, pose).inertia_kg_m2;
+        gains[j].kp_nm_per_rad = inertia * w * w;
+        gains[j].kd_nm_s_per_rad = 2.0 * options.damping_ratio * inertia * w;
+        gains[j].torque_limit_nm =
+            options.torque_scale *
+            default_torque_limit_nm(model.joint_name(j), model.options().body_mass_kg);
+    }
+    return gains;
+}
+
+MotorCommand pd_motor_command(const Eigen::Quaterniond &parent_world,
+                              const Eigen::Quaterniond &child_world,
+                              const Eigen::Quaterniond &target_local,
+                              const Eigen::Vector3d &target_rate_parent, const JointGains &gains,
+                              bool rate_feedforward)
+{
+    MotorCommand cmd;
+    const Eigen::Quaterniond current_local = parent_world.conjugate() * child_world;
+    // The error rotation acts on the left (parent frame): q_T = q_e q_S.
+    cmd.error_parent = rotation_vector(target_local * current_local.conjugate());
+    Eigen::Vector3d rate = (gains.kp_nm_per_rad / gains.kd_nm_s_per_rad) * cmd.error_parent;
+    if (rate_feedforward)
+        rate += target_rate_parent;
+    cmd.velocity_world = parent_world * rate;
+    cmd.cfm = 1.0 / gains.kd_nm_s_per_rad;
+    cmd.fmax = gains.torque_limit_nm;
+    return cmd;
+}
+
+} // namespace ictus

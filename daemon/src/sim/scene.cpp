@@ -1,0 +1,547 @@
+// The ODE scene: one owner for the world, space, contact group and bodies.
+#include "ictus/scene.hpp"
+
+#include <ode/ode.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace ictus
+{
+
+namespace
+{
+
+// dInitODE2 once per process, dCloseODE at exit (a function-local static is
+// initialised once, thread-safely, and destroyed after main returns).
+struct OdeLibrary {
+    OdeLibrary() { dInitODE2(0); }
+    ~OdeLibrary() { dCloseODE(); }
+};
+void ensure_ode()
+{
+    static OdeLibrary library;
+    // Collision needs per-thread data; idempotent for a thread that has it.
+    dAllocateODEDataForThread(dAllocateMaskAll);
+}
+
+constexpr unsigned long kDrumCategory = 1u;
+constexpr unsigned long kStickCategory = 2u;
+
+Eigen::Quaterniond to_eigen(const dReal *q)
+{
+    return Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+}
+void to_ode(const Eigen::Quaterniond &q, dQuaternion out)
+{
+    out[0] = q.w();
+    out[1] = q.x();
+    out[2] = q.y();
+    out[3] = q.z();
+}
+Eigen::Vector3d to_eigen3(const dReal *v)
+{
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+// A rotation taking ODE's local z axis (capsules, cylinders) onto `axis`.
+Eigen::Quaterniond z_onto(const Eigen::Vector3d &axis)
+{
+    return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis.normalized());
+}
+
+void set_rotation(dGeomID geom, const Eigen::Quaterniond &q, bool offset)
+{
+    const Eigen::Matrix3d r = q.toRotationMatrix();
+    dMatrix3 m;
+    for (int i = 0; i < 3; ++i) {
+        for (int k = 0; k < 3; ++k)
+            m[i * 4 + k] = r(i, k);
+        m[i * 4 + 3] = 0.0;
+    }
+    if (offset)
+        dGeomSetOffsetRotation(geom, m);
+    else
+        dGeomSetRotation(geom, m);
+}
+
+void check_finite_positive(const char *what, double v, double max = 1e300)
+{
+    if (!(std::isfinite(v) && v > 0.0 && v <= max)) {
+        std::ostringstream s;
+        s << what << ": expected a finite value in (0, " << max << "], got " << v;
+        throw CharacterError(s.str());
+    }
+}
+
+} // namespace
+
+double DrumParams::stiffness_n_per_m(double tip_radius_m) const
+{
+    return 2.0 * M_PI * tension_n_per_m / std::log(radius_m / tip_radius_m);
+}
+
+void validate(const SceneOptions &o)
+{
+    check_finite_positive("physics step (s)", o.step_s, 0.05);
+    if (o.quickstep_iterations < 1 || o.quickstep_iterations > 1000)
+        throw CharacterError("QuickStep iterations: expected 1..1000, got " +
+                             std::to_string(o.quickstep_iterations));
+    if (!(std::isfinite(o.gravity_mps2) && o.gravity_mps2 >= 0.0))
+        throw CharacterError("gravity: expected a finite value >= 0");
+    check_finite_positive("drum radius (m)", o.drum.radius_m, 5.0);
+    check_finite_positive("drum shell depth (m)", o.drum.shell_depth_m, 5.0);
+    check_finite_positive("drum tension (N/m)", o.drum.tension_n_per_m, 1e7);
+    if (!(std::isfinite(o.drum.contact_damping_n_s_per_m) &&
+          o.drum.contact_damping_n_s_per_m >= 0.0))
+        throw CharacterError("drum contact damping: expected a finite value >= 0");
+    if (!(std::isfinite(o.drum.friction) && o.drum.friction >= 0.0))
+        throw CharacterError("drum friction: expected a finite value >= 0");
+    if (!o.drum.center_m.allFinite())
+        throw CharacterError("drum position: expected finite coordinates");
+    check_finite_positive("divergence speed bound (m/s)", o.max_linear_speed_mps);
+    check_finite_positive("divergence angular speed bound (rad/s)", o.max_angular_speed_rad_s);
+    check_finite_positive("divergence joint separation bound (m)", o.max_joint_separation_m);
+    if (!(std::isfinite(o.stop_margin_rad) && o.stop_margin_rad >= 0.0))
+        throw CharacterError("limit stop margin: expected a finite value >= 0");
+}
+
+Scene::Scene(const CharacterModel &model, const SceneOptions &options, const CharacterPose &initial,
+             const std::vector<JointGains> &gains)
+    : model_(model), options_(options)
+{
+    validate(options_);
+    if (initial.local.size() != static_cast<size_t>(CharacterModel::kJoints))
+        throw CharacterError("scene: initial pose must have 19 joint rotations");
+    if (options_.drum.radius_m <= model_.options().stick.tip_radius_m)
+        throw CharacterError("drum radius: must exceed the stick tip radius");
+    set_gains(gains);
+    ensure_ode();
+    target_ = initial.local;
+    target_rate_.assign(CharacterModel::kJoints, Eigen::Vector3d::Zero());
+    motor_axes_world_.fill(false);
+    build(initial);
+}
+
+Scene::~Scene()
+{
+    // Joints and bodies belong to the world, geoms to the space.
+    if (contacts_)
+        dJointGroupDestroy(contacts_);
+    if (space_)
+        dSpaceDestroy(space_);
+    if (world_)
+        dWorldDestroy(world_);
+}
+
+void Scene::set_gains(const std::vector<JointGains> &gains)
+{
+    if (gains.size() != static_cast<size_t>(CharacterModel::kJoints))
+        throw CharacterError("gains: expected 19 joints, got " + std::to_string(gains.size()));
+    for (size_t j = 0; j < gains.size(); ++j) {
+        const std::string name = "gains of joint '" + model_.joint_name(static_cast<int>(j)) + "'";
+        check_finite_positive((name + ": k_s").c_str(), gains[j].kp_nm_per_rad);
+        check_finite_positive((name + ": k_d").c_str(), gains[j].kd_nm_s_per_rad);
+        check_finite_positive((name + ": torque limit").c_str(), gains[j].torque_limit_nm);
+    }
+    gains_ = gains;
+}
+
+void Scene::set_joint_limits(const std::vector<JointLimitRef> &limits)
+{
+    if (!limits.empty() && limits.size() != static_cast<size_t>(CharacterModel::kJoints))
+        throw CharacterError("joint limits: expected 19 joints, got " +
+                             std::to_string(limits.size()));
+    limits_ = limits;
+}
+
+void Scene::set_joint_targets(const std::vector<Eigen::Quaterniond> &local,
+                              const std::vector<Eigen::Vector3d> &rate_parent)
+{
+    const size_t n = CharacterModel::kJoints;
+    if (local.size() != n || rate_parent.size() != n)
+        throw CharacterError("joint targets: expected 19 rotations and 19 rates");
+    for (size_t j = 0; j < n; ++j) {
+        Eigen::Quaterniond q = local[j];
+        if (!q.coeffs().allFinite() || q.norm() < 1e-9 || !rate_parent[j].allFinite())
+            throw CharacterError("joint targets: non-finite target for joint '" +
+                                 model_.joint_name(static_cast<int>(j)) + "'");
+        q.normalize();
+        if (!limits_.empty() && limits_[j].active())
+            q = limits_[j].clamp(q).normalized();
+        target_[j] = q;
+        target_rate_[j] = rate_parent[j];
+    }
+}
+
+void Scene::build(const CharacterPose &initial)
+{
+    world_ = dWorldCreate();
+    dWorldSetGravity(world_, 0.0, -options_.gravity_mps2, 0.0); // y up, as the mocap
+    dWorldSetQuickStepNumIterations(world_, options_.quickstep_iterations);
+    dWorldSetERP(world_, 0.2);
+    dWorldSetCFM(world_, 1e-9);
+    space_ = dSimpleSpaceCreate(nullptr); // a handful of geoms: brute force is cheapest
+    contacts_ = dJointGroupCreate(0);
+
+    BodyFrames frames;
+    model_.forward(initial, frames);
+    for (int b = 0; b < CharacterModel::kBodies; ++b) {
+        double m;
+        Eigen::Vector3d c;
+        Eigen::Matrix3d inertia;
+        model_.merged_mass(b, m, c, inertia);
+        com_local_[b] = c;
+        dBodyID body = dBodyCreate(world_);
+        dMass mass;
+        // ODE wants the CoM at the body origin: the inertia is about c, in the
+        // body (joint) frame, and the body is placed at the world CoM.
+        dMassSetParameters(&mass, m, 0, 0, 0, inertia(0, 0), inertia(1, 1), inertia(2, 2),
+                           inertia(0, 1), inertia(0, 2), inertia(1, 2));
+        dBodySetMass(body, &mass);
+        const Eigen::Vector3d p = frames.origin_m[b] + frames.rotation[b] * c;
+        dBodySetPosition(body, p.x(), p.y(), p.z());
+        dQuaternion q;
+        to_ode(frames.rotation[b], q);
+        dBodySetQuaternion(body, q);
+        body_[b] = body;
+    }
+    pelvis_weld_ = dJointCreateFixed(world_, nullptr);
+    dJointAttach(pelvis_weld_, body_[0], nullptr);
+    dJointSetFixed(pelvis_weld_);
+
+    for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        const int child = j + 1;
+        const int parent = model_.bodies()[child].parent;
+        const Eigen::Vector3d anchor = frames.origin_m[child];
+        ball_[j] = dJointCreateBall(world_, nullptr);
+        dJointAttach(ball_[j], body_[child], body_[parent]);
+        dJointSetBallAnchor(ball_[j], anchor.x(), anchor.y(), anchor.z());
+        // Eq. 1 motor: body 1 = child so that the rows act on w_child - w_parent.
+        motor_[j] = dJointCreateAMotor(world_, nullptr);
+        dJointAttach(motor_[j], body_[child], body_[parent]);
+        dJointSetAMotorMode(motor_[j], dAMotorUser);
+        dJointSetAMotorNumAxes(motor_[j], 3);
+        static_assert(sizeof(Feedback) == sizeof(dJointFeedback), "feedback layout");
+        dJointSetFeedback(motor_[j], reinterpret_cast<dJointFeedback *>(&feedback_[j]));
+    }
+
+    // Sticks: geometry on the hand bodies (mass already merged into them).
+    const StickParams &sp = model_.options().stick;
+    for (int side = 0; side < 2; ++side) {
+        const int hb = model_.hand_body(static_cast<Side>(side));
+        const StickInHand &st = model_.stick(static_cast<Side>(side));
+        const double tip_r = sp.tip_radius_m;
+        const Eigen::Vector3d tip_centre = st.tip_m - tip_r * st.axis;
+        const double shaft_len =
+            std::max((tip_centre - st.butt_m).norm() - 2.0 * sp.shaft_radius_m, 1e-3);
+        stick_shaft_[side] = dCreateCapsule(space_, sp.shaft_radius_m, shaft_len);
+        stick_tip_[side] = dCreateSphere(space_, tip_r);
+        for (dGeomID g : {stick_shaft_[side], stick_tip_[side]}) {
+            dGeomSetBody(g, body_[hb]);
+            dGeomSetCategoryBits(g, kStickCategory);
+            dGeomSetCollideBits(g, kDrumCategory);
+        }
+        const Eigen::Vector3d shaft_mid = 0.5 * (st.butt_m + tip_centre) - com_local_[hb];
+        dGeomSetOffsetPosition(stick_shaft_[side], shaft_mid.x(), shaft_mid.y(), shaft_mid.z());
+        set_rotation(stick_shaft_[side], z_onto(st.axis), true);
+        const Eigen::Vector3d tip_off = tip_centre - com_local_[hb];
+        dGeomSetOffsetPosition(stick_tip_[side], tip_off.x(), tip_off.y(), tip_off.z());
+    }
+
+    // Drum: a static cylinder whose top face is the membrane.
+    const DrumParams &drum = options_.drum;
+    drum_ = dCreateCylinder(space_, drum.radius_m, drum.shell_depth_m);
+    const Eigen::Vector3d c = drum.center_m - Eigen::Vector3d(0, 0.5 * drum.shell_depth_m, 0);
+    dGeomSetPosition(drum_, c.x(), c.y(), c.z());
+    set_rotation(drum_, z_onto(Eigen::Vector3d::UnitY()), false);
+    dGeomSetCategoryBits(drum_, kDrumCategory);
+    dGeomSetCollideBits(drum_, kStickCategory);
+
+    // Soft contact from the membrane's spring-damper (ODE manual: ERP = h k /
+    // (h k + c), CFM = 1 / (h k + c)).
+    const double h = options_.step_s;
+    const double k = drum.stiffness_n_per_m(sp.tip_radius_m);
+    const double cd = drum.contact_damping_n_s_per_m;
+    contact_erp_ = h * k / (h * k + cd);
+    contact_cfm_ = 1.0 / (h * k + cd);
+}
+
+void Scene::near_callback(void *data, dGeomID a, dGeomID b)
+{
+    Scene *self = static_cast<Scene *>(data);
+    constexpr int kMax = 4;
+    dContactGeom geoms[kMax];
+    const int n = dCollide(a, b, kMax, geoms, sizeof(dContactGeom));
+    for (int i = 0; i < n; ++i) {
+        dContact contact;
+        contact.geom = geoms[i];
+        contact.surface.mode = dContactSoftERP | dContactSoftCFM | dContactApprox1;
+        contact.surface.mu = self->options_.drum.friction;
+        contact.surface.soft_erp = self->contact_erp_;
+        contact.surface.soft_cfm = self->contact_cfm_;
+        dJointID joint = dJointCreateContact(self->world_, self->contacts_, &contact);
+        dJointAttach(joint, dGeomGetBody(a), dGeomGetBody(b));
+    }
+    self->contacts_last_step_ += n;
+}
+
+void Scene::apply_control()
+{
+    stops_active_ = 0;
+    for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        const int child = j + 1;
+        const int parent = model_.bodies()[child].parent;
+        const Eigen::Quaterniond qp = to_eigen(dBodyGetQuaternion(body_[parent]));
+        const Eigen::Quaterniond qc = to_eigen(dBodyGetQuaternion(body_[child]));
+        const MotorCommand cmd = pd_motor_command(qp, qc, target_[j], target_rate_[j], gains_[j],
+                                                  options_.rate_feedforward);
+        dJointID m = motor_[j];
+
+        // Safety net: a joint outside its limit region by more than the
+        // margin meets a one-sided stop along the direction of the violation.
+        bool stop = false;
+        double violation = 0.0;
+        Eigen::Vector3d stop_axis = Eigen::Vector3d::UnitX();
+        if (options_.limit_stops && !limits_.empty() && limits_[j].active()) {
+            const Eigen::Quaterniond current = qp.conjugate() * qc;
+            const Eigen::Quaterniond inside = limits_[j].clamp(current);
+            const Eigen::Vector3d v = rotation_vector(current * inside.conjugate());
+            violation = v.norm();
+            if (violation > options_.stop_margin_rad) {
+                stop = true;
+                stop_axis = (qp * v).normalized();
+            }
+        }
+        Eigen::Vector3d axes[3];
+        if (stop) {
+            axes[0] = stop_axis;
+            axes[1] = stop_axis.unitOrthogonal();
+            axes[2] = axes[0].cross(axes[1]);
+            for (int i = 0; i < 3; ++i)
+                dJointSetAMotorAxis(m, i, 0, axes[i].x(), axes[i].y(), axes[i].z());
+            motor_axes_world_[j] = false;
+            ++stops_active_;
+        } else {
+            for (int i = 0; i < 3; ++i)
+                axes[i] = Eigen::Vector3d::Unit(i);
+            if (!motor_axes_world_[j]) {
+                for (int i = 0; i < 3; ++i)
+                    dJointSetAMotorAxis(m, i, 0, axes[i].x(), axes[i].y(), axes[i].z());
+                motor_axes_world_[j] = true;
+            }
+        }
+        for (int i = 0; i < 3; ++i)
+            motor_axes_[j][i] = axes[i];
+        static const int kVel[3] = {dParamVel1, dParamVel2, dParamVel3};
+        static const int kFMax[3] = {dParamFMax1, dParamFMax2, dParamFMax3};
+        static const int kCfm[3] = {dParamCFM1, dParamCFM2, dParamCFM3};
+        for (int i = 0; i < 3; ++i) {
+            dJointSetAMotorParam(m, kVel[i], cmd.velocity_world.dot(axes[i]));
+            dJointSetAMotorParam(m, kCfm[i], cmd.cfm);
+            // On a stopped axis only the stop acts: ODE would otherwise push
+            // with the full motor force as an explicit torque.
+            dJointSetAMotorParam(m, kFMax[i], (stop && i == 0) ? 0.0 : cmd.fmax);
+        }
+        if (stop) {
+            dJointSetAMotorAngle(m, 0, violation);
+            dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
+            dJointSetAMotorParam(m, dParamHiStop1, options_.stop_margin_rad);
+        } else {
+            dJointSetAMotorParam(m, dParamHiStop1, dInfinity);
+            dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
+        }
+    }
+}
+
+bool Scene::check() const
+{
+    for (int b = 0; b < CharacterModel::kBodies; ++b) {
+        const Eigen::Vector3d p = to_eigen3(dBodyGetPosition(body_[b]));
+        const Eigen::Vector3d v = to_eigen3(dBodyGetLinearVel(body_[b]));
+        const Eigen::Vector3d w = to_eigen3(dBodyGetAngularVel(body_[b]));
+        const Eigen::Quaterniond q = to_eigen(dBodyGetQuaternion(body_[b]));
+        if (!p.allFinite() || !v.allFinite() || !w.allFinite() || !q.coeffs().allFinite())
+            return false;
+        if (v.norm() > options_.max_linear_speed_mps || w.norm() > options_.max_angular_speed_rad_s)
+            return false;
+    }
+    for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        dVector3 a1, a2;
+        dJointGetBallAnchor(ball_[j], a1);
+        dJointGetBallAnchor2(ball_[j], a2);
+        const double d =
+            std::sqrt((a1[0] - a2[0]) * (a1[0] - a2[0]) + (a1[1] - a2[1]) * (a1[1] - a2[1]) +
+                      (a1[2] - a2[2]) * (a1[2] - a2[2]));
+        if (!(d <= options_.max_joint_separation_m))
+            return false;
+    }
+    return true;
+}
+
+StepResult Scene::step(StepTiming *timing)
+{
+    using clock = std::chrono::steady_clock;
+    clock::time_point t0, t1, t2, t3, t4;
+    if (timing)
+        t0 = clock::now();
+    apply_control();
+    if (timing)
+        t1 = clock::now();
+    contacts_last_step_ = 0;
+    dSpaceCollide(space_, this, &Scene::near_callback);
+    if (contacts_last_step_ > 0)
+        ++contact_steps_;
+    if (timing)
+        t2 = clock::now();
+    if (options_.stepper == Stepper::quick)
+        dWorldQuickStep(world_, options_.step_s);
+    else
+        dWorldStep(world_, options_.step_s);
+    dJointGroupEmpty(contacts_);
+    if (timing)
+        t3 = clock::now();
+    const bool ok = check();
+    if (timing) {
+        t4 = clock::now();
+        auto s = [](clock::time_point a, clock::time_point b) {
+            return std::chrono::duration<double>(b - a).count();
+        };
+        timing->control_s = s(t0, t1);
+        timing->collide_s = s(t1, t2);
+        timing->solve_s = s(t2, t3);
+        timing->check_s = s(t3, t4);
+    }
+    time_s_ += options_.step_s;
+    ++steps_;
+    if (ok)
+        return StepResult::ok;
+    ++divergences_;
+    reset(target_pose());
+    return StepResult::diverged;
+}
+
+CharacterPose Scene::target_pose() const
+{
+    CharacterPose pose;
+    const Eigen::Quaterniond q = to_eigen(dBodyGetQuaternion(body_[0]));
+    const Eigen::Vector3d c = to_eigen3(dBodyGetPosition(body_[0]));
+    pose.pelvis_rotation = q;
+    pose.pelvis_position_m = c - q * com_local_[0];
+    pose.local = target_;
+    return pose;
+}
+
+void Scene::reset(const CharacterPose &pose_in)
+{
+    if (pose_in.local.size() != static_cast<size_t>(CharacterModel::kJoints))
+        throw CharacterError("scene reset: pose must have 19 joint rotations");
+    CharacterPose pose = pose_in;
+    // The pelvis stays where it is welded.
+    const Eigen::Quaterniond q0 = to_eigen(dBodyGetQuaternion(body_[0]));
+    const Eigen::Vector3d c0 = to_eigen3(dBodyGetPosition(body_[0]));
+    pose.pelvis_rotation = q0.coeffs().allFinite() ? q0 : Eigen::Quaterniond::Identity();
+    pose.pelvis_position_m =
+        c0.allFinite() ? Eigen::Vector3d(c0 - q0 * com_local_[0]) : Eigen::Vector3d::Zero();
+    for (auto &q : pose.local)
+        q.normalize();
+    BodyFrames frames;
+    model_.forward(pose, frames);
+    for (int b = 0; b < CharacterModel::kBodies; ++b) {
+        const Eigen::Vector3d p = frames.origin_m[b] + frames.rotation[b] * com_local_[b];
+        dBodySetPosition(body_[b], p.x(), p.y(), p.z());
+        dQuaternion q;
+        to_ode(frames.rotation[b], q);
+        dBodySetQuaternion(body_[b], q);
+        dBodySetLinearVel(body_[b], 0, 0, 0);
+        dBodySetAngularVel(body_[b], 0, 0, 0);
+        dBodySetForce(body_[b], 0, 0, 0);
+        dBodySetTorque(body_[b], 0, 0, 0);
+    }
+    dJointGroupEmpty(contacts_);
+}
+
+void Scene::body_frames(BodyFrames &frames) const
+{
+    frames.origin_m.resize(CharacterModel::kBodies);
+    frames.rotation.resize(CharacterModel::kBodies);
+    for (int b = 0; b < CharacterModel::kBodies; ++b) {
+        const Eigen::Quaterniond q = to_eigen(dBodyGetQuaternion(body_[b]));
+        frames.rotation[b] = q;
+        frames.origin_m[b] = to_eigen3(dBodyGetPosition(body_[b])) - q * com_local_[b];
+    }
+}
+
+void Scene::local_rotations(std::vector<Eigen::Quaterniond> &local) const
+{
+    local.resize(CharacterModel::kJoints);
+    for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        const int child = j + 1;
+        const int parent = model_.bodies()[child].parent;
+        local[j] = to_eigen(dBodyGetQuaternion(body_[parent])).conjugate() *
+                   to_eigen(dBodyGetQuaternion(body_[child]));
+    }
+}
+
+Eigen::Vector3d Scene::tip_position(Side side) const
+{
+    const int hb = model_.hand_body(side);
+    const Eigen::Vector3d rel = model_.stick(side).tip_m - com_local_[hb];
+    dVector3 out;
+    dBodyGetRelPointPos(body_[hb], rel.x(), rel.y(), rel.z(), out);
+    return to_eigen3(out);
+}
+
+Eigen::Vector3d Scene::motor_torque(int joint) const
+{
+    return to_eigen3(feedback_.at(joint).t1);
+}
+
+bool Scene::motor_saturated(int joint) const
+{
+    const Eigen::Vector3d t = motor_torque(joint);
+    const double limit = gains_[joint].torque_limit_nm;
+    for (int i = 0; i < 3; ++i)
+        if (std::fabs(t.dot(motor_axes_[joint][i])) >= 0.999 * limit)
+            return true;
+    return false;
+}
+
+Eigen::Vector3d Scene::tip_velocity(Side side) const
+{
+    const int hb = model_.hand_body(side);
+    const Eigen::Vector3d rel = model_.stick(side).tip_m - com_local_[hb];
+    dVector3 out;
+    dBodyGetRelPointVel(body_[hb], rel.x(), rel.y(), rel.z(), out);
+    return to_eigen3(out);
+}
+
+double Scene::max_linear_speed_mps() const
+{
+    double m = 0.0;
+    for (dBodyID b : body_)
+        m = std::max(m, to_eigen3(dBodyGetLinearVel(b)).norm());
+    return m;
+}
+
+double Scene::max_angular_speed_rad_s() const
+{
+    double m = 0.0;
+    for (dBodyID b : body_)
+        m = std::max(m, to_eigen3(dBodyGetAngularVel(b)).norm());
+    return m;
+}
+
+void Scene::kick(int body, const Eigen::Vector3d &dv, const Eigen::Vector3d &dw)
+{
+    if (body < 0 || body >= CharacterModel::kBodies)
+        throw CharacterError("kick: no body " + std::to_string(body));
+    const Eigen::Vector3d v = to_eigen3(dBodyGetLinearVel(body_[body])) + dv;
+    const Eigen::Vector3d w = to_eigen3(dBodyGetAngularVel(body_[body])) + dw;
+    dBodySetLinearVel(body_[body], v.x(), v.y(), v.z());
+    dBodySetAngularVel(body_[body], w.x(), w.y(), w.z());
+}
+
+} // namespace ictus
