@@ -40,15 +40,19 @@ typedef struct impulse_shape {
 
 struct membrane {
     double sample_rate, radius, tension, density, t60, hf_damping, output_gain;
-    int modes;    /* requested mode count */
-    int count;    /* modes rounded up to MEMBRANE_PAD: the kernel's loop length */
-    int capacity; /* floats allocated per array */
+    double gain_smoothed; /* output gain as applied, follows output_gain in ~5 ms */
+    int modes;            /* requested mode count */
+    int count;            /* modes rounded up to MEMBRANE_PAD: the kernel's loop length */
+    int capacity;         /* floats allocated per array */
     /* Mode table (double), capacity entries; entries >= modes are padding. */
     double *mode_j, *mode_norm, *omega_model;
     int *mode_m, *mode_n, *mode_sin;
     /* SoA float state and coefficients (see membrane_kernel.inc). */
     float *q, *p, *c1, *c2, *c3, *eq, *ep, *dm;
     float *psi_strike, *psi_pick[MEMBRANE_PICKUPS];
+    /* A moved pickup crossfades from its old shapes over a few ms (no click). */
+    float *psi_pick_old[MEMBRANE_PICKUPS];
+    int pick_fade_left[MEMBRANE_PICKUPS], pick_fade_len;
     double mass_scale; /* 1 / sqrt(density * radius^2) */
     double strike_r, strike_theta;
     double pick_r[MEMBRANE_PICKUPS], pick_theta[MEMBRANE_PICKUPS];
@@ -228,9 +232,9 @@ static ictus_status build_modes(membrane *m, int modes)
         int *mm = malloc(sizeof(int) * (size_t)cap);
         int *mn = malloc(sizeof(int) * (size_t)cap);
         int *ms = malloc(sizeof(int) * (size_t)cap);
-        float *arrays[12];
+        float *arrays[13];
         int ok = mj && mnorm && om && mm && mn && ms;
-        for (int i = 0; i < 12; i++) {
+        for (int i = 0; i < 13; i++) {
             arrays[i] = alloc_floats(cap);
             ok = ok && arrays[i];
         }
@@ -251,7 +255,7 @@ static ictus_status build_modes(membrane *m, int modes)
         if (!ok) {
             free(zeros);
             free(mj), free(mnorm), free(om), free(mm), free(mn), free(ms);
-            for (int i = 0; i < 12; i++)
+            for (int i = 0; i < 13; i++)
                 free(arrays[i]);
             for (int i = 0; i < IMPULSE_CACHE; i++)
                 free(impulse[i]);
@@ -285,8 +289,11 @@ static ictus_status build_modes(membrane *m, int modes)
         free(m->mode_m), free(m->mode_n), free(m->mode_sin);
         free(m->q), free(m->p), free(m->c1), free(m->c2), free(m->c3);
         free(m->eq), free(m->ep), free(m->dm), free(m->psi_strike);
-        for (int i = 0; i < MEMBRANE_PICKUPS; i++)
+        for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
             free(m->psi_pick[i]);
+            free(m->psi_pick_old[i]);
+            m->pick_fade_left[i] = 0;
+        }
         m->mode_j = mj, m->mode_norm = mnorm, m->omega_model = om;
         m->mode_m = mm, m->mode_n = mn, m->mode_sin = ms;
         m->q = arrays[0], m->p = arrays[1], m->c1 = arrays[2], m->c2 = arrays[3];
@@ -294,7 +301,8 @@ static ictus_status build_modes(membrane *m, int modes)
         m->psi_strike = arrays[8];
         m->psi_pick[0] = arrays[9];
         m->psi_pick[1] = arrays[10];
-        free(arrays[11]);
+        m->psi_pick_old[0] = arrays[11];
+        m->psi_pick_old[1] = arrays[12];
         for (int i = 0; i < IMPULSE_CACHE; i++) {
             free(m->impulse_cache[i].psi);
             m->impulse_cache[i].psi = impulse[i];
@@ -394,6 +402,7 @@ membrane *membrane_new(double sample_rate_hz)
     m->t60 = MEMBRANE_DEFAULT_T60;
     m->hf_damping = MEMBRANE_DEFAULT_HF;
     m->output_gain = MEMBRANE_DEFAULT_GAIN;
+    m->gain_smoothed = MEMBRANE_DEFAULT_GAIN;
     m->strike_r = 0.3;
     m->pick_r[0] = 0.5;
     m->pick_r[1] = 0.5;
@@ -421,8 +430,10 @@ void membrane_free(membrane *m)
     free(m->mode_m), free(m->mode_n), free(m->mode_sin);
     free(m->q), free(m->p), free(m->c1), free(m->c2), free(m->c3);
     free(m->eq), free(m->ep), free(m->dm), free(m->psi_strike);
-    for (int i = 0; i < MEMBRANE_PICKUPS; i++)
+    for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
         free(m->psi_pick[i]);
+        free(m->psi_pick_old[i]);
+    }
     for (int i = 0; i < IMPULSE_CACHE; i++)
         free(m->impulse_cache[i].psi);
     free(m);
@@ -529,7 +540,11 @@ ictus_status membrane_set_pickup(membrane *m, int index, double r_over_a, double
         return ICTUS_CLAMPED; /* no such pickup: nothing changed */
     m->pick_r[index] = r_over_a;
     m->pick_theta[index] = theta_deg;
+    memcpy(m->psi_pick_old[index], m->psi_pick[index], sizeof(float) * (size_t)m->capacity);
     membrane_mode_shapes_(m, r_over_a, theta_deg, m->psi_pick[index]);
+    /* 5 ms linear crossfade from the old point, when there is something to hear. */
+    m->pick_fade_len = (int)(0.005 * m->sample_rate) + 1;
+    m->pick_fade_left[index] = membrane_energy(m) > 0.0 ? m->pick_fade_len : 0;
     refresh_contact_couplings(m);
     return s;
 }
@@ -830,7 +845,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
     _mm_setcsr(csr | 0x8040u);
 #endif
     const double T = 1.0 / m->sample_rate;
-    const double out_scale = m->output_gain * m->mass_scale;
+    /* One-pole gain smoothing, 5 ms time constant, per sample (block-size independent). */
+    const double gain_coef = 1.0 - exp(-1.0 / (0.005 * m->sample_rate));
     membrane_kernel_args a;
     memset(&a, 0, sizeof(a));
     a.count = m->count;
@@ -915,8 +931,24 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
         }
         double y[MEMBRANE_PICKUPS];
         int finite = 1;
+        if (m->gain_smoothed != m->output_gain) {
+            m->gain_smoothed += (m->output_gain - m->gain_smoothed) * gain_coef;
+            if (fabs(m->gain_smoothed - m->output_gain) <= 1e-9 * fabs(m->output_gain))
+                m->gain_smoothed = m->output_gain;
+        }
+        const double out_scale = m->gain_smoothed * m->mass_scale;
         for (int j = 0; j < MEMBRANE_PICKUPS; j++) {
             y[j] = out_scale * (a.pick_sum[j] + extra[j]);
+            if (m->pick_fade_left[j] > 0) {
+                /* Crossfade from a moved pickup: one more dot product per sample for
+                 * 5 ms (the contact's direct term uses the new point throughout). */
+                double old = 0.0;
+                for (int k = 0; k < m->count; k++)
+                    old += (double)m->psi_pick_old[j][k] * m->p[k];
+                double w = (double)m->pick_fade_left[j] / m->pick_fade_len;
+                y[j] = (1.0 - w) * y[j] + w * out_scale * (old + extra[j]);
+                m->pick_fade_left[j]--;
+            }
             finite = finite && fabs(y[j]) <= FLT_MAX;
         }
         if (!finite) {

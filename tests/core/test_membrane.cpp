@@ -313,3 +313,64 @@ TEST_CASE("Tension change keeps physical velocity continuous", "[core][membrane]
     CHECK(membrane_velocity_at(m.get(), 0.45, 70.0) == Approx(v).epsilon(1e-5));
     CHECK(membrane_displacement_at(m.get(), 0.45, 70.0) == Approx(w).epsilon(1e-5));
 }
+
+TEST_CASE("Setters while sounding do not click", "[core][membrane]")
+{
+    // A click is a step: the largest sample-to-sample difference right after a
+    // change must stay within the range of the differences while ringing before.
+    const char *names[] = {"tension", "radius", "density", "t60",          "hf_damping",
+                           "pickup",  "modes",  "gain",    "strike_point", "sample_rate"};
+    for (int which = 0; which < 10; which++) {
+        membrane_ptr m(membrane_new(48000.0));
+        membrane_set_modes(m.get(), 40);
+        membrane_set_t60(m.get(), 3.0);
+        membrane_strike(m.get(), 0.3, 10.0, 0.01, 0);
+        std::vector<float> before = tools::render(m.get(), 4800);
+        double max_step = 0.0;
+        for (size_t i = 2400; i + 1 < before.size(); i++)
+            max_step = std::max(max_step, (double)std::fabs(before[i + 1] - before[i]));
+        switch (which) {
+        case 0:
+            membrane_set_tension(m.get(), 4000.0);
+            break;
+        case 1:
+            membrane_set_radius(m.get(), 0.16);
+            break;
+        case 2:
+            membrane_set_density(m.get(), 0.3);
+            break;
+        case 3:
+            membrane_set_t60(m.get(), 0.2);
+            break;
+        case 4:
+            membrane_set_hf_damping(m.get(), 20.0);
+            break;
+        case 5:
+            membrane_set_pickup(m.get(), 0, 0.8, 200.0);
+            break;
+        case 6:
+            membrane_set_modes(m.get(), 200);
+            break;
+        case 7:
+            membrane_set_output_gain(m.get(), 0.5);
+            break;
+        case 8:
+            membrane_set_strike_point(m.get(), 0.9, 90.0);
+            break;
+        case 9:
+            membrane_set_sample_rate(m.get(), 44100.0);
+            break;
+        }
+        std::vector<float> after = tools::render(m.get(), 480);
+        double jump = std::fabs(after[0] - before.back());
+        double after_step = jump;
+        for (size_t i = 0; i + 1 < after.size(); i++)
+            after_step = std::max(after_step, (double)std::fabs(after[i + 1] - after[i]));
+        INFO(names[which] << ": step at the change " << jump << ", largest step after "
+                          << after_step << ", largest before " << max_step);
+        // The gain ramps from the default 0.16 to 0.5: later steps may grow by that ratio.
+        const double allowed = which == 7 ? 1.5 * 0.5 / 0.16 : 1.5;
+        CHECK(jump <= 1.5 * max_step);
+        CHECK(after_step <= allowed * max_step);
+    }
+}
