@@ -33,6 +33,7 @@ typedef struct _ictus_clock {
     double c_anchor;       /* logical time (clock_getlogicaltime) of stream sample 0 */
     double c_samples_done; /* samples computed since the anchor (exact in a double) */
     double c_sr;           /* this instance's sample rate (Hz), from its dsp method */
+    double c_window;       /* samples one block spans in logical time: max(n, one tick) */
     int c_anchored;        /* 0 until the first perform after a dsp method */
 } t_ictus_clock;
 

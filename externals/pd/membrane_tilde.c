@@ -40,8 +40,11 @@ int ictus_clock_offset_now(const t_ictus_clock *c)
     offset = floor(clock_gettimesince(c->c_anchor) * c->c_sr / 1000.0 + 0.5) - c->c_samples_done;
     if (!(offset > 0))
         return 0; /* a message from the past (cannot happen from the scheduler) */
-    if (offset > 1.0e9)
-        return 1000000000;
+    /* A message always falls inside the window the next block will cover; past
+     * it, DSP has stopped since the anchor was taken (dsp 0, switch~ off): the
+     * next perform re-anchors, so the message lands at its start. */
+    if (offset >= c->c_window)
+        return 0;
     return (int)offset;
 }
 
@@ -54,6 +57,7 @@ static void ictus_clock_advance_check(t_ictus_clock *c, int n)
     double ms_per_sample = 1000.0 / c->c_sr;
     double tick_samples = (double)sys_getblksize() * c->c_sr / sys_getsr();
     double window = (n > tick_samples) ? n : tick_samples;
+    c->c_window = window;
     if (c->c_anchored) {
         /* The block about to run ends at samples_done + n; with small blocks the
          * logical time may be up to one tick later. Anything else means DSP was

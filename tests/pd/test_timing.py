@@ -57,3 +57,27 @@ for sr in (44100, 48000, 96000):
             check(len(nz) > 0 and nz[0] == expected,
                   "sr %d block %s: strike at %.4f ms -> onset sample %s, expected %d"
                   % (sr, block, d, nz[0] if len(nz) else None, expected))
+
+# A strike sent while DSP is off lands on the first sample once DSP is back on
+# (not at a time computed from the stale anchor of the earlier run). tabwrite~
+# only advances while DSP runs, so the table index counts DSP samples: DSP runs
+# 0 .. 100 ms (4800 samples at 48 kHz), stops, the strike comes at 150 ms, DSP
+# resumes at 200 ms: the onset must be at index 4800.
+sr = 48000
+p = Patch(declare="-path %s/ictus" % args.build)
+mem = p.obj("membrane~")
+wav = os.path.join(work, "timing-dsp-off.wav")
+trig = recorder(p, [(mem, 0, "t")], 0.4, sr, wav)
+for d, text in ((100.0, "\\; pd dsp 0"), (150.0, "strike 0.3 0 0.01"), (200.0, "\\; pd dsp 1")):
+    dl = p.obj("delay %g" % d)
+    m = p.msg(text)
+    p.connect(trig, 0, dl, 0)
+    p.connect(dl, 0, m, 0)
+    p.connect(m, 0, mem, 0)
+rc, log = run_pd(p.text(), args.build, sr=sr, workdir=work)
+check(rc == 0 and not error_lines(log), "pd ran cleanly (DSP off and on)")
+x, _ = read_wav_float(wav)
+nz = np.flatnonzero(x[:, 0] != 0)
+check(len(nz) > 0 and nz[0] == 4800,
+      "strike while DSP is off lands when DSP resumes: onset %s, expected 4800"
+      % (nz[0] if len(nz) else None))
