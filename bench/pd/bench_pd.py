@@ -1,0 +1,100 @@
+"""membrane~ in real Pd: nanoseconds per mode per sample, against a bank of
+vanilla [bp~] filters (one per mode), all in `pd -batch` (as fast as the CPU
+goes). For each case a patch is generated, pd runs it for S seconds of audio,
+and the wall time of an otherwise identical empty patch is subtracted:
+
+    ns per mode-sample = (t_case - t_empty) / (N * sr * S)
+
+Cases, for N = 16, 256, 1024, 4096:
+  free     one membrane~ with N modes, struck once, ringing (t60 60 s, hfdamp 0)
+  contact  the same with a contact~ hit every 5 ms (a stroke lasts ~9 ms and a
+           new hit replaces it, so the stick is in contact the whole run)
+  bp~      N [bp~] fed by one [noise~] (noise~ is in the empty patch too)
+Best (smallest) of R runs each. Usage: bench_pd.py BUILD_DIR [--runs R]"""
+import argparse
+import os
+import subprocess
+import tempfile
+import time
+
+ap = argparse.ArgumentParser()
+ap.add_argument("build")
+ap.add_argument("--runs", type=int, default=3)
+ap.add_argument("--sr", type=int, default=48000)
+ap.add_argument("--sizes", default="16,256,1024,4096")
+args = ap.parse_args()
+lib = os.path.join(os.path.abspath(args.build), "ictus")
+sr = args.sr
+work = tempfile.mkdtemp(prefix="ictus-bench-")
+
+
+def patch(seconds, body):
+    """body(lines, first_index) appends objects after the fixed header; returns text."""
+    lines = ["#N canvas 0 0 600 400 12;", "#X declare -path %s;" % lib,
+             "#X obj 10 10 loadbang;",                     # 0
+             "#X msg 10 40 \\; pd dsp 1;",                 # 1
+             "#X obj 10 70 delay %.17g;" % (seconds * 1000.0),  # 2
+             "#X msg 10 100 \\; pd quit;",                 # 3
+             "#X obj 10 130 noise~;",                      # 4
+             "#X connect 0 0 1 0;", "#X connect 0 0 2 0;", "#X connect 2 0 3 0;"]
+    body(lines, 5)
+    return "\n".join(lines) + "\n"
+
+
+def empty(lines, i):
+    pass
+
+
+def membrane(n, with_contact):
+    def body(lines, i):
+        lines.append("#X obj 200 10 membrane~ bench-drum;")  # i
+        lines.append("#X msg 200 40 modes %d \\, t60 60 \\, hfdamp 0 \\, strike 0.3 0 0.01;" % n)
+        lines.append("#X connect 0 0 %d 0;" % (i + 1))
+        lines.append("#X connect %d 0 %d 0;" % (i + 1, i))
+        if with_contact:
+            lines.append("#X obj 300 10 contact~ bench-drum;")  # i+2
+            lines.append("#X obj 300 40 metro 5;")             # i+3
+            lines.append("#X msg 300 70 hit 1 0.3 0;")         # i+4
+            lines.append("#X connect 0 0 %d 0;" % (i + 3))
+            lines.append("#X connect %d 0 %d 0;" % (i + 3, i + 4))
+            lines.append("#X connect %d 0 %d 0;" % (i + 4, i + 2))
+    return body
+
+
+def bp_bank(n):
+    def body(lines, i):
+        for k in range(n):
+            # centre frequencies spread like a membrane's partials, Q 10
+            lines.append("#X obj %d %d bp~ %g 10;" % (200 + k % 40 * 10, 10 + k // 40, 100 + 5 * k))
+            lines.append("#X connect 4 0 %d 0;" % (i + k))
+    return body
+
+
+def run(text, name):
+    path = os.path.join(work, name + ".pd")
+    with open(path, "w") as f:
+        f.write(text)
+    best = None
+    for _ in range(args.runs):
+        t0 = time.perf_counter()
+        proc = subprocess.run(["pd", "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr),
+                               "-open", path], capture_output=True, text=True, timeout=1200)
+        dt = time.perf_counter() - t0
+        if proc.returncode != 0 or "error" in proc.stderr.lower() or "couldn't" in proc.stderr:
+            raise SystemExit("%s failed:\n%s" % (name, proc.stderr))
+        best = dt if best is None else min(best, dt)
+    return best
+
+
+print("membrane~ in Pd: ns per mode per sample, sr %d Hz, best of %d runs" % (sr, args.runs))
+print("%6s %8s %10s %10s %10s" % ("N", "audio s", "free", "contact", "bp~"))
+for n in [int(s) for s in args.sizes.split(",")]:
+    # about 1e9 mode-samples per case, at least 2 s and at most 120 s of audio
+    seconds = max(2.0, min(120.0, 1.0e9 / (n * sr)))
+    t_empty = run(patch(seconds, empty), "empty-%d" % n)
+    row = []
+    for name, body in (("free", membrane(n, False)), ("contact", membrane(n, True)),
+                       ("bp", bp_bank(n))):
+        t = run(patch(seconds, body), "%s-%d" % (name, n))
+        row.append((t - t_empty) * 1e9 / (n * sr * seconds))
+    print("%6d %8.1f %10.3f %10.3f %10.3f" % (n, seconds, row[0], row[1], row[2]), flush=True)
