@@ -175,7 +175,8 @@ TEST_CASE("IK tracking a target that leaves and re-enters the workspace has no j
     const Vector3d root = frames.joint_position_m[0];
     const Vector3d ray = Vector3d(0.6, -0.3, 0.75).normalized();
     const double reach = arm::reach();
-    // Out from 0.85 reach to 0.3 m beyond reach and back, 1 m/s, at 1 kHz, with a sideways wobble.
+    // Out from 0.85 reach to 0.3 m beyond reach and back, 1 m/s, at 1 kHz, with a sideways
+    // wobble so the ray turns too.
     const double speed_mps = 1.0, dt_s = 1e-3;
     const double out_distance = reach + 0.3 - 0.85 * reach;
     const int steps = static_cast<int>(2 * out_distance / (speed_mps * dt_s));
@@ -185,33 +186,53 @@ TEST_CASE("IK tracking a target that leaves and re-enters the workspace has no j
         const double radius = 0.85 * reach + (s < out_distance ? s : 2 * out_distance - s);
         return Vector3d(root + radius * ray + 0.05 * std::sin(2 * kPi * s) * side);
     };
+    // Exact tracking is continuous but not smooth at the boundary: to reach a point a depth
+    // d inside the reach sphere from the stretch, an arm folding once (segments a = clavicle +
+    // upper arm, b = forearm + hand/stick) must bend by phi = sqrt(2 d (a + b) / (a b)).
+    // Allow the target three 1 mm steps of depth before the arm leaves the stretch (an exact
+    // stretch is a singularity it leaves only through the target's sideways motion).
+    const double a = arm::kClavicle + arm::kUpperArm;
+    const double b = arm::kForearm + std::hypot(arm::kHand, arm::kStick);
+    const double fold_bound_rad = std::sqrt(2 * 3e-3 * (a + b) / (a * b));
+
     Quaterniond out[4], before[4];
     REQUIRE(solver.solve(chain, target_at(0), out).status == IkStatus::converged);
     chain.set_rotations(out);
-    double largest_change = 0.0;
-    int unreachable_calls = 0;
+    double largest_change = 0.0, worst_off_ray = 0.0;
+    int unreachable_calls = 0, singular_calls = 0;
     for (int step = 1; step <= steps; ++step) {
         for (int j = 0; j < 4; ++j)
             before[j] = chain.rotation(j);
         const Vector3d target = target_at(step);
+        const double depth_m = reach - (target - root).norm(); // < 0: out of reach
         const IkResult r = solver.solve(chain, target, out);
         REQUIRE(all_finite(out, 4));
         REQUIRE(std::isfinite(r.position_error_m));
-        if (r.status == IkStatus::unreachable)
-            ++unreachable_calls;
-        else
-            CHECK(r.status == IkStatus::converged);
-        largest_change = std::max(largest_change, largest_joint_change(before, out, 4));
         chain.set_rotations(out);
+        INFO("step " << step << " depth " << depth_m << " status " << to_string(r.status));
+        if (depth_m < 0.0) {
+            CHECK(r.status == IkStatus::unreachable);
+            ++unreachable_calls;
+            if (depth_m < -5e-3) // clear of the boundary: stretched toward the target
+                worst_off_ray = std::max(
+                    worst_off_ray,
+                    (chain.tip_position() - (root + reach * (target - root).normalized())).norm());
+        } else if (depth_m < 3e-3) {
+            CHECK((r.status == IkStatus::converged || r.status == IkStatus::singular));
+            singular_calls += r.status == IkStatus::singular;
+        } else {
+            CHECK(r.status == IkStatus::converged);
+        }
+        largest_change = std::max(largest_change, largest_joint_change(before, out, 4));
     }
-    std::printf("workspace boundary crossing: %d of %d calls unreachable, largest joint change "
-                "per 1 ms call %.4f rad\n",
-                unreachable_calls, steps, largest_change);
+    std::printf("workspace boundary crossing: %d of %d calls unreachable, %d singular, largest "
+                "joint change per 1 ms call %.4f rad (fold bound %.4f), tip off the ray out of "
+                "reach %.2e m\n",
+                unreachable_calls, steps, singular_calls, largest_change, fold_bound_rad,
+                worst_off_ray);
     CHECK(unreachable_calls > 0);
-    // The target moves 1 mm per call (1.1 mm with the wobble) and the shortest lever that can
-    // move the tip across the ray is the stick+hand (0.41 m): joints need ~3 mrad per call.
-    // 20 mrad (20 rad/s) allows for the redundancy's internal motion; a jump would exceed it.
-    CHECK(largest_change < 0.02);
+    CHECK(largest_change < fold_bound_rad);
+    CHECK(worst_off_ray < 1e-3);
     // Back inside, it tracks again.
     CHECK((chain.tip_position() - target_at(steps)).norm() < 1e-4);
 }
@@ -322,45 +343,58 @@ TEST_CASE("stick direction as a secondary task does not cost tip accuracy", "[ik
 {
     std::mt19937 rng(5);
     ictus::KinematicChain chain = arm::make();
-    ChainIkSolverPos_dls solver(4);
-    double worst_direction = 0.0, worst_direction_without = 0.0;
+    // A cold start with the second task takes more tries than the tracking budget: steps
+    // whose second-order tip slip is refused are retried with more damping (docs/ik.md).
+    ictus::IkParams params;
+    params.max_iterations = 48;
+    ChainIkSolverPos_dls solver(4, params);
+    std::vector<double> with_task, without_task;
+    std::vector<int> iterations;
     for (int trial = 0; trial < 200; ++trial) {
         Quaterniond truth[4], out[4], out_plain[4];
         arm::random_pose(rng, truth);
         ictus::KinematicChain posed = chain;
         posed.set_rotations(truth);
-        ictus::ChainFrames frames;
-        posed.forward(&frames); // a compatible (tip, direction) pair
-        const IkResult r =
-            solver.solve(chain, frames.tip_position_m, frames.stick_direction, 1.0, out);
-        const IkResult plain = solver.solve(chain, frames.tip_position_m, out_plain);
+        ictus::ChainFrames truth_frames, frames;
+        posed.forward(&truth_frames); // a compatible (tip, direction) pair
+        const IkResult r = solver.solve(chain, truth_frames.tip_position_m,
+                                        truth_frames.stick_direction, 1.0, out);
+        const IkResult plain = solver.solve(chain, truth_frames.tip_position_m, out_plain);
         REQUIRE(plain.status == IkStatus::converged);
         INFO("trial " << trial << " status " << to_string(r.status));
+        // The tip is never given up for the direction: converged, checked by FK.
         CHECK(r.status == IkStatus::converged);
         posed.set_rotations(out);
         posed.forward(&frames);
-        CHECK((frames.tip_position_m - tip_with(chain, truth)).norm() < 1e-4);
-        const Vector3d wanted = tip_with(chain, truth);
-        (void)wanted;
-        ictus::KinematicChain truth_chain = chain;
-        truth_chain.set_rotations(truth);
-        ictus::ChainFrames truth_frames;
-        truth_chain.forward(&truth_frames);
-        worst_direction = std::max(
-            worst_direction,
-            std::acos(std::min(1.0, frames.stick_direction.dot(truth_frames.stick_direction))));
-        ictus::KinematicChain plain_chain = chain;
-        plain_chain.set_rotations(out_plain);
-        plain_chain.forward(&frames);
-        worst_direction_without = std::max(
-            worst_direction_without,
-            std::acos(std::min(1.0, frames.stick_direction.dot(truth_frames.stick_direction))));
+        CHECK((frames.tip_position_m - truth_frames.tip_position_m).norm() < 1e-4);
+        const double angle = std::acos(
+            std::clamp(frames.stick_direction.dot(truth_frames.stick_direction), -1.0, 1.0));
+        CHECK(angle == Approx(r.direction_error_rad).margin(1e-9));
+        with_task.push_back(angle);
+        iterations.push_back(r.iterations);
+        posed.set_rotations(out_plain);
+        posed.forward(&frames);
+        without_task.push_back(std::acos(
+            std::clamp(frames.stick_direction.dot(truth_frames.stick_direction), -1.0, 1.0)));
     }
-    std::printf("stick direction error: worst %.2e rad with the secondary task, %.2f rad "
-                "without\n",
-                worst_direction, worst_direction_without);
-    CHECK(worst_direction < 2e-3);
-    CHECK(worst_direction_without > 0.1);
+    std::sort(with_task.begin(), with_task.end());
+    std::sort(without_task.begin(), without_task.end());
+    const double tolerance = solver.params().direction_tolerance_rad;
+    const auto within =
+        std::count_if(with_task.begin(), with_task.end(), [&](double x) { return x <= tolerance; });
+    std::printf("stick direction error from a cold start (48 iterations): with the secondary "
+                "task median %.1e rad, %ld of 200 within %.0e rad, worst %.1e; without: "
+                "median %.2f rad\n",
+                with_task[100], static_cast<long>(within), tolerance, with_task.back(),
+                without_task[100]);
+    print_histogram("cold start with the stick direction task", iterations);
+    // Without the task the redundancy leaves the stick anywhere; with it, most solves end
+    // within tolerance and the rest (nearly conflicting tasks, slow linear convergence) much
+    // closer than without.
+    CHECK(without_task[100] > 0.1);
+    CHECK(with_task[100] <= tolerance);
+    CHECK(within >= 180);
+    CHECK(with_task.back() < 0.1 * without_task[100]);
 }
 
 TEST_CASE("IK refuses bad input and leaves the warm start", "[ik]")

@@ -234,16 +234,11 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
             use_direction
                 ? direction_error(frames_[candidate], direction_target, &candidate_direction_step)
                 : 0.0;
-        // Accept what lowers the merit |e|^2 + (l e_d)^2, l = tolerance_m /
-        // direction_tolerance_rad: the tip dominates, but a direction gain may pay for a
-        // second-order tip slip that the next (first-priority) tip step takes back.
-        const double length_per_rad = params_.tolerance_m / params_.direction_tolerance_rad;
-        const auto merit = [&](double position_m, double direction_rad) {
-            return position_m * position_m +
-                   std::pow(length_per_rad * direction_rad, 2) * (use_direction ? 1.0 : 0.0);
-        };
-        const bool accept = merit(candidate_error_m, candidate_direction_error) <
-                            merit(error_m, result.direction_error_rad);
+        // Accept what brings the tip closer, or -- with the tip within tolerance -- turns the
+        // stick closer to its target: the tip is never traded for the direction.
+        const bool accept = candidate_error_m < error_m ||
+                            (use_direction && candidate_error_m <= params_.tolerance_m &&
+                             candidate_direction_error < result.direction_error_rad);
         limits_active = candidate_limited;
         if (accept) {
             current = candidate;
