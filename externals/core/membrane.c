@@ -18,6 +18,7 @@
 #endif
 
 #define STRIKE_QUEUE  64
+#define FADE_S        0.03 /* s: ring-out of modes dropped by membrane_set_modes() */
 #define IMPULSE_CACHE 4
 /* hf_damping range: ratio of the air-like to the viscous decay rate at 1 kHz. */
 #define MEMBRANE_HF_MAX     1000.0
@@ -42,8 +43,12 @@ struct membrane {
     double sample_rate, radius, tension, density, t60, hf_damping, output_gain;
     double gain_smoothed; /* output gain as applied, follows output_gain in ~5 ms */
     int modes;            /* requested mode count */
-    int count;            /* modes rounded up to MEMBRANE_PAD: the kernel's loop length */
-    int capacity;         /* floats allocated per array */
+    /* After the count shrinks, the dropped modes ring out over FADE_S (no input,
+     * T60 of FADE_S) before they go: modes .. fading_modes-1, fade_left samples. */
+    int fading_modes;
+    long fade_left;
+    int count;    /* modes rounded up to MEMBRANE_PAD: the kernel's loop length */
+    int capacity; /* floats allocated per array */
     /* Mode table (double), capacity entries; entries >= modes are padding. */
     double *mode_j, *mode_norm, *omega_model;
     int *mode_m, *mode_n, *mode_sin;
@@ -126,7 +131,7 @@ void membrane_mode_shapes_(const membrane *m, double r_over_a, double theta_deg,
     double theta = theta_deg * (M_PI / 180.0);
     double radial = 0.0;
     for (int k = 0; k < m->capacity; k++) {
-        if (k >= m->modes) {
+        if (k >= m->fading_modes) {
             psi[k] = 0.0f;
             continue;
         }
@@ -162,8 +167,9 @@ static void update_coefficients(membrane *m, int rescale)
     const double scale = m->mass_scale;
     for (int k = 0; k < m->capacity; k++) {
         double old_omega = m->omega_model[k];
-        double freq = (k < m->modes) ? m->mode_j[k] * c / (2.0 * M_PI * m->radius) : 0.0;
-        if (k >= m->modes || freq >= 0.95 * 0.5 * m->sample_rate || freq <= 0.0) {
+        int fading = k >= m->modes;
+        double freq = (k < m->fading_modes) ? m->mode_j[k] * c / (2.0 * M_PI * m->radius) : 0.0;
+        if (k >= m->fading_modes || freq >= 0.95 * 0.5 * m->sample_rate || freq <= 0.0) {
             /* Silent: frozen at zero, no input, no output. */
             m->c1[k] = m->c2[k] = m->c3[k] = m->eq[k] = m->ep[k] = m->dm[k] = 0.0f;
             m->q[k] = m->p[k] = 0.0f;
@@ -171,7 +177,7 @@ static void update_coefficients(membrane *m, int rescale)
             continue;
         }
         double omega = 2.0 * M_PI * freq;
-        double sigma = mode_decay_rate(m, omega);
+        double sigma = fading ? log(1000.0) / FADE_S : mode_decay_rate(m, omega);
         /* Inverse bilinear map of the wanted discrete poles z = exp((-sigma +- i w) T):
          * s = (2/T) tanh((-sigma +- i w) T / 2) = a +- i b, so the midpoint rule's poles
          * land exactly on the target pitch and decay. */
@@ -188,6 +194,8 @@ static void update_coefficients(membrane *m, int rescale)
         m->eq[k] = (float)(scale * T * h * wm / D);
         m->ep[k] = (float)(scale * T / D);
         m->dm[k] = (float)(scale / wm);
+        if (fading) /* ringing out: no input, invisible to the contacts */
+            m->eq[k] = m->ep[k] = m->dm[k] = 0.0f;
         if (rescale && old_omega > 0.0) {
             /* y = q / (sqrt(M) w'), y' = p / sqrt(M), sqrt(M) proportional to 1/scale. */
             double r = old_scale / scale;
@@ -321,13 +329,21 @@ static ictus_status build_modes(membrane *m, int modes)
         for (int i = 0; i < IMPULSE_CACHE; i++)
             m->impulse_cache[i].valid = 0;
     }
-    int old_modes = m->modes;
+    int old_limit = m->fading_modes > m->modes ? m->fading_modes : m->modes;
+    if (modes < old_limit && membrane_energy(m) > 0.0) {
+        /* Shrinking while sounding: the dropped modes ring out instead of
+         * vanishing with a click. */
+        m->fading_modes = old_limit;
+        m->fade_left = (long)(FADE_S * m->sample_rate) + 1;
+    } else {
+        m->fading_modes = modes;
+        m->fade_left = 0;
+    }
     m->modes = modes;
-    m->count = need;
+    m->count = padded(m->fading_modes);
     /* Modes dropped now start from rest if they come back later. */
-    for (int k = modes; k < m->capacity; k++)
+    for (int k = m->fading_modes; k < m->capacity; k++)
         m->q[k] = m->p[k] = 0.0f;
-    (void)old_modes;
     update_coefficients(m, 1);
     membrane_mode_shapes_(m, m->strike_r, m->strike_theta, m->psi_strike);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++)
@@ -612,6 +628,8 @@ void membrane_clear(membrane *m)
     memset(m->q, 0, sizeof(float) * (size_t)m->capacity);
     memset(m->p, 0, sizeof(float) * (size_t)m->capacity);
     m->queued = 0;
+    if (m->fade_left > 0)
+        m->fade_left = 1; /* nothing left to ring out: end the fade next block */
     for (int i = 0; i < m->contact_count; i++) {
         contact *c = m->contacts[i];
         c->active = c->touching = c->hit_pending = 0;
@@ -975,6 +993,20 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
     for (int c = 0; c < m->contact_count; c++)
         if (m->contacts[c]->hit_pending)
             m->contacts[c]->hit_offset -= n;
+    if (m->fade_left > 0) {
+        m->fade_left -= n;
+        if (m->fade_left <= 0) {
+            /* Rung out: drop them for good (no allocation, O(dropped modes)). */
+            for (int k = m->modes; k < m->count; k++) {
+                m->q[k] = m->p[k] = 0.0f;
+                m->c1[k] = m->c2[k] = m->c3[k] = m->eq[k] = m->ep[k] = m->dm[k] = 0.0f;
+                m->omega_model[k] = 0.0;
+            }
+            m->fading_modes = m->modes;
+            m->count = padded(m->modes);
+            m->fade_left = 0;
+        }
+    }
 #ifdef MEMBRANE_X86
     _mm_setcsr(csr);
 #endif
