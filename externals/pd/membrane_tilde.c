@@ -64,7 +64,8 @@ static void ictus_clock_advance_check(t_ictus_clock *c, int n)
          * stopped in between (switch~) or blocks overlap: re-anchor. */
         double elapsed = clock_gettimesince(c->c_anchor) / ms_per_sample;
         double end = c->c_samples_done + n;
-        if (elapsed < end - 0.5 || elapsed > end + tick_samples - n + 0.5)
+        double slack = n < tick_samples ? tick_samples - n : 0;
+        if (elapsed < end - 0.5 || elapsed > end + slack + 0.5)
             c->c_anchored = 0;
     }
     if (!c->c_anchored) {

@@ -81,3 +81,36 @@ nz = np.flatnonzero(x[:, 0] != 0)
 check(len(nz) > 0 and nz[0] == 4800,
       "strike while DSP is off lands when DSP resumes: onset %s, expected 4800"
       % (nz[0] if len(nz) else None))
+
+# A membrane~ in a [switch~] subpatch switched off from 100 to 200 ms: its
+# counter stood still meanwhile, so it must re-anchor when switched on again;
+# a strike at 251.3 ms then lands on sample round(251.3 * 48) = 12062 (the
+# parent records all along).
+sub = Patch()
+inl = sub.obj("inlet")
+rt = sub.obj("route float")
+mem = sub.obj("membrane~")
+out = sub.obj("outlet~")
+sw = sub.obj("switch~")
+sub.connect(inl, 0, rt, 0)
+sub.connect(rt, 0, sw, 0)
+sub.connect(rt, 1, mem, 0)
+sub.connect(mem, 0, out, 0)
+p = Patch(declare="-path %s/ictus" % args.build)
+s = p.subpatch("switched", sub)
+wav = os.path.join(work, "timing-switch.wav")
+trig = recorder(p, [(s, 0, "t")], 0.4, sr, wav)
+for d, text in ((0.0, "set 1"), (100.0, "set 0"), (200.0, "set 1"), (251.3, "strike 0.3 0 0.01")):
+    dl = p.obj("delay %g" % d)
+    # floats switch the subpatch, strikes go to membrane~
+    m = p.msg(text.replace("set ", "")) if text.startswith("set") else p.msg(text)
+    p.connect(trig, 0, dl, 0)
+    p.connect(dl, 0, m, 0)
+    p.connect(m, 0, s, 0)
+rc, log = run_pd(p.text(), args.build, sr=sr, workdir=work)
+check(rc == 0 and not error_lines(log), "pd ran cleanly (switch~)")
+x, _ = read_wav_float(wav)
+nz = np.flatnonzero(x[:, 0] != 0)
+check(len(nz) > 0 and nz[0] == 12062,
+      "strike after switch~ resumes is sample-accurate: onset %s, expected 12062"
+      % (nz[0] if len(nz) else None))
