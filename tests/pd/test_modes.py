@@ -35,7 +35,7 @@ p = Patch(declare="-path %s/ictus" % args.build)
 m = p.obj("membrane~ drum")
 trig = recorder(p, [(m, 0, "pick1")], seconds, sr, wav)
 setup = p.msg("radius %g \\, tension %g \\, density %g \\, modes 256 \\, t60 4 \\, hfdamp 0"
-              " \\, pickup 1 %g 0 \\, strike %g 0 0.01" % (radius, tension, density, pickup_r,
+              " \\, pickup 1 %g 0 \\, strike %g 0 0.01 \\, print" % (radius, tension, density, pickup_r,
                                                           strike_r))
 p.connect(trig, 1, setup, 0)
 p.connect(setup, 0, m, 0)
@@ -80,3 +80,9 @@ for i, (f, mm, n, w) in enumerate(modes):
           % (mm, n, f_meas, f, abs(f_meas - f), tol))
     checked += 1
 check(checked >= 6, "%d modes checked" % checked)
+
+# "print" lists the modes in the Pd window: the fundamental as theory has it
+f01 = jn_zeros(0, 1)[0] * c / (2 * np.pi * radius)
+line = [l for l in log.splitlines() if "mode  0 (0,1)" in l]
+check(len(line) == 1 and abs(float(line[0].split(":")[1].split("Hz")[0]) - f01) < 0.01,
+      "print shows the fundamental at %.2f Hz: %s" % (f01, line))
