@@ -378,3 +378,24 @@ TEST_CASE("Setters while sounding do not click", "[core][membrane]")
         CHECK(after_step <= allowed * max_step);
     }
 }
+
+TEST_CASE("Modes above 0.95 Nyquist are silent", "[core][membrane]")
+{
+    // At 1 kHz only (0,1) at 230 Hz and (1,1) at 367 Hz lie below 475 Hz; (2,1) at
+    // 491 Hz and (0,2) at 528 Hz (alias at 472 Hz) must not sound.
+    const double fs = 1000.0;
+    membrane_ptr m(membrane_new(fs));
+    membrane_set_modes(m.get(), 10);
+    membrane_set_t60(m.get(), 20.0);
+    membrane_set_pickup(m.get(), 0, 0.4, 20.0);
+    membrane_strike(m.get(), 0.37, 23.0, 0.01, 0);
+    const size_t n = 1u << 14;
+    std::vector<double> mag = tools::spectrum(tools::render(m.get(), n), n * 4, true);
+    const double bin = fs / (double)(n * 4);
+    double ref = tools::band_max(mag, bin, theory_hz(m.get(), 2.4048255576957729), 1.0);
+    CHECK(tools::band_max(mag, bin, theory_hz(m.get(), 3.8317059702075125), 1.0) > 1e-3 * ref);
+    double f21 = theory_hz(m.get(), 5.1356223018406828),
+           f02 = theory_hz(m.get(), 5.5200781102863106);
+    CHECK(tools::band_max(mag, bin, f21, 1.0) < 1e-4 * ref);
+    CHECK(tools::band_max(mag, bin, fs - f02, 1.0) < 1e-4 * ref);
+}
