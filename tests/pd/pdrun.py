@@ -4,7 +4,9 @@ A test builds a patch from a list of boxes and connections, runs
 `pd -nogui -nosound -batch -stderr`, and reads back what the patch wrote into a
 table (32-bit float WAV via soundfiler, see docs/externals.md)."""
 import os
+import atexit
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -93,7 +95,7 @@ def recorder(p, tables, seconds, sr, wav_path, quit_extra=None):
 def run_pd(patch_text, libdir, sr=48000, extra_args=(), workdir=None, name="test.pd",
            timeout=120):
     """Writes the patch into workdir and runs pd on it; returns (returncode, stderr)."""
-    workdir = workdir or tempfile.mkdtemp(prefix="ictus-pd-")
+    workdir = workdir or make_workdir("ictus-pd-")
     path = os.path.join(workdir, name)
     with open(path, "w") as f:
         f.write(patch_text)
@@ -134,6 +136,30 @@ def read_wav_float(path):
     return samples, sr
 
 
+_workdirs = []
+_failed = [False]
+
+
+def _cleanup():
+    if _failed[0] or os.environ.get("ICTUS_KEEP_TMP"):
+        for d in _workdirs:
+            print("kept for inspection:", d)
+        return
+    for d in _workdirs:
+        shutil.rmtree(d, ignore_errors=True)
+
+
+atexit.register(_cleanup)
+
+
+def make_workdir(prefix):
+    """A temporary folder for patches and WAVs, removed at exit unless a check
+    failed (or ICTUS_KEEP_TMP is set)."""
+    d = tempfile.mkdtemp(prefix=prefix)
+    _workdirs.append(d)
+    return d
+
+
 def error_lines(log):
     return [l for l in log.splitlines() if ERROR_RE.search(l)]
 
@@ -141,5 +167,6 @@ def error_lines(log):
 def check(cond, message):
     if not cond:
         print("FAIL:", message)
+        _failed[0] = True
         sys.exit(1)
     print("ok:", message)

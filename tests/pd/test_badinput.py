@@ -6,11 +6,10 @@ arguments, modes 0 and 1000000, a contact~ without a name and one naming a
 membrane~ that does not exist are all tried."""
 import argparse
 import os
-import tempfile
 
 import numpy as np
 
-from pdrun import Patch, check, read_wav_float, recorder, run_pd
+from pdrun import make_workdir, Patch, check, read_wav_float, recorder, run_pd
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -67,7 +66,7 @@ contact_cases = [
 ]
 
 sr = 48000
-work = tempfile.mkdtemp(prefix="ictus-bad-")
+work = make_workdir("ictus-bad-")
 wav = os.path.join(work, "bad.wav")
 p = Patch(declare="-path %s/ictus" % args.build)
 mem = p.obj("membrane~ bad-drum 1e+30 -5 nan")

@@ -7,11 +7,10 @@ parent is taken out. Also rendered with contact~ created before membrane~
 not change)."""
 import argparse
 import os
-import tempfile
 
 import numpy as np
 
-from pdrun import Patch, check, error_lines, read_wav_float, recorder, run_pd
+from pdrun import make_workdir, Patch, check, error_lines, read_wav_float, recorder, run_pd
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -27,7 +26,7 @@ score = [  # (delay ms, message to contact~ or membrane~)
     (233.37, "c", "hit 5 0.1 200"),
     (301.01, "c", "hit 1.2 0.8 10"),
 ]
-work = tempfile.mkdtemp(prefix="ictus-block-")
+work = make_workdir("ictus-block-")
 renders = {}
 for block, contact_first in ((1, False), (64, False), (1024, False), (64, True)):
     sub = Patch()

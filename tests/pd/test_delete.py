@@ -6,11 +6,10 @@ sort. Objects are created and deleted by messages to their subpatches
 ([; pd-mem clear(, [; pd-mem obj ...(), as a live patch would."""
 import argparse
 import os
-import tempfile
 
 import numpy as np
 
-from pdrun import Patch, check, read_wav_float, recorder, run_pd
+from pdrun import make_workdir, Patch, check, read_wav_float, recorder, run_pd
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -42,7 +41,7 @@ score = [
     (180.0, "\\; del-hit hit 3 0.4 90"),  # report 3
 ]
 sr = 48000
-work = tempfile.mkdtemp(prefix="ictus-delete-")
+work = make_workdir("ictus-delete-")
 wav = os.path.join(work, "delete.wav")
 p = Patch(declare="-path %s/ictus" % args.build)
 p.subpatch("mem", Patch())

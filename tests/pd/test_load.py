@@ -6,9 +6,8 @@ loads first, both classes exist once). Each patch plays a hit through contact~
 and must print the stroke's release report and no error line."""
 import argparse
 import os
-import tempfile
 
-from pdrun import Patch, check, error_lines, run_pd
+from pdrun import make_workdir, Patch, check, error_lines, run_pd
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -38,7 +37,7 @@ def play(declare, mem_name, con_name, contact_first, extra=(), beside_lib=False)
     p.connect(lb, 0, done, 0)
     p.connect(done, 0, quit_msg, 0)
     # A patch beside the ictus/ folder is written into the build folder itself.
-    work = build if beside_lib else tempfile.mkdtemp(prefix="ictus-load-")
+    work = build if beside_lib else make_workdir("ictus-load-")
     name = "ictus-load-test-%d.pd" % os.getpid()
     rc, log = run_pd(p.text(), build, extra_args=extra, workdir=work, name=name, timeout=60)
     if beside_lib:

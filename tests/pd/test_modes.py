@@ -12,12 +12,11 @@ Tolerance: 0.05 Hz + 2e-5 f (the core lands its discrete poles on the
 target frequency exactly, see membrane.c, so no integrator warping remains)."""
 import argparse
 import os
-import tempfile
 
 import numpy as np
 from scipy.special import jn_zeros, jv
 
-from pdrun import Patch, check, error_lines, read_wav_float, recorder, run_pd
+from pdrun import make_workdir, Patch, check, error_lines, read_wav_float, recorder, run_pd
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -29,7 +28,7 @@ radius, tension, density = 0.2, 2000.0, 0.25
 strike_r, pickup_r = 0.37, 0.61
 seconds = 1.5
 
-work = tempfile.mkdtemp(prefix="ictus-modes-")
+work = make_workdir("ictus-modes-")
 wav = os.path.join(work, "modes.wav")
 p = Patch(declare="-path %s/ictus" % args.build)
 m = p.obj("membrane~ drum")

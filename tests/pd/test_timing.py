@@ -7,11 +7,10 @@ delays its signal by 1024 - 64 = 960 samples (Pd's reblocking: it gathers 1024
 input samples before it computes); [block~ 1] adds no delay."""
 import argparse
 import os
-import tempfile
 
 import numpy as np
 
-from pdrun import Patch, check, error_lines, read_wav_float, recorder, run_pd
+from pdrun import make_workdir, Patch, check, error_lines, read_wav_float, recorder, run_pd
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -19,7 +18,7 @@ args = ap.parse_args()
 args.build = os.path.abspath(args.build)
 
 delays_ms = [123.45, 1000.0 / 3.0, 7.0, 250.0]
-work = tempfile.mkdtemp(prefix="ictus-timing-")
+work = make_workdir("ictus-timing-")
 for sr in (44100, 48000, 96000):
     for block in (None, 1, 1024):
         p = Patch(declare="-path %s/ictus" % args.build)
