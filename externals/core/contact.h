@@ -3,9 +3,9 @@
  * A stick of lumped mass m (kg) hits the membrane at (r/a, theta). With the
  * compression x = stick position - membrane displacement at the contact point
  * (positive into the membrane), the contact force is
- *     F = k x^alpha + lambda x^alpha dx/dt   for x > 0,  else 0,  and F >= 0,
- * where lambda is given per unit stiffness (unit s/m, Hunt & Crossley's mu), i.e.
- * the damping term is (lambda k) x^alpha dx/dt = k x^alpha * lambda dx/dt.
+ *     F = k x^alpha + lambda k x^alpha dx/dt = k x^alpha (1 + lambda dx/dt)
+ * for x > 0, else 0, and F >= 0. lambda is Hunt & Crossley's damping per unit
+ * stiffness (their mu), in s/m.
  * The contact is solved jointly with the membrane's modes, sample by sample
  * (Avanzini & Rocchesso), with an energy-consistent discretisation: the
  * spring term is a discrete gradient of V(x) = k x^(alpha+1)/(alpha+1) and the
