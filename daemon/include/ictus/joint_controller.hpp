@@ -34,7 +34,7 @@ struct JointGains {
 struct GainOptions {
     // Gains scale with the inertia I carried by each joint: k_s = I w^2,
     // k_d = 2 zeta I w, with w = 2 pi natural_frequency_hz.
-    double natural_frequency_hz = 15.0;
+    double natural_frequency_hz = 30.0;
     double damping_ratio = 1.0;
     double torque_scale = 1.0; // multiplies every joint's torque limit
     bool rate_feedforward = true;

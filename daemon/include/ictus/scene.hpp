@@ -124,7 +124,8 @@ class Scene
     Eigen::Vector3d tip_velocity(Side side) const;
     double max_linear_speed_mps() const;
     double max_angular_speed_rad_s() const;
-    // Adds a velocity change to a body's centre of mass (tests: injected kicks).
+    // Adds a velocity change to a body's centre of mass (tests: injected
+    // kicks). Throws CharacterError for a bad body or a non-finite change.
     void kick(int body, const Eigen::Vector3d &delta_linear_mps,
               const Eigen::Vector3d &delta_angular_rad_s);
 

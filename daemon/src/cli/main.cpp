@@ -6,6 +6,7 @@
 // was reset) at least once, 130 interrupted.
 #include "ictus/bvh.hpp"
 #include "ictus/character.hpp"
+#include "ictus/character_limits.hpp"
 #include "ictus/joint_limits.hpp"
 #include "ictus/track.hpp"
 
@@ -85,10 +86,11 @@ void track_usage(std::ostream &out)
            "  --stick-tip-radius M   (default 0.007)\n"
            "  --drum-pos X,Y,Z       membrane centre, m (default: under the lowest tips)\n"
            "  --drum-radius M        (default 0.178)   --drum-tension N/m (default 3000)\n"
-           "  --gain-hz HZ           PD natural frequency (default 15)\n"
+           "  --gain-hz HZ           PD natural frequency (default 30)\n"
            "  --damping-ratio Z      (default 1)       --torque-scale S (default 1)\n"
            "  --limits none|euler|quaternion   limits enforced (default quaternion)\n"
            "  --limit-k K            limit width in standard deviations (default 3)\n"
+           "  --limit-min-deg DEG    minimum half-width of a limit per axis (default 6)\n"
            "  --no-stops             clamp targets only, no safety-net stops\n"
            "  --ramp S               blend targets in over S seconds (default 0.25)\n"
            "  --smooth-hz HZ         low-pass the reference (Gaussian, default 10; 0: off)\n"
@@ -111,8 +113,9 @@ void limits_usage(std::ostream &out)
            "  --out FILE      JSON output (default limits.json; '-' prints JSON instead)\n"
            "  --scale M       metres per BVH unit (default 0.056444)\n"
            "  --skip-frames N frames dropped at the start (default 1)\n"
-           "  --k K           quaternion ellipsoid half-axes in std (default 3)\n"
-           "  --euler-k K     Euler limits in std (default 2.5)\n"
+           "  --k K           limits at mean -/+ k std (Euler) and ellipsoid half-axes of\n"
+           "                  k std (quaternion; default 3)\n"
+           "  --min-deg DEG   minimum half-width per axis (default 6)\n"
            "  --smooth-hz HZ, --despike-deg DEG   reference clean-up as in track\n"
            "\n"
            "example:\n"
@@ -191,20 +194,6 @@ ictus::BvhFile load_bvh(const std::string &path, double scale, int skip)
     return bvh;
 }
 
-// The character's joint-space series, one per joint, from every reference frame.
-void character_series(const ictus::ReferenceMotion &reference, const ictus::CharacterModel &model,
-                      std::vector<std::string> &names,
-                      std::vector<std::vector<Eigen::Quaterniond>> &series)
-{
-    names.clear();
-    series.assign(ictus::CharacterModel::kJoints, {});
-    for (int j = 0; j < ictus::CharacterModel::kJoints; ++j) {
-        names.push_back(model.joint_name(j));
-        for (int f = 0; f < reference.frames(); ++f)
-            series[j].push_back(reference.frame(f).local[j]);
-    }
-}
-
 class Progress
 {
   public:
@@ -234,7 +223,7 @@ class Progress
 int run_track(Args &args)
 {
     std::string mode, mocap, out_dir, limits_mode = "quaternion";
-    double scale = kCmuScale, limit_k = 3.0;
+    double scale = kCmuScale, limit_k = 3.0, limit_width_deg = 6.0;
     int skip = 1;
     bool quiet = false;
     ictus::CharacterOptions character;
@@ -309,6 +298,11 @@ int run_track(Args &args)
                                  limits_mode + "'");
         } else if (a == "--limit-k") {
             limit_k = parse_positive(a, args.value(a));
+        } else if (a == "--limit-min-deg") {
+            limit_width_deg = parse_double(a, args.value(a));
+            if (limit_width_deg < 0.0 || limit_width_deg >= 180.0)
+                throw UsageError("--limit-min-deg: expected 0 <= deg < 180, got '" +
+                                 std::to_string(limit_width_deg) + "'");
         } else if (a == "--no-stops") {
             options.scene.limit_stops = false;
         } else if (a == "--ramp") {
@@ -349,20 +343,12 @@ int run_track(Args &args)
     const ictus::ReferenceMotion raw(model, bvh.motion);
     const ictus::ReferenceMotion reference(model, bvh.motion, filter);
 
-    std::vector<ictus::JointLimit> limits;
-    std::vector<ictus::JointLimitRef> refs;
-    if (limits_mode != "none") {
-        std::vector<std::string> names;
-        std::vector<std::vector<Eigen::Quaterniond>> series;
-        character_series(reference, model, names, series);
-        ictus::LimitOptions lo;
-        lo.quaternion.k = limit_k;
-        lo.euler.k = limit_k;
-        limits = ictus::learn_limits(names, series, lo);
-        for (const ictus::JointLimit &l : limits)
-            refs.push_back(limits_mode == "euler" ? ictus::JointLimitRef::to(l.euler)
-                                                  : ictus::JointLimitRef::to(l.quaternion));
-    }
+    ictus::CharacterLimitOptions lim;
+    lim.kind = ictus::limit_kind_from_string(limits_mode);
+    lim.k = limit_k;
+    lim.min_half_width_rad = limit_width_deg * M_PI / 180.0;
+    const ictus::CharacterLimits limits(model, reference, lim);
+    const std::vector<ictus::JointLimitRef> refs = limits.refs();
 
     std::ofstream csv;
     if (!out_dir.empty()) {
@@ -393,6 +379,7 @@ int run_track(Args &args)
     j["body_mass_kg"] = character.body_mass_kg;
     j["limits"] = limits_mode;
     j["limit_k"] = limit_k;
+    j["limit_min_deg"] = limit_width_deg;
     j["limit_stops"] = options.scene.limit_stops;
     j["gain_hz"] = options.gains.natural_frequency_hz;
     j["damping_ratio"] = options.gains.damping_ratio;
@@ -426,7 +413,7 @@ int run_limits(Args &args)
     std::string file, out = "limits.json";
     double scale = kCmuScale;
     int skip = 1;
-    ictus::LimitOptions lo;
+    ictus::CharacterLimitOptions lo;
     ictus::ReferenceFilter filter;
     while (!args.done()) {
         const std::string a = args.next();
@@ -440,9 +427,13 @@ int run_limits(Args &args)
         } else if (a == "--skip-frames") {
             skip = parse_int(a, args.value(a), 0, 100000000);
         } else if (a == "--k") {
-            lo.quaternion.k = parse_positive(a, args.value(a));
-        } else if (a == "--euler-k") {
-            lo.euler.k = parse_positive(a, args.value(a));
+            lo.k = parse_positive(a, args.value(a));
+        } else if (a == "--min-deg") {
+            const double w = parse_double(a, args.value(a));
+            if (w < 0.0 || w >= 180.0)
+                throw UsageError("--min-deg: expected 0 <= deg < 180, got '" + std::to_string(w) +
+                                 "'");
+            lo.min_half_width_rad = w * M_PI / 180.0;
         } else if (a == "--smooth-hz") {
             filter.smooth_cutoff_hz = parse_double(a, args.value(a));
             if (filter.smooth_cutoff_hz < 0.0)
@@ -464,17 +455,17 @@ int run_limits(Args &args)
     const ictus::BvhFile bvh = load_bvh(file, scale, skip);
     const ictus::CharacterModel model = ictus::CharacterModel::from_skeleton(bvh.skeleton);
     const ictus::ReferenceMotion reference(model, bvh.motion, filter);
-    std::vector<std::string> names;
-    std::vector<std::vector<Eigen::Quaterniond>> series;
-    character_series(reference, model, names, series);
-    const std::vector<ictus::JointLimit> limits = ictus::learn_limits(names, series, lo);
-    nlohmann::json report = ictus::limits_report(limits, lo);
+    const ictus::CharacterLimits limits(model, reference, lo);
+    nlohmann::json report = limits.report();
     report["mocap"] = file;
     if (out == "-") {
         std::cout << report.dump(2) << "\n";
         return 0;
     }
-    ictus::print_limits(std::cout, limits);
+    std::vector<ictus::JointLimit> enforced = limits.learned();
+    for (size_t j = 0; j < enforced.size(); ++j)
+        enforced[j].euler = limits.euler(static_cast<int>(j)).limit;
+    ictus::print_limits(std::cout, enforced);
     std::ofstream js(out);
     js << report.dump(2) << "\n";
     if (!js)

@@ -538,6 +538,9 @@ void Scene::kick(int body, const Eigen::Vector3d &dv, const Eigen::Vector3d &dw)
 {
     if (body < 0 || body >= CharacterModel::kBodies)
         throw CharacterError("kick: no body " + std::to_string(body));
+    // ODE aborts (dDebug) on a NaN quaternion inside a step: refuse non-finite input here.
+    if (!dv.allFinite() || !dw.allFinite())
+        throw CharacterError("kick: velocity change must be finite");
     const Eigen::Vector3d v = to_eigen3(dBodyGetLinearVel(body_[body])) + dv;
     const Eigen::Vector3d w = to_eigen3(dBodyGetAngularVel(body_[body])) + dw;
     dBodySetLinearVel(body_[body], v.x(), v.y(), v.z());

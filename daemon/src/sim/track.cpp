@@ -119,7 +119,7 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     const long steps = std::max(1L, std::lround(duration / h));
     const double sample_rate =
         options.sample_rate_hz > 0.0 ? options.sample_rate_hz : reference.frame_rate_hz();
-    const long steps_per_sample = std::max(1L, std::lround(1.0 / (sample_rate * h)));
+    long last_sample_index = 0;
 
     const CharacterPose initial = reference.frame(0);
     const std::vector<JointGains> gains =
@@ -191,7 +191,11 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                 summary.joint_saturated_fraction[j] += 1.0;
         }
 
-        if ((n + 1) % steps_per_sample == 0) {
+        // Sample on the rate's grid (nearest following step), so that a 120 Hz
+        // CSV has 120 rows per second at any physics step.
+        const long sample_index = static_cast<long>(std::floor(t_next * sample_rate + 1e-9));
+        if (sample_index > last_sample_index) {
+            last_sample_index = sample_index;
             // Errors against the reference itself (not the ramped or clamped target).
             scene.local_rotations(sim_local);
             const auto ref_tips = reference_tips(model, ref_pose);

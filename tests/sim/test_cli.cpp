@@ -1,0 +1,206 @@
+// The real ictusd binary: help, usage errors, bad values for every option,
+// malformed files, and the files `track --out` writes.
+#include "sim_test_util.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace
+{
+
+struct Run {
+    int status;
+    std::string output; // stdout and stderr
+};
+
+Run ictusd(const std::string &args)
+{
+    const std::string cmd = std::string(ICTUSD_PATH) + " " + args + " 2>&1";
+    FILE *pipe = popen(cmd.c_str(), "r");
+    REQUIRE(pipe != nullptr);
+    std::string out;
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, pipe)) > 0)
+        out.append(buf, n);
+    const int st = pclose(pipe);
+    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+// A small valid BVH with the CMU joint names: the right elbow swings.
+std::string tiny_bvh()
+{
+    static const std::string path = simtest::write_temp(
+        "tiny.bvh", simtest::cmu_like_bvh(121, 1.0 / 120, [](int f, const std::string &j) {
+            if (j == "RightForeArm")
+                return Eigen::Vector3d(0, 20.0 * std::sin(2 * M_PI * f / 120.0), 0);
+            return Eigen::Vector3d(0, 0, 0);
+        }));
+    return path;
+}
+
+} // namespace
+
+TEST_CASE("ictusd --help and per-verb help exit 0 with examples", "[sim][cli]")
+{
+    for (const char *args : {"--help", "track --help", "limits --help"}) {
+        const Run r = ictusd(args);
+        INFO(args << "\n" << r.output);
+        CHECK(r.status == 0);
+        CHECK(r.output.find("usage: ictusd") != std::string::npos);
+        CHECK(r.output.find("example") != std::string::npos);
+    }
+}
+
+TEST_CASE("ictusd: unknown verbs and options are usage errors (exit 2)", "[sim][cli]")
+{
+    Run r = ictusd("");
+    CHECK(r.status == 2);
+    r = ictusd("dance");
+    CHECK(r.status == 2);
+    CHECK(r.output.find("unknown verb 'dance'") != std::string::npos);
+    r = ictusd("track --mode joint --mocap x.bvh --frobnicate");
+    CHECK(r.status == 2);
+    CHECK(r.output.find("unknown option '--frobnicate'") != std::string::npos);
+    r = ictusd("limits a.bvh --frobnicate");
+    CHECK(r.status == 2);
+    r = ictusd("track --mocap " + tiny_bvh());
+    CHECK(r.status == 2);
+    CHECK(r.output.find("--mode is required") != std::string::npos);
+    r = ictusd("track --mode joint");
+    CHECK(r.status == 2);
+    CHECK(r.output.find("--mocap") != std::string::npos);
+    r = ictusd("limits");
+    CHECK(r.status == 2);
+}
+
+TEST_CASE("ictusd track: every option refuses a bad value, naming it", "[sim][cli]")
+{
+    const std::string base = "track --mode joint --quiet --mocap " + tiny_bvh() + " ";
+    // option, bad value, text the message must contain
+    const std::vector<std::array<std::string, 3>> cases = {
+        {"--mode", "foo", "--mode"},
+        {"--scale", "0", "--scale"},
+        {"--scale", "abc", "--scale"},
+        {"--skip-frames", "-1", "--skip-frames"},
+        {"--duration", "-5", "--duration"},
+        {"--step", "-0.001", "--step"},
+        {"--step", "1", "physics step"},
+        {"--stepper", "slow", "--stepper"},
+        {"--iterations", "0", "--iterations"},
+        {"--body-mass", "0", "--body-mass"},
+        {"--grip", "italian", "grip"},
+        {"--stick-length", "-1", "--stick-length"},
+        {"--stick-mass", "nan", "--stick-mass"},
+        {"--stick-tip-radius", "0", "--stick-tip-radius"},
+        {"--drum-pos", "1,2", "--drum-pos"},
+        {"--drum-radius", "-0.1", "--drum-radius"},
+        {"--drum-tension", "0", "--drum-tension"},
+        {"--gain-hz", "0", "--gain-hz"},
+        {"--damping-ratio", "-1", "--damping-ratio"},
+        {"--torque-scale", "0", "--torque-scale"},
+        {"--limits", "loose", "--limits"},
+        {"--limit-k", "0", "--limit-k"},
+        {"--limit-min-deg", "-1", "--limit-min-deg"},
+        {"--ramp", "-1", "--ramp"},
+        {"--smooth-hz", "-1", "--smooth-hz"},
+        {"--despike-deg", "-1", "--despike-deg"},
+    };
+    for (const auto &c : cases) {
+        const Run r = ictusd(base + c[0] + " " + c[1]);
+        INFO(c[0] << " " << c[1] << " -> " << r.status << ": " << r.output);
+        CHECK(r.status == 2);
+        CHECK(r.output.find(c[2]) != std::string::npos);
+    }
+    // A missing value.
+    const Run r = ictusd(base + "--step");
+    CHECK(r.status == 2);
+    CHECK(r.output.find("--step: missing value") != std::string::npos);
+    // Values only the model can judge: exit 1 with the parameter named.
+    const Run tip = ictusd(base + "--stick-tip-radius 0.3");
+    CHECK(tip.status == 1);
+    CHECK(tip.output.find("tip radius") != std::string::npos);
+}
+
+TEST_CASE("ictusd: missing and malformed files are errors naming the file (exit 1)", "[sim][cli]")
+{
+    Run r = ictusd("track --mode joint --quiet --mocap /nonexistent/clip.bvh");
+    CHECK(r.status == 1);
+    CHECK(r.output.find("/nonexistent/clip.bvh") != std::string::npos);
+    const std::string bad =
+        simtest::write_temp("bad.bvh", "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n}\n");
+    r = ictusd("track --mode joint --quiet --mocap " + bad);
+    INFO(r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find(bad + ":5") != std::string::npos); // file:line (the '}' of line 5)
+    r = ictusd("limits " + bad);
+    CHECK(r.status == 1);
+    // A valid BVH without the CMU joints the character needs.
+    const std::string other = simtest::write_temp(
+        "other.bvh", "HIERARCHY\nROOT pelvis\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Yrotation "
+                     "Xrotation\n End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 2\nFrame "
+                     "Time: 0.01\n0 0 0\n0 0 0\n");
+    r = ictusd("track --mode joint --quiet --mocap " + other);
+    CHECK(r.status == 1);
+    CHECK(r.output.find("Hips") != std::string::npos);
+    // An output folder that cannot be created.
+    r = ictusd("track --mode joint --quiet --mocap " + tiny_bvh() + " --out /proc/ictus_test");
+    CHECK(r.status == 1);
+    CHECK(r.output.find("--out") != std::string::npos);
+}
+
+TEST_CASE("ictusd track --out writes the CSV and a summary with the required fields", "[sim][cli]")
+{
+    const std::string dir = "test_sim_out";
+    const Run r =
+        ictusd("track --mode joint --mocap " + tiny_bvh() + " --out " + dir + " --duration 1.5");
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    // Not a terminal: plain progress lines.
+    CHECK(r.output.find("track: 100%") != std::string::npos);
+    std::ifstream js(dir + "/summary.json");
+    REQUIRE(js.good());
+    const nlohmann::json s = nlohmann::json::parse(js);
+    CHECK(s.at("mode") == "joint");
+    CHECK(s.at("frames").get<int>() == 120); // 121 minus the skipped first frame
+    CHECK(s.at("tip_rms_mm").at("left").get<double>() >= 0.0);
+    CHECK(s.at("tip_rms_mm").at("right").get<double>() < 10.0);
+    CHECK(s.at("joint_rms_deg").size() == 19u);
+    CHECK(s.at("joint_rms_deg").at("r_elbow").get<double>() < 1.0);
+    CHECK(s.at("realtime_factor").get<double>() > 0.0);
+    CHECK(s.at("diverged") == false);
+    CHECK(s.at("duration_s").get<double>() == Approx(1.5));
+    std::ifstream csv(dir + "/track.csv");
+    std::string header, line;
+    std::getline(csv, header);
+    CHECK(header.find("r_elbow_err_deg") != std::string::npos);
+    CHECK(header.find("tip_right_sim_y_m") != std::string::npos);
+    int rows = 0;
+    while (std::getline(csv, line))
+        ++rows;
+    CHECK(rows == 180); // 1.5 s at the clip's 120 Hz
+}
+
+TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[sim][cli]")
+{
+    const std::string out = "test_sim_limits.json";
+    const Run r = ictusd("limits " + tiny_bvh() + " --out " + out);
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    CHECK(r.output.find("r_elbow") != std::string::npos);
+    std::ifstream js(out);
+    const nlohmann::json j = nlohmann::json::parse(js);
+    REQUIRE(j.at("joints").size() == 19u);
+    CHECK(j.at("joints")[0].at("name") == "lumbar");
+    CHECK(j.at("joints")[0].contains("quaternion"));
+    CHECK(j.at("joints")[0].contains("euler"));
+    const Run bad = ictusd("limits " + tiny_bvh() + " --k -2");
+    CHECK(bad.status == 2);
+    CHECK(bad.output.find("--k") != std::string::npos);
+}
