@@ -265,12 +265,14 @@ TEST_CASE("BVH: malformed files give FILE:LINE errors", "[mocap][bvh][errors]")
     }
     SECTION("NaN and infinity in the motion")
     {
-        require_error(minimal_bvh(20, "0 1 0 10 nan 0 0 0 5"), 20,
-                      "expected a finite number in column 4 (Hips Yrotation), got 'nan'");
+        require_error(
+            minimal_bvh(20, "0 1 0 10 nan 0 0 0 5"), 20,
+            "expected a finite number (|x| <= 1e9) in column 4 (Hips Yrotation), got 'nan'");
         require_error(minimal_bvh(19, "0 1 0 0 0 0 0 inf 0"), 19,
                       "column 7 (Chest Yrotation), got 'inf'");
         require_error(minimal_bvh(19, "0 1 0 0 0 0 0 1e999 0"), 19, "got '1e999'");
         require_error(minimal_bvh(19, "0 1 0 0 0 0 0 x 0"), 19, "got 'x'");
+        require_error(minimal_bvh(19, "0 1 0 0 0 0 0 -2e9 0"), 19, "got '-2e9'");
     }
     SECTION("absurd frame counts and frame times")
     {
@@ -306,7 +308,7 @@ TEST_CASE("BVH: malformed files give FILE:LINE errors", "[mocap][bvh][errors]")
         require_error(minimal_bvh(1, "HIERARCHIE"), 1, "expected 'HIERARCHY', got 'HIERARCHIE'");
         require_error(minimal_bvh(6, "  BONE Chest"), 6, "got 'BONE'");
         require_error(minimal_bvh(8, "OFFSET 0 nan 0"), 8,
-                      "expected an OFFSET coordinate (a finite number), got 'nan'");
+                      "expected an OFFSET coordinate (a finite number, |x| <= 1e9), got 'nan'");
         require_error(minimal_bvh(2, "ROOT"), 2, "expected a joint name, got end of line");
         require_error("", 0, "expected 'HIERARCHY', got end of file");
     }

@@ -149,7 +149,9 @@ TEST_CASE("CSV: malformed files give FILE:LINE errors", "[mocap][csv][errors]")
                   "expected 4 cells (as the header), got 3");
     require_error("time,m.x,m.y,m.z\n0,0,abc,0\n", 2,
                   "expected a number or an empty cell in column 3, got 'abc'");
-    require_error("time,m.x,m.y,m.z\n0,0,inf,0\n", 2, "expected a finite number in column 3");
+    require_error("time,m.x,m.y,m.z\n0,0,inf,0\n", 2,
+                  "expected a finite number (|x| <= 1e9) in column 3");
+    require_error("time,m.x,m.y,m.z\n0,0,2e9,0\n", 2, "got '2e9'");
     require_error("time,m.x,m.y,m.z\n,0,0,0\n", 2, "expected a time (s), got an empty cell");
     require_error("time,m.x,m.y,m.z,m.qw,m.qx,m.qy,m.qz\n0,0,0,0,0,0,0,0\n", 2,
                   "expected a non-zero quaternion for m");

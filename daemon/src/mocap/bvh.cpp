@@ -23,6 +23,8 @@ constexpr int kMaxJoints = 10000;
 constexpr int kMaxDepth = 500;          // nesting; guards the recursion
 constexpr double kMinFrameTimeS = 1e-5; // 100 kHz
 constexpr double kMaxFrameTimeS = 60.0;
+// Larger values are absurd for lengths or angles and could overflow in sums.
+constexpr double kMaxMagnitude = 1e9;
 
 // Walks the tokens of the hierarchy section, line by line.
 class Cursor
@@ -61,8 +63,9 @@ class Cursor
     {
         const std::string token = next(what);
         double value = 0.0;
-        if (!detail::parse_double(token, value) || !std::isfinite(value))
-            fail(what + " (a finite number)", token);
+        if (!detail::parse_double(token, value) || !std::isfinite(value) ||
+            std::fabs(value) > kMaxMagnitude)
+            fail(what + " (a finite number, |x| <= 1e9)", token);
         return value;
     }
 
@@ -361,10 +364,12 @@ class BvhParser
                                      std::to_string(read + 1) + ", got " +
                                      std::to_string(tokens.size()));
             for (std::size_t c = 0; c < channel_count; ++c) {
-                if (!detail::parse_double(tokens[c], values[c]) || !std::isfinite(values[c]))
+                if (!detail::parse_double(tokens[c], values[c]) || !std::isfinite(values[c]) ||
+                    std::fabs(values[c]) > kMaxMagnitude)
                     throw MocapError(source_, line_number,
-                                     "expected a finite number in column " + std::to_string(c) +
-                                         " (" + channel_label(c) + "), got " + quote(tokens[c]));
+                                     "expected a finite number (|x| <= 1e9) in column " +
+                                         std::to_string(c) + " (" + channel_label(c) + "), got " +
+                                         quote(tokens[c]));
             }
             if (read >= options_.skip_frames)
                 add_frame(values, joint_count);

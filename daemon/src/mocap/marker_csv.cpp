@@ -190,10 +190,10 @@ class CsvParser
             throw MocapError(source_, line,
                              "expected a number or an empty cell in column " +
                                  std::to_string(column + 1) + ", got " + quote(cell));
-        if (std::isinf(value))
+        if (std::isinf(value) || std::fabs(value) > 1e9) // absurd; could overflow later
             throw MocapError(source_, line,
-                             "expected a finite number in column " + std::to_string(column + 1) +
-                                 ", got " + quote(cell));
+                             "expected a finite number (|x| <= 1e9) in column " +
+                                 std::to_string(column + 1) + ", got " + quote(cell));
         return value;
     }
 

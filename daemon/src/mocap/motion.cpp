@@ -107,9 +107,9 @@ void check_rate(double rate_hz)
 std::size_t output_count(double duration_s, double rate_hz)
 {
     const double count = std::floor(duration_s * rate_hz + 1e-9) + 1.0;
-    if (count > 1e8)
+    if (count > 1e7)
         throw MocapError("resample", 0,
-                         "expected at most 1e8 output frames, got " + std::to_string(count));
+                         "expected at most 1e7 output frames, got " + std::to_string(count));
     return static_cast<std::size_t>(count);
 }
 
