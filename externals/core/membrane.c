@@ -799,7 +799,7 @@ static void solve_contacts(membrane *m, membrane_kernel_args *a, contact **act, 
                 if (j != i)
                     xf -= K[i][j] * F[j];
             double C = T * T / (2.0 * c->mass_kg) + K[i][i];
-            double Fi = contact_solve_(c, c->compression, xf, C, T, &x1[i]);
+            double Fi = contact_solve_(c, c->compression, xf, C, T, c->force, &x1[i]);
             change += fabs(Fi - F[i]);
             F[i] = Fi;
         }

@@ -67,8 +67,9 @@ int membrane_capacity_(const membrane *m);
 void membrane_mode_shapes_(const membrane *m, double r_over_a, double theta_deg, float *psi);
 /* Discrete-gradient Hunt-Crossley force for a compression step x0 -> x1 (contact.c). */
 double contact_force_law_(const contact *c, double x0, double x1, double dt);
-/* Solves x1 = x_free - compliance * F(x0, x1) for the compression x1; returns F. */
+/* Solves x1 = x_free - compliance * F(x0, x1) for the compression x1; returns F.
+ * force_guess (e.g. the last sample's force, or 0) only speeds it up. */
 double contact_solve_(const contact *c, double x0, double x_free, double compliance, double dt,
-                      double *x1);
+                      double force_guess, double *x1);
 
 #endif
