@@ -58,6 +58,9 @@ void contact_free(contact *c)
         membrane_detach_contact(c->owner, c);
     free(c->psi);
     free(c->psi_next);
+    free(c->gq);
+    free(c->gp);
+    free(c->wd);
     free(c);
 }
 

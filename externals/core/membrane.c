@@ -251,13 +251,14 @@ static ictus_status build_modes(membrane *m, int modes)
             impulse[i] = alloc_floats(cap);
             ok = ok && impulse[i];
         }
-        float *cpsi[MEMBRANE_MAX_CONTACTS][2];
+        float *cpsi[MEMBRANE_MAX_CONTACTS][5];
         for (int i = 0; i < MEMBRANE_MAX_CONTACTS; i++) {
-            cpsi[i][0] = cpsi[i][1] = NULL;
-            if (i < m->contact_count) {
-                cpsi[i][0] = alloc_floats(cap);
-                cpsi[i][1] = alloc_floats(cap);
-                ok = ok && cpsi[i][0] && cpsi[i][1];
+            for (int j = 0; j < 5; j++) {
+                cpsi[i][j] = NULL;
+                if (i < m->contact_count) {
+                    cpsi[i][j] = alloc_floats(cap);
+                    ok = ok && cpsi[i][j];
+                }
             }
         }
         if (!ok) {
@@ -268,7 +269,8 @@ static ictus_status build_modes(membrane *m, int modes)
             for (int i = 0; i < IMPULSE_CACHE; i++)
                 free(impulse[i]);
             for (int i = 0; i < MEMBRANE_MAX_CONTACTS; i++)
-                free(cpsi[i][0]), free(cpsi[i][1]);
+                for (int j = 0; j < 5; j++)
+                    free(cpsi[i][j]);
             return ICTUS_ENOMEM;
         }
         int k = 0;
@@ -318,9 +320,12 @@ static ictus_status build_modes(membrane *m, int modes)
         }
         for (int i = 0; i < m->contact_count; i++) {
             contact *c = m->contacts[i];
-            free(c->psi), free(c->psi_next);
+            free(c->psi), free(c->psi_next), free(c->gq), free(c->gp), free(c->wd);
             c->psi = cpsi[i][0];
             c->psi_next = cpsi[i][1];
+            c->gq = cpsi[i][2];
+            c->gp = cpsi[i][3];
+            c->wd = cpsi[i][4];
             c->psi_cap = cap;
         }
         m->capacity = cap;
@@ -391,6 +396,11 @@ static void contact_couplings(membrane *m, contact *c)
     double K = 0.0;
     for (int k = 0; k < m->count; k++)
         K += (double)c->psi[k] * c->psi[k] * m->dm[k] * m->eq[k];
+    for (int k = 0; k < m->capacity; k++) {
+        c->gq[k] = m->eq[k] * c->psi[k];
+        c->gp[k] = m->ep[k] * c->psi[k];
+        c->wd[k] = m->dm[k] * c->psi[k];
+    }
     c->self_compliance = K;
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
         c->pick_coupling[j] = dot_psi(m, m->psi_pick[j], c->psi, m->ep);
@@ -657,16 +667,23 @@ ictus_status membrane_attach_contact(membrane *m, contact *c)
         return ICTUS_ENOMEM;
     if (c->owner)
         membrane_detach_contact(c->owner, c);
-    float *a = alloc_floats(m->capacity), *b = alloc_floats(m->capacity);
-    if (!a || !b) {
-        free(a);
-        free(b);
+    float *arr[5];
+    int ok = 1;
+    for (int j = 0; j < 5; j++) {
+        arr[j] = alloc_floats(m->capacity);
+        ok = ok && arr[j];
+    }
+    if (!ok) {
+        for (int j = 0; j < 5; j++)
+            free(arr[j]);
         return ICTUS_ENOMEM;
     }
-    free(c->psi);
-    free(c->psi_next);
-    c->psi = a;
-    c->psi_next = b;
+    free(c->psi), free(c->psi_next), free(c->gq), free(c->gp), free(c->wd);
+    c->psi = arr[0];
+    c->psi_next = arr[1];
+    c->gq = arr[2];
+    c->gp = arr[3];
+    c->wd = arr[4];
     c->psi_cap = m->capacity;
     c->owner = m;
     c->slot = m->contact_count;
@@ -716,7 +733,7 @@ static void add_input(membrane *m, const float *psi, double force, membrane_kern
         for (int j = 0; j < MEMBRANE_PICKUPS; j++)
             dpick[j] += (double)m->psi_pick[j][k] * dp;
         for (int c = 0; c < a->contacts; c++)
-            dw[c] += (double)a->psi_contact[c][k] * m->dm[k] * dq;
+            dw[c] += (double)a->contact_wd[c][k] * dq;
     }
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
         a->pick_sum[j] += dpick[j];
@@ -890,13 +907,17 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             contact *ct = m->contacts[c];
             if (ct->active) {
                 act[na] = ct;
-                a.psi_contact[na] = ct->psi;
+                a.contact_gq[na] = ct->gq;
+                a.contact_gp[na] = ct->gp;
+                a.contact_wd[na] = ct->wd;
                 a.contact_force_pending[na] = (float)ct->force_pending;
                 na++;
             } else if (ct->force_pending != 0.0) {
                 /* A stroke just ended: its last force still has to go in. */
                 act[na] = ct;
-                a.psi_contact[na] = ct->psi;
+                a.contact_gq[na] = ct->gq;
+                a.contact_gp[na] = ct->gp;
+                a.contact_wd[na] = ct->wd;
                 a.contact_force_pending[na] = (float)ct->force_pending;
                 na++;
             }

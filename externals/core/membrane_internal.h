@@ -19,10 +19,13 @@ typedef struct membrane_kernel_args {
     const float *psi_pick[MEMBRANE_PICKUPS];
     float strike_force; /* N, at the strike point, during this sample */
     int contacts;       /* contacts whose displacement is wanted */
-    const float *psi_contact[MEMBRANE_MAX_CONTACTS];
+    /* Per contact: eq * psi, ep * psi (input vectors) and dm * psi (displacement
+     * weights), precomputed when the stroke or the coefficients change. */
+    const float *contact_gq[MEMBRANE_MAX_CONTACTS], *contact_gp[MEMBRANE_MAX_CONTACTS];
+    const float *contact_wd[MEMBRANE_MAX_CONTACTS];
     float contact_force_pending[MEMBRANE_MAX_CONTACTS]; /* last sample's forces, not yet in q, p */
     double pick_sum[MEMBRANE_PICKUPS];                  /* out: sum psi_pick * p */
-    double contact_w[MEMBRANE_MAX_CONTACTS];            /* out: sum psi_contact * dm * q */
+    double contact_w[MEMBRANE_MAX_CONTACTS];            /* out: sum wd * q */
 } membrane_kernel_args;
 
 void membrane_kernel_generic(membrane_kernel_args *a);
@@ -36,6 +39,7 @@ struct contact {
      * point of a hit that has not landed yet. Owned by the contact, sized by
      * the owner's capacity. */
     float *psi, *psi_next;
+    float *gq, *gp, *wd; /* eq psi, ep psi, dm psi at the stroke point */
     int psi_cap;
     /* A hit waiting to land. */
     int hit_pending, hit_offset;
