@@ -1,0 +1,422 @@
+/* ictus_timetag -- turns OSC bundle timetags into Pd logical-time delays.
+ *
+ * Vanilla Pd ignores OSC timetags ([oscparse] drops them) and has no object
+ * that reads the wall clock, and its 32-bit floats cannot hold an NTP time.
+ * This object takes the bytes of one UDP packet from [netreceive -u -b], checks
+ * them, unwraps bundles (nested ones too) and, for every OSC message inside,
+ * outputs first the delay (ms of logical time from now) at which the message
+ * should take effect, then the message's bytes, ready for [oscparse]. The
+ * patch schedules with that delay ([pipe], [delay]); membrane~/contact~ turn
+ * the resulting logical time into an exact sample.
+ *
+ * Clock mapping. The timetag is wall-clock time (NTP, CLOCK_REALTIME). Pd's
+ * logical time runs off the scheduler (the audio device, or the system clock
+ * with -nosound), so the object estimates the offset
+ *     O = wall - logical
+ * as the minimum of samples (wall now - logical now) taken every
+ * ICTUS_TIMETAG_SAMPLE_MS and on each packet: Pd never runs a logical time
+ * before its wall time, only late (scheduling, polling, load), so the smallest
+ * sample is the closest to the true mapping. The minimum is taken over a sliding
+ * window of ICTUS_TIMETAG_BUCKETS buckets of ICTUS_TIMETAG_BUCKET_MS each, so
+ * that it follows a slow drift between the audio clock and the wall clock (100
+ * ppm drifts 0.2 ms over the 2 s window). A message in a bundle with timetag T
+ * then takes effect at logical time T - O - latency, i.e. its delay is
+ *     delay = T - latency - O - logical_now  (ms)
+ * where `latency` (message, default 0) is the audio output latency to subtract
+ * so that the sound, not the computation, lands at T. A bundle already due
+ * (delay < 0) is late: its messages get delay 0 (fire now) and the late count
+ * goes up. Timetag 1 ("immediately") and plain messages get delay 0, not late.
+ *
+ * Outlets, right to left: info (`late <ms_late> <count>` per late bundle,
+ * `malformed <count> <reason>` per bad packet, `status ...` on request), the
+ * delay (float, ms), the message bytes (list). */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+#include <time.h>
+
+#include "m_pd.h"
+
+#if defined(__GNUC__)
+#define ICTUS_TIMETAG_EXPORT __attribute__((visibility("default")))
+#else
+#define ICTUS_TIMETAG_EXPORT
+#endif
+
+#define ICTUS_TIMETAG_SAMPLE_MS 2.0   /* offset sampling period */
+#define ICTUS_TIMETAG_BUCKET_MS 500.0 /* one bucket of the sliding minimum */
+#define ICTUS_TIMETAG_BUCKETS   4     /* window = 3..4 buckets = 1.5..2 s */
+#define ICTUS_TIMETAG_MAX_BYTES 65536 /* larger than any UDP datagram */
+#define ICTUS_TIMETAG_MAX_DEPTH 8     /* nested bundles */
+#define ICTUS_TIMETAG_MAX_POSTS 5     /* malformed packets reported in full */
+/* Seconds from the NTP epoch (1900) to the Unix epoch (1970). */
+#define ICTUS_NTP_UNIX_OFFSET 2208988800.0
+
+static t_class *ictus_timetag_class;
+
+typedef struct _ictus_timetag {
+    t_object x_obj;
+    t_outlet *x_bytes_out;
+    t_outlet *x_delay_out;
+    t_outlet *x_info_out;
+    t_clock *x_sample_clock;
+    double x_wall_base_s;                       /* CLOCK_REALTIME seconds at creation (whole) */
+    double x_logical_base;                      /* clock_getlogicaltime() at creation */
+    double x_bucket_min[ICTUS_TIMETAG_BUCKETS]; /* min offset per bucket (ms) */
+    long x_bucket_index;                        /* index of the current bucket */
+    int x_have_offset;
+    double x_latency_ms;
+    double x_late_count;
+    double x_malformed_count;
+    double x_packet_count;
+    unsigned char *x_buf; /* packet bytes */
+    int x_buf_size;
+    t_atom *x_atoms; /* one message's bytes as floats */
+    int x_atoms_size;
+} t_ictus_timetag;
+
+/* Wall-clock milliseconds since x_wall_base_s (a double keeps ~0.1 us here). */
+static double ictus_timetag_wall_ms(const t_ictus_timetag *x)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return ((double)ts.tv_sec - x->x_wall_base_s) * 1000.0 + (double)ts.tv_nsec * 1e-6;
+}
+
+static double ictus_timetag_logical_ms(const t_ictus_timetag *x)
+{
+    return clock_gettimesince(x->x_logical_base);
+}
+
+/* One offset sample into the sliding minimum. */
+static void ictus_timetag_sample(t_ictus_timetag *x)
+{
+    double logical = ictus_timetag_logical_ms(x);
+    double offset = ictus_timetag_wall_ms(x) - logical;
+    long bucket = (long)floor(logical / ICTUS_TIMETAG_BUCKET_MS);
+    int i;
+    if (!x->x_have_offset || bucket - x->x_bucket_index >= ICTUS_TIMETAG_BUCKETS) {
+        for (i = 0; i < ICTUS_TIMETAG_BUCKETS; i++)
+            x->x_bucket_min[i] = offset;
+        x->x_have_offset = 1;
+    } else {
+        /* buckets skipped since the last sample start empty (= this sample) */
+        for (long b = x->x_bucket_index + 1; b <= bucket; b++)
+            x->x_bucket_min[b % ICTUS_TIMETAG_BUCKETS] = offset;
+    }
+    x->x_bucket_index = bucket;
+    if (offset < x->x_bucket_min[bucket % ICTUS_TIMETAG_BUCKETS])
+        x->x_bucket_min[bucket % ICTUS_TIMETAG_BUCKETS] = offset;
+}
+
+static double ictus_timetag_offset(const t_ictus_timetag *x)
+{
+    double m = x->x_bucket_min[0];
+    int i;
+    for (i = 1; i < ICTUS_TIMETAG_BUCKETS; i++)
+        if (x->x_bucket_min[i] < m)
+            m = x->x_bucket_min[i];
+    return m;
+}
+
+static void ictus_timetag_tick(t_ictus_timetag *x)
+{
+    ictus_timetag_sample(x);
+    clock_delay(x->x_sample_clock, ICTUS_TIMETAG_SAMPLE_MS);
+}
+
+static void ictus_timetag_malformed(t_ictus_timetag *x, const char *reason, int offset)
+{
+    t_atom info[2];
+    x->x_malformed_count++;
+    if (x->x_malformed_count <= ICTUS_TIMETAG_MAX_POSTS)
+        pd_error(x, "ictus_timetag: malformed OSC packet (%s at byte %d)%s", reason, offset,
+                 x->x_malformed_count == ICTUS_TIMETAG_MAX_POSTS
+                     ? "; further ones are only counted (info outlet)"
+                     : "");
+    SETFLOAT(&info[0], (t_float)x->x_malformed_count);
+    SETSYMBOL(&info[1], gensym(reason));
+    outlet_anything(x->x_info_out, gensym("malformed"), 2, info);
+}
+
+static uint32_t ictus_timetag_u32(const unsigned char *p)
+{
+    return ((uint32_t)p[0] << 24) | ((uint32_t)p[1] << 16) | ((uint32_t)p[2] << 8) | p[3];
+}
+
+/* Length of the OSC string at p (with its 1..4 NUL padding bytes), or -1 if it
+ * does not end inside n bytes. */
+static int ictus_timetag_osc_string(const unsigned char *p, int n)
+{
+    int i;
+    for (i = 0; i < n; i++)
+        if (p[i] == 0)
+            return (i + 4) & ~3;
+    return -1;
+}
+
+/* Checks one OSC message (address, type tags, arguments) so that [oscparse]
+ * only ever gets well-formed input. Returns NULL or the reason. */
+static const char *ictus_timetag_check_message(const unsigned char *p, int n)
+{
+    int pos, len, tags, t;
+    if (n < 4 || (n & 3))
+        return "message-size";
+    if (p[0] != '/')
+        return "message-start";
+    if ((len = ictus_timetag_osc_string(p, n)) < 0 || len > n)
+        return "address";
+    pos = len;
+    if (pos == n)
+        return NULL; /* no type tag string: an old-style message without arguments */
+    if (p[pos] != ',')
+        return "type-tags";
+    if ((len = ictus_timetag_osc_string(p + pos, n - pos)) < 0 || pos + len > n)
+        return "type-tags";
+    tags = pos + 1;
+    pos += len;
+    for (t = tags; p[t] != 0; t++) {
+        int size;
+        switch (p[t]) {
+        case 'i':
+        case 'f':
+        case 'c':
+        case 'r':
+        case 'm':
+            size = 4;
+            break;
+        case 'h':
+        case 't':
+        case 'd':
+            size = 8;
+            break;
+        case 'T':
+        case 'F':
+        case 'N':
+        case 'I':
+            size = 0;
+            break;
+        case 's':
+        case 'S':
+            if ((size = ictus_timetag_osc_string(p + pos, n - pos)) < 0)
+                return "string-argument";
+            break;
+        case 'b':
+            if (pos + 4 > n)
+                return "blob-size";
+            size = 4 + (int)((ictus_timetag_u32(p + pos) + 3u) & ~3u);
+            if (size < 4)
+                return "blob-size";
+            break;
+        default:
+            return "unknown-type-tag";
+        }
+        if (size > n - pos)
+            return "arguments-short";
+        pos += size;
+    }
+    return pos == n ? NULL : "trailing-bytes";
+}
+
+/* Delay (ms of logical time) for a bundle with this NTP timetag; counts and
+ * reports late bundles. */
+static t_float ictus_timetag_delay(t_ictus_timetag *x, uint32_t seconds, uint32_t fraction)
+{
+    double tag_ms, delay;
+    if (seconds == 0 && fraction <= 1)
+        return 0; /* "immediately" */
+    tag_ms = ((double)seconds - ICTUS_NTP_UNIX_OFFSET - x->x_wall_base_s) * 1000.0 +
+             (double)fraction * (1000.0 / 4294967296.0);
+    delay = tag_ms - x->x_latency_ms - ictus_timetag_offset(x) - ictus_timetag_logical_ms(x);
+    if (delay < 0) {
+        t_atom info[2];
+        x->x_late_count++;
+        SETFLOAT(&info[0], (t_float)-delay);
+        SETFLOAT(&info[1], (t_float)x->x_late_count);
+        outlet_anything(x->x_info_out, gensym("late"), 2, info);
+        return 0;
+    }
+    return (t_float)delay;
+}
+
+/* Checks a whole element (message or bundle) before anything of it is output,
+ * so that a bad packet never produces half its messages. */
+static const char *ictus_timetag_check(const unsigned char *p, int n, int depth, int *where)
+{
+    int pos;
+    if (n >= 8 && !memcmp(p, "#bundle", 8)) {
+        if (depth >= ICTUS_TIMETAG_MAX_DEPTH)
+            return "bundle-depth";
+        if (n < 16)
+            return "bundle-timetag";
+        for (pos = 16; pos < n;) {
+            uint32_t size;
+            const char *why;
+            if (n - pos < 4)
+                return "element-size";
+            size = ictus_timetag_u32(p + pos);
+            if (size == 0 || (size & 3) || size > (uint32_t)(n - pos - 4)) {
+                *where = pos;
+                return "element-size";
+            }
+            if ((why = ictus_timetag_check(p + pos + 4, (int)size, depth + 1, where))) {
+                *where += pos + 4;
+                return why;
+            }
+            pos += 4 + (int)size;
+        }
+        return NULL;
+    }
+    *where = 0;
+    return ictus_timetag_check_message(p, n);
+}
+
+static void ictus_timetag_output_message(t_ictus_timetag *x, const unsigned char *p, int n,
+                                         t_float delay)
+{
+    int i;
+    if (n > x->x_atoms_size) {
+        /* message domain: allocation is fine here (never in DSP) */
+        t_atom *a =
+            (t_atom *)resizebytes(x->x_atoms, sizeof(t_atom) * x->x_atoms_size, sizeof(t_atom) * n);
+        if (!a) {
+            pd_error(x, "ictus_timetag: out of memory for a %d-byte message", n);
+            return;
+        }
+        x->x_atoms = a;
+        x->x_atoms_size = n;
+    }
+    for (i = 0; i < n; i++)
+        SETFLOAT(&x->x_atoms[i], p[i]);
+    outlet_float(x->x_delay_out, delay);
+    outlet_list(x->x_bytes_out, &s_list, n, x->x_atoms);
+}
+
+/* Outputs the messages of an already checked element; a nested bundle's own
+ * timetag applies to its messages (OSC 1.0 says it must not be earlier than
+ * the enclosing one; it is used as it is). */
+static void ictus_timetag_output(t_ictus_timetag *x, const unsigned char *p, int n, t_float delay)
+{
+    int pos;
+    if (n >= 8 && !memcmp(p, "#bundle", 8)) {
+        t_float bundle_delay =
+            ictus_timetag_delay(x, ictus_timetag_u32(p + 8), ictus_timetag_u32(p + 12));
+        for (pos = 16; pos < n;) {
+            int size = (int)ictus_timetag_u32(p + pos);
+            ictus_timetag_output(x, p + pos + 4, size, bundle_delay);
+            pos += 4 + size;
+        }
+        return;
+    }
+    ictus_timetag_output_message(x, p, n, delay);
+}
+
+static void ictus_timetag_list(t_ictus_timetag *x, t_symbol *s, int argc, t_atom *argv)
+{
+    int i, where = 0;
+    const char *why;
+    (void)s;
+    x->x_packet_count++;
+    ictus_timetag_sample(x);
+    if (argc < 1 || argc > ICTUS_TIMETAG_MAX_BYTES) {
+        ictus_timetag_malformed(x, "packet-size", argc);
+        return;
+    }
+    if (argc > x->x_buf_size) {
+        unsigned char *b = (unsigned char *)resizebytes(x->x_buf, x->x_buf_size, argc);
+        if (!b) {
+            pd_error(x, "ictus_timetag: out of memory for a %d-byte packet", argc);
+            return;
+        }
+        x->x_buf = b;
+        x->x_buf_size = argc;
+    }
+    for (i = 0; i < argc; i++) {
+        t_float f = atom_getfloatarg(i, argc, argv);
+        if (argv[i].a_type != A_FLOAT || f < 0 || f > 255 || f != (t_float)(int)f) {
+            ictus_timetag_malformed(x, "not-a-byte", i);
+            return;
+        }
+        x->x_buf[i] = (unsigned char)f;
+    }
+    if ((why = ictus_timetag_check(x->x_buf, argc, 0, &where))) {
+        ictus_timetag_malformed(x, why, where);
+        return;
+    }
+    ictus_timetag_output(x, x->x_buf, argc, 0);
+}
+
+/* latency <ms>: audio output latency to subtract from every delay. */
+static void ictus_timetag_latency(t_ictus_timetag *x, t_floatarg ms)
+{
+    if (!(ms >= 0 && ms <= 10000)) {
+        pd_error(x, "ictus_timetag: latency must be in [0, 10000] ms, got %g; using 0", ms);
+        ms = 0;
+    }
+    x->x_latency_ms = ms;
+}
+
+/* status: `status offset_ms late malformed packets` on the info outlet;
+ * offset_ms is the current estimate of wall - logical time (relative to the
+ * object's creation). */
+static void ictus_timetag_status(t_ictus_timetag *x)
+{
+    t_atom info[4];
+    SETFLOAT(&info[0], (t_float)ictus_timetag_offset(x));
+    SETFLOAT(&info[1], (t_float)x->x_late_count);
+    SETFLOAT(&info[2], (t_float)x->x_malformed_count);
+    SETFLOAT(&info[3], (t_float)x->x_packet_count);
+    outlet_anything(x->x_info_out, gensym("status"), 4, info);
+}
+
+static void ictus_timetag_reset(t_ictus_timetag *x)
+{
+    x->x_late_count = x->x_malformed_count = x->x_packet_count = 0;
+    x->x_have_offset = 0;
+    ictus_timetag_sample(x);
+}
+
+static void *ictus_timetag_new(t_floatarg latency_ms)
+{
+    t_ictus_timetag *x = (t_ictus_timetag *)pd_new(ictus_timetag_class);
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    x->x_wall_base_s = (double)ts.tv_sec;
+    x->x_logical_base = clock_getlogicaltime();
+    x->x_bytes_out = outlet_new(&x->x_obj, &s_list);
+    x->x_delay_out = outlet_new(&x->x_obj, &s_float);
+    x->x_info_out = outlet_new(&x->x_obj, 0);
+    x->x_buf = NULL;
+    x->x_buf_size = 0;
+    x->x_atoms = NULL;
+    x->x_atoms_size = 0;
+    x->x_have_offset = 0;
+    x->x_bucket_index = 0;
+    x->x_late_count = x->x_malformed_count = x->x_packet_count = 0;
+    ictus_timetag_latency(x, latency_ms);
+    ictus_timetag_sample(x);
+    x->x_sample_clock = clock_new(x, (t_method)ictus_timetag_tick);
+    clock_delay(x->x_sample_clock, ICTUS_TIMETAG_SAMPLE_MS);
+    return x;
+}
+
+static void ictus_timetag_free(t_ictus_timetag *x)
+{
+    clock_free(x->x_sample_clock);
+    if (x->x_buf)
+        freebytes(x->x_buf, x->x_buf_size);
+    if (x->x_atoms)
+        freebytes(x->x_atoms, sizeof(t_atom) * x->x_atoms_size);
+}
+
+ICTUS_TIMETAG_EXPORT void ictus_timetag_setup(void)
+{
+    ictus_timetag_class = class_new(gensym("ictus_timetag"), (t_newmethod)ictus_timetag_new,
+                                    (t_method)ictus_timetag_free, sizeof(t_ictus_timetag),
+                                    CLASS_DEFAULT, A_DEFFLOAT, 0);
+    class_addlist(ictus_timetag_class, ictus_timetag_list);
+    class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_latency, gensym("latency"),
+                    A_FLOAT, 0);
+    class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_status, gensym("status"), 0);
+    class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_reset, gensym("reset"), 0);
+}
