@@ -293,3 +293,37 @@ TEST_CASE("Two sticks at once: joint solve stays passive and both report", "[cor
     CHECK(e_out < e0);
     membrane_free(m);
 }
+
+TEST_CASE("Force buffer carries the stroke; the report is made once", "[core][contact]")
+{
+    const double fs = 48000.0;
+    membrane *m = membrane_new(fs);
+    contact *c = contact_new();
+    membrane_attach_contact(m, c);
+    std::vector<float> force(64), o0(64), o1(64);
+    float *outs[2] = {o0.data(), o1.data()};
+    contact_set_force_output(c, force.data(), 64);
+    contact_hit(c, 2.0, 0.3, 0.0, 10);
+    double integral = 0.0, peak = 0.0;
+    int first = -1, reports = 0;
+    contact_report rep{};
+    for (int b = 0; b < 200; b++) {
+        membrane_process(m, nullptr, outs, 64);
+        for (int i = 0; i < 64; i++) {
+            if (first < 0 && force[(size_t)i] > 0.0f)
+                first = b * 64 + i;
+            integral += force[(size_t)i] / fs;
+            peak = std::max(peak, (double)force[(size_t)i]);
+        }
+        reports += contact_take_report(c, &rep);
+    }
+    CHECK(first == 10); // the hit lands at its offset and pushes in that sample
+    REQUIRE(reports == 1);
+    CHECK(integral == Approx(rep.impulse_ns).epsilon(1e-5));
+    CHECK(peak == Approx(rep.peak_force_n).epsilon(1e-6));
+    // Momentum: the stick's change of momentum is the impulse.
+    CHECK(rep.impulse_ns ==
+          Approx(contact_get_mass(c) * (2.0 + rep.rebound_velocity_mps)).epsilon(1e-9));
+    membrane_free(m);
+    contact_free(c);
+}
