@@ -58,3 +58,5 @@ def strike(seq, hand, velocity=2.0, r_over_a=0.3, theta_deg=0.0, bounce=0, time_
 def now():
     """Wall-clock time (CLOCK_REALTIME, as Pd's [ictus_timetag] reads it)."""
     return time.clock_gettime(time.CLOCK_REALTIME)
+
+IMMEDIATE = struct.pack(">II", 0, 1)  # the OSC timetag "immediately"

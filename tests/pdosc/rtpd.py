@@ -1,0 +1,191 @@
+"""Runs the real pd binary in real time (no -batch: Pd's clock follows the
+system clock) with [ictus-receive PORT], and listens to what the patch reports
+back over UDP (FUDI text, [netsend -u]):
+
+    tick <logical_ms>;            every 2 ms of logical time ([metro 2] + [timer])
+    fire <logical_ms> <strike>;   when a strike comes out of ictus-receive
+    plain <logical_ms> <seq>;     (optional) a strike parsed by a bare [oscparse]
+    pose ... / reply ... / info ...;   the other outlets
+
+Python stamps each report with CLOCK_REALTIME on arrival. The smallest
+(arrival - logical_ms) over the ticks maps logical time to wall time,
+independently of [ictus_timetag] (another process, another clock read, another
+path): Pd runs a logical time no earlier than its wall time, so the smallest
+observed difference is the mapping (plus the loopback's few tens of us)."""
+import os
+import re
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "pd"))
+from pdrun import PD, PD_ENV, Patch, make_workdir  # noqa: E402
+from oscpacket import now  # noqa: E402
+
+
+def free_udp_port():
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+class Listener:
+    """UDP socket that stamps every datagram with the wall clock on arrival."""
+
+    def __init__(self):
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.settimeout(0.2)
+        self.port = self.sock.getsockname()[1]
+        self.items = []  # (wall_s, bytes)
+        self.lock = threading.Lock()
+        self.running = True
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self):
+        while self.running:
+            try:
+                data = self.sock.recv(65536)
+            except socket.timeout:
+                continue
+            except OSError:
+                return
+            t = now()
+            with self.lock:
+                self.items.append((t, data))
+
+    def snapshot(self):
+        with self.lock:
+            return list(self.items)
+
+    def close(self):
+        self.running = False
+        self.thread.join()
+        self.sock.close()
+
+
+def fudi_records(items):
+    """(wall_s, [atoms]) per FUDI message; numbers as floats."""
+    out = []
+    for t, data in items:
+        for msg in re.split(r"(?<!\\);", data.decode(errors="replace")):
+            # FUDI escapes spaces, commas and semicolons inside a symbol
+            words = [re.sub(r"\\(.)", r"\1", w) for w in re.split(r"(?<!\\)\s+", msg.strip())
+                     if w]
+            if not words:
+                continue
+            atoms = []
+            for w in words:
+                try:
+                    atoms.append(float(w))
+                except ValueError:
+                    atoms.append(w)
+            out.append((t, atoms))
+    return out
+
+
+def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=None,
+                control_msgs=()):
+    """The real-time test patch (see the module doc). control_msgs go into
+    ictus-receive's inlet at 300 ms (after 'connect localhost ctl_port')."""
+    p = Patch(declare="-path %s/ictus" % build)
+    recv = p.obj("ictus-receive %d" % pd_port)
+    lb = p.obj("loadbang")
+    t = p.obj("t b b b b")
+    p.connect(lb, 0, t, 0)
+    net = p.obj("netsend -u")
+    conn = p.msg("connect localhost %d" % report_port)
+    p.connect(t, 3, conn, 0)
+    p.connect(conn, 0, net, 0)
+    timer = p.obj("timer")
+    p.connect(t, 2, timer, 0)
+
+    def report(src, outlet, prefix):
+        lp = p.obj("list prepend %s" % prefix)
+        ls = p.obj("list prepend send")
+        lt = p.obj("list trim")
+        p.connect(src, outlet, lp, 0)
+        p.connect(lp, 0, ls, 0)
+        p.connect(ls, 0, lt, 0)
+        p.connect(lt, 0, net, 0)
+
+    def stamped(src, outlet, prefix):
+        """report '<prefix> <logical_ms> <the message>' when src outputs."""
+        tba = p.obj("t b a")
+        app = p.obj("list append")
+        tim = p.obj("timer")
+        p.connect(t, 2, tim, 0)
+        p.connect(src, outlet, tba, 0)
+        p.connect(tba, 1, app, 1)
+        p.connect(tba, 0, tim, 1)
+        p.connect(tim, 0, app, 0)
+        report(app, 0, prefix)
+
+    metro = p.obj("metro 2")
+    p.connect(t, 1, metro, 0)
+    p.connect(metro, 0, timer, 1)
+    report(timer, 0, "tick")
+    stamped(recv, 0, "fire")
+    report(recv, 1, "pose")
+    report(recv, 2, "reply")
+    report(recv, 3, "info")
+    if plain_port:
+        # a bare [oscparse] path: strikes fire on arrival, timetag ignored
+        nr = p.obj("netreceive -u -b %d" % plain_port)
+        op = p.obj("oscparse")
+        lt = p.obj("list trim")
+        rt = p.obj("route ictus")
+        rs = p.obj("route strike")
+        seq = p.obj("list split 1")
+        p.connect(nr, 0, op, 0)
+        p.connect(op, 0, lt, 0)
+        p.connect(lt, 0, rt, 0)
+        p.connect(rt, 0, rs, 0)
+        p.connect(rs, 0, seq, 0)
+        stamped(seq, 0, "plain")
+    if ctl_port:
+        d = p.obj("delay 300")
+        p.connect(t, 0, d, 0)
+        msgs = ["connect localhost %d" % ctl_port] + list(control_msgs)
+        m = p.msg(" \\, ".join(msgs))
+        p.connect(d, 0, m, 0)
+        p.connect(m, 0, recv, 0)
+    end = p.obj("delay %d" % int(seconds * 1000))
+    q = p.msg("\\; pd quit")
+    p.connect(t, 0, end, 0)
+    p.connect(end, 0, q, 0)
+    return p.text()
+
+
+def start_pd(patch_text, build, sr=48000, name="rt.pd"):
+    """Starts pd in real time on the patch; returns (Popen, workdir)."""
+    work = make_workdir("ictus-pdosc-")
+    path = os.path.join(work, name)
+    with open(path, "w") as f:
+        f.write(patch_text)
+    cmd = [PD, "-nogui", "-nosound", "-stderr", "-r", str(sr), "-path",
+           os.path.join(build, "ictus"), "-open", path]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            cwd=work, env=PD_ENV)
+    return proc, work
+
+
+def wait_for_ticks(listener, timeout=20.0, count=20):
+    """Waits until pd reports `count` ticks (it is up and its ports are open)."""
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        if sum(1 for _, a in fudi_records(listener.snapshot()) if a and a[0] == "tick") >= count:
+            return True
+        time.sleep(0.02)
+    return False
+
+
+def wall_of_logical(records):
+    """Offset (s) such that wall = offset + logical_ms / 1000: the minimum of
+    arrival - logical over the tick reports."""
+    return min(t - a[1] / 1000.0 for t, a in records if a[0] == "tick")

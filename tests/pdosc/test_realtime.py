@@ -1,0 +1,149 @@
+"""Real time: pd without -batch (its clock follows the system clock) runs
+[ictus-receive]; this script sends hand-built OSC bundles over loopback with
+timetag = now + lookahead and checks that each strike comes out at the logical
+time that corresponds to its timetag, within 1 ms. The logical-to-wall mapping
+is measured here, from pd's own tick reports (rtpd.py), not taken from the
+code under test. Also: strike fields come out in the documented order, a
+late bundle fires at once and is counted, pose/reply messages pass through,
+and control messages reach the daemon side as /ictus/<name> OSC."""
+import argparse
+import os
+import socket
+import struct
+import time
+
+from oscpacket import bundle, message, now, strike, timetag, IMMEDIATE
+from rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd, wait_for_ticks,
+                  wall_of_logical)
+from pdrun import check, error_lines
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", required=True)
+args = ap.parse_args()
+build = os.path.abspath(args.build)
+
+N_STRIKES = 24
+LOOKAHEAD_S = 0.060
+SPACING_S = 0.045
+SECONDS = 6.0
+
+reports = Listener()
+ctl = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+ctl.bind(("127.0.0.1", 0))
+ctl.settimeout(0.1)
+pd_port = free_udp_port()
+patch = build_patch(build, pd_port, reports.port, SECONDS, ctl_port=ctl.getsockname()[1],
+                    control_msgs=["tempo 96", "grip french", "ping"])
+proc, work = start_pd(patch, build)
+out = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+try:
+    check(wait_for_ticks(reports), "pd runs in real time and reports ticks")
+    time.sleep(0.3)  # let ictus_timetag collect clock samples (it samples every 2 ms)
+    sent = {}  # seq -> (timetag_s, hand, velocity, r_over_a, theta)
+    t_next = now() + LOOKAHEAD_S
+    for seq in range(1, N_STRIKES + 1):
+        # send each bundle LOOKAHEAD_S before its time, as the daemon does
+        while now() < t_next - LOOKAHEAD_S:
+            time.sleep(0.0005)
+        hand, vel, ra, th = seq % 2, 0.5 + 0.25 * seq, 0.01 * seq, 7.0 * seq
+        out.sendto(bundle(timetag(t_next), strike(seq, hand, vel, ra, th)), ("127.0.0.1", pd_port))
+        sent[seq] = (t_next, hand, vel, ra, th)
+        t_next += SPACING_S
+    time.sleep(0.2)
+    # a bundle 30 ms overdue: fires at once, counted as late
+    late_seq = 1000
+    t_late = now() - 0.030
+    out.sendto(bundle(timetag(t_late), strike(late_seq, 1)), ("127.0.0.1", pd_port))
+    t_late_sent = now()
+    # pass-through: pose bundle (immediate), reply, error, pong
+    out.sendto(bundle(IMMEDIATE, message("/ictus/pose/frame", "if", 42, 1.5),
+                      message("/ictus/pose/body", "iffffffff", 3, 1, 2, 3, 4, 5, 6, 7, 8)),
+               ("127.0.0.1", pd_port))
+    out.sendto(message("/ictus/reply", "ss", "tempo", "ok"), ("127.0.0.1", pd_port))
+    out.sendto(message("/ictus/error", "ss", "grip", "unknown grip"), ("127.0.0.1", pd_port))
+    out.sendto(message("/ictus/pong", ""), ("127.0.0.1", pd_port))
+    control = []
+    t0 = time.time()
+    while time.time() - t0 < 1.0:
+        try:
+            control.append(ctl.recv(65536))
+        except socket.timeout:
+            pass
+    log, _ = proc.communicate(timeout=30)
+finally:
+    if proc.poll() is None:
+        proc.kill()
+        proc.communicate()
+    reports.close()
+
+records = fudi_records(reports.snapshot())
+check(proc.returncode == 0 and not error_lines(log), "pd ran cleanly: %s" % error_lines(log))
+offset = wall_of_logical(records)
+fires = {int(a[9]): (t, a) for t, a in records if a[0] == "fire"}
+check(set(sent) <= set(fires), "all %d strikes came out (got %d)" % (len(sent), len(fires)))
+errors_ms, arrival_ms = [], []
+for seq, (tag, hand, vel, ra, th) in sorted(sent.items()):
+    t_arr, a = fires[seq]
+    logical_ms = a[1]
+    fields = a[2:]
+    check(len(fields) == 17, "strike %d has 17 fields" % seq)
+    # documented order: hand velocity r/a theta force bounce drum seq time x y vt J dur dx dy dz
+    check(abs(fields[0] - hand) < 1e-6 and abs(fields[1] - vel) < 1e-4
+          and abs(fields[2] - ra) < 1e-5 and abs(fields[3] - th) < 1e-3
+          and abs(fields[4] - 50.0) < 1e-3 and fields[5] == 0 and fields[7] == seq,
+          "strike %d fields in the documented order: %s" % (seq, fields[:8]))
+    errors_ms.append((offset + logical_ms / 1000.0 - tag) * 1000.0)
+    arrival_ms.append((t_arr - tag) * 1000.0)
+worst = max(abs(e) for e in errors_ms)
+print("onset - timetag (ms), per strike: %s" % " ".join("%.3f" % e for e in errors_ms))
+print("report arrival - timetag (ms): min %.3f median %.3f max %.3f"
+      % (min(arrival_ms), sorted(arrival_ms)[len(arrival_ms) // 2], max(arrival_ms)))
+check(worst <= 1.0, "every strike starts at its timetag within 1 ms (worst %.3f ms)" % worst)
+
+t_arr, a = fires.get(late_seq, (None, None))
+check(a is not None, "the late bundle fired")
+late_fire = offset + a[1] / 1000.0
+check(abs(late_fire - t_late_sent) < 0.010,
+      "the late bundle fired on arrival (%.2f ms after sending)" % ((late_fire - t_late_sent) * 1e3))
+lates = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "late"]
+# lateness is counted against the logical time at which pd handled the packet,
+# i.e. (in this test's own mapping) the fire time minus the timetag
+expected_late_ms = (late_fire - t_late) * 1000.0
+check(len(lates) == 1 and abs(lates[0][2] - expected_late_ms) < 1.0 and lates[0][3] == 1,
+      "one late report, %.2f ms late (expected %.2f): %s" % (lates[0][2] if lates else -1,
+                                                             expected_late_ms, lates))
+
+poses = [a[1:] for _, a in records if a[0] == "pose"]
+check(["frame", 42.0, 1.5] in poses and ["body", 3.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]
+      in poses, "pose frame and body pass through: %s" % poses)
+replies = [a[1:] for _, a in records if a[0] == "reply"]
+check(["reply", "tempo", "ok"] in replies and ["error", "grip", "unknown grip"] in replies
+      and ["pong"] in replies, "reply, error and pong pass through: %s" % replies)
+
+
+def decode(packet):
+    """address, type tags, args of an OSC message (f, i, s only)."""
+    end = packet.index(b"\0")
+    addr = packet[:end].decode()
+    pos = (end + 4) & ~3
+    tend = packet.index(b"\0", pos)
+    tags = packet[pos + 1:tend].decode()
+    pos = (tend + 4) & ~3
+    out = []
+    for t in tags:
+        if t == "f":
+            out.append(struct.unpack(">f", packet[pos:pos + 4])[0])
+            pos += 4
+        elif t == "i":
+            out.append(struct.unpack(">i", packet[pos:pos + 4])[0])
+            pos += 4
+        elif t == "s":
+            e = packet.index(b"\0", pos)
+            out.append(packet[pos:e].decode())
+            pos = (e + 4) & ~3
+    return addr, tags, out
+
+
+got = [decode(p) for p in control]
+check(("/ictus/tempo", "f", [96.0]) in got and ("/ictus/grip", "s", ["french"]) in got
+      and ("/ictus/ping", "", []) in got, "control messages sent as OSC: %s" % got)
