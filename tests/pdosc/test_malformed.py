@@ -1,0 +1,89 @@
+"""Malformed packets sent to [ictus-receive]'s port are dropped whole, counted
+(info outlet `malformed <count> <reason>`), reported with an error naming
+ictus_timetag (the first 5 only), and break nothing: strikes sent afterwards
+still start at their timetag within 1 ms. A well-formed /ictus/strike with the
+wrong argument count is refused by the abstraction with a message naming it."""
+import argparse
+import os
+import socket
+import struct
+import sys
+import time
+
+from oscpacket import bundle, message, now, osc_string, strike, timetag
+from rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd, wait_for_ticks,
+                  wall_of_logical)
+from pdrun import check
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", required=True)
+args = ap.parse_args()
+build = os.path.abspath(args.build)
+
+good = bundle(timetag(now() + 100.0), strike(1, 0))
+bad = [b"garbage!", b"hello world;", b"\xff" * 4000, b"/ictus/strike",  # no NUL, size % 4
+       osc_string("/ictus/strike") + osc_string(",q") + b"\0" * 4,      # unknown type tag
+       osc_string("/ictus/strike") + osc_string(",iiii") + b"\0" * 8,   # arguments short
+       osc_string("/ictus/strike") + osc_string(",i") + b"\0" * 8,      # trailing bytes
+       osc_string("/ictus/x") + osc_string(",s") + b"abcd",             # string without NUL
+       osc_string("/ictus/x") + osc_string(",b") + struct.pack(">i", 1000),  # blob too long
+       b"#bundle\0" + timetag(now()) + struct.pack(">i", 1000) + b"/a\0\0",    # element too long
+       b"#bundle\0" + timetag(now()) + struct.pack(">i", 3) + b"/a\0\0",       # size % 4
+       b"#bundle\0" + timetag(now()) + struct.pack(">i", -8) + b"/a\0\0"]      # negative size
+nested = message("/ictus/pong", "")
+for _ in range(10):  # deeper than ictus_timetag's limit of 8
+    nested = bundle(timetag(now()), nested)
+bad.append(nested)
+# every truncation of a good strike bundle, except 16 bytes (a valid empty bundle)
+bad += [good[:n] for n in range(1, len(good)) if n != 16]
+wrong_count = bundle(timetag(now()), message("/ictus/strike", "ii", 1, 2))
+
+reports = Listener()
+pd_port = free_udp_port()
+proc, work = start_pd(build_patch(build, pd_port, reports.port, 5.0), build)
+out = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+sent = {}
+try:
+    check(wait_for_ticks(reports), "pd runs in real time and reports ticks")
+    for i, packet in enumerate(bad):
+        out.sendto(packet, ("127.0.0.1", pd_port))
+        if i % 10 == 9:
+            time.sleep(0.005)  # stay well inside the socket's receive buffer
+    out.sendto(good[:16], ("127.0.0.1", pd_port))
+    out.sendto(wrong_count, ("127.0.0.1", pd_port))
+    time.sleep(0.3)
+    t = now() + 0.05
+    for seq in range(1, 11):
+        while now() < t - 0.05:
+            time.sleep(0.0005)
+        out.sendto(bundle(timetag(t), strike(seq, seq % 2)), ("127.0.0.1", pd_port))
+        sent[seq] = t
+        t += 0.04
+    log, _ = proc.communicate(timeout=30)
+finally:
+    if proc.poll() is None:
+        proc.kill()
+        proc.communicate()
+    reports.close()
+
+records = fudi_records(reports.snapshot())
+print(log)
+check(proc.returncode == 0, "pd exited normally (%s)" % proc.returncode)
+malformed = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "malformed"]
+check(len(malformed) == len(bad) and malformed[-1][2] == len(bad),
+      "each of the %d malformed packets counted once (%d reports, last count %s)"
+      % (len(bad), len(malformed), malformed[-1][2] if malformed else None))
+lines = [l for l in log.splitlines() if l.strip()]
+timetag_errors = [l for l in lines if "ictus_timetag: malformed OSC packet" in l]
+check(len(timetag_errors) == 5, "the first 5 malformed packets are reported by name (%d)"
+      % len(timetag_errors))
+check(any("ictus-receive: /ictus/strike has 2 arguments (expected 17)" in l for l in lines),
+      "a strike with 2 arguments is refused, naming the address")
+others = [l for l in lines if l not in timetag_errors and "ictus-receive: /ictus/strike has" not in l]
+check(not others, "nothing else in pd's log: %s" % others)
+offset = wall_of_logical(records)
+fires = {int(a[9]): a for _, a in records if a[0] == "fire"}
+check(sorted(fires) == sorted(sent), "exactly the 10 good strikes came out: %s" % sorted(fires))
+worst = max(abs(offset + fires[s][1] / 1000.0 - sent[s]) * 1000.0 for s in sent)
+check(worst <= 1.0, "after the malformed packets, strikes start at their timetag within 1 ms "
+      "(worst %.3f ms)" % worst)
