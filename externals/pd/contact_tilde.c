@@ -107,6 +107,10 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
 /* set NAME: play another membrane~ (takes effect at the next DSP sort, as delread~). */
 static void contact_tilde_set(t_contact_tilde *x, t_symbol *name)
 {
+    if (name == &s_) {
+        pd_error(x, "contact~: set: needs the name of a membrane~");
+        return;
+    }
     x->x_name = name;
     canvas_update_dsp();
 }

@@ -62,6 +62,7 @@ contact_cases = [
     ("hit 1e+09 0.5 0", "contact~: hit: velocity must be in (0, 50] m/s, got 1e+09; using 50"),
     ("hit 1 0.5", "contact~: hit: missing theta (deg)"),
     ("hit foo 0.5 0", "contact~: hit: velocity (m/s) must be a number, got 'foo'"),
+    ("set", "contact~: set: needs the name of a membrane~"),
     ("hit 2 0.3 0", None),
 ]
 
