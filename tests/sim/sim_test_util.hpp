@@ -6,7 +6,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -151,9 +154,31 @@ cmu_like_bvh(int frames, double frame_time_s,
     return out.str();
 }
 
+// A path in the system's temporary folder, unique to this process (CTest runs
+// test cases as parallel processes).
+// Removed when the process exits.
+inline std::string temp_path(const std::string &name)
+{
+    struct Registry {
+        std::vector<std::string> paths;
+        ~Registry()
+        {
+            std::error_code ec;
+            for (const std::string &p : paths)
+                std::filesystem::remove_all(p, ec);
+        }
+    };
+    static Registry registry;
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("ictus_test_sim_" + std::to_string(::getpid()) + "_" + name))
+                                 .string();
+    registry.paths.push_back(path);
+    return path;
+}
+
 inline std::string write_temp(const std::string &name, const std::string &text)
 {
-    const std::string path = "test_sim_" + name;
+    const std::string path = temp_path(name);
     std::ofstream(path) << text;
     return path;
 }

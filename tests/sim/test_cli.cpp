@@ -157,7 +157,7 @@ TEST_CASE("ictusd: missing and malformed files are errors naming the file (exit 
 
 TEST_CASE("ictusd track --out writes the CSV and a summary with the required fields", "[sim][cli]")
 {
-    const std::string dir = "test_sim_out";
+    const std::string dir = simtest::temp_path("out");
     const Run r =
         ictusd("track --mode joint --mocap " + tiny_bvh() + " --out " + dir + " --duration 1.5");
     INFO(r.output);
@@ -189,7 +189,7 @@ TEST_CASE("ictusd track --out writes the CSV and a summary with the required fie
 
 TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[sim][cli]")
 {
-    const std::string out = "test_sim_limits.json";
+    const std::string out = simtest::temp_path("limits.json");
     const Run r = ictusd("limits " + tiny_bvh() + " --out " + out);
     INFO(r.output);
     REQUIRE(r.status == 0);
@@ -200,7 +200,18 @@ TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[sim][cli]")
     CHECK(j.at("joints")[0].at("name") == "lumbar");
     CHECK(j.at("joints")[0].contains("quaternion"));
     CHECK(j.at("joints")[0].contains("euler"));
-    const Run bad = ictusd("limits " + tiny_bvh() + " --k -2");
-    CHECK(bad.status == 2);
-    CHECK(bad.output.find("--k") != std::string::npos);
+    const std::vector<std::array<std::string, 2>> cases = {
+        {"--k", "-2"},          {"--min-deg", "-1"},   {"--min-deg", "200"},    {"--scale", "0"},
+        {"--skip-frames", "x"}, {"--smooth-hz", "-1"}, {"--despike-deg", "-3"},
+    };
+    for (const auto &c : cases) {
+        const Run bad = ictusd("limits " + tiny_bvh() + " " + c[0] + " " + c[1]);
+        INFO(c[0] << " " << c[1] << " -> " << bad.output);
+        CHECK(bad.status == 2);
+        CHECK(bad.output.find(c[0]) != std::string::npos);
+    }
+    // Skipping every frame leaves nothing to learn from: a data error.
+    const Run empty = ictusd("limits " + tiny_bvh() + " --skip-frames 500");
+    INFO(empty.output);
+    CHECK(empty.status == 1);
 }
