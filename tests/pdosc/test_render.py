@@ -1,7 +1,9 @@
 """Offline: patches/ictus-render.pd plays an events file in the format of
-`ictusd render` (docs/osc.md: `<delay_ms since previous line> hit <hand>
-<normal_velocity_mps> <r_over_a> <theta_deg> <peak_force_n> <bounce>;`) in real
-pd batch mode, and each stroke starts on the sample its time names.
+`ictusd render` (daemon/include/ictus/strike.hpp, docs/osc.md:
+`<delay_ms since previous line> hit <hand> <drum> <bounce> <normal_velocity_mps>
+<r_over_a> <theta_deg> <peak_force_n> <impulse_n_s> <duration_ms>
+<tangential_velocity_mps> <time_s>;`) in real pd batch mode, and each stroke
+starts on the sample its time names.
 
 Strike times are drawn here (>= 200 ms apart, both hands, fractional ms), away
 from half-sample ties; the file holds their differences. The drum rings briefly
@@ -41,7 +43,8 @@ for sr in (44100, 48000):
     lines, prev = ["0 render-drum t60 0.01;"], 0.0
     for i, (tm, v) in enumerate(zip(times, velocities)):
         # same point for every stroke, so that peaks compare by velocity alone
-        lines.append("%.3f hit %d %g 0.3 45 %.1f %d;" % (tm - prev, i % 2, v, 50.0 * v, i % 4 == 3))
+        lines.append("%.3f hit %d 0 %d %g 0.3 45 %.1f 0.01 1.2 0.1 %.6f;"
+                     % (tm - prev, i % 2, i % 4 == 3, v, 50.0 * v, tm / 1000.0))
         prev = tm
     events = os.path.join(work, "events-%d.txt" % sr)
     with open(events, "w") as f:
