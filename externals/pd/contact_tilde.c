@@ -256,6 +256,6 @@ void ictus_contact_tilde_setup(void)
                         gensym(contact_tilde_params[i].p_name), A_GIMME, 0);
     class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_hit, gensym("hit"), A_GIMME,
                     0);
-    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_set, gensym("set"), A_SYMBOL,
+    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_set, gensym("set"), A_DEFSYM,
                     0);
 }
