@@ -176,14 +176,50 @@ static int zero_cmp(const void *pa, const void *pb)
     return a->n < b->n ? -1 : (a->n > b->n);
 }
 
+/* The first zero of J_m above `after` (itself a zero of J_m or a point below
+ * the first one, where J_m has no zero in between). Zeros of J_m, m >= 1, are
+ * more than pi apart (A&S 9.5.2 ff.), so stepping by 3 < pi brackets the next
+ * one alone. */
+static double bessel_next_zero(int m, double after)
+{
+    const double h = 3.0;
+    double lo = after + 1.0e-9 * (after > 1.0 ? after : 1.0);
+    double flo = ictus_bessel_j(m, lo);
+    for (int i = 0; i < 10000; i++) {
+        double hi = lo + h, fhi = ictus_bessel_j(m, hi);
+        if ((flo > 0.0) != (fhi > 0.0) || fhi == 0.0)
+            return bessel_zero_in(m, lo, hi, 0.5 * (lo + hi));
+        lo = hi;
+        flo = fhi;
+    }
+    return after; /* unreachable for legal m, after */
+}
+
+static int push_zero(ictus_bessel_zero_entry **list, int *len, int *cap, double j, int m, int n)
+{
+    if (*len == *cap) {
+        int grown_cap = *cap * 2;
+        ictus_bessel_zero_entry *grown = realloc(*list, sizeof(**list) * (size_t)grown_cap);
+        if (!grown)
+            return 0;
+        *list = grown;
+        *cap = grown_cap;
+    }
+    (*list)[*len].j = j;
+    (*list)[*len].m = m;
+    (*list)[*len].n = n;
+    (*len)++;
+    return 1;
+}
+
 int ictus_bessel_zeros_below(double x_max, ictus_bessel_zero_entry **out)
 {
-    /* Every J_m with m >= x_max has its first zero above x_max (j_{m,1} > m). */
-    int m_max = (int)ceil(x_max);
-    int count0 = (int)(x_max / M_PI) + 2;
-    int k0 = count0 + m_max + 3;
-    double *prev = malloc(sizeof(double) * (size_t)k0);
-    double *cur = malloc(sizeof(double) * (size_t)k0);
+    /* Level m holds the zeros of J_m below x_max plus the first one above: the
+     * zeros of J_{m+1} below x_max are then bracketed by consecutive entries, and
+     * its first zero above x_max is the next one after its last bracketed zero. */
+    int count0 = (int)(x_max / M_PI) + 3;
+    double *prev = malloc(sizeof(double) * (size_t)count0);
+    double *cur = malloc(sizeof(double) * (size_t)count0);
     int cap = 64, len = 0;
     ictus_bessel_zero_entry *list = malloc(sizeof(*list) * (size_t)cap);
     if (!prev || !cur || !list) {
@@ -192,45 +228,30 @@ int ictus_bessel_zeros_below(double x_max, ictus_bessel_zero_entry **out)
         free(list);
         return -1;
     }
-    int kprev = k0;
-    for (int i = 0; i < k0; i++)
-        prev[i] = bessel_zero0(i + 1);
-    for (int m = 0; m <= m_max; m++) {
-        int k = 0;
-        if (m == 0) {
-            for (int i = 0; i < k0; i++)
-                cur[i] = prev[i];
-            k = k0;
-        } else {
-            /* Level m needs (m_max - m + 2) zeros above x_max so that every later
-             * level still has brackets reaching past x_max. */
-            int above = 0, need = m_max - m + 2;
-            for (int i = 0; i + 1 < kprev && above < need; i++) {
-                cur[k] = bessel_zero_in(m, prev[i], prev[i + 1], 0.5 * (prev[i] + prev[i + 1]));
-                if (cur[k] >= x_max)
-                    above++;
-                k++;
-            }
-        }
-        if (k == 0 || cur[0] >= x_max)
+    int kprev = 0;
+    for (int n = 1; n <= count0; n++) {
+        prev[kprev++] = bessel_zero0(n);
+        if (prev[kprev - 1] >= x_max)
             break;
-        for (int i = 0; i < k && cur[i] < x_max; i++) {
-            if (len == cap) {
-                cap *= 2;
-                ictus_bessel_zero_entry *grown = realloc(list, sizeof(*list) * (size_t)cap);
-                if (!grown) {
-                    free(prev);
-                    free(cur);
-                    free(list);
-                    return -1;
-                }
-                list = grown;
-            }
-            list[len].j = cur[i];
-            list[len].m = m;
-            list[len].n = i + 1;
-            len++;
+    }
+    for (int i = 0; i < kprev && prev[i] < x_max; i++)
+        if (!push_zero(&list, &len, &cap, prev[i], 0, i + 1))
+            goto fail;
+    for (int m = 1;; m++) {
+        int k = 0;
+        for (int i = 0; i + 1 < kprev && prev[i] < x_max; i++)
+            cur[k++] = bessel_zero_in(m, prev[i], prev[i + 1], 0.5 * (prev[i] + prev[i + 1]));
+        if (k == 0 || cur[k - 1] < x_max) {
+            /* No zero above x_max yet: find the next one (there is room: a level
+             * never holds more zeros than the one below it). */
+            cur[k] = bessel_next_zero(m, k ? cur[k - 1] : (double)m);
+            k++;
         }
+        if (cur[0] >= x_max)
+            break; /* j_{m,1} increases with m: no higher order has a zero below */
+        for (int i = 0; i < k && cur[i] < x_max; i++)
+            if (!push_zero(&list, &len, &cap, cur[i], m, i + 1))
+                goto fail;
         double *t = prev;
         prev = cur;
         cur = t;
@@ -241,4 +262,9 @@ int ictus_bessel_zeros_below(double x_max, ictus_bessel_zero_entry **out)
     qsort(list, (size_t)len, sizeof(*list), zero_cmp);
     *out = list;
     return len;
+fail:
+    free(prev);
+    free(cur);
+    free(list);
+    return -1;
 }
