@@ -78,7 +78,8 @@ def run_once():
     bare = np.array([(offset + plain[s] / 1000.0 - t0) * 1e3
                      for s, (t0, tag) in sent.items() if s in plain])
     missing = 2 * len(sent) - len(sched) - len(bare)
-    return sched, bare, handled, missing
+    late = sum(1 for t, a in rec if a[0] == "info" and len(a) > 1 and a[1] == "late")
+    return sched, bare, handled, missing, late
 
 
 def row(name, ref, x):
@@ -89,13 +90,13 @@ def row(name, ref, x):
 
 best = None
 for r in range(args.runs):
-    sched, bare, handled, missing = run_once()
+    sched, bare, handled, missing, late = run_once()
     score = np.percentile(np.abs(sched), 99) + np.percentile(bare, 99)
-    print("run %d: scheduled p99 |err| %.3f ms, plain p99 %.3f ms, missing %d"
-          % (r + 1, np.percentile(np.abs(sched), 99), np.percentile(bare, 99), missing))
+    print("run %d: scheduled p99 |err| %.3f ms, plain p99 %.3f ms, missing %d, late %d"
+          % (r + 1, np.percentile(np.abs(sched), 99), np.percentile(bare, 99), missing, late))
     if best is None or score < best[0]:
-        best = (score, sched, bare, handled, missing)
-_, sched, bare, handled, missing = best
+        best = (score, sched, bare, handled, missing, late)
+_, sched, bare, handled, missing, late = best
 print()
 print("%d strikes, %.0f ms apart, lookahead %.0f ms, pd -nosound -r %d (block 64 = %.3f ms); "
       "best of %d runs; ms" % (args.strikes, args.spacing_ms, args.lookahead_ms, args.sr,
@@ -107,4 +108,4 @@ print("|----------------------------|-----------------|-----:|--------:|--------
 print(row("ictus-receive (scheduled)", "timetag", sched))
 print(row("bare oscparse (on arrival)", "send time", bare))
 print(row("ictus-receive, pd handled", "timetag (wall)", handled))
-print("missing strikes: %d" % missing)
+print("missing strikes: %d, late bundles (ictus-receive): %d" % (missing, late))
