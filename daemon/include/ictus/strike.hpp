@@ -77,6 +77,9 @@ class StrikeDetector
 
     // Changes take effect for the next contact (an ongoing one keeps its law).
     void set_membrane(const MembraneGeometry &membrane);
+    // A new membrane and no contact history (the scene was rebuilt); strike
+    // numbers continue.
+    void reset(const MembraneGeometry &membrane);
     const MembraneGeometry &membrane() const { return membrane_; }
     const StrikeDetectorOptions &options() const { return options_; }
 
@@ -95,6 +98,9 @@ class StrikeDetector
     bool over_membrane(const Eigen::Vector3d &center_m) const;
     bool in_contact(int hand) const { return hands_[hand].in_contact; }
     long strikes() const { return next_seq_; }
+    // Tips that came over the disk from the side below the membrane plane (shell hits, not
+    // strikes).
+    long side_entries() const { return side_entries_; }
 
   private:
     struct Hand {
@@ -102,6 +108,7 @@ class StrikeDetector
         TipSample previous;
         double previous_gap = 0.0;
         bool in_contact = false;
+        bool side_entry = false; // came in below the plane from outside the disk
         // The episode under way.
         StrikeEvent event;
         double last_force_n = 0.0;
@@ -123,6 +130,7 @@ class StrikeDetector
     StrikeDetectorOptions options_;
     std::array<Hand, 2> hands_;
     long next_seq_ = 0;
+    long side_entries_ = 0;
 };
 
 // strikes.csv: a header line and one line per event, fixed precision (so that

@@ -46,6 +46,12 @@ void StrikeDetector::set_membrane(const MembraneGeometry &membrane)
     membrane_ = membrane;
 }
 
+void StrikeDetector::reset(const MembraneGeometry &membrane)
+{
+    membrane_ = membrane;
+    hands_ = {};
+}
+
 double StrikeDetector::normal_force_n(double depth_m, double depth_rate_mps) const
 {
     // One-sided spring-damper: the membrane pushes, never pulls.
@@ -79,6 +85,21 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
     const bool touching = gap < 0.0 && over_membrane(s.center_m);
     const double depth_rate = -s.velocity_mps.dot(kNormal);
     bool ended = false;
+
+    // A tip that comes in over the disk already below the membrane plane
+    // entered from the side: that is the shell (or rim), not a strike on the
+    // membrane. It is ignored until the tip is above the plane again.
+    if (!h.in_contact && touching && h.has_previous && h.previous_gap < 0.0 && !h.side_entry) {
+        h.side_entry = true;
+        ++side_entries_;
+    }
+    if (h.side_entry) {
+        if (gap >= 0.0)
+            h.side_entry = false;
+        h.previous = s;
+        h.previous_gap = gap;
+        return false;
+    }
 
     if (!h.in_contact && touching) {
         // Onset: where the gap crosses zero between the last free sample and this one.
