@@ -1,10 +1,11 @@
-"""Malformed packets sent to [ictus-receive]'s port are dropped whole, counted
+"""Malformed and fuzzed packets sent to [ictus-receive]'s port are dropped whole, counted
 (info outlet `malformed <count> <reason>`), reported with an error naming
 ictus_timetag (the first 5 only), and break nothing: strikes sent afterwards
 still start at their timetag within 1 ms. A well-formed /ictus/strike with the
 wrong argument count is refused by the abstraction with a message naming it."""
 import argparse
 import os
+import random
 import socket
 import struct
 import sys
@@ -37,6 +38,18 @@ bad.append(nested)
 # every truncation of a good strike bundle, except 16 bytes (a valid empty bundle)
 bad += [good[:n] for n in range(1, len(good)) if n != 16]
 wrong_count = bundle(timetag(now()), message("/ictus/strike", "ii", 1, 2))
+# random bit flips in the framing of a strike bundle (header, timetag, element
+# size, address): whatever they become, pd must carry on. Their strikes carry
+# seq 999 and are ignored below.
+fuzz_base = bytearray(bundle(timetag(now()), strike(999, 0)))
+rng = random.Random(7)
+fuzz = []
+for _ in range(300):
+    b = bytearray(fuzz_base)
+    for _ in range(rng.randint(1, 3)):
+        i = rng.randrange(0, 36)
+        b[i] ^= 1 << rng.randrange(8)
+    fuzz.append(bytes(b))
 
 reports = Listener()
 pd_port = free_udp_port()
@@ -50,6 +63,10 @@ try:
         if i % 10 == 9:
             time.sleep(0.005)  # stay well inside the socket's receive buffer
     out.sendto(good[:16], ("127.0.0.1", pd_port))
+    for i, packet in enumerate(fuzz):
+        out.sendto(packet, ("127.0.0.1", pd_port))
+        if i % 10 == 9:
+            time.sleep(0.005)
     out.sendto(wrong_count, ("127.0.0.1", pd_port))
     time.sleep(0.3)
     t = now() + 0.05
@@ -70,9 +87,10 @@ records = fudi_records(reports.snapshot())
 print(log)
 check(proc.returncode == 0, "pd exited normally (%s)" % proc.returncode)
 malformed = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "malformed"]
-check(len(malformed) == len(bad) and malformed[-1][2] == len(bad),
-      "each of the %d malformed packets counted once (%d reports, last count %s)"
-      % (len(bad), len(malformed), malformed[-1][2] if malformed else None))
+check(len(malformed) >= len(bad) and malformed[len(bad) - 1][2] == len(bad)
+      and [m[2] for m in malformed] == list(range(1, len(malformed) + 1)),
+      "each of the %d malformed packets counted once (then %d of %d fuzzed ones)"
+      % (len(bad), len(malformed) - len(bad), len(fuzz)))
 lines = [l for l in log.splitlines() if l.strip()]
 timetag_errors = [l for l in lines if "ictus_timetag: malformed OSC packet" in l]
 check(len(timetag_errors) == 5, "the first 5 malformed packets are reported by name (%d)"
@@ -82,7 +100,7 @@ check(any("ictus-receive: /ictus/strike has 2 arguments (expected 17)" in l for 
 others = [l for l in lines if l not in timetag_errors and "ictus-receive: /ictus/strike has" not in l]
 check(not others, "nothing else in pd's log: %s" % others)
 offset = wall_of_logical(records)
-fires = {int(a[9]): a for _, a in records if a[0] == "fire"}
+fires = {int(a[9]): a for _, a in records if a[0] == "fire" and int(a[9]) != 999}
 check(sorted(fires) == sorted(sent), "exactly the 10 good strikes came out: %s" % sorted(fires))
 worst = max(abs(offset + fires[s][1] / 1000.0 - sent[s]) * 1000.0 for s in sent)
 check(worst <= 1.0, "after the malformed packets, strikes start at their timetag within 1 ms "
