@@ -90,11 +90,13 @@ def fudi_records(items):
 
 
 def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=None,
-                control_msgs=()):
+                control_msgs=(), listen_later=False):
     """The real-time test patch (see the module doc). control_msgs go into
-    ictus-receive's inlet at 300 ms (after 'connect localhost ctl_port')."""
+    ictus-receive's inlet at 300 ms (after 'connect localhost ctl_port'). With
+    listen_later, [ictus-receive] starts without a port and gets 'listen
+    pd_port' at 300 ms."""
     p = Patch(declare="-path %s/ictus" % build)
-    recv = p.obj("ictus-receive %d" % pd_port)
+    recv = p.obj("ictus-receive" if listen_later else "ictus-receive %d" % pd_port)
     lb = p.obj("loadbang")
     t = p.obj("t b b b b")
     p.connect(lb, 0, t, 0)
@@ -148,10 +150,11 @@ def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=
         p.connect(rt, 0, rs, 0)
         p.connect(rs, 0, seq, 0)
         stamped(seq, 0, "plain")
-    if ctl_port:
+    if ctl_port or listen_later:
         d = p.obj("delay 300")
         p.connect(t, 0, d, 0)
-        msgs = ["connect localhost %d" % ctl_port] + list(control_msgs)
+        msgs = (["listen %d" % pd_port] if listen_later else []) + (
+            ["connect localhost %d" % ctl_port] if ctl_port else []) + list(control_msgs)
         m = p.msg(" \\, ".join(msgs))
         p.connect(d, 0, m, 0)
         p.connect(m, 0, recv, 0)

@@ -5,7 +5,8 @@ time that corresponds to its timetag, within 1 ms. The logical-to-wall mapping
 is measured here, from pd's own tick reports (rtpd.py), not taken from the
 code under test. Also: strike fields come out in the documented order, a
 late bundle fires at once and is counted, pose/reply messages pass through,
-and control messages reach the daemon side as /ictus/<name> OSC."""
+and control messages reach the daemon side as /ictus/<name> OSC. The
+receiver starts without a port and gets `listen PORT` from its inlet."""
 import argparse
 import os
 import socket
@@ -33,12 +34,14 @@ ctl.bind(("127.0.0.1", 0))
 ctl.settimeout(0.1)
 pd_port = free_udp_port()
 patch = build_patch(build, pd_port, reports.port, SECONDS, ctl_port=ctl.getsockname()[1],
-                    control_msgs=["tempo 96", "grip french", "ping"])
+                    control_msgs=["tempo 96", "grip french", "ping"], listen_later=True)
 proc, work = start_pd(patch, build)
 out = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 try:
     check(wait_for_ticks(reports), "pd runs in real time and reports ticks")
-    time.sleep(0.3)  # let ictus_timetag collect clock samples (it samples every 2 ms)
+    # ictus-receive listens from 300 ms on ('listen PORT'); meanwhile
+    # ictus_timetag collects clock samples (every 2 ms)
+    time.sleep(0.6)
     sent = {}  # seq -> (timetag_s, hand, velocity, r_over_a, theta)
     t_next = now() + LOOKAHEAD_S
     for seq in range(1, N_STRIKES + 1):
