@@ -1,10 +1,9 @@
 /* contact.c -- Hunt-Crossley stick contact with an energy-consistent discretisation.
  *
- * Force law (contact.h; lambda is Hunt & Crossley's damping per unit stiffness,
- * in s/m, so that F = k x^alpha (1 + lambda dx/dt)):
- *     F = k x^a + lambda k x^a dx/dt   for x > 0, and F >= 0.
+ * Force law (contact.h; Hunt & Crossley, lambda in N s / m^(alpha+1)):
+ *     F = k x^a + lambda x^a dx/dt   for x > 0, and F >= 0.
  * Discretised over one sample (x0 -> x1) as
- *     F = max(0, (V(x1) - V(x0)) / (x1 - x0) + lambda k h (x1 - x0) / T),
+ *     F = max(0, (V(x1) - V(x0)) / (x1 - x0) + lambda h (x1 - x0) / T),
  *     V(x) = k x+^(a+1) / (a+1),  h = (x0+^a + x1+^a) / 2 >= 0.
  * The first term is a discrete gradient (its work over the step equals the change
  * of V exactly), the second term can only remove energy, and clamping F at 0 only
@@ -192,7 +191,7 @@ static double fast_pos_pow(double x, double a, int half_steps)
 /* What stays fixed while one sample's equation is solved: the start compression
  * x0 and its powers, so that each trial x1 costs one pow(). */
 typedef struct contact_step {
-    double k, a, damping_k_over_dt, x0, x0a, v0;
+    double k, a, damping_over_dt, x0, x0a, v0;
     int half_steps; /* 2a when that is a whole number, else -1 */
 } contact_step;
 
@@ -201,7 +200,7 @@ static contact_step step_begin(const contact *c, double x0, double dt)
     contact_step st;
     st.k = c->stiffness;
     st.a = c->alpha;
-    st.damping_k_over_dt = c->damping * c->stiffness / dt;
+    st.damping_over_dt = c->damping / dt;
     double twice = 2.0 * st.a;
     st.half_steps = (twice == floor(twice) && twice <= 8.0) ? (int)twice : -1;
     st.x0 = x0;
@@ -235,8 +234,8 @@ static double step_force(const contact_step *st, double x1, double *dforce)
     }
     double h = 0.5 * (st->x0a + x1a);
     double dh = x1 > 0.0 ? 0.5 * a * x1a / x1 : 0.0;
-    double f = spring + st->damping_k_over_dt * h * dx;
-    double df = dspring + st->damping_k_over_dt * (h + dh * dx);
+    double f = spring + st->damping_over_dt * h * dx;
+    double df = dspring + st->damping_over_dt * (h + dh * dx);
     /* Safety net for absurd states (e.g. 1e3 N s strikes on a 3 mg head): no
      * drumstick pushes with a teranewton, and a capped force stays finite. */
     if (!(f < CONTACT_FORCE_CAP)) {

@@ -3,9 +3,9 @@
  * A stick of lumped mass m (kg) hits the membrane at (r/a, theta). With the
  * compression x = stick position - membrane displacement at the contact point
  * (positive into the membrane), the contact force is
- *     F = k x^alpha + lambda k x^alpha dx/dt = k x^alpha (1 + lambda dx/dt)
- * for x > 0, else 0, and F >= 0. lambda is Hunt & Crossley's damping per unit
- * stiffness (their mu), in s/m.
+ *     F = k x^alpha + lambda x^alpha dx/dt     for x > 0, else 0, and F >= 0
+ * (Hunt & Crossley; lambda in N s / m^(alpha+1)). The ratio mu = lambda / k (s/m)
+ * is the damping per unit stiffness; the default lambda gives mu = 0.5 s/m.
  * The contact is solved jointly with the membrane's modes, sample by sample
  * (Avanzini & Rocchesso), with an energy-consistent discretisation: the
  * spring term is a discrete gradient of V(x) = k x^(alpha+1)/(alpha+1) and the
@@ -31,15 +31,15 @@ extern "C" {
 #define CONTACT_STIFFNESS_MAX 1.0e12
 #define CONTACT_ALPHA_MIN     1.0
 #define CONTACT_ALPHA_MAX     4.0
-#define CONTACT_DAMPING_MIN   0.0    /* lambda, s/m */
-#define CONTACT_DAMPING_MAX   1.0e3
+#define CONTACT_DAMPING_MIN   0.0    /* lambda, N s / m^(alpha+1) */
+#define CONTACT_DAMPING_MAX   1.0e13
 #define CONTACT_VELOCITY_MAX  50.0   /* m/s, |hit velocity| */
 
 /* Defaults: a 50 g snare stick with a felt-free wooden tip on Mylar. */
 #define CONTACT_DEFAULT_MASS      0.05
 #define CONTACT_DEFAULT_STIFFNESS 1.0e7
 #define CONTACT_DEFAULT_ALPHA     1.5
-#define CONTACT_DEFAULT_DAMPING   0.5
+#define CONTACT_DEFAULT_DAMPING   5.0e6 /* mu = lambda / k = 0.5 s/m */
 
 /* What a finished stroke reports (on release: the stick leaves the membrane). */
 typedef struct contact_report {

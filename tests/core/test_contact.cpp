@@ -128,7 +128,8 @@ TEST_CASE("Passivity over 10^4 random legal contacts", "[core][contact]")
         contact_set_stiffness(c, logu(1e3, CONTACT_STIFFNESS_MAX));
         contact_set_alpha(c,
                           CONTACT_ALPHA_MIN + (CONTACT_ALPHA_MAX - CONTACT_ALPHA_MIN) * u01(rng));
-        contact_set_damping(c, u01(rng) < 0.2 ? 0.0 : logu(1e-3, CONTACT_DAMPING_MAX));
+        // lambda spans mu = lambda / k from 1e-3 to 1e3 s/m.
+        contact_set_damping(c, u01(rng) < 0.2 ? 0.0 : logu(1e-3, 1e3) * contact_get_stiffness(c));
         double v = logu(0.01, CONTACT_VELOCITY_MAX);
         contact_report r{};
         // At least 20 samples across the Hertz time of the undamped contact.
@@ -169,7 +170,7 @@ TEST_CASE("Passivity with the membrane: total discrete energy never grows", "[co
         contact_set_mass(c, logu(0.005, 1.0));
         contact_set_stiffness(c, logu(1e4, 1e9));
         contact_set_alpha(c, 1.0 + 2.0 * u01(rng));
-        contact_set_damping(c, u01(rng) < 0.3 ? 0.0 : logu(0.01, 10.0));
+        contact_set_damping(c, u01(rng) < 0.3 ? 0.0 : logu(0.01, 10.0) * contact_get_stiffness(c));
         membrane_attach_contact(m, c);
         double v = logu(0.1, 20.0), r = 0.9 * u01(rng), th = 360.0 * u01(rng);
         contact_hit(c, v, r, th, 0);
