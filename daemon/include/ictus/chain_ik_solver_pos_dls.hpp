@@ -15,7 +15,7 @@ namespace ictus
 {
 
 enum class IkStatus {
-    converged,      // tip within tolerance of the target
+    converged,      // tip within tolerance of the target (direction: see direction_error_rad)
     max_iterations, // still approaching the target when the iteration budget ran out
     unreachable,    // target beyond the chain's reach: tip left as close as the solver got
     joint_limited,  // a joint limit stopped the tip short of a reachable target
@@ -27,7 +27,7 @@ const char *to_string(IkStatus status);
 
 struct IkResult {
     IkStatus status = IkStatus::invalid_input;
-    int iterations = 0;                // joint updates performed
+    int iterations = 0;                // steps tried (accepted or not), <= max_iterations
     double position_error_m = 0.0;     // |target - tip| at the returned configuration
     double direction_error_rad = 0.0;  // stick direction error (0 without secondary task)
     double min_singular_value_m = 0.0; // sigma_min(J) at the end when not converged, else 0
@@ -52,7 +52,7 @@ struct IkParams {
     int max_iterations = 16;
     double tolerance_m = 1e-5;
     // Secondary task (stick direction): the solver keeps iterating until the direction is
-    // within this too. tolerance_m / direction_tolerance_rad weighs the two in the merit.
+    // within this too (the tip staying within tolerance_m).
     double direction_tolerance_rad = 1e-3;
     // Damping (dimensionless: J_d maps rad to rad) of the secondary task's pseudo-inverse.
     double direction_damping = 0.1;
@@ -60,12 +60,13 @@ struct IkParams {
 
 // Damped-least-squares position IK, warm-started from the chain's current rotations (the
 // simulated state Theta^S): Theta^T = Theta^S + sum of steps
-//     dtheta = J^T (J J^T + lambda^2 I)^-1 e + (I - J^+ J) z,
+//     dtheta = J^T (J J^T + lambda^2 I)^-1 e  [+ (J_d N)^+ (w e_d - J_d dtheta), N = I - J^+ J]
 // with e = clamp(X^T - X^S), J the tip Jacobian with respect to world-frame joint angular
-// velocities, and z the optional stick-direction step projected into J's null space. Each
-// step is applied as world-frame rotation increments and the joint limits of the chain are
-// applied after it. All temporaries are members of fixed maximum size: construction and
-// solve() never allocate.
+// velocities, and the optional stick-direction task in J's null space. Each step is applied
+// as world-frame rotation increments, then the chain's joint limits; a step that does not
+// bring the tip closer is undone and retried with twice the damping (Levenberg-Marquardt).
+// All temporaries are members of fixed maximum size: construction and solve() never
+// allocate. Not thread-safe: one solver per arm (or per thread).
 class ChainIkSolverPos_dls
 {
   public:

@@ -98,7 +98,8 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
     bool valid = n > 0 && chain.joints() == n && rotations_out != nullptr &&
                  target_tip_m.allFinite() && chain.base_position().allFinite() &&
                  chain.base_rotation().coeffs().allFinite() && chain.tip_offset().allFinite() &&
-                 std::isfinite(direction_weight) && direction_weight <= 1.0 &&
+                 std::isfinite(direction_weight) && direction_weight >= 0.0 &&
+                 direction_weight <= 1.0 &&
                  (!use_direction ||
                   (target_direction.allFinite() && target_direction.squaredNorm() > 1e-24));
     // Warm start Theta^S. A rotation that is not a usable quaternion makes the input invalid
