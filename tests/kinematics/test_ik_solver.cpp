@@ -426,6 +426,8 @@ TEST_CASE("IK refuses bad input and leaves the warm start", "[ik]")
     CHECK(solver.solve(chain, good, Vector3d::Zero(), 0.5, out).status == IkStatus::invalid_input);
     CHECK(solver.solve(chain, good, Vector3d::UnitY(), nan, out).status == IkStatus::invalid_input);
     CHECK(solver.solve(chain, good, Vector3d::UnitY(), 1.5, out).status == IkStatus::invalid_input);
+    CHECK(solver.solve(chain, good, Vector3d::UnitY(), -0.5, out).status ==
+          IkStatus::invalid_input);
     expect_unchanged();
 
     // A chain of the wrong size.
