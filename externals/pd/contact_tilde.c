@@ -36,7 +36,7 @@ static const t_cparam contact_tilde_params[] = {
     {"stiffness", "N/m^alpha", CONTACT_STIFFNESS_MIN, CONTACT_STIFFNESS_MAX, contact_set_stiffness,
      contact_get_stiffness},
     {"alpha", "", CONTACT_ALPHA_MIN, CONTACT_ALPHA_MAX, contact_set_alpha, contact_get_alpha},
-    {"damping", "s/m", CONTACT_DAMPING_MIN, CONTACT_DAMPING_MAX, contact_set_damping,
+    {"damping", "N s/m^(alpha+1)", CONTACT_DAMPING_MIN, CONTACT_DAMPING_MAX, contact_set_damping,
      contact_get_damping},
 };
 #define NCPARAMS (int)(sizeof(contact_tilde_params) / sizeof(contact_tilde_params[0]))

@@ -356,17 +356,18 @@ static void ictus_timetag_latency(t_ictus_timetag *x, t_floatarg ms)
     x->x_latency_ms = ms;
 }
 
-/* status: `status offset_ms late malformed packets` on the info outlet;
+/* status: `status offset_ms late malformed packets latency_ms` on the info outlet;
  * offset_ms is the current estimate of wall - logical time (relative to the
  * object's creation). */
 static void ictus_timetag_status(t_ictus_timetag *x)
 {
-    t_atom info[4];
+    t_atom info[5];
     SETFLOAT(&info[0], (t_float)ictus_timetag_offset(x));
     SETFLOAT(&info[1], (t_float)x->x_late_count);
     SETFLOAT(&info[2], (t_float)x->x_malformed_count);
     SETFLOAT(&info[3], (t_float)x->x_packet_count);
-    outlet_anything(x->x_info_out, gensym("status"), 4, info);
+    SETFLOAT(&info[4], (t_float)x->x_latency_ms);
+    outlet_anything(x->x_info_out, gensym("status"), 5, info);
 }
 
 static void ictus_timetag_reset(t_ictus_timetag *x)
