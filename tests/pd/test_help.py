@@ -1,6 +1,8 @@
-"""The help patches (copied into <build>/ictus/ by the build) open in pd with
-no error line, also once DSP is switched on (contact~ looks for its membrane~
-then), and each has the parts a vanilla help patch has."""
+"""The help patches open in pd with no error line, also once DSP is switched on
+(contact~ looks for its membrane~ then): the copies in <build>/ictus/ with no
+search path, and the sources in help/ with -path <build> (their
+[declare -path . -lib ictus -lib ictus/ictus] covers both). Each has the parts a
+vanilla help patch has."""
 import argparse
 import os
 import subprocess
@@ -15,13 +17,17 @@ build = os.path.abspath(args.build)
 for name in ("membrane~-help.pd", "contact~-help.pd", "ictus-meta.pd"):
     path = os.path.join(build, "ictus", name)
     check(os.path.isfile(path), "%s is in the library folder" % name)
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-path", build, "-open", path,
-           "-send", "pd dsp 1", "-send", "pd quit"]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
-    log = proc.stdout + proc.stderr
-    bad = error_lines(log)
-    check(proc.returncode == 0 and not bad, "%s opens without errors%s"
-          % (name, "" if not bad else ": " + " | ".join(bad)))
+    source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "help", name)
+    # the copy beside the binaries with no search path (as Pd's help browser
+    # opens it), and the source file with -path <build>
+    for where, extra in ((path, []), (source, ["-path", build])):
+        cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr"] + extra + [
+            "-open", where, "-send", "pd dsp 1", "-send", "pd quit"]
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
+        log = proc.stdout + proc.stderr
+        bad = error_lines(log)
+        check(proc.returncode == 0 and not bad, "%s opens without errors (%s)%s"
+              % (where, " ".join(extra) or "no -path", "" if not bad else ": " + " | ".join(bad)))
     text = open(path).read()
     if name.endswith("-help.pd"):
         obj = name[:-len("-help.pd")]
