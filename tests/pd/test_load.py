@@ -3,7 +3,8 @@ objects find each other: [ictus/membrane~] with -path <build>, [declare -path
 <build>/ictus], a patch beside the ictus folder with [declare -path ictus],
 -lib ictus; contact~ created before or after membrane~ (whichever binary Pd
 loads first, both classes exist once). Each patch plays a hit through contact~
-and must print the stroke's release report and no error line."""
+and must print the stroke's release report (physically plausible) and no error
+line."""
 import argparse
 import os
 
@@ -47,7 +48,13 @@ def play(declare, mem_name, con_name, contact_first, extra=(), beside_lib=False)
                                                  declare, " ".join(extra))
     check(rc == 0 and not error_lines(log), "%s: loads without errors%s"
           % (what, "" if not error_lines(log) else ": " + " | ".join(error_lines(log))))
-    check("report:" in log, "%s: contact~ found the membrane~ and played it" % what)
+    reports = [l.split(":")[1].split() for l in log.splitlines() if l.startswith("report:")]
+    check(len(reports) == 1, "%s: contact~ found the membrane~ and played it" % what)
+    duration_ms, peak_n, rebound_mps = (float(v) for v in reports[0])
+    # a 1 m/s hit: the stick cannot leave faster than it came (energy), the
+    # stroke is short, the force pushes
+    check(0 < duration_ms < 50 and peak_n > 0 and 0 <= rebound_mps <= 1.0,
+          "%s: release report %s is physical" % (what, reports[0]))
 
 
 for first in (False, True):
