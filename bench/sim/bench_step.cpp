@@ -2,7 +2,7 @@
 // 19 PD motors of eq. 1, quaternion limits with stops, stick-drum collision)
 // at 1 kHz while tracking the CMU drumming clip, with a breakdown (targets,
 // control, collide, solve, check) and the real-time factor on one core.
-// usage: bench_sim_step [BVH] [seconds] [iterations]
+// usage: bench_sim_step [BVH] [seconds] [iterations] [drum raise above the lowest tips, m]
 #include "ictus/bvh.hpp"
 #include "ictus/joint_limits.hpp"
 #include "ictus/scene.hpp"
@@ -24,7 +24,8 @@ int main(int argc, char **argv)
     if (argc > 1)
         path = argv[1];
     const double seconds = argc > 2 ? std::atof(argv[2]) : 20.0;
-    const int iterations = argc > 3 ? std::atoi(argv[3]) : 20;
+    const int iterations = argc > 3 ? std::atoi(argv[3]) : 15;
+    const double drum_raise_m = argc > 4 ? std::atof(argv[4]) : 0.05;
     BvhOptions bo;
     bo.scale = 0.056444;
     bo.skip_frames = 1;
@@ -51,9 +52,9 @@ int main(int argc, char **argv)
 
     SceneOptions so;
     so.quickstep_iterations = iterations;
-    // The membrane 2 cm above the lowest reference tips, so that the sticks
+    // The membrane 5 cm above the lowest reference tips, so that the sticks
     // really strike it and the contact rows are part of the cost.
-    so.drum.center_m = auto_drum_center(model, reference) + Eigen::Vector3d(0, 0.02, 0);
+    so.drum.center_m = auto_drum_center(model, reference) + Eigen::Vector3d(0, drum_raise_m, 0);
     const CharacterPose initial = reference.frame(0);
     Scene scene(model, so, initial, default_gains(model, initial, GainOptions{}));
     scene.set_joint_limits(refs);

@@ -37,7 +37,7 @@ TEST_CASE("limits: the ellipsoid clamp is the nearest surface point (brute force
     std::mt19937 rng(7);
     std::normal_distribution<double> n(0.0, 1.0);
     const Eigen::Vector3d a = e.limit.k * e.limit.sigma_rad;
-    for (int trial = 0; trial < 20; ++trial) {
+    for (int trial = 0; trial < 12; ++trial) {
         const Eigen::Vector3d v(n(rng), n(rng), n(rng));
         const Eigen::Quaterniond q = e.limit.mean * exp_map(v);
         const Eigen::Quaterniond c = e.clamp(q);
@@ -49,17 +49,17 @@ TEST_CASE("limits: the ellipsoid clamp is the nearest surface point (brute force
         CHECK(e.limit.normalized_distance(c) == Approx(1.0).epsilon(1e-6));
         // The brute-force nearest point over a dense grid of the surface.
         double best = 1e9;
-        for (int i = 0; i <= 400; ++i) {
-            const double th = M_PI * i / 400;
-            for (int k = 0; k < 800; ++k) {
-                const double ph = 2 * M_PI * k / 800;
+        for (int i = 0; i <= 200; ++i) {
+            const double th = M_PI * i / 200;
+            for (int k = 0; k < 400; ++k) {
+                const double ph = 2 * M_PI * k / 400;
                 const Eigen::Vector3d s(a[0] * std::sin(th) * std::cos(ph),
                                         a[1] * std::sin(th) * std::sin(ph), a[2] * std::cos(th));
                 best = std::min(best, (e.limit.axes * s - tq).norm());
             }
         }
         CHECK((tc - tq).norm() <= best + 1e-6);
-        CHECK((tc - tq).norm() > best - 2e-3); // the grid's resolution
+        CHECK((tc - tq).norm() > best - 1e-2); // the grid's resolution
     }
 }
 

@@ -88,7 +88,7 @@ TEST_CASE("CMU 80_13 played back and forth for ten simulated minutes never diver
     CHECK(s.tip_rms_mm[1] < 50.0);
 }
 
-TEST_CASE("track: a slow synthetic swing is followed closely; CSV has one row per sample",
+TEST_CASE("track: a slow synthetic swing is followed closely, the CSV has one row per sample",
           "[sim][track]")
 {
     const Skeleton skel = simtest::cmu_like_skeleton();

@@ -46,7 +46,7 @@ enum class Stepper { quick, direct }; // dWorldQuickStep or dWorldStep
 struct SceneOptions {
     double step_s = 0.001;
     Stepper stepper = Stepper::quick;
-    int quickstep_iterations = 20;
+    int quickstep_iterations = 15;
     double gravity_mps2 = 9.81;
     DrumParams drum;
     // Divergence: any non-finite state, a body faster than these, or a ball
