@@ -187,6 +187,42 @@ TEST_CASE("ictusd track --out writes the CSV and a summary with the required fie
     CHECK(rows == 180); // 1.5 s at the clip's 120 Hz
 }
 
+TEST_CASE("ictusd track --gains overrides one joint and refuses bad files", "[sim][cli]")
+{
+    const std::string base = "track --mode joint --quiet --duration 0.5 --mocap " + tiny_bvh();
+    const std::string good = simtest::write_temp(
+        "gains.json", R"({"r_wrist": {"kp_nm_per_rad": 33.0, "torque_limit_nm": 7.5}})");
+    const std::string dir = simtest::temp_path("gains_out");
+    Run r = ictusd(base + " --gains " + good + " --out " + dir);
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    std::ifstream js(dir + "/summary.json");
+    const nlohmann::json s = nlohmann::json::parse(js);
+    CHECK(s.at("gains").at("r_wrist").at("kp_nm_per_rad").get<double>() == 33.0);
+    CHECK(s.at("gains").at("r_wrist").at("torque_limit_nm").get<double>() == 7.5);
+    // Untouched: the default wrist limit, 15 N m at 70 kg.
+    CHECK(s.at("gains").at("l_wrist").at("torque_limit_nm").get<double>() == Approx(15.0));
+    const std::vector<std::array<std::string, 2>> bad = {
+        {R"({"r_pinky": {"kp_nm_per_rad": 1}})", "r_pinky"},
+        {R"({"r_wrist": {"kp": 1}})", "unknown field 'kp'"},
+        {R"({"r_wrist": {"torque_limit_nm": -1}})", "torque_limit_nm"},
+        {R"({"r_wrist": {"torque_limit_nm": "strong"}})", "torque_limit_nm"},
+        {R"([1, 2])", "expected a JSON object"},
+        {R"({"r_wrist": )", "not valid JSON"},
+    };
+    for (const auto &b : bad) {
+        const std::string f = simtest::write_temp("bad_gains.json", b[0]);
+        r = ictusd(base + " --gains " + f);
+        INFO(b[0] << " -> " << r.output);
+        CHECK(r.status == 1);
+        CHECK(r.output.find(b[1]) != std::string::npos);
+        CHECK(r.output.find("bad_gains.json") != std::string::npos);
+    }
+    r = ictusd(base + " --gains /nonexistent/gains.json");
+    CHECK(r.status == 1);
+    CHECK(r.output.find("/nonexistent/gains.json") != std::string::npos);
+}
+
 TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[sim][cli]")
 {
     const std::string out = simtest::temp_path("limits.json");

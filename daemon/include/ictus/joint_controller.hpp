@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,14 @@ double default_torque_limit_nm(const std::string &joint_name, double body_mass_k
 // Throws CharacterError on non-finite or non-positive options.
 std::vector<JointGains> default_gains(const CharacterModel &model, const CharacterPose &pose,
                                       const GainOptions &options = {});
+
+// Per-joint overrides, e.g. {"l_wrist": {"kp_nm_per_rad": 40, "torque_limit_nm": 20}}:
+// any subset of kp_nm_per_rad, kd_nm_s_per_rad, torque_limit_nm per joint name.
+// Throws CharacterError naming `source`, the joint and the field on anything
+// unknown, non-numeric, non-finite or not > 0.
+void apply_gain_overrides(const CharacterModel &model, const nlohmann::json &overrides,
+                          const std::string &source, std::vector<JointGains> &gains);
+nlohmann::json gains_to_json(const CharacterModel &model, const std::vector<JointGains> &gains);
 
 // The motor row of eq. 1 for one joint. Inputs are world orientations of the
 // parent and child bodies, the target local rotation q_T and its rate w_T

@@ -88,6 +88,8 @@ void track_usage(std::ostream &out)
            "  --drum-radius M        (default 0.178)   --drum-tension N/m (default 3000)\n"
            "  --gain-hz HZ           PD natural frequency (default 30)\n"
            "  --damping-ratio Z      (default 1)       --torque-scale S (default 1)\n"
+           "  --gains FILE.json      per-joint overrides, e.g. {\"l_wrist\": {\"kp_nm_per_rad\":\n"
+           "                         40, \"kd_nm_s_per_rad\": 0.5, \"torque_limit_nm\": 20}}\n"
            "  --limits none|euler|quaternion   limits enforced (default quaternion)\n"
            "  --limit-k K            limit width in standard deviations (default 3)\n"
            "  --limit-min-deg DEG    minimum half-width of a limit per axis (default 6)\n"
@@ -222,7 +224,7 @@ class Progress
 
 int run_track(Args &args)
 {
-    std::string mode, mocap, out_dir, limits_mode = "quaternion";
+    std::string mode, mocap, out_dir, limits_mode = "quaternion", gains_file;
     double scale = kCmuScale, limit_k = 3.0, limit_width_deg = 6.0;
     int skip = 1;
     bool quiet = false;
@@ -291,6 +293,8 @@ int run_track(Args &args)
             options.gains.damping_ratio = parse_positive(a, args.value(a));
         } else if (a == "--torque-scale") {
             options.gains.torque_scale = parse_positive(a, args.value(a));
+        } else if (a == "--gains") {
+            gains_file = args.value(a);
         } else if (a == "--limits") {
             limits_mode = args.value(a);
             if (limits_mode != "none" && limits_mode != "euler" && limits_mode != "quaternion")
@@ -362,11 +366,27 @@ int run_track(Args &args)
             throw std::runtime_error("--out: cannot write '" + out_dir + "/track.csv'");
         csv.precision(9);
     }
+    // Gains: inertia-scaled defaults at the first pose, then per-joint overrides.
+    std::vector<ictus::JointGains> gains =
+        ictus::default_gains(model, reference.frame(0), options.gains);
+    if (!gains_file.empty()) {
+        std::ifstream in(gains_file);
+        if (!in)
+            throw std::runtime_error("--gains: cannot read '" + gains_file + "'");
+        nlohmann::json overrides;
+        try {
+            overrides = nlohmann::json::parse(in);
+        } catch (const nlohmann::json::parse_error &e) {
+            throw std::runtime_error(gains_file + ": not valid JSON (" + e.what() + ")");
+        }
+        ictus::apply_gain_overrides(model, overrides, gains_file, gains);
+    }
+
     options.interrupt = &g_interrupted;
     Progress progress(!quiet);
     ictus::TrackSummary summary = ictus::track_joint_space(
         model, reference, options, refs, out_dir.empty() ? nullptr : &csv,
-        [&](double f) { progress(f); }, nullptr, &raw);
+        [&](double f) { progress(f); }, &gains, &raw);
 
     nlohmann::json j = summary.to_json();
     j["mocap"] = mocap;
@@ -388,6 +408,7 @@ int run_track(Args &args)
     j["despike_deg"] = filter.spike_threshold_rad * 180.0 / M_PI;
     j["spikes_removed"] = reference.spikes_removed();
     j["interrupted"] = summary.interrupted;
+    j["gains"] = ictus::gains_to_json(model, gains);
     if (!out_dir.empty()) {
         csv.close();
         if (!csv)

@@ -77,6 +77,50 @@ std::vector<JointGains> default_gains(const CharacterModel &model, const Charact
     return gains;
 }
 
+void apply_gain_overrides(const CharacterModel &model, const nlohmann::json &overrides,
+                          const std::string &source, std::vector<JointGains> &gains)
+{
+    if (!overrides.is_object())
+        throw CharacterError(source + ": expected a JSON object {joint: {field: value}}");
+    if (gains.size() != static_cast<size_t>(CharacterModel::kJoints))
+        throw CharacterError(source + ": gains must cover the 19 joints");
+    for (auto it = overrides.begin(); it != overrides.end(); ++it) {
+        const int j = model.joint_index(it.key());
+        if (j < 0)
+            throw CharacterError(source + ": unknown joint '" + it.key() + "'");
+        if (!it.value().is_object())
+            throw CharacterError(source + ": joint '" + it.key() + "': expected an object");
+        for (auto f = it.value().begin(); f != it.value().end(); ++f) {
+            double *field = nullptr;
+            if (f.key() == "kp_nm_per_rad")
+                field = &gains[j].kp_nm_per_rad;
+            else if (f.key() == "kd_nm_s_per_rad")
+                field = &gains[j].kd_nm_s_per_rad;
+            else if (f.key() == "torque_limit_nm")
+                field = &gains[j].torque_limit_nm;
+            else
+                throw CharacterError(source + ": joint '" + it.key() + "': unknown field '" +
+                                     f.key() +
+                                     "' (kp_nm_per_rad, kd_nm_s_per_rad, torque_limit_nm)");
+            if (!f.value().is_number() || !std::isfinite(f.value().get<double>()) ||
+                f.value().get<double>() <= 0.0)
+                throw CharacterError(source + ": joint '" + it.key() + "': " + f.key() +
+                                     " must be a finite number > 0, got " + f.value().dump());
+            *field = f.value().get<double>();
+        }
+    }
+}
+
+nlohmann::json gains_to_json(const CharacterModel &model, const std::vector<JointGains> &gains)
+{
+    nlohmann::json j = nlohmann::json::object();
+    for (size_t i = 0; i < gains.size(); ++i)
+        j[model.joint_name(static_cast<int>(i))] = {{"kp_nm_per_rad", gains[i].kp_nm_per_rad},
+                                                    {"kd_nm_s_per_rad", gains[i].kd_nm_s_per_rad},
+                                                    {"torque_limit_nm", gains[i].torque_limit_nm}};
+    return j;
+}
+
 MotorCommand pd_motor_command(const Eigen::Quaterniond &parent_world,
                               const Eigen::Quaterniond &child_world,
                               const Eigen::Quaterniond &target_local,
