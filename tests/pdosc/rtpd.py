@@ -90,7 +90,7 @@ def fudi_records(items):
 
 
 def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=None,
-                control_msgs=(), listen_later=False):
+                control_msgs=(), listen_later=False, fudi_in_port=None):
     """The real-time test patch (see the module doc). control_msgs go into
     ictus-receive's inlet at 300 ms (after 'connect localhost ctl_port'). With
     listen_later, [ictus-receive] starts without a port and gets 'listen
@@ -158,6 +158,9 @@ def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=
         m = p.msg(" \\, ".join(msgs))
         p.connect(d, 0, m, 0)
         p.connect(m, 0, recv, 0)
+    if fudi_in_port:
+        nr = p.obj("netreceive -u %d" % fudi_in_port)
+        p.connect(nr, 0, recv, 0)
     end = p.obj("delay %d" % int(seconds * 1000))
     q = p.msg("\\; pd quit")
     p.connect(t, 0, end, 0)
