@@ -27,6 +27,9 @@
  * (delay < 0) is late: its messages get delay 0 (fire now) and the late count
  * goes up. Timetag 1 ("immediately") and plain messages get delay 0, not late.
  *
+ * `expect ADDRESS TAGS` makes messages to ADDRESS with other type tags
+ * malformed, so that a fixed namespace reaches the patch only as specified.
+ *
  * Outlets, right to left: info (`late <ms_late> <count>` per late bundle,
  * `malformed <count> <reason>` per bad packet, `status ...` on request), the
  * delay (float, ms), the message bytes (list). */
@@ -43,12 +46,13 @@
 #define ICTUS_TIMETAG_EXPORT
 #endif
 
-#define ICTUS_TIMETAG_SAMPLE_MS 2.0   /* offset sampling period */
-#define ICTUS_TIMETAG_BUCKET_MS 500.0 /* one bucket of the sliding minimum */
-#define ICTUS_TIMETAG_BUCKETS   4     /* window = 3..4 buckets = 1.5..2 s */
-#define ICTUS_TIMETAG_MAX_BYTES 65536 /* larger than any UDP datagram */
-#define ICTUS_TIMETAG_MAX_DEPTH 8     /* nested bundles */
-#define ICTUS_TIMETAG_MAX_POSTS 5     /* malformed packets reported in full */
+#define ICTUS_TIMETAG_SAMPLE_MS  2.0   /* offset sampling period */
+#define ICTUS_TIMETAG_BUCKET_MS  500.0 /* one bucket of the sliding minimum */
+#define ICTUS_TIMETAG_BUCKETS    4     /* window = 3..4 buckets = 1.5..2 s */
+#define ICTUS_TIMETAG_MAX_BYTES  65536 /* larger than any UDP datagram */
+#define ICTUS_TIMETAG_MAX_DEPTH  8     /* nested bundles */
+#define ICTUS_TIMETAG_MAX_POSTS  5     /* malformed packets reported in full */
+#define ICTUS_TIMETAG_MAX_EXPECT 16    /* `expect` rules */
 /* Seconds from the NTP epoch (1900) to the Unix epoch (1970). */
 #define ICTUS_NTP_UNIX_OFFSET 2208988800.0
 
@@ -73,6 +77,11 @@ typedef struct _ictus_timetag {
     int x_buf_size;
     t_atom *x_atoms; /* one message's bytes as floats */
     int x_atoms_size;
+    /* `expect ADDRESS TAGS`: messages to ADDRESS must have exactly these type
+     * tags (a fixed namespace, docs/osc.md), else the packet is malformed. */
+    t_symbol *x_expect_address[ICTUS_TIMETAG_MAX_EXPECT];
+    t_symbol *x_expect_tags[ICTUS_TIMETAG_MAX_EXPECT];
+    int x_expect_count;
 } t_ictus_timetag;
 
 /* Wall-clock milliseconds since x_wall_base_s (a double keeps ~0.1 us here). */
@@ -157,7 +166,8 @@ static int ictus_timetag_osc_string(const unsigned char *p, int n)
 
 /* Checks one OSC message (address, type tags, arguments) so that [oscparse]
  * only ever gets well-formed input. Returns NULL or the reason. */
-static const char *ictus_timetag_check_message(const unsigned char *p, int n)
+static const char *ictus_timetag_check_message(const t_ictus_timetag *x, const unsigned char *p,
+                                               int n)
 {
     int pos, len, tags, t;
     if (n < 4 || (n & 3))
@@ -174,6 +184,10 @@ static const char *ictus_timetag_check_message(const unsigned char *p, int n)
     if ((len = ictus_timetag_osc_string(p + pos, n - pos)) < 0 || pos + len > n)
         return "type-tags";
     tags = pos + 1;
+    for (t = 0; t < x->x_expect_count; t++)
+        if (!strcmp((const char *)p, x->x_expect_address[t]->s_name) &&
+            strcmp((const char *)p + tags, x->x_expect_tags[t]->s_name))
+            return "unexpected-type-tags";
     pos += len;
     for (t = tags; p[t] != 0; t++) {
         int size;
@@ -241,7 +255,8 @@ static t_float ictus_timetag_delay(t_ictus_timetag *x, uint32_t seconds, uint32_
 
 /* Checks a whole element (message or bundle) before anything of it is output,
  * so that a bad packet never produces half its messages. */
-static const char *ictus_timetag_check(const unsigned char *p, int n, int depth, int *where)
+static const char *ictus_timetag_check(const t_ictus_timetag *x, const unsigned char *p, int n,
+                                       int depth, int *where)
 {
     int pos;
     if (n >= 8 && !memcmp(p, "#bundle", 8)) {
@@ -259,7 +274,7 @@ static const char *ictus_timetag_check(const unsigned char *p, int n, int depth,
                 *where = pos;
                 return "element-size";
             }
-            if ((why = ictus_timetag_check(p + pos + 4, (int)size, depth + 1, where))) {
+            if ((why = ictus_timetag_check(x, p + pos + 4, (int)size, depth + 1, where))) {
                 *where += pos + 4;
                 return why;
             }
@@ -268,7 +283,7 @@ static const char *ictus_timetag_check(const unsigned char *p, int n, int depth,
         return NULL;
     }
     *where = 0;
-    return ictus_timetag_check_message(p, n);
+    return ictus_timetag_check_message(x, p, n);
 }
 
 static void ictus_timetag_output_message(t_ictus_timetag *x, const unsigned char *p, int n,
@@ -339,7 +354,7 @@ static void ictus_timetag_list(t_ictus_timetag *x, t_symbol *s, int argc, t_atom
         }
         x->x_buf[i] = (unsigned char)f;
     }
-    if ((why = ictus_timetag_check(x->x_buf, argc, 0, &where))) {
+    if ((why = ictus_timetag_check(x, x->x_buf, argc, 0, &where))) {
         ictus_timetag_malformed(x, why, where);
         return;
     }
@@ -370,6 +385,31 @@ static void ictus_timetag_status(t_ictus_timetag *x)
     outlet_anything(x->x_info_out, gensym("status"), 5, info);
 }
 
+/* expect ADDRESS TAGS: e.g. `expect /ictus/strike iiiifffffffffffff` (tags
+ * without the comma; an empty symbol for none). A new rule for the same
+ * address replaces the old one. */
+static void ictus_timetag_expect(t_ictus_timetag *x, t_symbol *address, t_symbol *tags)
+{
+    int i;
+    if (address->s_name[0] != '/') {
+        pd_error(x, "ictus_timetag: expect: address must start with '/', got '%s'",
+                 address->s_name);
+        return;
+    }
+    for (i = 0; i < x->x_expect_count; i++)
+        if (x->x_expect_address[i] == address)
+            break;
+    if (i == ICTUS_TIMETAG_MAX_EXPECT) {
+        pd_error(x, "ictus_timetag: expect: at most %d addresses; '%s' ignored",
+                 ICTUS_TIMETAG_MAX_EXPECT, address->s_name);
+        return;
+    }
+    x->x_expect_address[i] = address;
+    x->x_expect_tags[i] = tags;
+    if (i == x->x_expect_count)
+        x->x_expect_count++;
+}
+
 static void ictus_timetag_reset(t_ictus_timetag *x)
 {
     x->x_late_count = x->x_malformed_count = x->x_packet_count = 0;
@@ -393,6 +433,7 @@ static void *ictus_timetag_new(t_floatarg latency_ms)
     x->x_atoms_size = 0;
     x->x_have_offset = 0;
     x->x_bucket_index = 0;
+    x->x_expect_count = 0;
     x->x_late_count = x->x_malformed_count = x->x_packet_count = 0;
     ictus_timetag_latency(x, latency_ms);
     ictus_timetag_sample(x);
@@ -420,4 +461,6 @@ ICTUS_TIMETAG_EXPORT void ictus_timetag_setup(void)
                     A_FLOAT, 0);
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_status, gensym("status"), 0);
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_reset, gensym("reset"), 0);
+    class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_expect, gensym("expect"), A_SYMBOL,
+                    A_DEFSYMBOL, 0);
 }

@@ -1,8 +1,9 @@
 """Malformed and fuzzed packets sent to [ictus-receive]'s port are dropped whole, counted
 (info outlet `malformed <count> <reason>`), reported with an error naming
 ictus_timetag (the first 5 only), and break nothing: strikes sent afterwards
-still start at their timetag within 1 ms. A well-formed /ictus/strike with the
-wrong argument count is refused by the abstraction with a message naming it."""
+still start at their timetag within 1 ms. A well-formed /ictus/strike with
+other type tags than docs/osc.md fixes (wrong count, floats for ints, a string)
+is refused too: ictus-receive tells ictus_timetag `expect /ictus/strike ...`."""
 import argparse
 import os
 import random
@@ -35,9 +36,12 @@ nested = message("/ictus/pong", "")
 for _ in range(10):  # deeper than ictus_timetag's limit of 8
     nested = bundle(timetag(now()), nested)
 bad.append(nested)
+# 17 arguments but not the fixed type tags of /ictus/strike (docs/osc.md)
+bad.append(message("/ictus/strike", "iiiifffffffffffff".replace("i", "f"), *range(17)))
+bad.append(message("/ictus/strike", "iiiiffffffffffffs", *range(16), "x"))
+bad.append(bundle(timetag(now()), message("/ictus/strike", "ii", 1, 2)))  # 2 arguments
 # every truncation of a good strike bundle, except 16 bytes (a valid empty bundle)
 bad += [good[:n] for n in range(1, len(good)) if n != 16]
-wrong_count = bundle(timetag(now()), message("/ictus/strike", "ii", 1, 2))
 # random bit flips in the framing of a strike bundle (header, timetag, element
 # size, address): whatever they become, pd must carry on. Their strikes carry
 # seq 999 and are ignored below.
@@ -67,7 +71,6 @@ try:
         out.sendto(packet, ("127.0.0.1", pd_port))
         if i % 10 == 9:
             time.sleep(0.005)
-    out.sendto(wrong_count, ("127.0.0.1", pd_port))
     time.sleep(0.3)
     t = now() + 0.05
     for seq in range(1, 11):
@@ -95,9 +98,10 @@ lines = [l for l in log.splitlines() if l.strip()]
 timetag_errors = [l for l in lines if "ictus_timetag: malformed OSC packet" in l]
 check(len(timetag_errors) == 5, "the first 5 malformed packets are reported by name (%d)"
       % len(timetag_errors))
-check(any("ictus-receive: /ictus/strike has 2 arguments (expected 17)" in l for l in lines),
-      "a strike with 2 arguments is refused, naming the address")
-others = [l for l in lines if l not in timetag_errors and "ictus-receive: /ictus/strike has" not in l]
+# the three new ones, and the ,q / ,iiii / ,i strikes above (caught by their tags first)
+check(sum(1 for m in malformed[:len(bad)] if m[3] == "unexpected-type-tags") == 6,
+      "strikes with other type tags than ,iiiifffffffffffff are refused (unexpected-type-tags)")
+others = [l for l in lines if l not in timetag_errors]
 check(not others, "nothing else in pd's log: %s" % others)
 offset = wall_of_logical(records)
 fires = {int(a[9]): a for _, a in records if a[0] == "fire" and int(a[9]) != 999}
