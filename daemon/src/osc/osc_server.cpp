@@ -105,6 +105,9 @@ OscServer::OscServer(const OscServerOptions &options, LiveStatus *status)
     impl_->fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     if (impl_->fd < 0)
         throw OscError(std::string("socket: ") + std::strerror(errno));
+    // Room for bursts (Pd sending a score): the kernel caps it at rmem_max.
+    int rcvbuf = 1 << 20;
+    setsockopt(impl_->fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
     sockaddr_in sa{};
     sa.sin_family = AF_INET;
     sa.sin_addr = bind_addr;

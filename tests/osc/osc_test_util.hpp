@@ -1,0 +1,209 @@
+// Helpers for the OSC tests: real peers (liblo's oscdump and oscsend run as
+// child processes), free UDP ports, raw sockets that send and receive OSC.
+#pragma once
+
+#include <lo/lo.h>
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace osctest
+{
+
+// A port that was free a moment ago (bound to port 0 and closed).
+inline int free_udp_port()
+{
+    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in sa{};
+    sa.sin_family = AF_INET;
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    bind(fd, reinterpret_cast<sockaddr *>(&sa), sizeof sa);
+    socklen_t len = sizeof sa;
+    getsockname(fd, reinterpret_cast<sockaddr *>(&sa), &len);
+    close(fd);
+    return ntohs(sa.sin_port);
+}
+
+// A child process whose stdout we read line by line; killed (SIGTERM) and
+// reaped on destruction.
+class Child
+{
+  public:
+    explicit Child(const std::vector<std::string> &args)
+    {
+        int fds[2];
+        if (pipe(fds) != 0)
+            return;
+        pid_ = fork();
+        if (pid_ == 0) {
+            dup2(fds[1], STDOUT_FILENO);
+            close(fds[0]);
+            close(fds[1]);
+            std::vector<char *> argv;
+            for (const std::string &a : args)
+                argv.push_back(const_cast<char *>(a.c_str()));
+            argv.push_back(nullptr);
+            execvp(argv[0], argv.data());
+            _exit(127);
+        }
+        close(fds[1]);
+        fd_ = fds[0];
+    }
+    ~Child()
+    {
+        if (pid_ > 0) {
+            kill(pid_, SIGTERM);
+            waitpid(pid_, nullptr, 0);
+        }
+        if (fd_ >= 0)
+            close(fd_);
+    }
+    bool started() const { return pid_ > 0; }
+    // Next line of stdout, or false after `timeout_ms` without one.
+    bool line(std::string &out, int timeout_ms)
+    {
+        const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+        for (;;) {
+            const size_t nl = buffer_.find('\n');
+            if (nl != std::string::npos) {
+                out = buffer_.substr(0, nl);
+                buffer_.erase(0, nl + 1);
+                return true;
+            }
+            const int left = static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(
+                                                  end - std::chrono::steady_clock::now())
+                                                  .count());
+            if (left <= 0)
+                return false;
+            pollfd p{fd_, POLLIN, 0};
+            if (poll(&p, 1, left) <= 0)
+                return false;
+            char buf[4096];
+            const ssize_t n = read(fd_, buf, sizeof buf);
+            if (n <= 0)
+                return false;
+            buffer_.append(buf, static_cast<size_t>(n));
+        }
+    }
+
+  private:
+    pid_t pid_ = -1;
+    int fd_ = -1;
+    std::string buffer_;
+};
+
+// Runs a command to completion; its exit status.
+inline int run(const std::vector<std::string> &args)
+{
+    const pid_t pid = fork();
+    if (pid == 0) {
+        std::vector<char *> argv;
+        for (const std::string &a : args)
+            argv.push_back(const_cast<char *>(a.c_str()));
+        argv.push_back(nullptr);
+        execvp(argv[0], argv.data());
+        _exit(127);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A UDP socket on a loopback address that sends raw packets and receives
+// OSC replies.
+class Peer
+{
+  public:
+    explicit Peer(const char *address = "127.0.0.1")
+    {
+        fd_ = socket(AF_INET, SOCK_DGRAM, 0);
+        sockaddr_in sa{};
+        sa.sin_family = AF_INET;
+        inet_pton(AF_INET, address, &sa.sin_addr);
+        bind(fd_, reinterpret_cast<sockaddr *>(&sa), sizeof sa);
+        int big = 1 << 20;
+        setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &big, sizeof big);
+    }
+    ~Peer() { close(fd_); }
+    void send_raw(int port, const void *data, size_t size)
+    {
+        sockaddr_in to{};
+        to.sin_family = AF_INET;
+        to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        to.sin_port = htons(static_cast<uint16_t>(port));
+        sendto(fd_, data, size, 0, reinterpret_cast<sockaddr *>(&to), sizeof to);
+    }
+    void send(int port, const char *path, lo_message m)
+    {
+        size_t size = 0;
+        void *data = lo_message_serialise(m, path, nullptr, &size);
+        send_raw(port, data, size);
+        std::free(data);
+        lo_message_free(m);
+    }
+    // Next OSC message: path and its arguments rendered as text, or false.
+    struct Message {
+        std::string path, types;
+        std::vector<std::string> strings;
+        std::vector<float> floats;
+        std::vector<int> ints;
+    };
+    bool receive(Message &out, int timeout_ms)
+    {
+        pollfd p{fd_, POLLIN, 0};
+        if (poll(&p, 1, timeout_ms) <= 0)
+            return false;
+        unsigned char buf[65536];
+        const ssize_t n = recv(fd_, buf, sizeof buf, 0);
+        if (n <= 0)
+            return false;
+        int result = 0;
+        lo_message m = lo_message_deserialise(buf, static_cast<size_t>(n), &result);
+        if (!m)
+            return false;
+        out = Message();
+        out.path = reinterpret_cast<const char *>(buf);
+        out.types = lo_message_get_types(m);
+        lo_arg **argv = lo_message_get_argv(m);
+        for (size_t i = 0; i < out.types.size(); ++i) {
+            if (out.types[i] == 's')
+                out.strings.push_back(&argv[i]->s);
+            else if (out.types[i] == 'f')
+                out.floats.push_back(argv[i]->f);
+            else if (out.types[i] == 'i')
+                out.ints.push_back(argv[i]->i);
+        }
+        lo_message_free(m);
+        return true;
+    }
+    void drain()
+    {
+        Message m;
+        while (receive(m, 0)) {
+        }
+    }
+    int port() const
+    {
+        sockaddr_in sa{};
+        socklen_t len = sizeof sa;
+        getsockname(fd_, reinterpret_cast<sockaddr *>(&sa), &len);
+        return ntohs(sa.sin_port);
+    }
+
+  private:
+    int fd_ = -1;
+};
+
+} // namespace osctest
