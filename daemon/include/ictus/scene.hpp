@@ -73,6 +73,8 @@ struct StepTiming {
     double check_s = 0.0;
 };
 
+// Not thread-safe: one thread builds and steps a scene (ODE's collision
+// data is per thread and allocated for the constructing thread).
 class Scene
 {
   public:
