@@ -140,10 +140,15 @@ class CsvParser
                 for (int k = 0; k < 7; ++k)
                     if (lower(name.substr(dot + 1)) == kComponents[k])
                         component = k;
-            if (component < 0)
-                header_error("time, frame or NAME.x|y|z|qw|qx|qy|qz in column " +
-                                 std::to_string(c + 1),
-                             quote(name));
+            if (component < 0) {
+                // Real exports carry extra columns (marker residuals, frame flags):
+                // they are skipped with a warning rather than refusing the file.
+                if (warnings_)
+                    warnings_->push_back(source_ + ":" + std::to_string(header_line_) +
+                                         ": column " + std::to_string(c + 1) + " " + quote(name) +
+                                         " ignored (not time, frame or NAME.x|y|z|qw|qx|qy|qz)");
+                continue;
+            }
             const std::string object = name.substr(0, dot);
             auto found = object_of.find(object);
             if (found == object_of.end()) {
