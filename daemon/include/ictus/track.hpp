@@ -5,6 +5,7 @@
 #pragma once
 
 #include "ictus/character.hpp"
+#include "ictus/chain_ik_solver_pos_dls.hpp"
 #include "ictus/joint_controller.hpp"
 #include "ictus/scene.hpp"
 
@@ -18,7 +19,49 @@
 namespace ictus
 {
 
+enum class TrackMode {
+    joint,    // eq. 1 on every joint (ID mode)
+    cartesian // Algorithm 2: the arms' targets from IK (eq. 2) toward the stick tips
+};
+const char *to_string(TrackMode mode);
+TrackMode track_mode_from_string(const std::string &text); // throws CharacterError
+
+// The Cartesian (hybrid) mode's IK settings.
+struct CartesianOptions {
+    // The gain of eq. 2: the IK target is X^S + gain (X^T - X^S), solved from
+    // Theta^S, so the PD springs pull the tip toward X^T with gain times the
+    // stiffness they have in joint space. 1 is the plain IK of X^T.
+    double gain = 1.0;
+    // Velocity term added with it, c (V^T - V^S), in seconds: raising the
+    // stiffness by `gain` lowers the damping ratio by sqrt(gain), so the
+    // default (< 0) restores it, c = (sqrt(gain) - 1) 2 zeta / omega_n.
+    double velocity_gain_s = -1.0;
+    // Integral of the tip error (1/s) added to the IK target: removes the
+    // steady part of the PD lag (gravity on the arm). 0: off.
+    double integral_per_s = 0.0;
+    // Cap on the integral's offset, m.
+    double integral_limit_m = 0.05;
+    // Cap on the feedback correction (gain - 1) e + c (V^T - V^S), m: a large
+    // error (a fast stroke the arm cannot follow) must not throw the IK target
+    // far off the path, where the loop gain turns it into a runaway.
+    double correction_limit_m = 0.03;
+    // Where the feedback IK starts. simulated: Theta^S, eq. 2 literally (the
+    // arm's redundant directions then drift with the body: measured 30-40 deg
+    // RMS at the shoulder on CMU 80_13). kinematic: the kinematic IK's solution
+    // (the capture's arm pose when it has one), so the PD also holds the arm's
+    // null space where the capture has it, and the Cartesian error term of
+    // eq. 2 still corrects the tip.
+    bool start_from_simulated = false;
+    // The reference's arm rotations are meaningful (a full-body capture): the
+    // kinematic IK starts from them every step. Else (stick-only captures) it
+    // continues from its own last solution.
+    bool reference_has_arms = true;
+    IkParams ik;
+};
+
 struct TrackOptions {
+    TrackMode mode = TrackMode::joint;
+    CartesianOptions cartesian;
     SceneOptions scene;
     GainOptions gains;
     // Simulated time; 0 means the reference's length (longer runs play it
@@ -65,6 +108,14 @@ struct TrackSummary {
     long contact_steps = 0;
     long stop_steps = 0; // joint-steps during which a safety-net stop was active
     Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero();
+    // Cartesian mode: IK statistics over all arm solves (two per step).
+    double ik_mean_iterations = 0.0;
+    int ik_max_iterations = 0;
+    double ik_us_per_step = 0.0; // wall time of the IK (both arms, both solves)
+    long ik_not_converged = 0;   // solves that ended other than `converged`
+    // Elbow flexion (rotation angle of the elbow's local rotation), IK target
+    // Theta^T vs the capture, RMS over the samples [side], degrees.
+    double elbow_ik_rms_deg[2] = {0.0, 0.0};
     nlohmann::json to_json() const;
 };
 
@@ -78,7 +129,7 @@ Eigen::Vector3d auto_drum_center(const CharacterModel &model, const ReferenceMot
 
 using ProgressFn = std::function<void(double fraction)>;
 
-// Runs the tracking of `reference` (errors are measured against it, and also
+// Runs the tracking of `reference` in options.mode (errors are measured against it, and also
 // against `raw_reference` when given). `limits` as Scene::set_joint_limits (empty: none). When
 // csv is given, writes a header and one row per sample. Throws CharacterError.
 TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotion &reference,

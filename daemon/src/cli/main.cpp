@@ -239,10 +239,22 @@ int run_track(Args &args)
             return 0;
         } else if (a == "--mode") {
             mode = args.value(a);
-            if (mode != "joint")
-                throw UsageError("--mode: expected 'joint' (the Cartesian mode is not in this "
-                                 "version), got '" +
-                                 mode + "'");
+            try {
+                options.mode = ictus::track_mode_from_string(mode);
+            } catch (const ictus::CharacterError &e) {
+                throw UsageError(std::string("--") + e.what());
+            }
+        } else if (a == "--ik-gain") {
+            options.cartesian.gain = parse_positive(a, args.value(a));
+        } else if (a == "--ik-velocity-gain") {
+            options.cartesian.velocity_gain_s = parse_double(a, args.value(a));
+        } else if (a == "--ik-start") {
+            const std::string v = args.value(a);
+            if (v != "simulated" && v != "kinematic")
+                throw UsageError("--ik-start: expected simulated or kinematic, got '" + v + "'");
+            options.cartesian.start_from_simulated = v == "simulated";
+        } else if (a == "--ik-integral") {
+            options.cartesian.integral_per_s = parse_double(a, args.value(a));
         } else if (a == "--mocap") {
             mocap = args.value(a);
         } else if (a == "--out") {
@@ -329,7 +341,7 @@ int run_track(Args &args)
         }
     }
     if (mode.empty())
-        throw UsageError("track: --mode is required (--mode joint)");
+        throw UsageError("track: --mode is required (--mode joint or --mode cartesian)");
     if (mocap.empty())
         throw UsageError("track: --mocap FILE is required");
     options.drum_auto = !drum_pos_given;
@@ -409,6 +421,10 @@ int run_track(Args &args)
     j["spikes_removed"] = reference.spikes_removed();
     j["interrupted"] = summary.interrupted;
     j["gains"] = ictus::gains_to_json(model, gains);
+    if (options.mode == ictus::TrackMode::cartesian) {
+        j["ik"]["gain"] = options.cartesian.gain;
+        j["ik"]["integral_per_s"] = options.cartesian.integral_per_s;
+    }
     if (!out_dir.empty()) {
         csv.close();
         if (!csv)
@@ -418,12 +434,17 @@ int run_track(Args &args)
         if (!js)
             throw std::runtime_error("--out: cannot write '" + out_dir + "/summary.json'");
     }
-    std::cout << "mode joint, " << summary.duration_s << " s simulated, realtime factor "
-              << summary.realtime_factor << "\n"
+    std::cout << "mode " << summary.mode << ", " << summary.duration_s
+              << " s simulated, realtime factor " << summary.realtime_factor << "\n"
               << "tip rms (mm): left " << summary.tip_rms_mm[0] << ", right "
               << summary.tip_rms_mm[1] << "\n"
               << "joint rms (deg), all joints: " << j["joint_rms_deg_all"].get<double>() << "\n"
               << "divergences: " << summary.divergences << "\n";
+    if (options.mode == ictus::TrackMode::cartesian)
+        std::cout << "ik: " << summary.ik_mean_iterations << " iterations per solve (max "
+                  << summary.ik_max_iterations << "), " << summary.ik_us_per_step
+                  << " us per step; elbow flexion rms (deg) left " << summary.elbow_ik_rms_deg[0]
+                  << ", right " << summary.elbow_ik_rms_deg[1] << "\n";
     if (summary.interrupted)
         return 130;
     return summary.diverged ? 3 : 0;

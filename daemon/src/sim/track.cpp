@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <ostream>
 
 namespace ictus
@@ -18,7 +19,68 @@ double smoothstep(double x)
     x = std::min(1.0, std::max(0.0, x));
     return x * x * (3.0 - 2.0 * x);
 }
+
+// One arm of Algorithm 2: the chain thorax -> clavicle -> shoulder -> elbow ->
+// wrist -> stick tip (docs/ik.md), twice: `feedback` is solved every step from
+// the simulated state (eq. 2), `kinematic` follows the targets alone (warm-started
+// from its own last solution) and gives the target rates for the feedforward.
+struct ArmIk {
+    int joint[4] = {-1, -1, -1, -1};
+    int base_body = -1;
+    KinematicChain feedback, kinematic;
+    Eigen::Vector3d integral_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d previous_tip_target_m = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond theta_target[4], kinematic_target[4], previous_kinematic[4];
+};
+
+constexpr const char *kArmJoints[2][4] = {{"l_clavicle", "l_shoulder", "l_elbow", "l_wrist"},
+                                          {"r_clavicle", "r_shoulder", "r_elbow", "r_wrist"}};
+
+void build_arm(const CharacterModel &model, Side side, const CharacterPose &initial,
+               const std::vector<JointLimitRef> &limits, ArmIk &arm)
+{
+    const int s = static_cast<int>(side);
+    for (int k = 0; k < 4; ++k) {
+        arm.joint[k] = model.joint_index(kArmJoints[s][k]);
+        if (arm.joint[k] < 0)
+            throw CharacterError(std::string("cartesian mode: the character has no joint '") +
+                                 kArmJoints[s][k] + "'");
+    }
+    arm.base_body = model.joint_body(arm.joint[0]).parent;
+    for (KinematicChain *chain : {&arm.feedback, &arm.kinematic}) {
+        for (int k = 0; k < 4; ++k) {
+            const int j = arm.joint[k];
+            chain->add_joint(model.joint_body(j).offset_m, initial.local[j],
+                             limits.empty() ? JointLimitRef() : limits[j]);
+        }
+        chain->set_tip(model.stick(side).tip_m, model.stick(side).axis);
+    }
+    for (int k = 0; k < 4; ++k)
+        arm.theta_target[k] = arm.kinematic_target[k] = arm.previous_kinematic[k] =
+            initial.local[arm.joint[k]];
+}
+
+// Rotation angle of a local rotation, degrees: the elbow's flexion (its
+// other two axes stay within a few degrees in the captures).
+double rotation_angle_deg(const Eigen::Quaterniond &q)
+{
+    return rotation_vector(q).norm() * kRadToDeg;
+}
 } // namespace
+
+const char *to_string(TrackMode mode)
+{
+    return mode == TrackMode::cartesian ? "cartesian" : "joint";
+}
+
+TrackMode track_mode_from_string(const std::string &text)
+{
+    if (text == "joint")
+        return TrackMode::joint;
+    if (text == "cartesian")
+        return TrackMode::cartesian;
+    throw CharacterError("mode: expected joint or cartesian, got '" + text + "'");
+}
 
 void validate(const TrackOptions &o)
 {
@@ -30,6 +92,20 @@ void validate(const TrackOptions &o)
         throw CharacterError("ramp: expected a finite value >= 0 s");
     if (!(std::isfinite(o.sample_rate_hz) && o.sample_rate_hz >= 0.0))
         throw CharacterError("sample rate: expected a finite value >= 0 Hz");
+    const CartesianOptions &c = o.cartesian;
+    if (!(std::isfinite(c.gain) && c.gain > 0.0 && c.gain <= 100.0))
+        throw CharacterError("ik gain: expected 0 < gain <= 100, got " + std::to_string(c.gain));
+    if (!std::isfinite(c.velocity_gain_s) || c.velocity_gain_s > 1.0)
+        throw CharacterError("ik velocity gain: expected a value <= 1 s (< 0: automatic)");
+    if (!(std::isfinite(c.correction_limit_m) && c.correction_limit_m >= 0.0))
+        throw CharacterError("ik correction limit: expected a finite value >= 0 m");
+    if (!(std::isfinite(c.integral_per_s) && c.integral_per_s >= 0.0))
+        throw CharacterError("ik integral: expected a finite value >= 0 /s");
+    if (!(std::isfinite(c.integral_limit_m) && c.integral_limit_m >= 0.0))
+        throw CharacterError("ik integral limit: expected a finite value >= 0 m");
+    ChainIkSolverPos_dls probe(4);
+    if (!probe.set_params(c.ik))
+        throw CharacterError("ik parameters: expected finite positive values");
 }
 
 nlohmann::json TrackSummary::to_json() const
@@ -72,6 +148,14 @@ nlohmann::json TrackSummary::to_json() const
     j["contact_steps"] = contact_steps;
     j["stop_steps"] = stop_steps;
     j["drum_center_m"] = {drum_center_m.x(), drum_center_m.y(), drum_center_m.z()};
+    if (mode == "cartesian") {
+        j["ik"] = {{"mean_iterations", ik_mean_iterations},
+                   {"max_iterations", ik_max_iterations},
+                   {"us_per_step", ik_us_per_step},
+                   {"not_converged", ik_not_converged},
+                   {"elbow_flexion_rms_deg",
+                    {{"left", elbow_ik_rms_deg[0]}, {"right", elbow_ik_rms_deg[1]}}}};
+    }
     return j;
 }
 
@@ -128,7 +212,25 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     scene.set_joint_limits(limits);
 
     const int nj = CharacterModel::kJoints;
+    const bool cartesian = options.mode == TrackMode::cartesian;
+    const CartesianOptions &co = options.cartesian;
+    std::array<ArmIk, 2> arms;
+    std::unique_ptr<ChainIkSolverPos_dls> solver;
+    if (cartesian) {
+        for (int s = 0; s < 2; ++s)
+            build_arm(model, static_cast<Side>(s), initial, limits, arms[s]);
+        solver = std::make_unique<ChainIkSolverPos_dls>(4, co.ik);
+    }
+    const double velocity_gain_s =
+        co.velocity_gain_s >= 0.0 ? co.velocity_gain_s
+                                  : (std::sqrt(co.gain) - 1.0) * 2.0 * options.gains.damping_ratio /
+                                        (2.0 * M_PI * options.gains.natural_frequency_hz);
+    long ik_iterations = 0, ik_solves = 0;
+    double ik_wall_s = 0.0, elbow_sum2[2] = {0.0, 0.0};
+    BodyFrames sim_frames, target_frames;
+
     TrackSummary summary;
+    summary.mode = to_string(options.mode);
     summary.frames = reference.frames();
     summary.drum_center_m = options.scene.drum.center_m;
     for (int j = 0; j < nj; ++j)
@@ -153,6 +255,11 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             for (const char *what : {"ref", "sim"})
                 for (const char *axis : {"x", "y", "z"})
                     *csv << ",tip_" << side << '_' << what << '_' << axis << "_m";
+        // Elbow flexion (rotation angle, deg): capture, PD target (joint mode: the
+        // capture; Cartesian mode: Theta^T from IK), simulation.
+        for (const char *side : {"l", "r"})
+            for (const char *what : {"ref", "target", "sim"})
+                *csv << ',' << side << "_elbow_flexion_" << what << "_deg";
         *csv << ",contacts\n";
     }
 
@@ -177,6 +284,81 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             rate[j] = rotation_vector(target[j] * previous_target[j].conjugate()) / h;
         }
         previous_target = target;
+        if (cartesian) {
+            // Algorithm 2. X^T: the stick tips of the (blended) reference pose.
+            const auto ik_start = std::chrono::steady_clock::now();
+            target_pose.pelvis_position_m = ref_pose.pelvis_position_m;
+            target_pose.pelvis_rotation = ref_pose.pelvis_rotation;
+            target_pose.local = target;
+            model.forward(target_pose, target_frames);
+            scene.body_frames(sim_frames);
+            scene.local_rotations(sim_local);
+            for (int s = 0; s < 2; ++s) {
+                ArmIk &arm = arms[s];
+                const Side side = static_cast<Side>(s);
+                const int hb = model.hand_body(side);
+                const Eigen::Vector3d tip_target = model.tip_position(
+                    side, target_frames.origin_m[hb], target_frames.rotation[hb]);
+                // Kinematic IK: the arm's target trajectory without the body,
+                // for the target rates (feedforward of eq. 1).
+                arm.kinematic.set_base(target_frames.origin_m[arm.base_body],
+                                       target_frames.rotation[arm.base_body]);
+                if (co.reference_has_arms)
+                    for (int k = 0; k < 4; ++k)
+                        arm.kinematic_target[k] = target[arm.joint[k]];
+                arm.kinematic.set_rotations(arm.kinematic_target);
+                IkResult r = solver->solve(arm.kinematic, tip_target, arm.kinematic_target);
+                ik_iterations += r.iterations;
+                summary.ik_max_iterations = std::max(summary.ik_max_iterations, r.iterations);
+                summary.ik_not_converged += r.status != IkStatus::converged;
+                // Eq. 2 from the simulated state: Theta^T = Theta^S + dTheta^T toward
+                // X^S + gain (X^T - X^S) (+ the integral of the error).
+                arm.feedback.set_base(sim_frames.origin_m[arm.base_body],
+                                      sim_frames.rotation[arm.base_body]);
+                for (int k = 0; k < 4; ++k)
+                    arm.feedback.set_rotation(k, sim_local[arm.joint[k]]);
+                const Eigen::Vector3d sim_tip_chain = arm.feedback.tip_position();
+                if (!co.start_from_simulated)
+                    arm.feedback.set_rotations(arm.kinematic_target);
+                const Eigen::Vector3d error = tip_target - scene.tip_position(side);
+                const Eigen::Vector3d tip_target_velocity =
+                    n == 0 ? Eigen::Vector3d::Zero()
+                           : Eigen::Vector3d((tip_target - arm.previous_tip_target_m) / h);
+                arm.previous_tip_target_m = tip_target;
+                const Eigen::Vector3d velocity_error =
+                    tip_target_velocity - scene.tip_velocity(side);
+                if (co.integral_per_s > 0.0 && t_next >= options.ramp_s) {
+                    arm.integral_m += co.integral_per_s * h * error;
+                    const double norm = arm.integral_m.norm();
+                    if (norm > co.integral_limit_m)
+                        arm.integral_m *= co.integral_limit_m / norm;
+                }
+                Eigen::Vector3d correction =
+                    (co.gain - 1.0) * error + velocity_gain_s * velocity_error;
+                const double correction_norm = correction.norm();
+                if (correction_norm > co.correction_limit_m)
+                    correction *= co.correction_limit_m / correction_norm;
+                const Eigen::Vector3d ik_target =
+                    sim_tip_chain + error + correction + arm.integral_m;
+                r = solver->solve(arm.feedback, ik_target, arm.theta_target);
+                ik_iterations += r.iterations;
+                summary.ik_max_iterations = std::max(summary.ik_max_iterations, r.iterations);
+                summary.ik_not_converged += r.status != IkStatus::converged;
+                ik_solves += 2;
+                for (int k = 0; k < 4; ++k) {
+                    const int j = arm.joint[k];
+                    target[j] = arm.theta_target[k];
+                    rate[j] = n == 0 ? Eigen::Vector3d::Zero()
+                                     : Eigen::Vector3d(
+                                           rotation_vector(arm.kinematic_target[k] *
+                                                           arm.previous_kinematic[k].conjugate()) /
+                                           h);
+                    arm.previous_kinematic[k] = arm.kinematic_target[k];
+                }
+            }
+            ik_wall_s +=
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - ik_start).count();
+        }
         scene.set_joint_targets(target, rate);
         scene.step();
         summary.max_linear_speed_mps =
@@ -215,6 +397,10 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                     const double e = (ref_tips[s] - sim_tips[s]).norm() * 1e3;
                     tip_sum2[s] += e * e;
                     tip_max[s] = std::max(tip_max[s], e);
+                    const int elbow = model.joint_index(kArmJoints[s][2]);
+                    const double de = rotation_angle_deg(ref_pose.local[elbow]) -
+                                      rotation_angle_deg(target[elbow]);
+                    elbow_sum2[s] += de * de;
                 }
                 if (raw_reference) {
                     raw_reference->sample(t_next, raw_pose);
@@ -243,6 +429,12 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                 for (int s = 0; s < 2; ++s)
                     for (const Eigen::Vector3d &p : {ref_tips[s], sim_tips[s]})
                         *csv << ',' << p.x() << ',' << p.y() << ',' << p.z();
+                for (int s = 0; s < 2; ++s) {
+                    const int elbow = model.joint_index(kArmJoints[s][2]);
+                    *csv << ',' << rotation_angle_deg(ref_pose.local[elbow]) << ','
+                         << rotation_angle_deg(target[elbow]) << ','
+                         << rotation_angle_deg(sim_local[elbow]);
+                }
                 *csv << ',' << scene.contacts_last_step() << '\n';
             }
         }
@@ -273,6 +465,13 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
         summary.tip_rms_raw_mm[s] = std::sqrt(raw_tip_sum2[s] / ns);
     }
     summary.joint_rms_raw_deg_all = std::sqrt(raw_joint_sum2 / (ns * nj));
+    if (cartesian) {
+        summary.ik_mean_iterations =
+            ik_solves > 0 ? static_cast<double>(ik_iterations) / ik_solves : 0.0;
+        summary.ik_us_per_step = n > 0 ? 1e6 * ik_wall_s / n : 0.0;
+        for (int s = 0; s < 2; ++s)
+            summary.elbow_ik_rms_deg[s] = std::sqrt(elbow_sum2[s] / ns);
+    }
     summary.divergences = scene.divergences();
     summary.diverged = summary.divergences > 0;
     summary.contact_steps = scene.contact_steps();
