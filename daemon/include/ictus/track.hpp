@@ -28,23 +28,30 @@ TrackMode track_mode_from_string(const std::string &text); // throws CharacterEr
 
 // The Cartesian (hybrid) mode's IK settings.
 struct CartesianOptions {
-    // The gain of eq. 2: the IK target is X^S + gain (X^T - X^S), solved from
-    // Theta^S, so the PD springs pull the tip toward X^T with gain times the
-    // stiffness they have in joint space. 1 is the plain IK of X^T.
-    double gain = 1.0;
-    // Velocity term added with it, c (V^T - V^S), in seconds: raising the
-    // stiffness by `gain` lowers the damping ratio by sqrt(gain), so the
-    // default (< 0) restores it, c = (sqrt(gain) - 1) 2 zeta / omega_n.
-    double velocity_gain_s = -1.0;
-    // Integral of the tip error (1/s) added to the IK target: removes the
-    // steady part of the PD lag (gravity on the arm). 0: off.
+    // The gain of eq. 2: the IK target is X^S + gain (X^T - X^S) (+ the terms
+    // below), so the PD springs pull the tip toward X^T with `gain` times the
+    // stiffness they have in joint space. 1 is the plain IK of X^T. Default 10:
+    // on CMU 80_13 the tip RMS falls with the gain up to ~10 and is flat above
+    // (docs/ik.md, "Cartesian mode").
+    double gain = 10.0;
+    // Velocity term c (V^T - V^S), s, V^T the reference tip velocity: the
+    // damping that goes with the raised stiffness. < 0: automatic,
+    // (sqrt(gain) - 1) 2 zeta / omega_n (restores eq. 1's damping ratio); the
+    // default 0.1 s was the best measured on CMU 80_13.
+    double velocity_gain_s = 0.1;
+    // Acceleration feedforward, s^2: k_a A^T is added to the IK target, A^T the
+    // reference tip's acceleration (central difference over one reference
+    // frame). Off by default: measured no gain on CMU 80_13.
+    double acceleration_feedforward_s2 = 0.0;
+    // Integral of the tip error (1/s) added to the IK target. 0: off (measured
+    // no gain on CMU 80_13).
     double integral_per_s = 0.0;
-    // Cap on the integral's offset, m.
-    double integral_limit_m = 0.05;
-    // Cap on the feedback correction (gain - 1) e + c (V^T - V^S), m: a large
-    // error (a fast stroke the arm cannot follow) must not throw the IK target
-    // far off the path, where the loop gain turns it into a runaway.
-    double correction_limit_m = 0.03;
+    double integral_limit_m = 0.05; // cap on the integral's offset
+    // Cap on the correction (gain - 1)(X^T - X^S) + c (V^T - V^S) + k_a A^T, m:
+    // a large error (a target a joint limit keeps out of reach) must not throw
+    // the IK target far off the path, where the loop gain makes it a runaway
+    // (measured: 0.3 m excursions at gain 3 without a cap).
+    double correction_limit_m = 0.1;
     // Where the feedback IK starts. simulated: Theta^S, eq. 2 literally (the
     // arm's redundant directions then drift with the body: measured 30-40 deg
     // RMS at the shoulder on CMU 80_13). kinematic: the kinematic IK's solution

@@ -248,6 +248,10 @@ int run_track(Args &args)
             options.cartesian.gain = parse_positive(a, args.value(a));
         } else if (a == "--ik-velocity-gain") {
             options.cartesian.velocity_gain_s = parse_double(a, args.value(a));
+        } else if (a == "--ik-accel-ff") {
+            options.cartesian.acceleration_feedforward_s2 = parse_double(a, args.value(a));
+        } else if (a == "--ik-correction-limit") {
+            options.cartesian.correction_limit_m = parse_double(a, args.value(a));
         } else if (a == "--ik-start") {
             const std::string v = args.value(a);
             if (v != "simulated" && v != "kinematic")

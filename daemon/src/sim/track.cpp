@@ -29,7 +29,6 @@ struct ArmIk {
     int base_body = -1;
     KinematicChain feedback, kinematic;
     Eigen::Vector3d integral_m = Eigen::Vector3d::Zero();
-    Eigen::Vector3d previous_tip_target_m = Eigen::Vector3d::Zero();
     Eigen::Quaterniond theta_target[4], kinematic_target[4], previous_kinematic[4];
 };
 
@@ -97,6 +96,9 @@ void validate(const TrackOptions &o)
         throw CharacterError("ik gain: expected 0 < gain <= 100, got " + std::to_string(c.gain));
     if (!std::isfinite(c.velocity_gain_s) || c.velocity_gain_s > 1.0)
         throw CharacterError("ik velocity gain: expected a value <= 1 s (< 0: automatic)");
+    if (!(std::isfinite(c.acceleration_feedforward_s2) && c.acceleration_feedforward_s2 >= 0.0 &&
+          c.acceleration_feedforward_s2 <= 1.0))
+        throw CharacterError("ik acceleration feedforward: expected 0 <= s^2 <= 1");
     if (!(std::isfinite(c.correction_limit_m) && c.correction_limit_m >= 0.0))
         throw CharacterError("ik correction limit: expected a finite value >= 0 m");
     if (!(std::isfinite(c.integral_per_s) && c.integral_per_s >= 0.0))
@@ -228,6 +230,7 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     long ik_iterations = 0, ik_solves = 0;
     double ik_wall_s = 0.0, elbow_sum2[2] = {0.0, 0.0};
     BodyFrames sim_frames, target_frames;
+    CharacterPose around_pose;
 
     TrackSummary summary;
     summary.mode = to_string(options.mode);
@@ -293,6 +296,26 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             model.forward(target_pose, target_frames);
             scene.body_frames(sim_frames);
             scene.local_rotations(sim_local);
+            // Reference tip velocity and acceleration by central differences over
+            // one reference frame (the sampled reference is piecewise linear
+            // between frames, so per-step differences would be steps and spikes).
+            std::array<Eigen::Vector3d, 2> tip_velocity, tip_acceleration;
+            const double frame_s = 1.0 / reference.frame_rate_hz();
+            if (t_next - frame_s >= options.ramp_s) {
+                reference.sample(t_next - frame_s, around_pose);
+                const auto before = reference_tips(model, around_pose);
+                reference.sample(t_next + frame_s, around_pose);
+                const auto after = reference_tips(model, around_pose);
+                const auto now = reference_tips(model, ref_pose);
+                for (int s = 0; s < 2; ++s) {
+                    tip_velocity[s] = (after[s] - before[s]) / (2.0 * frame_s);
+                    tip_acceleration[s] =
+                        (after[s] - 2.0 * now[s] + before[s]) / (frame_s * frame_s);
+                }
+            } else {
+                tip_velocity.fill(Eigen::Vector3d::Zero());
+                tip_acceleration.fill(Eigen::Vector3d::Zero());
+            }
             for (int s = 0; s < 2; ++s) {
                 ArmIk &arm = arms[s];
                 const Side side = static_cast<Side>(s);
@@ -321,20 +344,16 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                 if (!co.start_from_simulated)
                     arm.feedback.set_rotations(arm.kinematic_target);
                 const Eigen::Vector3d error = tip_target - scene.tip_position(side);
-                const Eigen::Vector3d tip_target_velocity =
-                    n == 0 ? Eigen::Vector3d::Zero()
-                           : Eigen::Vector3d((tip_target - arm.previous_tip_target_m) / h);
-                arm.previous_tip_target_m = tip_target;
-                const Eigen::Vector3d velocity_error =
-                    tip_target_velocity - scene.tip_velocity(side);
+                const Eigen::Vector3d velocity_error = tip_velocity[s] - scene.tip_velocity(side);
                 if (co.integral_per_s > 0.0 && t_next >= options.ramp_s) {
                     arm.integral_m += co.integral_per_s * h * error;
                     const double norm = arm.integral_m.norm();
                     if (norm > co.integral_limit_m)
                         arm.integral_m *= co.integral_limit_m / norm;
                 }
-                Eigen::Vector3d correction =
-                    (co.gain - 1.0) * error + velocity_gain_s * velocity_error;
+                Eigen::Vector3d correction = (co.gain - 1.0) * error +
+                                             velocity_gain_s * velocity_error +
+                                             co.acceleration_feedforward_s2 * tip_acceleration[s];
                 const double correction_norm = correction.norm();
                 if (correction_norm > co.correction_limit_m)
                     correction *= co.correction_limit_m / correction_norm;
