@@ -9,6 +9,7 @@
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -21,6 +22,25 @@
 
 namespace osctest
 {
+
+// liblo's argument pointers are only 4-byte aligned, while lo_arg (a union
+// with 64-bit members) asks for 8: read the bytes, never the union member.
+inline float lo_arg_float(const lo_arg *a)
+{
+    float f;
+    std::memcpy(&f, a, sizeof f);
+    return f;
+}
+inline int32_t lo_arg_int(const lo_arg *a)
+{
+    int32_t i;
+    std::memcpy(&i, a, sizeof i);
+    return i;
+}
+inline const char *lo_arg_string(const lo_arg *a)
+{
+    return reinterpret_cast<const char *>(a);
+}
 
 // A port that was free a moment ago (bound to port 0 and closed).
 inline int free_udp_port()
@@ -48,6 +68,9 @@ class Child
             return;
         pid_ = fork();
         if (pid_ == 0) {
+            // Dies with the test, even when the test aborts (a sanitizer
+            // error): an orphan would hold ctest's output pipe open.
+            prctl(PR_SET_PDEATHSIG, SIGTERM);
             dup2(fds[1], STDOUT_FILENO);
             close(fds[0]);
             close(fds[1]);
@@ -179,11 +202,11 @@ class Peer
         lo_arg **argv = lo_message_get_argv(m);
         for (size_t i = 0; i < out.types.size(); ++i) {
             if (out.types[i] == 's')
-                out.strings.push_back(&argv[i]->s);
+                out.strings.push_back(lo_arg_string(argv[i]));
             else if (out.types[i] == 'f')
-                out.floats.push_back(argv[i]->f);
+                out.floats.push_back(lo_arg_float(argv[i]));
             else if (out.types[i] == 'i')
-                out.ints.push_back(argv[i]->i);
+                out.ints.push_back(lo_arg_int(argv[i]));
         }
         lo_message_free(m);
         return true;

@@ -112,7 +112,7 @@ TEST_CASE("render: two renders give identical bytes, the events add up to the st
     fs::remove_all(dir);
 }
 
-TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked rate; oscsend "
+TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked rate, and oscsend "
           "drives it",
           "[osc][verbs]")
 {

@@ -25,6 +25,25 @@ namespace ictus
 namespace
 {
 
+// liblo's argument pointers are only 4-byte aligned, while lo_arg (a union
+// with 64-bit members) asks for 8: read the bytes, never the union member.
+float lo_arg_float(const lo_arg *a)
+{
+    float f;
+    std::memcpy(&f, a, sizeof f);
+    return f;
+}
+int32_t lo_arg_int(const lo_arg *a)
+{
+    int32_t i;
+    std::memcpy(&i, a, sizeof i);
+    return i;
+}
+const char *lo_arg_string(const lo_arg *a)
+{
+    return reinterpret_cast<const char *>(a);
+}
+
 struct Counters {
     std::atomic<unsigned long> packets{0}, accepted{0}, unknown_address{0}, bad_type_tags{0},
         bad_values{0}, malformed{0}, oversized{0}, refused_peers{0}, bundles{0}, queue_full{0},
@@ -208,13 +227,13 @@ struct Reply {
         for (int i = 0; i < argc; ++i) {
             switch (types[i]) {
             case 'f':
-                lo_message_add_float(r, argv[i]->f);
+                lo_message_add_float(r, lo_arg_float(argv[i]));
                 break;
             case 'i':
-                lo_message_add_int32(r, argv[i]->i);
+                lo_message_add_int32(r, lo_arg_int(argv[i]));
                 break;
             case 's':
-                lo_message_add_string(r, &argv[i]->s);
+                lo_message_add_string(r, lo_arg_string(argv[i]));
                 break;
             default:
                 break;
@@ -380,14 +399,14 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
         Command cmd;
         cmd.kind = s.kind;
         if (s.types[0] == 'f') {
-            cmd.value = argv[0]->f;
+            cmd.value = lo_arg_float(argv[0]);
             if (!(std::isfinite(cmd.value) && cmd.value >= s.lo && cmd.value <= s.hi)) {
                 c.bad_values++;
                 reply.error(path, format_range(s, cmd.value));
                 return;
             }
             if (s.types[1] == 'f') {
-                cmd.value2 = argv[1]->f;
+                cmd.value2 = lo_arg_float(argv[1]);
                 if (!(std::isfinite(cmd.value2) && cmd.value2 >= s.lo && cmd.value2 <= s.hi)) {
                     c.bad_values++;
                     reply.error(path, format_range(s, cmd.value2));
@@ -395,7 +414,7 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
                 }
             }
         } else if (s.types[0] == 's') {
-            const char *text = &argv[0]->s;
+            const char *text = lo_arg_string(argv[0]);
             bool ok = false;
             std::string expected;
             if (s.kind == CommandKind::grip) {
@@ -431,9 +450,9 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
         lo_message echo = lo_message_new();
         for (int i = 0; types[i]; ++i) {
             if (types[i] == 'f')
-                lo_message_add_float(echo, argv[i]->f);
+                lo_message_add_float(echo, lo_arg_float(argv[i]));
             else if (types[i] == 's')
-                lo_message_add_string(echo, &argv[i]->s);
+                lo_message_add_string(echo, lo_arg_string(argv[i]));
         }
         reply.ok(path, echo);
         return;
