@@ -118,6 +118,13 @@ TEST_CASE("ictusd track: every option refuses a bad value, naming it", "[sim][cl
         {"--ramp", "-1", "--ramp"},
         {"--smooth-hz", "-1", "--smooth-hz"},
         {"--despike-deg", "-1", "--despike-deg"},
+        {"--ik-gain", "0", "--ik-gain"},
+        {"--ik-gain", "500", "ik gain"},
+        {"--ik-velocity-gain", "abc", "--ik-velocity-gain"},
+        {"--ik-accel-ff", "-1", "acceleration feedforward"},
+        {"--ik-correction-limit", "-1", "correction limit"},
+        {"--ik-integral", "-1", "ik integral"},
+        {"--ik-start", "nowhere", "--ik-start"},
     };
     for (const auto &c : cases) {
         const Run r = ictusd(base + c[0] + " " + c[1]);
@@ -192,6 +199,34 @@ TEST_CASE("ictusd track --out writes the CSV and a summary with the required fie
     while (std::getline(csv, line))
         ++rows;
     CHECK(rows == 180); // 1.5 s at the clip's 120 Hz
+}
+
+TEST_CASE("ictusd track --mode cartesian writes the same outputs plus IK statistics",
+          "[sim][cli][cartesian]")
+{
+    const std::string dir = simtest::temp_path("out_cartesian");
+    const Run r = ictusd("track --mode cartesian --quiet --mocap " + tiny_bvh() + " --out " + dir +
+                         " --duration 1");
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    CHECK(r.output.find("mode cartesian") != std::string::npos);
+    CHECK(r.output.find("ik: ") != std::string::npos);
+    std::ifstream js(dir + "/summary.json");
+    REQUIRE(js.good());
+    const nlohmann::json s = nlohmann::json::parse(js);
+    CHECK(s.at("mode") == "cartesian");
+    CHECK(s.at("ik").at("gain").get<double>() == Approx(10.0));
+    CHECK(s.at("ik").at("mean_iterations").get<double>() < 3.0);
+    CHECK(s.at("ik").at("us_per_step").get<double>() > 0.0);
+    CHECK(s.at("tip_rms_mm").at("right").get<double>() < 5.0);
+    std::ifstream csv(dir + "/track.csv");
+    std::string header;
+    std::getline(csv, header);
+    CHECK(header.find("r_elbow_flexion_target_deg") != std::string::npos);
+    // A bad mode names the choices.
+    const Run bad = ictusd("track --mode foo --mocap " + tiny_bvh());
+    CHECK(bad.status == 2);
+    CHECK(bad.output.find("joint or cartesian") != std::string::npos);
 }
 
 TEST_CASE("ictusd track --gains overrides one joint and refuses bad files", "[sim][cli]")
