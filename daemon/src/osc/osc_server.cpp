@@ -186,8 +186,10 @@ void OscServer::loop()
                                    reinterpret_cast<sockaddr *>(&peer), &len);
         if (n < 0)
             continue;
-        impl_->counters.packets++;
         handle(impl_->buffer, static_cast<std::size_t>(n), &peer);
+        // Counted once handled: a reader that sees N packets sees their
+        // categories counted too.
+        impl_->counters.packets++;
     }
 }
 
