@@ -108,7 +108,31 @@ TEST_CASE("render: two renders give identical bytes, the events add up to the st
         CHECK(std::stoi(f[3]) == bounce);
         CHECK(sum_ms == Approx(std::stod(f[5]) * 1e3).margin(1e-6 * (i + 1) + 1e-9));
         CHECK(ev[i].back() == ';');
+        // Physics of each contact of the real scene: it lasts, it pushes the
+        // membrane down, its peak is at least its mean force (impulse /
+        // duration), it starts on the disk (bead centre within the radius:
+        // r/a <= 1 + r_tip/R at the lowest point), the direction is a unit vector.
+        const double duration_ms = std::stod(f[14]), impulse = std::stod(f[13]);
+        const double peak = std::stod(f[12]);
+        CHECK(duration_ms > 0.0);
+        CHECK(impulse > 0.0);
+        CHECK(peak * 1.001 + 1e-3 >= impulse / (duration_ms * 1e-3));
+        CHECK(std::stod(f[8]) <= 1.0 + 0.007 / 0.178 + 1e-4);
+        const double fx = std::stod(f[15]), fy = std::stod(f[16]), fz = std::stod(f[17]);
+        CHECK(std::sqrt(fx * fx + fy * fy + fz * fz) == Approx(1.0).margin(1e-3));
+        CHECK(fy < 0.0);
     }
+    // The contact law of the drum in render.json is the membrane's:
+    // k = 2 pi T / ln(R / r_tip), r_tip = 7 mm (the default stick).
+    const std::string js = slurp((dir / "a/render.json").string());
+    auto number_after = [&](const std::string &key) {
+        const size_t at = js.find("\"" + key + "\":");
+        REQUIRE(at != std::string::npos);
+        return std::stod(js.substr(at + key.size() + 3));
+    };
+    const double tension = number_after("tension_n_per_m"), radius = number_after("radius_m");
+    CHECK(number_after("contact_stiffness_n_per_m") ==
+          Approx(2.0 * M_PI * tension / std::log(radius / 0.007)).epsilon(1e-9));
     fs::remove_all(dir);
 }
 
