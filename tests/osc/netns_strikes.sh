@@ -51,7 +51,9 @@ dump_pid=$!
 sleep 0.3
 
 # The command is sent from b while the daemon runs.
-(sleep 1.5 && ip netns exec "$b" oscsend 10.213.0.1 9001 /ictus/ping) &
+# Pings from b while the daemon runs, every 0.5 s (it may take a while to load
+# the clip and bind under a sanitizer): at least one must be answered.
+(for i in 1 2 3 4 5 6 7; do sleep 0.5; ip netns exec "$b" oscsend 10.213.0.1 9001 /ictus/ping; done) &
 ping_pid=$!
 ip netns exec "$a" "$ictusd" run --mocap "$clip" --duration 4 \
     --target osc.udp://10.213.0.2:9000 --bind 10.213.0.1 --allow 10.213.0.2 --port 9001 \
@@ -71,5 +73,5 @@ echo "received strikes: $received"
 echo "pose frames: $frames, pongs: $pongs"
 [ -n "$recorded" ] || { echo "FAIL: no strikes recorded"; exit 1; }
 [ "$recorded" = "$received" ] || { echo "FAIL: strikes lost between the namespaces"; exit 1; }
-[ "$pongs" = 1 ] || { echo "FAIL: expected one /ictus/pong across the namespaces"; exit 1; }
+[ "$pongs" -ge 1 ] || { echo "FAIL: no /ictus/pong came back across the namespaces"; exit 1; }
 echo "ok: every strike crossed from $a (10.213.0.1) to $b (10.213.0.2)"

@@ -159,10 +159,15 @@ TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked r
         done = true;
     });
     // Commands while it runs.
+    // Commands while it runs, repeated (loading the clip may take a while
+    // under a sanitizer before the port is bound): some must be answered.
     std::thread commands([&]() {
-        std::this_thread::sleep_for(std::chrono::milliseconds(1500));
-        osctest::run({"oscsend", "127.0.0.1", std::to_string(port), "/ictus/ping"});
-        osctest::run({"oscsend", "127.0.0.1", std::to_string(port), "/ictus/tempo", "f", "130"});
+        for (int i = 0; i < 6; ++i) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(500));
+            osctest::run({"oscsend", "127.0.0.1", std::to_string(port), "/ictus/ping"});
+            osctest::run(
+                {"oscsend", "127.0.0.1", std::to_string(port), "/ictus/tempo", "f", "130"});
+        }
     });
 
     // Read oscdump while the daemon runs (a full pipe would stall oscdump
@@ -203,7 +208,7 @@ TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked r
     CHECK(seqs == recorded);
     // 30 Hz over the run: one frame every 33 steps of 1 ms.
     CHECK(std::abs(frames - static_cast<int>(std::ceil(seconds * 1000.0 / 33.0))) <= 1);
-    CHECK(pongs == 1);
-    CHECK(replies == 1);
+    CHECK(pongs >= 1);
+    CHECK(replies >= 1); // a tempo accepted
     fs::remove_all(dir);
 }
