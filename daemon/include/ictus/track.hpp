@@ -8,6 +8,7 @@
 #include "ictus/chain_ik_solver_pos_dls.hpp"
 #include "ictus/joint_controller.hpp"
 #include "ictus/scene.hpp"
+#include "ictus/stick_capture.hpp"
 
 #include <csignal>
 #include <functional>
@@ -82,6 +83,11 @@ struct TrackOptions {
     bool drum_auto = true;
     // CSV rows per second of simulated time; 0: the reference's frame rate.
     double sample_rate_hz = 0.0;
+    // Stick-only capture (Cartesian mode only): the tip targets and the
+    // errors come from it instead of the reference's stick tips; the
+    // reference then only holds the trunk and legs, the arms start from a cold
+    // IK solve to the first tips, and drum_auto fits the drum to its strokes.
+    const TipTrajectory *tip_reference = nullptr;
     // Checked every step; when it becomes non-zero the run stops early (SIGINT).
     const volatile std::sig_atomic_t *interrupt = nullptr;
 };

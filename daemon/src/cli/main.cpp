@@ -8,6 +8,8 @@
 #include "ictus/character.hpp"
 #include "ictus/character_limits.hpp"
 #include "ictus/joint_limits.hpp"
+#include "ictus/marker_csv.hpp"
+#include "ictus/stick_capture.hpp"
 #include "ictus/track.hpp"
 
 #include <unistd.h>
@@ -64,13 +66,27 @@ void usage(std::ostream &out)
 
 void track_usage(std::ostream &out)
 {
-    out << "usage: ictusd track --mode joint --mocap FILE [options]\n"
+    out << "usage: ictusd track --mode joint|cartesian --mocap FILE [options]\n"
            "\n"
-           "Tracks the clip's joint rotations with per-joint PD controllers (eq. 1) on the\n"
-           "57-DoF character, pelvis anchored, sticks in the hands, a drum in front.\n"
+           "Tracks the clip with per-joint PD controllers (eq. 1) on the 57-DoF character,\n"
+           "pelvis anchored, sticks in the hands, a drum in front. joint: every joint follows\n"
+           "the capture's rotations. cartesian (Algorithm 2): the arms' targets come from IK\n"
+           "(eq. 2) toward the stick tips every step, the other joints follow the capture.\n"
            "\n"
-           "  --mode joint           control mode (joint space; the Cartesian mode comes later)\n"
-           "  --mocap FILE           BVH file with CMU joint names\n"
+           "  --mode joint|cartesian control mode\n"
+           "  --mocap FILE           BVH file with CMU joint names, or (cartesian) a stick-only\n"
+           "                         .csv capture (time,NAME.x,NAME.y,NAME.z,...; docs/mocap.md):\n"
+           "                         the default body is placed behind the sticks\n"
+           "  --left-stick NAME, --right-stick NAME   the capture's stick-tip objects (default:\n"
+           "                         named stick_l / stick_r, else containing left / right)\n"
+           "  --units mm|m, --up y|z, --rate HZ   how to read the .csv (default m, y, its time)\n"
+           "  --drum auto|X,Y,Z      membrane centre (auto: under the lowest strokes)\n"
+           "  --ik-gain G            eq. 2's gain on the tip error (default 10)\n"
+           "  --ik-velocity-gain S   tip velocity error term, s (default 0.1; < 0: automatic)\n"
+           "  --ik-accel-ff S2       tip acceleration feedforward, s^2 (default 0)\n"
+           "  --ik-integral PER_S    integral of the tip error (default 0)\n"
+           "  --ik-correction-limit M   cap on the IK target's correction (default 0.1)\n"
+           "  --ik-start kinematic|simulated   IK warm start (default kinematic; docs/ik.md)\n"
            "  --out DIR              write DIR/track.csv and DIR/summary.json\n"
            "  --scale M              metres per BVH unit (default 0.056444, the CMU files)\n"
            "  --skip-frames N        frames dropped at the start (default 1: the CMU\n"
@@ -100,8 +116,10 @@ void track_usage(std::ostream &out)
            "                         0: off)\n"
            "  --quiet                no progress output\n"
            "\n"
-           "example:\n"
-           "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n";
+           "examples:\n"
+           "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n"
+           "  ictusd track --mode cartesian --mocap ../shared/data/cmu/80_13.bvh --limit-k 4\n"
+           "  ictusd track --mode cartesian --mocap sticks.csv --units mm --up z --drum auto\n";
 }
 
 void limits_usage(std::ostream &out)
@@ -184,6 +202,16 @@ struct Args {
     }
 };
 
+bool is_csv(const std::string &path)
+{
+    if (path.size() < 4)
+        return false;
+    std::string ext = path.substr(path.size() - 4);
+    for (char &c : ext)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext == ".csv";
+}
+
 ictus::BvhFile load_bvh(const std::string &path, double scale, int skip)
 {
     ictus::BvhOptions o;
@@ -232,6 +260,9 @@ int run_track(Args &args)
     ictus::TrackOptions options;
     ictus::ReferenceFilter filter;
     bool drum_pos_given = false;
+    std::string left_stick, right_stick;
+    ictus::MarkerCsvOptions csv_options;
+    bool csv_options_given = false;
     while (!args.done()) {
         const std::string a = args.next();
         if (a == "--help" || a == "-h") {
@@ -246,6 +277,37 @@ int run_track(Args &args)
             }
         } else if (a == "--ik-gain") {
             options.cartesian.gain = parse_positive(a, args.value(a));
+        } else if (a == "--left-stick") {
+            left_stick = args.value(a);
+        } else if (a == "--right-stick") {
+            right_stick = args.value(a);
+        } else if (a == "--units") {
+            const std::string v = args.value(a);
+            if (v != "mm" && v != "m")
+                throw UsageError("--units: expected mm or m, got '" + v + "'");
+            csv_options.units =
+                v == "mm" ? ictus::MarkerCsvOptions::Units::mm : ictus::MarkerCsvOptions::Units::m;
+            csv_options_given = true;
+        } else if (a == "--up") {
+            const std::string v = args.value(a);
+            if (v != "y" && v != "z")
+                throw UsageError("--up: expected y or z, got '" + v + "'");
+            csv_options.up =
+                v == "z" ? ictus::MarkerCsvOptions::Up::z : ictus::MarkerCsvOptions::Up::y;
+            csv_options_given = true;
+        } else if (a == "--rate") {
+            csv_options.rate_hz = parse_positive(a, args.value(a));
+            csv_options_given = true;
+        } else if (a == "--drum") {
+            const std::string v = args.value(a);
+            if (v != "auto") {
+                try {
+                    options.scene.drum.center_m = parse_vec3(a, v);
+                } catch (const UsageError &) {
+                    throw UsageError("--drum: expected auto or X,Y,Z (m), got '" + v + "'");
+                }
+                drum_pos_given = true;
+            }
         } else if (a == "--ik-velocity-gain") {
             options.cartesian.velocity_gain_s = parse_double(a, args.value(a));
         } else if (a == "--ik-accel-ff") {
@@ -357,11 +419,54 @@ int run_track(Args &args)
         throw UsageError(std::string("track: ") + e.what());
     }
 
-    const ictus::BvhFile bvh = load_bvh(mocap, scale, skip);
+    // A .csv capture is stick-only (Cartesian mode): the default body holds a
+    // neutral pose and its arms follow the two stick tips.
+    const bool stick_only = is_csv(mocap);
+    if (stick_only && options.mode != ictus::TrackMode::cartesian)
+        throw UsageError("track: a stick-only capture (" + mocap + ") needs --mode cartesian");
+    if (!stick_only && (!left_stick.empty() || !right_stick.empty() || csv_options_given))
+        throw UsageError("track: --left-stick, --right-stick, --units, --up and --rate apply "
+                         "to stick-only .csv captures");
+    ictus::BvhFile bvh;
+    ictus::MarkerCapture capture;
+    std::array<int, 2> stick_tracks = {-1, -1};
+    if (stick_only) {
+        ictus::MocapWarnings warnings;
+        capture = ictus::read_marker_csv(mocap, csv_options, &warnings);
+        for (const std::string &w : warnings)
+            std::cerr << "ictusd: warning: " << w << "\n";
+        try {
+            stick_tracks = ictus::find_stick_tracks(capture, left_stick, right_stick);
+        } catch (const ictus::CharacterError &e) {
+            throw UsageError(std::string("track: ") + e.what());
+        }
+        bvh.skeleton = ictus::default_skeleton();
+        bvh.motion.frame_rate_hz = 100.0;
+        const ictus::Skeleton &sk = bvh.skeleton;
+        for (int f = 0; f < 2; ++f) {
+            // Standing height of the default body's hips (legs straight).
+            bvh.motion.root_position_m.push_back(Eigen::Vector3d(0.0, 0.9, 0.0));
+            bvh.motion.local_rotation.emplace_back(sk.joints.size(),
+                                                   Eigen::Quaterniond::Identity());
+        }
+        if (limits_mode != "none") {
+            std::cerr << "ictusd: note: stick-only capture: no joint limits (they are learned "
+                         "from a full-body capture)\n";
+            limits_mode = "none";
+        }
+    } else {
+        bvh = load_bvh(mocap, scale, skip);
+    }
     const ictus::CharacterModel model =
         ictus::CharacterModel::from_skeleton(bvh.skeleton, character);
     const ictus::ReferenceMotion raw(model, bvh.motion);
-    const ictus::ReferenceMotion reference(model, bvh.motion, filter);
+    const ictus::ReferenceMotion reference(model, bvh.motion,
+                                           stick_only ? ictus::ReferenceFilter{0.0, 0.0} : filter);
+    ictus::TipTrajectory tips;
+    if (stick_only) {
+        tips = ictus::place_behind_sticks(model, reference.frame(0), capture, stick_tracks);
+        options.tip_reference = &tips;
+    }
 
     ictus::CharacterLimitOptions lim;
     lim.kind = ictus::limit_kind_from_string(limits_mode);

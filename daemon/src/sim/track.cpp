@@ -198,16 +198,50 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
 {
     validate(options_in);
     TrackOptions options = options_in;
+    const TipTrajectory *tips_in = options.tip_reference;
+    if (tips_in) {
+        if (options.mode != TrackMode::cartesian)
+            throw CharacterError("a stick-only capture needs the Cartesian mode");
+        if (tips_in->time_s.size() < 2 || tips_in->tip_m[0].size() != tips_in->time_s.size() ||
+            tips_in->tip_m[1].size() != tips_in->time_s.size())
+            throw CharacterError("stick capture: expected at least two frames of both tips");
+        options.cartesian.reference_has_arms = false;
+    }
     if (options.drum_auto)
-        options.scene.drum.center_m = auto_drum_center(model, reference);
+        options.scene.drum.center_m =
+            tips_in ? fit_drum_to_strokes(*tips_in, model.options().stick.tip_radius_m)
+                    : auto_drum_center(model, reference);
     const double h = options.scene.step_s;
-    const double duration = options.duration_s > 0.0 ? options.duration_s : reference.duration_s();
+    const double duration = options.duration_s > 0.0 ? options.duration_s
+                            : tips_in                ? tips_in->duration_s()
+                                                     : reference.duration_s();
     const long steps = std::max(1L, std::lround(duration / h));
     const double sample_rate =
         options.sample_rate_hz > 0.0 ? options.sample_rate_hz : reference.frame_rate_hz();
     long last_sample_index = 0;
 
-    const CharacterPose initial = reference.frame(0);
+    CharacterPose initial = reference.frame(0);
+    if (tips_in) {
+        // The arms' first pose: a cold IK solve from the reference's arms to the
+        // first tips (repeated calls: the solver's per-call budget is 16 steps).
+        BodyFrames frames;
+        model.forward(initial, frames);
+        ChainIkSolverPos_dls cold(4, options.cartesian.ik);
+        for (int s = 0; s < 2; ++s) {
+            ArmIk arm;
+            build_arm(model, static_cast<Side>(s), initial, limits, arm);
+            arm.kinematic.set_base(frames.origin_m[arm.base_body], frames.rotation[arm.base_body]);
+            Eigen::Quaterniond q[4];
+            for (int call = 0; call < 20; ++call) {
+                const IkResult r = cold.solve(arm.kinematic, tips_in->tip_m[s][0], q);
+                arm.kinematic.set_rotations(q);
+                if (r.status == IkStatus::converged)
+                    break;
+            }
+            for (int k = 0; k < 4; ++k)
+                initial.local[arm.joint[k]] = arm.kinematic.rotation(k);
+        }
+    }
     const std::vector<JointGains> gains =
         gains_in ? *gains_in : default_gains(model, initial, options.gains);
     Scene scene(model, options.scene, initial, gains);
@@ -300,13 +334,24 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             // one reference frame (the sampled reference is piecewise linear
             // between frames, so per-step differences would be steps and spikes).
             std::array<Eigen::Vector3d, 2> tip_velocity, tip_acceleration;
-            const double frame_s = 1.0 / reference.frame_rate_hz();
+            const double frame_s =
+                tips_in ? tips_in->duration_s() / static_cast<double>(tips_in->time_s.size() - 1)
+                        : 1.0 / reference.frame_rate_hz();
             if (t_next - frame_s >= options.ramp_s) {
-                reference.sample(t_next - frame_s, around_pose);
-                const auto before = reference_tips(model, around_pose);
-                reference.sample(t_next + frame_s, around_pose);
-                const auto after = reference_tips(model, around_pose);
-                const auto now = reference_tips(model, ref_pose);
+                std::array<Eigen::Vector3d, 2> before, after, now;
+                if (tips_in) {
+                    for (int s = 0; s < 2; ++s) {
+                        before[s] = tips_in->sample(s, t_next - frame_s);
+                        after[s] = tips_in->sample(s, t_next + frame_s);
+                        now[s] = tips_in->sample(s, t_next);
+                    }
+                } else {
+                    reference.sample(t_next - frame_s, around_pose);
+                    before = reference_tips(model, around_pose);
+                    reference.sample(t_next + frame_s, around_pose);
+                    after = reference_tips(model, around_pose);
+                    now = reference_tips(model, ref_pose);
+                }
                 for (int s = 0; s < 2; ++s) {
                     tip_velocity[s] = (after[s] - before[s]) / (2.0 * frame_s);
                     tip_acceleration[s] =
@@ -320,8 +365,10 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                 ArmIk &arm = arms[s];
                 const Side side = static_cast<Side>(s);
                 const int hb = model.hand_body(side);
-                const Eigen::Vector3d tip_target = model.tip_position(
-                    side, target_frames.origin_m[hb], target_frames.rotation[hb]);
+                const Eigen::Vector3d tip_target =
+                    tips_in ? tips_in->sample(s, t_next)
+                            : model.tip_position(side, target_frames.origin_m[hb],
+                                                 target_frames.rotation[hb]);
                 // Kinematic IK: the arm's target trajectory without the body,
                 // for the target rates (feedforward of eq. 1).
                 arm.kinematic.set_base(target_frames.origin_m[arm.base_body],
@@ -399,7 +446,11 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             last_sample_index = sample_index;
             // Errors against the reference itself (not the ramped or clamped target).
             scene.local_rotations(sim_local);
-            const auto ref_tips = reference_tips(model, ref_pose);
+            std::array<Eigen::Vector3d, 2> ref_tips;
+            if (tips_in)
+                ref_tips = {tips_in->sample(0, t_next), tips_in->sample(1, t_next)};
+            else
+                ref_tips = reference_tips(model, ref_pose);
             std::array<Eigen::Vector3d, 2> sim_tips = {scene.tip_position(Side::left),
                                                        scene.tip_position(Side::right)};
             const bool counted = t_next >= options.ramp_s;
@@ -421,7 +472,7 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                                       rotation_angle_deg(target[elbow]);
                     elbow_sum2[s] += de * de;
                 }
-                if (raw_reference) {
+                if (raw_reference && !tips_in) {
                     raw_reference->sample(t_next, raw_pose);
                     const auto raw_tips = reference_tips(model, raw_pose);
                     for (int s = 0; s < 2; ++s)
