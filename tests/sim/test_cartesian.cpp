@@ -122,3 +122,134 @@ TEST_CASE("Cartesian options are validated, naming the option", "[sim][track][ca
     CHECK_THROWS_WITH(track_mode_from_string("foo"), Catch::Contains("joint or cartesian"));
     CHECK(track_mode_from_string("cartesian") == TrackMode::cartesian);
 }
+
+namespace
+{
+
+// Two sticks striking alternately at 2 Hz, 12 cm strokes, 0.3 m apart, in a
+// capture frame turned 120 degrees about the vertical and moved by (3, 0.8, 2)
+// m. Tip-space strokes centred where place_behind_sticks puts them are within
+// the default arm's reach (0.56 m from the shoulder, reach ~0.85 m).
+MarkerCapture synthetic_strokes(double seconds = 3.0, double rate_hz = 200.0)
+{
+    MarkerCapture c;
+    c.tracks.resize(2);
+    c.tracks[0].name = "Left Stick";
+    c.tracks[1].name = "RightStick";
+    const Eigen::AngleAxisd turn(120.0 * M_PI / 180.0, Eigen::Vector3d::UnitY());
+    const Eigen::Vector3d offset(3.0, 0.8, 2.0);
+    for (int f = 0; f < std::lround(seconds * rate_hz); ++f) {
+        const double t = f / rate_hz;
+        c.time_s.push_back(t);
+        for (int s = 0; s < 2; ++s) {
+            const double phase = 2 * M_PI * 2.0 * t + (s == 0 ? 0.0 : M_PI);
+            const Eigen::Vector3d p(s == 0 ? 0.15 : -0.15, 0.06 * (1 - std::cos(phase)), 0.0);
+            c.tracks[s].position_m.push_back(turn * p + offset);
+        }
+    }
+    return c;
+}
+
+CharacterPose held_pose(const CharacterModel &m)
+{
+    CharacterPose p = m.rest_pose();
+    p.pelvis_position_m = Eigen::Vector3d(0, 0.9, 0);
+    return p;
+}
+
+} // namespace
+
+TEST_CASE("stick-only: the sticks are found by name, or by the default names", "[sim][cartesian]")
+{
+    MarkerCapture c = synthetic_strokes(0.1);
+    CHECK(find_stick_tracks(c, "", "") == std::array<int, 2>{0, 1});
+    CHECK(find_stick_tracks(c, "RightStick", "Left Stick") == std::array<int, 2>{1, 0});
+    c.tracks[1].name = "STICK_R";
+    c.tracks.push_back(c.tracks[0]);
+    c.tracks.back().name = "stick_l"; // an exact default name wins over "left"
+    CHECK(find_stick_tracks(c, "", "") == std::array<int, 2>{2, 1});
+    CHECK_THROWS_WITH(find_stick_tracks(c, "nope", ""), Catch::Contains("'nope'"));
+    CHECK_THROWS_WITH(find_stick_tracks(c, "Left Stick", "Left Stick"),
+                      Catch::Contains("same object"));
+    c.tracks[1].name = "head";
+    CHECK_THROWS_WITH(find_stick_tracks(c, "", ""), Catch::Contains("no right stick"));
+}
+
+TEST_CASE("stick-only: placement behind the sticks and the drum under the strokes",
+          "[sim][cartesian]")
+{
+    const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
+    const MarkerCapture c = synthetic_strokes();
+    const TipTrajectory tips = place_behind_sticks(m, held_pose(m), c, {0, 1});
+    // The goal, from the shoulders' positions (rest pose: the pelvis at 0.9 m,
+    // the default skeleton's offsets summed by hand in CMU units x 0.056444:
+    // shoulder = pelvis + (+-3.1, 1.7 + 1.7 + 1.4, -0.2 + 0.2 + 0.3)).
+    const double u = 0.056444;
+    const Eigen::Vector3d shoulder_mid(0.0, 0.9 + 4.8 * u, 0.3 * u);
+    // The body faces +z (its left, +x, crossed with up).
+    const Eigen::Vector3d goal = shoulder_mid + Eigen::Vector3d(0, -kStickBelow_m, kStickForward_m);
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+    Eigen::Vector3d mean[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    for (int s = 0; s < 2; ++s)
+        for (const Eigen::Vector3d &p : tips.tip_m[s]) {
+            lo = lo.cwiseMin(p);
+            hi = hi.cwiseMax(p);
+            mean[s] += p / tips.tip_m[s].size();
+        }
+    CHECK((0.5 * (lo + hi) - goal).norm() < 1e-9);
+    // The capture's left stick ends up on the body's left (+x), 0.3 m apart,
+    // strokes vertical and 0.12 m high: the transform is rigid.
+    CHECK((mean[0] - mean[1] - Eigen::Vector3d(0.3, 0, 0)).norm() < 1e-9);
+    CHECK(hi.y() - lo.y() == Approx(0.12).margin(1e-6));
+    // Drum: the strokes' lowest points are the tips at the bottom of the box;
+    // centred between the sticks (each stick's strike points average to its
+    // lateral position, +-0.15 m about the goal), one tip radius below.
+    const double r = m.options().stick.tip_radius_m;
+    const Eigen::Vector3d drum = fit_drum_to_strokes(tips, r);
+    CHECK(drum.y() == Approx(lo.y() - r).margin(1e-6));
+    CHECK(drum.x() == Approx(goal.x()).margin(1e-3));
+    CHECK(drum.z() == Approx(goal.z()).margin(1e-3));
+    // A flat capture has no strokes.
+    TipTrajectory flat = tips;
+    for (auto &side : flat.tip_m)
+        for (Eigen::Vector3d &p : side)
+            p.y() = 1.0;
+    CHECK_THROWS_WITH(fit_drum_to_strokes(flat, r), Catch::Contains("no strokes"));
+}
+
+TEST_CASE("stick-only: the default body tracks synthetic strokes to a few millimetres",
+          "[sim][cartesian]")
+{
+    const Skeleton skel = default_skeleton();
+    const CharacterModel m = CharacterModel::from_skeleton(skel);
+    const Motion held = simtest::make_motion(
+        skel, 2, 100.0, [](int, const std::string &) { return Eigen::Quaterniond::Identity(); });
+    Motion held09 = held;
+    for (Eigen::Vector3d &p : held09.root_position_m)
+        p = Eigen::Vector3d(0, 0.9, 0);
+    const ReferenceMotion ref(m, held09);
+    const TipTrajectory tips = place_behind_sticks(m, ref.frame(0), synthetic_strokes(), {0, 1});
+    TrackOptions o;
+    o.mode = TrackMode::cartesian;
+    o.tip_reference = &tips;
+    const TrackSummary s = track_joint_space(m, ref, o);
+    INFO("tip rms mm " << s.tip_rms_mm[0] << " " << s.tip_rms_mm[1] << ", max " << s.tip_max_mm[0]
+                       << " " << s.tip_max_mm[1]);
+    CHECK_FALSE(s.diverged);
+    CHECK(s.duration_s == Approx(tips.duration_s()).margin(1e-3));
+    // Peak tip speed 0.75 m/s; the CMU clip's strokes (up to 10 m/s) are
+    // tracked to 5 mm, these slow ones to well under that.
+    CHECK(s.tip_rms_mm[0] < 3.0);
+    CHECK(s.tip_rms_mm[1] < 3.0);
+    CHECK(s.tip_max_mm[0] < 10.0);
+    CHECK(s.tip_max_mm[1] < 10.0);
+    // The drum was fitted under the strokes: one tip radius below the lowest tip.
+    double lowest = 1e9;
+    for (const auto &side : tips.tip_m)
+        for (const Eigen::Vector3d &p : side)
+            lowest = std::min(lowest, p.y());
+    CHECK(s.drum_center_m.y() == Approx(lowest - m.options().stick.tip_radius_m).margin(1e-6));
+    // Joint mode cannot take a stick-only capture.
+    o.mode = TrackMode::joint;
+    CHECK_THROWS_WITH(track_joint_space(m, ref, o), Catch::Contains("Cartesian mode"));
+}

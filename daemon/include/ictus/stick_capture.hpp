@@ -48,8 +48,9 @@ TipTrajectory place_behind_sticks(const CharacterModel &model, const CharacterPo
 
 // The drum membrane fitted to the lowest points of the strokes: per stick, the
 // local minima of tip height that lie within the lowest 25 % of that stick's
-// height range are the strike points; the membrane centre is their mean
-// position (x, z) and its height their median minus one tip radius.
+// height range are the strike points; the membrane centre (x, z) is the mean
+// over the sticks of each stick's mean strike point (each stick counts once),
+// its height the median strike height minus one tip radius.
 // Throws CharacterError when there are no minima.
 Eigen::Vector3d fit_drum_to_strokes(const TipTrajectory &tips, double tip_radius_m);
 

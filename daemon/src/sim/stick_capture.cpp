@@ -179,7 +179,9 @@ TipTrajectory place_behind_sticks(const CharacterModel &model, const CharacterPo
 
 Eigen::Vector3d fit_drum_to_strokes(const TipTrajectory &tips, double tip_radius_m)
 {
-    std::vector<Eigen::Vector3d> strikes;
+    std::vector<double> heights;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    int sticks_with_strokes = 0;
     for (int s = 0; s < 2; ++s) {
         const std::vector<Eigen::Vector3d> &p = tips.tip_m[s];
         double lo = 1e300, hi = -1e300;
@@ -188,20 +190,24 @@ Eigen::Vector3d fit_drum_to_strokes(const TipTrajectory &tips, double tip_radius
             hi = std::max(hi, x.y());
         }
         const double threshold = lo + 0.25 * (hi - lo);
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        int strokes = 0;
         for (size_t i = 1; i + 1 < p.size(); ++i)
-            if (p[i].y() <= p[i - 1].y() && p[i].y() < p[i + 1].y() && p[i].y() <= threshold)
-                strikes.push_back(p[i]);
+            if (p[i].y() <= p[i - 1].y() && p[i].y() < p[i + 1].y() && p[i].y() <= threshold) {
+                sum += p[i];
+                heights.push_back(p[i].y());
+                ++strokes;
+            }
+        if (strokes > 0) {
+            centre += sum / strokes;
+            ++sticks_with_strokes;
+        }
     }
-    if (strikes.empty())
+    if (sticks_with_strokes == 0)
         throw CharacterError("--drum auto: no strokes in the stick capture (no minima of tip "
                              "height)");
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    std::vector<double> heights;
-    for (const Eigen::Vector3d &x : strikes) {
-        centre += x;
-        heights.push_back(x.y());
-    }
-    centre /= static_cast<double>(strikes.size());
+    // Each stick counts once, however many strokes it played.
+    centre /= sticks_with_strokes;
     std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
     centre.y() = heights[heights.size() / 2] - tip_radius_m;
     return centre;
