@@ -19,7 +19,7 @@ int main(int argc, char **argv)
 {
     const char *env = std::getenv("ICTUS_DATA_DIR");
     std::string path = std::string(env ? env : ICTUS_DATA_DIR_DEFAULT) + "/cmu/80_13.bvh";
-    if (argc > 1)
+    if (argc > 1 && *argv[1])
         path = argv[1];
     const double seconds = argc > 2 ? std::atof(argv[2]) : 30.0;
     const int runs = argc > 3 ? std::max(1, std::atoi(argv[3])) : 3;
