@@ -267,6 +267,7 @@ TEST_CASE("ictusd track: a stick-only capture runs in Cartesian mode, drum fitte
     CHECK(s.at("duration_s").get<double>() == Approx(1.995).margin(0.002));
     CHECK(s.at("tip_rms_mm").at("left").get<double>() < 3.0);
     CHECK(s.at("tip_rms_mm").at("right").get<double>() < 3.0);
+    CHECK(s.at("ik").at("elbow_flexion_rms_deg").is_null()); // no captured elbow
     // The sticks were moved in front of the body (it faces +z, pelvis at the
     // origin's vertical): the drum under them, ahead of the pelvis and below
     // the shoulders (~1.17 m), above the floor.

@@ -128,7 +128,9 @@ struct TrackSummary {
     long ik_not_converged = 0;   // solves that ended other than `converged`
     // Elbow flexion (rotation angle of the elbow's local rotation), IK target
     // Theta^T vs the capture, RMS over the samples [side], degrees.
+    // Not measured (null in JSON) for stick-only captures: no captured elbow.
     double elbow_ik_rms_deg[2] = {0.0, 0.0};
+    bool elbow_measured = true;
     nlohmann::json to_json() const;
 };
 

@@ -549,11 +549,14 @@ int run_track(Args &args)
               << summary.tip_rms_mm[1] << "\n"
               << "joint rms (deg), all joints: " << j["joint_rms_deg_all"].get<double>() << "\n"
               << "divergences: " << summary.divergences << "\n";
-    if (options.mode == ictus::TrackMode::cartesian)
+    if (options.mode == ictus::TrackMode::cartesian) {
         std::cout << "ik: " << summary.ik_mean_iterations << " iterations per solve (max "
-                  << summary.ik_max_iterations << "), " << summary.ik_us_per_step
-                  << " us per step; elbow flexion rms (deg) left " << summary.elbow_ik_rms_deg[0]
-                  << ", right " << summary.elbow_ik_rms_deg[1] << "\n";
+                  << summary.ik_max_iterations << "), " << summary.ik_us_per_step << " us per step";
+        if (summary.elbow_measured)
+            std::cout << "; elbow flexion rms (deg) left " << summary.elbow_ik_rms_deg[0]
+                      << ", right " << summary.elbow_ik_rms_deg[1];
+        std::cout << "\n";
+    }
     if (summary.interrupted)
         return 130;
     return summary.diverged ? 3 : 0;

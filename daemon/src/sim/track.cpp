@@ -155,8 +155,10 @@ nlohmann::json TrackSummary::to_json() const
                    {"max_iterations", ik_max_iterations},
                    {"us_per_step", ik_us_per_step},
                    {"not_converged", ik_not_converged},
-                   {"elbow_flexion_rms_deg",
-                    {{"left", elbow_ik_rms_deg[0]}, {"right", elbow_ik_rms_deg[1]}}}};
+                   {"elbow_flexion_rms_deg", elbow_measured
+                                                 ? nlohmann::json{{"left", elbow_ik_rms_deg[0]},
+                                                                  {"right", elbow_ik_rms_deg[1]}}
+                                                 : nlohmann::json()}};
     }
     return j;
 }
@@ -541,6 +543,7 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
         summary.ik_us_per_step = n > 0 ? 1e6 * ik_wall_s / n : 0.0;
         for (int s = 0; s < 2; ++s)
             summary.elbow_ik_rms_deg[s] = std::sqrt(elbow_sum2[s] / ns);
+        summary.elbow_measured = tips_in == nullptr;
     }
     summary.divergences = scene.divergences();
     summary.diverged = summary.divergences > 0;
