@@ -383,8 +383,11 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                 ik_iterations += r.iterations;
                 summary.ik_max_iterations = std::max(summary.ik_max_iterations, r.iterations);
                 summary.ik_not_converged += r.status != IkStatus::converged;
-                // Eq. 2 from the simulated state: Theta^T = Theta^S + dTheta^T toward
-                // X^S + gain (X^T - X^S) (+ the integral of the error).
+                // Eq. 2 with its gain: the IK target is X^S + gain (X^T - X^S) (+ the
+                // velocity, acceleration and integral terms, capped), X^S from the
+                // simulated thorax and Theta^S. The solve starts from Theta^S (eq. 2
+                // literally) or from the kinematic solution, which holds the arm's
+                // null space (CartesianOptions::start_from_simulated, docs/ik.md).
                 arm.feedback.set_base(sim_frames.origin_m[arm.base_body],
                                       sim_frames.rotation[arm.base_body]);
                 for (int k = 0; k < 4; ++k)
