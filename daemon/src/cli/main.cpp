@@ -11,6 +11,7 @@
 #include "ictus/marker_csv.hpp"
 #include "ictus/stick_capture.hpp"
 #include "ictus/track.hpp"
+#include "ictus/verbs_osc.hpp"
 
 #include <unistd.h>
 
@@ -54,11 +55,17 @@ void usage(std::ostream &out)
            "           and report tracking errors and speed\n"
            "  limits   learn joint limits from a motion capture (Euler statistics and\n"
            "           Algorithm 1), print them and write them as JSON\n"
+           "  run      perform in real time: physics on the wall clock, strikes and poses\n"
+           "           out over OSC, control in over OSC (docs/osc.md)\n"
+           "  render   perform offline, as fast as possible and deterministic: strikes.csv\n"
+           "           and an events file for Pd's batch render (docs/osc.md)\n"
            "\n"
            "examples:\n"
            "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n"
            "  ictusd track --mode joint --mocap clip.bvh --duration 600 --grip german --quiet\n"
            "  ictusd limits ../shared/data/cmu/80_13.bvh --out limits.json\n"
+           "  ictusd render --mocap ../shared/data/cmu/80_13.bvh --out perf\n"
+           "  ictusd run --mocap ../shared/data/cmu/80_13.bvh --target osc.udp://127.0.0.1:9000\n"
            "\n"
            "exit status: 0 ok, 1 error in a file or the data, 2 usage error,\n"
            "             3 the simulation diverged (and was reset), 130 interrupted\n";
@@ -650,7 +657,13 @@ int main(int argc, char **argv)
             return run_track(args);
         if (verb == "limits")
             return run_limits(args);
-        throw UsageError("unknown verb '" + verb + "' (verbs: track, limits; see ictusd --help)");
+        // run and render parse their own options (argv[0] is the verb).
+        if (verb == "run")
+            return ictus::cmd_run(argc - 1, argv + 1);
+        if (verb == "render")
+            return ictus::cmd_render(argc - 1, argv + 1);
+        throw UsageError("unknown verb '" + verb +
+                         "' (verbs: track, limits, run, render; see ictusd --help)");
     } catch (const UsageError &e) {
         std::cerr << "ictusd: " << e.what() << "\n";
         return 2;
