@@ -19,23 +19,6 @@
 
 #define CONTACT_FORCE_CAP 1.0e12 /* N */
 
-static ictus_status clamp_range(double *v, double lo, double hi, double fallback)
-{
-    if (isnan(*v)) {
-        *v = fallback;
-        return ICTUS_CLAMPED;
-    }
-    if (*v < lo) {
-        *v = lo;
-        return ICTUS_CLAMPED;
-    }
-    if (*v > hi) {
-        *v = hi;
-        return ICTUS_CLAMPED;
-    }
-    return ICTUS_OK;
-}
-
 contact *contact_new(void)
 {
     contact *c = calloc(1, sizeof(*c));
@@ -65,7 +48,7 @@ void contact_free(contact *c)
 
 ictus_status contact_set_mass(contact *c, double v)
 {
-    ictus_status s = clamp_range(&v, CONTACT_MASS_MIN, CONTACT_MASS_MAX, CONTACT_DEFAULT_MASS);
+    ictus_status s = ictus_clamp(&v, CONTACT_MASS_MIN, CONTACT_MASS_MAX, CONTACT_DEFAULT_MASS);
     c->mass_kg = v;
     return s;
 }
@@ -73,14 +56,14 @@ ictus_status contact_set_mass(contact *c, double v)
 ictus_status contact_set_stiffness(contact *c, double v)
 {
     ictus_status s =
-        clamp_range(&v, CONTACT_STIFFNESS_MIN, CONTACT_STIFFNESS_MAX, CONTACT_DEFAULT_STIFFNESS);
+        ictus_clamp(&v, CONTACT_STIFFNESS_MIN, CONTACT_STIFFNESS_MAX, CONTACT_DEFAULT_STIFFNESS);
     c->stiffness = v;
     return s;
 }
 
 ictus_status contact_set_alpha(contact *c, double v)
 {
-    ictus_status s = clamp_range(&v, CONTACT_ALPHA_MIN, CONTACT_ALPHA_MAX, CONTACT_DEFAULT_ALPHA);
+    ictus_status s = ictus_clamp(&v, CONTACT_ALPHA_MIN, CONTACT_ALPHA_MAX, CONTACT_DEFAULT_ALPHA);
     c->alpha = v;
     return s;
 }
@@ -88,7 +71,7 @@ ictus_status contact_set_alpha(contact *c, double v)
 ictus_status contact_set_damping(contact *c, double v)
 {
     ictus_status s =
-        clamp_range(&v, CONTACT_DAMPING_MIN, CONTACT_DAMPING_MAX, CONTACT_DEFAULT_DAMPING);
+        ictus_clamp(&v, CONTACT_DAMPING_MIN, CONTACT_DAMPING_MAX, CONTACT_DEFAULT_DAMPING);
     c->damping = v;
     return s;
 }
@@ -113,8 +96,8 @@ double contact_get_damping(const contact *c)
 ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, double theta_deg,
                          int sample_offset)
 {
-    ictus_status s = clamp_range(&velocity_mps, 0.0, CONTACT_VELOCITY_MAX, 1.0);
-    if (clamp_range(&r_over_a, 0.0, 1.0, 0.0) != ICTUS_OK)
+    ictus_status s = ictus_clamp(&velocity_mps, 0.0, CONTACT_VELOCITY_MAX, 1.0);
+    if (ictus_clamp(&r_over_a, 0.0, 1.0, 0.0) != ICTUS_OK)
         s = ICTUS_CLAMPED;
     if (!isfinite(theta_deg)) {
         theta_deg = 0.0;

@@ -73,26 +73,9 @@ struct membrane {
 
 /* ---------------------------------------------------------------- helpers */
 
-static ictus_status clamp_double(double *v, double lo, double hi, double fallback)
-{
-    if (isnan(*v)) {
-        *v = fallback;
-        return ICTUS_CLAMPED;
-    }
-    if (*v < lo) {
-        *v = lo;
-        return ICTUS_CLAMPED;
-    }
-    if (*v > hi) {
-        *v = hi;
-        return ICTUS_CLAMPED;
-    }
-    return ICTUS_OK;
-}
-
 static ictus_status clamp_point(double *r_over_a, double *theta_deg)
 {
-    ictus_status s = clamp_double(r_over_a, 0.0, 1.0, 0.0);
+    ictus_status s = ictus_clamp(r_over_a, 0.0, 1.0, 0.0);
     if (!isfinite(*theta_deg)) {
         *theta_deg = 0.0;
         return ICTUS_CLAMPED;
@@ -420,7 +403,7 @@ membrane *membrane_new(double sample_rate_hz)
     membrane *m = calloc(1, sizeof(*m));
     if (!m)
         return NULL;
-    clamp_double(&sample_rate_hz, MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, 48000.0);
+    ictus_clamp(&sample_rate_hz, MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, 48000.0);
     m->sample_rate = sample_rate_hz;
     m->radius = MEMBRANE_DEFAULT_RADIUS;
     m->tension = MEMBRANE_DEFAULT_TENSION;
@@ -487,7 +470,7 @@ static ictus_status physics_changed(membrane *m, ictus_status s)
 
 ictus_status membrane_set_sample_rate(membrane *m, double sr)
 {
-    ictus_status s = clamp_double(&sr, MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, 48000.0);
+    ictus_status s = ictus_clamp(&sr, MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, 48000.0);
     m->sample_rate = sr;
     return physics_changed(m, s);
 }
@@ -495,7 +478,7 @@ ictus_status membrane_set_sample_rate(membrane *m, double sr)
 ictus_status membrane_set_radius(membrane *m, double r)
 {
     ictus_status s =
-        clamp_double(&r, MEMBRANE_RADIUS_MIN, MEMBRANE_RADIUS_MAX, MEMBRANE_DEFAULT_RADIUS);
+        ictus_clamp(&r, MEMBRANE_RADIUS_MIN, MEMBRANE_RADIUS_MAX, MEMBRANE_DEFAULT_RADIUS);
     m->radius = r;
     return physics_changed(m, s);
 }
@@ -503,7 +486,7 @@ ictus_status membrane_set_radius(membrane *m, double r)
 ictus_status membrane_set_tension(membrane *m, double t)
 {
     ictus_status s =
-        clamp_double(&t, MEMBRANE_TENSION_MIN, MEMBRANE_TENSION_MAX, MEMBRANE_DEFAULT_TENSION);
+        ictus_clamp(&t, MEMBRANE_TENSION_MIN, MEMBRANE_TENSION_MAX, MEMBRANE_DEFAULT_TENSION);
     m->tension = t;
     return physics_changed(m, s);
 }
@@ -511,7 +494,7 @@ ictus_status membrane_set_tension(membrane *m, double t)
 ictus_status membrane_set_density(membrane *m, double d)
 {
     ictus_status s =
-        clamp_double(&d, MEMBRANE_DENSITY_MIN, MEMBRANE_DENSITY_MAX, MEMBRANE_DEFAULT_DENSITY);
+        ictus_clamp(&d, MEMBRANE_DENSITY_MIN, MEMBRANE_DENSITY_MAX, MEMBRANE_DEFAULT_DENSITY);
     m->density = d;
     return physics_changed(m, s);
 }
@@ -547,14 +530,14 @@ ictus_status membrane_set_modes(membrane *m, int count)
 
 ictus_status membrane_set_t60(membrane *m, double t60)
 {
-    ictus_status s = clamp_double(&t60, MEMBRANE_T60_MIN, MEMBRANE_T60_MAX, MEMBRANE_DEFAULT_T60);
+    ictus_status s = ictus_clamp(&t60, MEMBRANE_T60_MIN, MEMBRANE_T60_MAX, MEMBRANE_DEFAULT_T60);
     m->t60 = t60;
     return physics_changed(m, s);
 }
 
 ictus_status membrane_set_hf_damping(membrane *m, double control)
 {
-    ictus_status s = clamp_double(&control, 0.0, MEMBRANE_HF_MAX, MEMBRANE_DEFAULT_HF);
+    ictus_status s = ictus_clamp(&control, 0.0, MEMBRANE_HF_MAX, MEMBRANE_DEFAULT_HF);
     m->hf_damping = control;
     return physics_changed(m, s);
 }
@@ -612,7 +595,7 @@ ictus_status membrane_strike(membrane *m, double r_over_a, double theta_deg, dou
 {
     ictus_status s = clamp_point(&r_over_a, &theta_deg);
     /* An impulse beyond 1e3 N s is no drum stroke; clamp rather than overflow floats. */
-    if (clamp_double(&impulse_ns, -1.0e3, 1.0e3, 0.0) != ICTUS_OK)
+    if (ictus_clamp(&impulse_ns, -1.0e3, 1.0e3, 0.0) != ICTUS_OK)
         s = ICTUS_CLAMPED;
     if (sample_offset < 0) {
         sample_offset = 0;
@@ -651,7 +634,7 @@ void membrane_clear(membrane *m)
 ictus_status membrane_set_output_gain(membrane *m, double gain)
 {
     ictus_status s =
-        clamp_double(&gain, -MEMBRANE_GAIN_MAX, MEMBRANE_GAIN_MAX, MEMBRANE_DEFAULT_GAIN);
+        ictus_clamp(&gain, -MEMBRANE_GAIN_MAX, MEMBRANE_GAIN_MAX, MEMBRANE_DEFAULT_GAIN);
     m->output_gain = gain;
     return s;
 }

@@ -3,6 +3,7 @@
 #ifndef ICTUS_MEMBRANE_INTERNAL_H
 #define ICTUS_MEMBRANE_INTERNAL_H
 
+#include <math.h>
 #include "contact.h"
 #include "membrane.h"
 
@@ -75,5 +76,24 @@ double contact_force_law_(const contact *c, double x0, double x1, double dt);
  * force_guess (e.g. the last sample's force, or 0) only speeds it up. */
 double contact_solve_(const contact *c, double x0, double x_free, double compliance, double dt,
                       double force_guess, double *x1);
+
+/* Clamps *v into [lo, hi]; NaN becomes `fallback`. ICTUS_CLAMPED when *v changed.
+ * Every setter of the core validates through this one rule. */
+static inline ictus_status ictus_clamp(double *v, double lo, double hi, double fallback)
+{
+    if (isnan(*v)) {
+        *v = fallback;
+        return ICTUS_CLAMPED;
+    }
+    if (*v < lo) {
+        *v = lo;
+        return ICTUS_CLAMPED;
+    }
+    if (*v > hi) {
+        *v = hi;
+        return ICTUS_CLAMPED;
+    }
+    return ICTUS_OK;
+}
 
 #endif
