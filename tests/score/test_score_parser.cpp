@@ -1,0 +1,380 @@
+// The score language: every statement form, the defaults, every error with
+// its exact line and column, nothing produced from a faulty score, and the
+// Pd message-box form (one statement per message) equal to the file form.
+#include "ictus/score.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <string>
+
+using namespace ictus;
+using Catch::Matchers::Contains;
+
+namespace
+{
+
+// The error a score gives, checked for its position and a word of its message.
+void require_error(const std::string &text, int line, int column, const std::string &words)
+{
+    try {
+        parse_score(text, "t.txt");
+        FAIL("no error for: " << text);
+    } catch (const ScoreError &e) {
+        INFO(e.what());
+        CHECK(e.source() == "t.txt");
+        CHECK(e.line() == line);
+        CHECK(e.column() == column);
+        CHECK_THAT(e.message(), Contains(words));
+        CHECK(std::string(e.what()) ==
+              "t.txt:" + std::to_string(line) + ":" + std::to_string(column) + ": " + e.message());
+    }
+}
+
+bool same_notes(const Score &a, const Score &b)
+{
+    if (a.notes.size() != b.notes.size() || a.length_beats != b.length_beats)
+        return false;
+    for (size_t i = 0; i < a.notes.size(); ++i) {
+        const ScoreNote &x = a.notes[i], &y = b.notes[i];
+        if (x.beat != y.beat || x.beats != y.beats || x.hand != y.hand || x.nuance != y.nuance ||
+            x.grip != y.grip || x.dynamics != y.dynamics || x.r_over_a != y.r_over_a ||
+            x.theta_deg != y.theta_deg || a.note_time_s(x) != b.note_time_s(y))
+            return false;
+    }
+    return true;
+}
+
+} // namespace
+
+TEST_CASE("score: a bare note takes every default", "[score][parser]")
+{
+    const Score s = parse_score("R\nL\n", "d");
+    REQUIRE(s.notes.size() == 2);
+    const ScoreNote &r = s.notes[0], &l = s.notes[1];
+    CHECK(r.hand == Side::right);
+    CHECK(l.hand == Side::left);
+    CHECK(r.nuance == Nuance::legato);
+    CHECK(r.grip == Grip::french);
+    CHECK(r.beats == 1.0);
+    CHECK(r.dynamics == 0.6);
+    CHECK(r.r_over_a == 0.3);
+    CHECK(r.theta_deg == 180.0); // performer's right = world -X = membrane x_m < 0
+    CHECK(l.theta_deg == 0.0);
+    CHECK(r.beat == 0.0);
+    CHECK(l.beat == 1.0);
+    CHECK(s.length_beats == 2.0);
+    // 120 bpm by default: a beat is half a second.
+    CHECK(s.note_time_s(l) == Approx(0.5).epsilon(1e-12));
+    CHECK(s.duration_s() == Approx(1.0).epsilon(1e-12));
+    CHECK(r.line == 1);
+    CHECK(l.line == 2);
+    CHECK(r.column == 1);
+}
+
+TEST_CASE("score: every note option", "[score][parser]")
+{
+    const Score s = parse_score("  right accent 0.8 1/2 at 0.5 -90\n"
+                                "left vertical_accent ff beats 1.5 at 0.2 270\n"
+                                "R staccato pp\n"
+                                "L tenuto p beats 3/4\n"
+                                "r vertical-accent mp\n"
+                                "l LEGATO MF at 0 540\n"
+                                "R f\n",
+                                "opts");
+    REQUIRE(s.notes.size() == 7);
+    const auto &n = s.notes;
+    CHECK(n[0].hand == Side::right);
+    CHECK(n[0].nuance == Nuance::accent);
+    CHECK(n[0].dynamics == 0.8);
+    CHECK(n[0].beats == 0.5);
+    CHECK(n[0].r_over_a == 0.5);
+    CHECK(n[0].theta_deg == -90.0);
+    CHECK(n[0].column == 3);
+    CHECK(n[1].nuance == Nuance::vertical_accent);
+    CHECK(n[1].dynamics == 1.0);
+    CHECK(n[1].beats == 1.5);
+    CHECK(n[1].theta_deg == -90.0); // 270 into (-180, 180]
+    CHECK(n[1].beat == 0.5);
+    CHECK(n[2].nuance == Nuance::staccato);
+    CHECK(n[2].dynamics == 0.2);
+    CHECK(n[2].beat == 2.0);
+    CHECK(n[3].nuance == Nuance::tenuto);
+    CHECK(n[3].dynamics == 0.3);
+    CHECK(n[3].beats == 0.75);
+    CHECK(n[4].nuance == Nuance::vertical_accent);
+    CHECK(n[4].dynamics == 0.45);
+    CHECK(n[5].nuance == Nuance::legato);
+    CHECK(n[5].dynamics == 0.6);
+    CHECK(n[5].r_over_a == 0.0);
+    CHECK(n[5].theta_deg == 180.0); // 540 = 180
+    CHECK(n[6].nuance == Nuance::legato);
+    CHECK(n[6].dynamics == 0.8);
+    // 0.5 + 1.5 + 1 + 0.75 + 1 + 1 + 1
+    CHECK(s.length_beats == 6.75);
+}
+
+TEST_CASE("score: the dynamics words rise from pp to ff, mf is the default", "[score][parser]")
+{
+    const auto &words = dynamics_words();
+    REQUIRE(words.size() == 6);
+    const char *order[] = {"pp", "p", "mp", "mf", "f", "ff"};
+    for (size_t i = 0; i < words.size(); ++i) {
+        CHECK(std::string(words[i].word) == order[i]);
+        if (i > 0)
+            CHECK(words[i].value > words[i - 1].value);
+        const Score s = parse_score(std::string("R ") + order[i], "w");
+        CHECK(s.notes[0].dynamics == words[i].value);
+    }
+    CHECK(words[3].value == kDefaultDynamics);
+    CHECK(words[5].value == 1.0);
+}
+
+TEST_CASE("score: every nuance name the gesture database uses is accepted", "[score][parser]")
+{
+    for (Nuance n : {Nuance::legato, Nuance::tenuto, Nuance::accent, Nuance::vertical_accent,
+                     Nuance::staccato}) {
+        const Score s = parse_score(std::string("L ") + to_string(n), "n");
+        CHECK(s.notes[0].nuance == n);
+    }
+}
+
+TEST_CASE("score: tempo, grip, rest, default beats and dynamics", "[score][parser]")
+{
+    const Score s = parse_score("tempo 60\n"
+                                "grip german\n"
+                                "R\n"
+                                "rest\n"
+                                "rest 1/2\n"
+                                "rest beats 2\n"
+                                "beats 1/4\n"
+                                "dynamics ff\n"
+                                "L\n"
+                                "grip french\n"
+                                "dynamics 0.35\n"
+                                "R accent\n",
+                                "g");
+    REQUIRE(s.notes.size() == 3);
+    CHECK(s.notes[0].grip == Grip::german);
+    CHECK(s.notes[0].beats == 1.0);
+    CHECK(s.notes[1].beat == 4.5); // 1 + 1 + 0.5 + 2
+    CHECK(s.notes[1].beats == 0.25);
+    CHECK(s.notes[1].dynamics == 1.0);
+    CHECK(s.notes[1].grip == Grip::german);
+    CHECK(s.notes[2].grip == Grip::french);
+    CHECK(s.notes[2].dynamics == 0.35);
+    CHECK(s.notes[2].beat == 4.75);
+    CHECK(s.length_beats == 5.0);
+    // 60 bpm: one second a beat.
+    CHECK(s.note_time_s(s.notes[2]) == Approx(4.75).epsilon(1e-12));
+}
+
+TEST_CASE("score: tempo changes, instant and gradual", "[score][parser]")
+{
+    const Score s = parse_score("tempo 100\nR\ntempo 100 -> 200 over 4\nR\nR\nR\nR\nR\n"
+                                "tempo -> 50 over 2\nR\nR\nR\n",
+                                "tc");
+    REQUIRE(s.notes.size() == 9);
+    CHECK(s.tempo.tempo_at_beat(0.5) == 100.0);
+    CHECK(s.tempo.tempo_at_beat(3.0) == Approx(150.0));
+    CHECK(s.tempo.tempo_at_beat(5.0) == Approx(200.0));
+    CHECK(s.tempo.tempo_at_beat(6.0) == Approx(200.0)); // the second ramp starts at beat 6
+    CHECK(s.tempo.tempo_at_beat(7.0) == Approx(125.0)); // from 200 toward 50, half way
+    CHECK(s.tempo.tempo_at_beat(8.5) == Approx(50.0));
+    // A ramp 100 -> 200 over 4 beats starting at t = 0.6 s: t(b) = 0.6 + 60/25 ln((100+25b)/100).
+    CHECK(s.note_time_s(s.notes[3]) == Approx(0.6 + 2.4 * std::log(1.5)).epsilon(1e-12));
+    // 'to' is the same as '->'.
+    const Score t = parse_score("tempo 100 to 200 over 4\nR\nR\n", "to");
+    const Score u = parse_score("tempo 100 -> 200 over 4\nR\nR\n", "arrow");
+    CHECK(same_notes(t, u));
+}
+
+TEST_CASE("score: repeat blocks expand, nested", "[score][parser]")
+{
+    const Score s =
+        parse_score("repeat 3\n  R\n  repeat 2\n    L 1/2\n  end\nend\nR accent\n", "rep");
+    REQUIRE(s.notes.size() == 3 * 3 + 1);
+    CHECK(s.notes[0].hand == Side::right);
+    CHECK(s.notes[1].hand == Side::left);
+    CHECK(s.notes[2].beat == 1.5);
+    CHECK(s.notes[3].beat == 2.0);
+    CHECK(s.notes[9].nuance == Nuance::accent);
+    CHECK(s.notes[9].beat == 6.0);
+    CHECK(s.notes[4].line == 4); // a repeated note keeps where it was written
+}
+
+TEST_CASE("score: separators and comments", "[score][parser]")
+{
+    const Score a = parse_score("tempo 96, grip french, R legato, L accent 0.8 # a comment\n"
+                                "# whole-line comment\n\n"
+                                "R 1/2; L 1/2;\n",
+                                "sep");
+    const Score b =
+        parse_score("tempo 96\ngrip french\nR legato\nL accent 0.8\nR 1/2\nL 1/2\n", "nl");
+    REQUIRE(a.notes.size() == 4);
+    CHECK(same_notes(a, b));
+    CHECK(a.notes[1].column == 34);
+    CHECK(a.notes[1].line == 1);
+    CHECK(a.notes[3].line == 4);
+    CHECK(a.notes[3].column == 8);
+}
+
+TEST_CASE("score: a Pd message box (statements one by one) equals the file", "[score][parser]")
+{
+    const std::string file = default_score_text();
+    ScoreBuilder builder("osc");
+    // As Pd sends it: each comma-separated message is one statement.
+    std::string statement;
+    int count = 0;
+    for (char c : file + "\n") {
+        if (c == ',' || c == '\n' || c == ';') {
+            const auto hash = statement.find('#');
+            if (hash != std::string::npos)
+                statement.erase(hash);
+            if (statement.find_first_not_of(' ') != std::string::npos) {
+                builder.add_statement(statement);
+                ++count;
+            }
+            statement.clear();
+        } else {
+            statement += c;
+        }
+    }
+    CHECK(builder.statements() == count);
+    CHECK(count > 30);
+    CHECK(same_notes(builder.finish(), parse_score(file, "default")));
+}
+
+TEST_CASE("score: the default score is Figure 5's: both hands, legato and accents, tempo change",
+          "[score][parser]")
+{
+    const Score s = parse_score(default_score_text(), "default");
+    int legato = 0, accent = 0, right = 0, left = 0;
+    for (const auto &n : s.notes) {
+        legato += n.nuance == Nuance::legato;
+        accent += n.nuance == Nuance::accent;
+        right += n.hand == Side::right;
+        left += n.hand == Side::left;
+    }
+    CHECK(legato >= 8);
+    CHECK(accent >= 6);
+    CHECK(right >= 10);
+    CHECK(left >= 10);
+    CHECK(s.tempo.changes().size() >= 2);
+    double lo = 1e9, hi = 0;
+    for (double b = 0; b < s.length_beats; b += 0.25) {
+        lo = std::min(lo, s.tempo.tempo_at_beat(b));
+        hi = std::max(hi, s.tempo.tempo_at_beat(b));
+    }
+    CHECK(hi - lo >= 40.0);
+    CHECK(s.duration_s() >= 10.0);
+    CHECK(s.duration_s() <= 16.0);
+}
+
+TEST_CASE("score: errors name the source, line, column and the fault", "[score][parser][errors]")
+{
+    require_error(
+        "R legatto", 1, 3,
+        "unknown nuance 'legatto' (valid: legato, tenuto, accent, vertical_accent, staccato)");
+    require_error("R\nX legato", 2, 1, "unknown statement 'X'");
+    require_error("tempo 96\n  tempo 9x6", 2, 9, "malformed number '9x6' for tempo");
+    require_error("tempo 500", 1, 7, "tempo 500 is out of range (20..400 bpm)");
+    require_error("tempo 10", 1, 7, "out of range (20..400 bpm)");
+    require_error("tempo", 1, 6, "tempo needs beats per minute");
+    require_error("tempo 96 -> 500 over 4", 1, 13, "tempo 500 is out of range");
+    require_error("tempo 96 -> 120 in 4", 1, 17, "expected 'over BEATS'");
+    require_error("tempo 96 -> 120 over", 1, 21, "needs the number of beats after 'over'");
+    require_error("tempo 96 -> 120 over 0", 1, 22, "out of range (1/32..64 beats)");
+    require_error("tempo 96 97", 1, 10, "unexpected '97' after the tempo");
+    require_error("grip spanish", 1, 6, "unknown grip 'spanish' (valid: french, german)");
+    require_error("grip", 1, 5, "grip needs a name");
+    require_error("L accent 1.5", 1, 10, "dynamics 1.5 is out of range (0..1");
+    require_error("L accent -0.1", 1, 10, "out of range (0..1");
+    require_error("L accent 0.8.1", 1, 10, "malformed number '0.8.1' for dynamics");
+    require_error("L accent fff", 1, 10, "unexpected 'fff' in a note");
+    require_error("L accent tenuto", 1, 10, "second nuance 'tenuto'");
+    require_error("L accent f 0.5", 1, 12, "second dynamics");
+    require_error("L 1/2 beats 1", 1, 7, "second duration");
+    require_error("L accent 1/0", 1, 10, "divides by zero");
+    require_error("L accent 1/x", 1, 10, "malformed fraction '1/x'");
+    require_error("L accent 1/64", 1, 10, "out of range (1/32..64 beats)");
+    require_error("L accent beats 65", 1, 16, "out of range (1/32..64 beats)");
+    require_error("L accent beats", 1, 15, "'beats' needs a duration");
+    require_error("L at 1.2 0", 1, 6, "r/a 1.2 is out of range (0..0.95");
+    require_error("L at 0.3", 1, 9, "'at' needs theta");
+    require_error("L at 0.3 north", 1, 10, "malformed number 'north' for theta");
+    require_error("L at nan 0", 1, 6, "malformed number 'nan'");
+    require_error("rest 0", 1, 6, "out of range");
+    require_error("rest 1 2", 1, 8, "unexpected '2' after the rest");
+    require_error("beats", 1, 6, "'beats' needs a duration");
+    require_error("dynamics loud", 1, 10, "unknown dynamics 'loud'");
+    require_error("repeat 2.5\nR\nend", 1, 8, "whole number 1..1000");
+    require_error("repeat 0\nR\nend", 1, 8, "whole number 1..1000");
+    require_error("R\nend", 2, 1, "'end' without 'repeat'");
+    require_error("R\n  repeat 2\nR\n", 2, 3, "'repeat' without 'end'");
+    require_error("end now", 1, 5, "unexpected 'now'");
+    // A count that would expand past the limits is refused, not expanded.
+    require_error("repeat 1000\nrepeat 1000\nR\nend\nend", 3, 1, "more than 100000 notes");
+}
+
+TEST_CASE("score: nothing is produced from a faulty score", "[score][parser][errors]")
+{
+    // The fault is on the last line: the first lines are fine but no Score is returned.
+    bool produced = false;
+    try {
+        Score s = parse_score("tempo 96\nR\nL\nR accent\nL bogus\n", "bad");
+        produced = true;
+    } catch (const ScoreError &e) {
+        CHECK(e.line() == 5);
+    }
+    CHECK_FALSE(produced);
+
+    // Statement by statement: the failing statement changes nothing, and the
+    // score is refused until reset.
+    ScoreBuilder b;
+    b.add_statement("tempo 96");
+    b.add_statement("R legato");
+    CHECK_THROWS_AS(b.add_statement("L legatto"), ScoreError);
+    CHECK(b.failed());
+    b.add_statement("L accent");
+    try {
+        b.finish();
+        FAIL("a score with a failed statement was produced");
+    } catch (const ScoreError &e) {
+        CHECK(e.source() == "osc");
+        CHECK(e.line() == 3); // the third statement
+        CHECK(e.column() == 3);
+        CHECK_THAT(e.what(), Contains("refused"));
+    }
+    b.reset();
+    CHECK_FALSE(b.failed());
+    CHECK(b.statements() == 0);
+    b.add_statement("R legato");
+    b.add_statement("L accent, R 1/2"); // a message may hold several statements
+    const Score s = b.finish();
+    REQUIRE(s.notes.size() == 3);
+    CHECK(s.notes[1].line == 2);
+    CHECK(s.notes[2].column == 11);
+
+    // A stray 'end' inside a message leaves the open repeat untouched.
+    ScoreBuilder r;
+    r.add_statement("repeat 2");
+    r.add_statement("R");
+    CHECK_THROWS_AS(r.add_statement("end, end"), ScoreError);
+    r.reset();
+    r.add_statement("repeat 2");
+    r.add_statement("R");
+    r.add_statement("end");
+    CHECK(r.finish().notes.size() == 2);
+}
+
+TEST_CASE("score: example files parse", "[score][parser]")
+{
+    for (const char *name : {"figure5.txt", "nuances.txt", "tempo_ramp.txt"}) {
+        const std::string path = std::string(ICTUS_SOURCE_DIR) + "/examples/scores/" + name;
+        INFO(path);
+        const Score s = load_score(path);
+        CHECK(s.notes.size() > 4);
+    }
+    CHECK_THROWS_AS(load_score("/nonexistent/score.txt"), ScoreError);
+}
