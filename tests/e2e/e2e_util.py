@@ -1,0 +1,196 @@
+"""The end-to-end chain for tests and scripts/main.sh: the files `ictusd render`
+writes (strikes.csv, events.txt, render.json: docs/osc.md), rendering an events
+file with patches/ictus-render.pd in the real pd (batch mode), and an onset
+detector that looks at the rendered signal only.
+
+How onsets are measured (docs/main-job.md, "Checking the onsets"):
+- The drum in the main render rings for seconds and the two hands strike a few
+  ms apart (the CMU clip has pairs 1.6 ms apart), bounces follow their stroke
+  within tens of ms: in one mixed signal the onset of a stroke that lands on a
+  ringing drum is not a well-defined sample. So the check renders the same
+  events file again in a few *passes*: the strikes are dealt into passes so
+  that within a pass consecutive strikes are at least MIN_GAP_S apart (greedy,
+  in time order), and the drum is given a short decay (render-drum t60 0.01,
+  every other line of the events file untouched: same delays, same hit lists).
+  Every strike is then played exactly once, onto a drum at rest.
+- The detector sees only the WAV: an onset is the first sample whose magnitude
+  (max over the two pickups) exceeds THRESHOLD after at least QUIET_S of
+  samples at or below it. It is matched to strikes.csv's time_s: the onset of
+  every strike within 1 ms (we measure the error in samples), and exactly as
+  many onsets as strikes in the pass (no extra onsets: a second contact made by
+  contact~, a click, a strike played twice would each fail).
+"""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "tests", "pd"))
+from pdrun import PD, PD_ENV, error_lines, read_wav_float  # noqa: E402
+
+RENDER_PATCH = os.path.join(ROOT, "patches", "ictus-render.pd")
+MIN_GAP_S = 0.060   # strikes closer than this go to different passes
+MEASURE_T60_S = 0.01  # the drum's decay in the onset passes
+THRESHOLD = 1e-7    # |y| above this after silence is an onset
+QUIET_S = 0.010     # silence needed before an onset
+
+
+def read_strikes(path):
+    """strikes.csv -> list of dicts (numbers converted), in file order."""
+    with open(path) as f:
+        lines = [l.strip() for l in f if l.strip()]
+    if not lines:
+        raise ValueError("%s: empty (no header)" % path)
+    header = lines[0].split(",")
+    rows = []
+    for n, line in enumerate(lines[1:], start=2):
+        cells = line.split(",")
+        if len(cells) != len(header):
+            raise ValueError("%s:%d: %d columns, header has %d" % (path, n, len(cells), len(header)))
+        row = {}
+        for name, cell in zip(header, cells):
+            row[name] = int(cell) if name in ("seq", "hand", "drum", "bounce", "stroke") else float(cell)
+        rows.append(row)
+    return rows
+
+
+def read_events(path):
+    """events.txt -> list of (delay_us, words after the delay) per line, the
+    delay in whole microseconds (the file writes ms with 3 decimals)."""
+    events = []
+    with open(path) as f:
+        text = f.read()
+    for n, raw in enumerate(text.split(";"), start=1):
+        words = raw.split()
+        if not words:
+            continue
+        delay_ms = words[0]
+        whole, _, frac = delay_ms.partition(".")
+        if not whole.isdigit() or (frac and not frac.isdigit()) or len(frac) > 3:
+            raise ValueError("%s: line %d: delay '%s' is not ms with <= 3 decimals" % (path, n, delay_ms))
+        events.append((int(whole) * 1000 + int((frac + "000")[:3]), words[1:]))
+    return events
+
+
+def hit_times_us(events):
+    """Absolute time (us) of every 'hit' line: the running sum of the delays."""
+    t, times = 0, []
+    for delay_us, words in events:
+        t += delay_us
+        if words and words[0] == "hit":
+            times.append(t)
+    return times
+
+
+def drum_lines(render_json):
+    """The drum of render.json as render-drum lines for ictus-render (membrane~
+    parameters; the simulation's contact law is its own and is not copied)."""
+    with open(render_json) as f:
+        drum = json.load(f)["drum"]
+    return ["render-drum radius %.6g" % drum["radius_m"],
+            "render-drum tension %.6g" % drum["tension_n_per_m"],
+            "render-drum density %.6g" % drum["density_kg_per_m2"]]
+
+
+def write_events(path, header_lines, events, keep=None):
+    """An events file: header lines at time 0, then the hit lines whose index
+    (among hits) is in `keep` (all when None), with delays recomputed from the
+    absolute times so that each kept hit keeps its time to the microsecond."""
+    out = ["0 %s;" % h for h in header_lines]
+    t, prev, k = 0, 0, 0
+    for delay_us, words in events:
+        t += delay_us
+        if words and words[0] == "hit":
+            if keep is None or k in keep:
+                d = t - prev
+                out.append("%d.%03d %s;" % (d // 1000, d % 1000, " ".join(words)))
+                prev = t
+            k += 1
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
+
+
+def render_pd(build, events_path, wav_path, seconds, sr=48000, timeout=300):
+    """patches/ictus-render.pd in pd batch mode -> (samples [n, 2], sr, log)."""
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr), "-path",
+           os.path.join(build, "ictus"), "-open", RENDER_PATCH, "-send",
+           "render-file %s" % os.path.abspath(events_path), "-send",
+           "render-out %s" % os.path.abspath(wav_path), "-send", "render-seconds %.3f" % seconds]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=PD_ENV)
+    log = proc.stdout + proc.stderr
+    if proc.returncode != 0:
+        raise RuntimeError("pd exited with %d:\n%s" % (proc.returncode, log))
+    x, file_sr = read_wav_float(wav_path)
+    return x, file_sr, log
+
+
+def passes(times_s, min_gap_s=MIN_GAP_S):
+    """Deals strike indices into passes, greedily in time order, so that within
+    a pass consecutive strikes are >= min_gap_s apart. Returns a list of lists."""
+    order = sorted(range(len(times_s)), key=lambda i: times_s[i])
+    result, last = [], []
+    for i in order:
+        for p, members in enumerate(result):
+            if times_s[i] - last[p] >= min_gap_s:
+                members.append(i)
+                last[p] = times_s[i]
+                break
+        else:
+            result.append([i])
+            last.append(times_s[i])
+    return result
+
+
+def detect_onsets(x, sr, threshold=THRESHOLD, quiet_s=QUIET_S):
+    """Sample indices where the signal (max |y| over channels) first exceeds
+    `threshold` after at least quiet_s of samples at or below it (the start of
+    the file counts as quiet)."""
+    y = np.abs(np.asarray(x, dtype=np.float64))
+    if y.ndim == 2:
+        y = y.max(axis=1)
+    loud = np.flatnonzero(y > threshold)
+    if loud.size == 0:
+        return []
+    quiet = int(round(quiet_s * sr))
+    gaps = np.diff(loud)
+    starts = [int(loud[0])] + [int(loud[k + 1]) for k in np.flatnonzero(gaps > quiet)]
+    return starts
+
+
+def check_onsets(build, events, strikes, work, sr=48000, header=(), log_errors=None):
+    """Renders the strikes in passes (see the module doc) and matches the
+    detected onsets to strikes.csv. Returns a dict: errors_ms (per strike, in
+    strike order), extra (onsets matched to no strike), missing (strikes
+    without an onset), passes, logs. header: extra render-drum lines."""
+    times = [s["time_s"] for s in strikes]
+    groups = passes(times)
+    errors = [None] * len(strikes)
+    extra, logs = [], []
+    tol = int(round(0.001 * sr))
+    for p, members in enumerate(groups):
+        ev = os.path.join(work, "pass-%d.txt" % p)
+        wav = os.path.join(work, "pass-%d.wav" % p)
+        write_events(ev, list(header) + ["render-drum t60 %g" % MEASURE_T60_S], events,
+                     keep=set(members))
+        seconds = round(max(times[i] for i in members) + 0.2, 3)
+        x, file_sr, log = render_pd(build, ev, wav, seconds, sr)
+        logs.append(log)
+        if file_sr != sr or not np.all(np.isfinite(x)):
+            raise RuntimeError("pass %d: WAV at %d Hz or not finite" % (p, file_sr))
+        onsets = detect_onsets(x, sr)
+        expected = {i: int(np.floor(times[i] * sr + 0.5)) for i in members}
+        used = set()
+        for i in sorted(members, key=lambda i: times[i]):
+            near = [o for o in onsets if abs(o - expected[i]) <= tol and o not in used]
+            if near:
+                best = min(near, key=lambda o: abs(o - expected[i]))
+                used.add(best)
+                errors[i] = (best - expected[i]) * 1000.0 / sr
+        extra += [(p, o / sr) for o in onsets if o not in used]
+    missing = [i for i, e in enumerate(errors) if e is None]
+    return {"errors_ms": errors, "extra": extra, "missing": missing, "passes": groups,
+            "logs": logs}
