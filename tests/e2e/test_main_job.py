@@ -1,0 +1,220 @@
+"""Issue 7: the README main job's core steps on the default score, in this
+build (scripts/main.sh --no-deps --no-build: ictusd render --out, pd batch
+render, figure5.py), and what it leaves in its output folder:
+- performance.wav: the events rendered to the sample. The onsets found in the
+  signal alone match strikes.csv within 1 ms with no extra onsets (the strikes
+  rendered again in passes on a drum at rest, e2e_util / docs/main-job.md), and
+  the main WAV itself is finite, sounds, is silent before the first strike and
+  starts on its sample;
+- tips.png and tips.svg exist and are non-trivial images;
+- performance.bvh parses (a BVH reader written here, independent of the
+  daemon's): the hierarchy's channel count matches every motion line, Frames
+  matches the lines, values finite; and when it carries the sticks
+  (LeftHandStick/RightHandStick end sites), forward kinematics here puts their
+  tips where tips.csv says the simulated tips were.
+Skipped (exit 77) with a message while `ictusd render` has no --score."""
+import argparse
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import e2e_util as u  # noqa: E402
+from pdrun import check, error_lines, make_workdir, read_wav_float  # noqa: E402
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", required=True)
+args = ap.parse_args()
+build = os.path.abspath(args.build)
+ictusd = os.path.join(build, "ictusd")
+check(os.access(ictusd, os.X_OK), "ictusd is built at %s" % ictusd)
+help_text = subprocess.run([ictusd, "render", "--help"], capture_output=True, text=True,
+                           timeout=60)
+if "--score" not in help_text.stdout + help_text.stderr:
+    print("SKIPPED: `ictusd render --help` has no --score yet: the main job's default score "
+          "cannot be rendered (issue 6's render verb)")
+    sys.exit(77)
+
+work = make_workdir("ictus-e2e-main-")
+out = os.path.join(work, "out")
+env = dict(os.environ)
+env.pop("LD_PRELOAD", None)
+if os.environ.get("ICTUS_PD_PRELOAD"):
+    # main.sh runs pd itself: under the ASan build, pd needs the runtime preloaded.
+    # A wrapper named pd first in PATH does that and nothing else.
+    bindir = os.path.join(work, "bin")
+    os.makedirs(bindir)
+    with open(os.path.join(bindir, "pd"), "w") as f:
+        f.write("#!/bin/sh\nLD_PRELOAD=%s exec %s \"$@\"\n" % (os.environ["ICTUS_PD_PRELOAD"],
+                                                               u.PD))
+    os.chmod(os.path.join(bindir, "pd"), 0o755)
+    env["PATH"] = bindir + os.pathsep + env["PATH"]
+cmd = ["bash", os.path.join(u.ROOT, "scripts", "main.sh"), "--no-deps", "--no-build",
+       "--build", build, "--out", out]
+proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env, cwd=work)
+print(proc.stdout[-3000:])
+check(proc.returncode == 0, "scripts/main.sh --no-deps --no-build ran: %s" % proc.stderr[-3000:])
+for name in ("performance.wav", "strikes.csv", "events.txt", "render.json", "tips.png",
+             "tips.svg", "performance.bvh"):
+    check(os.path.isfile(os.path.join(out, name)) and os.path.getsize(os.path.join(out, name)) > 0,
+          "main job wrote %s" % name)
+check(out in proc.stdout and "performance.wav" in proc.stdout,
+      "main job printed where its outputs are")
+
+# --- the sound ---------------------------------------------------------------
+strikes = u.read_strikes(os.path.join(out, "strikes.csv"))
+events = u.read_events(os.path.join(out, "events.txt"))
+check(len(strikes) >= 8, "the default score gives strikes (%d)" % len(strikes))
+times_us = u.hit_times_us(events)
+check(len(times_us) == len(strikes) and
+      all(t == round(s["time_s"] * 1e6) for t, s in zip(times_us, strikes)),
+      "events.txt holds strikes.csv's times to the microsecond")
+x, sr = read_wav_float(os.path.join(out, "performance.wav"))
+check(sr == 48000 and x.shape[1] == 2 and np.all(np.isfinite(x)), "performance.wav: 2 ch, 48 kHz, finite")
+check(x.shape[0] / sr > strikes[-1]["time_s"], "performance.wav lasts past the last strike")
+check(float(np.abs(x).max()) > 1e-3, "performance.wav sounds")
+first = u.detect_onsets(x, sr)[0]
+want = int(np.floor(strikes[0]["time_s"] * sr + 0.5))
+check(first == want, "performance.wav is silent before the first strike, which starts on its "
+      "sample (%d vs %d)" % (first, want))
+drum = u.drum_lines(os.path.join(out, "render.json"))
+result = u.check_onsets(build, events, strikes, work, header=drum)
+for p, log in enumerate(result["logs"]):
+    others = [l for l in error_lines(log) if "contact~: hit: velocity must be in" not in l]
+    check(not others, "onset pass %d has no error lines: %s" % (p, others))
+found = [abs(e) for e in result["errors_ms"] if e is not None]
+if found:
+    print("onset - strike time: max %.4f ms, mean %.4f ms, exact %d of %d, %d passes"
+          % (max(found), float(np.mean(found)), sum(e == 0 for e in found), len(found),
+             len(result["passes"])))
+check(not result["missing"], "every strike has an onset within 1 ms (missing %s)" % result["missing"])
+check(not result["extra"], "no extra onsets (%s)" % result["extra"])
+
+# --- the plot ------------------------------------------------------------------
+with open(os.path.join(out, "tips.png"), "rb") as f:
+    png = f.read()
+check(png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20000, "tips.png is a PNG (%d bytes)" % len(png))
+with open(os.path.join(out, "tips.svg")) as f:
+    svg = f.read()
+check("<svg" in svg and svg.count("<path") > 10, "tips.svg is an SVG with drawn paths")
+
+
+# --- the BVH ---------------------------------------------------------------------
+def parse_bvh(path):
+    """-> joints [(name, parent, offset, channels, end_site)], frame_time, frames [n, k]."""
+    with open(path) as f:
+        tokens_lines = f.read().splitlines()
+    i = 0
+    joints, stack = [], []
+
+    def toks(k):
+        return tokens_lines[k].split()
+
+    check(tokens_lines[0].strip() == "HIERARCHY", "BVH starts with HIERARCHY")
+    i = 1
+    pending = None
+    while True:
+        t = toks(i)
+        if not t:
+            i += 1
+            continue
+        if t[0] in ("ROOT", "JOINT"):
+            pending = (" ".join(t[1:]), False)
+        elif t[0] == "End":
+            pending = ((joints[stack[-1]][0] if stack else "?") + "_End", True)
+        elif t[0] == "{":
+            joints.append([pending[0], stack[-1] if stack else -1, None, [], pending[1]])
+            stack.append(len(joints) - 1)
+        elif t[0] == "OFFSET":
+            joints[stack[-1]][2] = np.array([float(v) for v in t[1:4]])
+        elif t[0] == "CHANNELS":
+            check(int(t[1]) == len(t) - 2, "BVH line %d: CHANNELS count matches" % (i + 1))
+            joints[stack[-1]][3] = t[2:]
+        elif t[0] == "}":
+            stack.pop()
+        elif t[0] == "MOTION":
+            break
+        else:
+            check(False, "BVH line %d: unexpected '%s'" % (i + 1, t[0]))
+        i += 1
+    check(not stack, "BVH hierarchy braces balance")
+    n_frames = int(toks(i + 1)[1])
+    frame_time = float(toks(i + 2)[2])
+    rows = [l.split() for l in tokens_lines[i + 3:] if l.strip()]
+    width = sum(len(j[3]) for j in joints)
+    check(len(rows) == n_frames, "BVH has Frames: %d motion lines (%d)" % (n_frames, len(rows)))
+    check(all(len(r) == width for r in rows), "every BVH motion line has %d values" % width)
+    data = np.array(rows, dtype=float) if rows else np.zeros((0, width))
+    check(np.all(np.isfinite(data)), "BVH values are finite")
+    return joints, frame_time, data
+
+
+def axis_matrix(axis, deg):
+    a = np.radians(deg)
+    c, s = np.cos(a), np.sin(a)
+    if axis == "X":
+        return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    if axis == "Y":
+        return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def fk(joints, row):
+    """World positions (file units) of every joint for one motion line:
+    R = product of the rotation channels in file order (intrinsic)."""
+    pos, rot, k = [None] * len(joints), [None] * len(joints), 0
+    for j, (name, parent, offset, channels, end) in enumerate(joints):
+        moved, r = np.zeros(3), np.eye(3)
+        for c in channels:
+            v = row[k]
+            k += 1
+            if c.endswith("position"):
+                moved["XYZ".index(c[0])] = v
+            else:
+                r = r @ axis_matrix(c[0], v)
+        if parent < 0:
+            pos[j], rot[j] = offset + moved, r
+        else:
+            pos[j] = pos[parent] + rot[parent] @ offset
+            rot[j] = rot[parent] @ r
+    return pos
+
+
+joints, frame_time, data = parse_bvh(os.path.join(out, "performance.bvh"))
+print("performance.bvh: %d joints, %d frames at %.6g s" % (len(joints), len(data), frame_time))
+check(len(joints) >= 20 and len(data) > 0 and 0 < frame_time < 1, "the BVH has a skeleton and frames")
+names = [j[0] for j in joints]
+tips_csv = os.path.join(out, "tips.csv")
+if "LeftHandStick_End" in names and "RightHandStick_End" in names and os.path.isfile(tips_csv):
+    # The exported sticks against the simulated tips: at every BVH frame whose
+    # time is a tips.csv sample, the tip heights agree to the printing
+    # precision of the two files (tips.csv's last digit) plus the drift of the
+    # physics' joints, which the exported pose (joint rotations) cannot show.
+    sys.path.insert(0, os.path.join(u.ROOT, "scripts"))
+    import figure5  # noqa: E402  (its column matcher)
+    with open(tips_csv) as f:
+        lines = [l.strip() for l in f if l.strip() and not l.startswith("#")]
+    header = lines[0].split(",")
+    cols = figure5.tip_columns(header)
+    table = np.array([[float(v) for v in l.split(",")] for l in lines[1:]])
+    t = table[:, header.index("time_s")]
+    worst = {}
+    for hand, end in (("left", "LeftHandStick_End"), ("right", "RightHandStick_End")):
+        j = names.index(end)
+        errs = []
+        for f_idx in range(len(data)):
+            k = int(np.searchsorted(t, f_idx * frame_time))
+            for kk in (k - 1, k):
+                if 0 <= kk < len(t) and abs(t[kk] - f_idx * frame_time) < 1e-6:
+                    errs.append(abs(fk(joints, data[f_idx])[j][1] - table[kk, cols[(hand, "sim")]]))
+                    break
+        worst[hand] = (max(errs) if errs else None, len(errs))
+    print("BVH stick tips vs tips.csv (sim y): %s" % worst)
+    check(all(n > 0 for _, n in worst.values()), "BVH frames fall on tips.csv samples")
+    check(all(e < 1e-3 for e, _ in worst.values()),
+          "BVH stick-tip heights match tips.csv within 1 mm: %s" % worst)
+else:
+    print("NOTE: performance.bvh has no stick end sites or there is no tips.csv: "
+          "tips not compared")
