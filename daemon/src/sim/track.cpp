@@ -1,6 +1,8 @@
 // Joint-space tracking run (ID mode, eq. 1).
 #include "ictus/track.hpp"
 
+#include "ictus/tracker.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,45 +20,6 @@ double smoothstep(double x)
 {
     x = std::min(1.0, std::max(0.0, x));
     return x * x * (3.0 - 2.0 * x);
-}
-
-// One arm of Algorithm 2: the chain thorax -> clavicle -> shoulder -> elbow ->
-// wrist -> stick tip (docs/ik.md), twice: `feedback` is solved every step from
-// the simulated state (eq. 2), `kinematic` follows the targets alone (warm-started
-// from its own last solution) and gives the target rates for the feedforward.
-struct ArmIk {
-    int joint[4] = {-1, -1, -1, -1};
-    int base_body = -1;
-    KinematicChain feedback, kinematic;
-    Eigen::Vector3d integral_m = Eigen::Vector3d::Zero();
-    Eigen::Quaterniond theta_target[4], kinematic_target[4], previous_kinematic[4];
-};
-
-constexpr const char *kArmJoints[2][4] = {{"l_clavicle", "l_shoulder", "l_elbow", "l_wrist"},
-                                          {"r_clavicle", "r_shoulder", "r_elbow", "r_wrist"}};
-
-void build_arm(const CharacterModel &model, Side side, const CharacterPose &initial,
-               const std::vector<JointLimitRef> &limits, ArmIk &arm)
-{
-    const int s = static_cast<int>(side);
-    for (int k = 0; k < 4; ++k) {
-        arm.joint[k] = model.joint_index(kArmJoints[s][k]);
-        if (arm.joint[k] < 0)
-            throw CharacterError(std::string("cartesian mode: the character has no joint '") +
-                                 kArmJoints[s][k] + "'");
-    }
-    arm.base_body = model.joint_body(arm.joint[0]).parent;
-    for (KinematicChain *chain : {&arm.feedback, &arm.kinematic}) {
-        for (int k = 0; k < 4; ++k) {
-            const int j = arm.joint[k];
-            chain->add_joint(model.joint_body(j).offset_m, initial.local[j],
-                             limits.empty() ? JointLimitRef() : limits[j]);
-        }
-        chain->set_tip(model.stick(side).tip_m, model.stick(side).axis);
-    }
-    for (int k = 0; k < 4; ++k)
-        arm.theta_target[k] = arm.kinematic_target[k] = arm.previous_kinematic[k] =
-            initial.local[arm.joint[k]];
 }
 
 // Rotation angle of a local rotation, degrees: the elbow's flexion (its
@@ -223,49 +186,19 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     long last_sample_index = 0;
 
     CharacterPose initial = reference.frame(0);
-    if (tips_in) {
-        // The arms' first pose: a cold IK solve from the reference's arms to the
-        // first tips (repeated calls: the solver's per-call budget is 16 steps).
-        BodyFrames frames;
-        model.forward(initial, frames);
-        ChainIkSolverPos_dls cold(4, options.cartesian.ik);
-        for (int s = 0; s < 2; ++s) {
-            ArmIk arm;
-            build_arm(model, static_cast<Side>(s), initial, limits, arm);
-            arm.kinematic.set_base(frames.origin_m[arm.base_body], frames.rotation[arm.base_body]);
-            Eigen::Quaterniond q[4];
-            for (int call = 0; call < 20; ++call) {
-                const IkResult r = cold.solve(arm.kinematic, tips_in->tip_m[s][0], q);
-                arm.kinematic.set_rotations(q);
-                if (r.status == IkStatus::converged)
-                    break;
-            }
-            for (int k = 0; k < 4; ++k)
-                initial.local[arm.joint[k]] = arm.kinematic.rotation(k);
-        }
-    }
+    if (tips_in) // The arms' first pose: a cold IK solve from the reference's arms to the first
+                 // tips.
+        Tracker::solve_arms(model, limits, options.cartesian.ik,
+                            {tips_in->tip_m[0][0], tips_in->tip_m[1][0]}, initial);
     const std::vector<JointGains> gains =
         gains_in ? *gains_in : default_gains(model, initial, options.gains);
-    Scene scene(model, options.scene, initial, gains);
-    scene.set_joint_limits(limits);
+    Tracker tracker(model, options.scene, initial, gains, limits, options.mode, options.cartesian,
+                    options.gains);
+    Scene &scene = tracker.scene();
 
     const int nj = CharacterModel::kJoints;
     const bool cartesian = options.mode == TrackMode::cartesian;
-    const CartesianOptions &co = options.cartesian;
-    std::array<ArmIk, 2> arms;
-    std::unique_ptr<ChainIkSolverPos_dls> solver;
-    if (cartesian) {
-        for (int s = 0; s < 2; ++s)
-            build_arm(model, static_cast<Side>(s), initial, limits, arms[s]);
-        solver = std::make_unique<ChainIkSolverPos_dls>(4, co.ik);
-    }
-    const double velocity_gain_s =
-        co.velocity_gain_s >= 0.0 ? co.velocity_gain_s
-                                  : (std::sqrt(co.gain) - 1.0) * 2.0 * options.gains.damping_ratio /
-                                        (2.0 * M_PI * options.gains.natural_frequency_hz);
-    long ik_iterations = 0, ik_solves = 0;
-    double ik_wall_s = 0.0, elbow_sum2[2] = {0.0, 0.0};
-    BodyFrames sim_frames, target_frames;
+    double elbow_sum2[2] = {0.0, 0.0};
     CharacterPose around_pose;
 
     TrackSummary summary;
@@ -302,9 +235,9 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
         *csv << ",contacts\n";
     }
 
-    CharacterPose ref_pose, target_pose = initial;
-    std::vector<Eigen::Quaterniond> previous_target = initial.local, target(nj), sim_local;
-    std::vector<Eigen::Vector3d> rate(nj, Eigen::Vector3d::Zero());
+    CharacterPose ref_pose, step_pose = initial;
+    std::vector<Eigen::Quaterniond> sim_local;
+    TipTargets tip_targets;
     long last_progress = -1;
     const auto wall_start = std::chrono::steady_clock::now();
 
@@ -318,24 +251,16 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
         // Targets for the end of this step, blended in from the initial pose.
         reference.sample(t_next, ref_pose);
         const double blend = options.ramp_s > 0.0 ? smoothstep(t_next / options.ramp_s) : 1.0;
-        for (int j = 0; j < nj; ++j) {
-            target[j] = initial.local[j].slerp(blend, ref_pose.local[j]);
-            rate[j] = rotation_vector(target[j] * previous_target[j].conjugate()) / h;
-        }
-        previous_target = target;
+        step_pose.pelvis_position_m = ref_pose.pelvis_position_m;
+        step_pose.pelvis_rotation = ref_pose.pelvis_rotation;
+        for (int j = 0; j < nj; ++j)
+            step_pose.local[j] = initial.local[j].slerp(blend, ref_pose.local[j]);
         if (cartesian) {
-            // Algorithm 2. X^T: the stick tips of the (blended) reference pose.
-            const auto ik_start = std::chrono::steady_clock::now();
-            target_pose.pelvis_position_m = ref_pose.pelvis_position_m;
-            target_pose.pelvis_rotation = ref_pose.pelvis_rotation;
-            target_pose.local = target;
-            model.forward(target_pose, target_frames);
-            scene.body_frames(sim_frames);
-            scene.local_rotations(sim_local);
+            // Algorithm 2. X^T: the stick tips of the (blended) reference pose,
+            // or of the stick-only capture.
             // Reference tip velocity and acceleration by central differences over
             // one reference frame (the sampled reference is piecewise linear
             // between frames, so per-step differences would be steps and spikes).
-            std::array<Eigen::Vector3d, 2> tip_velocity, tip_acceleration;
             const double frame_s =
                 tips_in ? tips_in->duration_s() / static_cast<double>(tips_in->time_s.size() - 1)
                         : 1.0 / reference.frame_rate_hz();
@@ -355,83 +280,21 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                     now = reference_tips(model, ref_pose);
                 }
                 for (int s = 0; s < 2; ++s) {
-                    tip_velocity[s] = (after[s] - before[s]) / (2.0 * frame_s);
-                    tip_acceleration[s] =
+                    tip_targets.velocity_mps[s] = (after[s] - before[s]) / (2.0 * frame_s);
+                    tip_targets.acceleration_mps2[s] =
                         (after[s] - 2.0 * now[s] + before[s]) / (frame_s * frame_s);
                 }
             } else {
-                tip_velocity.fill(Eigen::Vector3d::Zero());
-                tip_acceleration.fill(Eigen::Vector3d::Zero());
+                tip_targets.velocity_mps.fill(Eigen::Vector3d::Zero());
+                tip_targets.acceleration_mps2.fill(Eigen::Vector3d::Zero());
             }
-            for (int s = 0; s < 2; ++s) {
-                ArmIk &arm = arms[s];
-                const Side side = static_cast<Side>(s);
-                const int hb = model.hand_body(side);
-                const Eigen::Vector3d tip_target =
-                    tips_in ? tips_in->sample(s, t_next)
-                            : model.tip_position(side, target_frames.origin_m[hb],
-                                                 target_frames.rotation[hb]);
-                // Kinematic IK: the arm's target trajectory without the body,
-                // for the target rates (feedforward of eq. 1).
-                arm.kinematic.set_base(target_frames.origin_m[arm.base_body],
-                                       target_frames.rotation[arm.base_body]);
-                if (co.reference_has_arms)
-                    for (int k = 0; k < 4; ++k)
-                        arm.kinematic_target[k] = target[arm.joint[k]];
-                arm.kinematic.set_rotations(arm.kinematic_target);
-                IkResult r = solver->solve(arm.kinematic, tip_target, arm.kinematic_target);
-                ik_iterations += r.iterations;
-                summary.ik_max_iterations = std::max(summary.ik_max_iterations, r.iterations);
-                summary.ik_not_converged += r.status != IkStatus::converged;
-                // Eq. 2 with its gain: the IK target is X^S + gain (X^T - X^S) (+ the
-                // velocity, acceleration and integral terms, capped), X^S from the
-                // simulated thorax and Theta^S. The solve starts from Theta^S (eq. 2
-                // literally) or from the kinematic solution, which holds the arm's
-                // null space (CartesianOptions::start_from_simulated, docs/ik.md).
-                arm.feedback.set_base(sim_frames.origin_m[arm.base_body],
-                                      sim_frames.rotation[arm.base_body]);
-                for (int k = 0; k < 4; ++k)
-                    arm.feedback.set_rotation(k, sim_local[arm.joint[k]]);
-                const Eigen::Vector3d sim_tip_chain = arm.feedback.tip_position();
-                if (!co.start_from_simulated)
-                    arm.feedback.set_rotations(arm.kinematic_target);
-                const Eigen::Vector3d error = tip_target - scene.tip_position(side);
-                const Eigen::Vector3d velocity_error = tip_velocity[s] - scene.tip_velocity(side);
-                if (co.integral_per_s > 0.0 && t_next >= options.ramp_s) {
-                    arm.integral_m += co.integral_per_s * h * error;
-                    const double norm = arm.integral_m.norm();
-                    if (norm > co.integral_limit_m)
-                        arm.integral_m *= co.integral_limit_m / norm;
-                }
-                Eigen::Vector3d correction = (co.gain - 1.0) * error +
-                                             velocity_gain_s * velocity_error +
-                                             co.acceleration_feedforward_s2 * tip_acceleration[s];
-                const double correction_norm = correction.norm();
-                if (correction_norm > co.correction_limit_m)
-                    correction *= co.correction_limit_m / correction_norm;
-                const Eigen::Vector3d ik_target =
-                    sim_tip_chain + error + correction + arm.integral_m;
-                r = solver->solve(arm.feedback, ik_target, arm.theta_target);
-                ik_iterations += r.iterations;
-                summary.ik_max_iterations = std::max(summary.ik_max_iterations, r.iterations);
-                summary.ik_not_converged += r.status != IkStatus::converged;
-                ik_solves += 2;
-                for (int k = 0; k < 4; ++k) {
-                    const int j = arm.joint[k];
-                    target[j] = arm.theta_target[k];
-                    rate[j] = n == 0 ? Eigen::Vector3d::Zero()
-                                     : Eigen::Vector3d(
-                                           rotation_vector(arm.kinematic_target[k] *
-                                                           arm.previous_kinematic[k].conjugate()) /
-                                           h);
-                    arm.previous_kinematic[k] = arm.kinematic_target[k];
-                }
-            }
-            ik_wall_s +=
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - ik_start).count();
+            tip_targets.has_position = tips_in != nullptr;
+            if (tips_in)
+                for (int s = 0; s < 2; ++s)
+                    tip_targets.position_m[s] = tips_in->sample(s, t_next);
         }
-        scene.set_joint_targets(target, rate);
-        scene.step();
+        tracker.step(step_pose, cartesian ? &tip_targets : nullptr, t_next >= options.ramp_s);
+        const std::vector<Eigen::Quaterniond> &target = tracker.targets();
         summary.max_linear_speed_mps =
             std::max(summary.max_linear_speed_mps, scene.max_linear_speed_mps());
         summary.max_angular_speed_rad_s =
@@ -472,7 +335,7 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                     const double e = (ref_tips[s] - sim_tips[s]).norm() * 1e3;
                     tip_sum2[s] += e * e;
                     tip_max[s] = std::max(tip_max[s], e);
-                    const int elbow = model.joint_index(kArmJoints[s][2]);
+                    const int elbow = model.joint_index(Tracker::kArmJoints[s][2]);
                     const double de = rotation_angle_deg(ref_pose.local[elbow]) -
                                       rotation_angle_deg(target[elbow]);
                     elbow_sum2[s] += de * de;
@@ -505,7 +368,7 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                     for (const Eigen::Vector3d &p : {ref_tips[s], sim_tips[s]})
                         *csv << ',' << p.x() << ',' << p.y() << ',' << p.z();
                 for (int s = 0; s < 2; ++s) {
-                    const int elbow = model.joint_index(kArmJoints[s][2]);
+                    const int elbow = model.joint_index(Tracker::kArmJoints[s][2]);
                     *csv << ',' << rotation_angle_deg(ref_pose.local[elbow]) << ','
                          << rotation_angle_deg(target[elbow]) << ','
                          << rotation_angle_deg(sim_local[elbow]);
@@ -541,9 +404,12 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     }
     summary.joint_rms_raw_deg_all = std::sqrt(raw_joint_sum2 / (ns * nj));
     if (cartesian) {
+        const TrackerIkStats &ik = tracker.ik_stats();
         summary.ik_mean_iterations =
-            ik_solves > 0 ? static_cast<double>(ik_iterations) / ik_solves : 0.0;
-        summary.ik_us_per_step = n > 0 ? 1e6 * ik_wall_s / n : 0.0;
+            ik.solves > 0 ? static_cast<double>(ik.iterations) / ik.solves : 0.0;
+        summary.ik_max_iterations = ik.max_iterations;
+        summary.ik_not_converged = ik.not_converged;
+        summary.ik_us_per_step = n > 0 ? 1e6 * ik.wall_s / n : 0.0;
         for (int s = 0; s < 2; ++s)
             summary.elbow_ik_rms_deg[s] = std::sqrt(elbow_sum2[s] / ns);
         summary.elbow_measured = tips_in == nullptr;
