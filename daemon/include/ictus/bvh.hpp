@@ -12,6 +12,7 @@
 #include "ictus/motion.hpp"
 
 #include <Eigen/Geometry>
+#include <array>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -64,5 +65,46 @@ std::vector<Eigen::Vector3d> bvh_forward_kinematics(const BvhFile &bvh, int fram
 Eigen::Quaterniond axis_rotation(int axis, double angle_rad);
 
 const char *to_string(BvhChannel channel);
+
+} // namespace ictus
+
+// ---- BVH export (bvh_writer.cpp): the inverse of read_bvh ---------------------
+namespace ictus
+{
+
+struct BvhWriteOptions {
+    // File units per metre: 1 writes metres, 100 centimetres, 1 / 0.0254 inches.
+    // Read the file back with BvhOptions::scale = 1 / units_per_m. Finite, > 0.
+    double units_per_m = 1.0;
+    // Rotation channels written on every joint (end sites have none), as axis
+    // indices 0 = X, 1 = Y, 2 = Z, a permutation of {0, 1, 2}. The angles are
+    // those that read_bvh composes back: q = R_o0(a0) * R_o1(a1) * R_o2(a2)
+    // (intrinsic, file order). Default: Z Y X, the CMU order.
+    std::array<int, 3> rotation_order{{2, 1, 0}};
+    // Decimals of every number (9: 1e-9 degree, far below 1e-6 m of position).
+    int decimals = 9;
+};
+
+// Writes HIERARCHY (OFFSETs, CHANNELS: "Xposition Yposition Zposition" + the
+// rotation channels on the root, the rotation channels on every other joint,
+// end sites as "End Site") and MOTION (Frames, Frame Time = 1 / frame_rate_hz,
+// one line per frame). The root's position channels hold root_position_m minus
+// the root's OFFSET, so that read_bvh gives root_position_m back. Joints are
+// written depth first, children in index order: a skeleton read by read_bvh is
+// written in its own order. Local rotations of end sites are not written (BVH
+// has no channels there). Throws MocapError naming `source_name` and the frame
+// or joint on bad input (size mismatch, non-finite value, rate <= 0, an end
+// site with children, no root).
+void write_bvh(std::ostream &out, const Skeleton &skeleton, const Motion &motion,
+               const BvhWriteOptions &options = {}, const std::string &source_name = "<bvh>");
+// Same into a file; throws MocapError naming the path when it cannot be written.
+void write_bvh(const std::string &path, const Skeleton &skeleton, const Motion &motion,
+               const BvhWriteOptions &options = {});
+
+// Tait-Bryan angles (rad) of a rotation about the axes `order` (a permutation
+// of {0, 1, 2}): q = R_order[0](a[0]) * R_order[1](a[1]) * R_order[2](a[2]),
+// with a[1] in [-pi/2, pi/2]. At gimbal lock (a[1] = +-pi/2) a[0] and a[2]
+// are not unique; the pair returned still composes to q to rounding.
+Eigen::Vector3d euler_angles(const Eigen::Quaterniond &q, const std::array<int, 3> &order);
 
 } // namespace ictus

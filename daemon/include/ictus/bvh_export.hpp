@@ -1,0 +1,38 @@
+// bvh_export.hpp -- the simulated performance as motion of the mocap skeleton
+// the character was built from (CharacterModel::from_skeleton), for BVH export
+// (write_bvh, bvh.hpp): any 3D tool then shows the performance without Gem.
+#pragma once
+
+#include "ictus/character.hpp"
+#include "ictus/motion.hpp"
+
+#include <string>
+#include <vector>
+
+namespace ictus
+{
+
+// The inverse of CharacterModel::pose_from_motion. Each body's frame is its
+// source mocap joint's frame, and its joint rotation is the product of the
+// local rotations along its source path (parent-most first): the body's
+// rotation goes on the source joint itself, the joints merged into the path
+// (e.g. Spine1 between thorax and neck, LHipJoint) keep the identity, and so
+// does every joint the character leaves out (fingers, toes, end sites), which
+// then moves rigidly with its parent. With those identities the source joint
+// lands exactly where the character puts the body (the body's offset is the
+// sum of the path's OFFSETs), so forward_kinematics of the result at each
+// body's source joint equals CharacterModel::forward. Joints appended to the
+// skeleton after the source ones (e.g. by skeleton_with_sticks) get identity.
+// Throws CharacterError when a pose has the wrong number of joints, a source
+// joint is out of the skeleton, or rate_hz is not finite and > 0.
+Motion motion_from_poses(const CharacterModel &model, const Skeleton &skeleton,
+                         const std::vector<CharacterPose> &poses, double rate_hz);
+
+// The skeleton plus the two drumsticks, so that a BVH shows them: per hand a
+// joint "<Hand>Stick" (LeftHandStick / RightHandStick) below the hand's source
+// joint at the stick's grip point, with an end site at the tip. A stick is
+// rigid in its hand (identity rotation), so its tip follows the hand frame
+// exactly as CharacterModel::tip_position. Appended after the existing joints.
+Skeleton skeleton_with_sticks(const CharacterModel &model, const Skeleton &skeleton);
+
+} // namespace ictus
