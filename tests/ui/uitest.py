@@ -1,0 +1,145 @@
+"""Shared pieces of the tests/ui tests: where things are, how a test skips, an Xvfb
+display of its own, a screenshot, and a synthetic pose stream (docs/osc.md) built
+here from a standing figure, independently of the daemon."""
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "pd"))
+sys.path.insert(0, os.path.join(HERE, "..", "pdosc"))
+from pdrun import PD, PD_ENV, error_lines  # noqa: E402,F401
+import oscpacket  # noqa: E402
+
+SKIP = 77
+REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
+
+
+def fail(msg):
+    print("FAIL: " + msg)
+    sys.exit(1)
+
+
+def ok(cond, msg):
+    if not cond:
+        fail(msg)
+    print("ok: " + msg)
+
+
+def skip_or_fail(reason, missing_package=False):
+    """A piece that cannot run here skips (exit 77); under CI a package that
+    scripts/deps.sh installs must be there, so its absence fails."""
+    if missing_package and os.environ.get("CI") == "true":
+        fail(reason + " (CI=true: scripts/deps.sh installs it)")
+    print("SKIP: " + reason)
+    sys.exit(SKIP)
+
+
+def artifacts_dir(build):
+    path = os.path.join(build, "artifacts")
+    os.makedirs(path, exist_ok=True)
+    return path
+
+
+class Xvfb:
+    """An X server of our own (-displayfd picks a free display number)."""
+
+    def __init__(self, width=1280, height=800):
+        if not shutil.which("Xvfb"):
+            skip_or_fail("Xvfb not installed (Debian package xvfb)", missing_package=True)
+        r, w = os.pipe()
+        self.proc = subprocess.Popen(
+            ["Xvfb", "-displayfd", str(w), "-screen", "0", "%dx%dx24" % (width, height),
+             "-nolisten", "tcp", "+extension", "GLX"],
+            pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        os.close(w)
+        number = b""
+        deadline = time.time() + 10
+        while time.time() < deadline and not number.endswith(b"\n"):
+            chunk = os.read(r, 16)
+            if not chunk:
+                break
+            number += chunk
+        os.close(r)
+        if not number.strip():
+            self.stop()
+            skip_or_fail("Xvfb did not start")
+        self.display = ":" + number.decode().strip()
+
+    def env(self):
+        env = dict(PD_ENV)
+        env["DISPLAY"] = self.display
+        # Mesa's software rasteriser: no GPU here
+        env["LIBGL_ALWAYS_SOFTWARE"] = "1"
+        return env
+
+    def screenshot(self, path):
+        if not shutil.which("import"):
+            skip_or_fail("ImageMagick's import not installed (Debian package imagemagick)",
+                         missing_package=True)
+        subprocess.run(["import", "-display", self.display, "-window", "root", path],
+                       check=True, timeout=20, capture_output=True)
+        return path
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGTERM)
+            try:
+                self.proc.wait(5)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+
+def load_image(path):
+    try:
+        from PIL import Image
+    except ImportError:
+        skip_or_fail("python3-pil not installed", missing_package=True)
+    import numpy as np
+    return np.asarray(Image.open(path).convert("RGB")).astype(int)
+
+
+# A standing figure facing +Z (its left is +X), y up, metres: the joint centres of the
+# 20 bodies in docs/character.md's order, both sticks held over a drum in front.
+FIGURE = [
+    (0.0, 0.95, 0.0),    # 0 pelvis
+    (0.0, 1.05, 0.0),    # 1 abdomen
+    (0.0, 1.25, 0.0),    # 2 thorax
+    (0.0, 1.45, 0.0),    # 3 neck
+    (0.0, 1.52, 0.0),    # 4 upper neck
+    (0.0, 1.58, 0.0),    # 5 head
+    (0.03, 1.42, 0.0),   # 6 left clavicle
+    (0.19, 1.42, 0.0),   # 7 left upper arm (shoulder)
+    (0.25, 1.15, 0.06),  # 8 left forearm (elbow)
+    (0.22, 1.0, 0.3),    # 9 left hand (wrist)
+    (-0.03, 1.42, 0.0),  # 10 right clavicle
+    (-0.19, 1.42, 0.0),  # 11
+    (-0.25, 1.15, 0.06),  # 12
+    (-0.22, 1.0, 0.3),   # 13
+    (0.1, 0.9, 0.0),     # 14 left thigh (hip)
+    (0.11, 0.5, 0.02),   # 15 left shank (knee)
+    (0.11, 0.09, 0.0),   # 16 left foot (ankle)
+    (-0.1, 0.9, 0.0),    # 17
+    (-0.11, 0.5, 0.02),  # 18
+    (-0.11, 0.09, 0.0),  # 19
+]
+STICKS = [((0.06, 0.82, 0.62), (0.22, 0.98, 0.33)),   # left: tip, butt
+          ((-0.06, 0.82, 0.62), (-0.22, 0.98, 0.33))]
+DRUM = ((0.0, 0.76, 0.6), 0.178)
+IDENTITY = (1.0, 0.0, 0.0, 0.0)
+
+
+def pose_bundle(time_s, head_quat=IDENTITY):
+    """One pose frame as ictusd sends it: a bundle, timetag 'immediately'."""
+    msgs = [oscpacket.message("/ictus/pose/frame", "f", time_s)]
+    for i, p in enumerate(FIGURE):
+        q = head_quat if i == 5 else IDENTITY
+        msgs.append(oscpacket.message("/ictus/pose/body", "ifffffff", i, *p, *q))
+    for hand, (tip, butt) in enumerate(STICKS):
+        msgs.append(oscpacket.message("/ictus/pose/stick", "iffffff", hand, *tip, *butt))
+    msgs.append(oscpacket.message("/ictus/pose/drum", "iffff", 0, *DRUM[0], DRUM[1]))
+    return oscpacket.bundle(b"\0\0\0\0\0\0\0\1", *msgs)
