@@ -68,3 +68,12 @@ for obj in ("membrane~", "contact~", "ictus_timetag", "ictus-receive", "ictus-dr
             "ictus-graphics", "ictus-sound-panel", "ictus-view"):
     ok((" %s " % obj) in objects[0].replace(";", " "), "ictus-meta.pd lists %s" % obj)
     ok(os.path.isfile(os.path.join(libdir, obj + "-help.pd")), "%s has a help patch" % obj)
+# every abstraction and external in the library folder is in the meta file
+listed = " ".join(l for l in meta.splitlines() if "OBJECTS" in l or "INTERNAL" in l).replace(";", " ") + " "
+for f in sorted(os.listdir(libdir)):
+    stem, ext = os.path.splitext(f)
+    if ext not in (".pd", ".pd_linux") or stem.endswith("-help") or stem in ("ictus-meta", "ictus"):
+        continue
+    if ext == ".pd_linux":
+        stem = stem.replace("_tilde", "~")
+    ok((" %s " % stem) in listed, "ictus-meta.pd lists %s (in the library folder)" % stem)
