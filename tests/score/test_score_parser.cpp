@@ -114,7 +114,7 @@ TEST_CASE("score: every note option", "[score][parser]")
     CHECK(s.length_beats == 6.75);
 }
 
-TEST_CASE("score: the dynamics words rise from pp to ff, mf is the default", "[score][parser]")
+TEST_CASE("score: the dynamics words rise from pp to ff and mf is the default", "[score][parser]")
 {
     const auto &words = dynamics_words();
     REQUIRE(words.size() == 6);
@@ -139,7 +139,7 @@ TEST_CASE("score: every nuance name the gesture database uses is accepted", "[sc
     }
 }
 
-TEST_CASE("score: tempo, grip, rest, default beats and dynamics", "[score][parser]")
+TEST_CASE("score: tempo and grip and rest and default beats and dynamics", "[score][parser]")
 {
     const Score s = parse_score("tempo 60\n"
                                 "grip german\n"
@@ -169,7 +169,7 @@ TEST_CASE("score: tempo, grip, rest, default beats and dynamics", "[score][parse
     CHECK(s.note_time_s(s.notes[2]) == Approx(4.75).epsilon(1e-12));
 }
 
-TEST_CASE("score: tempo changes, instant and gradual", "[score][parser]")
+TEST_CASE("score: tempo changes instant and gradual", "[score][parser]")
 {
     const Score s = parse_score("tempo 100\nR\ntempo 100 -> 200 over 4\nR\nR\nR\nR\nR\n"
                                 "tempo -> 50 over 2\nR\nR\nR\n",
@@ -189,7 +189,7 @@ TEST_CASE("score: tempo changes, instant and gradual", "[score][parser]")
     CHECK(same_notes(t, u));
 }
 
-TEST_CASE("score: repeat blocks expand, nested", "[score][parser]")
+TEST_CASE("score: repeat blocks expand and nest", "[score][parser]")
 {
     const Score s =
         parse_score("repeat 3\n  R\n  repeat 2\n    L 1/2\n  end\nend\nR accent\n", "rep");
@@ -219,7 +219,7 @@ TEST_CASE("score: separators and comments", "[score][parser]")
     CHECK(a.notes[3].column == 8);
 }
 
-TEST_CASE("score: a Pd message box (statements one by one) equals the file", "[score][parser]")
+TEST_CASE("score: a Pd message box - statements one by one - equals the file", "[score][parser]")
 {
     const std::string file = default_score_text();
     ScoreBuilder builder("osc");
@@ -245,7 +245,8 @@ TEST_CASE("score: a Pd message box (statements one by one) equals the file", "[s
     CHECK(same_notes(builder.finish(), parse_score(file, "default")));
 }
 
-TEST_CASE("score: the default score is Figure 5's: both hands, legato and accents, tempo change",
+TEST_CASE("score: the default score is Figure 5 - both hands with legato and accents under a tempo "
+          "change",
           "[score][parser]")
 {
     const Score s = parse_score(default_score_text(), "default");
@@ -271,7 +272,8 @@ TEST_CASE("score: the default score is Figure 5's: both hands, legato and accent
     CHECK(s.duration_s() <= 16.0);
 }
 
-TEST_CASE("score: errors name the source, line, column and the fault", "[score][parser][errors]")
+TEST_CASE("score: errors name the source and line and column and the fault",
+          "[score][parser][errors]")
 {
     require_error(
         "R legatto", 1, 3,

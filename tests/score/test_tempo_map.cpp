@@ -58,7 +58,7 @@ TEST_CASE("tempo map: a linear ramp against its closed-form integral", "[score][
     CHECK(m.time_at_beat(12.5) == Approx(simpson_time(bpm, 12.5)).epsilon(1e-9));
 }
 
-TEST_CASE("tempo map: slowing down, and a change that cuts a ramp short", "[score][tempo]")
+TEST_CASE("tempo map: slowing down and a change that cuts a ramp short", "[score][tempo]")
 {
     // 200 -> 40 over 16 beats, cut at beat 8 by an instant 90.
     TempoMap m(200.0);

@@ -1,0 +1,518 @@
+// gesture_score.cpp -- a score into stick-tip targets (docs/score.md, "From
+// score to motion"). Per hand, the notes' gesture units are
+//  1. made C1 curves: cubic Hermite through the unit's samples, in two pieces
+//     split at the strike (the impact reverses the velocity there);
+//  2. time-warped around their strike: unit time u = P + sigma(tau), tau the
+//     plan time from the note's beat, sigma(0) = 0 and sigma'(0) = 1, so the
+//     strike lands on the beat with the unit's own impact velocity; the
+//     preparation and the lift are compressed (quadratic sigma) only when the
+//     time to the neighbouring strikes is shorter than they are;
+//  3. placed: rotated from the performer frame into the world and moved onto
+//     the note's spot of the head;
+//  4. co-articulated: consecutive units (and the rest tip, when the hand is
+//     idle) are cross-faded with a quintic smoothstep weight over a window
+//     strictly between two strikes. Both curves are C1 and the weight has zero
+//     slope at the window's ends, so the blend is C1; outside the windows a
+//     single unit rules, so the strikes are untouched.
+// The paper plans Figure 5 this way in spirit ("co-articulation between
+// successive motion units" in the Cartesian space); the warping and blending
+// are the classic motion-editing tools (Witkin & Popovic 1995 motion warping,
+// Kovar & Gleicher 2003 registration curves, cross-fades with ease curves).
+#include "ictus/gesture_score.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <tuple>
+
+namespace ictus
+{
+
+namespace
+{
+
+constexpr double kPi = 3.14159265358979323846;
+// A unit's end state is extended beyond the unit by a motion that stops
+// within this time (constant deceleration): C1 at the unit's ends.
+constexpr double kStopTime_s = 0.05;
+// A stroke's period when nothing sets it: gesture.hpp's nominal 0.5 s (120 bpm).
+constexpr double kNominalPeriod_s = 0.5;
+// Stick direction (performer frame) for units that carry none: forward, 15
+// degrees down.
+const Eigen::Vector3d kDefaultStickDir(0.0, -0.2588190451, 0.9659258263);
+
+// Cubic Hermite tangents of samples p[first..last] (spacing h): central
+// differences inside, second-order one-sided differences at the ends.
+std::vector<Eigen::Vector3d> hermite_tangents(const std::vector<Eigen::Vector3d> &p, int first,
+                                              int last, double h)
+{
+    const int n = last - first + 1;
+    std::vector<Eigen::Vector3d> m(static_cast<size_t>(n));
+    if (n == 2) {
+        m[0] = m[1] = (p[last] - p[first]) / h;
+        return m;
+    }
+    for (int i = 1; i + 1 < n; ++i)
+        m[i] = (p[first + i + 1] - p[first + i - 1]) / (2.0 * h);
+    m[0] = (-3.0 * p[first] + 4.0 * p[first + 1] - p[first + 2]) / (2.0 * h);
+    m[n - 1] = (3.0 * p[last] - 4.0 * p[last - 1] + p[last - 2]) / (2.0 * h);
+    return m;
+}
+
+// A gesture unit as a C1 curve in unit time u in [0, prep_s + lift_s],
+// performer frame, relative to the strike point.
+class UnitCurve
+{
+  public:
+    explicit UnitCurve(const GestureUnit &unit) : p_(unit.tip_m), dir_(unit.stick_dir)
+    {
+        const int n = static_cast<int>(p_.size());
+        const std::string name = "gesture unit '" + unit.source + "' (" + to_string(unit.grip) +
+                                 " " + to_string(unit.nuance) + ")";
+        if (!(unit.rate_hz > 0.0) || !std::isfinite(unit.rate_hz))
+            throw std::invalid_argument(name + ": rate_hz must be > 0");
+        if (n < 3 || unit.strike_index < 1 || unit.strike_index > n - 2)
+            throw std::invalid_argument(name + ": needs samples before and after its strike (" +
+                                        std::to_string(n) + " samples, strike at " +
+                                        std::to_string(unit.strike_index) + ")");
+        if (dir_.empty())
+            dir_.assign(p_.size(), kDefaultStickDir);
+        if (dir_.size() != p_.size())
+            throw std::invalid_argument(name + ": stick_dir and tip_m differ in length");
+        for (int i = 0; i < n; ++i)
+            if (!p_[i].allFinite() || !dir_[i].allFinite() || dir_[i].norm() < 1e-9)
+                throw std::invalid_argument(name + ": sample " + std::to_string(i) +
+                                            " is not finite (or a null stick direction)");
+        h_ = 1.0 / unit.rate_hz;
+        strike_ = unit.strike_index;
+        prep_s = strike_ * h_;
+        lift_s = (n - 1 - strike_) * h_;
+        prep_tangent_ = hermite_tangents(p_, 0, strike_, h_);
+        lift_tangent_ = hermite_tangents(p_, strike_, n - 1, h_);
+    }
+
+    double prep_s = 0.0; // start (top before) to the strike
+    double lift_s = 0.0; // strike to the end (top after)
+
+    void eval(double u, Eigen::Vector3d &pos, Eigen::Vector3d &vel) const
+    {
+        u = std::clamp(u, 0.0, prep_s + lift_s);
+        int i0;                                      // first sample of the segment
+        const std::vector<Eigen::Vector3d> *tangent; // of the piece
+        int piece_first;
+        double x; // segment coordinate in samples from piece_first
+        if (u <= prep_s) {
+            piece_first = 0;
+            tangent = &prep_tangent_;
+            x = u / h_;
+            i0 = std::min(static_cast<int>(x), strike_ - 1);
+        } else {
+            piece_first = strike_;
+            tangent = &lift_tangent_;
+            x = (u - prep_s) / h_;
+            const int last = static_cast<int>(p_.size()) - 1 - strike_;
+            i0 = std::min(static_cast<int>(x), last - 1);
+        }
+        const double s = x - i0;
+        const Eigen::Vector3d &a = p_[piece_first + i0], &b = p_[piece_first + i0 + 1];
+        const Eigen::Vector3d ma = (*tangent)[i0] * h_, mb = (*tangent)[i0 + 1] * h_;
+        const double s2 = s * s, s3 = s2 * s;
+        pos = (2 * s3 - 3 * s2 + 1) * a + (s3 - 2 * s2 + s) * ma + (-2 * s3 + 3 * s2) * b +
+              (s3 - s2) * mb;
+        vel = ((6 * s2 - 6 * s) * a + (3 * s2 - 4 * s + 1) * ma + (-6 * s2 + 6 * s) * b +
+               (3 * s2 - 2 * s) * mb) /
+              h_;
+    }
+
+    Eigen::Vector3d dir(double u) const
+    {
+        const double x = std::clamp(u / h_, 0.0, static_cast<double>(dir_.size() - 1));
+        const size_t i = std::min(static_cast<size_t>(x), dir_.size() - 2);
+        const double w = x - static_cast<double>(i);
+        return ((1.0 - w) * dir_[i] + w * dir_[i + 1]).normalized();
+    }
+
+    // The tip velocity just before the strike (the preparation's end).
+    Eigen::Vector3d impact_velocity() const { return prep_tangent_.back(); }
+
+  private:
+    std::vector<Eigen::Vector3d> p_, dir_;
+    std::vector<Eigen::Vector3d> prep_tangent_, lift_tangent_;
+    double h_ = 0.004;
+    int strike_ = 0;
+};
+
+// One piece of a hand's timeline: a placed, warped unit or the rest tip.
+struct Item {
+    bool rest = true;
+    Eigen::Vector3d rest_pos = Eigen::Vector3d::Zero();
+    Eigen::Vector3d rest_dir = Eigen::Vector3d::UnitZ();
+
+    const UnitCurve *curve = nullptr;
+    Eigen::Matrix3d to_world = Eigen::Matrix3d::Identity(); // performer -> world
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();       // tip target at the strike
+    double strike_t = 0.0;
+    double prep_t = 0.0, lift_t = 0.0; // plan time given to the preparation and the lift
+    double c = 0.0, d = 0.0;           // warp coefficients, sigma = tau + c tau^2 (tau < 0)
+    Eigen::Vector3d start_pos = Eigen::Vector3d::Zero(), start_vel = Eigen::Vector3d::Zero();
+    Eigen::Vector3d end_pos = Eigen::Vector3d::Zero(), end_vel = Eigen::Vector3d::Zero();
+    Eigen::Vector3d start_dir = Eigen::Vector3d::UnitZ(), end_dir = Eigen::Vector3d::UnitZ();
+
+    // The warped unit inside its own time span [strike - prep_t, strike + lift_t].
+    void warped(double tau, Eigen::Vector3d &pos, Eigen::Vector3d &vel) const
+    {
+        const double k = tau <= 0.0 ? c : d;
+        const double sigma = tau + k * tau * tau;
+        const double rate = 1.0 + 2.0 * k * tau; // d sigma / d tau, 1 at the strike
+        Eigen::Vector3d p, v;
+        curve->eval(curve->prep_s + sigma, p, v);
+        pos = origin + to_world * p;
+        vel = to_world * v * rate;
+    }
+
+    void prepare()
+    {
+        // sigma(-prep_t) = -prep_s and sigma(lift_t) = lift_s.
+        c = (prep_t - curve->prep_s) / (prep_t * prep_t);
+        d = (curve->lift_s - lift_t) / (lift_t * lift_t);
+        warped(-prep_t, start_pos, start_vel);
+        warped(lift_t, end_pos, end_vel);
+        start_dir = (to_world * curve->dir(0.0)).normalized();
+        end_dir = (to_world * curve->dir(curve->prep_s + curve->lift_s)).normalized();
+    }
+
+    void eval(double t, Eigen::Vector3d &pos, Eigen::Vector3d &dir) const
+    {
+        if (rest) {
+            pos = rest_pos;
+            dir = rest_dir;
+            return;
+        }
+        const double tau = t - strike_t;
+        // Beyond the unit: its end velocity brought to rest in kStopTime_s.
+        auto stop = [](double s) {
+            return s < kStopTime_s ? s - s * s / (2.0 * kStopTime_s) : 0.5 * kStopTime_s;
+        };
+        if (tau < -prep_t) {
+            pos = start_pos - start_vel * stop(-prep_t - tau);
+            dir = start_dir;
+        } else if (tau > lift_t) {
+            pos = end_pos + end_vel * stop(tau - lift_t);
+            dir = end_dir;
+        } else {
+            Eigen::Vector3d vel;
+            warped(tau, pos, vel);
+            const double k = tau <= 0.0 ? c : d;
+            dir = (to_world * curve->dir(curve->prep_s + tau + k * tau * tau)).normalized();
+        }
+    }
+};
+
+// Cross-fade between items[j] and items[j + 1] over [begin, end].
+struct Window {
+    double begin = 0.0, end = 0.0;
+};
+
+// Quintic smoothstep: 0 -> 1 with zero slope and curvature at both ends.
+double smoothstep5(double x)
+{
+    x = std::clamp(x, 0.0, 1.0);
+    return x * x * x * (10.0 + x * (-15.0 + 6.0 * x));
+}
+
+void check_unit(const Eigen::Vector3d &v, const char *name)
+{
+    if (!v.allFinite() || std::abs(v.norm() - 1.0) > 1e-6)
+        throw std::invalid_argument(std::string("PerformerFrame: ") + name +
+                                    " must be a unit vector");
+}
+
+void validate(const PerformerFrame &f, const PlanOptions &o)
+{
+    check_unit(f.right, "right");
+    check_unit(f.up, "up");
+    check_unit(f.forward, "forward");
+    if (std::abs(f.right.dot(f.up)) > 1e-6 || std::abs(f.up.dot(f.forward)) > 1e-6 ||
+        std::abs(f.forward.dot(f.right)) > 1e-6)
+        throw std::invalid_argument("PerformerFrame: right, up and forward must be orthogonal");
+    if (!(f.membrane_radius_m > 0.0) || !std::isfinite(f.membrane_radius_m))
+        throw std::invalid_argument("PerformerFrame: membrane_radius_m must be > 0");
+    if (!f.membrane_center_m.allFinite() || !f.rest_tip_m[0].allFinite() ||
+        !f.rest_tip_m[1].allFinite())
+        throw std::invalid_argument("PerformerFrame: positions must be finite");
+    auto bad = [](const char *what, double v) {
+        std::ostringstream s;
+        s << "PlanOptions: " << what << ", got " << v;
+        throw std::invalid_argument(s.str());
+    };
+    if (!(o.lead_in_s >= 0.2 && o.lead_in_s <= 60.0))
+        bad("lead_in_s must be 0.2..60 s", o.lead_in_s);
+    if (!(o.tail_s >= 0.0 && o.tail_s <= 60.0))
+        bad("tail_s must be 0..60 s", o.tail_s);
+    if (!(o.rate_hz >= 50.0 && o.rate_hz <= 20000.0))
+        bad("rate_hz must be 50..20000", o.rate_hz);
+    if (!(std::abs(o.strike_depth_m) <= 0.1))
+        bad("strike_depth_m must be within +-0.1 m", o.strike_depth_m);
+    if (!(o.blend_margin > 0.0 && o.blend_margin < 0.5))
+        bad("blend_margin must be in (0, 0.5)", o.blend_margin);
+    if (!(o.idle_return_s > 0.0) || !std::isfinite(o.idle_return_s))
+        bad("idle_return_s must be > 0", o.idle_return_s);
+    if (!(o.return_time_s > 0.0 && o.return_time_s <= 10.0))
+        bad("return_time_s must be in (0, 10] s", o.return_time_s);
+    if (!(o.min_stroke_interval_s > 0.0 && o.min_stroke_interval_s <= 10.0))
+        bad("min_stroke_interval_s must be in (0, 10] s", o.min_stroke_interval_s);
+    if (!(o.max_duration_s > 0.0) || !std::isfinite(o.max_duration_s))
+        bad("max_duration_s must be > 0", o.max_duration_s);
+}
+
+} // namespace
+
+PerformerFrame performer_frame_for_drum(const Eigen::Vector3d &membrane_center_m, double radius_m,
+                                        double rest_height_m)
+{
+    PerformerFrame f;
+    f.membrane_center_m = membrane_center_m;
+    f.membrane_radius_m = radius_m;
+    for (int s = 0; s < 2; ++s) {
+        const double side = s == static_cast<int>(Side::right) ? 1.0 : -1.0;
+        f.rest_tip_m[s] =
+            membrane_center_m + side * 0.1 * f.right + rest_height_m * f.up - 0.05 * f.forward;
+    }
+    return f;
+}
+
+Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg)
+{
+    // docs/osc.md: x_m along world +X, y_m along world -Z.
+    const double r = r_over_a * frame.membrane_radius_m, th = theta_deg * kPi / 180.0;
+    return frame.membrane_center_m + Eigen::Vector3d(r * std::cos(th), 0.0, -r * std::sin(th));
+}
+
+GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
+                             const PerformerFrame &frame, const PlanOptions &opt)
+{
+    validate(frame, opt);
+    Eigen::Matrix3d to_world;
+    to_world.col(0) = frame.right;
+    to_world.col(1) = frame.up;
+    to_world.col(2) = frame.forward;
+
+    GesturePlan plan;
+    plan.score_start_s = opt.lead_in_s;
+
+    // Units are shared by notes with the same grip, nuance, hand, dynamics
+    // and period. The parametric model's units are made at the hand's own
+    // period (strike to next strike, gesture.hpp's stroke_model), so the warp
+    // has little to do; imported units come from instantiate() and are warped.
+    std::map<std::tuple<int, int, int, double, long>, std::unique_ptr<UnitCurve>> units;
+    auto unit_for = [&](Grip g, Nuance n, Side s, double dynamics,
+                        double period_s) -> const UnitCurve & {
+        const long period_us = std::lround(period_s * 1e6);
+        const auto key = std::make_tuple(static_cast<int>(g), static_cast<int>(n),
+                                         static_cast<int>(s), dynamics, period_us);
+        auto it = units.find(key);
+        if (it == units.end()) {
+            const GestureUnit *stored = db.find(g, n, s);
+            const GestureUnit unit = !stored || stored->source == "model"
+                                         ? stroke_model(g, n, s, dynamics, period_us * 1e-6)
+                                         : db.instantiate(g, n, s, dynamics);
+            it = units.emplace(key, std::make_unique<UnitCurve>(unit)).first;
+        }
+        return *it->second;
+    };
+
+    // The notes, timed by the tempo map.
+    std::array<std::vector<size_t>, 2> by_hand;
+    for (const ScoreNote &n : score.notes) {
+        PlannedNote p;
+        p.time_s = opt.lead_in_s + score.note_time_s(n);
+        p.hand = n.hand;
+        p.nuance = n.nuance;
+        p.grip = n.grip;
+        p.dynamics = n.dynamics;
+        p.beats = n.beats;
+        p.tempo_bpm = score.tempo.tempo_at_beat(n.beat);
+        p.r_over_a = n.r_over_a;
+        p.theta_deg = n.theta_deg;
+        p.strike_point_m = membrane_point(frame, n.r_over_a, n.theta_deg);
+        p.tip_target_m = p.strike_point_m - opt.strike_depth_m * frame.up;
+        p.line = n.line;
+        p.column = n.column;
+        const std::vector<size_t> &same = by_hand[static_cast<int>(n.hand)];
+        if (!same.empty()) {
+            const PlannedNote &prev = plan.notes[same.back()];
+            if (p.time_s - prev.time_s < opt.min_stroke_interval_s) {
+                std::ostringstream m;
+                m << "this " << (n.hand == Side::right ? "right" : "left") << "-hand stroke comes "
+                  << (p.time_s - prev.time_s) * 1000.0 << " ms after the previous one (line "
+                  << prev.line << "), faster than one hand plays (minimum "
+                  << opt.min_stroke_interval_s * 1000.0
+                  << " ms): give it to the other hand or slow down";
+                throw ScoreError(score.source, n.line, n.column, m.str());
+            }
+        }
+        by_hand[static_cast<int>(n.hand)].push_back(plan.notes.size());
+        plan.notes.push_back(p);
+    }
+
+    const double beta = opt.blend_margin, tr = opt.return_time_s;
+    std::array<std::vector<Item>, 2> items;
+    std::array<std::vector<Window>, 2> windows;
+    double last_motion_end = 0.0;
+    for (int s = 0; s < 2; ++s) {
+        const std::vector<size_t> &idx = by_hand[s];
+        Item rest;
+        rest.rest_pos = frame.rest_tip_m[s];
+        if (idx.empty()) {
+            // A hand with nothing to play holds its stick as at the top of a legato stroke.
+            const Grip g = score.notes.empty() ? Grip::french : score.notes.front().grip;
+            const UnitCurve &u = unit_for(g, Nuance::legato, static_cast<Side>(s), kDefaultDynamics,
+                                          kNominalPeriod_s);
+            rest.rest_dir = (to_world * u.dir(0.0)).normalized();
+            items[s].push_back(rest);
+            continue;
+        }
+        const size_t n = idx.size();
+        std::vector<Item> placed(n);
+        std::vector<bool> via_rest(n, false); // note k -> k+1 through the rest tip
+        for (size_t k = 0; k < n; ++k) {
+            const PlannedNote &p = plan.notes[idx[k]];
+            Item &it = placed[k];
+            it.rest = false;
+            it.to_world = to_world;
+            it.origin = p.tip_target_m;
+            it.strike_t = p.time_s;
+        }
+        // A long gap goes through the rest tip: when it is longer than
+        // idle_return_s and leaves room for a nominal lift, two moves and a
+        // nominal preparation.
+        for (size_t k = 0; k + 1 < n; ++k) {
+            const double gap = placed[k + 1].strike_t - placed[k].strike_t;
+            via_rest[k] = gap > opt.idle_return_s && gap > 2.0 * kNominalPeriod_s + 2.0 * tr + 0.2;
+        }
+        for (size_t k = 0; k < n; ++k) {
+            // The unit's period: to the hand's next strike, else from its
+            // previous one, else nominal (a lone stroke).
+            double period = kNominalPeriod_s;
+            if (k + 1 < n && !via_rest[k])
+                period = placed[k + 1].strike_t - placed[k].strike_t;
+            else if (k > 0 && !via_rest[k - 1])
+                period = placed[k].strike_t - placed[k - 1].strike_t;
+            const PlannedNote &p = plan.notes[idx[k]];
+            placed[k].curve = &unit_for(p.grip, p.nuance, p.hand, p.dynamics, period);
+        }
+        for (size_t k = 0; k < n; ++k) {
+            Item &it = placed[k];
+            // Time before the strike: back to the previous strike (direct
+            // link) or to the plan's start (first note); unlimited after a rest.
+            double before = std::numeric_limits<double>::infinity();
+            if (k == 0)
+                before = it.strike_t;
+            else if (!via_rest[k - 1])
+                before = it.strike_t - placed[k - 1].strike_t;
+            double after = std::numeric_limits<double>::infinity();
+            if (k + 1 < n && !via_rest[k])
+                after = placed[k + 1].strike_t - it.strike_t;
+            it.prep_t = std::min(it.curve->prep_s, (1.0 - beta) * before);
+            it.lift_t = std::min(it.curve->lift_s, (1.0 - beta) * after);
+            it.prepare();
+            plan.notes[idx[k]].impact_velocity_mps = to_world * it.curve->impact_velocity();
+        }
+        // The timeline: rest, unit, [rest,] unit, ..., rest.
+        rest.rest_dir = placed.front().start_dir;
+        items[s].push_back(rest);
+        const double first_start = placed[0].strike_t - placed[0].prep_t;
+        windows[s].push_back({std::max(0.0, first_start - tr), first_start});
+        for (size_t k = 0; k < n; ++k) {
+            items[s].push_back(placed[k]);
+            const Item &it = placed[k];
+            if (k + 1 == n || via_rest[k]) {
+                Item back;
+                back.rest_pos = frame.rest_tip_m[s];
+                back.rest_dir = it.end_dir;
+                const double lift_end = it.strike_t + it.lift_t;
+                windows[s].push_back({lift_end, lift_end + tr});
+                last_motion_end = std::max(last_motion_end, lift_end + tr);
+                if (k + 1 < n) {
+                    items[s].push_back(back);
+                    const double next_start = placed[k + 1].strike_t - placed[k + 1].prep_t;
+                    windows[s].push_back({next_start - tr, next_start});
+                } else {
+                    items[s].push_back(back);
+                }
+            } else {
+                const double gap = placed[k + 1].strike_t - it.strike_t;
+                windows[s].push_back(
+                    {it.strike_t + beta * gap, placed[k + 1].strike_t - beta * gap});
+            }
+        }
+    }
+
+    plan.duration_s =
+        std::max(opt.lead_in_s + score.duration_s() + opt.tail_s, last_motion_end + 0.1);
+    if (plan.duration_s > opt.max_duration_s) {
+        const int line = score.notes.empty() ? 0 : score.notes.back().line;
+        const int column = score.notes.empty() ? 0 : score.notes.back().column;
+        std::ostringstream m;
+        m << "the performance lasts " << plan.duration_s << " s, longer than the planner's limit ("
+          << opt.max_duration_s << " s)";
+        throw ScoreError(score.source, line, column, m.str());
+    }
+
+    // Sample times: the grid plus each strike exactly.
+    std::vector<double> strikes;
+    for (const PlannedNote &p : plan.notes)
+        strikes.push_back(p.time_s);
+    std::sort(strikes.begin(), strikes.end());
+    const long grid = static_cast<long>(std::ceil(plan.duration_s * opt.rate_hz));
+    std::vector<double> &times = plan.tips.time_s;
+    times.reserve(static_cast<size_t>(grid) + 1 + strikes.size());
+    size_t next_strike = 0;
+    for (long i = 0; i <= grid; ++i) {
+        const double t = static_cast<double>(i) / opt.rate_hz;
+        while (next_strike < strikes.size() && strikes[next_strike] <= t + 1e-6) {
+            if (times.empty() || strikes[next_strike] > times.back() + 1e-9)
+                times.push_back(strikes[next_strike]);
+            ++next_strike;
+        }
+        if (times.empty() || t > times.back() + 1e-6)
+            times.push_back(t);
+    }
+
+    for (int s = 0; s < 2; ++s) {
+        auto &tip = plan.tips.tip_m[s];
+        auto &dir = plan.stick_dir[s];
+        tip.resize(times.size());
+        dir.resize(times.size());
+        const std::vector<Item> &its = items[s];
+        const std::vector<Window> &win = windows[s];
+        size_t j = 0;
+        for (size_t i = 0; i < times.size(); ++i) {
+            const double t = times[i];
+            while (j < win.size() && t > win[j].end)
+                ++j;
+            Eigen::Vector3d p0, d0;
+            its[j].eval(t, p0, d0);
+            if (j < win.size() && t >= win[j].begin && win[j].end > win[j].begin) {
+                Eigen::Vector3d p1, d1;
+                its[j + 1].eval(t, p1, d1);
+                const double w = smoothstep5((t - win[j].begin) / (win[j].end - win[j].begin));
+                p0 = (1.0 - w) * p0 + w * p1;
+                const Eigen::Vector3d blended = (1.0 - w) * d0 + w * d1;
+                d0 = blended.norm() > 1e-9 ? blended.normalized() : (w < 0.5 ? d0 : d1);
+            }
+            tip[i] = p0;
+            dir[i] = d0;
+        }
+    }
+    std::stable_sort(
+        plan.notes.begin(), plan.notes.end(),
+        [](const PlannedNote &a, const PlannedNote &b) { return a.time_s < b.time_s; });
+    return plan;
+}
+
+} // namespace ictus

@@ -1,0 +1,404 @@
+// From score to motion: strikes exactly on the beats at the notes' spots,
+// the tip lowest at each beat and once per note, continuity of position and
+// velocity across unit joins (checked by halving the sample step: a smooth
+// curve's sample-to-sample changes halve, a jump's do not), louder -> faster
+// at impact, idle hands back at rest, refused scores.
+#include "ictus/gesture_score.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+using namespace ictus;
+
+namespace
+{
+
+const Eigen::Vector3d kCenter(0.0, 0.7, 0.45);
+constexpr double kRadius = 0.178;
+
+PerformerFrame frame()
+{
+    return performer_frame_for_drum(kCenter, kRadius);
+}
+
+const GestureDatabase &db()
+{
+    static const GestureDatabase d = GestureDatabase::builtin();
+    return d;
+}
+
+// The sample index at exactly time t (strikes are sampled exactly).
+size_t index_at(const GesturePlan &plan, double t)
+{
+    const auto &ts = plan.tips.time_s;
+    const auto it = std::lower_bound(ts.begin(), ts.end(), t - 1e-9);
+    REQUIRE(it != ts.end());
+    REQUIRE(std::abs(*it - t) < 1e-9);
+    return static_cast<size_t>(it - ts.begin());
+}
+
+double height(const Eigen::Vector3d &p)
+{
+    return p.y();
+}
+
+// Largest sample-to-sample change of position and of velocity of one hand,
+// away from its strikes (the impact reverses the velocity: not a join).
+struct Steps {
+    double position_m = 0.0;
+    double velocity_mps = 0.0;
+};
+Steps max_steps(const GesturePlan &plan, int side, double exclude_s = 0.004)
+{
+    const auto &ts = plan.tips.time_s;
+    const auto &p = plan.tips.tip_m[side];
+    std::vector<double> strikes;
+    for (const auto &n : plan.notes)
+        if (static_cast<int>(n.hand) == side)
+            strikes.push_back(n.time_s);
+    auto near_strike = [&](double t) {
+        for (double s : strikes)
+            if (std::abs(t - s) < exclude_s)
+                return true;
+        return false;
+    };
+    Steps m;
+    for (size_t i = 0; i + 2 < ts.size(); ++i) {
+        if (near_strike(ts[i]) || near_strike(ts[i + 1]) || near_strike(ts[i + 2]))
+            continue;
+        const double h0 = ts[i + 1] - ts[i], h1 = ts[i + 2] - ts[i + 1];
+        // Only the regular grid (strike samples are skipped above).
+        const Eigen::Vector3d v0 = (p[i + 1] - p[i]) / h0, v1 = (p[i + 2] - p[i + 1]) / h1;
+        m.position_m = std::max(m.position_m, (p[i + 1] - p[i]).norm());
+        m.velocity_mps = std::max(m.velocity_mps, (v1 - v0).norm());
+    }
+    return m;
+}
+
+Score score_of(const std::string &text)
+{
+    return parse_score(text, "test");
+}
+
+} // namespace
+
+TEST_CASE("plan: every note's tip is at its spot on its beat", "[score][plan]")
+{
+    const Score score = parse_score(default_score_text(), "default");
+    PlanOptions opt;
+    const GesturePlan plan = plan_performance(score, db(), frame(), opt);
+    REQUIRE(plan.notes.size() == score.notes.size());
+    CHECK(plan.score_start_s == opt.lead_in_s);
+    CHECK(plan.duration_s >= opt.lead_in_s + score.duration_s() + opt.tail_s - 1e-9);
+    CHECK(plan.tips.time_s.size() == plan.tips.tip_m[0].size());
+    CHECK(plan.tips.time_s.size() == plan.stick_dir[1].size());
+    for (size_t k = 0; k < plan.notes.size(); ++k) {
+        const PlannedNote &n = plan.notes[k];
+        const ScoreNote &s = score.notes[k];
+        // The beat time from the tempo map, and the spot from the membrane
+        // frame of docs/osc.md (x_m = world +X, y_m = world -Z).
+        CHECK(n.time_s == Approx(opt.lead_in_s + score.tempo.time_at_beat(s.beat)).margin(1e-12));
+        const double th = s.theta_deg * M_PI / 180.0;
+        const Eigen::Vector3d spot =
+            kCenter + s.r_over_a * kRadius * Eigen::Vector3d(std::cos(th), 0.0, -std::sin(th));
+        CHECK((n.strike_point_m - spot).norm() < 1e-12);
+        const size_t i = index_at(plan, n.time_s);
+        const Eigen::Vector3d tip = plan.tips.tip_m[static_cast<int>(n.hand)][i];
+        INFO("note " << k << " line " << n.line << " t " << n.time_s);
+        CHECK((tip - spot).norm() < 1e-4);
+        // The sampled trajectory (linear between samples) gives the same.
+        CHECK((plan.tips.sample(static_cast<int>(n.hand), n.time_s) - spot).norm() < 1e-4);
+        CHECK(n.impact_velocity_mps.y() < -0.3); // moving down into the head
+    }
+}
+
+TEST_CASE("plan: the strike depth moves the target below the head", "[score][plan]")
+{
+    PlanOptions opt;
+    opt.strike_depth_m = 0.004;
+    const GesturePlan plan =
+        plan_performance(score_of("tempo 100\nR\nL\nR accent\n"), db(), frame(), opt);
+    for (const PlannedNote &n : plan.notes) {
+        const Eigen::Vector3d tip =
+            plan.tips.tip_m[static_cast<int>(n.hand)][index_at(plan, n.time_s)];
+        CHECK(tip.y() == Approx(kCenter.y() - 0.004).margin(1e-9));
+        CHECK(std::abs(tip.x() - n.strike_point_m.x()) < 1e-9);
+        CHECK((n.tip_target_m - (n.strike_point_m - Eigen::Vector3d(0, 0.004, 0))).norm() < 1e-12);
+    }
+}
+
+TEST_CASE("plan: notes placed on the head where the score says", "[score][plan]")
+{
+    const GesturePlan plan =
+        plan_performance(score_of("R at 0.5 90\nL at 0.8 -45\nR at 0 0\n"), db(), frame());
+    // theta 90 = y_m = world -Z (toward the performer).
+    CHECK(
+        (plan.notes[0].strike_point_m - (kCenter + Eigen::Vector3d(0, 0, -0.5 * kRadius))).norm() <
+        1e-12);
+    const double c = 0.8 * kRadius / std::sqrt(2.0);
+    CHECK((plan.notes[1].strike_point_m - (kCenter + Eigen::Vector3d(c, 0, c))).norm() < 1e-12);
+    CHECK((plan.notes[2].strike_point_m - kCenter).norm() < 1e-12);
+}
+
+TEST_CASE("plan: the tip is lowest at each beat and comes down once per note", "[score][plan]")
+{
+    for (const char *text :
+         {"tempo 96\nrepeat 3\nR legato, L accent f, R tenuto p, L staccato, R vertical_accent "
+          "ff\nend",
+          "tempo 200\nrepeat 6\nR, L 1/2, L 1/2\nend", "tempo 40\nR accent, L legato pp, R, L"}) {
+        INFO(text);
+        const Score score = score_of(text);
+        const GesturePlan plan = plan_performance(score, db(), frame());
+        const double head = kCenter.y();
+        for (int side = 0; side < 2; ++side) {
+            const auto &p = plan.tips.tip_m[side];
+            const auto &ts = plan.tips.time_s;
+            std::vector<double> strikes;
+            for (const auto &n : plan.notes)
+                if (static_cast<int>(n.hand) == side)
+                    strikes.push_back(n.time_s);
+            // Never below the head; the times within 2 mm of it form exactly
+            // one stretch per note, around its beat.
+            int stretches = 0;
+            bool low = false;
+            double stretch_start = 0.0;
+            for (size_t i = 0; i < ts.size(); ++i) {
+                CHECK(height(p[i]) >= head - 1e-9);
+                const bool now_low = height(p[i]) < head + 0.002;
+                if (now_low && !low) {
+                    ++stretches;
+                    stretch_start = ts[i];
+                }
+                if (!now_low && low) {
+                    // The stretch holds a strike.
+                    bool has = false;
+                    for (double s : strikes)
+                        has |= s >= stretch_start - 1e-9 && s <= ts[i];
+                    CHECK(has);
+                }
+                low = now_low;
+            }
+            CHECK(stretches == static_cast<int>(strikes.size()));
+            // The lowest point within +-40 ms of each beat is the beat's sample.
+            for (double s : strikes) {
+                const size_t k = index_at(plan, s);
+                double lowest = 1e9;
+                double when = 0.0;
+                for (size_t i = 0; i < ts.size(); ++i)
+                    if (std::abs(ts[i] - s) <= 0.04 && height(p[i]) < lowest) {
+                        lowest = height(p[i]);
+                        when = ts[i];
+                    }
+                CHECK(when == s);
+                CHECK(lowest == Approx(height(p[k])).margin(1e-12));
+            }
+        }
+    }
+}
+
+TEST_CASE("plan: position and velocity continuous across unit joins - C0 and C1", "[score][plan]")
+{
+    // Halving the sample step halves the largest sample-to-sample change of
+    // position (C0: no jump) and of velocity (C1: bounded acceleration) of a
+    // smooth curve; a jump of size J would keep a change >= J at both steps.
+    // Joins between units, to and from rest, different spots, grips and
+    // dynamics, a tempo ramp.
+    const Score score = score_of(
+        "tempo 60\nR legato pp, L accent ff at 0.6 30, R staccato at 0.2 200, L tenuto\n"
+        "tempo 60 -> 180 over 8\nrepeat 2\n R vertical_accent f, L legato p, R accent, L staccato "
+        "ff\nend\n"
+        "grip german\nR accent, L, R tenuto, L vertical_accent\nrest 12\nR legato, L accent\n");
+    PlanOptions coarse, fine;
+    coarse.rate_hz = 1000.0;
+    fine.rate_hz = 2000.0;
+    const GesturePlan a = plan_performance(score, db(), frame(), coarse);
+    const GesturePlan b = plan_performance(score, db(), frame(), fine);
+    for (int side = 0; side < 2; ++side) {
+        const Steps sa = max_steps(a, side), sb = max_steps(b, side);
+        INFO("side " << side << ": position step " << sa.position_m << " -> " << sb.position_m
+                     << " m, velocity step " << sa.velocity_mps << " -> " << sb.velocity_mps);
+        CHECK(sa.position_m > 0.0);
+        CHECK(sb.position_m < 0.6 * sa.position_m);
+        CHECK(sb.velocity_mps < 0.6 * sa.velocity_mps);
+        // And in absolute terms: no more than the curve's top speed times the step.
+        double top_speed = 0.0;
+        const auto &p = b.tips.tip_m[side];
+        for (size_t i = 0; i + 1 < p.size(); ++i)
+            top_speed = std::max(top_speed, (p[i + 1] - p[i]).norm() /
+                                                (b.tips.time_s[i + 1] - b.tips.time_s[i]));
+        CHECK(sb.position_m <= top_speed / 2000.0 * 1.000001);
+    }
+}
+
+TEST_CASE("plan: stick directions are unit vectors and continuous", "[score][plan]")
+{
+    const GesturePlan plan = plan_performance(
+        score_of("tempo 120\nR, L, R accent, L accent, grip german, R, L, rest 16, R"), db(),
+        frame());
+    for (int side = 0; side < 2; ++side) {
+        const auto &d = plan.stick_dir[side];
+        double max_step = 0.0;
+        for (size_t i = 0; i < d.size(); ++i) {
+            CHECK(std::abs(d[i].norm() - 1.0) < 1e-9);
+            if (i > 0)
+                max_step = std::max(max_step, (d[i] - d[i - 1]).norm());
+        }
+        CHECK(max_step < 0.05); // < 3 degrees per ms
+    }
+}
+
+TEST_CASE("plan: louder dynamics give a faster downward tip at the beat", "[score][plan]")
+{
+    for (Grip grip : {Grip::french, Grip::german}) {
+        for (Nuance nuance : {Nuance::legato, Nuance::tenuto, Nuance::accent,
+                              Nuance::vertical_accent, Nuance::staccato}) {
+            std::string text = std::string("tempo 96\ngrip ") + to_string(grip) + "\n";
+            for (double d : {0.1, 0.3, 0.5, 0.7, 0.9, 1.0})
+                text += std::string("R ") + to_string(nuance) + " " + std::to_string(d) + ", L " +
+                        to_string(nuance) + " " + std::to_string(d) + "\n";
+            const GesturePlan plan = plan_performance(score_of(text), db(), frame());
+            std::array<double, 2> previous = {0.0, 0.0};
+            for (const PlannedNote &n : plan.notes) {
+                const int side = static_cast<int>(n.hand);
+                // Downward speed over the last millisecond before the beat.
+                const size_t i = index_at(plan, n.time_s);
+                const auto &p = plan.tips.tip_m[side];
+                const auto &ts = plan.tips.time_s;
+                const double down = (p[i - 1].y() - p[i].y()) / (ts[i] - ts[i - 1]);
+                INFO(to_string(grip) << " " << to_string(nuance) << " d " << n.dynamics);
+                CHECK(down > previous[side]);
+                previous[side] = down;
+                // The unit's own impact speed, kept by the warp (sigma'(0) = 1).
+                CHECK(-n.impact_velocity_mps.y() == Approx(down).epsilon(0.05));
+            }
+        }
+    }
+}
+
+TEST_CASE("plan: the warp keeps an imported unit's impact speed and lands it on the beat",
+          "[score][plan]")
+{
+    // An imported unit (not the model's): instantiate() + the time warp.
+    GestureDatabase d = GestureDatabase::builtin();
+    GestureUnit u = stroke_model(Grip::french, Nuance::legato, Side::right, 0.6, 0.5);
+    u.source = "capture.csv";
+    d.add(u);
+    const GestureUnit unit = d.instantiate(Grip::french, Nuance::legato, Side::right, 0.6);
+    const double impact = unit.impact_speed_mps();
+    REQUIRE(impact > 0.5);
+    for (double bpm : {40.0, 120.0, 300.0}) {
+        // One hand every beat: the preparation and lift are squeezed at 300 bpm (0.2 s).
+        const Score score = score_of("tempo " + std::to_string(bpm) + "\nR, R, R, R, R, R\n");
+        const GesturePlan plan = plan_performance(score, d, frame());
+        for (const PlannedNote &n : plan.notes) {
+            INFO(bpm << " bpm, note at " << n.time_s);
+            CHECK(-n.impact_velocity_mps.y() == Approx(impact).epsilon(1e-6));
+            const size_t i = index_at(plan, n.time_s);
+            const auto &p = plan.tips.tip_m[1];
+            const double down =
+                (p[i - 1].y() - p[i].y()) / (plan.tips.time_s[i] - plan.tips.time_s[i - 1]);
+            CHECK(down == Approx(impact).epsilon(0.05));
+        }
+        if (bpm == 40.0) {
+            // Unhurried: the preparation is the unit's own, placed (identity warp).
+            const PlannedNote &n = plan.notes[2];
+            const Eigen::Vector3d right(-1, 0, 0), up(0, 1, 0), fwd(0, 0, 1);
+            const size_t k = index_at(plan, n.time_s);
+            for (int back_ms : {200, 100, 50, 10}) {
+                const size_t j = k - static_cast<size_t>(back_ms);
+                const double tau = plan.tips.time_s[j] - n.time_s;
+                const Eigen::Vector3d q = unit.sample(unit.strike_time_s() + tau);
+                const Eigen::Vector3d exact =
+                    n.tip_target_m + q.x() * right + q.y() * up + q.z() * fwd;
+                INFO("tau " << tau);
+                CHECK((plan.tips.tip_m[1][j] - exact).norm() < 2e-4);
+            }
+        }
+    }
+}
+
+TEST_CASE("plan: tempi 40 to 200 bpm with both grips and all nuances", "[score][plan]")
+{
+    for (int bpm : {40, 96, 200}) {
+        for (const char *grip : {"french", "german"}) {
+            const std::string text =
+                "tempo " + std::to_string(bpm) + "\ngrip " + grip +
+                "\nR legato, L tenuto, R accent, L vertical_accent, R staccato\n"
+                "L legato, R tenuto, L accent, R vertical_accent, L staccato\n";
+            const Score score = score_of(text);
+            const GesturePlan plan = plan_performance(score, db(), frame());
+            REQUIRE(plan.notes.size() == 10);
+            for (const PlannedNote &n : plan.notes) {
+                const Eigen::Vector3d tip =
+                    plan.tips.tip_m[static_cast<int>(n.hand)][index_at(plan, n.time_s)];
+                CHECK((tip - n.tip_target_m).norm() < 1e-4);
+                CHECK(n.tempo_bpm == bpm);
+            }
+            for (int side = 0; side < 2; ++side)
+                for (const auto &p : plan.tips.tip_m[side])
+                    REQUIRE(p.allFinite());
+        }
+    }
+}
+
+TEST_CASE("plan: an idle hand waits at its rest tip", "[score][plan]")
+{
+    const PerformerFrame f = frame();
+    // Right hand: a stroke, 9 s of rest (120 bpm), a stroke. Left: nothing.
+    const GesturePlan plan = plan_performance(score_of("R\nrest 18\nR\n"), db(), f);
+    REQUIRE(plan.notes.size() == 2);
+    const double middle = 0.5 * (plan.notes[0].time_s + plan.notes[1].time_s);
+    CHECK((plan.tips.sample(1, middle) - f.rest_tip_m[1]).norm() < 1e-9);
+    CHECK((plan.tips.tip_m[1].front() - f.rest_tip_m[1]).norm() < 1e-9);
+    CHECK((plan.tips.tip_m[1].back() - f.rest_tip_m[1]).norm() < 1e-9);
+    for (const auto &p : plan.tips.tip_m[0])
+        CHECK((p - f.rest_tip_m[0]).norm() < 1e-12);
+    // Rest tips of performer_frame_for_drum: 0.15 m above, 0.1 m to the side, 0.05 m nearer.
+    CHECK((f.rest_tip_m[1] - (kCenter + Eigen::Vector3d(-0.1, 0.15, -0.05))).norm() < 1e-12);
+    CHECK((f.rest_tip_m[0] - (kCenter + Eigen::Vector3d(0.1, 0.15, -0.05))).norm() < 1e-12);
+}
+
+TEST_CASE("plan: refuses what a hand cannot play and bad options or frames",
+          "[score][plan][errors]")
+{
+    // Two right-hand sixteenths at 400 bpm: 37.5 ms apart.
+    try {
+        plan_performance(score_of("tempo 400\nR 1/4\nR 1/4\n"), db(), frame());
+        FAIL("no error");
+    } catch (const ScoreError &e) {
+        INFO(e.what());
+        CHECK(e.line() == 3);
+        CHECK(e.column() == 1);
+        CHECK_THAT(e.message(), Catch::Matchers::Contains("faster than one hand plays"));
+    }
+    // Alternating hands, each hand's strokes are a beat (150 ms) apart: fine.
+    CHECK_NOTHROW(plan_performance(score_of("tempo 400\nR 1/2\nL 1/2\nR 1/2\n"), db(), frame()));
+    // Far too long.
+    try {
+        plan_performance(score_of("tempo 20\nrepeat 10\nrest 64\nend\nR\n"), db(), frame());
+        FAIL("no error");
+    } catch (const ScoreError &e) {
+        CHECK(e.line() == 5);
+        CHECK_THAT(e.message(), Catch::Matchers::Contains("longer than the planner's limit"));
+    }
+    PlanOptions bad;
+    bad.rate_hz = 0.0;
+    CHECK_THROWS_AS(plan_performance(score_of("R"), db(), frame(), bad), std::invalid_argument);
+    bad = PlanOptions();
+    bad.blend_margin = 0.5;
+    CHECK_THROWS_AS(plan_performance(score_of("R"), db(), frame(), bad), std::invalid_argument);
+    bad = PlanOptions();
+    bad.lead_in_s = std::nan("");
+    CHECK_THROWS_AS(plan_performance(score_of("R"), db(), frame(), bad), std::invalid_argument);
+    PerformerFrame f = frame();
+    f.up = Eigen::Vector3d(0, 2, 0);
+    CHECK_THROWS_AS(plan_performance(score_of("R"), db(), f, {}), std::invalid_argument);
+    f = frame();
+    f.forward = Eigen::Vector3d(0, 1, 0);
+    CHECK_THROWS_AS(plan_performance(score_of("R"), db(), f, {}), std::invalid_argument);
+    f = frame();
+    f.membrane_radius_m = -1;
+    CHECK_THROWS_AS(plan_performance(score_of("R"), db(), f, {}), std::invalid_argument);
+}
