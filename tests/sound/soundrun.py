@@ -17,15 +17,20 @@ MODELS = ("clips", "synth", "modal")
 
 
 def write_events(path, strokes, head=()):
-    """strokes: (time_ms, hand, velocity, r_over_a, theta_deg); head: lines sent
-    at time 0 (e.g. 'render-drum t60 0.02'). Times are written as differences in
-    whole microseconds, as `ictusd render` does, so they add up exactly."""
+    """strokes: (time_ms, hand, velocity, r_over_a, theta_deg), or (time_ms,
+    "text") for a control line at that time (e.g. "render-drum model synth");
+    head: lines at time 0 (e.g. 'render-drum t60 0.02'). Times are written as
+    differences in whole microseconds, as `ictusd render` does, so they add up
+    exactly."""
     lines = ["0 %s;" % h for h in head]
     prev_us = 0
-    for t_ms, hand, v, r, theta in strokes:
-        if isinstance(t_ms, str):  # a control line at that time: (time, text)
+    for item in strokes:
+        us = int(round(item[0] * 1000))
+        if isinstance(item[1], str):
+            lines.append("%.3f %s;" % ((us - prev_us) / 1000.0, item[1]))
+            prev_us = us
             continue
-        us = int(round(t_ms * 1000))
+        t_ms, hand, v, r, theta = item
         lines.append("%.3f hit %d 0 0 %g %g %g %.1f 0.01 1.2 0.1 %.6f;"
                      % ((us - prev_us) / 1000.0, hand, v, r, theta, 50.0 * v, us / 1e6))
         prev_us = us

@@ -1,0 +1,84 @@
+"""Bad input to the sound abstractions is refused or clamped with an error line
+naming the object and the parameter, and never makes NaN or a crash:
+velocity <= 0 (stroke ignored by clips and synth; contact~ refuses it in modal),
+volume out of 0..1 and fade out of 0..1000 (clamped), an unknown model,
+head parameters out of membrane~'s ranges (clamped by the synth, reported by
+membrane~). A clips abstraction without its clip file says which file is missing."""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from soundrun import (PD, PD_ENV, RENDER, check, make_workdir, read_wav_float,  # noqa: E402
+                      write_events)
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", required=True)
+args = ap.parse_args()
+build = os.path.abspath(args.build)
+work = make_workdir("ictus-sound-bad-")
+
+
+def run(model, items, head, seconds=0.6):
+    ev = os.path.join(work, "ev-%s.txt" % model)
+    wav = os.path.join(work, "out-%s.wav" % model)
+    write_events(ev, items, head=head)
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", "48000", "-path",
+           os.path.join(build, "ictus"), "-open", RENDER, "-send", "render-model %s" % model,
+           "-send", "render-file %s" % ev, "-send", "render-out %s" % wav,
+           "-send", "render-seconds %g" % seconds]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
+    x, _ = read_wav_float(wav)
+    return proc.returncode, proc.stdout + proc.stderr, x
+
+
+for model in ("clips", "synth", "modal"):
+    head = ["render-drum volume 3", "render-drum fade -5", "render-drum model guitar",
+            "render-drum model 7", "render-drum radius -1", "render-drum tension 1e9",
+            "render-drum t60 0"]
+    # the head is put back in range before the strokes that must sound
+    items = [(50.0, 0, 0.0, 0.3, 0.0), (100.0, 1, -2.0, 0.3, 0.0), (150.0, "render-drum radius 0.178"),
+             (150.0, "render-drum tension 3000"), (150.0, "render-drum t60 0.3"), (200.0, 0, 2.0, 1.7, 30.0),
+             (300.0, 1, 60.0, 0.3, 30.0)]
+    rc, log, x = run(model, items, head)
+    print(log)
+    check(rc == 0 and np.all(np.isfinite(x)), "%s: pd ran and the output is finite" % model)
+    check("error: ictus-sound: volume must be in 0..1 (clamped) - got: 3" in log
+          and "error: ictus-sound: fade must be in 0..1000 ms (clamped) - got: -5" in log
+          and "error: ictus-sound: model must be one of clips synth modal 0 1 2 - got: guitar" in log
+          and "error: ictus-sound: model must be one of clips synth modal 0 1 2 - got: 7" in log,
+          "%s: volume, fade and model errors name ictus-sound and the value" % model)
+    check("membrane~: radius" in log and "membrane~: tension" in log,
+          "%s: head parameters out of range are reported by membrane~" % model)
+    check("error: ictus-sound-synth: radius (m) must be in 0.01..2 (clamped) - got: -1" in log
+          and "error: ictus-sound-synth: t60 (s) must be in 0.005..60 (clamped) - got: 0" in log,
+          "%s: ... and clamped by the synth, naming the parameter" % model)
+    y = np.abs(x).max(axis=1)
+    if model != "modal":
+        check(("error: ictus-sound-%s: velocity must be > 0 m/s (stroke ignored) - got: 0" % model) in log
+              and ("error: ictus-sound-%s: velocity must be > 0 m/s (stroke ignored) - got: -2" % model) in log,
+              "%s: zero and negative velocities are refused, naming the object" % model)
+        check(y[:int(0.2 * 48000)].max() == 0, "%s: refused strokes make no sound" % model)
+    else:
+        check("contact~" in log, "modal: contact~ refuses the bad velocities")
+    check(y[int(0.2 * 48000):].max() > 0.01 and y.max() < 10.0,
+          "%s: r/a 1.7 and 60 m/s (clamped to 50) play, finite (peak %.3f < 10)" % (model, y.max()))
+
+# A clips abstraction whose clip file is missing names the file.
+lib = os.path.join(work, "lib")
+os.makedirs(lib)
+for f in ("ictus-sound-clips.pd", "ictus-sound-clips-voice.pd"):
+    shutil.copy(os.path.join(build, "ictus", f), lib)
+with open(os.path.join(lib, "t.pd"), "w") as f:
+    f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound-clips;\n")
+proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-open",
+                       os.path.join(lib, "t.pd"), "-send", "pd quit"],
+                      capture_output=True, text=True, timeout=60, env=PD_ENV)
+log = proc.stdout + proc.stderr
+print(log)
+check(proc.returncode == 0 and "error: ictus-sound-clips: clips/ictus-clips.wav" in log,
+      "a missing clip file is named in an error line")

@@ -1,0 +1,35 @@
+"""The help patches of the four sound abstractions (copied into <build>/ictus/)
+open in pd -nogui -stderr with DSP on and print no error line (the switcher's
+help prints only its model report, `model modal 2`), and have the parts of a
+vanilla help patch: the object on top, a working example with dac~, a
+[pd reference] subpatch, see also, the version."""
+import argparse
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from soundrun import PD, PD_ENV, check, error_lines  # noqa: E402
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", required=True)
+args = ap.parse_args()
+build = os.path.abspath(args.build)
+
+expected_output = {"ictus-sound": ["ictus-sound: model modal 2"]}
+for obj in ("ictus-sound", "ictus-sound-clips", "ictus-sound-synth", "ictus-sound-modal"):
+    name = obj + "-help.pd"
+    path = os.path.join(build, "ictus", name)
+    check(os.path.isfile(path), "%s is in the library folder" % name)
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-path", build, "-open", path,
+           "-send", "pd dsp 1", "-send", "pd quit"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
+    log = proc.stdout + proc.stderr
+    lines = [l for l in log.splitlines() if l.strip()]
+    check(proc.returncode == 0 and not error_lines(log) and lines == expected_output.get(obj, []),
+          "%s opens without errors (output: %s)" % (name, lines))
+    text = open(path).read()
+    check("pd reference" in text and "See also" in text and "ictus 0.1.0" in text,
+          "%s has [pd reference], see also and the version" % name)
+    check(("#X obj 20 14 %s;" % obj) in text and "dac~" in text,
+          "%s shows %s on top and a working example with dac~" % (name, obj))
