@@ -9,7 +9,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from soundrun import PD, PD_ENV, check, error_lines  # noqa: E402
+from soundrun import PD, PD_ENV, check, error_lines, make_workdir  # noqa: E402
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -33,3 +33,18 @@ for obj in ("ictus-sound", "ictus-sound-clips", "ictus-sound-synth", "ictus-soun
           "%s has [pd reference], see also and the version" % name)
     check(("#X obj 20 14 %s;" % obj) in text and "dac~" in text,
           "%s shows %s on top and a working example with dac~" % (name, obj))
+
+# The switcher's argument picks the first model (none: modal), names or numbers.
+
+work = make_workdir("ictus-sound-arg-")
+for arg, report in (("", "model modal 2"), ("clips", "model clips 0"), ("synth", "model synth 1"),
+                    ("1", "model synth 1"), ("0", "model clips 0"), ("modal", "model modal 2")):
+    patch = os.path.join(work, "arg.pd")
+    with open(patch, "w") as f:
+        f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound %s;\n#X obj 10 60 print got;\n"
+                "#X connect 0 2 1 0;\n" % arg)
+    proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
+                           os.path.join(build, "ictus"), "-open", patch, "-send", "pd quit"],
+                          capture_output=True, text=True, timeout=60, env=PD_ENV)
+    log = (proc.stdout + proc.stderr).strip()
+    check(log == "got: " + report, "[ictus-sound %s] starts with %s (%s)" % (arg, report, log))
