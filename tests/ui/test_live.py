@@ -1,0 +1,125 @@
+"""The live set-up of docs/ui.md with the real daemon, under Xvfb: `ictusd run` (score
+mode, the built-in score, no data needed) streams poses and strikes to
+[ictus-receive] -> [ictus-view] (a Gem window), and [ictus-physics] sends score
+statements back through [ictus-receive] to the daemon's command port.
+Checked: the daemon accepts every statement as the panel sends it (its replies
+`/ictus/score <statement>` come back, and `pong`), the view's rate meter reports
+the daemon's pose rate (30 Hz), and the screenshot (<build>/artifacts/gem-live.png)
+shows the character (left blue, right red, head yellow) and the drum's head."""
+import argparse
+import os
+import re
+import socket
+import subprocess
+import tempfile
+import time
+
+import uitest
+from uitest import ok, fail
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", required=True)
+ap.add_argument("--ictusd", required=True)
+args = ap.parse_args()
+build = os.path.abspath(args.build)
+art = uitest.artifacts_dir(build)
+if not os.path.isdir("/usr/lib/pd/extra/Gem"):
+    uitest.skip_or_fail("Gem is not installed (Debian package gem)", missing_package=True)
+STATEMENTS = ["tempo 120", "R accent ff", "L accent 0.8", "R legato 1/2", "L legato 1/2"]
+
+
+def free_udp_port():
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+to_pd, to_daemon = free_udp_port(), free_udp_port()
+work = tempfile.mkdtemp(prefix="ictus-ui-live-")
+patch = os.path.join(work, "live.pd")
+with open(patch, "w") as f:
+    f.write("#N canvas 0 0 400 300 12;\n"
+            "#X obj 10 10 ictus-receive %d;\n"
+            "#X obj 10 60 ictus-view;\n"
+            "#X obj 10 90 print view;\n"
+            "#X obj 200 10 loadbang;\n"
+            "#X msg 200 40 dimen 480 360 \\, camera front \\, window 1;\n"
+            "#X obj 200 120 print daemon;\n"
+            "#X obj 300 160 ictus-physics;\n"
+            "#X msg 300 100 connect 127.0.0.1 %d;\n"
+            "#X obj 500 10 delay 300;\n"
+            "#X msg 500 40 %s;\n"
+            "#X msg 700 100 ping;\n"
+            "#X connect 0 1 1 0;\n#X connect 1 0 2 0;\n#X connect 3 0 4 0;\n#X connect 4 0 1 0;\n"
+            "#X connect 0 2 5 0;\n#X connect 3 0 7 0;\n#X connect 7 0 0 0;\n#X connect 6 0 0 0;\n"
+            "#X connect 3 0 8 0;\n#X connect 8 0 9 0;\n#X connect 9 0 6 0;\n#X connect 8 0 10 0;\n"
+            "#X connect 10 0 0 0;\n"
+            % (to_pd, to_daemon, " \\, ".join(STATEMENTS)))
+
+x = uitest.Xvfb(800, 600)
+daemon = pd = None
+shot = os.path.join(art, "gem-live.png")
+pd_log_path = os.path.join(work, "pd.log")
+d_log_path = os.path.join(work, "ictusd.log")
+try:
+    d_log = open(d_log_path, "w")
+    daemon = subprocess.Popen([args.ictusd, "run", "--target", "osc.udp://127.0.0.1:%d" % to_pd,
+                               "--reply", "osc.udp://127.0.0.1:%d" % to_pd, "--port", str(to_daemon),
+                               "--duration", "60"], stdout=d_log, stderr=subprocess.STDOUT)
+    deadline = time.time() + 40  # ictusd is slow to start under ASan
+    while time.time() < deadline and "commands on" not in open(d_log_path).read():
+        if daemon.poll() is not None:
+            fail("ictusd exited:\n" + open(d_log_path).read())
+        time.sleep(0.2)
+    pd = subprocess.Popen([uitest.PD, "-nogui", "-nosound", "-stderr", "-path", os.path.join(build, "ictus"),
+                           "-open", patch], stdout=open(pd_log_path, "w"), stderr=subprocess.STDOUT,
+                          env=x.env())
+    deadline = time.time() + 30
+    rates = []
+    while time.time() < deadline:
+        time.sleep(0.5)
+        text = open(pd_log_path).read()
+        rates = [float(v) for v in re.findall(r"view: poserate (\S+)", text)]
+        if len(rates) >= 3 and text.count("daemon: reply /ictus/score") >= len(STATEMENTS) \
+                and "daemon: pong" in text:
+            break
+        if pd.poll() is not None:
+            fail("pd exited:\n" + text)
+    x.screenshot(shot)
+finally:
+    for p in (pd, daemon):
+        if p is not None and p.poll() is None:
+            p.terminate()
+            try:
+                p.wait(10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+    x.stop()
+
+text = open(pd_log_path).read()
+print("artefact: " + shot)
+bad = [l for l in uitest.error_lines(text) if "gem.conf" not in l and "DeckLink" not in l]
+ok(not bad, "pd log has no error lines" + ("" if not bad else ":\n" + "\n".join(bad)))
+if "Direct Rendering" not in text and re.search(r"gemglxwindow|could not open display", text, re.I):
+    uitest.skip_or_fail("Gem could not open a GL window under Xvfb here:\n" + text[-2000:])
+for s in STATEMENTS:
+    want = "daemon: reply /ictus/score " + s.replace(" ", "\\ ")
+    ok(want in text, "the daemon accepted the panel's statement %r (%s)" % (s, want))
+ok("daemon: error" not in text, "no error replies")
+ok("daemon: pong" in text, "ping -> pong")
+print("rate meter: %s" % rates)
+ok(any(abs(r - 30) <= 3 for r in rates), "the view receives the daemon's 30 Hz pose stream")
+img = uitest.load_image(shot)
+lit = img.sum(axis=2) > 0
+ys, xs = lit.nonzero()
+img = img[ys.min():ys.min() + 360, xs.min():xs.min() + 480]
+r, g, b = img[..., 0], img[..., 1], img[..., 2]
+counts = {"left (blue)": ((b > r + 50) & (b > g + 20)).sum(),
+          "right (red)": ((r > g + 60) & (r > b + 60)).sum(),
+          "head (yellow)": ((r > 120) & (g > 90) & (b < 0.6 * g) & (r > b + 60)).sum(),
+          "drum head (off-white)": ((r > 200) & (g > 200) & (b > 180)).sum()}
+for k, n in counts.items():
+    ok(n > 40, "the live view shows the %s: %d px" % (k, n))
