@@ -32,6 +32,8 @@ import numpy as np  # noqa: E402
 HANDS = ("right", "left")  # plotting order; strikes.csv: 0 left, 1 right
 HAND_ID = {"left": 0, "right": 1}
 COLOURS = {"right": "tab:red", "left": "tab:blue"}
+SHORT = {"legato": "leg", "tenuto": "ten", "accent": "acc", "vertical_accent": "v.acc",
+         "staccato": "stac"}
 
 
 def fail(message):
@@ -153,17 +155,17 @@ def main():
         ax_score.scatter([n["time_s"] for n in hn], [row] * len(hn), marker="|", s=200,
                          color=COLOURS[hand])
         for n in hn:
-            ax_score.annotate(n["nuance"], (n["time_s"], row), xytext=(2, 5),
-                              textcoords="offset points", fontsize=7, rotation=30)
+            ax_score.annotate(SHORT.get(n["nuance"], n["nuance"]), (n["time_s"], row),
+                              xytext=(2, 4), textcoords="offset points", fontsize=7, rotation=30)
     tempos = [(n["time_s"], n["tempo"]) for n in notes if n["tempo"] is not None]
     last, last_t = None, -1e9
     for tm, bpm in tempos:  # at each change, at most one label per second
         if last is None or (abs(bpm - last) >= 0.5 and tm - last_t >= 1.0):
-            ax_score.annotate("%.0f bpm" % bpm, (tm, 1.6), fontsize=7, color="0.3")
+            ax_score.annotate("%.0f bpm" % bpm, (tm, 2.3), fontsize=7, color="0.3")
             last, last_t = bpm, tm
     ax_score.set_yticks([0, 1])
     ax_score.set_yticklabels(["L", "R"])
-    ax_score.set_ylim(-0.5, 2.1)
+    ax_score.set_ylim(-0.5, 2.8)
     ax_score.set_title(args.title)
     # Tip heights: simulated solid, target dotted; strikes marked on the curve.
     for hand in HANDS:

@@ -1,49 +1,137 @@
 #!/usr/bin/env bash
-# The demo: installs what is missing, builds (externals and daemon; no tests or
-# benchmarks), renders patches/demo/demo.pd (two contact~ sticks and a few ideal
-# strikes on one membrane~, 4 s) through the real pd in batch mode into
-# out/demo.wav (32-bit float, stereo, 48 kHz), and checks it is finite and not silent.
-# Usage: scripts/main.sh [BUILD_DIR]   (default: build/)
+# The main job: the whole chain, headless (docs/main-job.md).
+#   1. installs the missing Debian packages (scripts/deps.sh)
+#   2. builds the Pd externals and ictusd (no tests, no benchmarks)
+#   3. ictusd render: the virtual percussionist plays the default score (the
+#      paper's Figure 5: legato and accent beats under a tempo change) with the
+#      built-in gesture database, offline: OUT/strikes.csv, OUT/events.txt,
+#      OUT/render.json, OUT/tips.csv, OUT/notes.csv, OUT/performance.bvh
+#   4. Pd in batch mode plays the events on the drum of render.json
+#      (patches/ictus-render.pd): OUT/performance.wav (2 pickups, 48 kHz, float)
+#   5. the tip-trajectory plot (scripts/figure5.py): OUT/tips.png and .svg
+# and prints where each output is and a short summary.
+#
+# usage: scripts/main.sh [--build DIR] [--out DIR] [--score FILE] [--no-deps] [--no-build]
+#        scripts/main.sh [BUILD_DIR]            (as before: the build folder)
+#   --build DIR   build folder (default build/)
+#   --out DIR     output folder (default out/)
+#   --score FILE  play this score instead of the default one (examples/scores/)
+#   --no-deps     do not run scripts/deps.sh
+#   --no-build    use the existing build in --build as it is
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-build=${1:-$root/build}
+build=$root/build
+out=$root/out
+score=
+deps=1
+do_build=1
+while [[ $# -gt 0 ]]; do
+    case $1 in
+    --build) build=$2; shift 2 ;;
+    --out) out=$2; shift 2 ;;
+    --score) score=$2; shift 2 ;;
+    --no-deps) deps=0; shift ;;
+    --no-build) do_build=0; shift ;;
+    -h | --help) sed -n '2,24p' "$0"; exit 0 ;;
+    -*) echo "main.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+    *) build=$1; shift ;;
+    esac
+done
+mkdir -p "$out"
+build=$(cd "$(dirname "$build")" && pwd)/$(basename "$build")
+out=$(cd "$out" && pwd)
 cd "$root"
 
-bash scripts/deps.sh
-bash scripts/build.sh "$build" -DICTUS_BUILD_TESTS=OFF -DICTUS_BUILD_BENCH=OFF \
-    -DICTUS_BUILD_DAEMON=ON
-
-mkdir -p "$root/out"
-wav="$root/out/demo.wav"
-rm -f "$wav"
-log="$root/out/demo.log"
-# -send after -open: the patch takes the output path from [r demo-out] when it writes.
-pd -nogui -nosound -batch -stderr -r 48000 -path "$build/ictus" \
-    -open "$root/patches/demo/demo.pd" -send "demo-out symbol $wav" >"$log" 2>&1 || {
-    cat "$log" >&2
-    echo "main.sh: pd failed" >&2
+if [[ $deps == 1 ]]; then
+    bash scripts/deps.sh
+fi
+if [[ $do_build == 1 ]]; then
+    bash scripts/build.sh "$build" -DICTUS_BUILD_TESTS=OFF -DICTUS_BUILD_BENCH=OFF \
+        -DICTUS_BUILD_EXTERNALS=ON -DICTUS_BUILD_DAEMON=ON
+fi
+ictusd=$build/ictusd
+if [[ ! -x $ictusd || ! -d $build/ictus ]]; then
+    echo "main.sh: no ictusd or Pd library in $build (run without --no-build)" >&2
     exit 1
-}
-if grep -Eiq "error|couldn't" "$log"; then
-    cat "$log" >&2
-    echo "main.sh: pd reported errors while rendering" >&2
+fi
+if ! "$ictusd" render --help 2>&1 | grep -q -- "--score"; then
+    echo "main.sh: this ictusd cannot render a score yet (no --score in 'ictusd render --help')" >&2
     exit 1
 fi
 
-/usr/bin/python3 - "$wav" <<'PY'
-import sys
+# 3. the performance, offline and deterministic
+rm -f "$out"/{strikes.csv,events.txt,render.json,tips.csv,notes.csv,performance.bvh} \
+    "$out"/{performance.wav,tips.png,tips.svg,pd.log}
+render=("$ictusd" render --out "$out")
+[[ -n $score ]] && render+=(--score "$score")
+"${render[@]}"
+for f in strikes.csv events.txt render.json; do
+    [[ -s $out/$f ]] || { echo "main.sh: ictusd render did not write $out/$f" >&2; exit 1; }
+done
+
+# 4. the sound: the events on the drum the physics used (radius, tension,
+# density from render.json), rendered to the sample by pd in batch mode
+read -r radius tension density seconds < <(/usr/bin/python3 - "$out" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1] + "/render.json"))
+drum = d["drum"]
+print(drum["radius_m"], drum["tension_n_per_m"], drum["density_kg_per_m2"],
+      "%.3f" % (float(d["duration_s"]) + 1.5))
+PY
+)
+wav=$out/performance.wav
+pd -nogui -nosound -batch -stderr -r 48000 -path "$build/ictus" \
+    -open "$root/patches/ictus-render.pd" \
+    -send "render-drum radius $radius" -send "render-drum tension $tension" \
+    -send "render-drum density $density" \
+    -send "render-file $out/events.txt" -send "render-out $wav" \
+    -send "render-seconds $seconds" >"$out/pd.log" 2>&1 || {
+    cat "$out/pd.log" >&2
+    echo "main.sh: pd failed (log: $out/pd.log)" >&2
+    exit 1
+}
+if grep -Eiq "error|couldn't" "$out/pd.log"; then
+    echo "main.sh: pd reported errors while rendering (log: $out/pd.log):" >&2
+    grep -Ei "error|couldn't" "$out/pd.log" >&2
+fi
+
+# 5. the figure
+/usr/bin/python3 "$root/scripts/figure5.py" "$out" --out "$out/tips"
+
+# where everything is, and a summary
+/usr/bin/python3 - "$out" <<'PY'
+import json, os, sys
 sys.path.insert(0, "tests/pd")
 import numpy as np
 from pdrun import read_wav_float
 
-x, sr = read_wav_float(sys.argv[1])
-seconds = x.shape[0] / sr
-peak = float(np.max(np.abs(x))) if x.size else 0.0
-rms = float(np.sqrt(np.mean(x.astype(np.float64) ** 2))) if x.size else 0.0
+out = sys.argv[1]
+wav = os.path.join(out, "performance.wav")
+x, sr = read_wav_float(wav)
 if x.shape[0] == 0 or not np.all(np.isfinite(x)):
-    sys.exit("main.sh: %s is empty or not finite" % sys.argv[1])
+    sys.exit("main.sh: %s is empty or not finite" % wav)
+peak = float(np.max(np.abs(x)))
 if peak < 1e-3:
-    sys.exit("main.sh: %s is silent (peak %g)" % (sys.argv[1], peak))
-print("demo: %d channels, %.2f s at %d Hz, peak %.3f, rms %.4f" % (x.shape[1], seconds, sr, peak, rms))
+    sys.exit("main.sh: %s is silent (peak %g)" % (wav, peak))
+meta = json.load(open(os.path.join(out, "render.json")))
+bvh = os.path.join(out, "performance.bvh")
+frames = joints = None
+if os.path.isfile(bvh):
+    with open(bvh) as f:
+        text = f.read()
+    joints = text.count("JOINT ") + text.count("ROOT ")
+    for line in text.splitlines():
+        if line.startswith("Frames:"):
+            frames = int(line.split()[1])
+print()
+print("main job: outputs in %s" % out)
+for name, what in (("performance.wav", "%d channels, %.2f s at %d Hz, peak %.3f"
+                    % (x.shape[1], x.shape[0] / sr, sr, peak)),
+                   ("strikes.csv", "%s strikes, %s bounces" % (meta.get("strikes"), meta.get("bounces"))),
+                   ("events.txt", "the strikes for Pd (qlist)"),
+                   ("tips.png", "stick-tip heights, score and strikes (and tips.svg)"),
+                   ("performance.bvh", "%s joints, %s frames" % (joints, frames)
+                    if frames is not None else "MISSING"),
+                   ("render.json", "drum, duration %.2f s" % float(meta.get("duration_s", 0)))):
+    print("  %-16s %s" % (name, what))
 PY
-echo "wrote $wav"

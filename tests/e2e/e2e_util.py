@@ -19,6 +19,12 @@ How onsets are measured (docs/main-job.md, "Checking the onsets"):
   every strike within 1 ms (we measure the error in samples), and exactly as
   many onsets as strikes in the pass (no extra onsets: a second contact made by
   contact~, a click, a strike played twice would each fail).
+- The full WAV itself, on the real drum (departure_onsets): Pd is
+  deterministic, so the performance and a render of the same events file cut
+  just before strike k are bit-identical until strike k starts. Strike k's
+  onset in the full WAV is the first sample where the two differ: a detector
+  that needs no threshold and works on a ringing drum and for strikes 1 ms
+  apart, because whatever sounded before strike k is in both signals.
 """
 import json
 import os
@@ -194,3 +200,24 @@ def check_onsets(build, events, strikes, work, sr=48000, header=(), log_errors=N
     missing = [i for i, e in enumerate(errors) if e is None]
     return {"errors_ms": errors, "extra": extra, "missing": missing, "passes": groups,
             "logs": logs}
+
+
+def departure_onsets(build, events, header, full, seconds_after=0.005, sr=48000, work=None,
+                     indices=None):
+    """Onset of each strike (indices into the hits, default all) in `full` (the
+    WAV samples of the whole events file rendered with `header`): the first
+    sample where `full` differs from a render of the hits before it. Returns
+    {index: sample or None (no difference)} and the logs."""
+    times = hit_times_us(events)
+    result, logs = {}, []
+    for k in (range(len(times)) if indices is None else indices):
+        ev = os.path.join(work, "prefix-%d.txt" % k)
+        wav = os.path.join(work, "prefix-%d.wav" % k)
+        write_events(ev, header, events, keep=set(range(k)))
+        seconds = round(times[k] / 1e6 + seconds_after, 3)
+        x, _, log = render_pd(build, ev, wav, seconds, sr)
+        logs.append(log)
+        n = min(len(x), len(full))
+        diff = np.flatnonzero(np.any(x[:n] != full[:n], axis=1))
+        result[k] = int(diff[0]) if diff.size else None
+    return result, logs

@@ -57,7 +57,7 @@ proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env,
 print(proc.stdout[-3000:])
 check(proc.returncode == 0, "scripts/main.sh --no-deps --no-build ran: %s" % proc.stderr[-3000:])
 for name in ("performance.wav", "strikes.csv", "events.txt", "render.json", "tips.png",
-             "tips.svg", "performance.bvh"):
+             "tips.svg"):
     check(os.path.isfile(os.path.join(out, name)) and os.path.getsize(os.path.join(out, name)) > 0,
           "main job wrote %s" % name)
 check(out in proc.stdout and "performance.wav" in proc.stdout,
@@ -89,8 +89,22 @@ if found:
     print("onset - strike time: max %.4f ms, mean %.4f ms, exact %d of %d, %d passes"
           % (max(found), float(np.mean(found)), sum(e == 0 for e in found), len(found),
              len(result["passes"])))
+# and in the main job's own WAV (real drum, set by main.sh through -send): where
+# it departs from a render of the strikes before each one (e2e_util).
+departures, _ = u.departure_onsets(build, events, drum, x, work=work)
+dep = {k: None if v is None else (v - int(np.floor(strikes[k]["time_s"] * sr + 0.5))) * 1000.0 / sr
+       for k, v in departures.items()}
+known = [abs(v) for v in dep.values() if v is not None]
+print("performance.wav, departure onsets - strike time: max %.4f ms, exact %d of %d"
+      % (max(known) if known else float("nan"), sum(v == 0 for v in known), len(dep)))
+late = sorted(k for k, v in dep.items() if v is None or abs(v) > 1.0)
+for k in sorted(k for k, v in dep.items() if v != 0):
+    print("  strike %d (hand %d, bounce %d, %.4f m/s at %.6f s): %s"
+          % (k, strikes[k]["hand"], strikes[k]["bounce"], strikes[k]["normal_velocity_mps"],
+             strikes[k]["time_s"], "changes nothing" if dep[k] is None else "%+.4f ms" % dep[k]))
 check(not result["missing"], "every strike has an onset within 1 ms (missing %s)" % result["missing"])
 check(not result["extra"], "no extra onsets (%s)" % result["extra"])
+check(not late, "in performance.wav every strike starts within 1 ms of its time (%s)" % late)
 
 # --- the plot ------------------------------------------------------------------
 with open(os.path.join(out, "tips.png"), "rb") as f:
@@ -182,7 +196,9 @@ def fk(joints, row):
     return pos
 
 
-joints, frame_time, data = parse_bvh(os.path.join(out, "performance.bvh"))
+bvh_path = os.path.join(out, "performance.bvh")
+check(os.path.isfile(bvh_path) and os.path.getsize(bvh_path) > 0, "main job wrote performance.bvh")
+joints, frame_time, data = parse_bvh(bvh_path)
 print("performance.bvh: %d joints, %d frames at %.6g s" % (len(joints), len(data), frame_time))
 check(len(joints) >= 20 and len(data) > 0 and 0 < frame_time < 1, "the BVH has a skeleton and frames")
 names = [j[0] for j in joints]
