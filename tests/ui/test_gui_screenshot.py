@@ -33,13 +33,14 @@ pd = None
 shot = os.path.join(art, "main-patch.png")
 counts = {}
 try:
+    log_path = copy + ".log"
     pd = subprocess.Popen([uitest.PD, "-nosound", "-stderr", "-open", copy],
-                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=x.env())
+                          stdout=open(log_path, "w"), stderr=subprocess.STDOUT, env=x.env())
     deadline = time.time() + 25
     while time.time() < deadline:
         time.sleep(1.0)
         if pd.poll() is not None:
-            fail("pd exited: " + pd.stdout.read().decode(errors="replace"))
+            fail("pd exited: " + open(log_path).read())
         x.screenshot(shot)
         img = uitest.load_image(shot)
         counts = {k: ((img == c).all(axis=2)) for k, (c, _) in PANELS.items()}
@@ -61,6 +62,10 @@ finally:
     os.remove(copy)
 
 print("artefact: " + shot)
+log = open(log_path).read()
+os.remove(log_path)
+bad = [l for l in uitest.error_lines(log) if "gem.conf" not in l and "DeckLink" not in l]
+ok(not bad, "pd with its GUI logs no error lines (Tcl errors included)" + ("" if not bad else ":\n" + "\n".join(bad)))
 img = uitest.load_image(shot)
 colours = len(set(map(tuple, img.reshape(-1, 3))))
 ok(colours > 20 and img.std() > 20, "the screenshot is not blank (%d colours, std %.0f)" % (colours, img.std()))
