@@ -1,16 +1,22 @@
 // verbs_osc.hpp -- the verbs that play the drum: `ictusd run` (real time,
 // wall-clock paced, OSC in and out on their own threads) and `ictusd render`
 // (offline, as fast as possible, deterministic: strikes.csv and a qlist
-// events file for a Pd batch patch). Both drive the character with a mocap
-// clip in joint space (paper eq. 1, as `ictusd track`) and detect strikes
-// with the interaction manager (strike.hpp). See docs/osc.md.
+// events file for a Pd batch patch). Two motion sources: a mocap clip in
+// joint space (paper eq. 1, as `ictusd track`), or a score performed through
+// its gesture plan (issue 6: stick-tip targets, Cartesian mode by default, on
+// the default body). Strikes come from the interaction manager (strike.hpp).
+// See docs/osc.md and docs/perform.md.
 #pragma once
 
 #include "ictus/character.hpp"
+#include "ictus/gesture.hpp"
+#include "ictus/gesture_score.hpp"
 #include "ictus/joint_controller.hpp"
 #include "ictus/osc_link.hpp"
 #include "ictus/scene.hpp"
+#include "ictus/score.hpp"
 #include "ictus/strike.hpp"
+#include "ictus/track.hpp"
 
 #include <memory>
 #include <string>
@@ -24,8 +30,33 @@ namespace ictus
 int cmd_run(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 
+// Score mode: how a gesture plan is performed (docs/perform.md, where the
+// defaults are measured).
+struct ScorePerformOptions {
+    std::string score_text; // the score; empty: default_score_text()
+    std::string score_name = "default";
+    std::string gestures; // gesture database JSON; empty: GestureDatabase::builtin()
+    TrackMode mode = TrackMode::cartesian;
+    bool grip_given = false; // else the character holds the sticks as the score's first note
+    PlanOptions plan;        // strike_depth_m below: the default here
+    // The tip targets are sampled this far ahead of the plan's clock: the
+    // controller's measured tracking lag (docs/perform.md), so that the
+    // physical tip, not the target, meets the membrane on the beat.
+    double time_advance_s = 0.0;
+    CartesianOptions cartesian;
+    // After each beat the target rebounds off the head at the impact speed
+    // and is caught with this time constant, s (0: off; docs/perform.md).
+    double rebound_s = 0.1;
+    // The drum relative to the performer (derived from the model's shoulders,
+    // facing +Z): membrane centre this far in front of and below the
+    // midpoint of the shoulders.
+    double drum_forward_m = 0.42;
+    double drum_below_m = 0.42;
+    ScorePerformOptions();
+};
+
 struct PerformanceOptions {
-    std::string mocap; // BVH with CMU joint names
+    std::string mocap; // BVH with CMU joint names; empty: score mode
     double scale_m_per_unit = 0.056444;
     int skip_frames = 1;
     CharacterOptions character;
@@ -37,10 +68,32 @@ struct PerformanceOptions {
     double tempo_bpm = 120.0;
     double drum_density_kg_per_m2 = 0.26; // for the sound only (membrane~)
     StrikeDetectorOptions strikes;
+    ScorePerformOptions score; // score mode (no mocap)
 };
 
-// The physics side of run and render: the character tracking the clip, the
-// drum, the strike detector, and the commands Pd may send.
+// How the strikes of a performance met its planned notes: per hand, each
+// primary (non-bounce) strike is given to the nearest note of that hand; a
+// note keeps the nearest of the strikes given to it (the others are extra).
+struct NoteMatch {
+    long strike_seq = -1; // -1: no strike for this note
+    double strike_time_s = 0.0;
+    double error_ms = 0.0; // strike - beat
+    double normal_velocity_mps = 0.0;
+    double duration_ms = 0.0;
+};
+struct MatchSummary {
+    std::vector<NoteMatch> notes; // [note], as the plan's notes
+    long primary_strikes = 0, bounces = 0;
+    long matched_notes = 0;
+    long extra_strikes = 0; // primary strikes not matched to a note
+    double mean_abs_error_ms = 0.0, max_abs_error_ms = 0.0;
+};
+// `origin_s`: simulation time of the plan's time 0.
+MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
+                           const std::vector<StrikeEvent> &strikes, double origin_s);
+
+// The physics side of run and render: the character tracking the clip or
+// performing a score, the drum, the strike detector, and the commands Pd may send.
 class Performance
 {
   public:
@@ -69,13 +122,51 @@ class Performance
     const StrikeDetector &detector() const { return detector_; }
     int divergences() const;
 
+    // Score mode.
+    bool score_mode() const { return options_.mocap.empty(); }
+    // The plan being performed (or last performed); nullptr before the first.
+    const GesturePlan *plan() const { return plan_ ? plan_.get() : nullptr; }
+    bool plan_active() const { return plan_active_; }
+    // Simulation time of the plan's time 0, and the plan's clock.
+    double plan_origin_s() const { return plan_origin_s_; }
+    double plan_time_s() const { return plan_time_s_; }
+    // The tip target X^T the controller was given in the last step [hand].
+    Eigen::Vector3d tip_target(int hand) const;
+    Eigen::Vector3d tip_position(int hand) const;
+    const PerformerFrame &performer_frame() const;
+    TrackMode mode() const;
+    // Plans the current score and starts it now (what /ictus/play does in
+    // score mode). Throws ScoreError / GestureError; on error nothing changes.
+    void start_score();
+
   private:
     struct Rig;
+    struct ScoreRig;
     void build();
+    void build_score(bool keep_pose);
+    int step_score(StrikeEvent out[2]);
+    bool apply_score(const Command &command, std::string *why);
+    int detect(const CharacterModel &model, const Scene &scene, StrikeEvent out[2]);
+    void start_rest_move();
+    Eigen::Vector3d target_at(int side, double plan_time_s) const;
     MembraneGeometry membrane() const;
     PerformanceOptions options_;
     std::unique_ptr<Rig> rig_;
+    std::unique_ptr<ScoreRig> score_rig_;
     StrikeDetector detector_;
+    // Score mode: the database, the statements received, the score and its plan.
+    std::unique_ptr<GestureDatabase> db_;
+    std::unique_ptr<ScoreBuilder> builder_;
+    std::unique_ptr<Score> score_;
+    std::unique_ptr<GesturePlan> plan_;
+    bool plan_active_ = false;
+    double plan_origin_s_ = 0.0, plan_time_s_ = 0.0;
+    // Between plans the tips move to (and hold) the rest tips.
+    std::array<Eigen::Vector3d, 2> rest_from_m_;
+    double rest_move_start_s_ = -1e9;
+    // Per hand, per note: plan time of the beat, the lead of the target's
+    // first contact before it, the approach speed there (target_at).
+    std::array<std::vector<double>, 2> beats_, lead_s_, approach_mps_;
     bool playing_ = true;
     bool rebuild_pending_ = false;
     double clip_time_s_ = 0.0;

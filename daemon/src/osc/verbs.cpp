@@ -34,11 +34,15 @@ struct UsageError : std::runtime_error {
 
 void run_usage(std::ostream &out)
 {
-    out << "usage: ictusd run --mocap FILE [options]\n"
+    out << "usage: ictusd run [--mocap FILE | --score FILE] [options]\n"
            "\n"
-           "Plays the clip in real time (joint space, eq. 1), sends every strike to Pd as an\n"
-           "OSC bundle time-tagged for exact scheduling, streams poses for graphics, and\n"
-           "listens for commands (play, stop, tempo, grip, drum ...). See docs/osc.md.\n"
+           "Plays in real time, sends every strike to Pd as an OSC bundle time-tagged for\n"
+           "exact scheduling, streams poses for graphics, and listens for commands (play,\n"
+           "stop, score statements, mode, grip, drum ...). See docs/osc.md, docs/perform.md.\n"
+           "With --mocap: the clip in joint space (eq. 1). Otherwise score mode: the score\n"
+           "(--score FILE, default: the built-in score) is planned into stick-tip targets and\n"
+           "performed (Cartesian mode by default); /ictus/score statements replace it at the\n"
+           "next /ictus/play.\n"
            "\n"
            "  --target URL        where strikes and poses go (default osc.udp://127.0.0.1:9000)\n"
            "  --port N            UDP port for commands (default 9001; 0: any free port)\n"
@@ -56,6 +60,7 @@ void run_usage(std::ostream &out)
            "\n"
            "examples:\n"
            "  ictusd run --mocap ../shared/data/cmu/80_13.bvh\n"
+           "  ictusd run --score examples/scores/figure5.score --mode cartesian\n"
            "  ictusd run --mocap clip.bvh --target osc.udp://10.0.0.2:9000 --bind 10.0.0.1 \\\n"
            "             --allow 10.0.0.2 --lookahead 0.05\n"
            "  oscsend localhost 9001 /ictus/tempo f 96\n";
@@ -63,20 +68,39 @@ void run_usage(std::ostream &out)
 
 void render_usage(std::ostream &out)
 {
-    out << "usage: ictusd render --mocap FILE --out DIR [options]\n"
+    out << "usage: ictusd render [--mocap FILE | --score FILE] --out DIR [options]\n"
            "\n"
-           "Plays the clip offline, as fast as possible and deterministically (same input,\n"
-           "same bytes), and writes DIR/strikes.csv, DIR/events.txt (qlist lines for a Pd\n"
-           "batch patch) and DIR/render.json (drum parameters for membrane~). docs/osc.md.\n"
+           "Plays offline, as fast as possible and deterministically (same input, same\n"
+           "bytes), and writes DIR/strikes.csv, DIR/events.txt (qlist lines for a Pd batch\n"
+           "patch) and DIR/render.json (drum parameters for membrane~, summary). docs/osc.md.\n"
+           "With --mocap the clip plays in joint space; otherwise the score (--score FILE, or\n"
+           "the built-in default score) is performed and DIR/tips.csv (stick-tip targets and\n"
+           "simulated tips) and DIR/notes.csv (each note and its strike) are written too\n"
+           "(docs/perform.md).\n"
+           "\n"
+           "  --tips-rate HZ      tips.csv rows per second (default 250; 0: none)\n"
+           "\n"
+           "score mode (run and render):\n"
+           "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
+           "  --gestures DB.json  gesture database (default: the built-in one)\n"
+           "  --mode M            cartesian (default, Algorithm 2) | joint (eq. 1, joint\n"
+           "                      targets from the IK of the tip targets)\n"
+           "  --strike-depth M    the target dips this far below the first contact (0.004)\n"
+           "  --advance S         tip targets sampled S ahead: the tracking lag (default 0)\n"
+           "  --rebound S         the target's rebound after a beat, time constant (0.015; 0: "
+           "off)\n"
+           "  --lead-in S         time before the score's first beat (default 1)\n"
+           "  --grip G            the sticks' grip (default: the score's first note's)\n"
+           "  --drum-pos X,Y,Z    membrane centre (default: in front of the shoulders)\n"
            "\n"
            "common options (run and render):\n"
-           "  --mocap FILE        BVH file with CMU joint names\n"
+           "  --mocap FILE        BVH file with CMU joint names (clip mode)\n"
            "  --scale M           metres per BVH unit (default 0.056444)\n"
            "  --skip-frames N     frames dropped at the start (default 1)\n"
-           "  --duration S        simulated seconds (render default: the clip's length)\n"
+           "  --duration S        simulated seconds (render default: the clip's or plan's length)\n"
            "  --step S            physics step (default 0.001)\n"
            "  --grip G            french | german\n"
-           "  --tempo BPM         playback tempo (default 120)\n"
+           "  --tempo BPM         clip playback tempo (default 120; a score sets its own)\n"
            "  --clip-bpm BPM      tempo at which the clip plays at its own speed (default 120)\n"
            "  --drum-pos X,Y,Z    membrane centre (default: under the clip's lowest tips)\n"
            "  --drum-radius M     (default 0.178)\n"
@@ -85,8 +109,10 @@ void render_usage(std::ostream &out)
            "  --bounce-height M   bounce rule height (default 0.01)\n"
            "  --bounce-window S   bounce rule window (default 0.15)\n"
            "\n"
-           "example:\n"
-           "  ictusd render --mocap ../shared/data/cmu/80_13.bvh --duration 10 --out out/r1\n";
+           "examples:\n"
+           "  ictusd render --mocap ../shared/data/cmu/80_13.bvh --duration 10 --out out/r1\n"
+           "  ictusd render --out out/fig5                  (the built-in score)\n"
+           "  ictusd render --score my.score --grip german --mode joint --out out/r2\n";
 }
 
 double parse_number(const std::string &option, const std::string &text, double lo, double hi)
@@ -136,7 +162,34 @@ bool common_option(const std::string &a, int &i, int argc, char **argv, Performa
         if (g != "french" && g != "german")
             throw UsageError("--grip: expected french or german, got '" + g + "'");
         o.character.grip = grip_from_string(g);
-    } else if (a == "--tempo")
+        o.score.grip_given = true;
+    } else if (a == "--score") {
+        const std::string path = value();
+        std::ifstream in(path, std::ios::binary);
+        if (!in)
+            throw UsageError("--score: cannot read '" + path + "'");
+        std::ostringstream text;
+        text << in.rdbuf();
+        o.score.score_text = text.str();
+        o.score.score_name = path;
+        if (o.score.score_text.empty())
+            throw UsageError("--score: '" + path + "' is empty");
+    } else if (a == "--gestures")
+        o.score.gestures = value();
+    else if (a == "--mode") {
+        const std::string m = value();
+        if (m != "joint" && m != "cartesian")
+            throw UsageError("--mode: expected joint or cartesian, got '" + m + "'");
+        o.score.mode = track_mode_from_string(m);
+    } else if (a == "--strike-depth")
+        o.score.plan.strike_depth_m = parse_number(a, value(), -0.05, 0.05);
+    else if (a == "--advance")
+        o.score.time_advance_s = parse_number(a, value(), 0, 0.1);
+    else if (a == "--rebound")
+        o.score.rebound_s = parse_number(a, value(), 0, 0.5);
+    else if (a == "--lead-in")
+        o.score.plan.lead_in_s = parse_number(a, value(), 0.2, 60);
+    else if (a == "--tempo")
         o.tempo_bpm = parse_number(a, value(), 20, 400);
     else if (a == "--clip-bpm")
         o.clip_bpm = parse_number(a, value(), 20, 400);
@@ -162,6 +215,53 @@ bool common_option(const std::string &a, int &i, int argc, char **argv, Performa
     return true;
 }
 
+// tips.csv: the stick-tip targets X^T and the simulated tips, both hands.
+void write_tips_header(std::ostream &out)
+{
+    out << "time_s";
+    for (const char *hand : {"left", "right"})
+        for (const char *what : {"target", "sim"})
+            for (const char *axis : {"x", "y", "z"})
+                out << ',' << hand << '_' << what << '_' << axis << "_m";
+    out << '\n';
+}
+
+void write_tips_row(std::ostream &out, const Performance &perf)
+{
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.4f", perf.time_s());
+    out << buf;
+    for (int hand = 0; hand < 2; ++hand)
+        for (const Eigen::Vector3d &p : {perf.tip_target(hand), perf.tip_position(hand)}) {
+            std::snprintf(buf, sizeof buf, ",%.5f,%.5f,%.5f", p.x(), p.y(), p.z());
+            out << buf;
+        }
+    out << '\n';
+}
+
+// notes.csv: the planned notes and the strike each one got.
+void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSummary &m,
+                     double origin_s)
+{
+    out << "index,time_s,hand,nuance,grip,dynamics,beats,tempo_bpm,line,strike_seq,strike_time_s,"
+           "error_ms,normal_velocity_mps,duration_ms\n";
+    char buf[256];
+    for (size_t i = 0; i < plan.notes.size(); ++i) {
+        const PlannedNote &n = plan.notes[i];
+        const NoteMatch &k = m.notes[i];
+        std::snprintf(buf, sizeof buf, "%zu,%.6f,%s,%s,%s,%.3f,%.4f,%.3f,%d,%ld,", i,
+                      origin_s + n.time_s, to_string(n.hand), to_string(n.nuance),
+                      to_string(n.grip), n.dynamics, n.beats, n.tempo_bpm, n.line, k.strike_seq);
+        out << buf;
+        if (k.strike_seq >= 0)
+            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f\n", k.strike_time_s, k.error_ms,
+                          k.normal_velocity_mps, k.duration_ms);
+        else
+            std::snprintf(buf, sizeof buf, ",,,\n");
+        out << buf;
+    }
+}
+
 nlohmann::json drum_json(const Performance &p)
 {
     const DrumParams &d = p.scene().options().drum;
@@ -172,6 +272,70 @@ nlohmann::json drum_json(const Performance &p)
     j["density_kg_per_m2"] = p.options().drum_density_kg_per_m2;
     j["contact_stiffness_n_per_m"] = p.detector().membrane().stiffness_n_per_m;
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
+    return j;
+}
+
+// render.json's "performance": how the strikes met the notes (docs/perform.md).
+nlohmann::json performance_json(const PerformanceOptions &o, const Performance &perf,
+                                const MatchSummary &m)
+{
+    const GesturePlan &plan = *perf.plan();
+    nlohmann::json j;
+    j["mode"] = to_string(perf.mode());
+    j["notes"] = plan.notes.size();
+    j["primary_strikes"] = m.primary_strikes;
+    j["bounces"] = m.bounces;
+    j["matched_notes"] = m.matched_notes;
+    j["missed_notes"] = static_cast<long>(plan.notes.size()) - m.matched_notes;
+    j["extra_strikes"] = m.extra_strikes;
+    j["timing_error_ms"] = {{"mean_abs", m.mean_abs_error_ms}, {"max_abs", m.max_abs_error_ms}};
+    double v_lo = 0.0, v_hi = 0.0, d_lo = 0.0, d_hi = 0.0, v_sum = 0.0, d_sum = 0.0;
+    long n = 0;
+    for (const NoteMatch &k : m.notes) {
+        if (k.strike_seq < 0)
+            continue;
+        if (n == 0) {
+            v_lo = v_hi = k.normal_velocity_mps;
+            d_lo = d_hi = k.duration_ms;
+        }
+        v_lo = std::min(v_lo, k.normal_velocity_mps);
+        v_hi = std::max(v_hi, k.normal_velocity_mps);
+        d_lo = std::min(d_lo, k.duration_ms);
+        d_hi = std::max(d_hi, k.duration_ms);
+        v_sum += k.normal_velocity_mps;
+        d_sum += k.duration_ms;
+        ++n;
+    }
+    j["impact_speed_mps"] = {{"min", v_lo}, {"mean", n ? v_sum / n : 0.0}, {"max", v_hi}};
+    j["contact_ms"] = {{"min", d_lo}, {"mean", n ? d_sum / n : 0.0}, {"max", d_hi}};
+    j["plan"] = {{"duration_s", plan.duration_s},
+                 {"origin_s", perf.plan_origin_s()},
+                 {"strike_depth_m", o.score.plan.strike_depth_m},
+                 {"time_advance_s", o.score.time_advance_s},
+                 {"lead_in_s", o.score.plan.lead_in_s}};
+    const PerformerFrame &f = perf.performer_frame();
+    j["performer"] = {{"right", {f.right.x(), f.right.y(), f.right.z()}},
+                      {"forward", {f.forward.x(), f.forward.y(), f.forward.z()}}};
+    nlohmann::json per_note = nlohmann::json::array();
+    for (size_t i = 0; i < plan.notes.size(); ++i) {
+        const PlannedNote &p = plan.notes[i];
+        const NoteMatch &k = m.notes[i];
+        nlohmann::json e = {{"time_s", perf.plan_origin_s() + p.time_s},
+                            {"hand", to_string(p.hand)},
+                            {"nuance", to_string(p.nuance)},
+                            {"dynamics", p.dynamics},
+                            {"line", p.line}};
+        if (k.strike_seq >= 0) {
+            e["strike_seq"] = k.strike_seq;
+            e["error_ms"] = k.error_ms;
+            e["impact_speed_mps"] = k.normal_velocity_mps;
+            e["contact_ms"] = k.duration_ms;
+        } else {
+            e["strike_seq"] = nullptr;
+        }
+        per_note.push_back(e);
+    }
+    j["per_note"] = per_note;
     return j;
 }
 
@@ -197,7 +361,7 @@ int cmd_render(int argc, char **argv)
 {
     return guarded("render", [&]() {
         PerformanceOptions o;
-        double duration = 0.0;
+        double duration = 0.0, tips_rate = 250.0;
         std::string out_dir;
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
@@ -208,12 +372,17 @@ int cmd_render(int argc, char **argv)
                 if (i + 1 >= argc)
                     throw UsageError("--out: missing value");
                 out_dir = argv[++i];
+            } else if (a == "--tips-rate") {
+                if (i + 1 >= argc)
+                    throw UsageError("--tips-rate: missing value");
+                tips_rate = parse_number(a, argv[++i], 0, 1000);
             } else if (!common_option(a, i, argc, argv, o, duration)) {
                 throw UsageError("unknown option '" + a + "' (see ictusd render --help)");
             }
         }
-        if (o.mocap.empty())
-            throw UsageError("--mocap FILE is required");
+        const bool score_mode = o.mocap.empty();
+        if (!score_mode && !o.score.score_text.empty())
+            throw UsageError("--score and --mocap are two motion sources: give one");
         if (out_dir.empty())
             throw UsageError("--out DIR is required");
         std::error_code ec;
@@ -222,16 +391,27 @@ int cmd_render(int argc, char **argv)
             throw std::runtime_error("--out: cannot create '" + out_dir + "': " + ec.message());
 
         Performance perf(o);
+        if (score_mode)
+            perf.start_score();
         if (duration <= 0.0)
             duration = perf.clip_duration_s();
         std::ofstream csv(out_dir + "/strikes.csv"), events(out_dir + "/events.txt");
         if (!csv || !events)
             throw std::runtime_error("--out: cannot write in '" + out_dir + "'");
+        std::ofstream tips;
+        if (score_mode) {
+            tips.open(out_dir + "/tips.csv");
+            if (!tips)
+                throw std::runtime_error("--out: cannot write in '" + out_dir + "'");
+            write_tips_header(tips);
+        }
         write_strikes_csv_header(csv);
         const auto wall0 = std::chrono::steady_clock::now();
         std::signal(SIGINT, on_sigint);
         const double h = perf.step_s();
         const long steps = std::max(1L, std::lround(duration / h));
+        const long tips_every =
+            tips_rate > 0.0 ? std::max(1L, std::lround(1.0 / (tips_rate * h))) : 0;
         StrikeEvent ev[2];
         double previous = 0.0;
         long strikes = 0, bounces = 0;
@@ -248,6 +428,8 @@ int cmd_render(int argc, char **argv)
             const int k = perf.step(ev);
             for (int i = 0; i < k; ++i)
                 emit(ev[i]);
+            if (tips.is_open() && tips_every && (n + 1) % tips_every == 0)
+                write_tips_row(tips, perf);
         }
         StrikeEvent last;
         while (perf.flush(last))
@@ -264,7 +446,10 @@ int cmd_render(int argc, char **argv)
         const double wall =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
         nlohmann::json j;
-        j["mocap"] = o.mocap;
+        if (score_mode)
+            j["score"] = o.score.score_text.empty() ? "default" : o.score.score_name;
+        else
+            j["mocap"] = o.mocap;
         j["duration_s"] = perf.time_s();
         j["step_s"] = h;
         j["strikes"] = strikes;
@@ -272,18 +457,29 @@ int cmd_render(int argc, char **argv)
         j["divergences"] = perf.divergences();
         j["side_entries"] = perf.detector().side_entries();
         j["grip"] = to_string(o.character.grip);
-        j["tempo_bpm"] = o.tempo_bpm;
+        if (!score_mode)
+            j["tempo_bpm"] = o.tempo_bpm;
         j["drum"] = drum_json(perf);
+        if (score_mode) {
+            const GesturePlan &plan = *perf.plan();
+            const MatchSummary m = match_strikes(plan.notes, all, perf.plan_origin_s());
+            std::ofstream notes(out_dir + "/notes.csv");
+            write_notes_csv(notes, plan, m, perf.plan_origin_s());
+            if (!notes)
+                throw std::runtime_error("--out: error writing in '" + out_dir + "'");
+            j["performance"] = performance_json(o, perf, m);
+        }
         std::ofstream js(out_dir + "/render.json");
         js << j.dump(2) << "\n";
         csv.close();
         events.close();
-        if (!js || !csv || !events)
+        if (!js || !csv || !events || (tips.is_open() && !tips))
             throw std::runtime_error("--out: error writing in '" + out_dir + "'");
         std::cout << "render: " << perf.time_s() << " s simulated in " << wall << " s ("
                   << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes
                   << " strikes (" << bounces << " bounces), wrote " << out_dir
-                  << "/{strikes.csv,events.txt,render.json}\n";
+                  << (score_mode ? "/{strikes.csv,events.txt,render.json,tips.csv,notes.csv}\n"
+                                 : "/{strikes.csv,events.txt,render.json}\n");
         return interrupted ? 130 : 0;
     });
 }
@@ -333,8 +529,8 @@ int cmd_run(int argc, char **argv)
                 throw UsageError("unknown option '" + a + "' (see ictusd run --help)");
             }
         }
-        if (o.mocap.empty())
-            throw UsageError("--mocap FILE is required");
+        if (!o.mocap.empty() && !o.score.score_text.empty())
+            throw UsageError("--score and --mocap are two motion sources: give one");
         std::ofstream csv;
         if (!out_dir.empty()) {
             std::error_code ec;
@@ -370,6 +566,8 @@ int cmd_run(int argc, char **argv)
             Command stop;
             stop.kind = CommandKind::stop;
             perf.apply(stop);
+        } else if (perf.score_mode()) {
+            perf.start_score();
         }
         std::cerr << "ictusd run: commands on " << io.bind_address << ":" << server.port()
                   << ", strikes and poses to " << so.target_url << "\n";
