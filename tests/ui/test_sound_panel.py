@@ -58,3 +58,28 @@ for want in ("ictus-sound-panel: modes: expected 1 to 4096 but got 5000 (clamped
     ok(want in lines, "out of range: %r" % want)
 named = [l for l in lines if l.startswith("ictus-sound-panel:")]
 ok(len(named) == 3, "exactly those three lines name a problem (%d)" % len(named))
+
+# The panel's messages against the real [ictus-sound] (docs/sound.md's interface):
+# every one is accepted without an error line, DSP on, and a model switch is
+# reported back into the panel (which shows it and sends nothing).
+with tempfile.TemporaryDirectory(prefix="ictus-ui-sound-") as work:
+    patch = os.path.join(work, "snd.pd")
+    preset = "radius 0.2 \\, tension 4000 \\, mass 0.03 \\, modes 64 \\, t60 1.5 \\, hfdamp 2 \\, volume 0.7"
+    with open(patch, "w") as f:
+        f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 loadbang;\n#X msg 10 40 %s;\n"
+                "#X obj 10 70 ictus-sound-panel;\n#X obj 10 100 ictus-sound modal;\n"
+                "#X msg 200 40 model synth \\, 1 3 0.3 0 \\, model clips \\, 0 2 0.5 90;\n"
+                "#X obj 200 140 print report;\n"
+                "#X connect 0 0 1 0;\n#X connect 1 0 2 0;\n#X connect 2 0 3 0;\n#X connect 3 2 2 0;\n"
+                "#X connect 0 0 4 0;\n#X connect 4 0 3 0;\n#X connect 3 2 5 0;\n" % preset)
+    proc = subprocess.run([uitest.PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
+                           os.path.join(build, "ictus"), "-open", patch, "-send", "pd dsp 1",
+                           "-send", "pd quit"],
+                          capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
+log = proc.stdout + proc.stderr
+print(log)
+ok(proc.returncode == 0 and not uitest.error_lines(log) and "ictus-sound-panel:" not in log,
+   "[ictus-sound] takes every message of the panel without an error line")
+reports = [l.split()[1:] for l in log.splitlines() if l.startswith("report: model")]
+ok(reports[-2:] == [["model", "synth", "1"], ["model", "clips", "0"]],
+   "the model switches are reported back into the panel (%s)" % reports)
