@@ -388,6 +388,27 @@ TEST_CASE("motion_from_poses: exported poses put every body where the character 
     CHECK(worst_tip < 1e-6);
     CHECK(worst_pose < 1e-7);
 
+    // pose_from_frames inverts forward: the body frames of a pose give the pose back.
+    double worst_inverse = 0.0;
+    for (const CharacterPose &pose : poses) {
+        BodyFrames frames;
+        model.forward(pose, frames);
+        const CharacterPose again = pose_from_frames(model, frames);
+        worst_inverse =
+            std::max(worst_inverse, (again.pelvis_position_m - pose.pelvis_position_m).norm());
+        worst_inverse =
+            std::max(worst_inverse, again.pelvis_rotation.angularDistance(pose.pelvis_rotation));
+        for (int j = 0; j < CharacterModel::kJoints; ++j)
+            worst_inverse =
+                std::max(worst_inverse, again.local[static_cast<std::size_t>(j)].angularDistance(
+                                            pose.local[static_cast<std::size_t>(j)]));
+    }
+    CHECK(worst_inverse < 1e-9);
+    BodyFrames too_few;
+    too_few.origin_m.resize(3);
+    too_few.rotation.resize(3);
+    CHECK_THROWS_WITH(pose_from_frames(model, too_few), Catch::Contains("3 bodies"));
+
     // Bad input: a pose with the wrong number of joints, a bad rate.
     std::vector<CharacterPose> bad = {poses[0]};
     bad[0].local.pop_back();

@@ -28,6 +28,14 @@ namespace ictus
 Motion motion_from_poses(const CharacterModel &model, const Skeleton &skeleton,
                          const std::vector<CharacterPose> &poses, double rate_hz);
 
+// The pose whose forward kinematics gives these body orientations (the
+// inverse of CharacterModel::forward for rotations): pelvis frame as given,
+// local[j] = rotation(parent)^-1 * rotation(body j + 1). For recording the
+// physics' bodies (Scene) as poses. Body origins other than the pelvis's are
+// not used: the exported skeleton places each body at its joint offset, so a
+// physics joint's drift (a few tenths of a mm at most) does not show.
+CharacterPose pose_from_frames(const CharacterModel &model, const BodyFrames &frames);
+
 // The skeleton plus the two drumsticks, so that a BVH shows them: per hand a
 // joint "<Hand>Stick" (LeftHandStick / RightHandStick) below the hand's source
 // joint at the stick's grip point, with an end site at the tip. A stick is

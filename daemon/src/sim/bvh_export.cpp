@@ -60,6 +60,27 @@ Motion motion_from_poses(const CharacterModel &model, const Skeleton &skeleton,
     return motion;
 }
 
+CharacterPose pose_from_frames(const CharacterModel &model, const BodyFrames &frames)
+{
+    if (static_cast<int>(frames.origin_m.size()) != CharacterModel::kBodies ||
+        static_cast<int>(frames.rotation.size()) != CharacterModel::kBodies)
+        throw CharacterError("BVH export: body frames for " +
+                             std::to_string(frames.rotation.size()) + " bodies, expected " +
+                             std::to_string(CharacterModel::kBodies));
+    CharacterPose pose;
+    pose.pelvis_position_m = frames.origin_m[0];
+    pose.pelvis_rotation = frames.rotation[0].normalized();
+    pose.local.resize(CharacterModel::kJoints);
+    for (int b = 1; b < CharacterModel::kBodies; ++b) {
+        const int p = model.bodies()[static_cast<std::size_t>(b)].parent;
+        pose.local[static_cast<std::size_t>(b - 1)] =
+            (frames.rotation[static_cast<std::size_t>(p)].conjugate() *
+             frames.rotation[static_cast<std::size_t>(b)])
+                .normalized();
+    }
+    return pose;
+}
+
 Skeleton skeleton_with_sticks(const CharacterModel &model, const Skeleton &skeleton)
 {
     Skeleton out = skeleton;
