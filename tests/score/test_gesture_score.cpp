@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -59,10 +60,8 @@ Steps max_steps(const GesturePlan &plan, int side, double exclude_s = 0.004)
         if (static_cast<int>(n.hand) == side)
             strikes.push_back(n.time_s);
     auto near_strike = [&](double t) {
-        for (double s : strikes)
-            if (std::abs(t - s) < exclude_s)
-                return true;
-        return false;
+        const auto it = std::lower_bound(strikes.begin(), strikes.end(), t - exclude_s);
+        return it != strikes.end() && *it < t + exclude_s;
     };
     Steps m;
     for (size_t i = 0; i + 2 < ts.size(); ++i) {
@@ -73,6 +72,23 @@ Steps max_steps(const GesturePlan &plan, int side, double exclude_s = 0.004)
         const Eigen::Vector3d v0 = (p[i + 1] - p[i]) / h0, v1 = (p[i + 2] - p[i + 1]) / h1;
         m.position_m = std::max(m.position_m, (p[i + 1] - p[i]).norm());
         m.velocity_mps = std::max(m.velocity_mps, (v1 - v0).norm());
+    }
+    return m;
+}
+
+// Largest change of velocity between consecutive sample intervals within
+// +-half_width_s of t.
+double local_velocity_step(const GesturePlan &plan, int side, double t, double half_width_s)
+{
+    const auto &ts = plan.tips.time_s;
+    const auto &p = plan.tips.tip_m[side];
+    double m = 0.0;
+    const auto first = std::lower_bound(ts.begin(), ts.end(), t - half_width_s);
+    for (size_t i = static_cast<size_t>(first - ts.begin());
+         i + 2 < ts.size() && ts[i] <= t + half_width_s; ++i) {
+        const Eigen::Vector3d v0 = (p[i + 1] - p[i]) / (ts[i + 1] - ts[i]);
+        const Eigen::Vector3d v1 = (p[i + 2] - p[i + 1]) / (ts[i + 2] - ts[i + 1]);
+        m = std::max(m, (v1 - v0).norm());
     }
     return m;
 }
@@ -88,6 +104,7 @@ TEST_CASE("plan: every note's tip is at its spot on its beat", "[score][plan]")
 {
     const Score score = parse_score(default_score_text(), "default");
     PlanOptions opt;
+    opt.rate_hz = 250.0; // the strikes are sampled exactly at any rate
     const GesturePlan plan = plan_performance(score, db(), frame(), opt);
     REQUIRE(plan.notes.size() == score.notes.size());
     CHECK(plan.score_start_s == opt.lead_in_s);
@@ -150,7 +167,9 @@ TEST_CASE("plan: the tip is lowest at each beat and comes down once per note", "
           "tempo 200\nrepeat 6\nR, L 1/2, L 1/2\nend", "tempo 40\nR accent, L legato pp, R, L"}) {
         INFO(text);
         const Score score = score_of(text);
-        const GesturePlan plan = plan_performance(score, db(), frame());
+        PlanOptions opt;
+        opt.rate_hz = 500.0;
+        const GesturePlan plan = plan_performance(score, db(), frame(), opt);
         const double head = kCenter.y();
         for (int side = 0; side < 2; ++side) {
             const auto &p = plan.tips.tip_m[side];
@@ -186,7 +205,7 @@ TEST_CASE("plan: the tip is lowest at each beat and comes down once per note", "
                 const size_t k = index_at(plan, s);
                 double lowest = 1e9;
                 double when = 0.0;
-                for (size_t i = 0; i < ts.size(); ++i)
+                for (size_t i = k > 40 ? k - 40 : 0; i < std::min(ts.size(), k + 41); ++i)
                     if (std::abs(ts[i] - s) <= 0.04 && height(p[i]) < lowest) {
                         lowest = height(p[i]);
                         when = ts[i];
@@ -207,16 +226,18 @@ TEST_CASE("plan: position and velocity continuous across unit joins - C0 and C1"
     // dynamics, a tempo ramp.
     const Score score = score_of(
         "tempo 60\nR legato pp, L accent ff at 0.6 30, R staccato at 0.2 200, L tenuto\n"
-        "tempo 60 -> 180 over 8\nrepeat 2\n R vertical_accent f, L legato p, R accent, L staccato "
-        "ff\nend\n"
-        "grip german\nR accent, L, R tenuto, L vertical_accent\nrest 12\nR legato, L accent\n");
+        "tempo 60 -> 180 over 8\nR vertical_accent f, L legato p, R accent, L staccato ff\n"
+        "grip german\nR accent, L, R tenuto, L vertical_accent\ntempo 120\nrest 9\n"
+        "R legato, L accent\n");
     PlanOptions coarse, fine;
-    coarse.rate_hz = 1000.0;
-    fine.rate_hz = 2000.0;
+    coarse.rate_hz = 500.0;
+    fine.rate_hz = 1000.0;
+    coarse.lead_in_s = fine.lead_in_s = 0.5;
+    coarse.tail_s = fine.tail_s = 0.0;
     const GesturePlan a = plan_performance(score, db(), frame(), coarse);
     const GesturePlan b = plan_performance(score, db(), frame(), fine);
     for (int side = 0; side < 2; ++side) {
-        const Steps sa = max_steps(a, side), sb = max_steps(b, side);
+        const Steps sa = max_steps(a, side, 0.006), sb = max_steps(b, side, 0.006);
         INFO("side " << side << ": position step " << sa.position_m << " -> " << sb.position_m
                      << " m, velocity step " << sa.velocity_mps << " -> " << sb.velocity_mps);
         CHECK(sa.position_m > 0.0);
@@ -228,7 +249,30 @@ TEST_CASE("plan: position and velocity continuous across unit joins - C0 and C1"
         for (size_t i = 0; i + 1 < p.size(); ++i)
             top_speed = std::max(top_speed, (p[i + 1] - p[i]).norm() /
                                                 (b.tips.time_s[i + 1] - b.tips.time_s[i]));
-        CHECK(sb.position_m <= top_speed / 2000.0 * 1.000001);
+        CHECK(sb.position_m <= top_speed / fine.rate_hz * 1.000001);
+
+        // The same locally at each join (the cross-fade's ends, a quarter of
+        // the gap after one strike and before the next, docs/score.md), where
+        // the curve is slow and a small jump could not hide under the large
+        // accelerations near the strikes.
+        std::vector<double> strikes;
+        for (const auto &n : a.notes)
+            if (static_cast<int>(n.hand) == side)
+                strikes.push_back(n.time_s);
+        int joins = 0;
+        for (size_t k = 0; k + 1 < strikes.size(); ++k) {
+            const double gap = strikes[k + 1] - strikes[k];
+            if (gap > PlanOptions().idle_return_s)
+                continue;
+            for (double join : {strikes[k] + 0.25 * gap, strikes[k + 1] - 0.25 * gap}) {
+                const double ca = local_velocity_step(a, side, join, 0.003);
+                const double cb = local_velocity_step(b, side, join, 0.003);
+                INFO("join at " << join << " s: velocity step " << ca << " -> " << cb << " m/s");
+                CHECK(cb <= 0.6 * ca + 1e-4);
+                ++joins;
+            }
+        }
+        CHECK(joins >= 10);
     }
 }
 
@@ -254,11 +298,14 @@ TEST_CASE("plan: louder dynamics give a faster downward tip at the beat", "[scor
     for (Grip grip : {Grip::french, Grip::german}) {
         for (Nuance nuance : {Nuance::legato, Nuance::tenuto, Nuance::accent,
                               Nuance::vertical_accent, Nuance::staccato}) {
-            std::string text = std::string("tempo 96\ngrip ") + to_string(grip) + "\n";
-            for (double d : {0.1, 0.3, 0.5, 0.7, 0.9, 1.0})
+            std::string text = std::string("tempo 150\ngrip ") + to_string(grip) + "\n";
+            for (double d : {0.1, 0.4, 0.7, 1.0})
                 text += std::string("R ") + to_string(nuance) + " " + std::to_string(d) + ", L " +
                         to_string(nuance) + " " + std::to_string(d) + "\n";
-            const GesturePlan plan = plan_performance(score_of(text), db(), frame());
+            PlanOptions opt;
+            opt.lead_in_s = 0.5;
+            opt.tail_s = 0.0;
+            const GesturePlan plan = plan_performance(score_of(text), db(), frame(), opt);
             std::array<double, 2> previous = {0.0, 0.0};
             for (const PlannedNote &n : plan.notes) {
                 const int side = static_cast<int>(n.hand);
@@ -328,7 +375,9 @@ TEST_CASE("plan: tempi 40 to 200 bpm with both grips and all nuances", "[score][
                 "\nR legato, L tenuto, R accent, L vertical_accent, R staccato\n"
                 "L legato, R tenuto, L accent, R vertical_accent, L staccato\n";
             const Score score = score_of(text);
-            const GesturePlan plan = plan_performance(score, db(), frame());
+            PlanOptions opt;
+            opt.rate_hz = 250.0;
+            const GesturePlan plan = plan_performance(score, db(), frame(), opt);
             REQUIRE(plan.notes.size() == 10);
             for (const PlannedNote &n : plan.notes) {
                 const Eigen::Vector3d tip =
