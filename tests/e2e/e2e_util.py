@@ -221,3 +221,38 @@ def departure_onsets(build, events, header, full, seconds_after=0.005, sr=48000,
         diff = np.flatnonzero(np.any(x[:n] != full[:n], axis=1))
         result[k] = int(diff[0]) if diff.size else None
     return result, logs
+
+
+def judge_departures(departures, strikes, sr):
+    """Judges departure_onsets on the full WAV. Returns (errors_ms by strike,
+    failures [(k, why)], notes [(k, text)]). A strike fails when it changes
+    nothing, when the WAV departs before its time (something sounded early),
+    or, for a primary stroke, more than 1 ms after it. A bounce may start
+    later than 1 ms: contact~ puts the stick on the head where the head is at
+    that sample, and a head still moving down from the stroke a few ms before
+    runs away from a slow bounce (0.1-0.2 m/s) until it swings back. That is
+    the two drum models (the daemon's and membrane~) disagreeing, not timing:
+    the same bounce on a drum at rest (the passes) starts on its sample. It is
+    reported as a note."""
+    errors, failures, notes = {}, [], []
+    for k, v in sorted(departures.items()):
+        s = strikes[k]
+        what = "strike %d (hand %d, %s, %.4f m/s at %.6f s)" % (
+            k, s["hand"], "bounce" if s["bounce"] else "stroke", s["normal_velocity_mps"],
+            s["time_s"])
+        if v is None:
+            errors[k] = None
+            failures.append((k, what + ": changes nothing in the WAV"))
+            continue
+        e = (v - int(np.floor(s["time_s"] * sr + 0.5))) * 1000.0 / sr
+        errors[k] = e
+        if e < 0:
+            failures.append((k, what + ": the WAV departs %.4f ms early" % -e))
+        elif e > 1.0 and not s["bounce"]:
+            failures.append((k, what + ": starts %+.4f ms late" % e))
+        elif e > 1.0:
+            notes.append((k, what + ": starts %+.4f ms late on a head still moving "
+                          "(on a drum at rest: see the passes)" % e))
+        elif e != 0:
+            notes.append((k, what + ": %+.4f ms" % e))
+    return errors, failures, notes
