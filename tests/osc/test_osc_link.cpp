@@ -275,8 +275,8 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
         {{"/ictus/tempo", "f", "nan"}, "/ictus/tempo", "tempo (bpm)"},
         {{"/ictus/drum/radius", "f", "-1"}, "/ictus/drum/radius", "drum radius (m)"},
         {{"/ictus/grip", "s", "matched"}, "/ictus/grip", "expected french or german"},
-        {{"/ictus/mode", "s", "cartesian"}, "/ictus/mode", "not implemented yet"},
-        {{"/ictus/score", "s", "4/4 q q q q"}, "/ictus/score", "score not implemented yet"},
+        {{"/ictus/mode", "s", "inverse"}, "/ictus/mode", "expected joint or cartesian"},
+        {{"/ictus/score", "i", "4"}, "/ictus/score", "expected ,s, got ,i"},
         {{"/ictus/volume", "f", "1"}, "/ictus/volume", "unknown address"},
     };
     for (const Bad &b : bad) {
@@ -293,9 +293,9 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
     CHECK_FALSE(server.pop_command(c));
     const ictus::OscServerCounters k = server.counters();
     CHECK(k.accepted == 5);
-    CHECK(k.bad_type_tags == 1);
+    CHECK(k.bad_type_tags == 2);
     CHECK(k.unknown_address == 1);
-    CHECK(k.bad_values == 6);
+    CHECK(k.bad_values == 5);
 
     // Status: the physics thread's numbers.
     status.time_s = 12.5;
@@ -305,6 +305,116 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
     CHECK(d.types == "sfifiiiiii");
     CHECK(std::stod(d.args[1]) == Approx(12.5));
     CHECK(std::stoi(d.args[4]) == 42);
+}
+
+TEST_CASE("osc in: score statements, score clear and the cartesian mode pass through to the "
+          "physics thread; too-long statements and wrong type tags are refused",
+          "[osc][link]")
+{
+    // oscsend (liblo's tool) sends, a plain socket receives the replies.
+    Peer replies;
+    ictus::OscServerOptions so;
+    so.port = 0;
+    so.reply_url = "osc.udp://127.0.0.1:" + std::to_string(replies.port());
+    ictus::OscServer server(so, nullptr);
+    const std::string port = std::to_string(server.port());
+    auto oscsend = [&](std::vector<std::string> args) {
+        args.insert(args.begin(), {"oscsend", "127.0.0.1", port});
+        REQUIRE(osctest::run(args) == 0);
+    };
+    auto pop = [&](ictus::Command &c) {
+        for (int i = 0; i < 200; ++i) {
+            if (server.pop_command(c))
+                return true;
+            std::this_thread::sleep_for(5ms);
+        }
+        return false;
+    };
+    auto reply = [&](Peer::Message &m) {
+        REQUIRE(replies.receive(m, 3000));
+        return m;
+    };
+    ictus::Command c;
+    Peer::Message m;
+
+    // Accepted: queued with their text, echoed back.
+    oscsend({"/ictus/score", "s", "L accent 0.8"});
+    REQUIRE(pop(c));
+    CHECK(c.kind == ictus::CommandKind::score);
+    CHECK(std::string(c.text) == "L accent 0.8");
+    reply(m);
+    CHECK(m.path == "/ictus/reply");
+    CHECK(m.types == "ss");
+    CHECK(m.strings == std::vector<std::string>{"/ictus/score", "L accent 0.8"});
+
+    oscsend({"/ictus/score/clear"});
+    REQUIRE(pop(c));
+    CHECK(c.kind == ictus::CommandKind::score_clear);
+    reply(m);
+    CHECK(m.path == "/ictus/reply");
+    CHECK(m.strings == std::vector<std::string>{"/ictus/score/clear"});
+
+    oscsend({"/ictus/mode", "s", "cartesian"});
+    REQUIRE(pop(c));
+    CHECK(c.kind == ictus::CommandKind::mode);
+    CHECK(std::string(c.text) == "cartesian");
+    reply(m);
+    CHECK(m.path == "/ictus/reply");
+
+    // The longest statement that fits Command::text (255 characters + NUL)
+    // arrives whole.
+    const size_t limit = ictus::Command::kMaxText - 1;
+    REQUIRE(limit == 255);
+    std::string longest;
+    while (longest.size() < limit)
+        longest += longest.size() % 10 == 9 ? ',' : 'R';
+    oscsend({"/ictus/score", "s", longest});
+    REQUIRE(pop(c));
+    CHECK(std::string(c.text) == longest);
+    reply(m);
+    CHECK(m.path == "/ictus/reply");
+
+    // Refused, with the address and the reason; nothing is queued.
+    struct Bad {
+        std::vector<std::string> args;
+        std::string message_part;
+    };
+    const Bad bad[] = {
+        {{"/ictus/score", "s", longest + "R"}, "256 characters exceed the limit of 255"},
+        {{"/ictus/score", "s", std::string(3000, 'L')}, "3000 characters exceed the limit of 255"},
+        {{"/ictus/score", "s", ""}, "score statement: empty"},
+        {{"/ictus/score", "s", "R legato\nL accent"}, "control character 10 at column 9"},
+        {{"/ictus/score", "i", "96"}, "type tags: expected ,s, got ,i"},
+        {{"/ictus/score", "f", "0.8"}, "type tags: expected ,s, got ,f"},
+        {{"/ictus/score", "ss", "R", "legato"}, "type tags: expected ,s, got ,ss"},
+        {{"/ictus/score"}, "type tags: expected ,s, got ,"},
+        {{"/ictus/score/clear", "s", "all"}, "type tags: expected ,, got ,s"},
+        {{"/ictus/mode", "s", "Cartesian"}, "mode: expected joint or cartesian, got 'Cartesian'"},
+    };
+    for (const Bad &b : bad) {
+        oscsend(b.args);
+        reply(m);
+        INFO(b.args[0] << " " << (m.strings.size() > 1 ? m.strings[1] : std::string("?")));
+        CHECK(m.path == "/ictus/error");
+        CHECK(m.types == "ss");
+        REQUIRE(m.strings.size() == 2);
+        CHECK(m.strings[0] == b.args[0]);
+        CHECK(m.strings[1].find(b.message_part) != std::string::npos);
+    }
+    // A statement beyond the packet limit (4096 bytes) never reaches parsing.
+    oscsend({"/ictus/score", "s", std::string(5000, 'R')});
+    reply(m);
+    CHECK(m.path == "/ictus/error");
+    CHECK(m.strings[1].find("exceeds the limit of 4096") != std::string::npos);
+
+    CHECK_FALSE(server.pop_command(c));
+    const ictus::OscServerCounters k = server.counters();
+    CHECK(k.accepted == 4);
+    CHECK(k.score_lines == 2);
+    CHECK(k.bad_type_tags == 5);
+    CHECK(k.bad_values == 5);
+    CHECK(k.oversized == 1);
+    CHECK(k.errors_sent == 11);
 }
 
 TEST_CASE("osc in: 10^5 random and malformed packets are counted and answered, the server "

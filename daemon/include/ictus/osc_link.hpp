@@ -11,6 +11,7 @@
 #include "ictus/strike.hpp"
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -118,17 +119,23 @@ enum class CommandKind {
     tempo,        // value = bpm
     grip,         // text = french | german
     nuance,       // text
-    mode,         // text = joint (cartesian is refused for now)
+    mode,         // text = joint | cartesian
     gains,        // value = stiffness scale, value2 = damping scale
     drum_radius,  // value = m
     drum_tension, // value = N/m
     drum_density, // value = kg/m^2
+    score,        // text = one score statement, e.g. "L accent 0.8" (docs/score.md)
+    score_clear,  // forget the statements received so far
 };
 
 struct Command {
+    // Room for one score statement: the longest text accepted is
+    // kMaxText - 1 bytes (the server refuses longer ones with an error naming
+    // the limit). Fixed size: commands cross a lock-free queue by value.
+    static constexpr std::size_t kMaxText = 256;
     CommandKind kind = CommandKind::play;
     double value = 0.0, value2 = 0.0;
-    char text[32] = {};
+    char text[kMaxText] = {};
 };
 
 // What the physics thread publishes for /ictus/status (atomics only).

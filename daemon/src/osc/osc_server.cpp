@@ -13,6 +13,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -267,6 +268,8 @@ const Spec kSpecs[] = {
     {"/ictus/drum/radius", "f", CommandKind::drum_radius, 0.05, 1.0, "drum radius (m)"},
     {"/ictus/drum/tension", "f", CommandKind::drum_tension, 10.0, 1e5, "drum tension (N/m)"},
     {"/ictus/drum/density", "f", CommandKind::drum_density, 0.01, 10.0, "drum density (kg/m^2)"},
+    {"/ictus/score", "s", CommandKind::score, 0, 0, "score statement"},
+    {"/ictus/score/clear", "", CommandKind::score_clear, 0, 0, ""},
 };
 
 bool one_of(const char *text, std::initializer_list<const char *> words)
@@ -275,6 +278,26 @@ bool one_of(const char *text, std::initializer_list<const char *> words)
         if (std::strcmp(text, w) == 0)
             return true;
     return false;
+}
+
+// Why a score statement cannot be queued, or "" when it can. The score's own
+// syntax is the physics thread's business (its parser names the fault's
+// position); here only what would not survive the trip: the length of
+// Command::text and characters that would split the line or the log.
+std::string score_statement_problem(const char *text, std::size_t length)
+{
+    if (length == 0)
+        return "score statement: empty (send one statement, e.g. \"R legato\")";
+    if (length >= Command::kMaxText)
+        return "score statement: " + std::to_string(length) + " characters exceed the limit of " +
+               std::to_string(Command::kMaxText - 1) + " (send one statement per message)";
+    for (std::size_t i = 0; i < length; ++i) {
+        const unsigned char ch = static_cast<unsigned char>(text[i]);
+        if ((ch < 0x20 && ch != '\t') || ch == 0x7f)
+            return "score statement: control character " + std::to_string(ch) + " at column " +
+                   std::to_string(i + 1) + " (one line per message)";
+    }
+    return "";
 }
 
 std::string format_range(const Spec &s, double v)
@@ -371,24 +394,6 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
         reply.ok(path, s);
         return;
     }
-    if (std::strcmp(path, "/ictus/score") == 0) {
-        const std::size_t n = std::strlen(types);
-        bool strings = n > 0;
-        for (std::size_t i = 0; i < n; ++i)
-            strings = strings && types[i] == 's';
-        if (!strings) {
-            c.bad_type_tags++;
-            reply.error(path, std::string("type tags: expected one or more s, got ,") + types);
-            return;
-        }
-        // Counted and acknowledged as an error: nothing plays scores yet (the
-        // gesture-score issue), and saying "ok" would be a lie.
-        c.score_lines++;
-        c.bad_values++;
-        reply.error(path, "score not implemented yet (line received, " +
-                              std::to_string(c.score_lines.load()) + " so far, not played)");
-        return;
-    }
     for (const Spec &s : kSpecs) {
         if (std::strcmp(path, s.address) != 0)
             continue;
@@ -417,31 +422,36 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
             }
         } else if (s.types[0] == 's') {
             const char *text = lo_arg_string(argv[0]);
-            bool ok = false;
-            std::string expected;
-            if (s.kind == CommandKind::grip) {
-                ok = one_of(text, {"french", "german"});
-                expected = "french or german";
-            } else if (s.kind == CommandKind::nuance) {
-                ok = one_of(text, {"legato", "tenuto", "accent", "vertical_accent", "staccato"});
-                expected = "legato, tenuto, accent, vertical_accent or staccato";
-            } else if (s.kind == CommandKind::mode) {
-                if (std::strcmp(text, "cartesian") == 0) {
-                    c.bad_values++;
-                    reply.error(path, "mode: cartesian is not implemented yet (joint only)");
-                    return;
+            // liblo checked the string's terminator inside the packet; the
+            // packet limit bounds its length.
+            const std::size_t length = std::strlen(text);
+            std::string problem;
+            if (s.kind == CommandKind::score) {
+                problem = score_statement_problem(text, length);
+            } else {
+                bool ok = false;
+                std::string expected;
+                if (s.kind == CommandKind::grip) {
+                    ok = one_of(text, {"french", "german"});
+                    expected = "french or german";
+                } else if (s.kind == CommandKind::nuance) {
+                    ok =
+                        one_of(text, {"legato", "tenuto", "accent", "vertical_accent", "staccato"});
+                    expected = "legato, tenuto, accent, vertical_accent or staccato";
+                } else if (s.kind == CommandKind::mode) {
+                    ok = one_of(text, {"joint", "cartesian"});
+                    expected = "joint or cartesian";
                 }
-                ok = std::strcmp(text, "joint") == 0;
-                expected = "joint or cartesian";
+                if (!ok)
+                    problem = std::string(s.what) + ": expected " + expected + ", got '" +
+                              std::string(text, std::min<std::size_t>(length, 40)) + "'";
             }
-            if (!ok) {
+            if (!problem.empty()) {
                 c.bad_values++;
-                std::string shown(text, strnlen(text, 40));
-                reply.error(path, std::string(s.what) + ": expected " + expected + ", got '" +
-                                      shown + "'");
+                reply.error(path, problem);
                 return;
             }
-            std::snprintf(cmd.text, sizeof cmd.text, "%s", text);
+            std::memcpy(cmd.text, text, length + 1); // fits: checked above
         }
         if (!commands_.push(cmd)) {
             c.queue_full++;
@@ -449,6 +459,8 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
             return;
         }
         c.accepted++;
+        if (s.kind == CommandKind::score)
+            c.score_lines++;
         lo_message echo = lo_message_new();
         for (int i = 0; types[i]; ++i) {
             if (types[i] == 'f')
