@@ -60,6 +60,14 @@ struct AnalyticContact {
     }
 };
 
+// Samples of a continuous motion (not of semi-implicit steps).
+ictus::StrikeDetectorOptions continuous_samples()
+{
+    ictus::StrikeDetectorOptions o;
+    o.semi_implicit_samples = false;
+    return o;
+}
+
 std::vector<StrikeEvent> run_detector(StrikeDetector &det, int hand,
                                       const std::vector<TipSample> &samples)
 {
@@ -94,7 +102,7 @@ TEST_CASE("strike: a bead on a linear spring gives the analytic duration, impuls
     // 0.032 ms, 1.6 %, 0.16 %.
     const Case cases[] = {{1e-5, 1e-4, 1e-4, 1e-4}, {1e-3, 0.05, 0.025, 0.005}};
     for (const Case &c : cases) {
-        StrikeDetector det(flat_membrane(a.k, 0.0));
+        StrikeDetector det(flat_membrane(a.k, 0.0), continuous_samples());
         std::vector<TipSample> samples;
         for (long n = 0; n * c.dt <= 0.2; ++n)
             samples.push_back(a.at(n * c.dt));
@@ -193,7 +201,7 @@ TEST_CASE("strike: bounces of a dropped bead are tagged by the apex heights betw
     std::vector<StrikeEvent> events;
     std::vector<double> apex_before; // the apex of the flight before each contact
     std::vector<double> since_release, v_in, v_out;
-    double apex = y - r, release_t = -1.0, last_v_before = 0.0;
+    double apex = y - r, release_t = -1.0;
     bool touching = false;
     StrikeEvent e;
     for (long n = 0; n * dt < 1.2; ++n) {
@@ -206,7 +214,10 @@ TEST_CASE("strike: bounces of a dropped bead are tagged by the apex heights betw
         if (now && !touching) {
             apex_before.push_back(apex);
             since_release.push_back(release_t < 0 ? 1e9 : t - release_t);
-            v_in.push_back(-last_v_before);
+            // This integrator moved the bead across the plane with the
+            // velocity it now has (y += v dt after v changed; no contact
+            // force in that step: it started above the plane).
+            v_in.push_back(-v);
         }
         if (!now && touching) {
             release_t = t;
@@ -214,10 +225,8 @@ TEST_CASE("strike: bounces of a dropped bead are tagged by the apex heights betw
             v_out.push_back(v);
         }
         touching = now;
-        if (!now) {
+        if (!now)
             apex = std::max(apex, y - r);
-            last_v_before = v;
-        }
         if (det.update(0, s, e))
             events.push_back(e);
         const double depth = r - y;
@@ -302,4 +311,139 @@ TEST_CASE("strike: CSV and events lines have fixed, documented formats", "[osc][
     ictus::write_events_line(ev, e, 1.0);
     CHECK(ev.str() ==
           "250.000 hit 1 0 1 1.5000 0.28090 0.00 19.123 0.090000 7.130 0.2000 1.250000;\n");
+}
+
+namespace
+{
+// A bead sampled as the Scene's integrator moves it (semi-implicit Euler:
+// p[n+1] = p[n] + h v[n+1]), from its velocities alone: the samples are
+// consistent by construction, and the velocity that crossed the membrane
+// plane in a step is the velocity of the sample that ends it.
+std::vector<TipSample> semi_implicit(double h, double gap0, const std::vector<double> &vy,
+                                     const std::vector<double> &vx)
+{
+    std::vector<TipSample> s;
+    Eigen::Vector3d p(0.0, 0.007 + gap0, 0.0);
+    for (size_t n = 0; n < vy.size(); ++n) {
+        const Eigen::Vector3d v(vx[n], vy[n], 0.0);
+        if (n > 0)
+            p += h * v;
+        TipSample t;
+        t.time_s = n * h;
+        t.center_m = p;
+        t.velocity_mps = v;
+        s.push_back(t);
+    }
+    return s;
+}
+} // namespace
+
+TEST_CASE("strike: a re-contact after a lift of less than one step has the velocity that crossed",
+          "[osc][strike]")
+{
+    // A press, a release rising at 1 m/s to a gap of 0.2 mm, and at once a
+    // re-contact moving down at 0.7 m/s (a stick the arm holds against the
+    // head). Gaps (mm) at 1 ms: 9.5, 8.5 ... 0.5, -0.5, -1.0, -0.8, +0.2, -0.5,
+    // -0.6, -0.2, +0.6, rising. The free sample before the re-contact is still
+    // rising (+1 m/s): reporting its velocity gave normal_velocity_mps = -1.
+    const double h = 1e-3;
+    std::vector<double> vy, vx;
+    for (int n = 0; n <= 10; ++n)
+        vy.push_back(-1.0);
+    for (double v : {-0.5, 0.2, 1.0, -0.7, -0.1, 0.4, 0.8, 0.8, 0.8, 0.8, 0.8})
+        vy.push_back(v);
+    for (size_t n = 0; n < vy.size(); ++n)
+        vx.push_back(n == 14 ? 0.3 : 0.2);
+    const std::vector<TipSample> s = semi_implicit(h, 0.0095, vy, vx);
+    REQUIRE(s[13].center_m.y() - 0.007 == Approx(0.0002).margin(1e-12));
+    REQUIRE(s[14].center_m.y() - 0.007 == Approx(-0.0005).margin(1e-12));
+    // Both readings of the samples agree here: the stroke's free sample
+    // approaches at 1 m/s (and could cross), the re-contact's is rising.
+    const bool semi_implicit = GENERATE(true, false);
+    ictus::StrikeDetectorOptions o;
+    o.semi_implicit_samples = semi_implicit;
+    StrikeDetector det(flat_membrane(5000.0, 0.0), o);
+    const auto ev = run_detector(det, 0, s);
+    REQUIRE(ev.size() == 2);
+    // The stroke: the free flight's 1 m/s, onset halfway through step 9-10.
+    CHECK_FALSE(ev[0].bounce);
+    CHECK(ev[0].normal_velocity_mps == Approx(1.0).epsilon(1e-12));
+    CHECK(ev[0].time_s == Approx(0.0095).margin(1e-12));
+    // The re-contact: a bounce (0.2 mm apex, 0 ms after the release) whose
+    // approach is the step's 0.7 mm in 1 ms down and 0.3 mm along x, its onset
+    // 0.2 / 0.7 of the way through step 13-14.
+    CHECK(ev[1].bounce);
+    CHECK(ev[1].stroke == 0);
+    CHECK(ev[1].normal_velocity_mps == Approx(0.7).epsilon(1e-9));
+    CHECK(ev[1].tangential_velocity_mps == Approx(0.3).epsilon(1e-9));
+    CHECK(ev[1].time_s == Approx(0.013 + 0.001 * 0.2 / 0.7).margin(1e-12));
+}
+
+TEST_CASE("strike: every onset's normal velocity is > 0; from physics steps it is the velocity "
+          "that crossed, from a continuous motion within one step's change of it",
+          "[osc][strike]")
+{
+    // 10^4 random steps that cross the plane, sampled as the Scene's
+    // integrator moves the bead: the free sample (gap 0 to 2 mm, vertical
+    // velocity -2 to +2 m/s, i.e. falling, hovering or still rising) and the
+    // first touching one, which the velocity v1 (< -g0 / h) carried across.
+    // Read as physics steps, the crossing velocity is v1 exactly. Read as
+    // samples of a continuous motion, an estimate can be off by at most the
+    // step's velocity change |v1 - v0|, and is never negative.
+    const double h = 1e-3;
+    unsigned state = 12345u;
+    auto uniform = [&](double lo, double hi) {
+        state = state * 1664525u + 1013904223u;
+        return lo + (hi - lo) * ((state >> 8) / 16777216.0);
+    };
+    int mean_cases = 0;
+    for (int i = 0; i < 10000; ++i) {
+        const double g0 = uniform(1e-7, 0.002);
+        const double v0 = uniform(-2.0, 2.0);
+        const double v1 = -g0 / h - uniform(1e-4, 3.0);
+        const std::vector<TipSample> s = semi_implicit(h, g0, {v0, v1}, {0.0, 0.0});
+        for (const bool steps : {true, false}) {
+            ictus::StrikeDetectorOptions o;
+            o.semi_implicit_samples = steps;
+            StrikeDetector det(flat_membrane(5000.0, 0.0), o);
+            StrikeEvent e;
+            REQUIRE_FALSE(det.update(0, s[0], e));
+            REQUIRE_FALSE(det.update(0, s[1], e));
+            REQUIRE(det.flush(e));
+            INFO("g0 " << g0 << " m, v0 " << v0 << " m/s, v1 " << v1 << " m/s, steps " << steps);
+            REQUIRE(e.normal_velocity_mps > 0.0);
+            if (steps) {
+                REQUIRE(e.normal_velocity_mps == Approx(-v1).epsilon(1e-9));
+                continue;
+            }
+            REQUIRE(std::fabs(e.normal_velocity_mps - (-v1)) <= std::fabs(v1 - v0) * (1 + 1e-9));
+            // A free sample that could not reach the plane in the step: the
+            // step's mean, here exactly v1.
+            if (!(-v0 * h >= g0)) {
+                ++mean_cases;
+                REQUIRE(e.normal_velocity_mps == Approx(-v1).epsilon(1e-9));
+            }
+        }
+    }
+    CHECK(mean_cases > 5000); // the rising and hovering half, at least
+}
+
+TEST_CASE("strike: a tip first seen below the membrane plane is no strike until it lifts",
+          "[osc][strike]")
+{
+    // Resting pressed into the head when watching starts (e.g. after a
+    // rebuild): no approach was seen, so no onset velocity exists to report.
+    const double h = 1e-3;
+    std::vector<double> vy(10, 0.0), vx(30, 0.0);
+    for (int n = 0; n < 5; ++n)
+        vy.push_back(1.0); // from 1.5 mm deep to 3.5 mm above
+    for (int n = 0; n < 15; ++n)
+        vy.push_back(-1.0); // and strikes again
+    const std::vector<TipSample> s = semi_implicit(h, -0.0015, vy, vx);
+    StrikeDetector det(flat_membrane(5000.0, 0.0));
+    const auto ev = run_detector(det, 1, s);
+    REQUIRE(ev.size() == 1);
+    CHECK(ev[0].normal_velocity_mps == Approx(1.0).epsilon(1e-12));
+    CHECK(ev[0].time_s == Approx(0.0175).margin(1e-12)); // gap 0.5 mm at 17 ms, 1 m/s
+    CHECK(det.side_entries() == 0);
 }

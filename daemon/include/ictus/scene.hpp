@@ -65,6 +65,17 @@ void validate(const SceneOptions &options);
 
 enum class StepResult { ok, diverged };
 
+// What the drum did to one stick in the last step, from the stick-drum contact
+// joints' feedback (dJointFeedback: the constraint forces ODE applied): the
+// force on the stick, N, world frame (normal and friction together). The force
+// on the membrane is its opposite. Zero when the stick did not touch the drum.
+struct StickDrumContact {
+    Eigen::Vector3d bead_force_n = Eigen::Vector3d::Zero();  // through the bead (tip sphere)
+    Eigen::Vector3d shaft_force_n = Eigen::Vector3d::Zero(); // through the shaft (capsule)
+    int bead_points = 0, shaft_points = 0;                   // contact points in the step
+    Eigen::Vector3d force_n() const { return bead_force_n + shaft_force_n; }
+};
+
 // Wall-clock seconds spent in the parts of the last step (only filled when asked).
 struct StepTiming {
     double control_s = 0.0;
@@ -122,8 +133,31 @@ class Scene
     // State, in the model's terms (body frame = joint frame, not the CoM).
     void body_frames(BodyFrames &frames) const;
     void local_rotations(std::vector<Eigen::Quaterniond> &local) const;
-    Eigen::Vector3d tip_position(Side side) const;
+    Eigen::Vector3d tip_position(Side side) const; // the stick's end point, world
     Eigen::Vector3d tip_velocity(Side side) const;
+    // The bead's centre (the tip minus the bead radius along the stick axis:
+    // the collision sphere's centre, what the strike detector watches) and
+    // the velocity of that point, world frame.
+    Eigen::Vector3d bead_position(Side side) const;
+    Eigen::Vector3d bead_velocity(Side side) const;
+    // The drum's action on each stick in the last step (see StickDrumContact).
+    const StickDrumContact &drum_contact(Side side) const
+    {
+        return drum_contact_[static_cast<int>(side)];
+    }
+    // The force the world exerts on the pelvis through its weld in the last
+    // step, N, world frame (with the drum contacts, the only external forces
+    // besides gravity: at rest they sum to the character's weight).
+    Eigen::Vector3d support_force_n() const;
+
+    // The drum, changed on the live scene: the membrane moves and resizes at
+    // once and the contact law (k = 2 pi T / ln(R / r_tip), c) is recomputed
+    // for the next step; the character is untouched. Throws CharacterError
+    // naming the bad value (the scene keeps its drum).
+    void set_drum(const DrumParams &drum);
+    const DrumParams &drum() const { return options_.drum; }
+    // The contact law's stiffness k in use, N/m.
+    double drum_contact_stiffness_n_per_m() const;
     double max_linear_speed_mps() const;
     double max_angular_speed_rad_s() const;
     // Adds a velocity change to a body's centre of mass (tests: injected
@@ -136,6 +170,8 @@ class Scene
     void apply_control();
     bool check() const;
     static void near_callback(void *data, dxGeom *a, dxGeom *b);
+    void place_drum();
+    void gather_contact_forces();
     CharacterPose target_pose() const;
 
     CharacterModel model_;
@@ -157,6 +193,17 @@ class Scene
         double f1[4], t1[4], f2[4], t2[4]; // layout of dJointFeedback (dVector3 = 4 dReal)
     };
     std::array<Feedback, CharacterModel::kJoints> feedback_{};
+    // One feedback slot per stick-drum contact point of the step: 2 sticks x
+    // (bead, shaft) x at most 4 points each (near_callback's kMax).
+    struct ContactSlot {
+        Feedback feedback;
+        int side = 0;
+        bool bead = false;
+    };
+    std::array<ContactSlot, 16> contact_slot_{};
+    int contact_slots_used_ = 0;
+    std::array<StickDrumContact, 2> drum_contact_{};
+    Feedback weld_feedback_{};
     std::array<std::array<Eigen::Vector3d, 3>, CharacterModel::kJoints> motor_axes_{};
     dxJoint *pelvis_weld_ = nullptr;
     dxGeom *drum_ = nullptr;

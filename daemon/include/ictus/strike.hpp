@@ -39,6 +39,17 @@ struct StrikeDetectorOptions {
     // previous release AND it starts within bounce_window_s of that release.
     double bounce_height_m = 0.01;
     double bounce_window_s = 0.15;
+    // How the samples were made, which decides the velocity that crossed the
+    // membrane plane (the pre-contact velocity of a strike):
+    // true, the Scene's physics steps: each sample's velocity is the one that
+    // carried the bead from the previous sample (semi-implicit Euler, p1 =
+    // p0 + h v1, and no contact acts in the step that crosses the plane: ODE
+    // collides at the step's start), so the crossing velocity is the step's
+    // (p1 - p0) / h.
+    // false, samples of a continuous trajectory (a kinematic reference, an
+    // analytic motion): the last free sample's velocity when it could have
+    // carried the bead across within the step, else the step's mean.
+    bool semi_implicit_samples = true;
 };
 
 // One contact episode of a stick tip with the membrane (one row of strikes.csv).
@@ -132,6 +143,19 @@ class StrikeDetector
     long next_seq_ = 0;
     long side_entries_ = 0;
 };
+
+class Scene;
+
+// The membrane of a Scene's drum as the detector sees it: the same disk and the
+// same contact law (k, c, friction, the sticks' bead radius).
+MembraneGeometry membrane_of(const Scene &scene, int drum_id = 0);
+
+// Feeds the detector both beads of `scene` (Scene::bead_position/velocity) at
+// the scene's time, once after each of its steps; writes the strikes ended in
+// that step to out[0..n) and returns n (<= 2). `time_offset_s` is added to
+// the scene's clock (a run that rebuilt its scene keeps one clock).
+int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out[2],
+                   double time_offset_s = 0.0);
 
 // strikes.csv: a header line and one line per event, fixed precision (so that
 // equal runs give equal bytes). Columns in docs/osc.md.

@@ -1,6 +1,8 @@
 // The interaction manager's strike detection (strike.hpp).
 #include "ictus/strike.hpp"
 
+#include "ictus/scene.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -32,6 +34,33 @@ double parabola_peak(const double t[3], const double f[3])
         return f[1];
     const double peak = f[0] + s0 * (ts - t[0]) + a * (ts - t[0]) * (ts - t[1]);
     return std::isfinite(peak) ? std::max(peak, f[1]) : f[1];
+}
+
+// The velocity with which the bead crossed the membrane plane between the
+// last free sample (gap g0 >= 0) and the first touching one (gap g1 < 0),
+// for the two kinds of samples (StrikeDetectorOptions::semi_implicit_samples).
+// Either way its normal part is > 0: the step's mean has (g0 - g1) / dt > 0
+// since the gap changed sign. The old rule, the free sample's velocity
+// regardless, gave re-contacts after a lift smaller than one step's motion a
+// negative normal velocity: the still rising bead's.
+Eigen::Vector3d approach_velocity(const TipSample &free, double g0, const TipSample &touching,
+                                  bool semi_implicit)
+{
+    const double dt = touching.time_s - free.time_s;
+    if (!(dt > 0.0)) // times not increasing (bad input): no speed measurable, never a negative one
+        return Eigen::Vector3d::Zero();
+    const Eigen::Vector3d mean = (touching.center_m - free.center_m) / dt;
+    if (semi_implicit)
+        return mean; // the velocity the bead crossed with (p1 = p0 + h v1)
+    // A continuous trajectory: the free sample's velocity is free of contact
+    // force, exact for a uniform flight, within one step's acceleration
+    // otherwise; but only if it could have brought the bead across (towards
+    // the membrane, by at least g0). If not (still rising, hovering,
+    // creeping), the approach that crossed began inside the step: its mean.
+    const double free_approach_mps = -free.velocity_mps.dot(kNormal);
+    if (free_approach_mps > 0.0 && free_approach_mps * dt >= g0)
+        return free.velocity_mps;
+    return mean;
 }
 } // namespace
 
@@ -88,10 +117,15 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
 
     // A tip that comes in over the disk already below the membrane plane
     // entered from the side: that is the shell (or rim), not a strike on the
-    // membrane. It is ignored until the tip is above the plane again.
-    if (!h.in_contact && touching && h.has_previous && h.previous_gap < 0.0 && !h.side_entry) {
-        h.side_entry = true;
-        ++side_entries_;
+    // membrane. It is ignored until the tip is above the plane again. So is a
+    // tip first seen below the plane (no approach was observed), uncounted.
+    if (!h.in_contact && touching && !h.side_entry) {
+        if (!h.has_previous) {
+            h.side_entry = true;
+        } else if (h.previous_gap < 0.0) {
+            h.side_entry = true;
+            ++side_entries_;
+        }
     }
     if (h.side_entry) {
         if (gap >= 0.0)
@@ -102,14 +136,11 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
     }
 
     if (!h.in_contact && touching) {
-        // Onset: where the gap crosses zero between the last free sample and this one.
-        double frac = 0.0;
-        TipSample before = s;
-        if (h.has_previous) {
-            before = h.previous;
-            const double g0 = std::max(h.previous_gap, 0.0);
-            frac = g0 > 0.0 ? g0 / (g0 - gap) : 0.0;
-        }
+        // Onset: where the gap crosses zero between the last free sample and
+        // this one (here previous_gap >= 0 > gap: the cases above left).
+        const TipSample &before = h.previous;
+        const double g0 = h.previous_gap;
+        const double frac = g0 > 0.0 ? g0 / (g0 - gap) : 0.0;
         const double t_on = before.time_s + frac * (s.time_s - before.time_s);
         const Eigen::Vector3d p_on = before.center_m + frac * (s.center_m - before.center_m) -
                                      membrane_.tip_radius_m * kNormal;
@@ -123,8 +154,7 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
         e.theta_deg = std::atan2(e.y_m, e.x_m) * 180.0 / M_PI;
         if (e.theta_deg <= -180.0)
             e.theta_deg += 360.0;
-        // Pre-contact velocity: the last sample before touching.
-        const Eigen::Vector3d v = before.velocity_mps;
+        const Eigen::Vector3d v = approach_velocity(before, g0, s, options_.semi_implicit_samples);
         e.normal_velocity_mps = -v.dot(kNormal);
         e.tangential_velocity_mps = (v - v.dot(kNormal) * kNormal).norm();
         e.bounce = h.released_once && (t_on - h.release_time_s) <= options_.bounce_window_s &&
@@ -224,6 +254,38 @@ bool StrikeDetector::flush(StrikeEvent &out)
             return true;
         }
     return false;
+}
+
+// ---- a Scene's strikes -------------------------------------------------------
+
+MembraneGeometry membrane_of(const Scene &scene, int drum_id)
+{
+    MembraneGeometry m;
+    const DrumParams &d = scene.drum();
+    m.center_m = d.center_m;
+    m.radius_m = d.radius_m;
+    m.tip_radius_m = scene.model().options().stick.tip_radius_m;
+    m.stiffness_n_per_m = scene.drum_contact_stiffness_n_per_m();
+    m.damping_n_s_per_m = d.contact_damping_n_s_per_m;
+    m.friction = d.friction;
+    m.drum_id = drum_id;
+    return m;
+}
+
+int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out[2],
+                   double time_offset_s)
+{
+    int n = 0;
+    for (int hand = 0; hand < 2; ++hand) {
+        const Side side = static_cast<Side>(hand);
+        TipSample s;
+        s.time_s = time_offset_s + scene.time_s();
+        s.center_m = scene.bead_position(side);
+        s.velocity_mps = scene.bead_velocity(side);
+        if (detector.update(hand, s, out[n]))
+            ++n;
+    }
+    return n;
 }
 
 // ---- files -----------------------------------------------------------------

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 namespace ictus
 {
@@ -224,7 +225,6 @@ void Scene::build(const CharacterPose &initial)
         dJointAttach(motor_[j], body_[child], body_[parent]);
         dJointSetAMotorMode(motor_[j], dAMotorUser);
         dJointSetAMotorNumAxes(motor_[j], 3);
-        static_assert(sizeof(Feedback) == sizeof(dJointFeedback), "feedback layout");
         dJointSetFeedback(motor_[j], reinterpret_cast<dJointFeedback *>(&feedback_[j]));
     }
 
@@ -252,26 +252,66 @@ void Scene::build(const CharacterPose &initial)
     }
 
     // Drum: a static cylinder whose top face is the membrane.
+    drum_ = dCreateCylinder(space_, options_.drum.radius_m, options_.drum.shell_depth_m);
+    dGeomSetCategoryBits(drum_, kDrumCategory);
+    dGeomSetCollideBits(drum_, kStickCategory);
+    place_drum();
+
+    static_assert(sizeof(Feedback) == sizeof(dJointFeedback), "feedback layout");
+    dJointSetFeedback(pelvis_weld_, reinterpret_cast<dJointFeedback *>(&weld_feedback_));
+}
+
+void Scene::place_drum()
+{
     const DrumParams &drum = options_.drum;
-    drum_ = dCreateCylinder(space_, drum.radius_m, drum.shell_depth_m);
+    dGeomCylinderSetParams(drum_, drum.radius_m, drum.shell_depth_m);
     const Eigen::Vector3d c = drum.center_m - Eigen::Vector3d(0, 0.5 * drum.shell_depth_m, 0);
     dGeomSetPosition(drum_, c.x(), c.y(), c.z());
     set_rotation(drum_, z_onto(Eigen::Vector3d::UnitY()), false);
-    dGeomSetCategoryBits(drum_, kDrumCategory);
-    dGeomSetCollideBits(drum_, kStickCategory);
 
     // Soft contact from the membrane's spring-damper (ODE manual: ERP = h k /
     // (h k + c), CFM = 1 / (h k + c)).
     const double h = options_.step_s;
-    const double k = drum.stiffness_n_per_m(sp.tip_radius_m);
+    const double k = drum_contact_stiffness_n_per_m();
     const double cd = drum.contact_damping_n_s_per_m;
     contact_erp_ = h * k / (h * k + cd);
     contact_cfm_ = 1.0 / (h * k + cd);
 }
 
+double Scene::drum_contact_stiffness_n_per_m() const
+{
+    return options_.drum.stiffness_n_per_m(model_.options().stick.tip_radius_m);
+}
+
+void Scene::set_drum(const DrumParams &drum)
+{
+    SceneOptions candidate = options_;
+    candidate.drum = drum;
+    validate(candidate); // throws naming the value; nothing changed yet
+    if (drum.radius_m <= model_.options().stick.tip_radius_m)
+        throw CharacterError("drum radius: must exceed the stick tip radius");
+    options_.drum = drum;
+    place_drum();
+}
+
 void Scene::near_callback(void *data, dGeomID a, dGeomID b)
 {
     Scene *self = static_cast<Scene *>(data);
+    // Only sticks meet the drum (category bits). The stick's geom goes first,
+    // so that its body is the contact joint's body 1 and the joint feedback's
+    // f1 is the force on the stick (the normal then points into the stick).
+    if (a == self->drum_)
+        std::swap(a, b);
+    int side = -1;
+    bool bead = false;
+    for (int s = 0; s < 2; ++s) {
+        if (a == self->stick_tip_[s]) {
+            side = s;
+            bead = true;
+        } else if (a == self->stick_shaft_[s]) {
+            side = s;
+        }
+    }
     constexpr int kMax = 4;
     dContactGeom geoms[kMax];
     const int n = dCollide(a, b, kMax, geoms, sizeof(dContactGeom));
@@ -284,8 +324,32 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         contact.surface.soft_cfm = self->contact_cfm_;
         dJointID joint = dJointCreateContact(self->world_, self->contacts_, &contact);
         dJointAttach(joint, dGeomGetBody(a), dGeomGetBody(b));
+        if (side >= 0 && self->contact_slots_used_ < static_cast<int>(self->contact_slot_.size())) {
+            ContactSlot &slot = self->contact_slot_[self->contact_slots_used_++];
+            slot.feedback = Feedback{};
+            slot.side = side;
+            slot.bead = bead;
+            dJointSetFeedback(joint, reinterpret_cast<dJointFeedback *>(&slot.feedback));
+        }
     }
     self->contacts_last_step_ += n;
+}
+
+void Scene::gather_contact_forces()
+{
+    drum_contact_ = {};
+    for (int i = 0; i < contact_slots_used_; ++i) {
+        const ContactSlot &slot = contact_slot_[i];
+        StickDrumContact &c = drum_contact_[slot.side];
+        const Eigen::Vector3d f = to_eigen3(slot.feedback.f1);
+        if (slot.bead) {
+            c.bead_force_n += f;
+            ++c.bead_points;
+        } else {
+            c.shaft_force_n += f;
+            ++c.shaft_points;
+        }
+    }
 }
 
 void Scene::apply_control()
@@ -391,6 +455,7 @@ StepResult Scene::step(StepTiming *timing)
     if (timing)
         t1 = clock::now();
     contacts_last_step_ = 0;
+    contact_slots_used_ = 0;
     dSpaceCollide(space_, this, &Scene::near_callback);
     if (contacts_last_step_ > 0)
         ++contact_steps_;
@@ -400,6 +465,8 @@ StepResult Scene::step(StepTiming *timing)
         dWorldQuickStep(world_, options_.step_s);
     else
         dWorldStep(world_, options_.step_s);
+    // The feedback slots are ours: read after the step, valid after the joints go.
+    gather_contact_forces();
     dJointGroupEmpty(contacts_);
     if (timing)
         t3 = clock::now();
@@ -461,6 +528,8 @@ void Scene::reset(const CharacterPose &pose_in)
         dBodySetTorque(body_[b], 0, 0, 0);
     }
     dJointGroupEmpty(contacts_);
+    drum_contact_ = {};
+    weld_feedback_ = Feedback{};
 }
 
 void Scene::body_frames(BodyFrames &frames) const
@@ -492,6 +561,33 @@ Eigen::Vector3d Scene::tip_position(Side side) const
     dVector3 out;
     dBodyGetRelPointPos(body_[hb], rel.x(), rel.y(), rel.z(), out);
     return to_eigen3(out);
+}
+
+Eigen::Vector3d Scene::bead_position(Side side) const
+{
+    const int hb = model_.hand_body(side);
+    const StickInHand &st = model_.stick(side);
+    const Eigen::Vector3d rel =
+        st.tip_m - model_.options().stick.tip_radius_m * st.axis - com_local_[hb];
+    dVector3 out;
+    dBodyGetRelPointPos(body_[hb], rel.x(), rel.y(), rel.z(), out);
+    return to_eigen3(out);
+}
+
+Eigen::Vector3d Scene::bead_velocity(Side side) const
+{
+    const int hb = model_.hand_body(side);
+    const StickInHand &st = model_.stick(side);
+    const Eigen::Vector3d rel =
+        st.tip_m - model_.options().stick.tip_radius_m * st.axis - com_local_[hb];
+    dVector3 out;
+    dBodyGetRelPointVel(body_[hb], rel.x(), rel.y(), rel.z(), out);
+    return to_eigen3(out);
+}
+
+Eigen::Vector3d Scene::support_force_n() const
+{
+    return to_eigen3(weld_feedback_.f1);
 }
 
 Eigen::Vector3d Scene::motor_torque(int joint) const
