@@ -10,6 +10,7 @@
 #include "ictus/joint_limits.hpp"
 #include "ictus/marker_csv.hpp"
 #include "ictus/stick_capture.hpp"
+#include "ictus/strike.hpp"
 #include "ictus/track.hpp"
 #include "ictus/verbs_osc.hpp"
 
@@ -25,7 +26,9 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <algorithm>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace
@@ -209,6 +212,46 @@ struct Args {
     }
 };
 
+// The options track and limits share: how a BVH clip is read and how its
+// reference motion is cleaned (ictusd track --help, ictusd limits --help).
+struct ClipOptions {
+    double scale = kCmuScale;
+    int skip = 1;
+    ictus::ReferenceFilter filter;
+};
+
+// When `a` is one of the clip options, reads its value into `clip` and
+// returns true; false otherwise (nothing consumed).
+bool parse_clip_option(const std::string &a, Args &args, ClipOptions &clip)
+{
+    if (a == "--scale") {
+        clip.scale = parse_positive(a, args.value(a));
+    } else if (a == "--skip-frames") {
+        clip.skip = parse_int(a, args.value(a), 0, 100000000);
+    } else if (a == "--smooth-hz") {
+        clip.filter.smooth_cutoff_hz = parse_double(a, args.value(a));
+        if (clip.filter.smooth_cutoff_hz < 0.0)
+            throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
+    } else if (a == "--despike-deg") {
+        clip.filter.spike_threshold_rad = parse_double(a, args.value(a)) * M_PI / 180.0;
+        if (clip.filter.spike_threshold_rad < 0.0)
+            throw UsageError("--despike-deg: expected a number >= 0 (0: off)");
+    } else {
+        return false;
+    }
+    return true;
+}
+
+// A limit's minimum half-width per axis, degrees (track --limit-min-deg,
+// limits --min-deg).
+double parse_min_half_width_deg(const std::string &option, const std::string &text)
+{
+    const double w = parse_double(option, text);
+    if (w < 0.0 || w >= 180.0)
+        throw UsageError(option + ": expected 0 <= deg < 180, got '" + text + "'");
+    return w;
+}
+
 bool is_csv(const std::string &path)
 {
     if (path.size() < 4)
@@ -230,6 +273,57 @@ ictus::BvhFile load_bvh(const std::string &path, double scale, int skip)
         std::cerr << "ictusd: warning: " << w << "\n";
     return bvh;
 }
+
+// strikes.csv of a verb that simulates (issue 5): the interaction manager on
+// the scene's beads, fed once after each physics step; rows in onset order
+// (seq), as render writes them. Strikes are few (a few per second): they are
+// kept and written at close(), so that the physics loop never writes a file.
+class StrikesCsv
+{
+  public:
+    StrikesCsv(std::string path, const ictus::StrikeDetectorOptions &options = {})
+        : path_(std::move(path)), detector_(ictus::MembraneGeometry{}, options)
+    {
+    }
+    // After each step of `scene` (its drum is read at the first call and
+    // whenever it moved: a scene changed by Scene::set_drum).
+    void after_step(const ictus::Scene &scene)
+    {
+        const ictus::MembraneGeometry m = ictus::membrane_of(scene);
+        if (!started_ || m.center_m != detector_.membrane().center_m ||
+            m.radius_m != detector_.membrane().radius_m ||
+            m.stiffness_n_per_m != detector_.membrane().stiffness_n_per_m)
+            detector_.set_membrane(m);
+        started_ = true;
+        ictus::StrikeEvent out[2];
+        const int n = ictus::detect_strikes(detector_, scene, out);
+        events_.insert(events_.end(), out, out + n);
+    }
+    // Ends open contacts and writes the file; throws naming it on error.
+    void close()
+    {
+        ictus::StrikeEvent e;
+        while (detector_.flush(e))
+            events_.push_back(e);
+        std::sort(
+            events_.begin(), events_.end(),
+            [](const ictus::StrikeEvent &a, const ictus::StrikeEvent &b) { return a.seq < b.seq; });
+        std::ofstream out(path_);
+        ictus::write_strikes_csv_header(out);
+        for (const ictus::StrikeEvent &event : events_)
+            ictus::write_strike_csv_row(out, event);
+        out.close();
+        if (!out)
+            throw std::runtime_error("--out: cannot write '" + path_ + "'");
+    }
+    long strikes() const { return static_cast<long>(events_.size()); }
+
+  private:
+    std::string path_;
+    ictus::StrikeDetector detector_;
+    std::vector<ictus::StrikeEvent> events_;
+    bool started_ = false;
+};
 
 class Progress
 {
@@ -260,12 +354,11 @@ class Progress
 int run_track(Args &args)
 {
     std::string mode, mocap, out_dir, limits_mode = "quaternion", gains_file;
-    double scale = kCmuScale, limit_k = 3.0, limit_width_deg = 6.0;
-    int skip = 1;
+    double limit_k = 3.0, limit_width_deg = 6.0;
+    ClipOptions clip;
     bool quiet = false;
     ictus::CharacterOptions character;
     ictus::TrackOptions options;
-    ictus::ReferenceFilter filter;
     bool drum_pos_given = false;
     std::string left_stick, right_stick;
     ictus::MarkerCsvOptions csv_options;
@@ -332,10 +425,7 @@ int run_track(Args &args)
             mocap = args.value(a);
         } else if (a == "--out") {
             out_dir = args.value(a);
-        } else if (a == "--scale") {
-            scale = parse_positive(a, args.value(a));
-        } else if (a == "--skip-frames") {
-            skip = parse_int(a, args.value(a), 0, 100000000);
+        } else if (parse_clip_option(a, args, clip)) {
         } else if (a == "--duration") {
             options.duration_s = parse_positive(a, args.value(a));
         } else if (a == "--step") {
@@ -388,10 +478,7 @@ int run_track(Args &args)
         } else if (a == "--limit-k") {
             limit_k = parse_positive(a, args.value(a));
         } else if (a == "--limit-min-deg") {
-            limit_width_deg = parse_double(a, args.value(a));
-            if (limit_width_deg < 0.0 || limit_width_deg >= 180.0)
-                throw UsageError("--limit-min-deg: expected 0 <= deg < 180, got '" +
-                                 std::to_string(limit_width_deg) + "'");
+            limit_width_deg = parse_min_half_width_deg(a, args.value(a));
         } else if (a == "--no-stops") {
             options.scene.limit_stops = false;
         } else if (a == "--ramp") {
@@ -399,14 +486,6 @@ int run_track(Args &args)
             if (options.ramp_s < 0.0)
                 throw UsageError("--ramp: expected a number >= 0, got " +
                                  std::to_string(options.ramp_s));
-        } else if (a == "--smooth-hz") {
-            filter.smooth_cutoff_hz = parse_double(a, args.value(a));
-            if (filter.smooth_cutoff_hz < 0.0)
-                throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
-        } else if (a == "--despike-deg") {
-            filter.spike_threshold_rad = parse_double(a, args.value(a)) * M_PI / 180.0;
-            if (filter.spike_threshold_rad < 0.0)
-                throw UsageError("--despike-deg: expected a number >= 0 (0: off)");
         } else if (a == "--quiet" || a == "-q") {
             quiet = true;
         } else {
@@ -462,13 +541,13 @@ int run_track(Args &args)
             limits_mode = "none";
         }
     } else {
-        bvh = load_bvh(mocap, scale, skip);
+        bvh = load_bvh(mocap, clip.scale, clip.skip);
     }
     const ictus::CharacterModel model =
         ictus::CharacterModel::from_skeleton(bvh.skeleton, character);
     const ictus::ReferenceMotion raw(model, bvh.motion);
-    const ictus::ReferenceMotion reference(model, bvh.motion,
-                                           stick_only ? ictus::ReferenceFilter{0.0, 0.0} : filter);
+    const ictus::ReferenceMotion reference(
+        model, bvh.motion, stick_only ? ictus::ReferenceFilter{0.0, 0.0} : clip.filter);
     ictus::TipTrajectory tips;
     if (stick_only) {
         tips = ictus::place_behind_sticks(model, reference.frame(0), capture, stick_tracks);
@@ -518,8 +597,8 @@ int run_track(Args &args)
 
     nlohmann::json j = summary.to_json();
     j["mocap"] = mocap;
-    j["scale_m_per_unit"] = scale;
-    j["skip_frames"] = skip;
+    j["scale_m_per_unit"] = clip.scale;
+    j["skip_frames"] = clip.skip;
     j["step_s"] = options.scene.step_s;
     j["stepper"] = options.scene.stepper == ictus::Stepper::quick ? "quick" : "direct";
     j["quickstep_iterations"] = options.scene.quickstep_iterations;
@@ -532,8 +611,8 @@ int run_track(Args &args)
     j["gain_hz"] = options.gains.natural_frequency_hz;
     j["damping_ratio"] = options.gains.damping_ratio;
     j["drum_radius_m"] = options.scene.drum.radius_m;
-    j["smooth_hz"] = filter.smooth_cutoff_hz;
-    j["despike_deg"] = filter.spike_threshold_rad * 180.0 / M_PI;
+    j["smooth_hz"] = clip.filter.smooth_cutoff_hz;
+    j["despike_deg"] = clip.filter.spike_threshold_rad * 180.0 / M_PI;
     j["spikes_removed"] = reference.spikes_removed();
     j["interrupted"] = summary.interrupted;
     j["gains"] = ictus::gains_to_json(model, gains);
@@ -572,10 +651,8 @@ int run_track(Args &args)
 int run_limits(Args &args)
 {
     std::string file, out = "limits.json";
-    double scale = kCmuScale;
-    int skip = 1;
+    ClipOptions clip;
     ictus::CharacterLimitOptions lo;
-    ictus::ReferenceFilter filter;
     while (!args.done()) {
         const std::string a = args.next();
         if (a == "--help" || a == "-h") {
@@ -583,26 +660,11 @@ int run_limits(Args &args)
             return 0;
         } else if (a == "--out") {
             out = args.value(a);
-        } else if (a == "--scale") {
-            scale = parse_positive(a, args.value(a));
-        } else if (a == "--skip-frames") {
-            skip = parse_int(a, args.value(a), 0, 100000000);
+        } else if (parse_clip_option(a, args, clip)) {
         } else if (a == "--k") {
             lo.k = parse_positive(a, args.value(a));
         } else if (a == "--min-deg") {
-            const double w = parse_double(a, args.value(a));
-            if (w < 0.0 || w >= 180.0)
-                throw UsageError("--min-deg: expected 0 <= deg < 180, got '" + std::to_string(w) +
-                                 "'");
-            lo.min_half_width_rad = w * M_PI / 180.0;
-        } else if (a == "--smooth-hz") {
-            filter.smooth_cutoff_hz = parse_double(a, args.value(a));
-            if (filter.smooth_cutoff_hz < 0.0)
-                throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
-        } else if (a == "--despike-deg") {
-            filter.spike_threshold_rad = parse_double(a, args.value(a)) * M_PI / 180.0;
-            if (filter.spike_threshold_rad < 0.0)
-                throw UsageError("--despike-deg: expected a number >= 0 (0: off)");
+            lo.min_half_width_rad = parse_min_half_width_deg(a, args.value(a)) * M_PI / 180.0;
         } else if (!a.empty() && a[0] == '-' && a != "-") {
             throw UsageError("limits: unknown option '" + a + "' (see ictusd limits --help)");
         } else if (file.empty()) {
@@ -613,9 +675,9 @@ int run_limits(Args &args)
     }
     if (file.empty())
         throw UsageError("limits: FILE is required (ictusd limits FILE)");
-    const ictus::BvhFile bvh = load_bvh(file, scale, skip);
+    const ictus::BvhFile bvh = load_bvh(file, clip.scale, clip.skip);
     const ictus::CharacterModel model = ictus::CharacterModel::from_skeleton(bvh.skeleton);
-    const ictus::ReferenceMotion reference(model, bvh.motion, filter);
+    const ictus::ReferenceMotion reference(model, bvh.motion, clip.filter);
     const ictus::CharacterLimits limits(model, reference, lo);
     nlohmann::json report = limits.report();
     report["mocap"] = file;
