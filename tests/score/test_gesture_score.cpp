@@ -131,6 +131,20 @@ TEST_CASE("plan: every note's tip is at its spot on its beat", "[score][plan]")
     }
 }
 
+TEST_CASE("plan: R+L strikes both sticks on the same beat", "[score][plan]")
+{
+    const GesturePlan plan =
+        plan_performance(score_of("tempo 90\nR+L accent, R, L, both legato\n"), db(), frame());
+    REQUIRE(plan.notes.size() == 6);
+    CHECK(plan.notes[0].time_s == plan.notes[1].time_s);
+    CHECK(plan.notes[4].time_s == plan.notes[5].time_s);
+    for (const PlannedNote &n : plan.notes) {
+        const Eigen::Vector3d tip =
+            plan.tips.tip_m[static_cast<int>(n.hand)][index_at(plan, n.time_s)];
+        CHECK((tip - n.tip_target_m).norm() < 1e-4);
+    }
+}
+
 TEST_CASE("plan: the strike depth moves the target below the head", "[score][plan]")
 {
     PlanOptions opt;

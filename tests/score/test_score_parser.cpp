@@ -114,6 +114,28 @@ TEST_CASE("score: every note option", "[score][parser]")
     CHECK(s.length_beats == 6.75);
 }
 
+TEST_CASE("score: R+L strikes both hands on one beat", "[score][parser]")
+{
+    const Score s = parse_score("R+L accent f 1/2\nboth\nL+R staccato\nR\n", "both");
+    REQUIRE(s.notes.size() == 7);
+    CHECK(s.notes[0].hand == Side::right);
+    CHECK(s.notes[1].hand == Side::left);
+    for (int i : {0, 1}) {
+        CHECK(s.notes[i].beat == 0.0);
+        CHECK(s.notes[i].beats == 0.5);
+        CHECK(s.notes[i].nuance == Nuance::accent);
+        CHECK(s.notes[i].dynamics == 0.8);
+    }
+    CHECK(s.notes[0].theta_deg == 180.0); // each hand on its own side
+    CHECK(s.notes[1].theta_deg == 0.0);
+    CHECK(s.notes[2].beat == 0.5);
+    CHECK(s.notes[3].beat == 0.5);
+    CHECK(s.notes[5].nuance == Nuance::staccato);
+    CHECK(s.notes[6].beat == 2.5);
+    CHECK(s.length_beats == 3.5);
+    require_error("R+L at 0.3 90", 1, 1, "'at' places one stick");
+}
+
 TEST_CASE("score: the dynamics words rise from pp to ff and mf is the default", "[score][parser]")
 {
     const auto &words = dynamics_words();
@@ -279,6 +301,7 @@ TEST_CASE("score: errors name the source and line and column and the fault",
         "R legatto", 1, 3,
         "unknown nuance 'legatto' (valid: legato, tenuto, accent, vertical_accent, staccato)");
     require_error("R\nX legato", 2, 1, "unknown statement 'X'");
+    require_error("R+X", 1, 1, "unknown statement 'R+X' (expected a hand R, L, right, left, R+L");
     require_error("tempo 96\n  tempo 9x6", 2, 9, "malformed number '9x6' for tempo");
     require_error("tempo 500", 1, 7, "tempo 500 is out of range (20..400 bpm)");
     require_error("tempo 10", 1, 7, "out of range (20..400 bpm)");

@@ -148,6 +148,7 @@ struct Statement {
     int column = 0;
     // note
     Side hand = Side::right;
+    bool both_hands = false; // R+L: one stroke of each hand on the same beat
     Nuance nuance = Nuance::legato;
     std::optional<double> beats;    // note, rest, default_beats
     std::optional<double> dynamics; // note, default_dynamics
@@ -379,6 +380,13 @@ class LineParser
             st.kind = Kind::note;
             st.hand = *hand;
             note_options(tk, st);
+        } else if (key == "r+l" || key == "l+r" || key == "both") {
+            st.kind = Kind::note;
+            st.both_hands = true;
+            note_options(tk, st);
+            if (st.r_over_a)
+                fail(tk[0].column, "'at' places one stick; " + tk[0].text +
+                                       " plays each hand on its default spot");
         } else if (key == "tempo") {
             st.kind = Kind::tempo;
             size_t i = 1;
@@ -445,9 +453,10 @@ class LineParser
             st.kind = Kind::end;
             no_more(tk, 1, "'end'");
         } else {
-            fail(tk[0].column, "unknown statement '" + tk[0].text +
-                                   "' (expected a hand R, L, right, left, or tempo, grip, rest, "
-                                   "beats, dynamics, repeat, end)");
+            fail(tk[0].column,
+                 "unknown statement '" + tk[0].text +
+                     "' (expected a hand R, L, right, left, R+L, or tempo, grip, rest, "
+                     "beats, dynamics, repeat, end)");
         }
         return st;
     }
@@ -619,15 +628,19 @@ Score ScoreBuilder::finish() const
             ScoreNote n;
             n.beat = beat;
             n.beats = st.beats.value_or(default_beats);
-            n.hand = st.hand;
             n.nuance = st.nuance;
             n.grip = grip;
             n.dynamics = st.dynamics.value_or(default_dynamics);
             n.r_over_a = st.r_over_a.value_or(kDefaultRadiusFraction);
-            n.theta_deg = st.theta_deg.value_or(kDefaultThetaDeg[static_cast<int>(st.hand)]);
             n.line = st.line;
             n.column = st.column;
-            score.notes.push_back(n);
+            for (Side hand : {Side::right, Side::left}) {
+                if (!st.both_hands && hand != st.hand)
+                    continue;
+                n.hand = hand;
+                n.theta_deg = st.theta_deg.value_or(kDefaultThetaDeg[static_cast<int>(hand)]);
+                score.notes.push_back(n);
+            }
             advance(st, n.beats);
             break;
         }
