@@ -183,6 +183,10 @@ def main():
                              label="%s %s" % (hand, "bounce" if bounce else "strike"))
     if drum_y is not None:
         ax_tips.axhline(drum_y, color="0.5", lw=0.8, ls="--", label="drum head")
+    # headroom above the highest lift for the legend
+    top = max(float(np.max(v)) for v in height.values())
+    bottom = min(float(np.min(v)) for v in height.values())
+    ax_tips.set_ylim(bottom - 0.03 * (top - bottom), top + 0.3 * (top - bottom))
     ax_tips.set_ylabel("tip height (m)")
     ax_tips.legend(fontsize=7, ncol=4, loc="upper right")
     ax_tips.grid(alpha=0.3)
