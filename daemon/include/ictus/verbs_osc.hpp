@@ -135,6 +135,12 @@ class Performance
     Eigen::Vector3d tip_position(int hand) const;
     const PerformerFrame &performer_frame() const;
     TrackMode mode() const;
+    // The planned target's speed toward the head as it reaches the contact,
+    // per note of plan() (m/s).
+    double planned_impact_speed_mps(size_t note) const
+    {
+        return note < planned_speed_mps_.size() ? planned_speed_mps_[note] : 0.0;
+    }
     // Plans the current score and starts it now (what /ictus/play does in
     // score mode). Throws ScoreError / GestureError; on error nothing changes.
     void start_score();
@@ -167,6 +173,7 @@ class Performance
     // Per hand, per note: plan time of the beat, the lead of the target's
     // first contact before it, the approach speed there (target_at).
     std::array<std::vector<double>, 2> beats_, lead_s_, approach_mps_;
+    std::vector<double> planned_speed_mps_; // [note of plan_]
     bool playing_ = true;
     bool rebuild_pending_ = false;
     double clip_time_s_ = 0.0;

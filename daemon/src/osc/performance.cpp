@@ -386,6 +386,12 @@ ScorePerformOptions::ScorePerformOptions()
     // contact on each beat, and is sampled the controller's lag ahead.
     plan.strike_depth_m = 0.004;
     time_advance_s = 0.0;
+    // Algorithm 2 for strokes: `ictusd track`'s CMU-tuned velocity term
+    // (c = 0.1 s) feeds the 1 kHz tip velocity back and makes the tip chatter
+    // at strike speeds (impact speeds +-20 % off the plan, not monotonic in
+    // the dynamics); without it and with gain 4 they are within ~1 %.
+    cartesian.gain = 4.0;
+    cartesian.velocity_gain_s = 0.0;
 }
 
 void Performance::build_score(bool keep_pose)
@@ -496,11 +502,13 @@ void Performance::start_score()
     // Per note: its beat, how long before it the target reaches the contact
     // (the lead that target_at removes) and its approach speed there.
     const PerformerFrame &frame = score_rig_->frame;
+    planned_speed_mps_.assign(plan_->notes.size(), 0.0);
     for (int s = 0; s < 2; ++s) {
         beats_[s].clear();
         lead_s_[s].clear();
         approach_mps_[s].clear();
-        for (const PlannedNote &n : plan_->notes) {
+        for (size_t i = 0; i < plan_->notes.size(); ++i) {
+            const PlannedNote &n = plan_->notes[i];
             if (static_cast<int>(n.hand) != s)
                 continue;
             auto height = [&](double t) {
@@ -524,6 +532,7 @@ void Performance::start_score()
             beats_[s].push_back(n.time_s);
             lead_s_[s].push_back(lead);
             approach_mps_[s].push_back(v);
+            planned_speed_mps_[i] = v;
         }
     }
     plan_active_ = true;

@@ -185,6 +185,10 @@ bool common_option(const std::string &a, int &i, int argc, char **argv, Performa
         o.score.plan.strike_depth_m = parse_number(a, value(), -0.05, 0.05);
     else if (a == "--advance")
         o.score.time_advance_s = parse_number(a, value(), 0, 0.1);
+    else if (a == "--ik-gain")
+        o.score.cartesian.gain = parse_number(a, value(), 0.1, 100);
+    else if (a == "--ik-velocity-gain")
+        o.score.cartesian.velocity_gain_s = parse_number(a, value(), 0, 1);
     else if (a == "--rebound")
         o.score.rebound_s = parse_number(a, value(), 0, 0.5);
     else if (a == "--lead-in")
@@ -324,7 +328,8 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
                             {"hand", to_string(p.hand)},
                             {"nuance", to_string(p.nuance)},
                             {"dynamics", p.dynamics},
-                            {"line", p.line}};
+                            {"line", p.line},
+                            {"planned_impact_speed_mps", perf.planned_impact_speed_mps(i)}};
         if (k.strike_seq >= 0) {
             e["strike_seq"] = k.strike_seq;
             e["error_ms"] = k.error_ms;
@@ -456,7 +461,7 @@ int cmd_render(int argc, char **argv)
         j["bounces"] = bounces;
         j["divergences"] = perf.divergences();
         j["side_entries"] = perf.detector().side_entries();
-        j["grip"] = to_string(o.character.grip);
+        j["grip"] = to_string(perf.options().character.grip);
         if (!score_mode)
             j["tempo_bpm"] = o.tempo_bpm;
         j["drum"] = drum_json(perf);

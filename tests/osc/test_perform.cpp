@@ -1,0 +1,351 @@
+// Score performance (issue 6, acceptance): a score is planned into stick-tip
+// targets and performed by the real simulation (Tracker on the Scene, the
+// strike detector on the tips). Over 40, 96 and 200 bpm, both grips, every
+// nuance and both control modes: exactly one primary strike per note, each
+// within 5 ms of its beat, none where no note is; louder dynamics and louder
+// nuances (gesture.hpp's documented kLoudnessOrder) hit the head faster.
+// The strikes are matched to the notes here, independently of the daemon's
+// own match_strikes (which render.json uses).
+#include "osc_test_util.hpp"
+
+#include "ictus/verbs_osc.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace ictus;
+
+namespace
+{
+
+// Under AddressSanitizer the simulation runs ~10x slower: the matrix keeps
+// every tempo and grip but only the Cartesian mode (joint mode is covered by
+// the release build).
+#ifdef ICTUS_PERFORM_QUICK
+constexpr bool kQuick = true;
+#else
+constexpr bool kQuick = false;
+#endif
+
+struct Performed {
+    std::vector<PlannedNote> notes;
+    std::vector<StrikeEvent> strikes; // in onset order
+    double origin_s = 0.0;
+    int divergences = 0;
+};
+
+Performed perform(const std::string &score, TrackMode mode, Grip grip)
+{
+    PerformanceOptions o;
+    o.score.score_text = score;
+    o.score.score_name = "test";
+    o.score.mode = mode;
+    o.score.grip_given = true;
+    o.character.grip = grip;
+    Performance perf(o);
+    perf.start_score();
+    Performed r;
+    r.notes = perf.plan()->notes;
+    r.origin_s = perf.plan_origin_s();
+    const long steps = std::lround(perf.plan()->duration_s / perf.step_s());
+    StrikeEvent ev[2];
+    for (long n = 0; n < steps; ++n) {
+        const int k = perf.step(ev);
+        r.strikes.insert(r.strikes.end(), ev, ev + k);
+    }
+    StrikeEvent last;
+    while (perf.flush(last))
+        r.strikes.push_back(last);
+    std::sort(r.strikes.begin(), r.strikes.end(),
+              [](const StrikeEvent &a, const StrikeEvent &b) { return a.time_s < b.time_s; });
+    r.divergences = perf.divergences();
+    return r;
+}
+
+// Per hand, the notes' beats and the primary strikes, both in time order:
+// the k-th strike answers the k-th note. Returns the impact speed per note
+// (and checks count and timing).
+std::vector<double> check_one_strike_per_note(const Performed &p, const std::string &what)
+{
+    std::vector<double> speed(p.notes.size(), 0.0);
+    for (int hand = 0; hand < 2; ++hand) {
+        std::vector<size_t> notes;
+        for (size_t i = 0; i < p.notes.size(); ++i)
+            if (static_cast<int>(p.notes[i].hand) == hand)
+                notes.push_back(i);
+        std::vector<const StrikeEvent *> primary;
+        for (const StrikeEvent &e : p.strikes)
+            if (e.hand == hand && !e.bounce)
+                primary.push_back(&e);
+        INFO(what << ", hand " << hand);
+        REQUIRE(primary.size() == notes.size());
+        for (size_t k = 0; k < notes.size(); ++k) {
+            const PlannedNote &n = p.notes[notes[k]];
+            const double error_ms = 1e3 * (primary[k]->time_s - (p.origin_s + n.time_s));
+            INFO("note at " << n.time_s << " s (" << to_string(n.nuance) << ", dynamics "
+                            << n.dynamics << ", line " << n.line << "): strike error " << error_ms
+                            << " ms, impact " << primary[k]->normal_velocity_mps << " m/s, contact "
+                            << primary[k]->duration_ms << " ms");
+            CHECK(std::abs(error_ms) <= 5.0);
+            // A strike is a hit of the head, not a press: the bead leaves it again
+            // well before the hand's next note.
+            CHECK(primary[k]->duration_ms < 80.0);
+            speed[notes[k]] = primary[k]->normal_velocity_mps;
+        }
+    }
+    return speed;
+}
+
+// Every nuance in both hands at mixed dynamics, plus two strokes of one hand
+// in a row; `beats` per note keeps each score a few seconds long.
+std::string nuance_score(int bpm, const char *grip, const char *beats)
+{
+    std::ostringstream s;
+    s << "tempo " << bpm << "\ngrip " << grip << "\n";
+    const char *lines[] = {"R legato",
+                           "L legato p",
+                           "R tenuto",
+                           "L tenuto f",
+                           "R accent f",
+                           "L accent",
+                           "R vertical_accent ff",
+                           "L vertical_accent",
+                           "R staccato mf",
+                           "L staccato pp",
+                           "R legato",
+                           "R accent"};
+    for (const char *l : lines)
+        s << l << ' ' << beats << "\n";
+    return s.str();
+}
+
+fs::path scratch(const std::string &name)
+{
+    const fs::path p =
+        fs::temp_directory_path() / ("ictus-perform-" + name + "-" + std::to_string(getpid()));
+    fs::remove_all(p);
+    return p;
+}
+
+std::string slurp(const fs::path &path)
+{
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+} // namespace
+
+TEST_CASE("perform: one primary strike per note, within 5 ms of its beat, at 40, 96 and 200 bpm, "
+          "both grips, every nuance",
+          "[perform][acceptance]")
+{
+    struct Tempo {
+        int bpm;
+        const char *beats; // per note: 0.75 s, 0.625 s, 0.3 s
+    };
+    const Tempo tempo = GENERATE(Tempo{40, "1/2"}, Tempo{96, "1/1"}, Tempo{200, "1/1"});
+    const char *grip = GENERATE("french", "german");
+    const TrackMode mode = GENERATE(TrackMode::cartesian, TrackMode::joint);
+    if (kQuick && mode == TrackMode::joint)
+        return;
+    const std::string what = std::to_string(tempo.bpm) + " bpm, " + grip + ", " + to_string(mode);
+    const Performed p =
+        perform(nuance_score(tempo.bpm, grip, tempo.beats), mode, grip_from_string(grip));
+    INFO(what);
+    REQUIRE(p.notes.size() == 12);
+    CHECK(p.divergences == 0);
+    check_one_strike_per_note(p, what);
+}
+
+TEST_CASE("perform: louder dynamics hit the head faster (monotonic over a dynamics grid)",
+          "[perform][acceptance]")
+{
+    const TrackMode mode = GENERATE(TrackMode::cartesian, TrackMode::joint);
+    if (kQuick && mode == TrackMode::joint)
+        return;
+    const char *grip = GENERATE("french", "german");
+    const double grid[] = {0.1, 0.3, 0.5, 0.7, 0.9};
+    std::ostringstream s;
+    s << "tempo 120\ngrip " << grip << "\n";
+    for (const char *hand : {"R", "L"})
+        for (double d : grid)
+            s << hand << " legato " << d << "\n";
+    const std::string what = std::string(grip) + ", " + to_string(mode);
+    const Performed p = perform(s.str(), mode, grip_from_string(grip));
+    const std::vector<double> speed = check_one_strike_per_note(p, what);
+    for (int hand = 0; hand < 2; ++hand) {
+        std::vector<std::pair<double, double>> by_dynamics; // (dynamics, speed)
+        for (size_t i = 0; i < p.notes.size(); ++i)
+            if (static_cast<int>(p.notes[i].hand) == hand)
+                by_dynamics.emplace_back(p.notes[i].dynamics, speed[i]);
+        std::sort(by_dynamics.begin(), by_dynamics.end());
+        REQUIRE(by_dynamics.size() == 5);
+        for (size_t k = 1; k < by_dynamics.size(); ++k) {
+            INFO(what << ", hand " << hand << ": dynamics " << by_dynamics[k - 1].first << " -> "
+                      << by_dynamics[k - 1].second << " m/s, " << by_dynamics[k].first << " -> "
+                      << by_dynamics[k].second << " m/s");
+            CHECK(by_dynamics[k].second > by_dynamics[k - 1].second);
+        }
+    }
+}
+
+TEST_CASE("perform: nuances hit the head in the gesture database's documented loudness order",
+          "[perform][acceptance]")
+{
+    const TrackMode mode = GENERATE(TrackMode::cartesian, TrackMode::joint);
+    if (kQuick && mode == TrackMode::joint)
+        return;
+    const char *grip = GENERATE("french", "german");
+    // Each nuance twice per hand at the same dynamics (mf), softest first.
+    std::ostringstream s;
+    s << "tempo 120\ngrip " << grip << "\n";
+    for (int rank = 0; rank < kNuances; ++rank)
+        for (int twice = 0; twice < 2; ++twice)
+            s << "R " << to_string(kLoudnessOrder[rank]) << " mf, L "
+              << to_string(kLoudnessOrder[rank]) << " mf\n";
+    const std::string what = std::string(grip) + ", " + to_string(mode);
+    const Performed p = perform(s.str(), mode, grip_from_string(grip));
+    const std::vector<double> speed = check_one_strike_per_note(p, what);
+    for (int hand = 0; hand < 2; ++hand) {
+        double mean[kNuances] = {};
+        for (size_t i = 0; i < p.notes.size(); ++i)
+            if (static_cast<int>(p.notes[i].hand) == hand)
+                mean[loudness_rank(p.notes[i].nuance)] += speed[i] / 2.0;
+        for (int rank = 1; rank < kNuances; ++rank) {
+            INFO(what << ", hand " << hand << ": " << to_string(kLoudnessOrder[rank - 1]) << ' '
+                      << mean[rank - 1] << " m/s, " << to_string(kLoudnessOrder[rank]) << ' '
+                      << mean[rank] << " m/s");
+            CHECK(mean[rank] > mean[rank - 1]);
+        }
+    }
+}
+
+TEST_CASE("perform: score statements as commands, play, a faulty score plays nothing, mode and "
+          "grip at once",
+          "[perform]")
+{
+    PerformanceOptions o;
+    o.score.score_text = "tempo 120\nR legato\n";
+    Performance perf(o);
+    auto command = [&](CommandKind kind, const char *text = "") {
+        Command c;
+        c.kind = kind;
+        std::snprintf(c.text, sizeof c.text, "%s", text);
+        std::string why;
+        const bool ok = perf.apply(c, &why);
+        return ok ? std::string() : (why.empty() ? std::string("refused") : why);
+    };
+    auto run_for = [&](double seconds) {
+        std::vector<StrikeEvent> out;
+        StrikeEvent ev[2];
+        const long steps = std::lround(seconds / perf.step_s());
+        for (long n = 0; n < steps; ++n) {
+            const int k = perf.step(ev);
+            out.insert(out.end(), ev, ev + k);
+        }
+        return out;
+    };
+    // Nothing plays before /ictus/play: the sticks hold their rest above the head.
+    CHECK(run_for(1.0).empty());
+
+    CHECK(command(CommandKind::score_clear).empty());
+    CHECK(command(CommandKind::score, "tempo 150").empty());
+    CHECK(command(CommandKind::score, "R accent f, L legato").empty());
+    CHECK(command(CommandKind::score, "R staccato, L tenuto").empty());
+    CHECK(command(CommandKind::play).empty());
+    REQUIRE(perf.plan() != nullptr);
+    REQUIRE(perf.plan()->notes.size() == 4);
+    const double origin = perf.plan_origin_s();
+    std::vector<StrikeEvent> strikes = run_for(perf.plan()->duration_s + 0.5);
+    long primary = 0;
+    for (const StrikeEvent &e : strikes)
+        primary += e.bounce ? 0 : 1;
+    CHECK(primary == 4);
+    CHECK(origin > 0.99); // it started when play came, on the simulation clock
+    CHECK_FALSE(perf.plan_active());
+
+    // A bad statement is refused with its position; play then refuses the
+    // whole score and nothing is played.
+    CHECK(command(CommandKind::score, "R lgato").find("lgato") != std::string::npos);
+    CHECK_FALSE(command(CommandKind::play).empty());
+    CHECK(run_for(1.5).empty());
+    CHECK(command(CommandKind::score_clear).empty());
+
+    // Mode and grip take effect at once, mid-performance, and it goes on.
+    CHECK(command(CommandKind::score, "tempo 100").empty());
+    CHECK(command(CommandKind::score, "R legato, L legato, R legato, L legato").empty());
+    CHECK(command(CommandKind::play).empty());
+    run_for(1.2);
+    CHECK(command(CommandKind::mode, "joint").empty());
+    CHECK(perf.mode() == TrackMode::joint);
+    CHECK(command(CommandKind::grip, "german").empty());
+    CHECK(perf.options().character.grip == Grip::german);
+    strikes = run_for(perf.plan()->duration_s);
+    primary = 0;
+    for (const StrikeEvent &e : strikes)
+        primary += e.bounce ? 0 : 1;
+    CHECK(primary >= 2); // the notes after the switch are still played
+    CHECK(perf.divergences() == 0);
+    CHECK_FALSE(command(CommandKind::mode, "hybrid").empty());
+}
+
+TEST_CASE("render --score: the files, the summary, deterministic bytes", "[perform][verbs]")
+{
+    const fs::path dir = scratch("render");
+    fs::create_directories(dir);
+    {
+        std::ofstream score(dir / "s.score");
+        score << "tempo 144\ngrip german\nR accent f, L legato, R tenuto p, L staccato\n";
+    }
+    for (const char *sub : {"a", "b"})
+        REQUIRE(osctest::run({ICTUSD_OSC_PATH, "render", "--score", (dir / "s.score").string(),
+                              "--out", (dir / sub).string()}) == 0);
+    for (const char *f : {"strikes.csv", "events.txt", "render.json", "tips.csv", "notes.csv"}) {
+        INFO(f);
+        REQUIRE(fs::exists(dir / "a" / f));
+        CHECK(slurp(dir / "a" / f) == slurp(dir / "b" / f));
+    }
+    const nlohmann::json j = nlohmann::json::parse(slurp(dir / "a" / "render.json"));
+    const nlohmann::json &p = j.at("performance");
+    CHECK(j.at("grip") == "german");
+    CHECK(p.at("notes") == 4);
+    CHECK(p.at("matched_notes") == 4);
+    CHECK(p.at("extra_strikes") == 0);
+    CHECK(p.at("timing_error_ms").at("max_abs").get<double>() <= 5.0);
+    // notes.csv: a header and one row per note; tips.csv: 250 rows per second.
+    std::istringstream notes(slurp(dir / "a" / "notes.csv"));
+    std::string line;
+    int rows = -1;
+    while (std::getline(notes, line))
+        ++rows;
+    CHECK(rows == 4);
+    std::istringstream tips(slurp(dir / "a" / "tips.csv"));
+    std::getline(tips, line);
+    CHECK(std::count(line.begin(), line.end(), ',') == 12);
+    rows = 0;
+    while (std::getline(tips, line))
+        ++rows;
+    CHECK(std::abs(rows - 250.0 * p.at("plan").at("duration_s").get<double>()) <= 2.0);
+
+    // Errors name the thing: a score with a fault, a missing file.
+    {
+        std::ofstream bad(dir / "bad.score");
+        bad << "tempo 120\nR legato\nL acent\n";
+    }
+    CHECK(osctest::run({ICTUSD_OSC_PATH, "render", "--score", (dir / "bad.score").string(), "--out",
+                        (dir / "c").string()}) == 1);
+    CHECK(osctest::run({ICTUSD_OSC_PATH, "render", "--score", (dir / "none.score").string(),
+                        "--out", (dir / "c").string()}) == 2);
+    fs::remove_all(dir);
+}
