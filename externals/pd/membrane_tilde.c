@@ -42,8 +42,12 @@ int ictus_clock_offset_now(const t_ictus_clock *c)
         return 0; /* a message from the past (cannot happen from the scheduler) */
     /* A message always falls inside the window the next block will cover; past
      * it, DSP has stopped since the anchor was taken (dsp 0, switch~ off): the
-     * next perform re-anchors, so the message lands at its start. */
-    if (offset >= c->c_window)
+     * next perform re-anchors, so the message lands at its start. Exactly at
+     * the window's end is not past it: a time in the window's last half sample
+     * rounds to the first sample of the block after, and the core carries a
+     * pending hit over (offset - n); returning 0 there started it a whole
+     * block early (found by tests/e2e: a strike at 9.483993 s, 48 kHz). */
+    if (offset > c->c_window)
         return 0;
     return (int)offset;
 }
