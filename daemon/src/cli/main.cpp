@@ -16,6 +16,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -26,7 +27,6 @@
 #include <iostream>
 #include <map>
 #include <sstream>
-#include <algorithm>
 #include <string>
 #include <utility>
 #include <vector>
@@ -285,16 +285,11 @@ class StrikesCsv
         : path_(std::move(path)), detector_(ictus::MembraneGeometry{}, options)
     {
     }
-    // After each step of `scene` (its drum is read at the first call and
-    // whenever it moved: a scene changed by Scene::set_drum).
+    // After each step of `scene` (its drum is read every step: a scene whose
+    // drum Scene::set_drum changed is watched on the new one).
     void after_step(const ictus::Scene &scene)
     {
-        const ictus::MembraneGeometry m = ictus::membrane_of(scene);
-        if (!started_ || m.center_m != detector_.membrane().center_m ||
-            m.radius_m != detector_.membrane().radius_m ||
-            m.stiffness_n_per_m != detector_.membrane().stiffness_n_per_m)
-            detector_.set_membrane(m);
-        started_ = true;
+        detector_.set_membrane(ictus::membrane_of(scene));
         ictus::StrikeEvent out[2];
         const int n = ictus::detect_strikes(detector_, scene, out);
         events_.insert(events_.end(), out, out + n);
@@ -322,7 +317,6 @@ class StrikesCsv
     std::string path_;
     ictus::StrikeDetector detector_;
     std::vector<ictus::StrikeEvent> events_;
-    bool started_ = false;
 };
 
 class Progress
