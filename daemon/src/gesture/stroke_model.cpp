@@ -1,0 +1,170 @@
+// stroke_model.cpp -- the parametric stroke model behind the built-in gesture
+// database (docs/gestures.md, "The stroke model", for the sources of each
+// choice). A unit is built in three layers:
+//   1. the tip height h(t): a downswing from the preparation apex whose
+//      acceleration grows toward the impact (h = H (1 - u^p), the "whip" of
+//      Dahl 2004), a velocity reversal at the strike, and a lift back to an
+//      apex whose shape is the nuance's (rebound, quick lift, held);
+//   2. how that height is made: the stick turns about the wrist (German
+//      grip, a wrist stroke in the stick's vertical plane) or about an axis
+//      tilted toward the vertical (French grip, thumbs up: forearm rotation
+//      plus wrist and finger flexion in the horizontal plane, which swings
+//      the tip outward), up to a saturation; the rest is the forearm
+//      lifting the wrist;
+//   3. the nuance's forward path: the accent draws the arm back (a larger
+//      loop), the vertical accent moves the wrist forward to cancel the arc.
+// Every quantity is a smooth function of h(t), so the unit is C1 except at
+// the strike, where the velocity reverses.
+#include "ictus/gesture.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace ictus
+{
+
+namespace
+{
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kNominalPeriod_s = 0.5;    // 120 bpm: the period the shapes are set at
+constexpr double kLegatoHeightFff_m = 0.36; // legato preparation height at d = 1
+
+struct NuanceShape {
+    double height_scale;  // preparation height relative to legato
+    double prep_fraction; // downswing duration / nominal period
+    double exponent;      // p in h = H (1 - u^p)
+    double lift_exponent; // q in h = H_l (1 - (1 - w)^q): rebound speed q H_l / L
+    double lift_hold;     // weight of a held (zero-speed) departure, tenuto
+    double lift_ratio;    // lift apex / preparation apex
+    double draw_back;     // extra backward pivot motion per metre of height (accent loop)
+    double verticality;   // fraction of the arc's backward motion cancelled
+};
+
+// Indexed by Nuance (enum order). See docs/gestures.md, table "Nuance shapes".
+const NuanceShape kShapes[kNuances] = {
+    // legato: relaxed rebound stroke
+    {1.00, 0.35, 3.0, 2.0, 0.0, 1.00, 0.00, 0.0},
+    // tenuto: low, stays close to the head after the strike
+    {0.55, 0.40, 2.5, 2.0, 0.7, 0.80, 0.00, 0.0},
+    // accent: higher preparation, larger loop, rebound controlled lower
+    {1.70, 0.40, 3.0, 2.0, 0.0, 0.75, 0.10, 0.0},
+    // vertical accent: highest, lifted vertically
+    {1.90, 0.40, 3.0, 2.5, 0.0, 0.90, 0.00, 0.85},
+    // staccato: lifts away quickly after the hit
+    {1.15, 0.30, 3.0, 4.0, 0.0, 1.00, 0.00, 0.0},
+};
+
+struct GripShape {
+    double pivot_to_tip_m;   // wrist to stick tip
+    double rotation_share;   // fraction of the height made by turning the stick
+    double axis_tilt_rad;    // rotation axis tilted from horizontal toward the vertical
+    double inward_yaw_rad;   // stick direction at the strike, toward the body's midline
+    double strike_pitch_rad; // stick direction at the strike, below horizontal
+};
+
+const GripShape kGerman = {0.35, 0.85, 0.0, 20.0 * kPi / 180.0, 8.0 * kPi / 180.0};
+const GripShape kFrench = {0.33, 0.70, 25.0 * kPi / 180.0, 25.0 * kPi / 180.0, 8.0 * kPi / 180.0};
+
+// Height profile at time t from the strike (s): prep over [-D, 0], lift over [0, L].
+double height(const NuanceShape &s, double H, double H_lift, double D, double L, double t)
+{
+    if (t <= 0.0) {
+        const double u = std::clamp((t + D) / D, 0.0, 1.0);
+        return H * (1.0 - std::pow(u, s.exponent));
+    }
+    const double w = std::clamp(t / L, 0.0, 1.0);
+    const double rebound = 1.0 - std::pow(1.0 - w, s.lift_exponent);
+    const double held = w * w * (3.0 - 2.0 * w);
+    return H_lift * (s.lift_hold * held + (1.0 - s.lift_hold) * rebound);
+}
+
+} // namespace
+
+GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double period_s)
+{
+    const NuanceShape &s = kShapes[static_cast<int>(n)];
+    const GripShape &gs = g == Grip::german ? kGerman : kFrench;
+    const double d = std::isfinite(dynamics) ? std::clamp(dynamics, 0.0, 1.0) : 0.6;
+    const double period = std::isfinite(period_s) ? std::clamp(period_s, 0.1, 4.0) : 0.5;
+    const double rate = 250.0;
+
+    // Timing: the downswing lasts prep_fraction of the period up to the
+    // nominal period; at slower tempi the extra time is spent in the lift.
+    // Heights shrink in proportion above the nominal tempo, so the impact
+    // speed p H / D depends on the dynamics and the nuance, not the tempo.
+    const double tempo_scale = std::min(1.0, period / kNominalPeriod_s);
+    const int strike_index = std::max(
+        2,
+        static_cast<int>(std::lround(s.prep_fraction * std::min(period, kNominalPeriod_s) * rate)));
+    const int lift_samples =
+        std::max(2, static_cast<int>(std::lround(period * rate)) - strike_index);
+    const double D = strike_index / rate, L = lift_samples / rate;
+    const double H = kLegatoHeightFff_m * s.height_scale * dynamics_height_factor(d) * tempo_scale;
+    const double H_lift = s.lift_ratio * H;
+
+    // Stick at the strike (right hand): forward, yawed inward (-x), pitched down.
+    const Eigen::Vector3d dir0(-std::sin(gs.inward_yaw_rad) * std::cos(gs.strike_pitch_rad),
+                               -std::sin(gs.strike_pitch_rad),
+                               std::cos(gs.inward_yaw_rad) * std::cos(gs.strike_pitch_rad));
+    const Eigen::Vector3d horiz = Eigen::Vector3d(dir0.x(), 0.0, dir0.z()).normalized();
+    // Wrist axis: horizontal, across the stick; turning about it raises the
+    // tip in the stick's vertical plane (German: wrist flexion, palms down).
+    Eigen::Vector3d across = Eigen::Vector3d::UnitY().cross(horiz).normalized();
+    if ((Eigen::AngleAxisd(0.1, across) * dir0).y() < dir0.y())
+        across = -across; // the sign that raises the tip
+    // French (thumbs up): wrist flexion turns the stick in the horizontal
+    // plane, so the axis tilts toward the vertical and the tip swings
+    // outward (+x for the right hand: Y x dir0 has x = dir0.z > 0).
+    const Eigen::Vector3d axis = (std::cos(gs.axis_tilt_rad) * across +
+                                  std::sin(gs.axis_tilt_rad) * Eigen::Vector3d::UnitY())
+                                     .normalized();
+    // Turning dir0 by phi about the axis: dir_y = c0 + (v_y - c0) cos phi + w sin phi
+    // (Rodrigues), c0 = a_y (a . dir0), w = (a x dir0)_y. Inverted in closed
+    // form for the rise the rotation must make.
+    const double R = gs.pivot_to_tip_m;
+    const double vy = dir0.y(), c0 = axis.y() * axis.dot(dir0), wy = axis.cross(dir0).y();
+    const double A = std::hypot(vy - c0, wy), delta = std::atan2(wy, vy - c0);
+    // The stick turns up to most of its range; smooth saturation (tanh) keeps C1.
+    const double rise_cap = 0.8 * R * (c0 + A - vy);
+
+    const Eigen::Vector3d pivot0 = -R * dir0; // tip at the origin at the strike
+    GestureUnit u;
+    u.grip = g;
+    u.nuance = n;
+    u.hand = h;
+    u.rate_hz = rate;
+    u.strike_index = strike_index;
+    u.dynamics = d;
+    u.period_s = period;
+    u.source = "model";
+    const int samples = strike_index + lift_samples + 1;
+    u.tip_m.reserve(samples);
+    u.stick_dir.reserve(samples);
+    // The arc's backward motion is cancelled by moving the wrist forward
+    // (vertical accent); computed after the rotation below.
+    for (int k = 0; k < samples; ++k) {
+        const double t = (k - strike_index) / rate;
+        const double hk = height(s, H, H_lift, D, L, t);
+        const double rise_rot = rise_cap * std::tanh(gs.rotation_share * hk / rise_cap);
+        const double target = std::clamp((vy + rise_rot / R - c0) / A, -1.0, 1.0);
+        const double phi = delta - std::acos(target);
+        const Eigen::Vector3d dir = Eigen::AngleAxisd(phi, axis) * dir0;
+        Eigen::Vector3d tip = pivot0 + Eigen::Vector3d(0.0, hk - R * (dir.y() - vy), 0.0) + R * dir;
+        const double arc_back = tip.z(); // < 0: the arc brings the tip toward the body
+        tip.z() += -s.verticality * arc_back - s.draw_back * hk;
+        tip.y() = hk; // exact (removes rounding of the decomposition)
+        u.tip_m.push_back(tip);
+        u.stick_dir.push_back(dir.normalized());
+    }
+    u.tip_m[strike_index] = Eigen::Vector3d::Zero();
+    if (h == Side::left) // mirror image: x is the performer's right
+        for (int k = 0; k < samples; ++k) {
+            u.tip_m[k].x() = -u.tip_m[k].x();
+            u.stick_dir[k].x() = -u.stick_dir[k].x();
+        }
+    return u;
+}
+
+} // namespace ictus
