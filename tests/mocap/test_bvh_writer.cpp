@@ -409,6 +409,42 @@ TEST_CASE("motion_from_poses: exported poses put every body where the character 
     too_few.rotation.resize(3);
     CHECK_THROWS_WITH(pose_from_frames(model, too_few), Catch::Contains("3 bodies"));
 
+    // BvhRecorder: body frames in, a BVH file out that reads back to the same
+    // stick tips (through pose_from_frames, motion_from_poses, write_bvh).
+    {
+        BvhRecorder recorder(model, clip.skeleton, 120.0);
+        for (const CharacterPose &pose : poses) {
+            BodyFrames frames;
+            model.forward(pose, frames);
+            recorder.record(frames);
+        }
+        CHECK(recorder.frames() == static_cast<int>(poses.size()));
+        const mocap_test::TempFile file("recorded.bvh", "");
+        recorder.write(file.path());
+        const BvhFile recorded = read_bvh(file.path());
+        CHECK(recorded.motion.frame_rate_hz == 120.0);
+        REQUIRE(recorded.motion.frames() == static_cast<int>(poses.size()));
+        const int tip = recorded.skeleton.find("RightHandStick_End");
+        REQUIRE(tip >= 0);
+        double worst_recorded = 0.0;
+        for (std::size_t f = 0; f < poses.size(); ++f) {
+            BodyFrames frames;
+            model.forward(poses[f], frames);
+            const int hb = model.hand_body(Side::right);
+            const Eigen::Vector3d want =
+                model.tip_position(Side::right, frames.origin_m[static_cast<std::size_t>(hb)],
+                                   frames.rotation[static_cast<std::size_t>(hb)]);
+            worst_recorded =
+                std::max(worst_recorded,
+                         (forward_kinematics(recorded.skeleton, recorded.motion,
+                                             static_cast<int>(f))[static_cast<std::size_t>(tip)] -
+                          want)
+                             .norm());
+        }
+        CHECK(worst_recorded < 1e-6);
+        CHECK_THROWS_WITH(BvhRecorder(model, clip.skeleton, -1.0), Catch::Contains("frame rate"));
+    }
+
     // Bad input: a pose with the wrong number of joints, a bad rate.
     std::vector<CharacterPose> bad = {poses[0]};
     bad[0].local.pop_back();

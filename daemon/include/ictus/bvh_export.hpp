@@ -3,6 +3,7 @@
 // (write_bvh, bvh.hpp): any 3D tool then shows the performance without Gem.
 #pragma once
 
+#include "ictus/bvh.hpp"
 #include "ictus/character.hpp"
 #include "ictus/motion.hpp"
 
@@ -42,5 +43,28 @@ CharacterPose pose_from_frames(const CharacterModel &model, const BodyFrames &fr
 // rigid in its hand (identity rotation), so its tip follows the hand frame
 // exactly as CharacterModel::tip_position. Appended after the existing joints.
 Skeleton skeleton_with_sticks(const CharacterModel &model, const Skeleton &skeleton);
+
+// Records a performance frame by frame and writes it as BVH: the source
+// skeleton with the sticks, metres, Z Y X channels. Keeps copies of the model
+// and skeleton (no references to objects that may die first). Offline use:
+// record() appends (allocates); not for the real-time loop. Frame f of the
+// file is the f-th recorded frame at time f / rate_hz: record at t = 0 and
+// then every 1 / rate_hz.
+class BvhRecorder
+{
+  public:
+    BvhRecorder(const CharacterModel &model, const Skeleton &source, double rate_hz);
+    // The physics' body frames (Scene::body_frames) of one frame.
+    void record(const BodyFrames &frames);
+    int frames() const { return static_cast<int>(poses_.size()); }
+    // Throws MocapError naming the path when it cannot be written.
+    void write(const std::string &path, const BvhWriteOptions &options = {}) const;
+
+  private:
+    CharacterModel model_;
+    Skeleton skeleton_; // with the sticks
+    double rate_hz_;
+    std::vector<CharacterPose> poses_;
+};
 
 } // namespace ictus

@@ -107,4 +107,22 @@ Skeleton skeleton_with_sticks(const CharacterModel &model, const Skeleton &skele
     return out;
 }
 
+BvhRecorder::BvhRecorder(const CharacterModel &model, const Skeleton &source, double rate_hz)
+    : model_(model), skeleton_(skeleton_with_sticks(model, source)), rate_hz_(rate_hz)
+{
+    if (!(std::isfinite(rate_hz) && rate_hz > 0.0))
+        throw CharacterError("BVH export: frame rate must be finite and > 0, got " +
+                             std::to_string(rate_hz));
+}
+
+void BvhRecorder::record(const BodyFrames &frames)
+{
+    poses_.push_back(pose_from_frames(model_, frames));
+}
+
+void BvhRecorder::write(const std::string &path, const BvhWriteOptions &options) const
+{
+    write_bvh(path, skeleton_, motion_from_poses(model_, skeleton_, poses_, rate_hz_), options);
+}
+
 } // namespace ictus
