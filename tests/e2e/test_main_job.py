@@ -141,7 +141,8 @@ def parse_bvh(path):
         elif t[0] == "OFFSET":
             joints[stack[-1]][2] = np.array([float(v) for v in t[1:4]])
         elif t[0] == "CHANNELS":
-            check(int(t[1]) == len(t) - 2, "BVH line %d: CHANNELS count matches" % (i + 1))
+            if int(t[1]) != len(t) - 2:
+                check(False, "BVH line %d: CHANNELS count matches the names" % (i + 1))
             joints[stack[-1]][3] = t[2:]
         elif t[0] == "}":
             stack.pop()
