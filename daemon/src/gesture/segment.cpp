@@ -79,6 +79,8 @@ std::vector<GestureUnit> segment_strokes(const std::vector<double> &time_s,
     const Eigen::Vector3d forward = up.cross(right); // performer frame: a reflection of the world
 
     const double rate = opts.rate_hz;
+    if ((time_s.back() - time_s.front()) * rate > 1e8)
+        throw GestureError("segment_strokes: more than 1e8 samples at the output rate");
     const int count =
         1 + static_cast<int>(std::floor((time_s.back() - time_s.front()) * rate + 1e-9));
     if (count < 3)
