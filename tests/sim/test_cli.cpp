@@ -403,3 +403,28 @@ TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[sim][cli]")
     INFO(empty.output);
     CHECK(empty.status == 1);
 }
+
+TEST_CASE("ictusd gestures is a verb of ictusd: help, export of the built-in database, usage "
+          "errors",
+          "[sim][cli]")
+{
+    Run r = ictusd("--help");
+    CHECK(r.output.find("gestures") != std::string::npos);
+    r = ictusd("gestures --help");
+    INFO(r.output);
+    CHECK(r.status == 0);
+    CHECK(r.output.find("usage: ictusd gestures") != std::string::npos);
+    // The built-in database holds one unit per grip x nuance x hand (issue 6):
+    // 2 x 5 x 2 = 20.
+    const std::string path = simtest::temp_path("gestures.json");
+    std::remove(path.c_str());
+    r = ictusd("gestures --export " + path);
+    CHECK(r.status == 0);
+    CHECK(r.output.find("wrote 20 units to " + path) != std::string::npos);
+    CHECK(std::ifstream(path).good());
+    std::remove(path.c_str());
+    r = ictusd("gestures --frobnicate");
+    CHECK(r.status == 2);
+    r = ictusd("gestures");
+    CHECK(r.status == 2); // exactly one action is required
+}

@@ -1,12 +1,14 @@
 // ictusd -- the ictus simulation daemon: a physically simulated percussionist.
-// Verbs: track (joint-space PD tracking of a mocap clip, paper eq. 1) and
-// limits (joint limits learned from a clip, paper Algorithm 1). See
+// Verbs: track (joint-space PD tracking of a mocap clip, paper eq. 1),
+// limits (joint limits learned from a clip, paper Algorithm 1), run and
+// render (docs/osc.md), gestures (the gesture database, issue 6). See
 // docs/character.md. Exit status: 0 ok, 1 runtime error (file, data), 2 usage
 // error (unknown verb or option, bad value), 3 the simulation diverged (and
 // was reset) at least once, 130 interrupted.
 #include "ictus/bvh.hpp"
 #include "ictus/character.hpp"
 #include "ictus/character_limits.hpp"
+#include "ictus/gesture.hpp"
 #include "ictus/joint_limits.hpp"
 #include "ictus/marker_csv.hpp"
 #include "ictus/stick_capture.hpp"
@@ -62,6 +64,8 @@ void usage(std::ostream &out)
            "           out over OSC, control in over OSC (docs/osc.md)\n"
            "  render   perform offline, as fast as possible and deterministic: strikes.csv\n"
            "           and an events file for Pd's batch render (docs/osc.md)\n"
+           "  gestures the gesture database: list, export, or import units segmented\n"
+           "           from a capture (ictusd gestures --help)\n"
            "\n"
            "examples:\n"
            "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n"
@@ -69,6 +73,7 @@ void usage(std::ostream &out)
            "  ictusd limits ../shared/data/cmu/80_13.bvh --out limits.json\n"
            "  ictusd render --mocap ../shared/data/cmu/80_13.bvh --out perf\n"
            "  ictusd run --mocap ../shared/data/cmu/80_13.bvh --target osc.udp://127.0.0.1:9000\n"
+           "  ictusd gestures --list\n"
            "\n"
            "exit status: 0 ok, 1 error in a file or the data, 2 usage error,\n"
            "             3 the simulation diverged (and was reset), 130 interrupted\n";
@@ -718,8 +723,10 @@ int main(int argc, char **argv)
             return ictus::cmd_run(argc - 1, argv + 1);
         if (verb == "render")
             return ictus::cmd_render(argc - 1, argv + 1);
+        if (verb == "gestures")
+            return ictus::cmd_gestures(argc - 1, argv + 1);
         throw UsageError("unknown verb '" + verb +
-                         "' (verbs: track, limits, run, render; see ictusd --help)");
+                         "' (verbs: track, limits, run, render, gestures; see ictusd --help)");
     } catch (const UsageError &e) {
         std::cerr << "ictusd: " << e.what() << "\n";
         return 2;
