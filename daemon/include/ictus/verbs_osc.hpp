@@ -119,6 +119,10 @@ class Performance
     double tempo_bpm() const { return options_.tempo_bpm; }
     const PerformanceOptions &options() const { return options_; }
     const Scene &scene() const;
+    // The character being simulated and the mocap skeleton it was built from
+    // (score mode: default_skeleton()), for recording the performance as BVH.
+    const CharacterModel &model() const;
+    const Skeleton &skeleton() const { return skeleton_; }
     const StrikeDetector &detector() const { return detector_; }
     int divergences() const;
 
@@ -157,6 +161,7 @@ class Performance
     Eigen::Vector3d target_at(int side, double plan_time_s) const;
     MembraneGeometry membrane() const;
     PerformanceOptions options_;
+    Skeleton skeleton_;
     std::unique_ptr<Rig> rig_;
     std::unique_ptr<ScoreRig> score_rig_;
     StrikeDetector detector_;

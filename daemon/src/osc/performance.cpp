@@ -141,6 +141,7 @@ void Performance::build()
         std::cerr << "ictusd: warning: " << w << "\n";
     const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton, options_.character);
     const double previous_time = rig_ ? time_s() : 0.0;
+    skeleton_ = bvh.skeleton;
     if (rig_)
         divergences_before_ += rig_->scene->divergences();
     rig_.reset(new Rig(model, bvh.motion));
@@ -180,6 +181,11 @@ MembraneGeometry Performance::membrane() const
     m.damping_n_s_per_m = d.contact_damping_n_s_per_m;
     m.friction = d.friction;
     return m;
+}
+
+const CharacterModel &Performance::model() const
+{
+    return rig_ ? rig_->model : score_rig_->model;
 }
 
 const Scene &Performance::scene() const
@@ -405,6 +411,7 @@ void Performance::build_score(bool keep_pose)
     motion.local_rotation.emplace_back(skeleton.joints.size(), Eigen::Quaterniond::Identity());
     const CharacterModel model = CharacterModel::from_skeleton(skeleton, options_.character);
     const double previous_time = score_rig_ ? time_s() : 0.0;
+    skeleton_ = skeleton;
     std::vector<Eigen::Quaterniond> previous_local;
     if (score_rig_) {
         divergences_before_ += score_rig_->tracker->scene().divergences();

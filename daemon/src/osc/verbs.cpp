@@ -1,4 +1,5 @@
 // `ictusd run` and `ictusd render` (verbs_osc.hpp, docs/osc.md).
+#include "ictus/bvh_export.hpp"
 #include "ictus/verbs_osc.hpp"
 
 #include "ictus/mocap_error.hpp"
@@ -79,6 +80,7 @@ void render_usage(std::ostream &out)
            "(docs/perform.md).\n"
            "\n"
            "  --tips-rate HZ      tips.csv rows per second (default 250; 0: none)\n"
+           "  --bvh-rate HZ       performance.bvh frames per second (default 250; 0: none)\n"
            "\n"
            "score mode (run and render):\n"
            "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
@@ -366,7 +368,7 @@ int cmd_render(int argc, char **argv)
 {
     return guarded("render", [&]() {
         PerformanceOptions o;
-        double duration = 0.0, tips_rate = 250.0;
+        double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0;
         std::string out_dir;
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
@@ -377,6 +379,10 @@ int cmd_render(int argc, char **argv)
                 if (i + 1 >= argc)
                     throw UsageError("--out: missing value");
                 out_dir = argv[++i];
+            } else if (a == "--bvh-rate") {
+                if (i + 1 >= argc)
+                    throw UsageError("--bvh-rate: missing value");
+                bvh_rate = parse_number(a, argv[++i], 0, 1000);
             } else if (a == "--tips-rate") {
                 if (i + 1 >= argc)
                     throw UsageError("--tips-rate: missing value");
@@ -417,6 +423,16 @@ int cmd_render(int argc, char **argv)
         const long steps = std::max(1L, std::lround(duration / h));
         const long tips_every =
             tips_rate > 0.0 ? std::max(1L, std::lround(1.0 / (tips_rate * h))) : 0;
+        // performance.bvh: the simulated bodies on the source skeleton (plus
+        // the sticks), frame f at f / bvh_rate s, from t = 0.
+        const long bvh_every = bvh_rate > 0.0 ? std::max(1L, std::lround(1.0 / (bvh_rate * h))) : 0;
+        std::unique_ptr<BvhRecorder> bvh;
+        BodyFrames frames;
+        if (bvh_every) {
+            bvh.reset(new BvhRecorder(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h)));
+            perf.scene().body_frames(frames);
+            bvh->record(frames);
+        }
         StrikeEvent ev[2];
         double previous = 0.0;
         long strikes = 0, bounces = 0;
@@ -435,7 +451,13 @@ int cmd_render(int argc, char **argv)
                 emit(ev[i]);
             if (tips.is_open() && tips_every && (n + 1) % tips_every == 0)
                 write_tips_row(tips, perf);
+            if (bvh && (n + 1) % bvh_every == 0) {
+                perf.scene().body_frames(frames);
+                bvh->record(frames);
+            }
         }
+        if (bvh)
+            bvh->write(out_dir + "/performance.bvh");
         StrikeEvent last;
         while (perf.flush(last))
             emit(last);
@@ -483,8 +505,9 @@ int cmd_render(int argc, char **argv)
         std::cout << "render: " << perf.time_s() << " s simulated in " << wall << " s ("
                   << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes
                   << " strikes (" << bounces << " bounces), wrote " << out_dir
-                  << (score_mode ? "/{strikes.csv,events.txt,render.json,tips.csv,notes.csv}\n"
-                                 : "/{strikes.csv,events.txt,render.json}\n");
+                  << (score_mode ? "/{strikes.csv,events.txt,render.json,tips.csv,notes.csv"
+                                 : "/{strikes.csv,events.txt,render.json")
+                  << (bvh ? ",performance.bvh}\n" : "}\n");
         return interrupted ? 130 : 0;
     });
 }
