@@ -90,6 +90,9 @@ struct TrackOptions {
     const TipTrajectory *tip_reference = nullptr;
     // Checked every step; when it becomes non-zero the run stops early (SIGINT).
     const volatile std::sig_atomic_t *interrupt = nullptr;
+    // Called on the calling thread after every physics step, the ramp
+    // included (e.g. the strike detector behind `ictusd track`'s strikes.csv).
+    std::function<void(const Scene &)> on_step;
 };
 // Throws CharacterError naming the first bad option.
 void validate(const TrackOptions &options);

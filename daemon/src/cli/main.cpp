@@ -26,6 +26,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -102,7 +103,7 @@ void track_usage(std::ostream &out)
            "  --ik-integral PER_S    integral of the tip error (default 0)\n"
            "  --ik-correction-limit M   cap on the IK target's correction (default 0.1)\n"
            "  --ik-start kinematic|simulated   IK warm start (default kinematic; docs/ik.md)\n"
-           "  --out DIR              write DIR/track.csv and DIR/summary.json\n"
+           "  --out DIR              write DIR/track.csv, DIR/strikes.csv and DIR/summary.json\n"
            "  --scale M              metres per BVH unit (default 0.056444, the CMU files)\n"
            "  --skip-frames N        frames dropped at the start (default 1: the CMU\n"
            "                         converter's reference pose)\n"
@@ -589,6 +590,12 @@ int run_track(Args &args)
     }
 
     options.interrupt = &g_interrupted;
+    // strikes.csv: every verb that simulates writes it (docs/osc.md).
+    std::unique_ptr<StrikesCsv> strikes;
+    if (!out_dir.empty()) {
+        strikes.reset(new StrikesCsv(out_dir + "/strikes.csv"));
+        options.on_step = [&](const ictus::Scene &scene) { strikes->after_step(scene); };
+    }
     Progress progress(!quiet);
     ictus::TrackSummary summary = ictus::track_joint_space(
         model, reference, options, refs, out_dir.empty() ? nullptr : &csv,
@@ -618,6 +625,10 @@ int run_track(Args &args)
     if (options.mode == ictus::TrackMode::cartesian) {
         j["ik"]["gain"] = options.cartesian.gain;
         j["ik"]["integral_per_s"] = options.cartesian.integral_per_s;
+    }
+    if (strikes) {
+        strikes->close();
+        j["strikes"] = strikes->strikes();
     }
     if (!out_dir.empty()) {
         csv.close();

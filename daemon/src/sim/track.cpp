@@ -294,6 +294,8 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                     tip_targets.position_m[s] = tips_in->sample(s, t_next);
         }
         tracker.step(step_pose, cartesian ? &tip_targets : nullptr, t_next >= options.ramp_s);
+        if (options.on_step)
+            options.on_step(scene);
         const std::vector<Eigen::Quaterniond> &target = tracker.targets();
         summary.max_linear_speed_mps =
             std::max(summary.max_linear_speed_mps, scene.max_linear_speed_mps());
