@@ -3,6 +3,8 @@
 // to oscdump and answers oscsend. They need the CMU clip (ICTUS_DATA_DIR).
 #include "osc_test_util.hpp"
 
+#include "ictus/verbs_osc.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <atomic>
@@ -211,4 +213,46 @@ TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked r
     CHECK(pongs >= 1);
     CHECK(replies >= 1); // a tempo accepted
     fs::remove_all(dir);
+}
+
+// Issue 5: drum parameters sent while a clip plays take effect at once (not at
+// the next play): the scene's contact law and the detector's membrane follow.
+TEST_CASE("clip mode: drum radius and tension apply at once, to the scene and the detector",
+          "[osc][verbs]")
+{
+    const std::string clip = clip_or_skip();
+    if (clip.empty())
+        return;
+    ictus::PerformanceOptions o;
+    o.mocap = clip;
+    ictus::Performance perf(o);
+    ictus::StrikeEvent ev[2];
+    for (int n = 0; n < 50; ++n)
+        perf.step(ev);
+    const double t_before = perf.time_s();
+    ictus::Command c;
+    c.kind = ictus::CommandKind::drum_tension;
+    c.value = 6000.0;
+    std::string why;
+    REQUIRE(perf.apply(c, &why));
+    c.kind = ictus::CommandKind::drum_radius;
+    c.value = 0.2;
+    REQUIRE(perf.apply(c, &why));
+    const double r_tip = perf.model().options().stick.tip_radius_m;
+    // Static point-load stiffness of a membrane, k = 2 pi T / ln(R / r) (scene.hpp).
+    const double k = 2.0 * M_PI * 6000.0 / std::log(0.2 / r_tip);
+    CHECK(perf.scene().drum().tension_n_per_m == 6000.0);
+    CHECK(perf.scene().drum().radius_m == 0.2);
+    CHECK(perf.scene().drum_contact_stiffness_n_per_m() == Approx(k).epsilon(1e-12));
+    CHECK(perf.detector().membrane().radius_m == 0.2);
+    CHECK(perf.detector().membrane().stiffness_n_per_m == Approx(k).epsilon(1e-12));
+    // No rebuild: the clock and the scene go on.
+    CHECK(perf.time_s() == Approx(t_before));
+    perf.step(ev);
+    CHECK(perf.time_s() == Approx(t_before + perf.step_s()));
+    c.kind = ictus::CommandKind::drum_radius;
+    c.value = 0.001; // smaller than the bead
+    CHECK_FALSE(perf.apply(c, &why));
+    CHECK(why.find("drum radius") != std::string::npos);
+    CHECK(perf.scene().drum().radius_m == 0.2);
 }

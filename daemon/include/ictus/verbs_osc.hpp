@@ -160,6 +160,7 @@ class Performance
     void start_rest_move();
     Eigen::Vector3d target_at(int side, double plan_time_s) const;
     MembraneGeometry membrane() const;
+    void apply_drum_now();
     PerformanceOptions options_;
     Skeleton skeleton_;
     std::unique_ptr<Rig> rig_;

@@ -183,6 +183,14 @@ MembraneGeometry Performance::membrane() const
     return m;
 }
 
+// Clip mode: the live scene's drum changes at once (Scene::set_drum), and the
+// strike detector watches the new membrane from its next contact on.
+void Performance::apply_drum_now()
+{
+    rig_->scene->set_drum(options_.scene.drum);
+    detector_.set_membrane(membrane());
+}
+
 const CharacterModel &Performance::model() const
 {
     return rig_ ? rig_->model : score_rig_->model;
@@ -285,7 +293,8 @@ bool Performance::apply(const Command &c, std::string *why)
         rebuild_pending_ = true;
         return true;
     case CommandKind::nuance:
-        return fail("nuance: stored for the score player, which is not implemented yet");
+        return fail("nuance: a clip has no nuances; without --mocap the daemon plays scores, whose "
+                    "notes name their nuance (/ictus/score \"R accent\")");
     case CommandKind::mode:
         if (std::strcmp(c.text, "joint") != 0)
             return fail("mode: only joint is implemented");
@@ -306,11 +315,11 @@ bool Performance::apply(const Command &c, std::string *why)
         if (!(c.value > rig_->model.options().stick.tip_radius_m * 2.0))
             return fail("drum radius: must exceed the stick tip's diameter");
         options_.scene.drum.radius_m = c.value;
-        rebuild_pending_ = true;
+        apply_drum_now();
         return true;
     case CommandKind::drum_tension:
         options_.scene.drum.tension_n_per_m = c.value;
-        rebuild_pending_ = true;
+        apply_drum_now();
         return true;
     case CommandKind::drum_density:
         // The membrane's density changes its modes (membrane~), not the
