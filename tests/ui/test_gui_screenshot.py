@@ -36,7 +36,7 @@ try:
     log_path = copy + ".log"
     pd = subprocess.Popen([uitest.PD, "-nosound", "-stderr", "-open", copy],
                           stdout=open(log_path, "w"), stderr=subprocess.STDOUT, env=x.env())
-    deadline = time.time() + 25
+    deadline = time.time() + 60  # the GUI comes up in ~2 s alone, much later on a loaded machine
     while time.time() < deadline:
         time.sleep(1.0)
         if pd.poll() is not None:
