@@ -173,6 +173,7 @@ class Scene
     void place_drum();
     void gather_contact_forces();
     CharacterPose target_pose() const;
+    Eigen::Vector3d bead_rel_com(Side side) const;
 
     CharacterModel model_;
     SceneOptions options_;

@@ -563,25 +563,28 @@ Eigen::Vector3d Scene::tip_position(Side side) const
     return to_eigen3(out);
 }
 
-Eigen::Vector3d Scene::bead_position(Side side) const
+// The bead's centre (the tip minus one bead radius along the stick), relative
+// to the hand body's centre of mass, in its frame: what ODE's point queries take.
+Eigen::Vector3d Scene::bead_rel_com(Side side) const
 {
     const int hb = model_.hand_body(side);
     const StickInHand &st = model_.stick(side);
-    const Eigen::Vector3d rel =
-        st.tip_m - model_.options().stick.tip_radius_m * st.axis - com_local_[hb];
+    return st.tip_m - model_.options().stick.tip_radius_m * st.axis - com_local_[hb];
+}
+
+Eigen::Vector3d Scene::bead_position(Side side) const
+{
+    const Eigen::Vector3d rel = bead_rel_com(side);
     dVector3 out;
-    dBodyGetRelPointPos(body_[hb], rel.x(), rel.y(), rel.z(), out);
+    dBodyGetRelPointPos(body_[model_.hand_body(side)], rel.x(), rel.y(), rel.z(), out);
     return to_eigen3(out);
 }
 
 Eigen::Vector3d Scene::bead_velocity(Side side) const
 {
-    const int hb = model_.hand_body(side);
-    const StickInHand &st = model_.stick(side);
-    const Eigen::Vector3d rel =
-        st.tip_m - model_.options().stick.tip_radius_m * st.axis - com_local_[hb];
+    const Eigen::Vector3d rel = bead_rel_com(side);
     dVector3 out;
-    dBodyGetRelPointVel(body_[hb], rel.x(), rel.y(), rel.z(), out);
+    dBodyGetRelPointVel(body_[model_.hand_body(side)], rel.x(), rel.y(), rel.z(), out);
     return to_eigen3(out);
 }
 
