@@ -4,7 +4,7 @@
 // the previous output as Algorithm 2 warm-starts from the simulated state; then cold starts
 // on random reachable targets. Prints a table: best of `repeats` runs (others share the CPU).
 // Usage: bench_ik [seconds_of_motion=20] [repeats=5]
-#include "ictus/chain_ik_solver_pos_dls.hpp"
+#include "ictus/control/chain_ik_solver_pos_dls.hpp"
 
 #include <algorithm>
 #include <chrono>

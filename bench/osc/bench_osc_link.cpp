@@ -2,8 +2,9 @@
 // costs the physics thread, and how long a strike takes from post_strike() to
 // a UDP receiver on loopback (timetag "immediately", so no scheduling), p50 /
 // p99 / max. Also the strike detector's cost per step. Prints its figures.
-#include "ictus/osc_link.hpp"
-#include "ictus/strike.hpp"
+#include "ictus/net/osc_sender.hpp"
+#include "ictus/net/osc_server.hpp"
+#include "ictus/sim/strike_detector.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>

@@ -3,10 +3,10 @@
 // at 1 kHz while tracking the CMU drumming clip, with a breakdown (targets,
 // control, collide, solve, check) and the real-time factor on one core.
 // usage: bench_sim_step [BVH] [seconds] [iterations] [drum raise above the lowest tips, m]
-#include "ictus/bvh.hpp"
-#include "ictus/joint_limits.hpp"
-#include "ictus/scene.hpp"
-#include "ictus/track.hpp"
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/mocap/joint_limits.hpp"
+#include "ictus/sim/scene.hpp"
+#include "ictus/perform/track.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -27,7 +27,7 @@ int main(int argc, char **argv)
     const int iterations = argc > 3 ? std::atoi(argv[3]) : 15;
     const double drum_raise_m = argc > 4 ? std::atof(argv[4]) : 0.05;
     BvhOptions bo;
-    bo.scale = 0.056444;
+    bo.scale = ictus::kCmuBvhScale_m;
     bo.skip_frames = 1;
     BvhFile bvh;
     try {
@@ -72,7 +72,7 @@ int main(int argc, char **argv)
         reference.sample((n + 1) * so.step_s, pose);
         for (int j = 0; j < CharacterModel::kJoints; ++j) {
             target[j] = pose.local[j];
-            rate[j] = rotation_vector(target[j] * previous[j].conjugate()) / so.step_s;
+            rate[j] = log_map(target[j] * previous[j].conjugate()) / so.step_s;
         }
         previous = target;
         scene.set_joint_targets(target, rate);

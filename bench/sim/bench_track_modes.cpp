@@ -3,9 +3,9 @@
 // on the CMU drumming clip at 1 kHz on one core: microseconds per step, the
 // IK's share, and the real-time factor (target: >= 20x for the hybrid mode).
 // usage: bench_sim_track_modes [BVH] [seconds] [runs]
-#include "ictus/bvh.hpp"
-#include "ictus/character_limits.hpp"
-#include "ictus/track.hpp"
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/character/character_limits.hpp"
+#include "ictus/perform/track.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -24,7 +24,7 @@ int main(int argc, char **argv)
     const double seconds = argc > 2 ? std::atof(argv[2]) : 30.0;
     const int runs = argc > 3 ? std::max(1, std::atoi(argv[3])) : 3;
     BvhOptions bo;
-    bo.scale = 0.056444;
+    bo.scale = ictus::kCmuBvhScale_m;
     bo.skip_frames = 1;
     BvhFile bvh;
     try {

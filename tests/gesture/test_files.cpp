@@ -1,7 +1,8 @@
 // The database's JSON file (exact round trip, errors with file and line) and
 // the `gestures` verb (cmd_gestures, run in-process and through ictusd when
 // the verb is wired in).
-#include "ictus/gesture.hpp"
+#include "ictus/cli/verbs.hpp"
+#include "ictus/gesture/gesture.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -62,7 +63,8 @@ int run_verb(std::vector<std::string> args)
     for (auto &a : args)
         argv.push_back(a.data());
     argv.push_back(nullptr);
-    return cmd_gestures(static_cast<int>(args.size()), argv.data());
+    ictus::cli::Args parsed(static_cast<int>(args.size()), argv.data());
+    return ictus::cli::run_verb("gestures", [&] { return ictus::cli::cmd_gestures(parsed); });
 }
 
 } // namespace

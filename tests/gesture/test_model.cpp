@@ -3,7 +3,7 @@
 // lowest point with a downward approach, C1 elsewhere, the loudness order of
 // preparation heights and impact speeds, monotonic dynamics, the nuances'
 // path features, the grips' lateral arc, the mirror image of the hands.
-#include "ictus/gesture.hpp"
+#include "ictus/gesture/gesture.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -2,7 +2,7 @@
 // stroke model: |sin| arches, irregular times and heights, a bounce, a
 // rotated performer) must give back the strikes, the count and the frame.
 // Import from a stick-only CSV and from the CMU BVH clip.
-#include "ictus/gesture.hpp"
+#include "ictus/gesture/gesture.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -14,7 +14,7 @@
 //    period (h = (1 - cos 2 pi tau) / 2, no forward motion); and the height
 //    below a stronger baseline: a raised-cosine downswing with the
 //    recording's own apex time.
-#include "ictus/gesture.hpp"
+#include "ictus/gesture/gesture.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -2,7 +2,7 @@
 // 0.29 m, forearm 0.27 m, hand 0.08 m + stick 0.40 m held forward. y is up, +x to the right.
 #pragma once
 
-#include "ictus/kinematics.hpp"
+#include "ictus/control/kinematic_chain.hpp"
 
 #include <atomic>
 #include <cmath>

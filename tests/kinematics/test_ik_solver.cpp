@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "arm_fixture.hpp"
-#include "ictus/chain_ik_solver_pos_dls.hpp"
+#include "ictus/control/chain_ik_solver_pos_dls.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,6 +1,6 @@
 // gesture_unit.cpp -- nuance names, the unit's interpolant, the database and
 // its JSON form (docs/gestures.md, "File format").
-#include "ictus/gesture.hpp"
+#include "ictus/gesture/gesture.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -2,12 +2,11 @@
 // rule, the cut at the maxima between strikes, the performer frame; import
 // from BVH and marker CSV; the TrajOptDrums reader. docs/gestures.md,
 // "Segmentation" and "Import".
-#include "ictus/gesture.hpp"
+#include "ictus/gesture/gesture.hpp"
 
-#include "ictus/bvh.hpp"
-#include "ictus/marker_csv.hpp"
-#include "ictus/stick_capture.hpp"
-#include "ictus/track.hpp"
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/mocap/marker_csv.hpp"
+#include "ictus/character/stick_capture.hpp"
 
 #include <algorithm>
 #include <cmath>

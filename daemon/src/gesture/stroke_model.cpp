@@ -15,7 +15,7 @@
 //      loop), the vertical accent moves the wrist forward to cancel the arc.
 // Every quantity is a smooth function of h(t), so the unit is C1 except at
 // the strike, where the velocity reverses.
-#include "ictus/gesture.hpp"
+#include "ictus/gesture/gesture.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>

@@ -2,7 +2,7 @@
 //
 // The hierarchy is read token by token (line numbers kept for messages), the
 // motion section line by line, so a wrong value count is reported on its line.
-#include "ictus/bvh.hpp"
+#include "ictus/mocap/bvh.hpp"
 
 #include "text_lines.hpp"
 

@@ -1,7 +1,7 @@
 // bvh_writer.cpp -- BVH export: a skeleton and its motion as a Biovision
 // Hierarchy file that read_bvh (bvh.cpp) reads back to the same joint frames.
 // Used to export the simulated performance for 3D tools without Gem.
-#include "ictus/bvh.hpp"
+#include "ictus/mocap/bvh.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,7 +1,7 @@
 // joint_limits.cpp -- the paper's two joint-limit formulations ("Virtual
 // Character Modeling"): Euler-angle statistics, and Algorithm 1 (tangent space
 // of the mean quaternion, SVD, ellipsoid of k standard deviations).
-#include "ictus/joint_limits.hpp"
+#include "ictus/mocap/joint_limits.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -169,7 +169,7 @@ EulerLimit learn_euler_limit(const std::vector<Eigen::Quaterniond> &series,
 
 Eigen::Vector3d QuaternionLimit::tangent(const Eigen::Quaterniond &q) const
 {
-    return log_map(mean.conjugate() * q.normalized());
+    return log_map((mean.conjugate() * q.normalized()).normalized());
 }
 
 double QuaternionLimit::normalized_distance(const Eigen::Quaterniond &q) const

@@ -1,5 +1,5 @@
 // marker_csv.cpp -- CSV of tracked objects -> MarkerCapture (y up, metres).
-#include "ictus/marker_csv.hpp"
+#include "ictus/mocap/marker_csv.hpp"
 
 #include "text_lines.hpp"
 

@@ -1,5 +1,5 @@
 // mocap_error.cpp -- MocapError: "FILE:LINE: message".
-#include "ictus/mocap_error.hpp"
+#include "ictus/mocap/mocap_error.hpp"
 
 namespace ictus
 {

@@ -1,6 +1,6 @@
 // motion.cpp -- lookups, forward kinematics and resampling of captured motion.
-#include "ictus/mocap_error.hpp"
-#include "ictus/motion.hpp"
+#include "ictus/mocap/mocap_error.hpp"
+#include "ictus/mocap/motion.hpp"
 
 #include <algorithm>
 #include <cmath>

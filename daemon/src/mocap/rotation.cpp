@@ -1,5 +1,5 @@
-// rotation.cpp -- quaternion log/exp, sign-robust mean, Tait-Bryan angles.
-#include "ictus/joint_limits.hpp"
+// rotation.cpp -- sign-robust mean rotation and Tait-Bryan angles (joint_limits.hpp).
+#include "ictus/mocap/joint_limits.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -8,29 +8,6 @@
 
 namespace ictus
 {
-
-Eigen::Vector3d log_map(const Eigen::Quaterniond &q_in)
-{
-    Eigen::Quaterniond q = q_in.normalized();
-    if (q.w() < 0.0)
-        q.coeffs() = -q.coeffs(); // same rotation; keeps the angle in [0, pi]
-    const double sin_half = q.vec().norm();
-    if (sin_half < 1e-12)
-        return 2.0 * q.vec(); // angle ~ 2 sin(angle/2) for tiny angles
-    const double angle = 2.0 * std::atan2(sin_half, q.w());
-    return q.vec() * (angle / sin_half);
-}
-
-Eigen::Quaterniond exp_map(const Eigen::Vector3d &rotation_vector_rad)
-{
-    const double angle = rotation_vector_rad.norm();
-    if (angle < 1e-12)
-        return Eigen::Quaterniond(1.0, 0.5 * rotation_vector_rad.x(), 0.5 * rotation_vector_rad.y(),
-                                  0.5 * rotation_vector_rad.z())
-            .normalized();
-    const Eigen::Vector3d v = rotation_vector_rad * (std::sin(0.5 * angle) / angle);
-    return Eigen::Quaterniond(std::cos(0.5 * angle), v.x(), v.y(), v.z());
-}
 
 Eigen::Quaterniond mean_rotation(const std::vector<Eigen::Quaterniond> &series)
 {

@@ -1,7 +1,7 @@
 // text_lines.cpp -- line splitting and number parsing shared by the readers.
 #include "text_lines.hpp"
 
-#include "ictus/mocap_error.hpp"
+#include "ictus/mocap/mocap_error.hpp"
 
 #include <cctype>
 #include <charconv>

@@ -18,7 +18,7 @@
 // successive motion units" in the Cartesian space); the warping and blending
 // are the classic motion-editing tools (Witkin & Popovic 1995 motion warping,
 // Kovar & Gleicher 2003 registration curves, cross-fades with ease curves).
-#include "ictus/gesture_score.hpp"
+#include "ictus/score/gesture_score.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -41,10 +41,6 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kStopTime_s = 0.05;
 // A stroke's period when nothing sets it: gesture.hpp's nominal 0.5 s (120 bpm).
 constexpr double kNominalPeriod_s = 0.5;
-// Stick direction (performer frame) for units that carry none: forward, 15
-// degrees down.
-const Eigen::Vector3d kDefaultStickDir(0.0, -0.2588190451, 0.9659258263);
-
 // Cubic Hermite tangents of samples p[first..last] (spacing h): central
 // differences inside, second-order one-sided differences at the ends.
 std::vector<Eigen::Vector3d> hermite_tangents(const std::vector<Eigen::Vector3d> &p, int first,
@@ -80,7 +76,7 @@ class UnitCurve
                                         std::to_string(n) + " samples, strike at " +
                                         std::to_string(unit.strike_index) + ")");
         if (dir_.empty())
-            dir_.assign(p_.size(), kDefaultStickDir);
+            dir_.assign(p_.size(), kDefaultStickDirection);
         if (dir_.size() != p_.size())
             throw std::invalid_argument(name + ": stick_dir and tip_m differ in length");
         for (int i = 0; i < n; ++i)

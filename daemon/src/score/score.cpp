@@ -3,7 +3,7 @@
 // Parsing is in two passes so that nothing is produced from a faulty score:
 // every statement is parsed and range-checked first (add_line), and only a
 // complete, balanced statement list is executed into a Score (finish).
-#include "ictus/score.hpp"
+#include "ictus/score/score.hpp"
 
 #include <algorithm>
 #include <cctype>

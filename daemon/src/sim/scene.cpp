@@ -1,5 +1,5 @@
 // The ODE scene: one owner for the world, space, contact group and bodies.
-#include "ictus/scene.hpp"
+#include "ictus/sim/scene.hpp"
 
 #include <ode/ode.h>
 
@@ -372,7 +372,7 @@ void Scene::apply_control()
         if (options_.limit_stops && !limits_.empty() && limits_[j].active()) {
             const Eigen::Quaterniond current = qp.conjugate() * qc;
             const Eigen::Quaterniond inside = limits_[j].clamp(current);
-            const Eigen::Vector3d v = rotation_vector(current * inside.conjugate());
+            const Eigen::Vector3d v = log_map(current * inside.conjugate());
             violation = v.norm();
             if (violation > options_.stop_margin_rad) {
                 stop = true;

@@ -1,0 +1,191 @@
+// character.hpp -- the virtual percussionist as a kinematic and inertial model:
+// 20 rigid bodies (pelvis + 19) joined by 19 three-DoF joints (57 DoF), segment
+// lengths from a mocap skeleton, masses and inertia from de Leva (1996), two
+// drumsticks held in the hands with a French or German grip. No ODE here: the
+// Scene (scene.hpp) builds the physical character from this model, and the
+// Cartesian mode can run forward kinematics on it. See docs/character.md.
+#pragma once
+
+#include "ictus/mocap/motion.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ictus
+{
+
+// Any problem building the character or its reference motion (missing joint,
+// bad option value). what() names the thing and the value.
+class CharacterError : public std::runtime_error
+{
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+// French: thumbs up, palms facing; German: palms down (paper, "Results").
+enum class Grip { french, german };
+const char *to_string(Grip grip);
+Grip grip_from_string(const std::string &text); // throws CharacterError
+
+// A snare drumstick. Defaults: a 5A stick (16 in, ~50 g, 14.5 mm shaft).
+struct StickParams {
+    double length_m = 0.406;
+    double mass_kg = 0.050;
+    double tip_radius_m = 0.007;     // the bead at the far end
+    double shaft_radius_m = 0.00725; // 14.5 mm diameter
+    double grip_from_butt_m = 0.13;  // fulcrum: about a third of the length
+    // Angle between the stick and the finger axis, towards the thumb (German)
+    // or towards the palm normal (French): the stick leaves the fist between
+    // thumb and index finger, pointing inwards.
+    double grip_angle_rad = 0.5236; // 30 degrees
+};
+
+struct CharacterOptions {
+    double body_mass_kg = 70.0;
+    StickParams stick;
+    Grip grip = Grip::french; // the paper's recorded gestures used the French grip
+};
+
+enum class Side { left = 0, right = 1 };
+
+// One rigid body and the joint that attaches it to its parent.
+struct BodySpec {
+    std::string name;       // body: "thorax", "l_forearm"
+    std::string joint_name; // joint to the parent: "thorax", "l_elbow"; "" for the pelvis
+    std::string source;     // the mocap joint whose frame this body's frame is
+    // Mocap joints (indices in the source skeleton) whose local rotations are
+    // composed, parent-most first, into this joint's local rotation.
+    std::vector<int> source_path;
+    int parent = -1;                                         // body index, -1 for the pelvis
+    Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();      // joint centre in the parent frame
+    Eigen::Vector3d distal_m = Eigen::Vector3d::Zero();      // distal end in this frame (rest)
+    double length_m = 0.0;                                   // |distal_m|, from the mocap
+    double mass_kg = 0.0;                                    // segment only (no stick)
+    Eigen::Vector3d com_m = Eigen::Vector3d::Zero();         // in this body's frame
+    Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero(); // about com_m, body frame
+};
+
+// Stick pose in its hand's body frame; the stick's axis points from the butt to the tip.
+struct StickInHand {
+    Eigen::Vector3d grip_m = Eigen::Vector3d::Zero(); // fulcrum point
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitX();  // unit, butt -> tip
+    Eigen::Vector3d butt_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d tip_m = Eigen::Vector3d::Zero(); // the stick's end point
+    Eigen::Vector3d com_m = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero(); // about com_m, hand frame
+};
+
+// A configuration of the character: pelvis in the world, local rotation of each
+// of the 19 joints relative to its parent body (joint j moves body j + 1).
+struct CharacterPose {
+    Eigen::Vector3d pelvis_position_m = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond pelvis_rotation = Eigen::Quaterniond::Identity();
+    std::vector<Eigen::Quaterniond> local; // [joint]
+};
+
+// World frames of all bodies: joint centre (body frame origin) and orientation.
+struct BodyFrames {
+    std::vector<Eigen::Vector3d> origin_m;    // [body]
+    std::vector<Eigen::Quaterniond> rotation; // [body]
+};
+
+class CharacterModel
+{
+  public:
+    static constexpr int kJoints = 19;
+    static constexpr int kBodies = kJoints + 1;
+
+    // Builds the character from a CMU-style skeleton (joint names as in the CMU
+    // BVH files, see docs/character.md for the mapping). Throws CharacterError
+    // naming a missing joint or a bad option.
+    static CharacterModel from_skeleton(const Skeleton &skeleton,
+                                        const CharacterOptions &options = {});
+
+    const std::vector<BodySpec> &bodies() const { return bodies_; }
+    const BodySpec &joint_body(int joint) const { return bodies_[joint + 1]; }
+    const std::string &joint_name(int joint) const { return bodies_[joint + 1].joint_name; }
+    int body_index(const std::string &body_name) const;   // -1 when absent
+    int joint_index(const std::string &joint_name) const; // -1 when absent
+    int hand_body(Side side) const { return hand_body_[static_cast<int>(side)]; }
+    const StickInHand &stick(Side side) const { return stick_[static_cast<int>(side)]; }
+    const CharacterOptions &options() const { return options_; }
+    double total_mass_kg() const;
+
+    // The character's pose at one frame of a motion of the source skeleton.
+    CharacterPose pose_from_motion(const Motion &motion, int frame) const;
+    // The rest pose (all local rotations identity) at the given pelvis frame.
+    CharacterPose rest_pose() const;
+
+    // Forward kinematics of the character (not of the source skeleton: joints
+    // merged into others move with them, see docs/character.md).
+    void forward(const CharacterPose &pose, BodyFrames &frames) const;
+    // World position of a stick's end point in a given pose of its hand.
+    Eigen::Vector3d tip_position(Side side, const Eigen::Vector3d &hand_origin_m,
+                                 const Eigen::Quaterniond &hand_rotation) const;
+
+    // Inertia of everything carried by a joint (its subtree, sticks included)
+    // about the joint centre, at the given pose: the scalar mean of the
+    // diagonal, kg m^2, and the subtree's mass. Used to scale PD gains.
+    struct SubtreeInertia {
+        double inertia_kg_m2;
+        double mass_kg;
+    };
+    SubtreeInertia subtree_inertia(int joint, const CharacterPose &pose) const;
+
+    // Mass and inertia of a body with its stick merged in (hands), as used by
+    // the physics: centre of mass in the body frame, inertia about it.
+    void merged_mass(int body, double &mass_kg, Eigen::Vector3d &com_m,
+                     Eigen::Matrix3d &inertia_kg_m2) const;
+
+  private:
+    std::vector<BodySpec> bodies_;
+    std::array<int, 2> hand_body_{{-1, -1}};
+    std::array<StickInHand, 2> stick_;
+    CharacterOptions options_;
+};
+
+// The reference (target) motion in the character's joint space: per frame the
+// 19 local rotations, pelvis held at the first frame's pose. Sampled at any
+// time by slerp; past the end the motion plays backwards and forwards again
+// (ping-pong), so that long runs have no jump at the seam.
+// Clean-up of captured rotations before they become PD targets. Captured
+// joint angles carry one-frame spikes and jitter that no human (and no
+// torque-limited PD) follows: differentiated twice at 120 Hz they ask for
+// thousands of rad/s^2 (docs/character.md).
+struct ReferenceFilter {
+    // A frame further than this from the midpoint of its two neighbours,
+    // while the neighbours are closer than it to each other, is replaced by
+    // that midpoint (one-frame spikes). 0 disables.
+    double spike_threshold_rad = 0.0873; // 5 degrees
+    // Zero-phase Gaussian smoothing in each frame's tangent space, kernel
+    // sigma = 1 / (2 pi cutoff) (response exp(-1/2) at the cutoff). 0 disables.
+    double smooth_cutoff_hz = 10.0;
+};
+
+class ReferenceMotion
+{
+  public:
+    // Without a filter: the motion's rotations as they are.
+    ReferenceMotion(const CharacterModel &model, const Motion &motion);
+    ReferenceMotion(const CharacterModel &model, const Motion &motion,
+                    const ReferenceFilter &filter);
+    // Number of one-frame spikes replaced by the filter.
+    int spikes_removed() const { return spikes_removed_; }
+    double frame_rate_hz() const { return frame_rate_hz_; }
+    int frames() const { return static_cast<int>(frames_.size()); }
+    double duration_s() const;
+    const CharacterPose &frame(int f) const { return frames_[f]; }
+    // Pose at time t (s); local rotations only are interpolated.
+    void sample(double time_s, CharacterPose &pose) const;
+
+  private:
+    double frame_rate_hz_ = 0.0;
+    std::vector<CharacterPose> frames_;
+    int spikes_removed_ = 0;
+};
+
+} // namespace ictus

@@ -1,0 +1,61 @@
+// args.hpp -- the one argument module of ictusd's verbs: the usage error, the
+// strict number parsers, the argv walker, the interrupt flag (SIGINT/SIGTERM)
+// and the exit-status mapping every verb shares. Exit status: 0 ok, 1 error in
+// a file or the data, 2 usage error, 3 the simulation diverged, 130 interrupted.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <csignal>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ictus
+{
+namespace cli
+{
+
+// A bad command line: the verb exits with status 2.
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// Strict parsers: the whole text must be a finite number. Each throws a
+// UsageError naming the option and the text.
+double parse_number(const std::string &option, const std::string &text);
+double parse_number(const std::string &option, const std::string &text, double lo, double hi);
+double parse_positive(const std::string &option, const std::string &text);
+int parse_int(const std::string &option, const std::string &text, int lo, int hi);
+// "X,Y,Z" (each a number).
+Eigen::Vector3d parse_vec3(const std::string &option, const std::string &text);
+std::vector<std::string> split(const std::string &text, char separator);
+
+// The argv walker: options with one value, flags, positional arguments.
+class Args
+{
+  public:
+    Args(int argc, char **argv); // argv[0] is skipped (the program or the verb)
+    bool done() const { return at_ >= items_.size(); }
+    const std::string &next() { return items_[at_++]; }
+    // The value of `option` (the next item); UsageError "OPTION: missing value".
+    std::string value(const std::string &option);
+
+  private:
+    std::vector<std::string> items_;
+    size_t at_ = 0;
+};
+
+// Set by SIGINT (and SIGTERM once install_interrupt_handler(true) ran); the
+// loops of track, run and render check it every step.
+extern volatile std::sig_atomic_t g_interrupted;
+void install_interrupt_handler(bool also_sigterm = false);
+
+// Runs a verb: its return value is the exit status; an exception is printed
+// as "ictusd VERB: what" and mapped to 2 (UsageError, a bad network option)
+// or 1 (anything else: a file, the data).
+int run_verb(const char *verb, const std::function<int()> &body);
+
+} // namespace cli
+} // namespace ictus

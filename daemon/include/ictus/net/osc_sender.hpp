@@ -1,0 +1,95 @@
+// osc_sender.hpp -- the OSC link between ictusd and Pd, way out (paper,
+// Figure 3: the physics, graphics, interaction and sound managers run
+// asynchronously and talk OSC): strike bundles, time-tagged for exact
+// scheduling, and a pose stream for graphics, each sent by its own thread from
+// lock-free queues fed by the physics thread. The way in is osc_server.hpp.
+// The namespace, type tags and units are in docs/osc.md.
+#pragma once
+
+#include "ictus/base/spsc_queue.hpp"
+#include "ictus/perform/commands.hpp"
+#include "ictus/sim/strike_detector.hpp"
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+namespace ictus
+{
+
+// Bad option, unbindable address, unresolvable target; what() names it.
+class OscError : public std::runtime_error
+{
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+// NTP time (OSC timetags) as 32.32 fixed point, and the current wall clock in it.
+using NtpTime = std::uint64_t;
+NtpTime ntp_now();
+NtpTime ntp_add_seconds(NtpTime t, double seconds);
+double ntp_diff_seconds(NtpTime a, NtpTime b); // a - b
+
+// ---- out --------------------------------------------------------------------
+
+// A snapshot of the scene for graphics (world frame, y up, metres).
+struct OscSenderOptions {
+    std::string target_url = "osc.udp://127.0.0.1:9000";
+    // Strike bundles carry the timetag epoch + time_s + lookahead_s. A
+    // lookahead of 0 sends them as "immediately" (timetag 1).
+    double lookahead_s = 0.010;
+};
+
+struct OscSenderCounters {
+    unsigned long strikes_sent = 0, poses_sent = 0, tips_sent = 0;
+    unsigned long send_errors = 0;
+    unsigned long strikes_dropped = 0, poses_dropped = 0, tips_dropped = 0; // queue full
+};
+
+// Two threads: strikes (urgent) and the pose / tip stream, each with its own
+// liblo address. post_* are for one producer thread (the physics thread):
+// lock-free, never block, false when the queue is full (counted).
+class OscSender
+{
+  public:
+    explicit OscSender(const OscSenderOptions &options); // throws OscError
+    ~OscSender();                                        // stops and joins
+    OscSender(const OscSender &) = delete;
+    OscSender &operator=(const OscSender &) = delete;
+
+    // The wall-clock (NTP) time of simulation time 0; may be moved while
+    // running (the physics thread re-anchors after falling behind).
+    void set_epoch(NtpTime epoch) { epoch_.store(epoch, std::memory_order_release); }
+    NtpTime epoch() const { return epoch_.load(std::memory_order_acquire); }
+
+    bool post_strike(const StrikeEvent &event);
+    bool post_pose(const PoseSnapshot &pose);
+    bool post_tip(const TipState &tip);
+
+    // Sends what is queued and joins the threads.
+    void stop();
+    OscSenderCounters counters() const;
+    const OscSenderOptions &options() const { return options_; }
+
+  private:
+    void strike_loop();
+    void pose_loop();
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    OscSenderOptions options_;
+    std::atomic<NtpTime> epoch_{0};
+    std::atomic<bool> running_{true};
+    std::atomic<unsigned long> strikes_sent_{0}, poses_sent_{0}, tips_sent_{0}, send_errors_{0};
+    SpscQueue<StrikeEvent, 1024> strikes_;
+    SpscQueue<PoseSnapshot, 16> poses_;
+    SpscQueue<TipState, 1024> tips_;
+    std::thread strike_thread_, pose_thread_;
+};
+
+// ---- in -----------------------------------------------------------------------
+
+} // namespace ictus

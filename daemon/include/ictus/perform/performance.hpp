@@ -1,0 +1,187 @@
+// performance.hpp -- the physics side of `ictusd run` (real time) and `ictusd
+// render` (offline): the character playing the drum, one physics step at a
+// time, with the commands Pd may send applied between steps. Two motion
+// sources: a mocap clip in joint space (paper eq. 1, as `ictusd track`), or a
+// score performed through its gesture plan (stick-tip targets, Cartesian mode
+// by default, on the default body). Strikes come from the interaction manager
+// (sim/strike_detector.hpp). No network and no files here: the verbs in cli/
+// own those. See docs/perform.md and docs/osc.md.
+#pragma once
+
+#include "ictus/character/character.hpp"
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/gesture/gesture.hpp"
+#include "ictus/score/gesture_score.hpp"
+#include "ictus/control/joint_controller.hpp"
+#include "ictus/perform/commands.hpp"
+#include "ictus/sim/scene.hpp"
+#include "ictus/score/score.hpp"
+#include "ictus/sim/strike_detector.hpp"
+#include "ictus/perform/track.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ictus
+{
+
+// Score mode: how a gesture plan is performed (docs/perform.md, where the
+// defaults are measured).
+struct ScorePerformOptions {
+    std::string score_text; // the score; empty: default_score_text()
+    std::string score_name = "default";
+    std::string gestures; // gesture database JSON; empty: GestureDatabase::builtin()
+    TrackMode mode = TrackMode::cartesian;
+    bool grip_given = false; // else the character holds the sticks as the score's first note
+    PlanOptions plan;        // strike_depth_m below: the default here
+    // The tip targets are sampled this far ahead of the plan's clock: the
+    // controller's measured tracking lag (docs/perform.md), so that the
+    // physical tip, not the target, meets the membrane on the beat.
+    double time_advance_s = 0.0;
+    CartesianOptions cartesian;
+    // After each beat the target rebounds off the head at the impact speed
+    // and is caught with this time constant, s (0: off; docs/perform.md).
+    double rebound_s = 0.1;
+    // The drum relative to the performer (derived from the model's shoulders,
+    // facing +Z): membrane centre this far in front of and below the
+    // midpoint of the shoulders.
+    double drum_forward_m = 0.42;
+    double drum_below_m = 0.42;
+    ScorePerformOptions();
+};
+
+struct PerformanceOptions {
+    std::string mocap; // BVH with CMU joint names; empty: score mode
+    double scale_m_per_unit = kCmuBvhScale_m;
+    int skip_frames = 1;
+    CharacterOptions character;
+    SceneOptions scene;
+    GainOptions gains;
+    bool drum_auto = true; // drum under the clip's lowest tips
+    double ramp_s = 0.25;
+    double clip_bpm = 120.0; // tempo at which the clip plays at its own speed
+    double tempo_bpm = 120.0;
+    double drum_density_kg_per_m2 = 0.26; // for the sound only (membrane~)
+    StrikeDetectorOptions strikes;
+    ScorePerformOptions score; // score mode (no mocap)
+};
+
+// How the strikes of a performance met its planned notes: per hand, each
+// primary (non-bounce) strike is given to the nearest note of that hand; a
+// note keeps the nearest of the strikes given to it (the others are extra).
+struct NoteMatch {
+    long strike_seq = -1; // -1: no strike for this note
+    double strike_time_s = 0.0;
+    double error_ms = 0.0; // strike - beat
+    double normal_velocity_mps = 0.0;
+    double duration_ms = 0.0;
+};
+struct MatchSummary {
+    std::vector<NoteMatch> notes; // [note], as the plan's notes
+    long primary_strikes = 0, bounces = 0;
+    long matched_notes = 0;
+    long extra_strikes = 0; // primary strikes not matched to a note
+    double mean_abs_error_ms = 0.0, max_abs_error_ms = 0.0;
+};
+// `origin_s`: simulation time of the plan's time 0.
+MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
+                           const std::vector<StrikeEvent> &strikes, double origin_s);
+
+// The physics side of run and render: the character tracking the clip or
+// performing a score, the drum, the strike detector, and the commands Pd may send.
+class Performance
+{
+  public:
+    explicit Performance(const PerformanceOptions &options); // throws on bad file/options
+    ~Performance();
+
+    // One physics step; returns the number of strikes ended in it (<= 2),
+    // written to out[0..n).
+    int step(StrikeEvent out[2]);
+    // Ends contacts still open (end of a run).
+    bool flush(StrikeEvent &out) { return detector_.flush(out); }
+    // Applies a command from the OSC thread. Returns false with a reason when
+    // it cannot be applied (the OSC thread has already validated the values).
+    bool apply(const Command &command, std::string *why = nullptr);
+
+    void pose(PoseSnapshot &out) const;
+    void tip(int hand, TipState &out) const;
+    double time_s() const;
+    // The clip's length at the current tempo, s.
+    double clip_duration_s() const;
+    double step_s() const { return options_.scene.step_s; }
+    bool playing() const { return playing_; }
+    double tempo_bpm() const { return options_.tempo_bpm; }
+    const PerformanceOptions &options() const { return options_; }
+    const Scene &scene() const;
+    // The character being simulated and the mocap skeleton it was built from
+    // (score mode: default_skeleton()), for recording the performance as BVH.
+    const CharacterModel &model() const;
+    const Skeleton &skeleton() const { return skeleton_; }
+    const StrikeDetector &detector() const { return detector_; }
+    int divergences() const;
+
+    // Score mode.
+    bool score_mode() const { return options_.mocap.empty(); }
+    // The plan being performed (or last performed); nullptr before the first.
+    const GesturePlan *plan() const { return plan_ ? plan_.get() : nullptr; }
+    bool plan_active() const { return plan_active_; }
+    // Simulation time of the plan's time 0, and the plan's clock.
+    double plan_origin_s() const { return plan_origin_s_; }
+    double plan_time_s() const { return plan_time_s_; }
+    // The tip target X^T the controller was given in the last step [hand].
+    Eigen::Vector3d tip_target(int hand) const;
+    Eigen::Vector3d tip_position(int hand) const;
+    const PerformerFrame &performer_frame() const;
+    TrackMode mode() const;
+    // The planned target's speed toward the head as it reaches the contact,
+    // per note of plan() (m/s).
+    double planned_impact_speed_mps(size_t note) const
+    {
+        return note < planned_speed_mps_.size() ? planned_speed_mps_[note] : 0.0;
+    }
+    // Plans the current score and starts it now (what /ictus/play does in
+    // score mode). Throws ScoreError / GestureError; on error nothing changes.
+    void start_score();
+
+  private:
+    struct Rig;
+    struct ScoreRig;
+    void build();
+    void build_score(bool keep_pose);
+    int step_score(StrikeEvent out[2]);
+    bool apply_score(const Command &command, std::string *why);
+    void start_rest_move();
+    Eigen::Vector3d target_at(int side, double plan_time_s) const;
+    void apply_drum_now();
+    PerformanceOptions options_;
+    Skeleton skeleton_;
+    std::unique_ptr<BvhFile> clip_; // clip mode: the capture, read once
+    mutable BodyFrames frames_;     // scratch of pose()
+    std::unique_ptr<Rig> rig_;
+    std::unique_ptr<ScoreRig> score_rig_;
+    StrikeDetector detector_;
+    // Score mode: the database, the statements received, the score and its plan.
+    std::unique_ptr<GestureDatabase> db_;
+    std::unique_ptr<ScoreBuilder> builder_;
+    std::unique_ptr<Score> score_;
+    std::unique_ptr<GesturePlan> plan_;
+    bool plan_active_ = false;
+    double plan_origin_s_ = 0.0, plan_time_s_ = 0.0;
+    // Between plans the tips move to (and hold) the rest tips.
+    std::array<Eigen::Vector3d, 2> rest_from_m_;
+    double rest_move_start_s_ = -1e9;
+    // Per hand, per note: plan time of the beat, the lead of the target's
+    // first contact before it, the approach speed there (target_at).
+    std::array<std::vector<double>, 2> beats_, lead_s_, approach_mps_;
+    std::vector<double> planned_speed_mps_; // [note of plan_]
+    bool playing_ = true;
+    bool rebuild_pending_ = false;
+    double clip_time_s_ = 0.0;
+    double time_offset_s_ = 0.0; // simulation time at the last (re)build
+    double gain_scale_[2] = {1.0, 1.0};
+    int divergences_before_ = 0;
+};
+
+} // namespace ictus

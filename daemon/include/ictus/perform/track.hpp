@@ -1,0 +1,113 @@
+// track.hpp -- joint-space tracking of a reference motion (the paper's ID mode,
+// eq. 1): the headless run behind `ictusd track --mode joint`. Writes, if
+// asked, a CSV of reference vs simulated joint rotations and stick tips, and
+// returns a summary (tip and joint RMS errors, real-time factor, divergences).
+#pragma once
+
+#include "ictus/character/character.hpp"
+#include "ictus/character/stick_capture.hpp"
+#include "ictus/control/joint_controller.hpp"
+#include "ictus/perform/tracker.hpp"
+#include "ictus/sim/scene.hpp"
+
+#include <csignal>
+#include <functional>
+#include <iosfwd>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace ictus
+{
+
+struct TrackOptions {
+    TrackMode mode = TrackMode::joint;
+    CartesianOptions cartesian;
+    SceneOptions scene;
+    GainOptions gains;
+    // Simulated time; 0 means the reference's length (longer runs play it
+    // back and forth).
+    double duration_s = 0.0;
+    // Targets are blended from the initial pose over this time (a step in the
+    // targets at start-up jolts the trunk, ode-findings.md); errors are not
+    // counted during it.
+    double ramp_s = 0.25;
+    // Place the drum under the lowest reference stick tips (else scene.drum.center_m).
+    bool drum_auto = true;
+    // CSV rows per second of simulated time; 0: the reference's frame rate.
+    double sample_rate_hz = 0.0;
+    // Stick-only capture (Cartesian mode only): the tip targets and the
+    // errors come from it instead of the reference's stick tips; the
+    // reference then only holds the trunk and legs, the arms start from a cold
+    // IK solve to the first tips, and drum_auto fits the drum to its strokes.
+    const TipTrajectory *tip_reference = nullptr;
+    // Checked every step; when it becomes non-zero the run stops early (SIGINT).
+    const volatile std::sig_atomic_t *interrupt = nullptr;
+    // Called on the calling thread after every physics step, the ramp
+    // included (e.g. the strike detector behind `ictusd track`'s strikes.csv).
+    std::function<void(const Scene &)> on_step;
+};
+// Throws CharacterError naming the first bad option.
+void validate(const TrackOptions &options);
+
+struct TrackSummary {
+    std::string mode = "joint";
+    int frames = 0;  // reference frames
+    int samples = 0; // rows measured (and written to the CSV)
+    long steps = 0;
+    double duration_s = 0.0;
+    double wall_time_s = 0.0;
+    double realtime_factor = 0.0;
+    double tip_rms_mm[2] = {0.0, 0.0}; // left, right
+    double tip_max_mm[2] = {0.0, 0.0};
+    // Against the unfiltered capture, when given (includes what the filter
+    // removed: spikes and jitter no torque-limited body follows).
+    double tip_rms_raw_mm[2] = {0.0, 0.0};
+    double joint_rms_raw_deg_all = 0.0;
+    std::vector<std::string> joint_names;
+    std::vector<double> joint_rms_deg;
+    std::vector<double> joint_max_deg;
+    std::vector<double> joint_peak_torque_nm;     // largest motor torque seen (norm)
+    std::vector<double> joint_saturated_fraction; // of steps with an axis at its limit
+    bool diverged = false;
+    bool interrupted = false;
+    int divergences = 0;
+    double max_linear_speed_mps = 0.0;
+    double max_angular_speed_rad_s = 0.0;
+    long contact_steps = 0;
+    long stop_steps = 0; // joint-steps during which a safety-net stop was active
+    Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero();
+    // Cartesian mode: IK statistics over all arm solves (two per step).
+    double ik_mean_iterations = 0.0;
+    int ik_max_iterations = 0;
+    double ik_us_per_step = 0.0; // wall time of the IK (both arms, both solves)
+    long ik_not_converged = 0;   // solves that ended other than `converged`
+    // Elbow flexion (rotation angle of the elbow's local rotation), IK target
+    // Theta^T vs the capture, RMS over the samples [side], degrees.
+    // Not measured (null in JSON) for stick-only captures: no captured elbow.
+    double elbow_ik_rms_deg[2] = {0.0, 0.0};
+    bool elbow_measured = true;
+    nlohmann::json to_json() const;
+};
+
+// The reference stick tips [side] at the reference's frame f.
+std::array<Eigen::Vector3d, 2> reference_tips(const CharacterModel &model,
+                                              const CharacterPose &pose);
+
+// A drum centre under the lowest reference tips: x, z the mean of the two
+// tips at their lowest, y half a tip radius below the lower of them.
+Eigen::Vector3d auto_drum_center(const CharacterModel &model, const ReferenceMotion &reference);
+
+using ProgressFn = std::function<void(double fraction)>;
+
+// Runs the tracking of `reference` in options.mode (errors are measured against it, and also
+// against `raw_reference` when given). `limits` as Scene::set_joint_limits (empty: none). When
+// csv is given, writes a header and one row per sample. Throws CharacterError.
+TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotion &reference,
+                               const TrackOptions &options,
+                               const std::vector<JointLimitRef> &limits = {},
+                               std::ostream *csv = nullptr, const ProgressFn &progress = {},
+                               const std::vector<JointGains> *gains = nullptr,
+                               const ReferenceMotion *raw_reference = nullptr);
+
+} // namespace ictus

@@ -1,0 +1,110 @@
+// gesture_score.hpp -- from a score to motion: the gesture score. Each note
+// selects a gesture unit (grip x nuance x hand, scaled by its dynamics),
+// time-warped so its strike lands exactly on the note's beat, placed at the
+// note's spot on the drum, and co-articulated with the hand's previous and
+// next units into one smooth (C1) stick-tip trajectory per hand: the targets
+// X^T of the Cartesian controller (paper, Eq. 2 and Figure 5). The method is
+// described in docs/score.md.
+#pragma once
+
+#include "ictus/character/character.hpp"
+#include "ictus/gesture/gesture.hpp"
+#include "ictus/score/score.hpp"
+#include "ictus/character/stick_capture.hpp"
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+namespace ictus
+{
+
+// The stick's direction the planner assumes for units that carry none, and
+// the performance for the tip's contact height: butt to tip, 15 degrees below
+// the horizontal, forward (y up, the default performer facing +Z).
+const Eigen::Vector3d kDefaultStickDirection(0.0, -0.2588190451, 0.9659258263);
+
+// Where the performer and the drum are (world frame, m). The axes are unit
+// and orthogonal: right = the performer's right, up, forward = toward the drum.
+struct PerformerFrame {
+    // Defaults: the Scene's default drum (scene.hpp) and performer_frame_for_drum's rest tips.
+    Eigen::Vector3d membrane_center_m = Eigen::Vector3d(0.0, 0.7, 0.45);
+    Eigen::Vector3d right = -Eigen::Vector3d::UnitX();
+    Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+    Eigen::Vector3d forward = Eigen::Vector3d::UnitZ();
+    double membrane_radius_m = 0.178;
+    // Where each stick tip waits when its hand has nothing to play [Side].
+    std::array<Eigen::Vector3d, 2> rest_tip_m = {Eigen::Vector3d(0.1, 0.85, 0.4),
+                                                 Eigen::Vector3d(-0.1, 0.85, 0.4)};
+};
+
+// The shared frames of the brief (the character faces +Z: right = world -X),
+// a drum of `radius_m` centred at `membrane_center_m`, and rest tips
+// `rest_height_m` above the head, 0.1 m to each side of the centre and
+// 0.05 m nearer the performer.
+PerformerFrame performer_frame_for_drum(const Eigen::Vector3d &membrane_center_m, double radius_m,
+                                        double rest_height_m = 0.15);
+
+// A point of the head from the membrane frame of docs/osc.md (x_m = world
+// +X, y_m = world -Z, around the centre).
+Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg);
+
+// One note as it will be played.
+struct PlannedNote {
+    double time_s = 0.0; // the strike, plan clock (0 = start of the plan)
+    Side hand = Side::right;
+    Nuance nuance = Nuance::legato;
+    Grip grip = Grip::french;
+    double dynamics = 0.0;
+    double beats = 0.0;
+    double tempo_bpm = 0.0;                                        // at the note's beat
+    Eigen::Vector3d strike_point_m = Eigen::Vector3d::Zero();      // on the head, world
+    Eigen::Vector3d tip_target_m = Eigen::Vector3d::Zero();        // the tip at time_s: strike
+                                                                   // point - strike_depth_m * up
+    Eigen::Vector3d impact_velocity_mps = Eigen::Vector3d::Zero(); // planned, just before
+    double r_over_a = 0.0;
+    double theta_deg = 0.0;
+    int line = 0; // where the note is written
+    int column = 0;
+};
+
+struct PlanOptions {
+    double lead_in_s = 1.0; // time before the score's beat 0 (>= 0.2 s)
+    double tail_s = 1.0;    // time after the score's end (>= 0)
+    double rate_hz = 1000.0;
+    // The target passes this far below the membrane at the strike (the
+    // physics helper tunes it; < 0 is above).
+    double strike_depth_m = 0.0;
+    // Co-articulation: the blend between two units of one hand spans the
+    // middle of the gap between their strikes, leaving this fraction of the
+    // gap at each end to the units alone (0 < f < 0.5).
+    double blend_margin = 0.25;
+    // A hand with no stroke for longer than this goes back to its rest tip.
+    double idle_return_s = 4.0;
+    double return_time_s = 0.6; // the move between the rest tip and a stroke
+    // Two strokes of one hand closer than this are refused (no hand plays
+    // single strokes that fast; use the other hand).
+    double min_stroke_interval_s = 0.1;
+    double max_duration_s = 900.0; // longer performances are refused
+};
+
+// The gesture score, ready for the controller.
+struct GesturePlan {
+    // Both tips, world. Samples every 1 / rate_hz plus one exactly at each
+    // strike, so the sampled trajectory passes through each tip target on
+    // its beat.
+    TipTrajectory tips;
+    std::array<std::vector<Eigen::Vector3d>, 2> stick_dir; // [side][frame], unit, butt -> tip
+    std::vector<PlannedNote> notes;                        // in time order
+    double duration_s = 0.0;
+    double score_start_s = 0.0; // plan time of the score's beat 0 (= lead_in_s)
+};
+
+// Plans the whole performance before anything plays. Throws ScoreError (at
+// the note's line and column) for a note its hand cannot play in time or a
+// performance too long, std::invalid_argument for bad options or frame, and
+// lets GestureError from the database through.
+GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
+                             const PerformerFrame &frame, const PlanOptions &options = {});
+
+} // namespace ictus

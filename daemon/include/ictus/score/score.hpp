@@ -1,0 +1,162 @@
+// score.hpp -- the score language: what the virtual percussionist plays,
+// written the same way in a Pd message box (one statement per message) and in
+// a text file (one statement per line, or separated by ';' or ','). A score
+// is parsed whole before any note is produced, so a bad score plays nothing.
+// The language, its defaults and its errors are documented in docs/score.md.
+#pragma once
+
+#include "ictus/character/character.hpp"
+#include "ictus/gesture/gesture.hpp"
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ictus
+{
+
+// A fault in a score. what() is "source:line:column: message"; line and
+// column are 1-based (for statements added one by one, line is the
+// statement's number and column counts in that statement's text).
+class ScoreError : public std::runtime_error
+{
+  public:
+    ScoreError(const std::string &source, int line, int column, const std::string &message);
+    const std::string &source() const { return source_; }
+    int line() const { return line_; }
+    int column() const { return column_; }
+    const std::string &message() const { return message_; }
+
+  private:
+    std::string source_;
+    int line_;
+    int column_;
+    std::string message_;
+};
+
+// Limits the parser enforces (docs/score.md).
+constexpr double kMinTempoBpm = 20.0;
+constexpr double kMaxTempoBpm = 400.0;
+constexpr double kMinNoteBeats = 1.0 / 32.0;
+constexpr double kMaxNoteBeats = 64.0;
+constexpr double kMaxRampBeats = 1024.0;
+constexpr double kMaxRadiusFraction = 0.95; // r/a: the bead must land on the head
+constexpr int kMaxRepeat = 1000;
+constexpr int kMaxScoreNotes = 100000; // after repeats are expanded
+constexpr double kMaxScoreBeats = 100000.0;
+
+// Defaults: a note with nothing but a hand.
+constexpr double kDefaultTempoBpm = 120.0;
+constexpr double kDefaultNoteBeats = 1.0;
+constexpr double kDefaultDynamics = 0.6; // mf
+constexpr double kDefaultRadiusFraction = 0.3;
+// Membrane-frame angle (docs/osc.md: x_m along world +X, the performer's
+// left; y_m along world -Z, toward the performer) of each hand's default
+// spot: the right hand plays on the performer's right (x_m < 0).
+constexpr double kDefaultThetaDeg[2] = {0.0, 180.0}; // [Side::left, Side::right]
+
+// One stroke of the score, in beats (times come from the tempo map).
+struct ScoreNote {
+    double beat = 0.0;  // onset (the strike), beats from the start of the score
+    double beats = 1.0; // duration: the next statement starts this much later
+    Side hand = Side::right;
+    Nuance nuance = Nuance::legato;
+    Grip grip = Grip::french;
+    double dynamics = kDefaultDynamics; // 0 (softest) .. 1 (loudest)
+    double r_over_a = kDefaultRadiusFraction;
+    double theta_deg = 180.0; // membrane frame, in (-180, 180]
+    int line = 0;             // where the note was written
+    int column = 0;
+};
+
+// Tempo as a function of score position: a list of changes, each setting the
+// tempo at a beat and optionally ramping it linearly (in beats) to another
+// tempo over some beats, then holding it until the next change. Time is the
+// integral of 60 / tempo(beat) d(beat) (closed form per piece).
+class TempoMap
+{
+  public:
+    struct Change {
+        double beat = 0.0;         // where the change starts
+        double start_bpm = 120.0;  // tempo at `beat`
+        double end_bpm = 120.0;    // tempo at beat + ramp_beats and after
+        double ramp_beats = 0.0;   // 0: instant change
+        double start_time_s = 0.0; // time_at_beat(beat), filled in by add()
+    };
+
+    explicit TempoMap(double initial_bpm = kDefaultTempoBpm);
+    // Changes must come in non-decreasing beat order; a change cuts short a
+    // ramp still running at its beat. Throws std::invalid_argument otherwise.
+    void add(double beat, double start_bpm, double end_bpm, double ramp_beats);
+
+    double tempo_at_beat(double beat) const; // bpm
+    double time_at_beat(double beat) const;  // s from beat 0; beats < 0 at the first tempo
+    double beat_at_time(double time_s) const;
+    const std::vector<Change> &changes() const { return changes_; }
+
+  private:
+    std::vector<Change> changes_; // changes_[0] at beat 0
+    const Change &change_at(double beat) const;
+};
+
+// A whole parsed score.
+struct Score {
+    std::string source;           // file name or "osc", for messages
+    std::vector<ScoreNote> notes; // in onset order (ties: in the order written)
+    TempoMap tempo;               // beat -> time
+    double length_beats = 0.0;    // end of the last statement (note or rest)
+    double duration_s() const { return tempo.time_at_beat(length_beats); }
+    double note_time_s(const ScoreNote &note) const { return tempo.time_at_beat(note.beat); }
+};
+
+// Builds a score one statement at a time, as statements arrive from Pd
+// (`/ictus/score ,s "L accent 0.8"`). Each add_statement() counts as one line
+// for error positions. A statement that throws changes nothing; once one has
+// thrown, finish() refuses the score (throws the first error again) so a
+// score with a fault is never played, even in part.
+class ScoreBuilder
+{
+  public:
+    explicit ScoreBuilder(std::string source_name = "osc");
+    ~ScoreBuilder();
+    ScoreBuilder(ScoreBuilder &&) noexcept;
+    ScoreBuilder &operator=(ScoreBuilder &&) noexcept;
+
+    // Parses one statement (it may hold several separated by ',' or ';',
+    // and a '#' comment). Throws ScoreError.
+    void add_statement(const std::string &text);
+    // The statements so far as a score; throws ScoreError when a statement
+    // failed or a `repeat` is still open. The builder is left as it was.
+    Score finish() const;
+    int statements() const; // how many add_statement() calls so far
+    bool failed() const;
+    void reset(); // back to an empty score, errors forgotten
+
+  private:
+    friend Score parse_score(const std::string &, const std::string &);
+    struct State;
+    std::unique_ptr<State> state_;
+    // Parses `text` as line `line` and appends its statements (all or none).
+    void add_line(const std::string &text, int line);
+};
+
+// Parses a whole score (a file's contents): statements separated by
+// newlines, ';' or ','; '#' starts a comment. Throws ScoreError at the first
+// fault, naming `source_name`, the line and the column.
+Score parse_score(const std::string &text, const std::string &source_name);
+// Reads and parses a file; throws ScoreError (line 0) when it cannot be read.
+Score load_score(const std::string &path);
+
+// The built-in score the main job plays (the paper's Figure 5: legato and
+// accent beats of both hands under a tempo change, ~15 s).
+const char *default_score_text();
+
+// Dynamics words and their values (pp .. ff), for docs and tests.
+struct DynamicsWord {
+    const char *word;
+    double value;
+};
+const std::vector<DynamicsWord> &dynamics_words();
+
+} // namespace ictus

@@ -1,0 +1,223 @@
+// scene.hpp -- the one owner of ODE state: world, collision space, contact
+// group, the physical character (20 bodies, 19 ball joints + angular motors,
+// pelvis welded to the world), the sticks merged into the hands, and the drum.
+// Fixed step: control (eq. 1 motor rows), collide, step, clear contacts, check.
+// See docs/character.md.
+#pragma once
+
+#include "ictus/character/character.hpp"
+#include "ictus/control/joint_controller.hpp"
+#include "ictus/character/joint_limit_ref.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <vector>
+
+// ODE's opaque handles, so that users of the scene need not include ode.h.
+struct dxWorld;
+struct dxSpace;
+struct dxJointGroup;
+struct dxBody;
+struct dxJoint;
+struct dxGeom;
+
+namespace ictus
+{
+
+// The drum: a membrane disk (the top face of a short cylinder). Contact with
+// the sticks is a spring-damper normal to the membrane: the stiffness of a
+// circular membrane of tension T pressed by a tip of radius r is
+// k = 2 pi T / ln(R / r) (static point-load deflection of a membrane); the
+// interaction issue refines this.
+struct DrumParams {
+    Eigen::Vector3d center_m = Eigen::Vector3d(0.0, 0.7, 0.45); // membrane centre, world
+    double radius_m = 0.178;                                    // 14 in snare
+    double shell_depth_m = 0.10;
+    double tension_n_per_m = 3000.0;
+    double contact_damping_n_s_per_m = 10.0;
+    double friction = 0.3;
+    // k = 2 pi T / ln(R / r_tip), N/m.
+    double stiffness_n_per_m(double tip_radius_m) const;
+};
+
+enum class Stepper { quick, direct }; // dWorldQuickStep or dWorldStep
+
+struct SceneOptions {
+    double step_s = 0.001;
+    Stepper stepper = Stepper::quick;
+    int quickstep_iterations = 15;
+    double gravity_mps2 = 9.81;
+    DrumParams drum;
+    // Divergence: any non-finite state, a body faster than these, or a ball
+    // joint pulled apart by more than max_joint_separation_m.
+    double max_linear_speed_mps = 50.0;
+    double max_angular_speed_rad_s = 400.0;
+    double max_joint_separation_m = 0.05;
+    // Safety-net stops: a joint further than this outside its limit region
+    // meets a one-sided stop (limits must be set, stops enabled).
+    bool limit_stops = true;
+    double stop_margin_rad = 0.0873; // 5 degrees
+    bool rate_feedforward = true;
+};
+// Throws CharacterError naming the first bad option.
+void validate(const SceneOptions &options);
+
+enum class StepResult { ok, diverged };
+
+// What the drum did to one stick in the last step, from the stick-drum contact
+// joints' feedback (dJointFeedback: the constraint forces ODE applied): the
+// force on the stick, N, world frame (normal and friction together). The force
+// on the membrane is its opposite. Zero when the stick did not touch the drum.
+struct StickDrumContact {
+    Eigen::Vector3d bead_force_n = Eigen::Vector3d::Zero();  // through the bead (tip sphere)
+    Eigen::Vector3d shaft_force_n = Eigen::Vector3d::Zero(); // through the shaft (capsule)
+    int bead_points = 0, shaft_points = 0;                   // contact points in the step
+    Eigen::Vector3d force_n() const { return bead_force_n + shaft_force_n; }
+};
+
+// Wall-clock seconds spent in the parts of the last step (only filled when asked).
+struct StepTiming {
+    double control_s = 0.0;
+    double collide_s = 0.0;
+    double solve_s = 0.0;
+    double check_s = 0.0;
+};
+
+// Not thread-safe: one thread builds and steps a scene (ODE's collision
+// data is per thread and allocated for the constructing thread).
+class Scene
+{
+  public:
+    // Builds the physical character in `initial` pose (zero velocities).
+    // gains.size() must be CharacterModel::kJoints.
+    Scene(const CharacterModel &model, const SceneOptions &options, const CharacterPose &initial,
+          const std::vector<JointGains> &gains);
+    ~Scene();
+    Scene(const Scene &) = delete;
+    Scene &operator=(const Scene &) = delete;
+
+    const CharacterModel &model() const { return model_; }
+    const SceneOptions &options() const { return options_; }
+    const std::vector<JointGains> &gains() const { return gains_; }
+    void set_gains(const std::vector<JointGains> &gains);
+
+    // Joint limits, one per joint (inactive refs for joints without a limit),
+    // or an empty vector for none. Targets are clamped into the limit region;
+    // stops catch a joint that leaves it anyway. The limits must outlive the scene.
+    void set_joint_limits(const std::vector<JointLimitRef> &limits);
+
+    // Targets for eq. 1: local rotations [joint] and their rates (rad/s, parent
+    // frame). Clamped into the limits here.
+    void set_joint_targets(const std::vector<Eigen::Quaterniond> &local,
+                           const std::vector<Eigen::Vector3d> &rate_parent);
+    const std::vector<Eigen::Quaterniond> &joint_targets() const { return target_; }
+
+    // One fixed step. On divergence the character is reset to the current
+    // targets' pose at rest and StepResult::diverged is returned.
+    StepResult step(StepTiming *timing = nullptr);
+    // Places the character in `pose` (pelvis ignored: it is welded), at rest.
+    void reset(const CharacterPose &pose);
+
+    double time_s() const { return time_s_; }
+    long steps() const { return steps_; }
+    int divergences() const { return divergences_; }
+    int contacts_last_step() const { return contacts_last_step_; }
+    long contact_steps() const { return contact_steps_; }
+    int stops_active_last_step() const { return stops_active_; }
+    // Motor torque of each joint in the last step (N m, on the child, world
+    // frame; ODE joint feedback), and whether any axis hit its torque limit.
+    Eigen::Vector3d motor_torque(int joint) const;
+    bool motor_saturated(int joint) const;
+
+    // State, in the model's terms (body frame = joint frame, not the CoM).
+    void body_frames(BodyFrames &frames) const;
+    void local_rotations(std::vector<Eigen::Quaterniond> &local) const;
+    Eigen::Vector3d tip_position(Side side) const; // the stick's end point, world
+    Eigen::Vector3d tip_velocity(Side side) const;
+    // The bead's centre (the tip minus the bead radius along the stick axis:
+    // the collision sphere's centre, what the strike detector watches) and
+    // the velocity of that point, world frame.
+    Eigen::Vector3d bead_position(Side side) const;
+    Eigen::Vector3d bead_velocity(Side side) const;
+    // The drum's action on each stick in the last step (see StickDrumContact).
+    const StickDrumContact &drum_contact(Side side) const
+    {
+        return drum_contact_[static_cast<int>(side)];
+    }
+    // The force the world exerts on the pelvis through its weld in the last
+    // step, N, world frame (with the drum contacts, the only external forces
+    // besides gravity: at rest they sum to the character's weight).
+    Eigen::Vector3d support_force_n() const;
+
+    // The drum, changed on the live scene: the membrane moves and resizes at
+    // once and the contact law (k = 2 pi T / ln(R / r_tip), c) is recomputed
+    // for the next step; the character is untouched. Throws CharacterError
+    // naming the bad value (the scene keeps its drum).
+    void set_drum(const DrumParams &drum);
+    const DrumParams &drum() const { return options_.drum; }
+    // The contact law's stiffness k in use, N/m.
+    double drum_contact_stiffness_n_per_m() const;
+    double max_linear_speed_mps() const;
+    double max_angular_speed_rad_s() const;
+    // Adds a velocity change to a body's centre of mass (tests: injected
+    // kicks). Throws CharacterError for a bad body or a non-finite change.
+    void kick(int body, const Eigen::Vector3d &delta_linear_mps,
+              const Eigen::Vector3d &delta_angular_rad_s);
+
+  private:
+    void build(const CharacterPose &initial);
+    void apply_control();
+    bool check() const;
+    static void near_callback(void *data, dxGeom *a, dxGeom *b);
+    void place_drum();
+    void gather_contact_forces();
+    CharacterPose target_pose() const;
+    Eigen::Vector3d bead_rel_com(Side side) const;
+
+    CharacterModel model_;
+    SceneOptions options_;
+    std::vector<JointGains> gains_;
+    std::vector<JointLimitRef> limits_;
+    std::vector<Eigen::Quaterniond> target_;
+    std::vector<Eigen::Vector3d> target_rate_;
+    std::array<Eigen::Vector3d, CharacterModel::kBodies> com_local_; // merged, body frame
+    std::array<bool, CharacterModel::kJoints> motor_axes_world_;
+
+    dxWorld *world_ = nullptr;
+    dxSpace *space_ = nullptr;
+    dxJointGroup *contacts_ = nullptr;
+    std::array<dxBody *, CharacterModel::kBodies> body_{};
+    std::array<dxJoint *, CharacterModel::kJoints> ball_{};
+    std::array<dxJoint *, CharacterModel::kJoints> motor_{};
+    struct Feedback {
+        double f1[4], t1[4], f2[4], t2[4]; // layout of dJointFeedback (dVector3 = 4 dReal)
+    };
+    std::array<Feedback, CharacterModel::kJoints> feedback_{};
+    // One feedback slot per stick-drum contact point of the step: 2 sticks x
+    // (bead, shaft) x at most 4 points each (near_callback's kMax).
+    struct ContactSlot {
+        Feedback feedback;
+        int side = 0;
+        bool bead = false;
+    };
+    std::array<ContactSlot, 16> contact_slot_{};
+    int contact_slots_used_ = 0;
+    std::array<StickDrumContact, 2> drum_contact_{};
+    Feedback weld_feedback_{};
+    std::array<std::array<Eigen::Vector3d, 3>, CharacterModel::kJoints> motor_axes_{};
+    dxJoint *pelvis_weld_ = nullptr;
+    dxGeom *drum_ = nullptr;
+    std::array<dxGeom *, 2> stick_shaft_{};
+    std::array<dxGeom *, 2> stick_tip_{};
+    double contact_erp_ = 0.0, contact_cfm_ = 0.0;
+
+    double time_s_ = 0.0;
+    long steps_ = 0;
+    int divergences_ = 0;
+    int contacts_last_step_ = 0;
+    long contact_steps_ = 0;
+    int stops_active_ = 0;
+};
+
+} // namespace ictus

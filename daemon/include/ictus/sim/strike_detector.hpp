@@ -1,0 +1,143 @@
+// strike_detector.hpp -- the interaction manager's strike detection (paper, "Motion-Sound
+// Physics Mapping" and Figure 3): from the stick tips' states, step by step,
+// the contact episodes of each tip with the drum membrane, each reported when
+// it ends as a StrikeEvent (onset time, position, pre-contact velocity, force
+// direction and amplitude, impulse, duration, bounce tag).
+//
+// The contact law is the Scene's: the membrane pushes the tip's bead (a sphere
+// of radius r_tip) with a spring-damper normal to the membrane,
+//     F_n = max(0, k d + c d'),   k = 2 pi T / ln(R / r_tip)   (scene.hpp),
+// where d is the penetration of the bead below the membrane plane. The
+// detector evaluates that law on the sampled tip states, so it needs nothing
+// from inside ODE. See docs/osc.md for the CSV columns and the OSC layout.
+#pragma once
+
+#include "ictus/sim/strike_event.hpp"
+
+#include <Eigen/Core>
+#include <array>
+
+namespace ictus
+{
+
+// The drum as the detector sees it: a disk in a plane (world frame, y up).
+// Membrane coordinates: x_m along world +X, y_m along world -Z, normal +Y
+// (right-handed, x_m × y_m = normal); theta = atan2(y_m, x_m) in degrees.
+struct MembraneGeometry {
+    Eigen::Vector3d center_m = Eigen::Vector3d(0.0, 0.7, 0.45);
+    double radius_m = 0.178;
+    double stiffness_n_per_m = 5825.0; // k of the contact law
+    double damping_n_s_per_m = 10.0;   // c of the contact law
+    double friction = 0.3;             // Coulomb coefficient (force direction only)
+    double tip_radius_m = 0.007;       // the bead's radius
+    int drum_id = 0;
+};
+
+struct StrikeDetectorOptions {
+    // A new contact of the same hand is a bounce (same stroke) when the bead
+    // did not rise more than bounce_height_m above the membrane since the
+    // previous release AND it starts within bounce_window_s of that release.
+    double bounce_height_m = 0.01;
+    double bounce_window_s = 0.15;
+    // How the samples were made, which decides the velocity that crossed the
+    // membrane plane (the pre-contact velocity of a strike):
+    // true, the Scene's physics steps: each sample's velocity is the one that
+    // carried the bead from the previous sample (semi-implicit Euler, p1 =
+    // p0 + h v1, and no contact acts in the step that crosses the plane: ODE
+    // collides at the step's start), so the crossing velocity is the step's
+    // (p1 - p0) / h.
+    // false, samples of a continuous trajectory (a kinematic reference, an
+    // analytic motion): the last free sample's velocity when it could have
+    // carried the bead across within the step, else the step's mean.
+    bool semi_implicit_samples = true;
+};
+
+// Tip state fed to the detector: the centre of the bead (not the stick's end
+// point) and its velocity, world frame, at simulation time time_s.
+struct TipSample {
+    double time_s = 0.0;
+    Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
+};
+
+class StrikeDetector
+{
+  public:
+    explicit StrikeDetector(const MembraneGeometry &membrane = {},
+                            const StrikeDetectorOptions &options = {});
+
+    // Changes take effect for the next contact (an ongoing one keeps its law).
+    void set_membrane(const MembraneGeometry &membrane);
+    // A new membrane and no contact history (the scene was rebuilt); strike
+    // numbers continue.
+    void reset(const MembraneGeometry &membrane);
+    const MembraneGeometry &membrane() const { return membrane_; }
+    const StrikeDetectorOptions &options() const { return options_; }
+
+    // Feeds one sample per hand per physics step, times increasing. Returns
+    // true and fills `out` when this sample ends a contact episode of that hand.
+    bool update(int hand, const TipSample &sample, StrikeEvent &out);
+    // Ends ongoing contacts (end of a run): true and fills `out` for one of them
+    // per call, release at the last sample's time.
+    bool flush(StrikeEvent &out);
+
+    // Contact force law at penetration d (m, > 0 inside) and rate d' (m/s).
+    double normal_force_n(double depth_m, double depth_rate_mps) const;
+    // Gap between the bead and the membrane plane (m, < 0: penetrating), and
+    // whether the bead is over the membrane disk.
+    double gap_m(const Eigen::Vector3d &center_m) const;
+    bool over_membrane(const Eigen::Vector3d &center_m) const;
+    bool in_contact(int hand) const { return hands_[hand].in_contact; }
+    long strikes() const { return next_seq_; }
+    // The smallest seq of a contact still under way (strikes() when none): every
+    // strike numbered below it has been reported (or was lost to a reset).
+    long first_open_seq() const;
+    // Tips that came over the disk from the side below the membrane plane (shell hits, not
+    // strikes).
+    long side_entries() const { return side_entries_; }
+
+  private:
+    struct Hand {
+        bool has_previous = false;
+        TipSample previous;
+        double previous_gap = 0.0;
+        bool in_contact = false;
+        bool side_entry = false; // came in below the plane from outside the disk
+        // The episode under way.
+        StrikeEvent event;
+        double last_force_n = 0.0;
+        double last_time_s = 0.0;
+        // The largest force sample and its neighbours (sub-step peak by a parabola).
+        double peak_t[3] = {0, 0, 0}, peak_f[3] = {0, 0, 0};
+        bool peak_has_before = false, peak_has_after = false;
+        Eigen::Vector3d friction_sum = Eigen::Vector3d::Zero(); // sum of F dt, tangential
+        // Since the last release.
+        bool released_once = false;
+        double release_time_s = 0.0;
+        double max_gap_since_release = 0.0;
+        long stroke = -1;
+    };
+    void finish(Hand &h, double release_time_s, StrikeEvent &out);
+    void to_membrane(const Eigen::Vector3d &world_m, double &x_m, double &y_m) const;
+
+    MembraneGeometry membrane_;
+    StrikeDetectorOptions options_;
+    std::array<Hand, 2> hands_;
+    long next_seq_ = 0;
+    long side_entries_ = 0;
+};
+
+class Scene;
+
+// The membrane of a Scene's drum as the detector sees it: the same disk and the
+// same contact law (k, c, friction, the sticks' bead radius).
+MembraneGeometry membrane_of(const Scene &scene, int drum_id = 0);
+
+// Feeds the detector both beads of `scene` (Scene::bead_position/velocity) at
+// the scene's time, once after each of its steps; writes the strikes ended in
+// that step to out[0..n) and returns n (<= 2). `time_offset_s` is added to
+// the scene's clock (a run that rebuilt its scene keeps one clock).
+int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out[2],
+                   double time_offset_s = 0.0);
+
+} // namespace ictus

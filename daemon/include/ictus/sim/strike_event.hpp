@@ -1,0 +1,83 @@
+// strike_event.hpp -- a strike as the rest of the chain sees it: one contact
+// episode of a stick tip with the membrane, and its fields declared once
+// (name, integer or real, decimals in files). strikes.csv, the events file
+// for Pd and the /ictus/strike OSC message are each a list of these fields
+// (docs/osc.md gives the three layouts).
+#pragma once
+
+#include <Eigen/Core>
+#include <iosfwd>
+
+namespace ictus
+{
+
+// One contact episode of a stick tip with the membrane (one row of strikes.csv).
+struct StrikeEvent {
+    long seq = 0;        // 0, 1, 2 ... in order of onset within a run
+    int hand = 0;        // 0 left, 1 right
+    int drum = 0;        // drum id
+    bool bounce = false; // a re-contact of the same stroke
+    long stroke = 0;     // per hand: increments on every non-bounce strike
+    double time_s = 0.0; // onset, simulation clock, interpolated within the step
+    double x_m = 0.0;    // onset position of the bead's lowest point, membrane frame
+    double y_m = 0.0;
+    double r_over_a = 0.0;                // distance from the centre / membrane radius
+    double theta_deg = 0.0;               // atan2(y, x), (-180, 180]
+    double normal_velocity_mps = 0.0;     // just before contact, > 0 towards the membrane
+    double tangential_velocity_mps = 0.0; // just before contact, magnitude in the plane
+    double peak_force_n = 0.0;            // peak normal force (parabola through the samples)
+    double impulse_n_s = 0.0;             // integral of F_n over the episode
+    double duration_ms = 0.0;             // onset to release (both interpolated)
+    Eigen::Vector3d force_dir = Eigen::Vector3d(0.0, -1.0, 0.0); // on the membrane, world, unit
+};
+
+// The fields of a StrikeEvent, in strikes.csv's column order.
+enum class StrikeField {
+    seq,
+    hand,
+    drum,
+    bounce,
+    stroke,
+    time_s,
+    x_m,
+    y_m,
+    r_over_a,
+    theta_deg,
+    normal_velocity_mps,
+    tangential_velocity_mps,
+    peak_force_n,
+    impulse_n_s,
+    duration_ms,
+    force_dir_x,
+    force_dir_y,
+    force_dir_z,
+};
+constexpr int kStrikeFieldCount = static_cast<int>(StrikeField::force_dir_z) + 1;
+
+struct StrikeFieldInfo {
+    const char *name; // column name, with its unit
+    bool integer;     // an integer (seq, hand, ...) or a real
+    int decimals;     // fixed decimals of a real in the files
+};
+const StrikeFieldInfo &strike_field_info(StrikeField field);
+// A field's value (integers exactly, as doubles).
+double strike_field(const StrikeEvent &event, StrikeField field);
+long strike_field_integer(const StrikeEvent &event, StrikeField field);
+
+// The three layouts: strikes.csv (every field), the /ictus/strike OSC message
+// (after its address), the events file's `hit` line (after "hit").
+extern const StrikeField kCsvStrikeFields[kStrikeFieldCount];
+extern const StrikeField kOscStrikeFields[17];
+extern const StrikeField kEventsStrikeFields[11];
+
+// strikes.csv: a header line and one line per event, fixed precision (so that
+// equal runs give equal bytes).
+void write_strikes_csv_header(std::ostream &out);
+void write_strike_csv_row(std::ostream &out, const StrikeEvent &event);
+
+// The events file for Pd ([qlist] / [text sequence] format): one line per strike,
+//   <delay_ms since previous line> hit <kEventsStrikeFields>;
+// The first delay is from time 0. Fixed precision, see docs/osc.md.
+void write_events_line(std::ostream &out, const StrikeEvent &event, double previous_time_s);
+
+} // namespace ictus

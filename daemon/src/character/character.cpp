@@ -1,0 +1,552 @@
+// The character model: CMU skeleton -> 19 ball joints, de Leva masses, sticks.
+#include "ictus/character/character.hpp"
+#include "ictus/character/anthropometry.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <sstream>
+
+namespace ictus
+{
+
+const char *to_string(Grip grip)
+{
+    return grip == Grip::french ? "french" : "german";
+}
+
+Grip grip_from_string(const std::string &text)
+{
+    std::string lower = text;
+    std::transform(lower.begin(), lower.end(), lower.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (lower == "french")
+        return Grip::french;
+    if (lower == "german")
+        return Grip::german;
+    throw CharacterError("grip: expected french or german, got '" + text + "'");
+}
+
+namespace
+{
+
+// How a body's mass and inertia are taken from the table.
+enum class MassRule {
+    table,          // the de Leva row as is, CoM from the proximal joint
+    table_reversed, // CoM fraction measured from the distal (cranial) end
+    share,          // a given fraction of body mass, CoM at mid-segment
+};
+
+struct MapRow {
+    const char *body;
+    const char *joint;
+    const char *source; // mocap joint (the body frame)
+    int parent;         // body index
+    const char *distal; // mocap joint, or "X/end" for X's end site
+    DeLevaSegment segment;
+    MassRule rule;
+    double mass_fraction; // for MassRule::share, or the table row's share used
+};
+
+// de Leva has no clavicle and treats head+neck as one segment: the clavicles
+// (shoulder girdle) take 1 % of body mass each out of the upper trunk, and the
+// two neck segments 0.8 % each out of the head+neck segment. The pelvis (LPT)
+// is anchored, its mass only matters for the record.
+constexpr double kClavicleShare = 0.010;
+constexpr double kNeckShare = 0.008;
+
+const MapRow kMap[CharacterModel::kBodies] = {
+    {"pelvis", "", "Hips", -1, "LowerBack", DeLevaSegment::lower_trunk, MassRule::table_reversed,
+     0},
+    {"abdomen", "lumbar", "LowerBack", 0, "Spine", DeLevaSegment::middle_trunk,
+     MassRule::table_reversed, 0},
+    {"thorax", "thorax", "Spine", 1, "Spine1", DeLevaSegment::upper_trunk, MassRule::table_reversed,
+     0.1596 - 2 * kClavicleShare},
+    {"neck", "neck", "Neck", 2, "Neck1", DeLevaSegment::head, MassRule::share, kNeckShare},
+    {"upper_neck", "upper_neck", "Neck1", 3, "Head", DeLevaSegment::head, MassRule::share,
+     kNeckShare},
+    {"head", "head", "Head", 4, "Head/end", DeLevaSegment::head, MassRule::table_reversed,
+     0.0694 - 2 * kNeckShare},
+    {"l_clavicle", "l_clavicle", "LeftShoulder", 2, "LeftArm", DeLevaSegment::upper_trunk,
+     MassRule::share, kClavicleShare},
+    {"l_upper_arm", "l_shoulder", "LeftArm", 6, "LeftForeArm", DeLevaSegment::upper_arm,
+     MassRule::table, 0},
+    {"l_forearm", "l_elbow", "LeftForeArm", 7, "LeftHand", DeLevaSegment::forearm, MassRule::table,
+     0},
+    {"l_hand", "l_wrist", "LeftHand", 8, "LeftHandIndex1", DeLevaSegment::hand, MassRule::table, 0},
+    {"r_clavicle", "r_clavicle", "RightShoulder", 2, "RightArm", DeLevaSegment::upper_trunk,
+     MassRule::share, kClavicleShare},
+    {"r_upper_arm", "r_shoulder", "RightArm", 10, "RightForeArm", DeLevaSegment::upper_arm,
+     MassRule::table, 0},
+    {"r_forearm", "r_elbow", "RightForeArm", 11, "RightHand", DeLevaSegment::forearm,
+     MassRule::table, 0},
+    {"r_hand", "r_wrist", "RightHand", 12, "RightHandIndex1", DeLevaSegment::hand, MassRule::table,
+     0},
+    {"l_thigh", "l_hip", "LeftUpLeg", 0, "LeftLeg", DeLevaSegment::thigh, MassRule::table, 0},
+    {"l_shank", "l_knee", "LeftLeg", 14, "LeftFoot", DeLevaSegment::shank, MassRule::table, 0},
+    {"l_foot", "l_ankle", "LeftFoot", 15, "LeftToeBase/end", DeLevaSegment::foot, MassRule::table,
+     0},
+    {"r_thigh", "r_hip", "RightUpLeg", 0, "RightLeg", DeLevaSegment::thigh, MassRule::table, 0},
+    {"r_shank", "r_knee", "RightLeg", 17, "RightFoot", DeLevaSegment::shank, MassRule::table, 0},
+    {"r_foot", "r_ankle", "RightFoot", 18, "RightToeBase/end", DeLevaSegment::foot, MassRule::table,
+     0},
+};
+
+bool finite_positive(double v)
+{
+    return std::isfinite(v) && v > 0.0;
+}
+
+std::string fmt(double v)
+{
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+// The mocap joint `name`, or for "X/end" the first end site below X.
+int find_joint(const Skeleton &skeleton, const std::string &name)
+{
+    const auto slash = name.find("/end");
+    if (slash == std::string::npos) {
+        const int j = skeleton.find(name);
+        if (j < 0)
+            throw CharacterError("skeleton: no joint named '" + name +
+                                 "' (the character expects CMU joint names, see "
+                                 "docs/character.md)");
+        return j;
+    }
+    const int parent = find_joint(skeleton, name.substr(0, slash));
+    for (int j = 0; j < static_cast<int>(skeleton.joints.size()); ++j)
+        if (skeleton.joints[j].parent == parent && skeleton.joints[j].end_site)
+            return j;
+    throw CharacterError("skeleton: joint '" + name.substr(0, slash) + "' has no end site");
+}
+
+// Mocap joints from `ancestor` (exclusive) down to `joint` (inclusive), parent-most first.
+std::vector<int> path_between(const Skeleton &skeleton, int ancestor, int joint)
+{
+    std::vector<int> path;
+    for (int j = joint; j != ancestor; j = skeleton.joints[j].parent) {
+        if (j < 0)
+            throw CharacterError("skeleton: joint '" + skeleton.joints[joint].name +
+                                 "' is not below '" + skeleton.joints[ancestor].name + "'");
+        path.push_back(j);
+    }
+    std::reverse(path.begin(), path.end());
+    return path;
+}
+
+// Rest-pose offset along a path: the sum of OFFSETs (exact when the rotations
+// of joints with zero-length children are all that the path composes, as in
+// the CMU files; see docs/character.md).
+Eigen::Vector3d rest_offset(const Skeleton &skeleton, const std::vector<int> &path)
+{
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int j : path)
+        sum += skeleton.joints[j].offset_m;
+    return sum;
+}
+
+// Principal inertia of a segment: radii of gyration (fractions of length_m)
+// about the antero-posterior axis (sagittal), the remaining one (transverse)
+// and the long axis. The character faces +z with y up at rest (CMU).
+Eigen::Matrix3d segment_inertia(double mass_kg, double length_m, const Eigen::Vector3d &long_dir,
+                                const SegmentParameters &row)
+{
+    Eigen::Vector3d u = long_dir.norm() > 1e-9 ? long_dir.normalized() : Eigen::Vector3d::UnitY();
+    Eigen::Vector3d ap = Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitZ().dot(u) * u;
+    if (ap.norm() < 0.3)
+        ap = Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitX().dot(u) * u;
+    ap.normalize();
+    const Eigen::Vector3d other = u.cross(ap);
+    const double l2 = length_m * length_m;
+    return mass_kg * l2 *
+           (row.radius_sagittal * row.radius_sagittal * ap * ap.transpose() +
+            row.radius_transverse * row.radius_transverse * other * other.transpose() +
+            row.radius_long * row.radius_long * u * u.transpose());
+}
+
+Eigen::Matrix3d parallel_axis(double mass_kg, const Eigen::Vector3d &d)
+{
+    return mass_kg * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+}
+
+} // namespace
+
+CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
+                                             const CharacterOptions &options)
+{
+    const StickParams &s = options.stick;
+    if (!finite_positive(options.body_mass_kg) || options.body_mass_kg > 500.0)
+        throw CharacterError("body mass: expected 0 < kg <= 500, got " + fmt(options.body_mass_kg));
+    if (!finite_positive(s.length_m) || s.length_m > 2.0)
+        throw CharacterError("stick length: expected 0 < m <= 2, got " + fmt(s.length_m));
+    if (!finite_positive(s.mass_kg) || s.mass_kg > 2.0)
+        throw CharacterError("stick mass: expected 0 < kg <= 2, got " + fmt(s.mass_kg));
+    if (!finite_positive(s.tip_radius_m) || s.tip_radius_m * 2.0 >= s.length_m)
+        throw CharacterError("stick tip radius: expected 0 < m < length/2, got " +
+                             fmt(s.tip_radius_m));
+    if (!finite_positive(s.shaft_radius_m) || s.shaft_radius_m * 2.0 >= s.length_m)
+        throw CharacterError("stick shaft radius: expected 0 < m < length/2, got " +
+                             fmt(s.shaft_radius_m));
+    if (!(s.grip_from_butt_m >= 0.0) || s.grip_from_butt_m >= s.length_m)
+        throw CharacterError("stick grip point: expected 0 <= m < length, got " +
+                             fmt(s.grip_from_butt_m));
+    if (!std::isfinite(s.grip_angle_rad) || std::fabs(s.grip_angle_rad) > 1.5708)
+        throw CharacterError("stick grip angle: expected |rad| <= pi/2, got " +
+                             fmt(s.grip_angle_rad));
+
+    CharacterModel model;
+    model.options_ = options;
+    model.bodies_.resize(kBodies);
+    std::vector<int> source(kBodies), distal(kBodies);
+    for (int b = 0; b < kBodies; ++b) {
+        source[b] = find_joint(skeleton, kMap[b].source);
+        distal[b] = find_joint(skeleton, kMap[b].distal);
+    }
+
+    // Inertia lengths: limbs use their mocap lengths; segments whose mocap
+    // length does not span the anatomical segment (trunk, head, hand, foot)
+    // use de Leva's mean length scaled by the subject's limb proportions.
+    double ratio_sum = 0.0;
+    int ratio_n = 0;
+    for (int b = 0; b < kBodies; ++b) {
+        const DeLevaSegment seg = kMap[b].segment;
+        if (seg == DeLevaSegment::upper_arm || seg == DeLevaSegment::forearm ||
+            seg == DeLevaSegment::thigh || seg == DeLevaSegment::shank) {
+            const double l =
+                rest_offset(skeleton, path_between(skeleton, source[b], distal[b])).norm();
+            ratio_sum += l / de_leva_male(seg).length_m;
+            ++ratio_n;
+        }
+    }
+    const double size_ratio = ratio_n > 0 ? ratio_sum / ratio_n : 1.0;
+    if (!finite_positive(size_ratio))
+        throw CharacterError("skeleton: limb lengths are zero (check --scale)");
+
+    for (int b = 0; b < kBodies; ++b) {
+        const MapRow &row = kMap[b];
+        BodySpec &body = model.bodies_[b];
+        body.name = row.body;
+        body.joint_name = row.joint;
+        body.source = row.source;
+        body.parent = row.parent;
+        if (b > 0) {
+            body.source_path = path_between(skeleton, source[row.parent], source[b]);
+            body.offset_m = rest_offset(skeleton, body.source_path);
+        } else {
+            body.source_path = {source[0]};
+        }
+        body.distal_m = rest_offset(skeleton, path_between(skeleton, source[b], distal[b]));
+        body.length_m = body.distal_m.norm();
+
+        const SegmentParameters &table = de_leva_male(row.segment);
+        const bool limb =
+            row.segment == DeLevaSegment::upper_arm || row.segment == DeLevaSegment::forearm ||
+            row.segment == DeLevaSegment::thigh || row.segment == DeLevaSegment::shank;
+        const double inertia_length = limb ? body.length_m : table.length_m * size_ratio;
+        double fraction = table.mass_fraction;
+        if (row.mass_fraction > 0.0)
+            fraction = row.mass_fraction;
+        body.mass_kg = fraction * options.body_mass_kg;
+        switch (row.rule) {
+        case MassRule::table:
+            body.com_m = table.com_fraction * body.distal_m;
+            break;
+        case MassRule::table_reversed:
+            body.com_m = (1.0 - table.com_fraction) * body.distal_m;
+            break;
+        case MassRule::share:
+            body.com_m = 0.5 * body.distal_m;
+            break;
+        }
+        // Shares carved out of a table segment keep that segment's radii of
+        // gyration relative to their own (mocap) length.
+        const double len =
+            row.rule == MassRule::share ? std::max(body.length_m, 0.02) : inertia_length;
+        body.inertia_kg_m2 = segment_inertia(body.mass_kg, len, body.distal_m, table);
+    }
+
+    // Sticks. Hand frame at rest: fingers along distal_m, thumb towards the
+    // thumb's end site, palm normal facing down (the CMU T-pose).
+    for (int side = 0; side < 2; ++side) {
+        const int hb = side == 0 ? 9 : 13;
+        model.hand_body_[side] = hb;
+        const BodySpec &hand = model.bodies_[hb];
+        const Eigen::Vector3d f =
+            hand.distal_m.norm() > 1e-9 ? hand.distal_m.normalized() : Eigen::Vector3d::UnitX();
+        Eigen::Vector3d t = Eigen::Vector3d::UnitZ();
+        const int thumb = skeleton.find(side == 0 ? "LThumb" : "RThumb");
+        if (thumb >= 0) {
+            const int hand_joint = source[hb];
+            try {
+                const int thumb_end =
+                    find_joint(skeleton, std::string(side == 0 ? "LThumb" : "RThumb") + "/end");
+                const Eigen::Vector3d d =
+                    rest_offset(skeleton, path_between(skeleton, hand_joint, thumb_end));
+                if (d.norm() > 1e-9)
+                    t = d;
+            } catch (const CharacterError &) {
+            }
+        }
+        t = (t - t.dot(f) * f);
+        if (t.norm() < 1e-6)
+            t = Eigen::Vector3d::UnitZ() - f.z() * f;
+        t.normalize();
+        Eigen::Vector3d n = f.cross(t);
+        if (n.y() > 0.0)
+            n = -n;
+        const double a = s.grip_angle_rad;
+        StickInHand &st = model.stick_[side];
+        st.axis =
+            (std::cos(a) * f + std::sin(a) * (options.grip == Grip::german ? t : n)).normalized();
+        // The fulcrum sits in the fist: at the hand's CoM along the fingers,
+        // 2.5 cm towards the palm.
+        st.grip_m = de_leva_male(DeLevaSegment::hand).com_fraction * hand.distal_m + 0.025 * n;
+        st.butt_m = st.grip_m - s.grip_from_butt_m * st.axis;
+        st.tip_m = st.grip_m + (s.length_m - s.grip_from_butt_m) * st.axis;
+        st.com_m = 0.5 * (st.butt_m + st.tip_m);
+        const Eigen::Matrix3d aa = st.axis * st.axis.transpose();
+        st.inertia_kg_m2 =
+            s.mass_kg * s.length_m * s.length_m / 12.0 * (Eigen::Matrix3d::Identity() - aa) +
+            0.5 * s.mass_kg * s.shaft_radius_m * s.shaft_radius_m * aa;
+    }
+    return model;
+}
+
+int CharacterModel::body_index(const std::string &name) const
+{
+    for (int b = 0; b < kBodies; ++b)
+        if (bodies_[b].name == name)
+            return b;
+    return -1;
+}
+
+int CharacterModel::joint_index(const std::string &name) const
+{
+    for (int j = 0; j < kJoints; ++j)
+        if (bodies_[j + 1].joint_name == name)
+            return j;
+    return -1;
+}
+
+double CharacterModel::total_mass_kg() const
+{
+    double m = 0.0;
+    for (const BodySpec &b : bodies_)
+        m += b.mass_kg;
+    return m + 2.0 * options_.stick.mass_kg;
+}
+
+CharacterPose CharacterModel::pose_from_motion(const Motion &motion, int frame) const
+{
+    if (frame < 0 || frame >= motion.frames())
+        throw CharacterError("motion: frame " + std::to_string(frame) + " out of range [0, " +
+                             std::to_string(motion.frames()) + ")");
+    const auto &rot = motion.local_rotation[frame];
+    CharacterPose pose;
+    pose.local.resize(kJoints);
+    for (int b = 0; b < kBodies; ++b) {
+        Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+        for (int j : bodies_[b].source_path) {
+            if (j >= static_cast<int>(rot.size()))
+                throw CharacterError("motion: frame " + std::to_string(frame) +
+                                     " has fewer rotations than the skeleton has joints");
+            q = q * rot[j];
+        }
+        q.normalize();
+        if (b == 0)
+            pose.pelvis_rotation = q;
+        else
+            pose.local[b - 1] = q;
+    }
+    pose.pelvis_position_m = motion.root_position_m[frame];
+    return pose;
+}
+
+CharacterPose CharacterModel::rest_pose() const
+{
+    CharacterPose pose;
+    pose.local.assign(kJoints, Eigen::Quaterniond::Identity());
+    return pose;
+}
+
+void CharacterModel::forward(const CharacterPose &pose, BodyFrames &frames) const
+{
+    frames.origin_m.resize(kBodies);
+    frames.rotation.resize(kBodies);
+    frames.origin_m[0] = pose.pelvis_position_m;
+    frames.rotation[0] = pose.pelvis_rotation;
+    for (int b = 1; b < kBodies; ++b) {
+        const int p = bodies_[b].parent;
+        frames.origin_m[b] = frames.origin_m[p] + frames.rotation[p] * bodies_[b].offset_m;
+        frames.rotation[b] = frames.rotation[p] * pose.local[b - 1];
+    }
+}
+
+Eigen::Vector3d CharacterModel::tip_position(Side side, const Eigen::Vector3d &hand_origin_m,
+                                             const Eigen::Quaterniond &hand_rotation) const
+{
+    return hand_origin_m + hand_rotation * stick(side).tip_m;
+}
+
+void CharacterModel::merged_mass(int body, double &mass_kg, Eigen::Vector3d &com_m,
+                                 Eigen::Matrix3d &inertia_kg_m2) const
+{
+    const BodySpec &b = bodies_[body];
+    mass_kg = b.mass_kg;
+    com_m = b.com_m;
+    inertia_kg_m2 = b.inertia_kg_m2;
+    for (int side = 0; side < 2; ++side) {
+        if (hand_body_[side] != body)
+            continue;
+        const StickInHand &st = stick_[side];
+        const double ms = options_.stick.mass_kg;
+        const double m = mass_kg + ms;
+        const Eigen::Vector3d c = (mass_kg * com_m + ms * st.com_m) / m;
+        inertia_kg_m2 = inertia_kg_m2 + parallel_axis(mass_kg, com_m - c) + st.inertia_kg_m2 +
+                        parallel_axis(ms, st.com_m - c);
+        mass_kg = m;
+        com_m = c;
+    }
+}
+
+CharacterModel::SubtreeInertia CharacterModel::subtree_inertia(int joint,
+                                                               const CharacterPose &pose) const
+{
+    BodyFrames frames;
+    forward(pose, frames);
+    const int top = joint + 1;
+    const Eigen::Vector3d pivot = frames.origin_m[top];
+    Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+    double mass = 0.0;
+    for (int b = top; b < kBodies; ++b) {
+        int a = b;
+        while (a > top)
+            a = bodies_[a].parent;
+        if (a != top)
+            continue;
+        double m;
+        Eigen::Vector3d c;
+        Eigen::Matrix3d i;
+        merged_mass(b, m, c, i);
+        const Eigen::Matrix3d r = frames.rotation[b].toRotationMatrix();
+        const Eigen::Vector3d cw = frames.origin_m[b] + r * c;
+        inertia += r * i * r.transpose() + parallel_axis(m, cw - pivot);
+        mass += m;
+    }
+    return {inertia.trace() / 3.0, mass};
+}
+
+ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &motion)
+{
+    if (motion.frames() < 1)
+        throw CharacterError("motion: no frames");
+    if (!finite_positive(motion.frame_rate_hz))
+        throw CharacterError("motion: frame rate must be > 0, got " + fmt(motion.frame_rate_hz));
+    frame_rate_hz_ = motion.frame_rate_hz;
+    frames_.reserve(motion.frames());
+    for (int f = 0; f < motion.frames(); ++f) {
+        frames_.push_back(model.pose_from_motion(motion, f));
+        // The pelvis is anchored: the whole reference keeps the first frame's.
+        frames_.back().pelvis_position_m = frames_.front().pelvis_position_m;
+        frames_.back().pelvis_rotation = frames_.front().pelvis_rotation;
+    }
+}
+
+ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &motion,
+                                 const ReferenceFilter &filter)
+    : ReferenceMotion(model, motion)
+{
+    if (!(std::isfinite(filter.spike_threshold_rad) && filter.spike_threshold_rad >= 0.0))
+        throw CharacterError("reference filter: spike threshold must be >= 0 rad");
+    if (!(std::isfinite(filter.smooth_cutoff_hz) && filter.smooth_cutoff_hz >= 0.0))
+        throw CharacterError("reference filter: smoothing cutoff must be >= 0 Hz");
+    const int n = frames();
+    auto angle = [](const Eigen::Quaterniond &a, const Eigen::Quaterniond &b) {
+        return 2.0 * std::acos(std::min(1.0, std::fabs(a.dot(b))));
+    };
+    if (filter.spike_threshold_rad > 0.0) {
+        for (int j = 0; j < CharacterModel::kJoints; ++j) {
+            for (int f = 1; f + 1 < n; ++f) {
+                const Eigen::Quaterniond &a = frames_[f - 1].local[j];
+                const Eigen::Quaterniond &b = frames_[f + 1].local[j];
+                const Eigen::Quaterniond mid = a.slerp(0.5, b);
+                const double off = angle(frames_[f].local[j], mid);
+                if (off > filter.spike_threshold_rad && angle(a, b) < off) {
+                    frames_[f].local[j] = mid;
+                    ++spikes_removed_;
+                }
+            }
+        }
+    }
+    if (filter.smooth_cutoff_hz > 0.0 && n > 2) {
+        const double sigma_frames = frame_rate_hz_ / (2.0 * M_PI * filter.smooth_cutoff_hz);
+        const int half = static_cast<int>(std::ceil(3.0 * sigma_frames));
+        std::vector<double> w(2 * half + 1);
+        for (int k = -half; k <= half; ++k)
+            w[k + half] = std::exp(-0.5 * k * k / (sigma_frames * sigma_frames));
+        std::vector<Eigen::Quaterniond> smoothed(n);
+        for (int j = 0; j < CharacterModel::kJoints; ++j) {
+            for (int f = 0; f < n; ++f) {
+                // Weighted mean of the neighbours' rotation vectors relative to
+                // this frame (a tangent-space average: no Euler angles).
+                const Eigen::Quaterniond &q = frames_[f].local[j];
+                Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+                double wsum = 0.0;
+                for (int k = -half; k <= half; ++k) {
+                    const int g = f + k;
+                    if (g < 0 || g >= n)
+                        continue;
+                    Eigen::Quaterniond d = q.conjugate() * frames_[g].local[j];
+                    if (d.w() < 0.0)
+                        d.coeffs() = -d.coeffs();
+                    const double s = d.vec().norm();
+                    const Eigen::Vector3d v =
+                        s < 1e-12 ? Eigen::Vector3d(2.0 * d.vec())
+                                  : Eigen::Vector3d(d.vec() * (2.0 * std::atan2(s, d.w()) / s));
+                    sum += w[k + half] * v;
+                    wsum += w[k + half];
+                }
+                const Eigen::Vector3d mean = sum / wsum;
+                const double a = mean.norm();
+                const Eigen::Quaterniond e =
+                    a < 1e-12 ? Eigen::Quaterniond::Identity()
+                              : Eigen::Quaterniond(Eigen::AngleAxisd(a, mean / a));
+                smoothed[f] = (q * e).normalized();
+            }
+            for (int f = 0; f < n; ++f)
+                frames_[f].local[j] = smoothed[f];
+        }
+    }
+}
+
+double ReferenceMotion::duration_s() const
+{
+    return (frames() - 1) / frame_rate_hz_;
+}
+
+void ReferenceMotion::sample(double time_s, CharacterPose &pose) const
+{
+    const int n = frames();
+    pose.pelvis_position_m = frames_[0].pelvis_position_m;
+    pose.pelvis_rotation = frames_[0].pelvis_rotation;
+    pose.local.resize(CharacterModel::kJoints);
+    if (n == 1 || !(time_s > 0.0)) {
+        pose.local = frames_[0].local;
+        return;
+    }
+    const double span = n - 1;
+    double u = std::fmod(time_s * frame_rate_hz_, 2.0 * span);
+    if (u > span)
+        u = 2.0 * span - u;
+    int i = static_cast<int>(std::floor(u));
+    if (i >= n - 1)
+        i = n - 2;
+    const double a = u - i;
+    for (int j = 0; j < CharacterModel::kJoints; ++j)
+        pose.local[j] = frames_[i].local[j].slerp(a, frames_[i + 1].local[j]);
+}
+
+} // namespace ictus

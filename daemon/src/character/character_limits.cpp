@@ -1,0 +1,128 @@
+// Joint limits as the simulation enforces them (see character_limits.hpp).
+#include "ictus/character/character_limits.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace ictus
+{
+
+const char *to_string(LimitKind kind)
+{
+    switch (kind) {
+    case LimitKind::none:
+        return "none";
+    case LimitKind::euler:
+        return "euler";
+    case LimitKind::quaternion:
+        return "quaternion";
+    }
+    return "?";
+}
+
+LimitKind limit_kind_from_string(const std::string &text)
+{
+    if (text == "none")
+        return LimitKind::none;
+    if (text == "euler")
+        return LimitKind::euler;
+    if (text == "quaternion")
+        return LimitKind::quaternion;
+    throw CharacterError("limits: expected none, euler or quaternion, got '" + text + "'");
+}
+
+Eigen::Quaterniond EllipsoidJointLimit::clamp(const Eigen::Quaterniond &q) const
+{
+    const Eigen::Vector3d v = limit.tangent(q);
+    const Eigen::Vector3d p = limit.axes.transpose() * v; // principal coordinates
+    const Eigen::Vector3d a = limit.k * limit.sigma_rad;  // half-axes
+    double inside = 0.0;
+    for (int i = 0; i < 3; ++i)
+        inside += (p[i] / a[i]) * (p[i] / a[i]);
+    if (inside <= 1.0)
+        return q.normalized();
+    // Closest point: x_i = a_i^2 p_i / (a_i^2 + t) with t >= 0 the root of
+    // f(t) = sum (a_i p_i / (a_i^2 + t))^2 - 1, decreasing and convex, so
+    // Newton from t = 0 converges monotonically.
+    double t = 0.0;
+    for (int it = 0; it < 60; ++it) {
+        double f = -1.0, df = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            const double d = a[i] * a[i] + t;
+            const double r = a[i] * p[i] / d;
+            f += r * r;
+            df -= 2.0 * r * r / d;
+        }
+        if (std::fabs(f) < 1e-12 || df == 0.0)
+            break;
+        t -= f / df;
+    }
+    Eigen::Vector3d x;
+    for (int i = 0; i < 3; ++i)
+        x[i] = a[i] * a[i] * p[i] / (a[i] * a[i] + t);
+    return (limit.mean * exp_map(limit.axes * x)).normalized();
+}
+
+CharacterLimits::CharacterLimits(const CharacterModel &model, const ReferenceMotion &reference,
+                                 const CharacterLimitOptions &options)
+    : options_(options)
+{
+    if (!(std::isfinite(options.k) && options.k > 0.0))
+        throw CharacterError("limit k: expected a finite value > 0");
+    if (!(std::isfinite(options.min_half_width_rad) && options.min_half_width_rad >= 0.0 &&
+          options.min_half_width_rad < M_PI))
+        throw CharacterError("limit minimum half-width: expected 0 <= rad < pi");
+    learn_options_.quaternion.k = options.k;
+    learn_options_.euler.k = options.k;
+    // Algorithm 1 with the minimum width as its spread floor: k sigma >= w.
+    learn_options_.quaternion.sigma_floor_rad =
+        std::max(1e-3, options.min_half_width_rad / options.k);
+    std::vector<std::string> names;
+    std::vector<std::vector<Eigen::Quaterniond>> series(CharacterModel::kJoints);
+    for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        names.push_back(model.joint_name(j));
+        series[j].reserve(reference.frames());
+        for (int f = 0; f < reference.frames(); ++f)
+            series[j].push_back(reference.frame(f).local[j]);
+    }
+    learned_ = learn_limits(names, series, learn_options_);
+    for (const JointLimit &l : learned_) {
+        ellipsoid_.push_back({l.quaternion});
+        EulerJointLimit e{l.euler};
+        for (int i = 0; i < 3; ++i) {
+            const double mid = 0.5 * (e.limit.lower_rad[i] + e.limit.upper_rad[i]);
+            const double half = std::max(0.5 * (e.limit.upper_rad[i] - e.limit.lower_rad[i]),
+                                         options.min_half_width_rad);
+            e.limit.lower_rad[i] = mid - half;
+            e.limit.upper_rad[i] = mid + half;
+        }
+        euler_.push_back(e);
+    }
+}
+
+std::vector<JointLimitRef> CharacterLimits::refs() const
+{
+    std::vector<JointLimitRef> refs;
+    if (options_.kind == LimitKind::none)
+        return refs;
+    for (size_t j = 0; j < learned_.size(); ++j)
+        refs.push_back(options_.kind == LimitKind::euler ? JointLimitRef::to(euler_[j])
+                                                         : JointLimitRef::to(ellipsoid_[j]));
+    return refs;
+}
+
+nlohmann::json CharacterLimits::report() const
+{
+    std::vector<JointLimit> enforced = learned_;
+    for (size_t j = 0; j < enforced.size(); ++j)
+        enforced[j].euler = euler_[j].limit;
+    nlohmann::json r = limits_report(enforced, learn_options_);
+    r["enforced"] = to_string(options_.kind);
+    r["min_half_width_deg"] = options_.min_half_width_rad * 180.0 / M_PI;
+    r["note"] = "Euler limits widened and quaternion spreads floored to the minimum "
+                "half-width; the quaternion clamp is the closest ellipsoid point "
+                "(docs/character.md)";
+    return r;
+}
+
+} // namespace ictus

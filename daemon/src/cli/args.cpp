@@ -1,0 +1,127 @@
+// args.cpp -- the argument module of ictusd (args.hpp).
+#include "ictus/cli/args.hpp"
+
+#include "ictus/net/osc_sender.hpp" // OscError: a bad --target/--bind is a usage error
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+
+namespace ictus
+{
+namespace cli
+{
+
+volatile std::sig_atomic_t g_interrupted = 0;
+
+namespace
+{
+void on_interrupt(int)
+{
+    g_interrupted = 1;
+}
+} // namespace
+
+void install_interrupt_handler(bool also_sigterm)
+{
+    std::signal(SIGINT, on_interrupt);
+    if (also_sigterm)
+        std::signal(SIGTERM, on_interrupt);
+}
+
+double parse_number(const std::string &option, const std::string &text)
+{
+    char *end = nullptr;
+    errno = 0;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+        throw UsageError(option + ": expected a number, got '" + text + "'");
+    return v;
+}
+
+double parse_number(const std::string &option, const std::string &text, double lo, double hi)
+{
+    char *end = nullptr;
+    errno = 0;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v) || v < lo || v > hi) {
+        std::ostringstream s;
+        s << option << ": expected a number in [" << lo << ", " << hi << "], got '" << text << "'";
+        throw UsageError(s.str());
+    }
+    return v;
+}
+
+double parse_positive(const std::string &option, const std::string &text)
+{
+    const double v = parse_number(option, text);
+    if (!(v > 0.0))
+        throw UsageError(option + ": expected a number > 0, got '" + text + "'");
+    return v;
+}
+
+int parse_int(const std::string &option, const std::string &text, int lo, int hi)
+{
+    char *end = nullptr;
+    errno = 0;
+    const long v = std::strtol(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0' || errno == ERANGE || v < lo || v > hi)
+        throw UsageError(option + ": expected an integer in [" + std::to_string(lo) + ", " +
+                         std::to_string(hi) + "], got '" + text + "'");
+    return static_cast<int>(v);
+}
+
+std::vector<std::string> split(const std::string &text, char separator)
+{
+    std::vector<std::string> parts;
+    std::stringstream in(text);
+    std::string part;
+    while (std::getline(in, part, separator))
+        parts.push_back(part);
+    return parts;
+}
+
+Eigen::Vector3d parse_vec3(const std::string &option, const std::string &text)
+{
+    const std::vector<std::string> parts = split(text, ',');
+    if (parts.size() != 3)
+        throw UsageError(option + ": expected X,Y,Z, got '" + text + "'");
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i)
+        v[i] = parse_number(option, parts[static_cast<size_t>(i)]);
+    return v;
+}
+
+Args::Args(int argc, char **argv)
+{
+    for (int i = 1; i < argc; ++i)
+        items_.emplace_back(argv[i]);
+}
+
+std::string Args::value(const std::string &option)
+{
+    if (done())
+        throw UsageError(option + ": missing value");
+    return next();
+}
+
+int run_verb(const char *verb, const std::function<int()> &body)
+{
+    try {
+        return body();
+    } catch (const UsageError &e) {
+        std::cerr << "ictusd " << verb << ": " << e.what() << "\n";
+        return 2;
+    } catch (const OscError &e) {
+        std::cerr << "ictusd " << verb << ": " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception &e) {
+        std::cerr << "ictusd " << verb << ": " << e.what() << "\n";
+        return 1;
+    }
+}
+
+} // namespace cli
+} // namespace ictus

@@ -1,0 +1,189 @@
+// verb_gestures.cpp -- `ictusd gestures`: list, export and import gesture
+// units (docs/gestures.md).
+#include "ictus/cli/verbs.hpp"
+#include "ictus/gesture/gesture.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <string>
+
+namespace ictus
+{
+namespace cli
+{
+
+namespace
+{
+
+void gestures_usage(std::ostream &out)
+{
+    out << "usage: ictusd gestures --list [--db FILE.json]\n"
+           "       ictusd gestures --export FILE.json\n"
+           "       ictusd gestures --import CAPTURE --grip french|german --nuance N\n"
+           "                       --hand left|right [--db IN.json] --out FILE.json\n"
+           "\n"
+           "The gesture database: one unit (a stroke of one stick tip, 250 Hz, strike\n"
+           "marked) per grip x nuance x hand. Nuances: legato, tenuto, accent,\n"
+           "vertical_accent, staccato. Without --db the built-in units of the parametric\n"
+           "stroke model are used (docs/gestures.md).\n"
+           "\n"
+           "  --list             print the units: samples, strike time, preparation height,\n"
+           "                     impact speed\n"
+           "  --export FILE      write the built-in database as JSON\n"
+           "  --import CAPTURE   segment a capture (.bvh with CMU joint names: the\n"
+           "                     character's stick tip; .csv: stick-only, both sticks) into\n"
+           "                     strokes at the tip-height minima, add the stroke with the\n"
+           "                     median impact speed to the database (IN, else the built-in)\n"
+           "                     and write it to --out\n"
+           "  --stroke K         import stroke K (0-based) instead of the median one\n"
+           "  --dynamics D       the level the captured strokes represent (default 0.6)\n"
+           "  --scale M, --skip-frames N   BVH reading (default 0.056444, 1)\n"
+           "  --units mm|m, --up y|z, --rate HZ, --left-stick NAME, --right-stick NAME\n"
+           "                     CSV reading (as ictusd track)\n"
+           "\n"
+           "examples:\n"
+           "  ictusd gestures --list\n"
+           "  ictusd gestures --export gestures.json\n"
+           "  ictusd gestures --import ../shared/data/cmu/80_13.bvh --grip french \\\n"
+           "      --nuance legato --hand right --out mine.json\n"
+           "  ictusd gestures --list --db mine.json\n";
+}
+
+void print_units(const GestureDatabase &db)
+{
+    std::printf("%-7s %-16s %-6s %-12s %8s %8s %9s %9s %9s\n", "grip", "nuance", "hand", "source",
+                "samples", "strike_s", "period_s", "height_m", "impact_mps");
+    for (const GestureUnit &u : db.units())
+        std::printf("%-7s %-16s %-6s %-12s %8d %8.3f %9.3f %9.3f %9.2f\n", to_string(u.grip),
+                    to_string(u.nuance), to_string(u.hand), u.source.c_str(), u.samples(),
+                    u.strike_time_s(), u.period_s, u.preparation_height_m(), u.impact_speed_mps());
+}
+
+} // namespace
+
+int cmd_gestures(Args &args)
+{
+    {
+        bool list = false;
+        std::string export_path, import_path, db_path, out_path;
+        std::string grip, nuance, hand;
+        int stroke = -1;
+        double dynamics = 0.6;
+        ImportOptions io;
+        while (!args.done()) {
+            const std::string a = args.next();
+            auto value = [&]() { return args.value(a); };
+            if (a == "--help" || a == "-h") {
+                gestures_usage(std::cout);
+                return 0;
+            } else if (a == "--list") {
+                list = true;
+            } else if (a == "--export") {
+                export_path = value();
+            } else if (a == "--import") {
+                import_path = value();
+            } else if (a == "--db") {
+                db_path = value();
+            } else if (a == "--out") {
+                out_path = value();
+            } else if (a == "--grip") {
+                grip = value();
+            } else if (a == "--nuance") {
+                nuance = value();
+            } else if (a == "--hand") {
+                hand = value();
+            } else if (a == "--stroke") {
+                const double k = parse_number(a, value());
+                if (k < 0 || k != std::floor(k) || k > 1e6)
+                    throw UsageError("--stroke: expected an index >= 0");
+                stroke = static_cast<int>(k);
+            } else if (a == "--dynamics") {
+                dynamics = parse_number(a, value());
+                if (dynamics < 0.0 || dynamics > 1.0)
+                    throw UsageError("--dynamics: must be in [0, 1], got " +
+                                     std::to_string(dynamics));
+            } else if (a == "--scale") {
+                io.bvh_scale = parse_number(a, value());
+                if (!(io.bvh_scale > 0.0))
+                    throw UsageError("--scale: must be > 0");
+            } else if (a == "--skip-frames") {
+                const double k = parse_number(a, value());
+                if (k < 0 || k != std::floor(k) || k > 1e9)
+                    throw UsageError("--skip-frames: expected an integer >= 0");
+                io.bvh_skip_frames = static_cast<int>(k);
+            } else if (a == "--units") {
+                const std::string v = value();
+                if (v != "mm" && v != "m")
+                    throw UsageError("--units: expected mm or m, got '" + v + "'");
+                io.csv_mm = v == "mm";
+            } else if (a == "--up") {
+                const std::string v = value();
+                if (v != "y" && v != "z")
+                    throw UsageError("--up: expected y or z, got '" + v + "'");
+                io.csv_z_up = v == "z";
+            } else if (a == "--rate") {
+                io.csv_rate_hz = parse_number(a, value());
+                if (!(io.csv_rate_hz > 0.0))
+                    throw UsageError("--rate: must be > 0");
+            } else if (a == "--left-stick") {
+                io.left_stick = value();
+            } else if (a == "--right-stick") {
+                io.right_stick = value();
+            } else {
+                throw UsageError("unknown option '" + a + "' (see ictusd gestures --help)");
+            }
+        }
+        const int actions = list + !export_path.empty() + !import_path.empty();
+        if (actions != 1)
+            throw UsageError("give exactly one of --list, --export FILE, --import CAPTURE");
+
+        if (!export_path.empty()) {
+            const GestureDatabase db = GestureDatabase::builtin();
+            db.save_json(export_path);
+            std::cout << "wrote " << db.units().size() << " units to " << export_path << "\n";
+            return 0;
+        }
+        if (list) {
+            const GestureDatabase db =
+                db_path.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(db_path);
+            print_units(db);
+            return 0;
+        }
+        // --import
+        if (grip.empty() || nuance.empty() || hand.empty() || out_path.empty())
+            throw UsageError("--import needs --grip, --nuance, --hand and --out");
+        Grip g;
+        Nuance n;
+        Side h;
+        try {
+            g = grip_from_string(grip);
+            n = nuance_from_string(nuance);
+            h = side_from_string(hand);
+        } catch (const std::runtime_error &e) {
+            throw UsageError(e.what());
+        }
+        GestureDatabase db =
+            db_path.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(db_path);
+        const std::vector<GestureUnit> units = import_capture(import_path, g, n, h, io);
+        if (stroke >= static_cast<int>(units.size()))
+            throw UsageError("--stroke " + std::to_string(stroke) + ": the capture has " +
+                             std::to_string(units.size()) + " strokes");
+        const GestureUnit &picked = stroke >= 0 ? units[stroke] : representative_unit(units);
+        GestureUnit chosen = picked;
+        chosen.dynamics = dynamics;
+        std::cout << import_path << ": " << units.size() << " strokes; importing stroke "
+                  << (&picked - units.data()) << " (strike at "
+                  << chosen.capture_time_s + chosen.strike_time_s() << " s, impact "
+                  << chosen.impact_speed_mps() << " m/s, preparation "
+                  << chosen.preparation_height_m() << " m)\n";
+        db.add(chosen);
+        db.save_json(out_path);
+        std::cout << "wrote " << db.units().size() << " units to " << out_path << "\n";
+        return 0;
+    }
+}
+
+} // namespace cli
+} // namespace ictus

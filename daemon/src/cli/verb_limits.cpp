@@ -1,0 +1,130 @@
+// `ictusd limits`: joint limits learned from a clip (Euler statistics and
+// Algorithm 1), printed and written as JSON; and the clip options it shares
+// with `ictusd track` (verbs.hpp).
+#include "ictus/character/character_limits.hpp"
+#include "ictus/cli/verbs.hpp"
+#include "ictus/mocap/joint_limits.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+
+namespace ictus
+{
+namespace cli
+{
+
+namespace
+{
+void limits_usage(std::ostream &out)
+{
+    out << "usage: ictusd limits FILE [options]\n"
+           "\n"
+           "Learns the limits of the character's 19 joints from a BVH clip: Euler angles\n"
+           "(ZYX, mean -/+ k std) and quaternions (Algorithm 1: mean, log map, SVD,\n"
+           "ellipsoid of k std). Prints a table and writes JSON.\n"
+           "\n"
+           "  --out FILE      JSON output (default limits.json; '-' prints JSON instead)\n"
+           "  --scale M       metres per BVH unit (default 0.056444)\n"
+           "  --skip-frames N frames dropped at the start (default 1)\n"
+           "  --k K           limits at mean -/+ k std (Euler) and ellipsoid half-axes of\n"
+           "                  k std (quaternion; default 3)\n"
+           "  --min-deg DEG   minimum half-width per axis (default 6)\n"
+           "  --smooth-hz HZ, --despike-deg DEG   reference clean-up as in track\n"
+           "\n"
+           "example:\n"
+           "  ictusd limits ../shared/data/cmu/80_13.bvh --out limits.json\n";
+}
+} // namespace
+
+bool parse_clip_option(const std::string &a, Args &args, ClipOptions &clip)
+{
+    if (a == "--scale") {
+        clip.scale = parse_positive(a, args.value(a));
+    } else if (a == "--skip-frames") {
+        clip.skip = parse_int(a, args.value(a), 0, 100000000);
+    } else if (a == "--smooth-hz") {
+        clip.filter.smooth_cutoff_hz = parse_number(a, args.value(a));
+        if (clip.filter.smooth_cutoff_hz < 0.0)
+            throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
+    } else if (a == "--despike-deg") {
+        clip.filter.spike_threshold_rad = parse_number(a, args.value(a)) * M_PI / 180.0;
+        if (clip.filter.spike_threshold_rad < 0.0)
+            throw UsageError("--despike-deg: expected a number >= 0 (0: off)");
+    } else {
+        return false;
+    }
+    return true;
+}
+
+double parse_min_half_width_deg(const std::string &option, const std::string &text)
+{
+    const double w = parse_number(option, text);
+    if (w < 0.0 || w >= 180.0)
+        throw UsageError(option + ": expected 0 <= deg < 180, got '" + text + "'");
+    return w;
+}
+
+BvhFile load_bvh(const std::string &path, double scale, int skip)
+{
+    BvhOptions o;
+    o.scale = scale;
+    o.skip_frames = skip;
+    MocapWarnings warnings;
+    BvhFile bvh = read_bvh(path, o, &warnings);
+    for (const std::string &w : warnings)
+        std::cerr << "ictusd: warning: " << w << "\n";
+    return bvh;
+}
+
+int cmd_limits(Args &args)
+{
+    std::string file, out = "limits.json";
+    ClipOptions clip;
+    CharacterLimitOptions lo;
+    while (!args.done()) {
+        const std::string a = args.next();
+        if (a == "--help" || a == "-h") {
+            limits_usage(std::cout);
+            return 0;
+        } else if (a == "--out") {
+            out = args.value(a);
+        } else if (parse_clip_option(a, args, clip)) {
+        } else if (a == "--k") {
+            lo.k = parse_positive(a, args.value(a));
+        } else if (a == "--min-deg") {
+            lo.min_half_width_rad = parse_min_half_width_deg(a, args.value(a)) * M_PI / 180.0;
+        } else if (!a.empty() && a[0] == '-' && a != "-") {
+            throw UsageError("limits: unknown option '" + a + "' (see ictusd limits --help)");
+        } else if (file.empty()) {
+            file = a;
+        } else {
+            throw UsageError("limits: one FILE expected, got also '" + a + "'");
+        }
+    }
+    if (file.empty())
+        throw UsageError("limits: FILE is required (ictusd limits FILE)");
+    const BvhFile bvh = load_bvh(file, clip.scale, clip.skip);
+    const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton);
+    const ReferenceMotion reference(model, bvh.motion, clip.filter);
+    const CharacterLimits limits(model, reference, lo);
+    nlohmann::json report = limits.report();
+    report["mocap"] = file;
+    if (out == "-") {
+        std::cout << report.dump(2) << "\n";
+        return 0;
+    }
+    std::vector<JointLimit> enforced = limits.learned();
+    for (size_t j = 0; j < enforced.size(); ++j)
+        enforced[j].euler = limits.euler(static_cast<int>(j)).limit;
+    print_limits(std::cout, enforced);
+    std::ofstream js(out);
+    js << report.dump(2) << "\n";
+    if (!js)
+        throw std::runtime_error("--out: cannot write '" + out + "'");
+    std::cout << "wrote " << out << "\n";
+    return 0;
+}
+
+} // namespace cli
+} // namespace ictus

@@ -1,0 +1,408 @@
+// `ictusd render`: the performance offline, as fast as possible and
+// deterministic (same input, same bytes): strikes.csv, events.txt for Pd's
+// batch render, render.json, and in score mode tips.csv, notes.csv; the
+// performance as BVH. Also the options run and render share (verbs.hpp).
+// Nothing is written while the physics runs: every output is kept in memory
+// and written at the end. docs/osc.md, docs/perform.md.
+#include "ictus/character/bvh_export.hpp"
+#include "ictus/cli/verbs.hpp"
+#include "ictus/perform/strike_log.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace ictus
+{
+namespace cli
+{
+
+namespace
+{
+
+void render_usage(std::ostream &out)
+{
+    out << "usage: ictusd render [--mocap FILE | --score FILE] --out DIR [options]\n"
+           "\n"
+           "Plays offline, as fast as possible and deterministically (same input, same\n"
+           "bytes), and writes DIR/strikes.csv, DIR/events.txt (qlist lines for a Pd batch\n"
+           "patch) and DIR/render.json (drum parameters for membrane~, summary). docs/osc.md.\n"
+           "With --mocap the clip plays in joint space; otherwise the score (--score FILE, or\n"
+           "the built-in default score) is performed and DIR/tips.csv (stick-tip targets and\n"
+           "simulated tips) and DIR/notes.csv (each note and its strike) are written too\n"
+           "(docs/perform.md).\n"
+           "\n"
+           "  --tips-rate HZ      tips.csv rows per second (default 250; 0: none)\n"
+           "  --bvh-rate HZ       performance.bvh frames per second (default 250; 0: none)\n"
+           "\n"
+           "score mode (run and render):\n"
+           "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
+           "  --gestures DB.json  gesture database (default: the built-in one)\n"
+           "  --mode M            cartesian (default, Algorithm 2) | joint (eq. 1, joint\n"
+           "                      targets from the IK of the tip targets)\n"
+           "  --strike-depth M    the target dips this far below the first contact (0.004)\n"
+           "  --advance S         tip targets sampled S ahead: the tracking lag (default 0)\n"
+           "  --rebound S         the target's rebound after a beat, time constant (0.015; 0: "
+           "off)\n"
+           "  --lead-in S         time before the score's first beat (default 1)\n"
+           "  --grip G            the sticks' grip (default: the score's first note's)\n"
+           "  --drum-pos X,Y,Z    membrane centre (default: in front of the shoulders)\n"
+           "\n"
+           "common options (run and render):\n"
+           "  --mocap FILE        BVH file with CMU joint names (clip mode)\n"
+           "  --scale M           metres per BVH unit (default 0.056444)\n"
+           "  --skip-frames N     frames dropped at the start (default 1)\n"
+           "  --duration S        simulated seconds (render default: the clip's or plan's length)\n"
+           "  --step S            physics step (default 0.001)\n"
+           "  --grip G            french | german\n"
+           "  --tempo BPM         clip playback tempo (default 120; a score sets its own)\n"
+           "  --clip-bpm BPM      tempo at which the clip plays at its own speed (default 120)\n"
+           "  --drum-pos X,Y,Z    membrane centre (default: under the clip's lowest tips)\n"
+           "  --drum-radius M     (default 0.178)\n"
+           "  --drum-tension N/M  (default 3000)\n"
+           "  --drum-density KG/M2  for the sound (default 0.26)\n"
+           "  --bounce-height M   bounce rule height (default 0.01)\n"
+           "  --bounce-window S   bounce rule window (default 0.15)\n"
+           "\n"
+           "examples:\n"
+           "  ictusd render --mocap ../shared/data/cmu/80_13.bvh --duration 10 --out out/r1\n"
+           "  ictusd render --out out/fig5                  (the built-in score)\n"
+           "  ictusd render --score my.score --grip german --mode joint --out out/r2\n";
+}
+
+// tips.csv: the stick-tip targets X^T and the simulated tips, both hands.
+void write_tips_header(std::ostream &out)
+{
+    out << "time_s";
+    for (const char *hand : {"left", "right"})
+        for (const char *what : {"target", "sim"})
+            for (const char *axis : {"x", "y", "z"})
+                out << ',' << hand << '_' << what << '_' << axis << "_m";
+    out << '\n';
+}
+
+void write_tips_row(std::ostream &out, const Performance &perf)
+{
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.4f", perf.time_s());
+    out << buf;
+    for (int hand = 0; hand < 2; ++hand)
+        for (const Eigen::Vector3d &p : {perf.tip_target(hand), perf.tip_position(hand)}) {
+            std::snprintf(buf, sizeof buf, ",%.5f,%.5f,%.5f", p.x(), p.y(), p.z());
+            out << buf;
+        }
+    out << '\n';
+}
+
+// notes.csv: the planned notes and the strike each one got.
+void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSummary &m,
+                     double origin_s)
+{
+    out << "index,time_s,hand,nuance,grip,dynamics,beats,tempo_bpm,line,strike_seq,strike_time_s,"
+           "error_ms,normal_velocity_mps,duration_ms\n";
+    char buf[256];
+    for (size_t i = 0; i < plan.notes.size(); ++i) {
+        const PlannedNote &n = plan.notes[i];
+        const NoteMatch &k = m.notes[i];
+        std::snprintf(buf, sizeof buf, "%zu,%.6f,%s,%s,%s,%.3f,%.4f,%.3f,%d,%ld,", i,
+                      origin_s + n.time_s, to_string(n.hand), to_string(n.nuance),
+                      to_string(n.grip), n.dynamics, n.beats, n.tempo_bpm, n.line, k.strike_seq);
+        out << buf;
+        if (k.strike_seq >= 0)
+            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f\n", k.strike_time_s, k.error_ms,
+                          k.normal_velocity_mps, k.duration_ms);
+        else
+            std::snprintf(buf, sizeof buf, ",,,\n");
+        out << buf;
+    }
+}
+
+nlohmann::json drum_json(const Performance &p)
+{
+    const DrumParams &d = p.scene().options().drum;
+    nlohmann::json j;
+    j["center_m"] = {d.center_m.x(), d.center_m.y(), d.center_m.z()};
+    j["radius_m"] = d.radius_m;
+    j["tension_n_per_m"] = d.tension_n_per_m;
+    j["density_kg_per_m2"] = p.options().drum_density_kg_per_m2;
+    j["contact_stiffness_n_per_m"] = p.detector().membrane().stiffness_n_per_m;
+    j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
+    return j;
+}
+
+// render.json's "performance": how the strikes met the notes (docs/perform.md).
+nlohmann::json performance_json(const PerformanceOptions &o, const Performance &perf,
+                                const MatchSummary &m)
+{
+    const GesturePlan &plan = *perf.plan();
+    nlohmann::json j;
+    j["mode"] = to_string(perf.mode());
+    j["notes"] = plan.notes.size();
+    j["primary_strikes"] = m.primary_strikes;
+    j["bounces"] = m.bounces;
+    j["matched_notes"] = m.matched_notes;
+    j["missed_notes"] = static_cast<long>(plan.notes.size()) - m.matched_notes;
+    j["extra_strikes"] = m.extra_strikes;
+    j["timing_error_ms"] = {{"mean_abs", m.mean_abs_error_ms}, {"max_abs", m.max_abs_error_ms}};
+    double v_lo = 0.0, v_hi = 0.0, d_lo = 0.0, d_hi = 0.0, v_sum = 0.0, d_sum = 0.0;
+    long n = 0;
+    for (const NoteMatch &k : m.notes) {
+        if (k.strike_seq < 0)
+            continue;
+        if (n == 0) {
+            v_lo = v_hi = k.normal_velocity_mps;
+            d_lo = d_hi = k.duration_ms;
+        }
+        v_lo = std::min(v_lo, k.normal_velocity_mps);
+        v_hi = std::max(v_hi, k.normal_velocity_mps);
+        d_lo = std::min(d_lo, k.duration_ms);
+        d_hi = std::max(d_hi, k.duration_ms);
+        v_sum += k.normal_velocity_mps;
+        d_sum += k.duration_ms;
+        ++n;
+    }
+    j["impact_speed_mps"] = {{"min", v_lo}, {"mean", n ? v_sum / n : 0.0}, {"max", v_hi}};
+    j["contact_ms"] = {{"min", d_lo}, {"mean", n ? d_sum / n : 0.0}, {"max", d_hi}};
+    j["plan"] = {{"duration_s", plan.duration_s},
+                 {"origin_s", perf.plan_origin_s()},
+                 {"strike_depth_m", o.score.plan.strike_depth_m},
+                 {"time_advance_s", o.score.time_advance_s},
+                 {"lead_in_s", o.score.plan.lead_in_s}};
+    const PerformerFrame &f = perf.performer_frame();
+    j["performer"] = {{"right", {f.right.x(), f.right.y(), f.right.z()}},
+                      {"forward", {f.forward.x(), f.forward.y(), f.forward.z()}}};
+    nlohmann::json per_note = nlohmann::json::array();
+    for (size_t i = 0; i < plan.notes.size(); ++i) {
+        const PlannedNote &p = plan.notes[i];
+        const NoteMatch &k = m.notes[i];
+        nlohmann::json e = {{"time_s", perf.plan_origin_s() + p.time_s},
+                            {"hand", to_string(p.hand)},
+                            {"nuance", to_string(p.nuance)},
+                            {"dynamics", p.dynamics},
+                            {"line", p.line},
+                            {"planned_impact_speed_mps", perf.planned_impact_speed_mps(i)}};
+        if (k.strike_seq >= 0) {
+            e["strike_seq"] = k.strike_seq;
+            e["error_ms"] = k.error_ms;
+            e["impact_speed_mps"] = k.normal_velocity_mps;
+            e["contact_ms"] = k.duration_ms;
+        } else {
+            e["strike_seq"] = nullptr;
+        }
+        per_note.push_back(e);
+    }
+    j["per_note"] = per_note;
+    return j;
+}
+
+} // namespace
+
+// Options shared by run and render. Returns false when `a` is not one of them.
+bool parse_performance_option(const std::string &a, Args &args, PerformanceOptions &o,
+                              double &duration)
+{
+    auto value = [&]() { return args.value(a); };
+    if (a == "--mocap")
+        o.mocap = value();
+    else if (a == "--scale")
+        o.scale_m_per_unit = parse_number(a, value(), 1e-6, 1e3);
+    else if (a == "--skip-frames")
+        o.skip_frames = static_cast<int>(parse_number(a, value(), 0, 1e8));
+    else if (a == "--duration")
+        duration = parse_number(a, value(), 1e-3, 1e7);
+    else if (a == "--step")
+        o.scene.step_s = parse_number(a, value(), 1e-5, 0.01);
+    else if (a == "--grip") {
+        const std::string g = value();
+        if (g != "french" && g != "german")
+            throw UsageError("--grip: expected french or german, got '" + g + "'");
+        o.character.grip = grip_from_string(g);
+        o.score.grip_given = true;
+    } else if (a == "--score") {
+        const std::string path = value();
+        std::ifstream in(path, std::ios::binary);
+        if (!in)
+            throw UsageError("--score: cannot read '" + path + "'");
+        std::ostringstream text;
+        text << in.rdbuf();
+        o.score.score_text = text.str();
+        o.score.score_name = path;
+        if (o.score.score_text.empty())
+            throw UsageError("--score: '" + path + "' is empty");
+    } else if (a == "--gestures")
+        o.score.gestures = value();
+    else if (a == "--mode") {
+        const std::string m = value();
+        if (m != "joint" && m != "cartesian")
+            throw UsageError("--mode: expected joint or cartesian, got '" + m + "'");
+        o.score.mode = track_mode_from_string(m);
+    } else if (a == "--strike-depth")
+        o.score.plan.strike_depth_m = parse_number(a, value(), -0.05, 0.05);
+    else if (a == "--advance")
+        o.score.time_advance_s = parse_number(a, value(), 0, 0.1);
+    else if (a == "--ik-gain")
+        o.score.cartesian.gain = parse_number(a, value(), 0.1, 100);
+    else if (a == "--ik-velocity-gain")
+        o.score.cartesian.velocity_gain_s = parse_number(a, value(), 0, 1);
+    else if (a == "--rebound")
+        o.score.rebound_s = parse_number(a, value(), 0, 0.5);
+    else if (a == "--lead-in")
+        o.score.plan.lead_in_s = parse_number(a, value(), 0.2, 60);
+    else if (a == "--tempo")
+        o.tempo_bpm = parse_number(a, value(), 20, 400);
+    else if (a == "--clip-bpm")
+        o.clip_bpm = parse_number(a, value(), 20, 400);
+    else if (a == "--drum-pos") {
+        const std::vector<std::string> p = split(value(), ',');
+        if (p.size() != 3)
+            throw UsageError("--drum-pos: expected X,Y,Z");
+        for (int k = 0; k < 3; ++k)
+            o.scene.drum.center_m[k] = parse_number(a, p[k], -100, 100);
+        o.drum_auto = false;
+    } else if (a == "--drum-radius")
+        o.scene.drum.radius_m = parse_number(a, value(), 0.05, 1.0);
+    else if (a == "--drum-tension")
+        o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
+    else if (a == "--drum-density")
+        o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
+    else if (a == "--bounce-height")
+        o.strikes.bounce_height_m = parse_number(a, value(), 0, 1);
+    else if (a == "--bounce-window")
+        o.strikes.bounce_window_s = parse_number(a, value(), 0, 10);
+    else
+        return false;
+    return true;
+}
+
+int cmd_render(Args &args)
+{
+    PerformanceOptions o;
+    double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0;
+    std::string out_dir;
+    while (!args.done()) {
+        const std::string a = args.next();
+        if (a == "--help" || a == "-h") {
+            render_usage(std::cout);
+            return 0;
+        } else if (a == "--out") {
+            out_dir = args.value(a);
+        } else if (a == "--bvh-rate") {
+            bvh_rate = parse_number(a, args.value(a), 0, 1000);
+        } else if (a == "--tips-rate") {
+            tips_rate = parse_number(a, args.value(a), 0, 1000);
+        } else if (!parse_performance_option(a, args, o, duration)) {
+            throw UsageError("unknown option '" + a + "' (see ictusd render --help)");
+        }
+    }
+    const bool score_mode = o.mocap.empty();
+    if (!score_mode && !o.score.score_text.empty())
+        throw UsageError("--score and --mocap are two motion sources: give one");
+    if (out_dir.empty())
+        throw UsageError("--out DIR is required");
+    std::error_code ec;
+    std::filesystem::create_directories(out_dir, ec);
+    if (ec)
+        throw std::runtime_error("--out: cannot create '" + out_dir + "': " + ec.message());
+
+    Performance perf(o);
+    if (score_mode)
+        perf.start_score();
+    if (duration <= 0.0)
+        duration = perf.clip_duration_s();
+    // tips.csv rows, kept in memory until the end (about 100 bytes a row).
+    std::ostringstream tips;
+    if (score_mode)
+        write_tips_header(tips);
+    const auto wall0 = std::chrono::steady_clock::now();
+    const double h = perf.step_s();
+    const long steps = std::max(1L, std::lround(duration / h));
+    const long tips_every =
+        score_mode && tips_rate > 0.0 ? std::max(1L, std::lround(1.0 / (tips_rate * h))) : 0;
+    // performance.bvh: the simulated bodies on the source skeleton (plus
+    // the sticks), frame f at f / bvh_rate s, from t = 0.
+    const long bvh_every = bvh_rate > 0.0 ? std::max(1L, std::lround(1.0 / (bvh_rate * h))) : 0;
+    std::unique_ptr<BvhRecorder> bvh;
+    BodyFrames frames;
+    if (bvh_every) {
+        bvh.reset(new BvhRecorder(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h)));
+        perf.scene().body_frames(frames);
+        bvh->record(frames);
+    }
+    StrikeLog log;
+    StrikeEvent ev[2];
+    bool interrupted = false;
+    for (long n = 0; n < steps; ++n) {
+        if (g_interrupted) {
+            interrupted = true;
+            break;
+        }
+        const int k = perf.step(ev);
+        log.add(ev, k, perf.detector().first_open_seq());
+        if (tips_every && (n + 1) % tips_every == 0)
+            write_tips_row(tips, perf);
+        if (bvh && (n + 1) % bvh_every == 0) {
+            perf.scene().body_frames(frames);
+            bvh->record(frames);
+        }
+    }
+    StrikeEvent last;
+    while (perf.flush(last))
+        log.add_flushed(last);
+    log.finish();
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+
+    auto write = [&](const std::string &name, const std::function<bool(std::ostream &)> &fill) {
+        std::ofstream out(out_dir + "/" + name);
+        if (!fill(out) || !out)
+            throw std::runtime_error("--out: cannot write '" + out_dir + "/" + name + "'");
+    };
+    const long strikes = static_cast<long>(log.strikes().size()), bounces = log.bounces();
+    write("strikes.csv", [&](std::ostream &out) { return log.write_csv(out); });
+    write("events.txt", [&](std::ostream &out) { return log.write_events(out); });
+    if (bvh)
+        bvh->write(out_dir + "/performance.bvh");
+    nlohmann::json j;
+    if (score_mode)
+        j["score"] = o.score.score_text.empty() ? "default" : o.score.score_name;
+    else
+        j["mocap"] = o.mocap;
+    j["duration_s"] = perf.time_s();
+    j["step_s"] = h;
+    j["strikes"] = strikes;
+    j["bounces"] = bounces;
+    j["divergences"] = perf.divergences();
+    j["side_entries"] = perf.detector().side_entries();
+    j["grip"] = to_string(perf.options().character.grip);
+    if (!score_mode)
+        j["tempo_bpm"] = o.tempo_bpm;
+    j["drum"] = drum_json(perf);
+    if (score_mode) {
+        const GesturePlan &plan = *perf.plan();
+        const MatchSummary m = match_strikes(plan.notes, log.strikes(), perf.plan_origin_s());
+        write("notes.csv", [&](std::ostream &out) {
+            write_notes_csv(out, plan, m, perf.plan_origin_s());
+            return true;
+        });
+        write("tips.csv", [&](std::ostream &out) { return static_cast<bool>(out << tips.str()); });
+        j["performance"] = performance_json(o, perf, m);
+    }
+    write("render.json", [&](std::ostream &out) { return static_cast<bool>(out << j.dump(2) << "\n"); });
+    std::cout << "render: " << perf.time_s() << " s simulated in " << wall << " s ("
+              << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes
+              << " strikes (" << bounces << " bounces), wrote " << out_dir
+              << (score_mode ? "/{strikes.csv,events.txt,render.json,tips.csv,notes.csv"
+                             : "/{strikes.csv,events.txt,render.json")
+              << (bvh ? ",performance.bvh}\n" : "}\n");
+    return interrupted ? 130 : 0;
+}
+
+} // namespace cli
+} // namespace ictus

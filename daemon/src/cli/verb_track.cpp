@@ -1,0 +1,488 @@
+// `ictusd track`: tracking of a mocap clip by the simulated character, in
+// joint space (eq. 1) or Cartesian space (Algorithm 2); errors, speed and the
+// strikes on the drum (docs/character.md, docs/ik.md). Four steps: parse the
+// command line, load the capture and build the character, run, report.
+#include "ictus/character/character_limits.hpp"
+#include "ictus/character/stick_capture.hpp"
+#include "ictus/cli/verbs.hpp"
+#include "ictus/mocap/marker_csv.hpp"
+#include "ictus/perform/strike_log.hpp"
+#include "ictus/perform/track.hpp"
+
+#include <unistd.h>
+
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+namespace ictus
+{
+namespace cli
+{
+
+namespace
+{
+
+void track_usage(std::ostream &out)
+{
+    out << "usage: ictusd track --mode joint|cartesian --mocap FILE [options]\n"
+           "\n"
+           "Tracks the clip with per-joint PD controllers (eq. 1) on the 57-DoF character,\n"
+           "pelvis anchored, sticks in the hands, a drum in front. joint: every joint follows\n"
+           "the capture's rotations. cartesian (Algorithm 2): the arms' targets come from IK\n"
+           "(eq. 2) toward the stick tips every step, the other joints follow the capture.\n"
+           "\n"
+           "  --mode joint|cartesian control mode\n"
+           "  --mocap FILE           BVH file with CMU joint names, or (cartesian) a stick-only\n"
+           "                         .csv capture (time,NAME.x,NAME.y,NAME.z,...; docs/mocap.md):\n"
+           "                         the default body is placed behind the sticks\n"
+           "  --left-stick NAME, --right-stick NAME   the capture's stick-tip objects (default:\n"
+           "                         named stick_l / stick_r, else containing left / right)\n"
+           "  --units mm|m, --up y|z, --rate HZ   how to read the .csv (default m, y, its time)\n"
+           "  --drum auto|X,Y,Z      membrane centre (auto: under the lowest strokes)\n"
+           "  --ik-gain G            eq. 2's gain on the tip error (default 10)\n"
+           "  --ik-velocity-gain S   tip velocity error term, s (default 0.1; < 0: automatic)\n"
+           "  --ik-accel-ff S2       tip acceleration feedforward, s^2 (default 0)\n"
+           "  --ik-integral PER_S    integral of the tip error (default 0)\n"
+           "  --ik-correction-limit M   cap on the IK target's correction (default 0.1)\n"
+           "  --ik-start kinematic|simulated   IK warm start (default kinematic; docs/ik.md)\n"
+           "  --out DIR              write DIR/track.csv, DIR/strikes.csv and DIR/summary.json\n"
+           "  --scale M              metres per BVH unit (default 0.056444, the CMU files)\n"
+           "  --skip-frames N        frames dropped at the start (default 1: the CMU\n"
+           "                         converter's reference pose)\n"
+           "  --duration S           simulated seconds (default: the clip; longer runs play\n"
+           "                         it forwards and backwards)\n"
+           "  --step S               physics step, s (default 0.001)\n"
+           "  --stepper quick|direct dWorldQuickStep (default) or dWorldStep\n"
+           "  --iterations N         QuickStep iterations (default 15)\n"
+           "  --body-mass KG         body mass for de Leva's table (default 70)\n"
+           "  --grip french|german   hand-stick orientation (default french)\n"
+           "  --stick-length M       (default 0.406)   --stick-mass KG (default 0.05)\n"
+           "  --stick-tip-radius M   (default 0.007)\n"
+           "  --drum-pos X,Y,Z       membrane centre, m (default: under the lowest tips)\n"
+           "  --drum-radius M        (default 0.178)   --drum-tension N/m (default 3000)\n"
+           "  --gain-hz HZ           PD natural frequency (default 30)\n"
+           "  --damping-ratio Z      (default 1)       --torque-scale S (default 1)\n"
+           "  --gains FILE.json      per-joint overrides, e.g. {\"l_wrist\": {\"kp_nm_per_rad\":\n"
+           "                         40, \"kd_nm_s_per_rad\": 0.5, \"torque_limit_nm\": 20}}\n"
+           "  --limits none|euler|quaternion   limits enforced (default quaternion)\n"
+           "  --limit-k K            limit width in standard deviations (default 3)\n"
+           "  --limit-min-deg DEG    minimum half-width of a limit per axis (default 6)\n"
+           "  --no-stops             clamp targets only, no safety-net stops\n"
+           "  --ramp S               blend targets in over S seconds (default 0.25)\n"
+           "  --smooth-hz HZ         low-pass the reference (Gaussian, default 10; 0: off)\n"
+           "  --despike-deg DEG      replace one-frame spikes larger than DEG (default 5;\n"
+           "                         0: off)\n"
+           "  --quiet                no progress output\n"
+           "\n"
+           "examples:\n"
+           "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n"
+           "  ictusd track --mode cartesian --mocap ../shared/data/cmu/80_13.bvh --limit-k 4\n"
+           "  ictusd track --mode cartesian --mocap sticks.csv --units mm --up z --drum auto\n";
+}
+
+// The command line of a track run.
+struct TrackArgs {
+    bool help = false;
+    std::string mode, mocap, out_dir, limits_mode = "quaternion", gains_file;
+    double limit_k = 3.0, limit_width_deg = 6.0;
+    ClipOptions clip;
+    bool quiet = false;
+    CharacterOptions character;
+    TrackOptions options;
+    bool drum_pos_given = false;
+    std::string left_stick, right_stick;
+    MarkerCsvOptions csv_options;
+    bool csv_options_given = false;
+    bool stick_only = false; // a .csv capture: stick tips only (Cartesian mode)
+};
+
+bool is_csv(const std::string &path)
+{
+    if (path.size() < 4)
+        return false;
+    std::string ext = path.substr(path.size() - 4);
+    for (char &c : ext)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext == ".csv";
+}
+
+TrackArgs parse_track_args(Args &args)
+{
+    TrackArgs t;
+    while (!args.done()) {
+        const std::string a = args.next();
+        if (a == "--help" || a == "-h") {
+            track_usage(std::cout);
+            t.help = true;
+            return t;
+        } else if (a == "--mode") {
+            t.mode = args.value(a);
+            try {
+                t.options.mode = track_mode_from_string(t.mode);
+            } catch (const CharacterError &e) {
+                throw UsageError(std::string("--") + e.what());
+            }
+        } else if (a == "--ik-gain") {
+            t.options.cartesian.gain = parse_positive(a, args.value(a));
+        } else if (a == "--left-stick") {
+            t.left_stick = args.value(a);
+        } else if (a == "--right-stick") {
+            t.right_stick = args.value(a);
+        } else if (a == "--units") {
+            const std::string v = args.value(a);
+            if (v != "mm" && v != "m")
+                throw UsageError("--units: expected mm or m, got '" + v + "'");
+            t.csv_options.units =
+                v == "mm" ? MarkerCsvOptions::Units::mm : MarkerCsvOptions::Units::m;
+            t.csv_options_given = true;
+        } else if (a == "--up") {
+            const std::string v = args.value(a);
+            if (v != "y" && v != "z")
+                throw UsageError("--up: expected y or z, got '" + v + "'");
+            t.csv_options.up =
+                v == "z" ? MarkerCsvOptions::Up::z : MarkerCsvOptions::Up::y;
+            t.csv_options_given = true;
+        } else if (a == "--rate") {
+            t.csv_options.rate_hz = parse_positive(a, args.value(a));
+            t.csv_options_given = true;
+        } else if (a == "--drum") {
+            const std::string v = args.value(a);
+            if (v != "auto") {
+                try {
+                    t.options.scene.drum.center_m = parse_vec3(a, v);
+                } catch (const UsageError &) {
+                    throw UsageError("--drum: expected auto or X,Y,Z (m), got '" + v + "'");
+                }
+                t.drum_pos_given = true;
+            }
+        } else if (a == "--ik-velocity-gain") {
+            t.options.cartesian.velocity_gain_s = parse_number(a, args.value(a));
+        } else if (a == "--ik-accel-ff") {
+            t.options.cartesian.acceleration_feedforward_s2 = parse_number(a, args.value(a));
+        } else if (a == "--ik-correction-limit") {
+            t.options.cartesian.correction_limit_m = parse_number(a, args.value(a));
+        } else if (a == "--ik-start") {
+            const std::string v = args.value(a);
+            if (v != "simulated" && v != "kinematic")
+                throw UsageError("--ik-start: expected simulated or kinematic, got '" + v + "'");
+            t.options.cartesian.start_from_simulated = v == "simulated";
+        } else if (a == "--ik-integral") {
+            t.options.cartesian.integral_per_s = parse_number(a, args.value(a));
+        } else if (a == "--mocap") {
+            t.mocap = args.value(a);
+        } else if (a == "--out") {
+            t.out_dir = args.value(a);
+        } else if (parse_clip_option(a, args, t.clip)) {
+        } else if (a == "--duration") {
+            t.options.duration_s = parse_positive(a, args.value(a));
+        } else if (a == "--step") {
+            t.options.scene.step_s = parse_positive(a, args.value(a));
+        } else if (a == "--stepper") {
+            const std::string s = args.value(a);
+            if (s == "quick")
+                t.options.scene.stepper = Stepper::quick;
+            else if (s == "direct")
+                t.options.scene.stepper = Stepper::direct;
+            else
+                throw UsageError("--stepper: expected quick or direct, got '" + s + "'");
+        } else if (a == "--iterations") {
+            t.options.scene.quickstep_iterations = parse_int(a, args.value(a), 1, 1000);
+        } else if (a == "--body-mass") {
+            t.character.body_mass_kg = parse_positive(a, args.value(a));
+        } else if (a == "--grip") {
+            const std::string g = args.value(a);
+            try {
+                t.character.grip = grip_from_string(g);
+            } catch (const CharacterError &e) {
+                throw UsageError(std::string("--") + e.what());
+            }
+        } else if (a == "--stick-length") {
+            t.character.stick.length_m = parse_positive(a, args.value(a));
+        } else if (a == "--stick-mass") {
+            t.character.stick.mass_kg = parse_positive(a, args.value(a));
+        } else if (a == "--stick-tip-radius") {
+            t.character.stick.tip_radius_m = parse_positive(a, args.value(a));
+        } else if (a == "--drum-pos") {
+            t.options.scene.drum.center_m = parse_vec3(a, args.value(a));
+            t.drum_pos_given = true;
+        } else if (a == "--drum-radius") {
+            t.options.scene.drum.radius_m = parse_positive(a, args.value(a));
+        } else if (a == "--drum-tension") {
+            t.options.scene.drum.tension_n_per_m = parse_positive(a, args.value(a));
+        } else if (a == "--gain-hz") {
+            t.options.gains.natural_frequency_hz = parse_positive(a, args.value(a));
+        } else if (a == "--damping-ratio") {
+            t.options.gains.damping_ratio = parse_positive(a, args.value(a));
+        } else if (a == "--torque-scale") {
+            t.options.gains.torque_scale = parse_positive(a, args.value(a));
+        } else if (a == "--gains") {
+            t.gains_file = args.value(a);
+        } else if (a == "--limits") {
+            t.limits_mode = args.value(a);
+            if (t.limits_mode != "none" && t.limits_mode != "euler" && t.limits_mode != "quaternion")
+                throw UsageError("--limits: expected none, euler or quaternion, got '" +
+                                 t.limits_mode + "'");
+        } else if (a == "--limit-k") {
+            t.limit_k = parse_positive(a, args.value(a));
+        } else if (a == "--limit-min-deg") {
+            t.limit_width_deg = parse_min_half_width_deg(a, args.value(a));
+        } else if (a == "--no-stops") {
+            t.options.scene.limit_stops = false;
+        } else if (a == "--ramp") {
+            t.options.ramp_s = parse_number(a, args.value(a));
+            if (t.options.ramp_s < 0.0)
+                throw UsageError("--ramp: expected a number >= 0, got " +
+                                 std::to_string(t.options.ramp_s));
+        } else if (a == "--quiet" || a == "-q") {
+            t.quiet = true;
+        } else {
+            throw UsageError("track: unknown option '" + a + "' (see ictusd track --help)");
+        }
+    }
+    if (t.mode.empty())
+        throw UsageError("track: --mode is required (--mode joint or --mode cartesian)");
+    if (t.mocap.empty())
+        throw UsageError("track: --mocap FILE is required");
+    t.options.drum_auto = !t.drum_pos_given;
+    // Option values that only the model can judge (e.g. a too-long step) are
+    // usage errors too: check them before reading the file.
+    try {
+        validate(t.options);
+    } catch (const CharacterError &e) {
+        throw UsageError(std::string("track: ") + e.what());
+    }
+    // A .csv capture is stick-only (Cartesian mode): the default body holds a
+    // neutral pose and its arms follow the two stick tips.
+    t.stick_only = is_csv(t.mocap);
+    if (t.stick_only && t.options.mode != TrackMode::cartesian)
+        throw UsageError("track: a stick-only capture (" + t.mocap + ") needs --mode cartesian");
+    if (!t.stick_only && (!t.left_stick.empty() || !t.right_stick.empty() || t.csv_options_given))
+        throw UsageError("track: --left-stick, --right-stick, --units, --up and --rate apply "
+                         "to stick-only .csv captures");
+    if (t.stick_only && t.limits_mode != "none") {
+        std::cerr << "ictusd: note: stick-only capture: no joint limits (they are learned "
+                     "from a full-body capture)\n";
+        t.limits_mode = "none";
+    }
+    return t;
+}
+
+// What a track run needs, built from the files: the character, its reference
+// motion (cleaned, and raw for the errors), limits, gains, the stick tips of a
+// stick-only capture. Members refer to one another: built in place, never moved.
+struct TrackInput {
+    BvhFile bvh;
+    std::unique_ptr<CharacterModel> model;
+    std::unique_ptr<ReferenceMotion> raw, reference;
+    TipTrajectory tips;
+    std::unique_ptr<CharacterLimits> limits;
+    std::vector<JointLimitRef> limit_refs;
+    std::vector<JointGains> gains;
+};
+
+void load_track_input(TrackArgs &t, TrackInput &in)
+{
+    MarkerCapture capture;
+    std::array<int, 2> stick_tracks = {-1, -1};
+    if (t.stick_only) {
+        MocapWarnings warnings;
+        capture = read_marker_csv(t.mocap, t.csv_options, &warnings);
+        for (const std::string &w : warnings)
+            std::cerr << "ictusd: warning: " << w << "\n";
+        try {
+            stick_tracks = find_stick_tracks(capture, t.left_stick, t.right_stick);
+        } catch (const CharacterError &e) {
+            throw UsageError(std::string("track: ") + e.what());
+        }
+        in.bvh.skeleton = default_skeleton();
+        in.bvh.motion.frame_rate_hz = 100.0;
+        for (int f = 0; f < 2; ++f) {
+            // Standing height of the default body's hips (legs straight).
+            in.bvh.motion.root_position_m.push_back(Eigen::Vector3d(0.0, 0.9, 0.0));
+            in.bvh.motion.local_rotation.emplace_back(in.bvh.skeleton.joints.size(),
+                                                      Eigen::Quaterniond::Identity());
+        }
+    } else {
+        in.bvh = load_bvh(t.mocap, t.clip.scale, t.clip.skip);
+    }
+    in.model = std::make_unique<CharacterModel>(
+        CharacterModel::from_skeleton(in.bvh.skeleton, t.character));
+    const CharacterModel &model = *in.model;
+    in.raw = std::make_unique<ReferenceMotion>(model, in.bvh.motion);
+    in.reference = std::make_unique<ReferenceMotion>(
+        model, in.bvh.motion, t.stick_only ? ReferenceFilter{0.0, 0.0} : t.clip.filter);
+    if (t.stick_only) {
+        in.tips = place_behind_sticks(model, in.reference->frame(0), capture, stick_tracks);
+        t.options.tip_reference = &in.tips;
+    }
+    CharacterLimitOptions lim;
+    lim.kind = limit_kind_from_string(t.limits_mode);
+    lim.k = t.limit_k;
+    lim.min_half_width_rad = t.limit_width_deg * M_PI / 180.0;
+    in.limits = std::make_unique<CharacterLimits>(model, *in.reference, lim);
+    in.limit_refs = in.limits->refs();
+    // Gains: inertia-scaled defaults at the first pose, then per-joint overrides.
+    in.gains = default_gains(model, in.reference->frame(0), t.options.gains);
+    if (!t.gains_file.empty()) {
+        std::ifstream file(t.gains_file);
+        if (!file)
+            throw std::runtime_error("--gains: cannot read '" + t.gains_file + "'");
+        nlohmann::json overrides;
+        try {
+            overrides = nlohmann::json::parse(file);
+        } catch (const nlohmann::json::parse_error &e) {
+            throw std::runtime_error(t.gains_file + ": not valid JSON (" + e.what() + ")");
+        }
+        apply_gain_overrides(model, overrides, t.gains_file, in.gains);
+    }
+}
+
+class Progress
+{
+  public:
+    explicit Progress(bool enabled) : enabled_(enabled), tty_(isatty(STDERR_FILENO) == 1) {}
+    void operator()(double fraction)
+    {
+        if (!enabled_)
+            return;
+        const int pct = static_cast<int>(fraction * 100.0 + 0.5);
+        if (tty_) {
+            const int width = 40, filled = pct * width / 100;
+            std::cerr << "\rtrack [" << std::string(filled, '#') << std::string(width - filled, ' ')
+                      << "] " << pct << "%" << std::flush;
+            if (pct >= 100)
+                std::cerr << "\n";
+        } else if (pct / 10 != last_decile_) {
+            last_decile_ = pct / 10;
+            std::cerr << "track: " << pct << "%\n";
+        }
+    }
+
+  private:
+    bool enabled_, tty_;
+    int last_decile_ = -1;
+};
+
+// The simulation: track.csv streamed as it runs, strikes kept in order.
+TrackSummary run_tracking(TrackArgs &t, const TrackInput &in, std::ostream *csv, StrikeLog &log)
+{
+    t.options.interrupt = &g_interrupted;
+    // strikes.csv: every verb that simulates writes it (docs/osc.md), through
+    // the interaction manager on the scene's beads, fed after each physics step.
+    StrikeDetector detector;
+    if (!t.out_dir.empty())
+        t.options.on_step = [&](const Scene &scene) {
+            detector.set_membrane(membrane_of(scene));
+            StrikeEvent out[2];
+            const int n = detect_strikes(detector, scene, out);
+            log.add(out, n, detector.first_open_seq());
+        };
+    Progress progress(!t.quiet);
+    TrackSummary summary = track_joint_space(
+        *in.model, *in.reference, t.options, in.limit_refs, csv, [&](double f) { progress(f); },
+        &in.gains, in.raw.get());
+    StrikeEvent e;
+    while (detector.flush(e))
+        log.add_flushed(e);
+    log.finish();
+    t.options.on_step = nullptr;
+    return summary;
+}
+
+// summary.json, strikes.csv and the lines on stdout; the exit status.
+int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary,
+           const StrikeLog &log)
+{
+    const TrackOptions &options = t.options;
+    nlohmann::json j = summary.to_json();
+    j["mocap"] = t.mocap;
+    j["scale_m_per_unit"] = t.clip.scale;
+    j["skip_frames"] = t.clip.skip;
+    j["step_s"] = options.scene.step_s;
+    j["stepper"] = options.scene.stepper == Stepper::quick ? "quick" : "direct";
+    j["quickstep_iterations"] = options.scene.quickstep_iterations;
+    j["grip"] = to_string(t.character.grip);
+    j["body_mass_kg"] = t.character.body_mass_kg;
+    j["limits"] = t.limits_mode;
+    j["limit_k"] = t.limit_k;
+    j["limit_min_deg"] = t.limit_width_deg;
+    j["limit_stops"] = options.scene.limit_stops;
+    j["gain_hz"] = options.gains.natural_frequency_hz;
+    j["damping_ratio"] = options.gains.damping_ratio;
+    j["drum_radius_m"] = options.scene.drum.radius_m;
+    j["smooth_hz"] = t.clip.filter.smooth_cutoff_hz;
+    j["despike_deg"] = t.clip.filter.spike_threshold_rad * 180.0 / M_PI;
+    j["spikes_removed"] = in.reference->spikes_removed();
+    j["interrupted"] = summary.interrupted;
+    j["gains"] = gains_to_json(*in.model, in.gains);
+    if (options.mode == TrackMode::cartesian) {
+        j["ik"]["gain"] = options.cartesian.gain;
+        j["ik"]["integral_per_s"] = options.cartesian.integral_per_s;
+    }
+    if (!t.out_dir.empty()) {
+        const std::string strikes_path = t.out_dir + "/strikes.csv";
+        std::ofstream strikes(strikes_path);
+        if (!log.write_csv(strikes))
+            throw std::runtime_error("--out: cannot write '" + strikes_path + "'");
+        j["strikes"] = static_cast<long>(log.strikes().size());
+        std::ofstream js(t.out_dir + "/summary.json");
+        js << j.dump(2) << "\n";
+        if (!js)
+            throw std::runtime_error("--out: cannot write '" + t.out_dir + "/summary.json'");
+    }
+    std::cout << "mode " << summary.mode << ", " << summary.duration_s
+              << " s simulated, realtime factor " << summary.realtime_factor << "\n"
+              << "tip rms (mm): left " << summary.tip_rms_mm[0] << ", right "
+              << summary.tip_rms_mm[1] << "\n"
+              << "joint rms (deg), all joints: " << j["joint_rms_deg_all"].get<double>() << "\n"
+              << "divergences: " << summary.divergences << "\n";
+    if (options.mode == TrackMode::cartesian) {
+        std::cout << "ik: " << summary.ik_mean_iterations << " iterations per solve (max "
+                  << summary.ik_max_iterations << "), " << summary.ik_us_per_step << " us per step";
+        if (summary.elbow_measured)
+            std::cout << "; elbow flexion rms (deg) left " << summary.elbow_ik_rms_deg[0]
+                      << ", right " << summary.elbow_ik_rms_deg[1];
+        std::cout << "\n";
+    }
+    if (summary.interrupted)
+        return 130;
+    return summary.diverged ? 3 : 0;
+}
+
+} // namespace
+
+int cmd_track(Args &args)
+{
+    TrackArgs t = parse_track_args(args);
+    if (t.help)
+        return 0;
+    TrackInput in;
+    load_track_input(t, in);
+    std::ofstream csv;
+    if (!t.out_dir.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(t.out_dir, ec);
+        if (ec)
+            throw std::runtime_error("--out: cannot create directory '" + t.out_dir +
+                                     "': " + ec.message());
+        csv.open(t.out_dir + "/track.csv");
+        if (!csv)
+            throw std::runtime_error("--out: cannot write '" + t.out_dir + "/track.csv'");
+        csv.precision(9);
+    }
+    StrikeLog log;
+    const TrackSummary summary = run_tracking(t, in, t.out_dir.empty() ? nullptr : &csv, log);
+    if (!t.out_dir.empty()) {
+        csv.close();
+        if (!csv)
+            throw std::runtime_error("--out: error writing '" + t.out_dir + "/track.csv'");
+    }
+    return report(t, in, summary, log);
+}
+
+} // namespace cli
+} // namespace ictus

@@ -1,0 +1,283 @@
+// chain_ik_solver_pos_dls.cpp -- damped-least-squares IK (paper eq. 2, Wampler 1986).
+#include "ictus/control/chain_ik_solver_pos_dls.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace ictus
+{
+
+const char *to_string(IkStatus status)
+{
+    switch (status) {
+    case IkStatus::converged:
+        return "converged";
+    case IkStatus::max_iterations:
+        return "max_iterations";
+    case IkStatus::unreachable:
+        return "unreachable";
+    case IkStatus::joint_limited:
+        return "joint_limited";
+    case IkStatus::singular:
+        return "singular";
+    case IkStatus::invalid_input:
+        return "invalid_input";
+    }
+    return "unknown";
+}
+
+static bool params_valid(const IkParams &p)
+{
+    const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
+    return positive(p.damping_m) && positive(p.max_error_step_m) &&
+           positive(p.max_joint_step_rad) && positive(p.tolerance_m) &&
+           positive(p.direction_tolerance_rad) && positive(p.direction_damping) &&
+           p.max_iterations >= 1 && p.max_iterations <= 10000;
+}
+
+ChainIkSolverPos_dls::ChainIkSolverPos_dls(int joints, const IkParams &params)
+    : joints_(joints >= 1 && joints <= KinematicChain::kMaxJoints ? joints : 0),
+      params_(params_valid(params) ? params : IkParams())
+{
+    // Size every temporary once; their storage is inline (fixed maximum size), so neither
+    // this nor solve() touches the heap.
+    jacobian_.setZero(3, 3 * joints_);
+    step_.setZero(3 * joints_);
+    projector_.setZero(3 * joints_, 3 * joints_);
+    jacobian_solved_.setZero(3, 3 * joints_);
+    direction_jacobian_.setZero(3, 3 * joints_);
+    jjt_.setZero();
+    for (auto &rotations : rotation_)
+        for (auto &q : rotations)
+            q.setIdentity();
+}
+
+bool ChainIkSolverPos_dls::set_params(const IkParams &params)
+{
+    if (!params_valid(params))
+        return false;
+    params_ = params;
+    return true;
+}
+
+IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
+                                     const Eigen::Vector3d &target_tip_m,
+                                     Eigen::Quaterniond *rotations_out)
+{
+    return solve(chain, target_tip_m, Eigen::Vector3d::UnitX(), 0.0, rotations_out);
+}
+
+double ChainIkSolverPos_dls::direction_error(const ChainFrames &frames,
+                                             const Eigen::Vector3d &target_direction,
+                                             Eigen::Vector3d *rotation_vector)
+{
+    // The world rotation vector turning the stick onto the target direction (shortest arc).
+    const Eigen::Vector3d &d = frames.stick_direction;
+    const Eigen::Vector3d axis = d.cross(target_direction);
+    const double sin_angle = axis.norm();
+    const double angle = std::atan2(sin_angle, d.dot(target_direction));
+    if (sin_angle > 1e-12)
+        *rotation_vector = axis * (angle / sin_angle);
+    else if (angle < 1.0)
+        rotation_vector->setZero();
+    else // opposite: any axis across the stick will do
+        *rotation_vector = d.unitOrthogonal() * angle;
+    return angle;
+}
+
+IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
+                                     const Eigen::Vector3d &target_tip_m,
+                                     const Eigen::Vector3d &target_direction,
+                                     double direction_weight, Eigen::Quaterniond *rotations_out)
+{
+    IkResult result;
+    const int n = joints_;
+    const bool use_direction = direction_weight > 0.0;
+    bool valid = n > 0 && chain.joints() == n && rotations_out != nullptr &&
+                 target_tip_m.allFinite() && chain.base_position().allFinite() &&
+                 chain.base_rotation().coeffs().allFinite() && chain.tip_offset().allFinite() &&
+                 std::isfinite(direction_weight) && direction_weight >= 0.0 &&
+                 direction_weight <= 1.0 &&
+                 (!use_direction ||
+                  (target_direction.allFinite() && target_direction.squaredNorm() > 1e-24));
+    // Warm start Theta^S. A rotation that is not a usable quaternion makes the input invalid
+    // and is replaced by the identity, so the outputs never hold NaN.
+    for (int j = 0; j < n && j < chain.joints(); ++j) {
+        const Eigen::Quaterniond &q = chain.rotation(j);
+        const double norm = q.norm();
+        if (q.coeffs().allFinite() && norm > 1e-12) {
+            rotation_[0][j] = Eigen::Quaterniond(q.coeffs() / norm);
+        } else {
+            rotation_[0][j].setIdentity();
+            valid = false;
+        }
+        if (!chain.offset(j).allFinite())
+            valid = false;
+    }
+    if (!valid) {
+        // The warm start as given (not even renormalised), except where it is unusable.
+        if (rotations_out != nullptr)
+            for (int j = 0; j < n && j < chain.joints(); ++j)
+                rotations_out[j] = rotation_[0][j].isApprox(chain.rotation(j), 1e-12)
+                                       ? chain.rotation(j)
+                                       : rotation_[0][j];
+        result.status = IkStatus::invalid_input;
+        result.position_error_m = std::numeric_limits<double>::infinity();
+        return result;
+    }
+
+    const Eigen::Vector3d direction_target =
+        use_direction ? target_direction.normalized() : Eigen::Vector3d::UnitX();
+    // Levenberg-Marquardt on top of Wampler's damping: a step that does not reduce the tip
+    // error is undone and retried with twice the damping; accepted steps halve it again, never
+    // below damping_m. Plain DLS oscillates where the residual stays large (targets out of
+    // reach: the neglected curvature term |e| * L of the arm exceeds lambda^2 near the
+    // stretch), see docs/ik.md.
+    double damping_m = params_.damping_m;
+    double secondary_weight = direction_weight;
+    Eigen::Vector3d direction_step = Eigen::Vector3d::Zero();
+    int current = 0;
+    chain.forward(rotation_[current].data(), &frames_[current]);
+    Eigen::Vector3d error = target_tip_m - frames_[current].tip_position_m;
+    double error_m = error.norm();
+    result.direction_error_rad =
+        use_direction ? direction_error(frames_[current], direction_target, &direction_step) : 0.0;
+    bool limits_active = false;
+    const auto done = [&]() {
+        return error_m <= params_.tolerance_m &&
+               (!use_direction || result.direction_error_rad <= params_.direction_tolerance_rad);
+    };
+    while (!done() && result.iterations < params_.max_iterations) {
+        const ChainFrames &frames = frames_[current];
+        // Eq. 2 with Wampler's damped (singularity-robust) pseudo-inverse:
+        // dtheta = J^T (J J^T + lambda^2 I)^-1 e. J J^T is only 3x3, so the solve is cheap.
+        KinematicChain::tip_jacobian(frames, n, jacobian_);
+        jjt_.noalias() = jacobian_ * jacobian_.transpose();
+        jjt_.diagonal().array() += damping_m * damping_m;
+        llt_.compute(jjt_);
+        const Eigen::Vector3d clamped_error =
+            error_m > params_.max_error_step_m
+                ? Eigen::Vector3d(error * (params_.max_error_step_m / error_m))
+                : error;
+        step_.noalias() = jacobian_.transpose() * llt_.solve(clamped_error);
+
+        if (use_direction && secondary_weight > 0.0) {
+            // Secondary task, strictly below the tip (task priority, Nakamura et al. 1987):
+            // dtheta += (J_d N)^+ (w e_d - J_d dtheta_tip), N = I - J^+ J the null-space
+            // projector of the tip task. The stick turns with every joint alike, J_d = [I..I].
+            // N uses the undamped pseudo-inverse (a 1e-6 m regulariser only): a damped one
+            // leaks the secondary step into the tip by lambda^2 / sigma^2 and the two tasks
+            // then fight. N stays a bounded projector even at singularities.
+            jjt_.noalias() = jacobian_ * jacobian_.transpose();
+            jjt_.diagonal().array() += 1e-12;
+            projector_llt_.compute(jjt_);
+            jacobian_solved_ = projector_llt_.solve(jacobian_);
+            projector_.noalias() = -jacobian_.transpose() * jacobian_solved_;
+            projector_.diagonal().array() += 1.0;
+            direction_jacobian_.setZero();
+            Eigen::Vector3d stick_turn_from_tip_step = Eigen::Vector3d::Zero();
+            for (int j = 0; j < n; ++j) {
+                direction_jacobian_ += projector_.middleRows<3>(3 * j);
+                stick_turn_from_tip_step += step_.segment<3>(3 * j);
+            }
+            const Eigen::Vector3d residual =
+                secondary_weight * direction_step - stick_turn_from_tip_step;
+            direction_jjt_.noalias() = direction_jacobian_ * direction_jacobian_.transpose();
+            direction_jjt_.diagonal().array() +=
+                params_.direction_damping * params_.direction_damping;
+            direction_llt_.compute(direction_jjt_);
+            step_.noalias() += direction_jacobian_.transpose() * direction_llt_.solve(residual);
+        }
+
+        // Scale the whole step (keeping its direction) so no joint turns more than the bound.
+        double largest_rad = 0.0;
+        for (int j = 0; j < n; ++j)
+            largest_rad = std::max(largest_rad, step_.segment<3>(3 * j).norm());
+        if (!(largest_rad > 1e-14))
+            break; // stalled: nothing left that the damped step can do
+        if (largest_rad > params_.max_joint_step_rad)
+            step_ *= params_.max_joint_step_rad / largest_rad;
+
+        // A world-frame increment w_j of joint j is the local rotation exp(R_parent^T w_j):
+        // q_j <- R_parent^-1 exp(w_j) R_parent q_j, with R_parent from the current FK. Then
+        // the chain's joint limits.
+        const int candidate = 1 - current;
+        bool candidate_limited = false;
+        for (int j = 0; j < n; ++j) {
+            const Eigen::Quaterniond &parent =
+                j == 0 ? chain.base_rotation() : frames.joint_rotation[j - 1];
+            const Eigen::Vector3d local_step = parent.conjugate() * step_.segment<3>(3 * j);
+            Eigen::Quaterniond q = exp_map(local_step) * rotation_[current][j];
+            q.normalize();
+            const JointLimitRef &limit = chain.limit(j);
+            if (limit.active()) {
+                Eigen::Quaterniond clamped = limit.clamp(q);
+                const double norm = clamped.norm();
+                if (clamped.coeffs().allFinite() && norm > 1e-12) {
+                    clamped.coeffs() /= norm;
+                    // |q.clamped| < 1 unless they are the same rotation (up to sign).
+                    if (std::abs(clamped.dot(q)) < 1.0 - 1e-12)
+                        candidate_limited = true;
+                    q = clamped;
+                }
+            }
+            rotation_[candidate][j] = q;
+        }
+        ++result.iterations;
+
+        chain.forward(rotation_[candidate].data(), &frames_[candidate]);
+        const Eigen::Vector3d candidate_error = target_tip_m - frames_[candidate].tip_position_m;
+        const double candidate_error_m = candidate_error.norm();
+        Eigen::Vector3d candidate_direction_step = Eigen::Vector3d::Zero();
+        const double candidate_direction_error =
+            use_direction
+                ? direction_error(frames_[candidate], direction_target, &candidate_direction_step)
+                : 0.0;
+        // Accept what brings the tip closer, or -- with the tip within tolerance -- turns the
+        // stick closer to its target: the tip is never traded for the direction.
+        const bool accept = candidate_error_m < error_m ||
+                            (use_direction && candidate_error_m <= params_.tolerance_m &&
+                             candidate_direction_error < result.direction_error_rad);
+        limits_active = candidate_limited;
+        if (accept) {
+            current = candidate;
+            error = candidate_error;
+            error_m = candidate_error_m;
+            result.direction_error_rad = candidate_direction_error;
+            direction_step = candidate_direction_step;
+            damping_m = std::max(params_.damping_m, 0.5 * damping_m);
+        } else {
+            damping_m *= 2.0;
+            secondary_weight *= 0.5;
+        }
+    }
+
+    for (int j = 0; j < n; ++j)
+        rotations_out[j] = rotation_[current][j];
+    result.position_error_m = error_m;
+    result.limits_active = limits_active;
+    if (error_m <= params_.tolerance_m) {
+        result.status = IkStatus::converged;
+        return result;
+    }
+
+    // Not there: say why. sigma_min of the final Jacobian, from the 3x3 J J^T in closed form.
+    KinematicChain::tip_jacobian(frames_[current], n, jacobian_);
+    jjt_.noalias() = jacobian_ * jacobian_.transpose();
+    eigen_.computeDirect(jjt_, Eigen::EigenvaluesOnly);
+    result.min_singular_value_m = std::sqrt(std::max(0.0, eigen_.eigenvalues()(0)));
+    const double target_distance_m = (target_tip_m - frames_[current].joint_position_m[0]).norm();
+    if (target_distance_m > chain.reach_m() - params_.tolerance_m)
+        result.status = IkStatus::unreachable;
+    else if (result.limits_active)
+        result.status = IkStatus::joint_limited;
+    else if (result.min_singular_value_m < params_.damping_m)
+        result.status = IkStatus::singular;
+    else
+        result.status = IkStatus::max_iterations;
+    return result;
+}
+
+} // namespace ictus

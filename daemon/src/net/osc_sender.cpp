@@ -1,0 +1,247 @@
+// OSC out: strike bundles and the pose stream (osc_link.hpp, docs/osc.md).
+#include "ictus/net/osc_sender.hpp"
+
+#include <lo/lo.h>
+#include <semaphore.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+
+namespace ictus
+{
+
+// ---- time ---------------------------------------------------------------------
+
+namespace
+{
+constexpr std::uint64_t kNtpUnixOffset = 2208988800ull; // 1900 -> 1970, s
+
+lo_timetag to_lo(NtpTime t)
+{
+    lo_timetag tt;
+    tt.sec = static_cast<std::uint32_t>(t >> 32);
+    tt.frac = static_cast<std::uint32_t>(t & 0xffffffffu);
+    return tt;
+}
+
+// Waits on a semaphore for at most `ms` (the consumers' idle wait: the
+// producers only sem_post, which never blocks).
+void wait_ms(sem_t *sem, long ms)
+{
+    timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    ts.tv_nsec += ms * 1000000L;
+    ts.tv_sec += ts.tv_nsec / 1000000000L;
+    ts.tv_nsec %= 1000000000L;
+    while (sem_timedwait(sem, &ts) == -1 && errno == EINTR) {
+    }
+}
+} // namespace
+
+NtpTime ntp_now()
+{
+    timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    const std::uint64_t sec = static_cast<std::uint64_t>(ts.tv_sec) + kNtpUnixOffset;
+    const std::uint64_t frac = (static_cast<std::uint64_t>(ts.tv_nsec) << 32) / 1000000000ull;
+    return (sec << 32) | frac;
+}
+
+NtpTime ntp_add_seconds(NtpTime t, double seconds)
+{
+    // 2^32 units per second; exact in integers, so strike times keep their
+    // sub-microsecond spacing whatever the epoch.
+    const double units = std::round(seconds * 4294967296.0);
+    return static_cast<NtpTime>(static_cast<std::int64_t>(t) + static_cast<std::int64_t>(units));
+}
+
+double ntp_diff_seconds(NtpTime a, NtpTime b)
+{
+    return static_cast<double>(static_cast<std::int64_t>(a - b)) / 4294967296.0;
+}
+
+// ---- sender -------------------------------------------------------------------
+
+struct OscSender::Impl {
+    lo_address strike_target = nullptr;
+    lo_address pose_target = nullptr;
+    sem_t strike_ready, pose_ready;
+    ~Impl()
+    {
+        if (strike_target)
+            lo_address_free(strike_target);
+        if (pose_target)
+            lo_address_free(pose_target);
+    }
+};
+
+OscSender::OscSender(const OscSenderOptions &options) : impl_(new Impl), options_(options)
+{
+    if (!(std::isfinite(options.lookahead_s) && options.lookahead_s >= 0.0 &&
+          options.lookahead_s <= 10.0))
+        throw OscError("lookahead: expected 0 to 10 s, got " + std::to_string(options.lookahead_s));
+    impl_->strike_target = lo_address_new_from_url(options.target_url.c_str());
+    impl_->pose_target = lo_address_new_from_url(options.target_url.c_str());
+    if (!impl_->strike_target || !impl_->pose_target)
+        throw OscError("target: not an OSC URL: '" + options.target_url +
+                       "' (expected e.g. osc.udp://127.0.0.1:9000)");
+    sem_init(&impl_->strike_ready, 0, 0);
+    sem_init(&impl_->pose_ready, 0, 0);
+    epoch_.store(ntp_now());
+    strike_thread_ = std::thread(&OscSender::strike_loop, this);
+    pose_thread_ = std::thread(&OscSender::pose_loop, this);
+}
+
+OscSender::~OscSender()
+{
+    stop();
+    sem_destroy(&impl_->strike_ready);
+    sem_destroy(&impl_->pose_ready);
+}
+
+void OscSender::stop()
+{
+    if (running_.exchange(false)) {
+        sem_post(&impl_->strike_ready);
+        sem_post(&impl_->pose_ready);
+    }
+    if (strike_thread_.joinable())
+        strike_thread_.join();
+    if (pose_thread_.joinable())
+        pose_thread_.join();
+}
+
+bool OscSender::post_strike(const StrikeEvent &event)
+{
+    if (!strikes_.push(event))
+        return false;
+    sem_post(&impl_->strike_ready);
+    return true;
+}
+
+bool OscSender::post_pose(const PoseSnapshot &pose)
+{
+    if (!poses_.push(pose))
+        return false;
+    sem_post(&impl_->pose_ready);
+    return true;
+}
+
+bool OscSender::post_tip(const TipState &tip)
+{
+    if (!tips_.push(tip))
+        return false;
+    sem_post(&impl_->pose_ready);
+    return true;
+}
+
+OscSenderCounters OscSender::counters() const
+{
+    OscSenderCounters c;
+    c.strikes_sent = strikes_sent_.load();
+    c.poses_sent = poses_sent_.load();
+    c.tips_sent = tips_sent_.load();
+    c.send_errors = send_errors_.load();
+    c.strikes_dropped = strikes_.dropped();
+    c.poses_dropped = poses_.dropped();
+    c.tips_dropped = tips_.dropped();
+    return c;
+}
+
+void OscSender::strike_loop()
+{
+    StrikeEvent e;
+    for (;;) {
+        const bool running = running_.load();
+        while (strikes_.pop(e)) {
+            // The strike sounds at its simulation time plus the lookahead, on
+            // the wall clock that simulation time 0 was anchored to.
+            lo_timetag tt = LO_TT_IMMEDIATE;
+            if (options_.lookahead_s > 0.0)
+                tt = to_lo(ntp_add_seconds(epoch(), e.time_s + options_.lookahead_s));
+            lo_bundle b = lo_bundle_new(tt);
+            lo_message m = lo_message_new();
+            for (StrikeField f : kOscStrikeFields) {
+                if (strike_field_info(f).integer)
+                    lo_message_add_int32(m, static_cast<std::int32_t>(strike_field_integer(e, f)));
+                else
+                    lo_message_add_float(m, static_cast<float>(strike_field(e, f)));
+            }
+            lo_bundle_add_message(b, "/ictus/strike", m);
+            if (lo_send_bundle(impl_->strike_target, b) < 0)
+                send_errors_.fetch_add(1);
+            else
+                strikes_sent_.fetch_add(1);
+            lo_bundle_free_recursive(b);
+        }
+        if (!running)
+            return;
+        wait_ms(&impl_->strike_ready, 100);
+    }
+}
+
+void OscSender::pose_loop()
+{
+    PoseSnapshot p;
+    TipState t;
+    for (;;) {
+        const bool running = running_.load();
+        while (poses_.pop(p)) {
+            // One bundle per frame, "immediately": graphics draws the latest.
+            lo_bundle b = lo_bundle_new(LO_TT_IMMEDIATE);
+            lo_message frame = lo_message_new();
+            lo_message_add_float(frame, static_cast<float>(p.time_s));
+            lo_bundle_add_message(b, "/ictus/pose/frame", frame);
+            for (int i = 0; i < p.bodies && i < PoseSnapshot::kMaxBodies; ++i) {
+                lo_message m = lo_message_new();
+                lo_message_add_int32(m, i);
+                for (float v : p.position_m[i])
+                    lo_message_add_float(m, v);
+                for (float v : p.rotation_wxyz[i])
+                    lo_message_add_float(m, v);
+                lo_bundle_add_message(b, "/ictus/pose/body", m);
+            }
+            for (int hand = 0; hand < 2; ++hand) {
+                lo_message m = lo_message_new();
+                lo_message_add_int32(m, hand);
+                for (float v : p.stick_tip_m[hand])
+                    lo_message_add_float(m, v);
+                for (float v : p.stick_butt_m[hand])
+                    lo_message_add_float(m, v);
+                lo_bundle_add_message(b, "/ictus/pose/stick", m);
+            }
+            lo_message d = lo_message_new();
+            lo_message_add_int32(d, 0);
+            for (float v : p.drum_center_m)
+                lo_message_add_float(d, v);
+            lo_message_add_float(d, p.drum_radius_m);
+            lo_bundle_add_message(b, "/ictus/pose/drum", d);
+            if (lo_send_bundle(impl_->pose_target, b) < 0)
+                send_errors_.fetch_add(1);
+            else
+                poses_sent_.fetch_add(1);
+            lo_bundle_free_recursive(b);
+        }
+        while (tips_.pop(t)) {
+            lo_message m = lo_message_new();
+            lo_message_add_int32(m, t.hand);
+            for (float v : t.position_m)
+                lo_message_add_float(m, v);
+            for (float v : t.velocity_mps)
+                lo_message_add_float(m, v);
+            lo_message_add_float(m, static_cast<float>(t.time_s));
+            if (lo_send_message(impl_->pose_target, "/ictus/tip", m) < 0)
+                send_errors_.fetch_add(1);
+            else
+                tips_sent_.fetch_add(1);
+            lo_message_free(m);
+        }
+        if (!running)
+            return;
+        wait_ms(&impl_->pose_ready, 100);
+    }
+}
+
+} // namespace ictus

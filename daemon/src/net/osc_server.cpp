@@ -1,0 +1,480 @@
+// OSC in: Pd (or anything that speaks OSC) controls the daemon (osc_link.hpp,
+// docs/osc.md). A plain UDP socket of our own, so that the bind address, the
+// peer allow-list and the packet size are checked before any parsing; liblo
+// deserialises and validates each message; handlers check the type tags and
+// the values, queue a Command for the physics thread and reply over OSC.
+#include "ictus/net/osc_server.hpp"
+
+#include <lo/lo.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+namespace ictus
+{
+
+namespace
+{
+
+// liblo's argument pointers are only 4-byte aligned, while lo_arg (a union
+// with 64-bit members) asks for 8: read the bytes, never the union member.
+float lo_arg_float(const lo_arg *a)
+{
+    float f;
+    std::memcpy(&f, a, sizeof f);
+    return f;
+}
+int32_t lo_arg_int(const lo_arg *a)
+{
+    int32_t i;
+    std::memcpy(&i, a, sizeof i);
+    return i;
+}
+const char *lo_arg_string(const lo_arg *a)
+{
+    return reinterpret_cast<const char *>(a);
+}
+
+struct Counters {
+    std::atomic<unsigned long> packets{0}, accepted{0}, unknown_address{0}, bad_type_tags{0},
+        bad_values{0}, malformed{0}, oversized{0}, refused_peers{0}, bundles{0}, queue_full{0},
+        replies{0}, errors_sent{0}, score_lines{0};
+};
+
+bool parse_ipv4(const std::string &text, in_addr &out)
+{
+    return inet_pton(AF_INET, text.c_str(), &out) == 1;
+}
+
+} // namespace
+
+struct OscServer::Impl {
+    int fd = -1;
+    std::vector<in_addr> allow;
+    bool reply_fixed = false;
+    sockaddr_in reply_to{};
+    Counters counters;
+    // Rate-limited log: at most one line per second, with the count of the
+    // lines suppressed since.
+    std::chrono::steady_clock::time_point last_log{};
+    unsigned long suppressed = 0;
+    unsigned char buffer[65536 + 1];
+    ~Impl()
+    {
+        if (fd >= 0)
+            close(fd);
+    }
+    void log(const char *what, const std::string &detail)
+    {
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_log < std::chrono::seconds(1)) {
+            ++suppressed;
+            return;
+        }
+        if (suppressed)
+            std::fprintf(stderr, "ictusd: osc: (%lu similar lines suppressed)\n", suppressed);
+        suppressed = 0;
+        last_log = now;
+        std::fprintf(stderr, "ictusd: osc: %s: %s\n", what, detail.c_str());
+    }
+};
+
+OscServer::OscServer(const OscServerOptions &options, LiveStatus *status)
+    : impl_(new Impl), options_(options), status_(status)
+{
+    in_addr bind_addr;
+    if (!parse_ipv4(options.bind_address, bind_addr))
+        throw OscError("--bind: expected a numeric IPv4 address, got '" + options.bind_address +
+                       "'");
+    if (options.port < 0 || options.port > 65535)
+        throw OscError("--port: expected 0 to 65535, got " + std::to_string(options.port));
+    if (options.max_packet_bytes < 64 || options.max_packet_bytes > 65536)
+        throw OscError("max packet size: expected 64 to 65536 bytes");
+    for (const std::string &a : options.allow) {
+        in_addr ia;
+        if (!parse_ipv4(a, ia))
+            throw OscError("--allow: expected numeric IPv4 addresses, got '" + a + "'");
+        impl_->allow.push_back(ia);
+    }
+    if (!options.reply_url.empty()) {
+        char *host = lo_url_get_hostname(options.reply_url.c_str());
+        char *port = lo_url_get_port(options.reply_url.c_str());
+        const bool ok = host && port && parse_ipv4(host, impl_->reply_to.sin_addr) &&
+                        std::atoi(port) > 0 && std::atoi(port) < 65536;
+        if (ok) {
+            impl_->reply_to.sin_family = AF_INET;
+            impl_->reply_to.sin_port = htons(static_cast<uint16_t>(std::atoi(port)));
+        }
+        std::free(host);
+        std::free(port);
+        if (!ok)
+            throw OscError("--reply: expected osc.udp://IPV4:PORT, got '" + options.reply_url +
+                           "'");
+        impl_->reply_fixed = true;
+    }
+    impl_->fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    if (impl_->fd < 0)
+        throw OscError(std::string("socket: ") + std::strerror(errno));
+    // Room for bursts (Pd sending a score): the kernel caps it at rmem_max.
+    int rcvbuf = 1 << 20;
+    setsockopt(impl_->fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
+    sockaddr_in sa{};
+    sa.sin_family = AF_INET;
+    sa.sin_addr = bind_addr;
+    sa.sin_port = htons(static_cast<uint16_t>(options.port));
+    if (bind(impl_->fd, reinterpret_cast<sockaddr *>(&sa), sizeof sa) != 0)
+        throw OscError("--bind/--port: cannot bind " + options.bind_address + ":" +
+                       std::to_string(options.port) + ": " + std::strerror(errno));
+    socklen_t len = sizeof sa;
+    getsockname(impl_->fd, reinterpret_cast<sockaddr *>(&sa), &len);
+    port_ = ntohs(sa.sin_port);
+    thread_ = std::thread(&OscServer::loop, this);
+}
+
+OscServer::~OscServer()
+{
+    stop();
+}
+
+void OscServer::stop()
+{
+    running_.store(false);
+    if (thread_.joinable())
+        thread_.join();
+}
+
+OscServerCounters OscServer::counters() const
+{
+    const Counters &c = impl_->counters;
+    OscServerCounters o;
+    o.packets = c.packets;
+    o.accepted = c.accepted;
+    o.unknown_address = c.unknown_address;
+    o.bad_type_tags = c.bad_type_tags;
+    o.bad_values = c.bad_values;
+    o.malformed = c.malformed;
+    o.oversized = c.oversized;
+    o.refused_peers = c.refused_peers;
+    o.bundles = c.bundles;
+    o.queue_full = c.queue_full;
+    o.replies = c.replies;
+    o.errors_sent = c.errors_sent;
+    o.score_lines = c.score_lines;
+    return o;
+}
+
+void OscServer::loop()
+{
+    pollfd pfd{impl_->fd, POLLIN, 0};
+    while (running_.load()) {
+        // A short poll so that stop() is seen within 50 ms.
+        if (poll(&pfd, 1, 50) <= 0)
+            continue;
+        sockaddr_in peer{};
+        socklen_t len = sizeof peer;
+        // MSG_TRUNC: the real length of a datagram longer than the buffer.
+        const ssize_t n = recvfrom(impl_->fd, impl_->buffer, sizeof impl_->buffer, MSG_TRUNC,
+                                   reinterpret_cast<sockaddr *>(&peer), &len);
+        if (n < 0)
+            continue;
+        handle(impl_->buffer, static_cast<std::size_t>(n), &peer);
+        // Counted once handled: a reader that sees N packets sees their
+        // categories counted too.
+        impl_->counters.packets++;
+    }
+}
+
+namespace
+{
+
+struct Reply {
+    int fd;
+    const sockaddr_in *to;
+    Counters *counters;
+    void send(const char *path, lo_message m)
+    {
+        unsigned char buf[1024];
+        std::size_t size = sizeof buf;
+        if (lo_message_length(m, path) <= sizeof buf &&
+            lo_message_serialise(m, path, buf, &size) != nullptr)
+            sendto(fd, buf, size, 0, reinterpret_cast<const sockaddr *>(to), sizeof *to);
+        lo_message_free(m);
+    }
+    void error(const char *address, const std::string &text)
+    {
+        lo_message m = lo_message_new();
+        lo_message_add_string(m, address);
+        lo_message_add_string(m, text.c_str());
+        send("/ictus/error", m);
+        counters->errors_sent++;
+    }
+    void ok(const char *address, lo_message extra = nullptr)
+    {
+        lo_message m = extra ? extra : lo_message_new();
+        // The replied-to address first: rebuild with it in front.
+        lo_message r = lo_message_new();
+        lo_message_add_string(r, address);
+        const int argc = lo_message_get_argc(m);
+        const char *types = lo_message_get_types(m);
+        lo_arg **argv = lo_message_get_argv(m);
+        for (int i = 0; i < argc; ++i) {
+            switch (types[i]) {
+            case 'f':
+                lo_message_add_float(r, lo_arg_float(argv[i]));
+                break;
+            case 'i':
+                lo_message_add_int32(r, lo_arg_int(argv[i]));
+                break;
+            case 's':
+                lo_message_add_string(r, lo_arg_string(argv[i]));
+                break;
+            default:
+                break;
+            }
+        }
+        lo_message_free(m);
+        send("/ictus/reply", r);
+        counters->replies++;
+    }
+};
+
+// The commands: address, type tags, and what a value must be.
+struct Spec {
+    const char *address;
+    const char *types;
+    CommandKind kind;
+    double lo, hi; // range of the first float
+    const char *what;
+};
+
+const Spec kSpecs[] = {
+    {"/ictus/play", "", CommandKind::play, 0, 0, ""},
+    {"/ictus/stop", "", CommandKind::stop, 0, 0, ""},
+    {"/ictus/tempo", "f", CommandKind::tempo, 20.0, 400.0, "tempo (bpm)"},
+    {"/ictus/grip", "s", CommandKind::grip, 0, 0, "grip"},
+    {"/ictus/nuance", "s", CommandKind::nuance, 0, 0, "nuance"},
+    {"/ictus/mode", "s", CommandKind::mode, 0, 0, "mode"},
+    {"/ictus/gains", "ff", CommandKind::gains, 0.05, 4.0, "gain scale"},
+    {"/ictus/drum/radius", "f", CommandKind::drum_radius, 0.05, 1.0, "drum radius (m)"},
+    {"/ictus/drum/tension", "f", CommandKind::drum_tension, 10.0, 1e5, "drum tension (N/m)"},
+    {"/ictus/drum/density", "f", CommandKind::drum_density, 0.01, 10.0, "drum density (kg/m^2)"},
+    {"/ictus/score", "s", CommandKind::score, 0, 0, "score statement"},
+    {"/ictus/score/clear", "", CommandKind::score_clear, 0, 0, ""},
+};
+
+bool one_of(const char *text, std::initializer_list<const char *> words)
+{
+    for (const char *w : words)
+        if (std::strcmp(text, w) == 0)
+            return true;
+    return false;
+}
+
+// Why a score statement cannot be queued, or "" when it can. The score's own
+// syntax is the physics thread's business (its parser names the fault's
+// position); here only what would not survive the trip: the length of
+// Command::text and characters that would split the line or the log.
+std::string score_statement_problem(const char *text, std::size_t length)
+{
+    if (length == 0)
+        return "score statement: empty (send one statement, e.g. \"R legato\")";
+    if (length >= Command::kMaxText)
+        return "score statement: " + std::to_string(length) + " characters exceed the limit of " +
+               std::to_string(Command::kMaxText - 1) + " (send one statement per message)";
+    for (std::size_t i = 0; i < length; ++i) {
+        const unsigned char ch = static_cast<unsigned char>(text[i]);
+        if ((ch < 0x20 && ch != '\t') || ch == 0x7f)
+            return "score statement: control character " + std::to_string(ch) + " at column " +
+                   std::to_string(i + 1) + " (one line per message)";
+    }
+    return "";
+}
+
+std::string format_range(const Spec &s, double v)
+{
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s: expected %g to %g, got %g", s.what, s.lo, s.hi, v);
+    return buf;
+}
+
+} // namespace
+
+void OscServer::handle(const unsigned char *data, std::size_t size, const void *peer_ptr)
+{
+    const sockaddr_in &peer = *static_cast<const sockaddr_in *>(peer_ptr);
+    Impl &im = *impl_;
+    Counters &c = im.counters;
+    if (!im.allow.empty()) {
+        bool allowed = false;
+        for (const in_addr &a : im.allow)
+            allowed = allowed || a.s_addr == peer.sin_addr.s_addr;
+        if (!allowed) {
+            // No reply to a stranger: that would make us a reflector.
+            c.refused_peers++;
+            char ip[INET_ADDRSTRLEN];
+            inet_ntop(AF_INET, &peer.sin_addr, ip, sizeof ip);
+            im.log("refused peer", ip);
+            return;
+        }
+    }
+    Reply reply{im.fd, im.reply_fixed ? &im.reply_to : &peer, &c};
+    if (size > options_.max_packet_bytes) {
+        c.oversized++;
+        im.log("oversized packet", std::to_string(size) + " bytes");
+        reply.error("", "packet of " + std::to_string(size) + " bytes exceeds the limit of " +
+                            std::to_string(options_.max_packet_bytes));
+        return;
+    }
+    if (size >= 8 && std::memcmp(data, "#bundle", 8) == 0) {
+        c.bundles++;
+        im.log("bundle", "bundles are not accepted");
+        reply.error("#bundle", "bundles are not accepted: send plain messages");
+        return;
+    }
+    // liblo checks the whole packet: padding, type tags, argument sizes.
+    int result = 0;
+    std::vector<unsigned char> copy(data, data + size); // liblo may swap bytes in place
+    lo_message m = lo_message_deserialise(copy.data(), size, &result);
+    if (!m) {
+        c.malformed++;
+        im.log("malformed packet",
+               std::to_string(size) + " bytes, liblo error " + std::to_string(result));
+        reply.error("", "malformed OSC packet (liblo error " + std::to_string(result) + ")");
+        return;
+    }
+    // The path is the packet's first string; deserialise validated it.
+    const char *path = reinterpret_cast<const char *>(copy.data());
+    const char *types = lo_message_get_types(m);
+    lo_arg **argv = lo_message_get_argv(m);
+    struct Free {
+        lo_message m;
+        ~Free() { lo_message_free(m); }
+    } free_m{m};
+
+    if (std::strcmp(path, "/ictus/ping") == 0) {
+        if (types[0] != '\0') {
+            c.bad_type_tags++;
+            reply.error(path, std::string("type tags: expected none, got ,") + types);
+            return;
+        }
+        c.accepted++;
+        lo_message pong = lo_message_new();
+        reply.send("/ictus/pong", pong);
+        c.replies++;
+        return;
+    }
+    if (std::strcmp(path, "/ictus/status") == 0) {
+        if (types[0] != '\0') {
+            c.bad_type_tags++;
+            reply.error(path, std::string("type tags: expected none, got ,") + types);
+            return;
+        }
+        c.accepted++;
+        lo_message s = lo_message_new();
+        lo_message_add_float(s, status_ ? static_cast<float>(status_->time_s.load()) : 0.0f);
+        lo_message_add_int32(s, status_ ? status_->playing.load() : 0);
+        lo_message_add_float(s, status_ ? static_cast<float>(status_->tempo_bpm.load()) : 0.0f);
+        lo_message_add_int32(s, status_ ? static_cast<int>(status_->strikes.load()) : 0);
+        lo_message_add_int32(s, static_cast<int>(c.packets.load()));
+        lo_message_add_int32(s, static_cast<int>(c.accepted.load()));
+        const OscServerCounters snap = counters();
+        lo_message_add_int32(s, static_cast<int>(snap.errors()));
+        lo_message_add_int32(s, static_cast<int>(c.refused_peers.load()));
+        lo_message_add_int32(s, status_ ? static_cast<int>(status_->overruns.load()) : 0);
+        reply.ok(path, s);
+        return;
+    }
+    for (const Spec &s : kSpecs) {
+        if (std::strcmp(path, s.address) != 0)
+            continue;
+        if (std::strcmp(types, s.types) != 0) {
+            c.bad_type_tags++;
+            im.log("wrong type tags", std::string(path) + " ," + types);
+            reply.error(path, std::string("type tags: expected ,") + s.types + ", got ," + types);
+            return;
+        }
+        Command cmd;
+        cmd.kind = s.kind;
+        if (s.types[0] == 'f') {
+            cmd.value = lo_arg_float(argv[0]);
+            if (!(std::isfinite(cmd.value) && cmd.value >= s.lo && cmd.value <= s.hi)) {
+                c.bad_values++;
+                reply.error(path, format_range(s, cmd.value));
+                return;
+            }
+            if (s.types[1] == 'f') {
+                cmd.value2 = lo_arg_float(argv[1]);
+                if (!(std::isfinite(cmd.value2) && cmd.value2 >= s.lo && cmd.value2 <= s.hi)) {
+                    c.bad_values++;
+                    reply.error(path, format_range(s, cmd.value2));
+                    return;
+                }
+            }
+        } else if (s.types[0] == 's') {
+            const char *text = lo_arg_string(argv[0]);
+            // liblo checked the string's terminator inside the packet; the
+            // packet limit bounds its length.
+            const std::size_t length = std::strlen(text);
+            std::string problem;
+            if (s.kind == CommandKind::score) {
+                problem = score_statement_problem(text, length);
+            } else {
+                bool ok = false;
+                std::string expected;
+                if (s.kind == CommandKind::grip) {
+                    ok = one_of(text, {"french", "german"});
+                    expected = "french or german";
+                } else if (s.kind == CommandKind::nuance) {
+                    ok =
+                        one_of(text, {"legato", "tenuto", "accent", "vertical_accent", "staccato"});
+                    expected = "legato, tenuto, accent, vertical_accent or staccato";
+                } else if (s.kind == CommandKind::mode) {
+                    ok = one_of(text, {"joint", "cartesian"});
+                    expected = "joint or cartesian";
+                }
+                if (!ok)
+                    problem = std::string(s.what) + ": expected " + expected + ", got '" +
+                              std::string(text, std::min<std::size_t>(length, 40)) + "'";
+            }
+            if (!problem.empty()) {
+                c.bad_values++;
+                reply.error(path, problem);
+                return;
+            }
+            std::memcpy(cmd.text, text, length + 1); // fits: checked above
+        }
+        if (!commands_.push(cmd)) {
+            c.queue_full++;
+            reply.error(path, "command queue full (the physics thread is not reading)");
+            return;
+        }
+        c.accepted++;
+        if (s.kind == CommandKind::score)
+            c.score_lines++;
+        lo_message echo = lo_message_new();
+        for (int i = 0; types[i]; ++i) {
+            if (types[i] == 'f')
+                lo_message_add_float(echo, lo_arg_float(argv[i]));
+            else if (types[i] == 's')
+                lo_message_add_string(echo, lo_arg_string(argv[i]));
+        }
+        reply.ok(path, echo);
+        return;
+    }
+    c.unknown_address++;
+    std::string shown(path, strnlen(path, 80));
+    im.log("unknown address", shown);
+    reply.error(path, "unknown address (see docs/osc.md)");
+}
+
+} // namespace ictus

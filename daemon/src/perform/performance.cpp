@@ -1,0 +1,733 @@
+// The physics side of `ictusd run` and `ictusd render` (verbs_osc.hpp): the
+// character tracks the clip in joint space (eq. 1, the sim helper's Scene) or
+// performs a score's gesture plan (Tracker: Algorithm 2 or joint targets from
+// IK), and the interaction manager watches the stick tips against the drum.
+// Score mode is described in docs/perform.md.
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/character/character_limits.hpp"
+#include "ictus/character/stick_capture.hpp"
+#include "ictus/perform/track.hpp"
+#include "ictus/perform/tracker.hpp"
+#include "ictus/perform/performance.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <iostream>
+#include <limits>
+
+namespace ictus
+{
+
+namespace
+{
+double median(std::vector<double> v)
+{
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+// Where the clip strikes: the reference stick tips' local minima of height
+// reached at more than 1 m/s downwards (the mimed strokes; a captured
+// performance without a drum still "hits" a plane). The membrane goes at the
+// median of those points, so that about half of the mimed strokes reach it
+// and are stopped by it. (track.hpp's auto_drum_center puts the drum under
+// the lowest tips, which in a mimed clip are in the rest pose, not in a stroke.)
+Eigen::Vector3d strike_drum_center(const CharacterModel &model, const ReferenceMotion &reference,
+                                   const Eigen::Vector3d &fallback)
+{
+    const int frames = reference.frames();
+    std::vector<std::array<Eigen::Vector3d, 2>> tips(static_cast<size_t>(frames));
+    for (int f = 0; f < frames; ++f)
+        tips[static_cast<size_t>(f)] = reference_tips(model, reference.frame(f));
+    std::vector<double> xs, ys, zs;
+    const double rate = reference.frame_rate_hz();
+    for (int hand = 0; hand < 2; ++hand)
+        for (int f = 2; f + 2 < frames; ++f) {
+            auto y = [&](int g) { return tips[static_cast<size_t>(g)][hand].y(); };
+            const bool minimum =
+                y(f) < y(f - 1) && y(f) <= y(f + 1) && y(f) < y(f - 2) && y(f) <= y(f + 2);
+            const double approach_mps = (y(f - 2) - y(f)) * rate / 2.0;
+            if (minimum && approach_mps > 1.0) {
+                xs.push_back(tips[static_cast<size_t>(f)][hand].x());
+                ys.push_back(y(f));
+                zs.push_back(tips[static_cast<size_t>(f)][hand].z());
+            }
+        }
+    if (xs.size() < 4)
+        return fallback;
+    return Eigen::Vector3d(median(xs), median(ys), median(zs));
+}
+} // namespace
+
+// Clip mode: everything that depends on the grip or the drum, rebuilt together
+// when they change (the tracker's Scene keeps references to the limits, which
+// are declared first and so outlive it).
+struct Performance::Rig {
+    CharacterModel model;
+    ReferenceMotion reference;
+    CharacterLimits limits;
+    std::vector<JointGains> base_gains, gains;
+    std::unique_ptr<Tracker> tracker;
+    // Per-step scratch, sized once (no allocation in the loop).
+    CharacterPose ref_pose, step_pose;
+    Rig(const CharacterModel &m, const Motion &motion)
+        : model(m), reference(model, motion, ReferenceFilter{}), limits(model, reference)
+    {
+    }
+};
+
+// The character, its controller and the drum of score mode, rebuilt together
+// when the grip or the drum changes (a Scene has no setters for them).
+struct Performance::ScoreRig {
+    CharacterModel model;
+    std::vector<JointGains> base_gains, gains;
+    std::unique_ptr<Tracker> tracker;
+    CharacterPose body; // the reference held by the trunk and legs (arms: IK)
+    PerformerFrame frame;
+    TipTargets tips;
+    explicit ScoreRig(const CharacterModel &m) : model(m) {}
+};
+
+Performance::Performance(const PerformanceOptions &options)
+    : options_(options), detector_(MembraneGeometry{}, options.strikes)
+{
+    validate(options_.scene);
+    if (!(options_.clip_bpm > 0.0 && std::isfinite(options_.clip_bpm)))
+        throw CharacterError("clip tempo: expected a finite value > 0 bpm");
+    if (!(options_.tempo_bpm >= 20.0 && options_.tempo_bpm <= 400.0))
+        throw CharacterError("tempo: expected 20 to 400 bpm");
+    if (!score_mode()) {
+        // Read once: a rebuild (grip change at /ictus/play) starts from this copy,
+        // so that the physics thread never touches the disk.
+        BvhOptions bo;
+        bo.scale = options_.scale_m_per_unit;
+        bo.skip_frames = options_.skip_frames;
+        MocapWarnings warnings;
+        clip_ = std::make_unique<BvhFile>(read_bvh(options_.mocap, bo, &warnings));
+        for (const std::string &w : warnings)
+            std::cerr << "ictusd: warning: " << w << "\n";
+        build();
+        return;
+    }
+    const ScorePerformOptions &so = options_.score;
+    if (!(std::isfinite(so.time_advance_s) && so.time_advance_s >= 0.0 && so.time_advance_s <= 0.1))
+        throw CharacterError("time advance: expected 0 to 0.1 s");
+    if (!(std::isfinite(so.drum_forward_m) && std::abs(so.drum_forward_m) <= 2.0 &&
+          std::isfinite(so.drum_below_m) && std::abs(so.drum_below_m) <= 2.0))
+        throw CharacterError("drum placement: expected offsets within 2 m");
+    db_ = std::make_unique<GestureDatabase>(
+        so.gestures.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(so.gestures));
+    builder_ = std::make_unique<ScoreBuilder>("osc");
+    score_ = std::make_unique<Score>(
+        parse_score(so.score_text.empty() ? default_score_text() : so.score_text, so.score_name));
+    if (!so.grip_given && !score_->notes.empty())
+        options_.character.grip = score_->notes.front().grip;
+    build_score(false);
+    playing_ = false;
+}
+
+Performance::~Performance() = default;
+
+void Performance::build()
+{
+    const BvhFile &bvh = *clip_;
+    const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton, options_.character);
+    const double previous_time = rig_ ? time_s() : 0.0;
+    skeleton_ = bvh.skeleton;
+    if (rig_)
+        divergences_before_ += rig_->tracker->scene().divergences();
+    rig_.reset(new Rig(model, bvh.motion));
+    Rig &r = *rig_;
+    if (options_.drum_auto)
+        options_.scene.drum.center_m =
+            strike_drum_center(r.model, r.reference, auto_drum_center(r.model, r.reference));
+    const CharacterPose initial = r.reference.frame(0);
+    r.base_gains = default_gains(r.model, initial, options_.gains);
+    scale_gains(r.base_gains, gain_scale_, r.gains);
+    // Eq. 1 on every joint: the tracker's joint mode, as `ictusd track --mode joint`.
+    r.tracker = std::make_unique<Tracker>(r.model, options_.scene, initial, r.gains,
+                                          r.limits.refs(), TrackMode::joint);
+    r.ref_pose = initial;
+    r.step_pose = initial;
+    // The simulation clock keeps running across rebuilds (strike times and
+    // timetags stay monotonic); the clip restarts from its beginning.
+    time_offset_s_ = previous_time;
+    clip_time_s_ = 0.0;
+    detector_.reset(membrane_of(scene()));
+}
+
+// Clip mode: the live scene's drum changes at once (Scene::set_drum), and the
+// strike detector watches the new membrane from its next contact on.
+void Performance::apply_drum_now()
+{
+    rig_->tracker->scene().set_drum(options_.scene.drum);
+    detector_.set_membrane(membrane_of(scene()));
+}
+
+const CharacterModel &Performance::model() const
+{
+    return rig_ ? rig_->model : score_rig_->model;
+}
+
+const Scene &Performance::scene() const
+{
+    return rig_ ? rig_->tracker->scene() : score_rig_->tracker->scene();
+}
+
+double Performance::time_s() const
+{
+    return time_offset_s_ + scene().time_s();
+}
+
+double Performance::clip_duration_s() const
+{
+    if (!rig_)
+        return plan_ ? plan_->duration_s : 0.0;
+    return rig_->reference.duration_s() * options_.clip_bpm / options_.tempo_bpm;
+}
+
+int Performance::divergences() const
+{
+    return divergences_before_ + scene().divergences();
+}
+
+int Performance::step(StrikeEvent out[2])
+{
+    if (!rig_)
+        return step_score(out);
+    Rig &r = *rig_;
+    const double h = options_.scene.step_s;
+    if (playing_)
+        clip_time_s_ += h * options_.tempo_bpm / options_.clip_bpm;
+    const double since_build = r.tracker->scene().time_s() + h;
+    // Targets for the end of this step, blended in from the first frame.
+    r.reference.sample(clip_time_s_, r.ref_pose);
+    blend_pose(r.reference.frame(0), r.ref_pose, ramp_weight(since_build, options_.ramp_s),
+               r.step_pose);
+    r.tracker->step(r.step_pose, nullptr);
+    return detect_strikes(detector_, r.tracker->scene(), out, time_offset_s_);
+}
+
+bool Performance::apply(const Command &c, std::string *why)
+{
+    if (score_mode())
+        return apply_score(c, why);
+    auto fail = [&](const std::string &text) {
+        if (why)
+            *why = text;
+        return false;
+    };
+    switch (c.kind) {
+    case CommandKind::play:
+        if (rebuild_pending_) {
+            // Grip or drum changed while stopped or playing: the character and
+            // the drum are rebuilt at the clip's first frame (a Scene has no
+            // setters for them).
+            rebuild_pending_ = false;
+            build();
+        }
+        playing_ = true;
+        return true;
+    case CommandKind::stop:
+        playing_ = false;
+        return true;
+    case CommandKind::tempo:
+        options_.tempo_bpm = c.value;
+        return true;
+    case CommandKind::grip:
+        options_.character.grip = grip_from_string(c.text);
+        rebuild_pending_ = true;
+        return true;
+    case CommandKind::nuance:
+        return fail("nuance: a clip has no nuances; without --mocap the daemon plays scores, whose "
+                    "notes name their nuance (/ictus/score \"R accent\")");
+    case CommandKind::mode:
+        if (std::strcmp(c.text, "joint") != 0)
+            return fail("mode: only joint is implemented");
+        return true;
+    case CommandKind::gains: {
+        gain_scale_[0] = c.value;
+        gain_scale_[1] = c.value2;
+        Rig &r = *rig_;
+        scale_gains(r.base_gains, gain_scale_, r.gains);
+        r.tracker->scene().set_gains(r.gains);
+        return true;
+    }
+    case CommandKind::drum_radius:
+        if (!(c.value > rig_->model.options().stick.tip_radius_m * 2.0))
+            return fail("drum radius: must exceed the stick tip's diameter");
+        options_.scene.drum.radius_m = c.value;
+        apply_drum_now();
+        return true;
+    case CommandKind::drum_tension:
+        options_.scene.drum.tension_n_per_m = c.value;
+        apply_drum_now();
+        return true;
+    case CommandKind::drum_density:
+        // The membrane's density changes its modes (membrane~), not the
+        // contact stiffness 2 pi T / ln(R / r): nothing to rebuild.
+        options_.drum_density_kg_per_m2 = c.value;
+        return true;
+    case CommandKind::score:
+    case CommandKind::score_clear:
+        return fail("score: the daemon plays a clip (--mocap); start it without --mocap to "
+                    "perform scores");
+    }
+    return fail("unknown command");
+}
+
+void Performance::pose(PoseSnapshot &p) const
+{
+    const CharacterModel &model = this->model();
+    BodyFrames &frames = frames_;
+    scene().body_frames(frames);
+    p.time_s = time_s();
+    p.bodies = std::min<int>(CharacterModel::kBodies, PoseSnapshot::kMaxBodies);
+    for (int b = 0; b < p.bodies; ++b) {
+        for (int i = 0; i < 3; ++i)
+            p.position_m[b][i] = static_cast<float>(frames.origin_m[b][i]);
+        const Eigen::Quaterniond &q = frames.rotation[b];
+        p.rotation_wxyz[b][0] = static_cast<float>(q.w());
+        p.rotation_wxyz[b][1] = static_cast<float>(q.x());
+        p.rotation_wxyz[b][2] = static_cast<float>(q.y());
+        p.rotation_wxyz[b][3] = static_cast<float>(q.z());
+    }
+    for (int hand = 0; hand < 2; ++hand) {
+        const Side side = static_cast<Side>(hand);
+        const int hb = model.hand_body(side);
+        const StickInHand &st = model.stick(side);
+        const Eigen::Vector3d tip = frames.origin_m[hb] + frames.rotation[hb] * st.tip_m;
+        const Eigen::Vector3d butt = frames.origin_m[hb] + frames.rotation[hb] * st.butt_m;
+        for (int i = 0; i < 3; ++i) {
+            p.stick_tip_m[hand][i] = static_cast<float>(tip[i]);
+            p.stick_butt_m[hand][i] = static_cast<float>(butt[i]);
+        }
+    }
+    for (int i = 0; i < 3; ++i)
+        p.drum_center_m[i] = static_cast<float>(options_.scene.drum.center_m[i]);
+    p.drum_radius_m = static_cast<float>(options_.scene.drum.radius_m);
+}
+
+void Performance::tip(int hand, TipState &out) const
+{
+    const Side side = static_cast<Side>(hand & 1);
+    out.time_s = time_s();
+    out.hand = hand & 1;
+    const Eigen::Vector3d p = scene().tip_position(side);
+    const Eigen::Vector3d v = scene().tip_velocity(side);
+    for (int i = 0; i < 3; ++i) {
+        out.position_m[i] = static_cast<float>(p[i]);
+        out.velocity_mps[i] = static_cast<float>(v[i]);
+    }
+}
+
+// ---- score mode (docs/perform.md) ---------------------------------------------
+
+namespace
+{
+// The stick-tip sits this far above the membrane plane when its bead touches
+// it: the bead's centre is one tip radius above, the end point a further
+// r * (stick axis . up) (the stick points down at the head, so less than 2 r).
+// The plan's strike points are raised by it, so that the planned tip target
+// on the beat is the tip at first contact (strike_depth_m is then measured
+// from the contact, not from the plane).
+double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_world)
+{
+    return tip_radius_m * (1.0 + stick_dir_world.normalized().y());
+}
+} // namespace
+
+ScorePerformOptions::ScorePerformOptions()
+{
+    // Measured in docs/perform.md: the target dips this far below the first
+    // contact on each beat, and is sampled the controller's lag ahead.
+    plan.strike_depth_m = 0.004;
+    time_advance_s = 0.0;
+    // Algorithm 2 for strokes: `ictusd track`'s CMU-tuned velocity term
+    // (c = 0.1 s) feeds the 1 kHz tip velocity back and makes the tip chatter
+    // at strike speeds (impact speeds +-20 % off the plan, not monotonic in
+    // the dynamics); without it and with gain 4 they are within ~1 %.
+    cartesian.gain = 4.0;
+    cartesian.velocity_gain_s = 0.0;
+}
+
+void Performance::build_score(bool keep_pose)
+{
+    // The default body (stick_capture.hpp), standing with the hips 0.9 m up,
+    // pelvis welded, facing +Z.
+    const Skeleton skeleton = default_skeleton();
+    Motion motion;
+    motion.frame_rate_hz = 100.0;
+    motion.root_position_m.push_back(Eigen::Vector3d(0.0, 0.9, 0.0));
+    motion.local_rotation.emplace_back(skeleton.joints.size(), Eigen::Quaterniond::Identity());
+    const CharacterModel model = CharacterModel::from_skeleton(skeleton, options_.character);
+    const double previous_time = score_rig_ ? time_s() : 0.0;
+    skeleton_ = skeleton;
+    std::vector<Eigen::Quaterniond> previous_local;
+    if (score_rig_) {
+        divergences_before_ += score_rig_->tracker->scene().divergences();
+        if (keep_pose)
+            score_rig_->tracker->scene().local_rotations(previous_local);
+    }
+    auto rig = std::make_unique<ScoreRig>(model);
+    ScoreRig &r = *rig;
+    r.body = model.pose_from_motion(motion, 0);
+
+    // The drum in front of the performer: from the midpoint of the shoulders,
+    // drum_forward_m along the facing direction and drum_below_m down, unless
+    // a centre was given.
+    BodyFrames frames;
+    model.forward(r.body, frames);
+    const Eigen::Vector3d shoulder[2] = {frames.origin_m[model.body_index("l_upper_arm")],
+                                         frames.origin_m[model.body_index("r_upper_arm")]};
+    Eigen::Vector3d left = shoulder[0] - shoulder[1];
+    left.y() = 0.0;
+    left.normalize();
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d forward = left.cross(up);
+    if (options_.drum_auto)
+        options_.scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
+                                       options_.score.drum_forward_m * forward -
+                                       options_.score.drum_below_m * up;
+    const DrumParams &drum = options_.scene.drum;
+    // The plan's frame: the brief's shared frames (right = -left), the membrane
+    // raised by the tip's contact height (see contact_height_m).
+    r.frame = performer_frame_for_drum(
+        drum.center_m +
+            contact_height_m(options_.character.stick.tip_radius_m, kDefaultStickDirection) * up,
+        drum.radius_m);
+    r.frame.right = -left;
+    r.frame.forward = forward;
+
+    // Start: the arms solved to hold the sticks at the rest tips (or the
+    // pose the old rig was in, when a grip or drum change rebuilds it).
+    CharacterPose initial = r.body;
+    if (keep_pose && previous_local.size() == initial.local.size())
+        initial.local = previous_local;
+    else
+        Tracker::solve_arms(model, {}, options_.score.cartesian.ik, r.frame.rest_tip_m, initial);
+    r.base_gains = default_gains(model, initial, options_.gains);
+    scale_gains(r.base_gains, gain_scale_, r.gains);
+    CartesianOptions co = options_.score.cartesian;
+    co.reference_has_arms = false; // the body's reference has no arm motion
+    r.tracker = std::make_unique<Tracker>(model, options_.scene, initial, r.gains,
+                                          std::vector<JointLimitRef>{}, options_.score.mode, co,
+                                          options_.gains);
+    r.tips.has_position = true;
+    for (int s = 0; s < 2; ++s)
+        r.tips.position_m[s] = r.tracker->scene().tip_position(static_cast<Side>(s));
+    if (!keep_pose)
+        rest_from_m_ = r.frame.rest_tip_m;
+    score_rig_ = std::move(rig);
+    time_offset_s_ = previous_time;
+    detector_.reset(membrane_of(scene()));
+}
+
+const PerformerFrame &Performance::performer_frame() const
+{
+    static const PerformerFrame none;
+    return score_rig_ ? score_rig_->frame : none;
+}
+
+TrackMode Performance::mode() const
+{
+    return score_rig_ ? score_rig_->tracker->mode() : TrackMode::joint;
+}
+
+Eigen::Vector3d Performance::tip_target(int hand) const
+{
+    return score_rig_ ? score_rig_->tips.position_m[hand & 1] : tip_position(hand);
+}
+
+Eigen::Vector3d Performance::tip_position(int hand) const
+{
+    return scene().tip_position(static_cast<Side>(hand & 1));
+}
+
+void Performance::start_score()
+{
+    if (!score_rig_)
+        throw CharacterError("play: not in score mode");
+    // Planning allocates (the whole trajectory at 1 kHz): a bounded one-off
+    // on the physics thread at /ictus/play (docs/perform.md, measured there).
+    auto plan = std::make_unique<GesturePlan>(
+        plan_performance(*score_, *db_, score_rig_->frame, options_.score.plan));
+    plan_ = std::move(plan);
+    // Per note: its beat, how long before it the target reaches the contact
+    // (the lead that target_at removes) and its approach speed there.
+    const PerformerFrame &frame = score_rig_->frame;
+    planned_speed_mps_.assign(plan_->notes.size(), 0.0);
+    for (int s = 0; s < 2; ++s) {
+        beats_[s].clear();
+        lead_s_[s].clear();
+        approach_mps_[s].clear();
+        for (size_t i = 0; i < plan_->notes.size(); ++i) {
+            const PlannedNote &n = plan_->notes[i];
+            if (static_cast<int>(n.hand) != s)
+                continue;
+            auto height = [&](double t) {
+                return (plan_->tips.sample(s, t) - frame.membrane_center_m).dot(frame.up);
+            };
+            double lead = 0.0;
+            constexpr double kSearch_s = 0.05, kStep_s = 1e-4;
+            if (height(n.time_s) < 0.0)
+                for (double back = kStep_s; back <= kSearch_s; back += kStep_s) {
+                    const double h0 = height(n.time_s - back),
+                                 h1 = height(n.time_s - back + kStep_s);
+                    if (h0 >= 0.0) {
+                        lead = back - kStep_s * h0 / (h0 - h1); // linear between the two
+                        break;
+                    }
+                }
+            constexpr double kApproach_s = 0.002;
+            const double t_contact = n.time_s - lead;
+            const double v =
+                std::max(0.0, (height(t_contact - kApproach_s) - height(t_contact)) / kApproach_s);
+            beats_[s].push_back(n.time_s);
+            lead_s_[s].push_back(lead);
+            approach_mps_[s].push_back(v);
+            planned_speed_mps_[i] = v;
+        }
+    }
+    plan_active_ = true;
+    playing_ = true;
+    plan_time_s_ = 0.0;
+    plan_origin_s_ = time_s();
+}
+
+void Performance::start_rest_move()
+{
+    for (int s = 0; s < 2; ++s)
+        rest_from_m_[s] = score_rig_->tips.position_m[s];
+    rest_move_start_s_ = time_s();
+}
+
+Eigen::Vector3d Performance::target_at(int s, double t) const
+{
+    const GesturePlan &plan = *plan_;
+    const std::vector<double> &beats = beats_[s];
+    if (beats.empty())
+        return plan.tips.sample(s, t);
+    // The contact on the beat: the plan's target passes strike_depth_m below
+    // the first contact at the beat, so it reaches the contact a little
+    // before (depth / speed: 4 ms for a soft 1 m/s stroke). Each note's
+    // target is delayed by that lead, the delay interpolated linearly in
+    // time between the hand's beats (a rate change of well under 2 %).
+    auto it = std::upper_bound(beats.begin(), beats.end(), t);
+    const size_t k = static_cast<size_t>(it - beats.begin()); // beats[k-1] <= t < beats[k]
+    const std::vector<double> &lead = lead_s_[s];
+    double delay;
+    if (k == 0)
+        delay = lead.front();
+    else if (k == beats.size())
+        delay = lead.back();
+    else {
+        const double w = (t - beats[k - 1]) / (beats[k] - beats[k - 1]);
+        delay = (1.0 - w) * lead[k - 1] + w * lead[k];
+    }
+    const double tp = t - delay; // plan time
+    const Eigen::Vector3d p = plan.tips.sample(s, tp);
+    double tc = options_.score.rebound_s;
+    if (tc <= 0.0)
+        return p;
+    // The rebound. A real stick bounces off the head at about its impact
+    // speed and the hand catches it; the units of the database lift slowly
+    // after the strike, so an arm driven down at the impact speed toward a
+    // target that barely rises presses into the head for 30-70 ms
+    // (docs/perform.md). After each beat the target gets an upward offset
+    //     r(tau) = v tau exp(-tau / tc),
+    // v the target's approach speed at the beat: it leaves the head at the
+    // impact speed, peaks v tc / e above the unit at tau = tc and fades
+    // smoothly (never faster downward than 0.14 v), so the hand does not
+    // strike again.
+    it = std::upper_bound(beats.begin(), beats.end(), tp);
+    if (it == beats.begin())
+        return p;
+    const size_t j = static_cast<size_t>(it - beats.begin()) - 1;
+    const double beat = beats[j];
+    if (it != beats.end())
+        tc = std::min(tc, 0.1 * (*it - beat)); // faded out (< 5e-4 v tc) by the next beat
+    const double tau = tp - beat;
+    if (tau >= 20.0 * tc)
+        return p;
+    return p + approach_mps_[s][j] * tau * std::exp(-tau / tc) * score_rig_->frame.up;
+}
+
+int Performance::step_score(StrikeEvent out[2])
+{
+    ScoreRig &r = *score_rig_;
+    const double h = options_.scene.step_s;
+    TipTargets &tips = r.tips;
+    if (plan_active_) {
+        // Targets for the end of this step, time_advance_s ahead (the lag).
+        plan_time_s_ += h;
+        const GesturePlan &plan = *plan_;
+        const double t = plan_time_s_ + options_.score.time_advance_s;
+        // V^T by a central difference over one plan sample (1 ms): the plan
+        // is piecewise linear between its samples.
+        const double dt = 1.0 / options_.score.plan.rate_hz;
+        for (int s = 0; s < 2; ++s) {
+            tips.position_m[s] = target_at(s, t);
+            tips.velocity_mps[s] = (target_at(s, t + dt) - target_at(s, t - dt)) / (2.0 * dt);
+        }
+        if (plan_time_s_ >= plan.duration_s) {
+            plan_active_ = false;
+            playing_ = false;
+            start_rest_move();
+        }
+    } else {
+        // Between plans: a smooth move (0.6 s) to the rest tips, then hold.
+        const double move_s = options_.score.plan.return_time_s;
+        const double x = (time_s() + h - rest_move_start_s_) / move_s;
+        const double w = smoothstep(x);
+        const double dw = x > 0.0 && x < 1.0 ? 6.0 * x * (1.0 - x) / move_s : 0.0;
+        for (int s = 0; s < 2; ++s) {
+            const Eigen::Vector3d d = r.frame.rest_tip_m[s] - rest_from_m_[s];
+            tips.position_m[s] =
+                x >= 1.0 ? r.frame.rest_tip_m[s] : Eigen::Vector3d(rest_from_m_[s] + w * d);
+            tips.velocity_mps[s] = dw * d;
+        }
+    }
+    r.tracker->step(r.body, &tips, true);
+    return detect_strikes(detector_, r.tracker->scene(), out, time_offset_s_);
+}
+
+bool Performance::apply_score(const Command &c, std::string *why)
+{
+    auto fail = [&](const std::string &text) {
+        if (why)
+            *why = text;
+        return false;
+    };
+    ScoreRig &r = *score_rig_;
+    try {
+        switch (c.kind) {
+        case CommandKind::play:
+            if (builder_->statements() > 0)
+                *score_ = builder_->finish(); // throws: nothing changes, nothing plays
+            start_score();
+            return true;
+        case CommandKind::stop:
+            // The performance ends; the sticks go back to their rest.
+            if (plan_active_)
+                start_rest_move();
+            plan_active_ = false;
+            playing_ = false;
+            return true;
+        case CommandKind::tempo:
+            return fail("tempo: in score mode the tempo is part of the score (/ictus/score "
+                        "\"tempo 96\")");
+        case CommandKind::nuance:
+            return fail("nuance: in score mode each note names its nuance (/ictus/score "
+                        "\"R accent\")");
+        case CommandKind::grip:
+            // At once: the character is rebuilt in its current pose with the
+            // sticks in the new grip (the plan, in tip space, goes on).
+            options_.character.grip = grip_from_string(c.text);
+            build_score(true);
+            return true;
+        case CommandKind::mode:
+            r.tracker->set_mode(track_mode_from_string(c.text));
+            return true;
+        case CommandKind::gains:
+            gain_scale_[0] = c.value;
+            gain_scale_[1] = c.value2;
+            scale_gains(r.base_gains, gain_scale_, r.gains);
+            r.tracker->scene().set_gains(r.gains);
+            return true;
+        case CommandKind::drum_radius:
+        case CommandKind::drum_tension: {
+            if (c.kind == CommandKind::drum_radius) {
+                if (!(c.value > options_.character.stick.tip_radius_m * 2.0))
+                    return fail("drum radius: must exceed the stick tip's diameter");
+                options_.scene.drum.radius_m = c.value;
+            } else {
+                options_.scene.drum.tension_n_per_m = c.value;
+            }
+            // At once: the scene is rebuilt around the current pose; a plan
+            // under way is planned again on the new drum and goes on from
+            // where it was (the notes keep their times).
+            const TrackMode mode = r.tracker->mode();
+            build_score(true);
+            score_rig_->tracker->set_mode(mode);
+            if (plan_active_) {
+                const double t = plan_time_s_, origin = plan_origin_s_;
+                start_score();
+                plan_time_s_ = t;
+                plan_origin_s_ = origin;
+            }
+            return true;
+        }
+        case CommandKind::drum_density:
+            options_.drum_density_kg_per_m2 = c.value;
+            return true;
+        case CommandKind::score:
+            // Parsed now (an error names the statement and column); played at
+            // the next /ictus/play. A score with a faulty statement never plays.
+            builder_->add_statement(c.text);
+            return true;
+        case CommandKind::score_clear:
+            builder_->reset();
+            return true;
+        }
+    } catch (const std::exception &e) {
+        return fail(e.what());
+    }
+    return fail("unknown command");
+}
+
+MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
+                           const std::vector<StrikeEvent> &strikes, double origin_s)
+{
+    MatchSummary m;
+    m.notes.assign(notes.size(), NoteMatch{});
+    std::vector<double> best(notes.size(), std::numeric_limits<double>::infinity());
+    for (const StrikeEvent &e : strikes) {
+        if (e.bounce) {
+            ++m.bounces;
+            continue;
+        }
+        ++m.primary_strikes;
+        // The nearest note of the strike's hand.
+        long nearest = -1;
+        double nearest_d = std::numeric_limits<double>::infinity();
+        for (size_t i = 0; i < notes.size(); ++i) {
+            if (static_cast<int>(notes[i].hand) != e.hand)
+                continue;
+            const double d = std::abs(e.time_s - (origin_s + notes[i].time_s));
+            if (d < nearest_d) {
+                nearest_d = d;
+                nearest = static_cast<long>(i);
+            }
+        }
+        if (nearest < 0) {
+            ++m.extra_strikes;
+            continue;
+        }
+        const size_t i = static_cast<size_t>(nearest);
+        if (m.notes[i].strike_seq >= 0)
+            ++m.extra_strikes; // the note already has one: one of the two is extra
+        if (nearest_d < best[i]) {
+            best[i] = nearest_d;
+            m.notes[i].strike_seq = e.seq;
+            m.notes[i].strike_time_s = e.time_s;
+            m.notes[i].error_ms = 1e3 * (e.time_s - (origin_s + notes[i].time_s));
+            m.notes[i].normal_velocity_mps = e.normal_velocity_mps;
+            m.notes[i].duration_ms = e.duration_ms;
+        }
+    }
+    double sum = 0.0;
+    for (const NoteMatch &n : m.notes) {
+        if (n.strike_seq < 0)
+            continue;
+        ++m.matched_notes;
+        sum += std::abs(n.error_ms);
+        m.max_abs_error_ms = std::max(m.max_abs_error_ms, std::abs(n.error_ms));
+    }
+    m.mean_abs_error_ms = m.matched_notes > 0 ? sum / m.matched_notes : 0.0;
+    return m;
+}
+
+} // namespace ictus

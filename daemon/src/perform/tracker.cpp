@@ -1,0 +1,263 @@
+// The per-step controller: eq. 1 toward a reference pose, Algorithm 2 for the
+// arms toward stick-tip targets (tracker.hpp).
+#include "ictus/perform/tracker.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace ictus
+{
+
+double smoothstep(double x)
+{
+    x = std::min(1.0, std::max(0.0, x));
+    return x * x * (3.0 - 2.0 * x);
+}
+
+double ramp_weight(double t_s, double ramp_s)
+{
+    return ramp_s > 0.0 ? smoothstep(t_s / ramp_s) : 1.0;
+}
+
+void blend_pose(const CharacterPose &from, const CharacterPose &to, double w, CharacterPose &out)
+{
+    out.pelvis_position_m = to.pelvis_position_m;
+    out.pelvis_rotation = to.pelvis_rotation;
+    for (size_t j = 0; j < out.local.size(); ++j)
+        out.local[j] = from.local[j].slerp(w, to.local[j]);
+}
+
+const char *to_string(TrackMode mode)
+{
+    return mode == TrackMode::cartesian ? "cartesian" : "joint";
+}
+
+TrackMode track_mode_from_string(const std::string &text)
+{
+    if (text == "joint")
+        return TrackMode::joint;
+    if (text == "cartesian")
+        return TrackMode::cartesian;
+    throw CharacterError("mode: expected joint or cartesian, got '" + text + "'");
+}
+
+
+// One arm of Algorithm 2: the chain thorax -> clavicle -> shoulder -> elbow ->
+// wrist -> stick tip (docs/ik.md), twice: `feedback` is solved every step from
+// the simulated state (eq. 2), `kinematic` follows the targets alone (warm-started
+// from its own last solution) and gives the target rates for the feedforward.
+struct Tracker::Arm {
+    int joint[4] = {-1, -1, -1, -1};
+    int base_body = -1;
+    KinematicChain feedback, kinematic;
+    Eigen::Vector3d integral_m = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond theta_target[4], kinematic_target[4], previous_kinematic[4];
+};
+
+namespace
+{
+void build_arm(const CharacterModel &model, int side, const CharacterPose &initial,
+               const std::vector<JointLimitRef> &limits, int joint[4], int &base_body,
+               KinematicChain *chains[2])
+{
+    for (int k = 0; k < 4; ++k) {
+        joint[k] = model.joint_index(Tracker::kArmJoints[side][k]);
+        if (joint[k] < 0)
+            throw CharacterError(std::string("cartesian mode: the character has no joint '") +
+                                 Tracker::kArmJoints[side][k] + "'");
+    }
+    base_body = model.joint_body(joint[0]).parent;
+    for (int c = 0; c < 2; ++c) {
+        KinematicChain *chain = chains[c];
+        if (!chain)
+            continue;
+        for (int k = 0; k < 4; ++k) {
+            const int j = joint[k];
+            chain->add_joint(model.joint_body(j).offset_m, initial.local[j],
+                             limits.empty() ? JointLimitRef() : limits[j]);
+        }
+        const Side s = static_cast<Side>(side);
+        chain->set_tip(model.stick(s).tip_m, model.stick(s).axis);
+    }
+}
+} // namespace
+
+Tracker::Tracker(const CharacterModel &model, const SceneOptions &scene_options,
+                 const CharacterPose &initial, const std::vector<JointGains> &gains,
+                 const std::vector<JointLimitRef> &limits, TrackMode mode,
+                 const CartesianOptions &cartesian, const GainOptions &gain_options)
+    : mode_(mode), cartesian_(cartesian)
+{
+    const int nj = CharacterModel::kJoints;
+    if (static_cast<int>(initial.local.size()) != nj)
+        throw CharacterError("tracker: the initial pose needs one rotation per joint");
+    ChainIkSolverPos_dls probe(4);
+    if (!probe.set_params(cartesian.ik))
+        throw CharacterError("ik parameters: expected finite positive values");
+    velocity_gain_s_ = cartesian.velocity_gain_s >= 0.0
+                           ? cartesian.velocity_gain_s
+                           : (std::sqrt(cartesian.gain) - 1.0) * 2.0 * gain_options.damping_ratio /
+                                 (2.0 * M_PI * gain_options.natural_frequency_hz);
+    scene_ = std::make_unique<Scene>(model, scene_options, initial, gains);
+    scene_->set_joint_limits(limits);
+    // The arms are built in both modes: joint mode uses their kinematic IK
+    // when a step brings tip targets, and the mode may change while running.
+    for (int s = 0; s < 2; ++s) {
+        arms_[s] = std::make_unique<Arm>();
+        Arm &arm = *arms_[s];
+        KinematicChain *chains[2] = {&arm.feedback, &arm.kinematic};
+        build_arm(scene_->model(), s, initial, limits, arm.joint, arm.base_body, chains);
+        for (int k = 0; k < 4; ++k)
+            arm.theta_target[k] = arm.kinematic_target[k] = arm.previous_kinematic[k] =
+                initial.local[arm.joint[k]];
+    }
+    solver_ = std::make_unique<ChainIkSolverPos_dls>(4, cartesian.ik);
+    previous_reference_ = initial.local;
+    target_ = initial.local;
+    sim_local_ = initial.local;
+    rate_.assign(nj, Eigen::Vector3d::Zero());
+    target_pose_ = initial;
+    model.forward(initial, sim_frames_);
+    target_frames_ = sim_frames_;
+}
+
+Tracker::~Tracker() = default;
+
+const Eigen::Quaterniond &Tracker::kinematic_target(int side, int k) const
+{
+    return arms_[side & 1]->kinematic_target[k & 3];
+}
+
+StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips, bool integrate)
+{
+    const CharacterModel &model = scene_->model();
+    const int nj = CharacterModel::kJoints;
+    const double h = scene_->options().step_s;
+    for (int j = 0; j < nj; ++j) {
+        target_[j] = reference.local[j];
+        rate_[j] = log_map(target_[j] * previous_reference_[j].conjugate()) / h;
+    }
+    previous_reference_ = reference.local; // same size: no allocation
+    const bool cartesian = mode_ == TrackMode::cartesian;
+    if (cartesian && !tips)
+        throw CharacterError("cartesian mode: a step needs tip targets");
+    if (tips) {
+        // Algorithm 2 (Cartesian), or the kinematic IK alone (joint mode with tips).
+        const CartesianOptions &co = cartesian_;
+        const auto ik_start = std::chrono::steady_clock::now();
+        target_pose_.pelvis_position_m = reference.pelvis_position_m;
+        target_pose_.pelvis_rotation = reference.pelvis_rotation;
+        target_pose_.local = target_;
+        model.forward(target_pose_, target_frames_);
+        if (cartesian) {
+            scene_->body_frames(sim_frames_);
+            scene_->local_rotations(sim_local_);
+        }
+        for (int s = 0; s < 2; ++s) {
+            Arm &arm = *arms_[s];
+            const Side side = static_cast<Side>(s);
+            const int hb = model.hand_body(side);
+            const Eigen::Vector3d tip_target =
+                tips->has_position ? tips->position_m[s]
+                                   : model.tip_position(side, target_frames_.origin_m[hb],
+                                                        target_frames_.rotation[hb]);
+            // Kinematic IK: the arm's target trajectory without the body,
+            // for the target rates (feedforward of eq. 1).
+            arm.kinematic.set_base(target_frames_.origin_m[arm.base_body],
+                                   target_frames_.rotation[arm.base_body]);
+            if (co.reference_has_arms)
+                for (int k = 0; k < 4; ++k)
+                    arm.kinematic_target[k] = target_[arm.joint[k]];
+            arm.kinematic.set_rotations(arm.kinematic_target);
+            IkResult r = solver_->solve(arm.kinematic, tip_target, arm.kinematic_target);
+            ik_stats_.iterations += r.iterations;
+            ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
+            ik_stats_.not_converged += r.status != IkStatus::converged;
+            ++ik_stats_.solves;
+            if (cartesian) {
+                // Eq. 2 with its gain: the IK target is X^S + gain (X^T - X^S) (+ the
+                // velocity, acceleration and integral terms, capped), X^S from the
+                // simulated thorax and Theta^S. The solve starts from Theta^S (eq. 2
+                // literally) or from the kinematic solution, which holds the arm's
+                // null space (CartesianOptions::start_from_simulated, docs/ik.md).
+                arm.feedback.set_base(sim_frames_.origin_m[arm.base_body],
+                                      sim_frames_.rotation[arm.base_body]);
+                for (int k = 0; k < 4; ++k)
+                    arm.feedback.set_rotation(k, sim_local_[arm.joint[k]]);
+                const Eigen::Vector3d sim_tip_chain = arm.feedback.tip_position();
+                if (!co.start_from_simulated)
+                    arm.feedback.set_rotations(arm.kinematic_target);
+                const Eigen::Vector3d error = tip_target - scene_->tip_position(side);
+                const Eigen::Vector3d velocity_error =
+                    tips->velocity_mps[s] - scene_->tip_velocity(side);
+                if (co.integral_per_s > 0.0 && integrate) {
+                    arm.integral_m += co.integral_per_s * h * error;
+                    const double norm = arm.integral_m.norm();
+                    if (norm > co.integral_limit_m)
+                        arm.integral_m *= co.integral_limit_m / norm;
+                }
+                Eigen::Vector3d correction =
+                    (co.gain - 1.0) * error + velocity_gain_s_ * velocity_error +
+                    co.acceleration_feedforward_s2 * tips->acceleration_mps2[s];
+                const double correction_norm = correction.norm();
+                if (correction_norm > co.correction_limit_m)
+                    correction *= co.correction_limit_m / correction_norm;
+                const Eigen::Vector3d ik_target =
+                    sim_tip_chain + error + correction + arm.integral_m;
+                r = solver_->solve(arm.feedback, ik_target, arm.theta_target);
+                ik_stats_.iterations += r.iterations;
+                ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
+                ik_stats_.not_converged += r.status != IkStatus::converged;
+                ++ik_stats_.solves;
+            } else {
+                for (int k = 0; k < 4; ++k)
+                    arm.theta_target[k] = arm.kinematic_target[k];
+            }
+            for (int k = 0; k < 4; ++k) {
+                const int j = arm.joint[k];
+                target_[j] = arm.theta_target[k];
+                rate_[j] =
+                    steps_ == 0
+                        ? Eigen::Vector3d::Zero()
+                        : Eigen::Vector3d(log_map(arm.kinematic_target[k] *
+                                                          arm.previous_kinematic[k].conjugate()) /
+                                          h);
+                arm.previous_kinematic[k] = arm.kinematic_target[k];
+            }
+        }
+        ik_stats_.wall_s +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - ik_start).count();
+    }
+    scene_->set_joint_targets(target_, rate_);
+    ++steps_;
+    return scene_->step();
+}
+
+void Tracker::solve_arms(const CharacterModel &model, const std::vector<JointLimitRef> &limits,
+                         const IkParams &ik, const std::array<Eigen::Vector3d, 2> &tips,
+                         CharacterPose &pose)
+{
+    BodyFrames frames;
+    model.forward(pose, frames);
+    ChainIkSolverPos_dls cold(4, ik);
+    for (int s = 0; s < 2; ++s) {
+        int joint[4], base_body = -1;
+        KinematicChain chain;
+        KinematicChain *chains[2] = {&chain, nullptr};
+        build_arm(model, s, pose, limits, joint, base_body, chains);
+        chain.set_base(frames.origin_m[base_body], frames.rotation[base_body]);
+        Eigen::Quaterniond q[4];
+        // Repeated calls: the solver's per-call budget is 16 steps.
+        for (int call = 0; call < 20; ++call) {
+            const IkResult r = cold.solve(chain, tips[s], q);
+            chain.set_rotations(q);
+            if (r.status == IkStatus::converged)
+                break;
+        }
+        for (int k = 0; k < 4; ++k)
+            pose.local[joint[k]] = chain.rotation(k);
+    }
+}
+
+} // namespace ictus

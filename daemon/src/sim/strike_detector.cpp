@@ -1,0 +1,300 @@
+// The interaction manager's strike detection (strike.hpp).
+#include "ictus/sim/strike_detector.hpp"
+
+#include "ictus/sim/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+
+namespace ictus
+{
+
+namespace
+{
+const Eigen::Vector3d kNormal = Eigen::Vector3d::UnitY(); // membrane normal (world y up)
+
+// Vertex of the parabola through three samples, when it is a maximum inside
+// them; else the middle sample. Sampled at 1 kHz a 3-6 ms contact has only a
+// few force samples, and the largest of them underestimates the peak
+// (ode-findings.md); the parabola recovers most of the difference.
+double parabola_peak(const double t[3], const double f[3])
+{
+    const double h0 = t[1] - t[0], h1 = t[2] - t[1];
+    if (!(h0 > 0.0 && h1 > 0.0))
+        return f[1];
+    const double s0 = (f[1] - f[0]) / h0, s1 = (f[2] - f[1]) / h1;
+    const double a = (s1 - s0) / (t[2] - t[0]);
+    if (!(a < 0.0))
+        return f[1];
+    // f(t) = f0 + s0 (t - t0) + a (t - t0)(t - t1); f'(t*) = 0.
+    const double ts = 0.5 * (t[0] + t[1]) - s0 / (2.0 * a);
+    if (ts < t[0] || ts > t[2])
+        return f[1];
+    const double peak = f[0] + s0 * (ts - t[0]) + a * (ts - t[0]) * (ts - t[1]);
+    return std::isfinite(peak) ? std::max(peak, f[1]) : f[1];
+}
+
+// The velocity with which the bead crossed the membrane plane between the
+// last free sample (gap g0 >= 0) and the first touching one (gap g1 < 0),
+// for the two kinds of samples (StrikeDetectorOptions::semi_implicit_samples).
+// Either way its normal part is > 0: the step's mean has (g0 - g1) / dt > 0
+// since the gap changed sign. The old rule, the free sample's velocity
+// regardless, gave re-contacts after a lift smaller than one step's motion a
+// negative normal velocity: the still rising bead's.
+Eigen::Vector3d approach_velocity(const TipSample &free, double g0, const TipSample &touching,
+                                  bool semi_implicit)
+{
+    const double dt = touching.time_s - free.time_s;
+    if (!(dt > 0.0)) // times not increasing (bad input): no speed measurable, never a negative one
+        return Eigen::Vector3d::Zero();
+    const Eigen::Vector3d mean = (touching.center_m - free.center_m) / dt;
+    if (semi_implicit)
+        return mean; // the velocity the bead crossed with (p1 = p0 + h v1)
+    // A continuous trajectory: the free sample's velocity is free of contact
+    // force, exact for a uniform flight, within one step's acceleration
+    // otherwise; but only if it could have brought the bead across (towards
+    // the membrane, by at least g0). If not (still rising, hovering,
+    // creeping), the approach that crossed began inside the step: its mean.
+    const double free_approach_mps = -free.velocity_mps.dot(kNormal);
+    if (free_approach_mps > 0.0 && free_approach_mps * dt >= g0)
+        return free.velocity_mps;
+    return mean;
+}
+} // namespace
+
+StrikeDetector::StrikeDetector(const MembraneGeometry &membrane,
+                               const StrikeDetectorOptions &options)
+    : membrane_(membrane), options_(options)
+{
+}
+
+void StrikeDetector::set_membrane(const MembraneGeometry &membrane)
+{
+    membrane_ = membrane;
+}
+
+long StrikeDetector::first_open_seq() const
+{
+    long first = next_seq_;
+    for (const Hand &h : hands_)
+        if (h.in_contact)
+            first = std::min(first, h.event.seq);
+    return first;
+}
+
+void StrikeDetector::reset(const MembraneGeometry &membrane)
+{
+    membrane_ = membrane;
+    hands_ = {};
+}
+
+double StrikeDetector::normal_force_n(double depth_m, double depth_rate_mps) const
+{
+    // One-sided spring-damper: the membrane pushes, never pulls.
+    return std::max(0.0, membrane_.stiffness_n_per_m * depth_m +
+                             membrane_.damping_n_s_per_m * depth_rate_mps);
+}
+
+double StrikeDetector::gap_m(const Eigen::Vector3d &center_m) const
+{
+    return (center_m - membrane_.center_m).dot(kNormal) - membrane_.tip_radius_m;
+}
+
+bool StrikeDetector::over_membrane(const Eigen::Vector3d &center_m) const
+{
+    double x, y;
+    to_membrane(center_m, x, y);
+    return x * x + y * y <= membrane_.radius_m * membrane_.radius_m;
+}
+
+void StrikeDetector::to_membrane(const Eigen::Vector3d &world_m, double &x_m, double &y_m) const
+{
+    const Eigen::Vector3d d = world_m - membrane_.center_m;
+    x_m = d.x();
+    y_m = -d.z();
+}
+
+bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
+{
+    Hand &h = hands_[static_cast<size_t>(hand & 1)];
+    const double gap = gap_m(s.center_m);
+    const bool touching = gap < 0.0 && over_membrane(s.center_m);
+    const double depth_rate = -s.velocity_mps.dot(kNormal);
+    bool ended = false;
+
+    // A tip that comes in over the disk already below the membrane plane
+    // entered from the side: that is the shell (or rim), not a strike on the
+    // membrane. It is ignored until the tip is above the plane again. So is a
+    // tip first seen below the plane (no approach was observed), uncounted.
+    if (!h.in_contact && touching && !h.side_entry) {
+        if (!h.has_previous) {
+            h.side_entry = true;
+        } else if (h.previous_gap < 0.0) {
+            h.side_entry = true;
+            ++side_entries_;
+        }
+    }
+    if (h.side_entry) {
+        if (gap >= 0.0)
+            h.side_entry = false;
+        h.previous = s;
+        h.previous_gap = gap;
+        return false;
+    }
+
+    if (!h.in_contact && touching) {
+        // Onset: where the gap crosses zero between the last free sample and
+        // this one (here previous_gap >= 0 > gap: the cases above left).
+        const TipSample &before = h.previous;
+        const double g0 = h.previous_gap;
+        const double frac = g0 > 0.0 ? g0 / (g0 - gap) : 0.0;
+        const double t_on = before.time_s + frac * (s.time_s - before.time_s);
+        const Eigen::Vector3d p_on = before.center_m + frac * (s.center_m - before.center_m) -
+                                     membrane_.tip_radius_m * kNormal;
+        StrikeEvent &e = h.event;
+        e = StrikeEvent();
+        e.hand = hand & 1;
+        e.drum = membrane_.drum_id;
+        e.time_s = t_on;
+        to_membrane(p_on, e.x_m, e.y_m);
+        e.r_over_a = std::hypot(e.x_m, e.y_m) / membrane_.radius_m;
+        e.theta_deg = std::atan2(e.y_m, e.x_m) * 180.0 / M_PI;
+        if (e.theta_deg <= -180.0)
+            e.theta_deg += 360.0;
+        const Eigen::Vector3d v = approach_velocity(before, g0, s, options_.semi_implicit_samples);
+        e.normal_velocity_mps = -v.dot(kNormal);
+        e.tangential_velocity_mps = (v - v.dot(kNormal) * kNormal).norm();
+        e.bounce = h.released_once && (t_on - h.release_time_s) <= options_.bounce_window_s &&
+                   h.max_gap_since_release < options_.bounce_height_m;
+        if (!e.bounce)
+            ++h.stroke;
+        e.stroke = std::max(h.stroke, 0L);
+        e.seq = next_seq_++;
+        // The force law at the onset (the damper acts at once).
+        const double f_on = normal_force_n(0.0, -v.dot(kNormal));
+        h.last_force_n = f_on;
+        h.last_time_s = t_on;
+        h.friction_sum.setZero();
+        h.peak_t[1] = t_on;
+        h.peak_f[1] = f_on;
+        h.peak_has_before = false;
+        h.peak_has_after = false;
+        h.in_contact = true;
+    }
+
+    if (h.in_contact && touching) {
+        const double f = normal_force_n(-gap, depth_rate);
+        const double dt = s.time_s - h.last_time_s;
+        h.event.impulse_n_s += 0.5 * (h.last_force_n + f) * dt;
+        // Kinetic friction on the membrane along the tip's sliding direction.
+        const Eigen::Vector3d vt = s.velocity_mps - s.velocity_mps.dot(kNormal) * kNormal;
+        if (vt.norm() > 1e-6)
+            h.friction_sum +=
+                membrane_.friction * 0.5 * (h.last_force_n + f) * dt * vt.normalized();
+        if (f > h.peak_f[1]) {
+            h.peak_t[0] = h.last_time_s;
+            h.peak_f[0] = h.last_force_n;
+            h.peak_has_before = true;
+            h.peak_t[1] = s.time_s;
+            h.peak_f[1] = f;
+            h.peak_has_after = false;
+        } else if (!h.peak_has_after && h.peak_t[1] == h.last_time_s) {
+            h.peak_t[2] = s.time_s;
+            h.peak_f[2] = f;
+            h.peak_has_after = true;
+        }
+        h.last_force_n = f;
+        h.last_time_s = s.time_s;
+    } else if (h.in_contact && !touching) {
+        // Release where the gap crosses zero again (at once when the tip left
+        // the disk sideways).
+        double frac = 1.0;
+        const double g0 = std::min(h.previous_gap, 0.0);
+        if (gap >= 0.0 && g0 < 0.0)
+            frac = -g0 / (gap - g0);
+        const double t_rel = h.previous.time_s + frac * (s.time_s - h.previous.time_s);
+        const double f_rel = normal_force_n(0.0, depth_rate);
+        const double dt = t_rel - h.last_time_s;
+        h.event.impulse_n_s += 0.5 * (h.last_force_n + f_rel) * dt;
+        if (!h.peak_has_after && h.peak_t[1] == h.last_time_s) {
+            h.peak_t[2] = t_rel;
+            h.peak_f[2] = f_rel;
+            h.peak_has_after = true;
+        }
+        finish(h, t_rel, out);
+        ended = true;
+    }
+
+    if (!h.in_contact) {
+        if (ended)
+            h.max_gap_since_release = std::max(gap, 0.0);
+        else
+            h.max_gap_since_release = std::max(h.max_gap_since_release, gap);
+    }
+    h.previous = s;
+    h.previous_gap = gap;
+    h.has_previous = true;
+    return ended;
+}
+
+void StrikeDetector::finish(Hand &h, double release_time_s, StrikeEvent &out)
+{
+    StrikeEvent &e = h.event;
+    e.duration_ms = (release_time_s - e.time_s) * 1e3;
+    e.peak_force_n =
+        (h.peak_has_before && h.peak_has_after) ? parabola_peak(h.peak_t, h.peak_f) : h.peak_f[1];
+    // Force on the membrane: the normal impulse pushes it down, friction drags it along.
+    const Eigen::Vector3d total = -e.impulse_n_s * kNormal + h.friction_sum;
+    e.force_dir =
+        total.norm() > 0.0 ? Eigen::Vector3d(total.normalized()) : Eigen::Vector3d(-kNormal);
+    out = e;
+    h.in_contact = false;
+    h.released_once = true;
+    h.release_time_s = release_time_s;
+}
+
+bool StrikeDetector::flush(StrikeEvent &out)
+{
+    for (Hand &h : hands_)
+        if (h.in_contact) {
+            finish(h, h.last_time_s, out);
+            return true;
+        }
+    return false;
+}
+
+// ---- a Scene's strikes -------------------------------------------------------
+
+MembraneGeometry membrane_of(const Scene &scene, int drum_id)
+{
+    MembraneGeometry m;
+    const DrumParams &d = scene.drum();
+    m.center_m = d.center_m;
+    m.radius_m = d.radius_m;
+    m.tip_radius_m = scene.model().options().stick.tip_radius_m;
+    m.stiffness_n_per_m = scene.drum_contact_stiffness_n_per_m();
+    m.damping_n_s_per_m = d.contact_damping_n_s_per_m;
+    m.friction = d.friction;
+    m.drum_id = drum_id;
+    return m;
+}
+
+int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out[2],
+                   double time_offset_s)
+{
+    int n = 0;
+    for (int hand = 0; hand < 2; ++hand) {
+        const Side side = static_cast<Side>(hand);
+        TipSample s;
+        s.time_s = time_offset_s + scene.time_s();
+        s.center_m = scene.bead_position(side);
+        s.velocity_mps = scene.bead_velocity(side);
+        if (detector.update(hand, s, out[n]))
+            ++n;
+    }
+    return n;
+}
+
+} // namespace ictus

@@ -1,0 +1,216 @@
+// strike_event.cpp -- the strike's fields and the files made of them
+// (strike_event.hpp, docs/osc.md).
+#include "ictus/sim/strike_event.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+
+namespace ictus
+{
+
+namespace
+{
+constexpr StrikeFieldInfo kInfo[kStrikeFieldCount] = {
+    {"seq", true, 0},
+    {"hand", true, 0},
+    {"drum", true, 0},
+    {"bounce", true, 0},
+    {"stroke", true, 0},
+    {"time_s", false, 6},
+    {"x_m", false, 5},
+    {"y_m", false, 5},
+    {"r_over_a", false, 5},
+    {"theta_deg", false, 2},
+    {"normal_velocity_mps", false, 4},
+    {"tangential_velocity_mps", false, 4},
+    {"peak_force_n", false, 3},
+    {"impulse_n_s", false, 6},
+    {"duration_ms", false, 3},
+    {"force_dir_x", false, 4},
+    {"force_dir_y", false, 4},
+    {"force_dir_z", false, 4},
+};
+
+// Fixed notation with a given number of decimals; -0 printed as 0 so that
+// equal physics gives equal bytes.
+void put(std::ostream &out, double v, int decimals)
+{
+    char buf[64];
+    if (!std::isfinite(v))
+        v = 0.0; // never NaN in a file (the inputs are checked upstream)
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+    if (buf[0] == '-') {
+        bool zero = true;
+        for (const char *c = buf + 1; *c; ++c)
+            if (*c != '0' && *c != '.')
+                zero = false;
+        if (zero) {
+            out << (buf + 1);
+            return;
+        }
+    }
+    out << buf;
+}
+
+void put_field(std::ostream &out, const StrikeEvent &e, StrikeField f)
+{
+    const StrikeFieldInfo &info = strike_field_info(f);
+    if (info.integer)
+        out << strike_field_integer(e, f);
+    else
+        put(out, strike_field(e, f), info.decimals);
+}
+} // namespace
+
+const StrikeField kCsvStrikeFields[kStrikeFieldCount] = {
+    StrikeField::seq,
+    StrikeField::hand,
+    StrikeField::drum,
+    StrikeField::bounce,
+    StrikeField::stroke,
+    StrikeField::time_s,
+    StrikeField::x_m,
+    StrikeField::y_m,
+    StrikeField::r_over_a,
+    StrikeField::theta_deg,
+    StrikeField::normal_velocity_mps,
+    StrikeField::tangential_velocity_mps,
+    StrikeField::peak_force_n,
+    StrikeField::impulse_n_s,
+    StrikeField::duration_ms,
+    StrikeField::force_dir_x,
+    StrikeField::force_dir_y,
+    StrikeField::force_dir_z,
+};
+
+// /ictus/strike iiii fffffffffffff: the CSV's fields without the stroke number.
+const StrikeField kOscStrikeFields[17] = {
+    StrikeField::seq,
+    StrikeField::hand,
+    StrikeField::drum,
+    StrikeField::bounce,
+    StrikeField::time_s,
+    StrikeField::x_m,
+    StrikeField::y_m,
+    StrikeField::r_over_a,
+    StrikeField::theta_deg,
+    StrikeField::normal_velocity_mps,
+    StrikeField::tangential_velocity_mps,
+    StrikeField::peak_force_n,
+    StrikeField::impulse_n_s,
+    StrikeField::duration_ms,
+    StrikeField::force_dir_x,
+    StrikeField::force_dir_y,
+    StrikeField::force_dir_z,
+};
+
+// A hit line: what a drum patch needs first (patches/ictus-render.pd plays them).
+const StrikeField kEventsStrikeFields[11] = {
+    StrikeField::hand,
+    StrikeField::drum,
+    StrikeField::bounce,
+    StrikeField::normal_velocity_mps,
+    StrikeField::r_over_a,
+    StrikeField::theta_deg,
+    StrikeField::peak_force_n,
+    StrikeField::impulse_n_s,
+    StrikeField::duration_ms,
+    StrikeField::tangential_velocity_mps,
+    StrikeField::time_s,
+};
+
+const StrikeFieldInfo &strike_field_info(StrikeField field)
+{
+    return kInfo[static_cast<int>(field)];
+}
+
+long strike_field_integer(const StrikeEvent &e, StrikeField field)
+{
+    switch (field) {
+    case StrikeField::seq:
+        return e.seq;
+    case StrikeField::hand:
+        return e.hand;
+    case StrikeField::drum:
+        return e.drum;
+    case StrikeField::bounce:
+        return e.bounce ? 1 : 0;
+    case StrikeField::stroke:
+        return e.stroke;
+    default:
+        return std::lround(strike_field(e, field));
+    }
+}
+
+double strike_field(const StrikeEvent &e, StrikeField field)
+{
+    switch (field) {
+    case StrikeField::seq:
+    case StrikeField::hand:
+    case StrikeField::drum:
+    case StrikeField::bounce:
+    case StrikeField::stroke:
+        return static_cast<double>(strike_field_integer(e, field));
+    case StrikeField::time_s:
+        return e.time_s;
+    case StrikeField::x_m:
+        return e.x_m;
+    case StrikeField::y_m:
+        return e.y_m;
+    case StrikeField::r_over_a:
+        return e.r_over_a;
+    case StrikeField::theta_deg:
+        return e.theta_deg;
+    case StrikeField::normal_velocity_mps:
+        return e.normal_velocity_mps;
+    case StrikeField::tangential_velocity_mps:
+        return e.tangential_velocity_mps;
+    case StrikeField::peak_force_n:
+        return e.peak_force_n;
+    case StrikeField::impulse_n_s:
+        return e.impulse_n_s;
+    case StrikeField::duration_ms:
+        return e.duration_ms;
+    case StrikeField::force_dir_x:
+        return e.force_dir.x();
+    case StrikeField::force_dir_y:
+        return e.force_dir.y();
+    case StrikeField::force_dir_z:
+        return e.force_dir.z();
+    }
+    return 0.0;
+}
+
+void write_strikes_csv_header(std::ostream &out)
+{
+    for (int i = 0; i < kStrikeFieldCount; ++i)
+        out << (i ? "," : "") << strike_field_info(kCsvStrikeFields[i]).name;
+    out << '\n';
+}
+
+void write_strike_csv_row(std::ostream &out, const StrikeEvent &e)
+{
+    for (int i = 0; i < kStrikeFieldCount; ++i) {
+        if (i)
+            out << ',';
+        put_field(out, e, kCsvStrikeFields[i]);
+    }
+    out << '\n';
+}
+
+void write_events_line(std::ostream &out, const StrikeEvent &e, double previous_time_s)
+{
+    // Delays from whole microseconds, so that the delays add up to the onset times exactly.
+    const long long t_us = std::llround(e.time_s * 1e6);
+    const long long prev_us = std::llround(previous_time_s * 1e6);
+    put(out, static_cast<double>(t_us - prev_us) * 1e-3, 3);
+    out << " hit";
+    for (StrikeField f : kEventsStrikeFields) {
+        out << ' ';
+        put_field(out, e, f);
+    }
+    out << ";\n";
+}
+
+} // namespace ictus
