@@ -2,7 +2,7 @@
 // CMU drumming file's documented facts (data README), and malformed files.
 #include "mocap_test_util.hpp"
 
-#include "ictus/bvh.hpp"
+#include "ictus/mocap/bvh.hpp"
 
 #include <fstream>
 #include <sstream>

@@ -6,9 +6,9 @@
 // CharacterModel::forward puts it.
 #include "mocap_test_util.hpp"
 
-#include "ictus/bvh.hpp"
-#include "ictus/bvh_export.hpp"
-#include "ictus/character.hpp"
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/character/bvh_export.hpp"
+#include "ictus/character/character.hpp"
 
 #include <random>
 #include <sstream>

@@ -2,8 +2,8 @@
 // angles with known ranges, and Algorithm 1 recovering known axes and spreads.
 #include "mocap_test_util.hpp"
 
-#include "ictus/bvh.hpp"
-#include "ictus/joint_limits.hpp"
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/mocap/joint_limits.hpp"
 
 #include <random>
 #include <sstream>

@@ -2,7 +2,7 @@
 // gap filling (value, warning, refusal), and malformed files.
 #include "mocap_test_util.hpp"
 
-#include "ictus/marker_csv.hpp"
+#include "ictus/mocap/marker_csv.hpp"
 
 #include <sstream>
 

@@ -1,8 +1,8 @@
 // Resampling from capture rate to physics rate against analytic motions.
 #include "mocap_test_util.hpp"
 
-#include "ictus/joint_limits.hpp"
-#include "ictus/motion.hpp"
+#include "ictus/mocap/joint_limits.hpp"
+#include "ictus/mocap/motion.hpp"
 
 using namespace ictus;
 using namespace mocap_test;

@@ -1,6 +1,7 @@
 // The OSC link with real peers: liblo's oscdump receives what the sender
 // emits, oscsend drives the server, raw UDP sockets fuzz it.
-#include "ictus/osc_link.hpp"
+#include "ictus/net/osc_sender.hpp"
+#include "ictus/net/osc_server.hpp"
 #include "osc_test_util.hpp"
 
 #include <catch2/catch.hpp>

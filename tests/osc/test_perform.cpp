@@ -8,7 +8,7 @@
 // own match_strikes (which render.json uses).
 #include "osc_test_util.hpp"
 
-#include "ictus/verbs_osc.hpp"
+#include "ictus/perform/performance.hpp"
 
 #include <catch2/catch.hpp>
 

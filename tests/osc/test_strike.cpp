@@ -1,7 +1,7 @@
 // Strike detection against analytic contacts: a ball meeting a linear spring
 // (duration pi sqrt(m/k), impulse 2 m v, peak v sqrt(k m)), bounce tagging on
 // a ball bouncing to known apex heights, membrane coordinates, file formats.
-#include "ictus/strike.hpp"
+#include "ictus/sim/strike_detector.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -3,7 +3,7 @@
 // to oscdump and answers oscsend. They need the CMU clip (ICTUS_DATA_DIR).
 #include "osc_test_util.hpp"
 
-#include "ictus/verbs_osc.hpp"
+#include "ictus/perform/performance.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -3,7 +3,7 @@
 // velocity across unit joins (checked by halving the sample step: a smooth
 // curve's sample-to-sample changes halve, a jump's do not), louder -> faster
 // at impact, idle hands back at rest, refused scores.
-#include "ictus/gesture_score.hpp"
+#include "ictus/score/gesture_score.hpp"
 
 #include <catch2/catch.hpp>
 

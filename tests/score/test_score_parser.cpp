@@ -1,7 +1,7 @@
 // The score language: every statement form, the defaults, every error with
 // its exact line and column, nothing produced from a faulty score, and the
 // Pd message-box form (one statement per message) equal to the file form.
-#include "ictus/score.hpp"
+#include "ictus/score/score.hpp"
 
 #include <catch2/catch.hpp>
 

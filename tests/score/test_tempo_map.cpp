@@ -1,7 +1,7 @@
 // The tempo map: beat times are the integral of 60 / tempo(beat). Checked
 // against the closed form of a linear ramp and against a numerical integral
 // (Simpson's rule on the tempo curve, a second method).
-#include "ictus/score.hpp"
+#include "ictus/score/score.hpp"
 
 #include <catch2/catch.hpp>
 

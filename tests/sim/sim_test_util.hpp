@@ -2,7 +2,7 @@
 // numbers, not the captured ones), BVH text for it, and the data folder.
 #pragma once
 
-#include "ictus/motion.hpp"
+#include "ictus/mocap/motion.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -3,9 +3,9 @@
 // 5 mm RMS and better than joint-space tracking with the same gains (the
 // paper's Figure 4 claim); on a synthetic motion its IK targets must agree
 // with the motion that made the tips.
-#include "ictus/bvh.hpp"
-#include "ictus/character_limits.hpp"
-#include "ictus/track.hpp"
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/character/character_limits.hpp"
+#include "ictus/perform/track.hpp"
 #include "sim_test_util.hpp"
 
 #include <catch2/catch.hpp>

@@ -1,6 +1,6 @@
 // The character model: mapping, anthropometry (de Leva 1996), sticks and grips.
-#include "ictus/anthropometry.hpp"
-#include "ictus/character.hpp"
+#include "ictus/character/anthropometry.hpp"
+#include "ictus/character/character.hpp"
 #include "sim_test_util.hpp"
 
 #include <catch2/catch.hpp>

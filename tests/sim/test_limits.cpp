@@ -1,8 +1,8 @@
 // Joint limits as enforced: targets clamped into the learned region, the joint
 // stays inside, the ellipsoid clamp is the closest point, stops catch a kick.
-#include "ictus/character_limits.hpp"
-#include "ictus/joint_controller.hpp"
-#include "ictus/scene.hpp"
+#include "ictus/character/character_limits.hpp"
+#include "ictus/control/joint_controller.hpp"
+#include "ictus/sim/scene.hpp"
 #include "sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -97,7 +97,7 @@ TEST_CASE("limits: a target outside the learned region is clamped and the joint 
             scene.local_rotations(local);
             const Eigen::Quaterniond inside = limits.refs()[elbow].clamp(local[elbow]);
             const double outside_deg =
-                rotation_vector(local[elbow] * inside.conjugate()).norm() * 180 / M_PI;
+                log_map(local[elbow] * inside.conjugate()).norm() * 180 / M_PI;
             worst_outside_deg = std::max(worst_outside_deg, outside_deg);
             if (i >= 1000)
                 settled_outside_deg = std::max(settled_outside_deg, outside_deg);
@@ -110,7 +110,7 @@ TEST_CASE("limits: a target outside the learned region is clamped and the joint 
         else
             CHECK(limits.euler(elbow).limit.contains(clamped, 1e-9));
         // ...and far from the requested one.
-        CHECK(rotation_vector(targets[elbow] * clamped.conjugate()).norm() * 180 / M_PI > 20.0);
+        CHECK(log_map(targets[elbow] * clamped.conjugate()).norm() * 180 / M_PI > 20.0);
         // Settled, the joint is outside only by its gravity sag (0.05 degrees
         // at the elbow, test_scene.cpp); in the jump to the clamped target it
         // overshoots by less than two degrees.
@@ -149,7 +149,7 @@ TEST_CASE("limits: a kicked joint meets the safety-net stop", "[sim][limits]")
             std::vector<Eigen::Quaterniond> local;
             scene.local_rotations(local);
             const Eigen::Quaterniond inside = limits.ellipsoid(elbow).clamp(local[elbow]);
-            worst = std::max(worst, rotation_vector(local[elbow] * inside.conjugate()).norm());
+            worst = std::max(worst, log_map(local[elbow] * inside.conjugate()).norm());
         }
         return worst * 180 / M_PI;
     };

@@ -1,7 +1,7 @@
 // The ODE scene: still-pose PD equilibrium against statics, divergence handling.
-#include "ictus/joint_controller.hpp"
-#include "ictus/scene.hpp"
-#include "ictus/strike.hpp"
+#include "ictus/control/joint_controller.hpp"
+#include "ictus/sim/scene.hpp"
+#include "ictus/sim/strike_detector.hpp"
 #include "sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -88,7 +88,7 @@ TEST_CASE("still pose: each joint sags by its gravity torque over k_s, and no mo
         REQUIRE(tg < gains[j].torque_limit_nm);
         const double predicted_deg = tg / gains[j].kp_nm_per_rad * 180 / M_PI;
         const double err_deg =
-            rotation_vector(pose.local[j] * local[j].conjugate()).norm() * 180 / M_PI;
+            log_map(pose.local[j] * local[j].conjugate()).norm() * 180 / M_PI;
         INFO("joint " << m.joint_name(j) << ": sag " << err_deg << " deg, statics " << predicted_deg
                       << " deg, direct solver " << direct);
         if (direct) {
@@ -129,7 +129,7 @@ TEST_CASE("divergence is detected, counted and the character reset to its target
     std::vector<Eigen::Quaterniond> local;
     scene.local_rotations(local);
     for (int j = 0; j < CharacterModel::kJoints; ++j)
-        CHECK(rotation_vector(pose.local[j] * local[j].conjugate()).norm() < 1e-9);
+        CHECK(log_map(pose.local[j] * local[j].conjugate()).norm() < 1e-9);
     CHECK(scene.max_linear_speed_mps() == 0.0);
     // And it carries on.
     for (int i = 0; i < 100; ++i)

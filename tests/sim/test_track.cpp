@@ -1,8 +1,8 @@
 // Joint-space tracking (eq. 1) of the CMU drumming clip and of a synthetic
 // motion: error bounds, no divergence over ten simulated minutes, CSV format.
-#include "ictus/bvh.hpp"
-#include "ictus/character_limits.hpp"
-#include "ictus/track.hpp"
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/character/character_limits.hpp"
+#include "ictus/perform/track.hpp"
 #include "sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
