@@ -203,8 +203,11 @@ TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked r
     const std::vector<std::string> csv = lines(slurp((dir / "strikes.csv").string()));
     REQUIRE(csv.size() >= 2);
     std::set<long> recorded;
-    for (size_t i = 1; i < csv.size(); ++i)
+    for (size_t i = 1; i < csv.size(); ++i) {
+        // In onset order, as track and render write it: seq 0, 1, 2 ...
+        CHECK(std::stol(csv[i]) == static_cast<long>(i - 1));
         recorded.insert(std::stol(csv[i]));
+    }
     std::printf("run: %zu strikes recorded, %zu received by oscdump, %d pose frames in %.1f s\n",
                 recorded.size(), seqs.size(), frames, seconds);
     CHECK(seqs == recorded);

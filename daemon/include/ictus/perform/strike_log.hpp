@@ -18,13 +18,15 @@ namespace ictus
 class StrikeOrder
 {
   public:
-    // A strike the detector just reported (the oldest is let go, out of order,
-    // if more than kCapacity wait: never with two hands).
+    // A strike the detector just reported. Held until release() or flush();
+    // if kCapacity already wait (never with two hands: at most one strike
+    // waits for the other hand's contact), the lowest is let go first.
     template <typename Emit> void push(const StrikeEvent &event, Emit &&emit)
     {
         if (held_ == kCapacity) {
-            emit(pending_[0]);
-            remove(0);
+            const int k = lowest();
+            emit(pending_[k]);
+            remove(k);
         }
         pending_[held_++] = event;
     }
