@@ -211,7 +211,7 @@ def main():
     print("figure5: %d notes, %d strikes (%d primary, %d bounces)"
           % (len(notes), len(strikes), len(primary), len(strikes) - len(primary)))
     if notes:
-        # Each note's nearest primary strike of its hand (issue 6: within +-5 ms).
+        # Each note's nearest primary strike of its hand (docs/perform.md: within +-5 ms).
         errors = []
         for n in notes:
             cand = [s["time_s"] for s in primary if s["hand"] == n["hand"]]

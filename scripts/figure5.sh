@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The paper's Figure 5 from one command (issue 6): the virtual percussionist
+# The paper's Figure 5 from one command (docs/main-job.md): the virtual percussionist
 # plays a score that mixes legato and accent beats of both hands under a tempo
 # change (examples/scores/figure5.txt: 80 bpm, then 80 -> 140 bpm), and the
 # heights of the right and left stick tips are plotted against time with the

@@ -1,4 +1,4 @@
-"""Issue 7: the README main job's core steps on the default score, in this
+"""The README main job (docs/main-job.md)'s core steps on the default score, in this
 build (scripts/main.sh --no-deps --no-build: ictusd render --out, pd batch
 render, figure5.py), and what it leaves in its output folder:
 - performance.wav: the events rendered to the sample. The onsets found in the
@@ -34,7 +34,7 @@ help_text = subprocess.run([ictusd, "render", "--help"], capture_output=True, te
                            timeout=60)
 if "--score" not in help_text.stdout + help_text.stderr:
     print("SKIPPED: `ictusd render --help` has no --score yet: the main job's default score "
-          "cannot be rendered (issue 6's render verb)")
+          "cannot be rendered (the render verb, docs/perform.md)")
     sys.exit(77)
 
 work = make_workdir("ictus-e2e-main-")

@@ -1,4 +1,4 @@
-"""Issue 5, offline, end to end: the real `ictusd render` -> its events.txt ->
+"""Offline, end to end (docs/osc.md): the real `ictusd render` -> its events.txt ->
 patches/ictus-render.pd in the real pd (batch mode) -> WAV, and the onsets
 found in the WAV (the signal only, e2e_util.detect_onsets) against the
 daemon's strike log strikes.csv: every strike's onset within 1 ms, no extra
@@ -56,7 +56,7 @@ if args.source == "mocap":
 else:
     if "--score" not in help_text:
         print("SKIPPED: `ictusd render --help` has no --score yet: the default score cannot "
-              "be rendered (issue 6's render verb)")
+              "be rendered (the render verb, docs/perform.md)")
         sys.exit(SKIP)
     cmd = [ictusd, "render", "--out", out]
     if args.score:

@@ -1,4 +1,4 @@
-// Score performance (issue 6, acceptance): a score is planned into stick-tip
+// Score performance (docs/perform.md, its acceptance bounds): a score is planned into stick-tip
 // targets and performed by the real simulation (Tracker on the Scene, the
 // strike detector on the tips). Over 40, 96 and 200 bpm, both grips, every
 // nuance and both control modes: exactly one primary strike per note, each

@@ -218,7 +218,7 @@ TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked r
     fs::remove_all(dir);
 }
 
-// Issue 5: drum parameters sent while a clip plays take effect at once (not at
+// docs/osc.md: drum parameters sent while a clip plays take effect at once (not at
 // the next play): the scene's contact law and the detector's membrane follow.
 TEST_CASE("clip mode: drum radius and tension apply at once, to the scene and the detector",
           "[osc][verbs]")

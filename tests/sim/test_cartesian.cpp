@@ -52,7 +52,7 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
     CHECK(cart.mode == "cartesian");
     CHECK_FALSE(cart.diverged);
     CHECK(cart.samples > 900);
-    // The issue's requirement (and the paper's Figure 4 observation).
+    // docs/ik.md's bound (and the paper's Figure 4 observation).
     for (int s = 0; s < 2; ++s) {
         CHECK(cart.tip_rms_mm[s] <= 5.0);
         CHECK(cart.tip_rms_mm[s] < joint.tip_rms_mm[s]);

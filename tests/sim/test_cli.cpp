@@ -414,7 +414,7 @@ TEST_CASE("ictusd gestures is a verb of ictusd: help, export of the built-in dat
     INFO(r.output);
     CHECK(r.status == 0);
     CHECK(r.output.find("usage: ictusd gestures") != std::string::npos);
-    // The built-in database holds one unit per grip x nuance x hand (issue 6):
+    // The built-in database holds one unit per grip x nuance x hand (docs/gestures.md):
     // 2 x 5 x 2 = 20.
     const std::string path = simtest::temp_path("gestures.json");
     std::remove(path.c_str());

@@ -163,8 +163,12 @@ void OscSender::strike_loop()
                 tt = to_lo(ntp_add_seconds(epoch(), e.time_s + options_.lookahead_s));
             lo_bundle b = lo_bundle_new(tt);
             lo_message m = lo_message_new();
-            for (StrikeField f : kOscStrikeFields) {
-                if (strike_field_info(f).integer)
+            for (int i = 0; i < kStrikeFieldCount; ++i) {
+                const StrikeField f = static_cast<StrikeField>(i);
+                const StrikeFieldInfo &info = strike_field_info(f);
+                if (!info.in_osc)
+                    continue;
+                if (info.integer)
                     lo_message_add_int32(m, static_cast<std::int32_t>(strike_field_integer(e, f)));
                 else
                     lo_message_add_float(m, static_cast<float>(strike_field(e, f)));

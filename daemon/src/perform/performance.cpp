@@ -392,7 +392,7 @@ void Performance::build_score(bool keep_pose)
                                        options_.score.drum_forward_m * forward -
                                        options_.score.drum_below_m * up;
     const DrumParams &drum = options_.scene.drum;
-    // The plan's frame: the brief's shared frames (right = -left), the membrane
+    // The plan's frame: the shared frames of docs/perform.md (right = -left), the membrane
     // raised by the tip's contact height (see contact_height_m).
     r.frame = performer_frame_for_drum(
         drum.center_m +

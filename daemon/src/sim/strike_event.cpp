@@ -12,24 +12,24 @@ namespace ictus
 namespace
 {
 constexpr StrikeFieldInfo kInfo[kStrikeFieldCount] = {
-    {"seq", true, 0},
-    {"hand", true, 0},
-    {"drum", true, 0},
-    {"bounce", true, 0},
-    {"stroke", true, 0},
-    {"time_s", false, 6},
-    {"x_m", false, 5},
-    {"y_m", false, 5},
-    {"r_over_a", false, 5},
-    {"theta_deg", false, 2},
-    {"normal_velocity_mps", false, 4},
-    {"tangential_velocity_mps", false, 4},
-    {"peak_force_n", false, 3},
-    {"impulse_n_s", false, 6},
-    {"duration_ms", false, 3},
-    {"force_dir_x", false, 4},
-    {"force_dir_y", false, 4},
-    {"force_dir_z", false, 4},
+    {"seq", true, 0, true},
+    {"hand", true, 0, true},
+    {"drum", true, 0, true},
+    {"bounce", true, 0, true},
+    {"stroke", true, 0, false}, // per hand; the OSC message has none (docs/osc.md)
+    {"time_s", false, 6, true},
+    {"x_m", false, 5, true},
+    {"y_m", false, 5, true},
+    {"r_over_a", false, 5, true},
+    {"theta_deg", false, 2, true},
+    {"normal_velocity_mps", false, 4, true},
+    {"tangential_velocity_mps", false, 4, true},
+    {"peak_force_n", false, 3, true},
+    {"impulse_n_s", false, 6, true},
+    {"duration_ms", false, 3, true},
+    {"force_dir_x", false, 4, true},
+    {"force_dir_y", false, 4, true},
+    {"force_dir_z", false, 4, true},
 };
 
 // Fixed notation with a given number of decimals; -0 printed as 0 so that
@@ -62,48 +62,6 @@ void put_field(std::ostream &out, const StrikeEvent &e, StrikeField f)
         put(out, strike_field(e, f), info.decimals);
 }
 } // namespace
-
-const StrikeField kCsvStrikeFields[kStrikeFieldCount] = {
-    StrikeField::seq,
-    StrikeField::hand,
-    StrikeField::drum,
-    StrikeField::bounce,
-    StrikeField::stroke,
-    StrikeField::time_s,
-    StrikeField::x_m,
-    StrikeField::y_m,
-    StrikeField::r_over_a,
-    StrikeField::theta_deg,
-    StrikeField::normal_velocity_mps,
-    StrikeField::tangential_velocity_mps,
-    StrikeField::peak_force_n,
-    StrikeField::impulse_n_s,
-    StrikeField::duration_ms,
-    StrikeField::force_dir_x,
-    StrikeField::force_dir_y,
-    StrikeField::force_dir_z,
-};
-
-// /ictus/strike iiii fffffffffffff: the CSV's fields without the stroke number.
-const StrikeField kOscStrikeFields[17] = {
-    StrikeField::seq,
-    StrikeField::hand,
-    StrikeField::drum,
-    StrikeField::bounce,
-    StrikeField::time_s,
-    StrikeField::x_m,
-    StrikeField::y_m,
-    StrikeField::r_over_a,
-    StrikeField::theta_deg,
-    StrikeField::normal_velocity_mps,
-    StrikeField::tangential_velocity_mps,
-    StrikeField::peak_force_n,
-    StrikeField::impulse_n_s,
-    StrikeField::duration_ms,
-    StrikeField::force_dir_x,
-    StrikeField::force_dir_y,
-    StrikeField::force_dir_z,
-};
 
 // A hit line: what a drum patch needs first (patches/ictus-render.pd plays them).
 const StrikeField kEventsStrikeFields[11] = {
@@ -185,7 +143,7 @@ double strike_field(const StrikeEvent &e, StrikeField field)
 void write_strikes_csv_header(std::ostream &out)
 {
     for (int i = 0; i < kStrikeFieldCount; ++i)
-        out << (i ? "," : "") << strike_field_info(kCsvStrikeFields[i]).name;
+        out << (i ? "," : "") << kInfo[i].name;
     out << '\n';
 }
 
@@ -194,7 +152,7 @@ void write_strike_csv_row(std::ostream &out, const StrikeEvent &e)
     for (int i = 0; i < kStrikeFieldCount; ++i) {
         if (i)
             out << ',';
-        put_field(out, e, kCsvStrikeFields[i]);
+        put_field(out, e, static_cast<StrikeField>(i));
     }
     out << '\n';
 }

@@ -106,7 +106,7 @@ class Tracker
   public:
     // mode joint: eq. 1 on every joint toward the reference (and, when a step
     // gives tip targets, the arms toward the kinematic IK of those targets:
-    // "joint targets through IK", issue 6). mode cartesian: Algorithm 2.
+    // "joint targets through IK", docs/perform.md). mode cartesian: Algorithm 2.
     // `gain_options` only for the automatic velocity gain (cartesian.velocity_gain_s < 0).
     // `limits` as Scene::set_joint_limits (empty: none; they must outlive the tracker).
     // Throws CharacterError (a joint missing from the model, bad options).

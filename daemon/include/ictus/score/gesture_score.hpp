@@ -38,7 +38,7 @@ struct PerformerFrame {
                                                  Eigen::Vector3d(-0.1, 0.85, 0.4)};
 };
 
-// The shared frames of the brief (the character faces +Z: right = world -X),
+// The shared frames (docs/perform.md; the character faces +Z: right = world -X),
 // a drum of `radius_m` centred at `membrane_center_m`, and rest tips
 // `rest_height_m` above the head, 0.1 m to each side of the centre and
 // 0.05 m nearer the performer.

@@ -28,8 +28,8 @@ namespace ictus
 // The drum: a membrane disk (the top face of a short cylinder). Contact with
 // the sticks is a spring-damper normal to the membrane: the stiffness of a
 // circular membrane of tension T pressed by a tip of radius r is
-// k = 2 pi T / ln(R / r) (static point-load deflection of a membrane); the
-// interaction issue refines this.
+// k = 2 pi T / ln(R / r) (static point-load deflection of a membrane;
+// docs/character.md).
 struct DrumParams {
     Eigen::Vector3d center_m = Eigen::Vector3d(0.0, 0.7, 0.45); // membrane centre, world
     double radius_m = 0.178;                                    // 14 in snare

@@ -31,7 +31,7 @@ struct StrikeEvent {
     Eigen::Vector3d force_dir = Eigen::Vector3d(0.0, -1.0, 0.0); // on the membrane, world, unit
 };
 
-// The fields of a StrikeEvent, in strikes.csv's column order.
+// The fields of a StrikeEvent, in strikes.csv's column order (and the OSC message's).
 enum class StrikeField {
     seq,
     hand,
@@ -58,16 +58,16 @@ struct StrikeFieldInfo {
     const char *name; // column name, with its unit
     bool integer;     // an integer (seq, hand, ...) or a real
     int decimals;     // fixed decimals of a real in the files
+    bool in_osc;      // part of the /ictus/strike message
 };
 const StrikeFieldInfo &strike_field_info(StrikeField field);
 // A field's value (integers exactly, as doubles).
 double strike_field(const StrikeEvent &event, StrikeField field);
 long strike_field_integer(const StrikeEvent &event, StrikeField field);
 
-// The three layouts: strikes.csv (every field), the /ictus/strike OSC message
-// (after its address), the events file's `hit` line (after "hit").
-extern const StrikeField kCsvStrikeFields[kStrikeFieldCount];
-extern const StrikeField kOscStrikeFields[17];
+// The three layouts: strikes.csv has every field in StrikeField's order; the
+// /ictus/strike OSC message those with in_osc, in the same order; the events
+// file's `hit` line these, after "hit":
 extern const StrikeField kEventsStrikeFields[11];
 
 // strikes.csv: a header line and one line per event, fixed precision (so that
