@@ -454,13 +454,6 @@ int BvhFile::channelled_joints() const
     return count;
 }
 
-Eigen::Quaterniond axis_rotation(int axis, double angle_rad)
-{
-    const Eigen::Vector3d axes[3] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
-                                     Eigen::Vector3d::UnitZ()};
-    return Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, axes[axis < 0 || axis > 2 ? 0 : axis]));
-}
-
 const char *to_string(BvhChannel channel)
 {
     switch (channel) {

@@ -218,24 +218,6 @@ class Writer
 
 } // namespace
 
-Eigen::Vector3d euler_angles(const Eigen::Quaterniond &q, const std::array<int, 3> &order)
-{
-    // R = R_i(a) R_j(b) R_k(c). With s = +1 for the cyclic orders (XYZ, YZX,
-    // ZXY) and -1 for the others: R(i,k) = s sin b, and a from the j and k rows
-    // of the third column. c is taken from M = R_i(a)^T R = R_j(b) R_k(c),
-    // whose row j is that of R_k(c) alone: stable at gimbal lock, where the
-    // textbook atan2(R(i,j), R(i,i)) loses c (Shoemake's method, as in Eigen).
-    const int i = order[0], j = order[1], k = order[2];
-    const double s = ((j - i + 3) % 3 == 1) ? 1.0 : -1.0;
-    const Eigen::Matrix3d r = q.normalized().toRotationMatrix();
-    Eigen::Vector3d angles;
-    angles[1] = std::atan2(s * r(i, k), std::hypot(r(i, i), r(i, j)));
-    angles[0] = std::atan2(-s * r(j, k), r(k, k));
-    const Eigen::Matrix3d m = axis_rotation(i, angles[0]).toRotationMatrix().transpose() * r;
-    angles[2] = std::atan2(s * m(j, i), m(j, j));
-    return angles;
-}
-
 void write_bvh(std::ostream &out, const Skeleton &skeleton, const Motion &motion,
                const BvhWriteOptions &options, const std::string &source_name)
 {

@@ -1,8 +1,10 @@
-// rotation.cpp -- sign-robust mean rotation and Tait-Bryan angles (joint_limits.hpp).
+// rotation.cpp -- the sign-robust mean rotation and the named Tait-Bryan orders
+// (joint_limits.hpp) over base/rotation.hpp.
 #include "ictus/mocap/joint_limits.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 
@@ -69,55 +71,22 @@ EulerOrder euler_order_from_string(const std::string &text)
 
 namespace
 {
-
-// Axis indices (i, j, k) of an order; `cyclic` when (i, j, k) is an even
-// permutation of (0, 1, 2).
-void order_axes(EulerOrder order, int &i, int &j, int &k, bool &cyclic)
+// The axes (i, j, k) of an order, 0 = x.
+std::array<int, 3> order_axes(EulerOrder order)
 {
     const char *name = to_string(order);
-    i = name[0] - 'X';
-    j = name[1] - 'X';
-    k = name[2] - 'X';
-    cyclic = ((j - i + 3) % 3) == 1;
+    return {name[0] - 'X', name[1] - 'X', name[2] - 'X'};
 }
-
 } // namespace
 
 Eigen::Vector3d euler_angles(const Eigen::Quaterniond &q, EulerOrder order)
 {
-    int i, j, k;
-    bool cyclic;
-    order_axes(order, i, j, k, cyclic);
-    const Eigen::Matrix3d r = q.normalized().toRotationMatrix();
-    // R = R_i(a0) R_j(a1) R_k(a2). For a cyclic order R(i,k) = sin a1,
-    // R(j,k) = -sin a0 cos a1, R(k,k) = cos a0 cos a1, R(i,j) = -cos a1 sin a2,
-    // R(i,i) = cos a1 cos a2; an anti-cyclic order flips the off-diagonal signs.
-    const double s = cyclic ? 1.0 : -1.0;
-    const double sin_a1 = std::clamp(s * r(i, k), -1.0, 1.0);
-    Eigen::Vector3d a;
-    a[1] = std::asin(sin_a1);
-    if (std::fabs(sin_a1) < 1.0 - 1e-12) {
-        a[0] = std::atan2(-s * r(j, k), r(k, k));
-        a[2] = std::atan2(-s * r(i, j), r(i, i));
-    } else {
-        // Gimbal lock: only a0 +/- a2 is defined; put it all in a0.
-        a[2] = 0.0;
-        a[0] = std::atan2(s * r(k, j), r(j, j));
-    }
-    return a;
+    return euler_angles(q, order_axes(order));
 }
 
 Eigen::Quaterniond from_euler(const Eigen::Vector3d &angles_rad, EulerOrder order)
 {
-    int i, j, k;
-    bool cyclic;
-    order_axes(order, i, j, k, cyclic);
-    const Eigen::Vector3d axes[3] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
-                                     Eigen::Vector3d::UnitZ()};
-    return (Eigen::Quaterniond(Eigen::AngleAxisd(angles_rad[0], axes[i])) *
-            Eigen::Quaterniond(Eigen::AngleAxisd(angles_rad[1], axes[j])) *
-            Eigen::Quaterniond(Eigen::AngleAxisd(angles_rad[2], axes[k])))
-        .normalized();
+    return from_euler(angles_rad, order_axes(order));
 }
 
 } // namespace ictus

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 
 namespace ictus
 {
@@ -21,5 +22,16 @@ Eigen::Quaterniond exp_map(const Eigen::Vector3d &rotation_vector_rad);
 
 // Angle in [0, pi] of the rotation taking `from` to `to`.
 double rotation_angle_between(const Eigen::Quaterniond &from, const Eigen::Quaterniond &to);
+
+// The rotation by angle_rad about axis 0 (x), 1 (y) or 2 (z).
+Eigen::Quaterniond axis_rotation(int axis, double angle_rad);
+
+// Tait-Bryan angles (rad) of a rotation about the axes `axes` (a permutation
+// of {0, 1, 2}), intrinsic: q = R_axes[0](a[0]) * R_axes[1](a[1]) * R_axes[2](a[2]),
+// a[0], a[2] in (-pi, pi], a[1] in [-pi/2, pi/2]. At gimbal lock (a[1] = +-pi/2)
+// a[0] and a[2] are not unique; the pair returned still composes to q to rounding.
+Eigen::Vector3d euler_angles(const Eigen::Quaterniond &q, const std::array<int, 3> &axes);
+// The rotation of Tait-Bryan angles (rad) about `axes`, as above.
+Eigen::Quaterniond from_euler(const Eigen::Vector3d &angles_rad, const std::array<int, 3> &axes);
 
 } // namespace ictus

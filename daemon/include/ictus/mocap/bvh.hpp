@@ -8,6 +8,7 @@
 // World frame as in BVH: right-handed, y up. See docs/mocap.md.
 #pragma once
 
+#include "ictus/base/rotation.hpp" // axis_rotation, euler_angles: the BVH Euler composition
 #include "ictus/mocap/mocap_error.hpp"
 #include "ictus/mocap/motion.hpp"
 
@@ -64,10 +65,6 @@ BvhFile parse_bvh(std::istream &in, const std::string &source_name, const BvhOpt
 // Forward kinematics honouring non-root position channels (joint_translation_m).
 std::vector<Eigen::Vector3d> bvh_forward_kinematics(const BvhFile &bvh, int frame);
 
-// Rotation about x, y or z by angle_rad (right-handed); the building block of
-// the BVH Euler composition.
-Eigen::Quaterniond axis_rotation(int axis, double angle_rad);
-
 const char *to_string(BvhChannel channel);
 
 } // namespace ictus
@@ -105,10 +102,5 @@ void write_bvh(std::ostream &out, const Skeleton &skeleton, const Motion &motion
 void write_bvh(const std::string &path, const Skeleton &skeleton, const Motion &motion,
                const BvhWriteOptions &options = {});
 
-// Tait-Bryan angles (rad) of a rotation about the axes `order` (a permutation
-// of {0, 1, 2}): q = R_order[0](a[0]) * R_order[1](a[1]) * R_order[2](a[2]),
-// with a[1] in [-pi/2, pi/2]. At gimbal lock (a[1] = +-pi/2) a[0] and a[2]
-// are not unique; the pair returned still composes to q to rounding.
-Eigen::Vector3d euler_angles(const Eigen::Quaterniond &q, const std::array<int, 3> &order);
 
 } // namespace ictus

@@ -32,8 +32,8 @@ enum class EulerOrder { XYZ, XZY, YXZ, YZX, ZXY, ZYX };
 const char *to_string(EulerOrder order);
 // Parses "XYZ".."ZYX" (case-insensitive); throws MocapError otherwise.
 EulerOrder euler_order_from_string(const std::string &text);
-// Angles (rad) a0, a1, a2 with a0, a2 in (-pi, pi], a1 in [-pi/2, pi/2].
-// At gimbal lock (|a1| = pi/2) a2 is set to 0.
+// Angles (rad) a0, a1, a2 with a0, a2 in (-pi, pi], a1 in [-pi/2, pi/2]
+// (base/rotation.hpp's euler_angles about the order's axes).
 Eigen::Vector3d euler_angles(const Eigen::Quaterniond &q, EulerOrder order);
 Eigen::Quaterniond from_euler(const Eigen::Vector3d &angles_rad, EulerOrder order);
 
