@@ -87,8 +87,7 @@ TEST_CASE("still pose: each joint sags by its gravity torque over k_s, and no mo
         const double tg = gravity_torque(m, pose, j, so.gravity_mps2);
         REQUIRE(tg < gains[j].torque_limit_nm);
         const double predicted_deg = tg / gains[j].kp_nm_per_rad * 180 / M_PI;
-        const double err_deg =
-            log_map(pose.local[j] * local[j].conjugate()).norm() * 180 / M_PI;
+        const double err_deg = log_map(pose.local[j] * local[j].conjugate()).norm() * 180 / M_PI;
         INFO("joint " << m.joint_name(j) << ": sag " << err_deg << " deg, statics " << predicted_deg
                       << " deg, direct solver " << direct);
         if (direct) {

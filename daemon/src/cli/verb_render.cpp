@@ -394,10 +394,11 @@ int cmd_render(Args &args)
         write("tips.csv", [&](std::ostream &out) { return static_cast<bool>(out << tips.str()); });
         j["performance"] = performance_json(o, perf, m);
     }
-    write("render.json", [&](std::ostream &out) { return static_cast<bool>(out << j.dump(2) << "\n"); });
+    write("render.json",
+          [&](std::ostream &out) { return static_cast<bool>(out << j.dump(2) << "\n"); });
     std::cout << "render: " << perf.time_s() << " s simulated in " << wall << " s ("
-              << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes
-              << " strikes (" << bounces << " bounces), wrote " << out_dir
+              << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes << " strikes ("
+              << bounces << " bounces), wrote " << out_dir
               << (score_mode ? "/{strikes.csv,events.txt,render.json,tips.csv,notes.csv"
                              : "/{strikes.csv,events.txt,render.json")
               << (bvh ? ",performance.bvh}\n" : "}\n");

@@ -151,8 +151,7 @@ int cmd_run(Args &args)
     const double h = perf.step_s();
     const auto period =
         std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(h));
-    const long pose_every =
-        pose_rate > 0.0 ? std::max(1L, std::lround(1.0 / (pose_rate * h))) : 0;
+    const long pose_every = pose_rate > 0.0 ? std::max(1L, std::lround(1.0 / (pose_rate * h))) : 0;
     const long tip_every = tip_rate > 0.0 ? std::max(1L, std::lround(1.0 / (tip_rate * h))) : 0;
     const long steps = duration > 0.0 ? std::lround(duration / h) : -1;
     // Simulation time 0 is now, on the wall clock and in NTP.
@@ -221,9 +220,9 @@ int cmd_run(Args &args)
     const OscServerCounters rc = server.counters();
     std::cout << "run: " << perf.time_s() << " s simulated, " << sc.strikes_sent
               << " strikes sent (" << sc.strikes_dropped << " dropped), " << sc.poses_sent
-              << " poses, " << sc.send_errors << " send errors; " << rc.packets
-              << " packets in, " << rc.accepted << " accepted, " << rc.errors() << " errors, "
-              << rc.refused_peers << " refused; " << status.overruns.load() << " overruns\n";
+              << " poses, " << sc.send_errors << " send errors; " << rc.packets << " packets in, "
+              << rc.accepted << " accepted, " << rc.errors() << " errors, " << rc.refused_peers
+              << " refused; " << status.overruns.load() << " overruns\n";
     return g_interrupted ? 130 : 0;
 }
 

@@ -143,8 +143,7 @@ TrackArgs parse_track_args(Args &args)
             const std::string v = args.value(a);
             if (v != "y" && v != "z")
                 throw UsageError("--up: expected y or z, got '" + v + "'");
-            t.csv_options.up =
-                v == "z" ? MarkerCsvOptions::Up::z : MarkerCsvOptions::Up::y;
+            t.csv_options.up = v == "z" ? MarkerCsvOptions::Up::z : MarkerCsvOptions::Up::y;
             t.csv_options_given = true;
         } else if (a == "--rate") {
             t.csv_options.rate_hz = parse_positive(a, args.value(a));
@@ -223,7 +222,8 @@ TrackArgs parse_track_args(Args &args)
             t.gains_file = args.value(a);
         } else if (a == "--limits") {
             t.limits_mode = args.value(a);
-            if (t.limits_mode != "none" && t.limits_mode != "euler" && t.limits_mode != "quaternion")
+            if (t.limits_mode != "none" && t.limits_mode != "euler" &&
+                t.limits_mode != "quaternion")
                 throw UsageError("--limits: expected none, euler or quaternion, got '" +
                                  t.limits_mode + "'");
         } else if (a == "--limit-k") {

@@ -304,8 +304,7 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                 ++summary.samples;
                 for (int j = 0; j < nj; ++j) {
                     const double e =
-                        log_map(ref_pose.local[j] * sim_local[j].conjugate()).norm() *
-                        kRadToDeg;
+                        log_map(ref_pose.local[j] * sim_local[j].conjugate()).norm() * kRadToDeg;
                     joint_sum2[j] += e * e;
                     joint_max[j] = std::max(joint_max[j], e);
                 }
@@ -337,8 +336,7 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                     const Eigen::Vector3d r = log_map(ref_pose.local[j]) * kRadToDeg;
                     const Eigen::Vector3d q = log_map(sim_local[j]) * kRadToDeg;
                     const double e =
-                        log_map(ref_pose.local[j] * sim_local[j].conjugate()).norm() *
-                        kRadToDeg;
+                        log_map(ref_pose.local[j] * sim_local[j].conjugate()).norm() * kRadToDeg;
                     *csv << ',' << r.x() << ',' << r.y() << ',' << r.z() << ',' << q.x() << ','
                          << q.y() << ',' << q.z() << ',' << e;
                 }

@@ -42,7 +42,6 @@ TrackMode track_mode_from_string(const std::string &text)
     throw CharacterError("mode: expected joint or cartesian, got '" + text + "'");
 }
 
-
 // One arm of Algorithm 2: the chain thorax -> clavicle -> shoulder -> elbow ->
 // wrist -> stick tip (docs/ik.md), twice: `feedback` is solved every step from
 // the simulated state (eq. 2), `kinematic` follows the targets alone (warm-started
@@ -217,12 +216,11 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
             for (int k = 0; k < 4; ++k) {
                 const int j = arm.joint[k];
                 target_[j] = arm.theta_target[k];
-                rate_[j] =
-                    steps_ == 0
-                        ? Eigen::Vector3d::Zero()
-                        : Eigen::Vector3d(log_map(arm.kinematic_target[k] *
-                                                          arm.previous_kinematic[k].conjugate()) /
-                                          h);
+                rate_[j] = steps_ == 0
+                               ? Eigen::Vector3d::Zero()
+                               : Eigen::Vector3d(log_map(arm.kinematic_target[k] *
+                                                         arm.previous_kinematic[k].conjugate()) /
+                                                 h);
                 arm.previous_kinematic[k] = arm.kinematic_target[k];
             }
         }

@@ -65,16 +65,11 @@ void put_field(std::ostream &out, const StrikeEvent &e, StrikeField f)
 
 // A hit line: what a drum patch needs first (patches/ictus-render.pd plays them).
 const StrikeField kEventsStrikeFields[11] = {
-    StrikeField::hand,
-    StrikeField::drum,
-    StrikeField::bounce,
-    StrikeField::normal_velocity_mps,
-    StrikeField::r_over_a,
-    StrikeField::theta_deg,
-    StrikeField::peak_force_n,
-    StrikeField::impulse_n_s,
-    StrikeField::duration_ms,
-    StrikeField::tangential_velocity_mps,
+    StrikeField::hand,         StrikeField::drum,
+    StrikeField::bounce,       StrikeField::normal_velocity_mps,
+    StrikeField::r_over_a,     StrikeField::theta_deg,
+    StrikeField::peak_force_n, StrikeField::impulse_n_s,
+    StrikeField::duration_ms,  StrikeField::tangential_velocity_mps,
     StrikeField::time_s,
 };
 

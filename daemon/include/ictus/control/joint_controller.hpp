@@ -42,7 +42,6 @@ struct GainOptions {
     bool rate_feedforward = true;
 };
 
-
 // gains = base with every kp scaled by scale[0] and every kd by scale[1]
 // (the live /ictus/gains command).
 void scale_gains(const std::vector<JointGains> &base, const double scale[2],

@@ -102,5 +102,4 @@ void write_bvh(std::ostream &out, const Skeleton &skeleton, const Motion &motion
 void write_bvh(const std::string &path, const Skeleton &skeleton, const Motion &motion,
                const BvhWriteOptions &options = {});
 
-
 } // namespace ictus

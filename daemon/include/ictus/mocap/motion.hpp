@@ -7,7 +7,8 @@
 #include <string>
 #include <vector>
 
-namespace ictus {
+namespace ictus
+{
 
 // One joint of a mocap skeleton. The root has parent == -1. `offset_m` is the
 // joint's position in its parent's frame at the rest pose (BVH OFFSET, scaled).
@@ -30,8 +31,8 @@ struct Skeleton {
 // World frame: right-handed, y up (readers convert other conventions).
 struct Motion {
     double frame_rate_hz = 0.0;
-    std::vector<Eigen::Vector3d> root_position_m;                  // [frame]
-    std::vector<std::vector<Eigen::Quaterniond>> local_rotation;  // [frame][joint]
+    std::vector<Eigen::Vector3d> root_position_m;                // [frame]
+    std::vector<std::vector<Eigen::Quaterniond>> local_rotation; // [frame][joint]
     int frames() const { return static_cast<int>(root_position_m.size()); }
 };
 
@@ -47,12 +48,12 @@ std::vector<Eigen::Quaterniond> world_rotations(const Skeleton &skeleton, const 
 // gap filling.
 struct MarkerTrack {
     std::string name;
-    std::vector<Eigen::Vector3d> position_m;        // [frame]
-    std::vector<Eigen::Quaterniond> orientation;    // [frame] or empty
+    std::vector<Eigen::Vector3d> position_m;     // [frame]
+    std::vector<Eigen::Quaterniond> orientation; // [frame] or empty
 };
 
 struct MarkerCapture {
-    std::vector<double> time_s;  // [frame], strictly increasing
+    std::vector<double> time_s; // [frame], strictly increasing
     std::vector<MarkerTrack> tracks;
     int find(const std::string &name) const;
 };
@@ -62,4 +63,4 @@ Motion resample(const Motion &motion, double rate_hz);
 // Resamples marker tracks onto a uniform grid at rate_hz from time_s.front().
 MarkerCapture resample(const MarkerCapture &capture, double rate_hz);
 
-}  // namespace ictus
+} // namespace ictus

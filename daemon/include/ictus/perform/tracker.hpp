@@ -69,7 +69,6 @@ struct CartesianOptions {
     IkParams ik;
 };
 
-
 // The targets' ramp at start-up (a step in the targets jolts the trunk,
 // docs/character.md): the smoothstep 3x^2 - 2x^3 of t / ramp_s, 1 from ramp_s
 // on (and at once when ramp_s is 0).
