@@ -95,15 +95,15 @@ int cmd_limits(Args &args)
         } else if (a == "--min-deg") {
             lo.min_half_width_rad = parse_min_half_width_deg(a, args.value(a)) * M_PI / 180.0;
         } else if (!a.empty() && a[0] == '-' && a != "-") {
-            throw UsageError("limits: unknown option '" + a + "' (see ictusd limits --help)");
+            throw UsageError("unknown option '" + a + "' (see ictusd limits --help)");
         } else if (file.empty()) {
             file = a;
         } else {
-            throw UsageError("limits: one FILE expected, got also '" + a + "'");
+            throw UsageError("one FILE expected, got also '" + a + "'");
         }
     }
     if (file.empty())
-        throw UsageError("limits: FILE is required (ictusd limits FILE)");
+        throw UsageError("FILE is required (ictusd limits FILE)");
     const BvhFile bvh = load_bvh(file, clip.scale, clip.skip);
     const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton);
     const ReferenceMotion reference(model, bvh.motion, clip.filter);

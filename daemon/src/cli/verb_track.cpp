@@ -240,28 +240,28 @@ TrackArgs parse_track_args(Args &args)
         } else if (a == "--quiet" || a == "-q") {
             t.quiet = true;
         } else {
-            throw UsageError("track: unknown option '" + a + "' (see ictusd track --help)");
+            throw UsageError("unknown option '" + a + "' (see ictusd track --help)");
         }
     }
     if (t.mode.empty())
-        throw UsageError("track: --mode is required (--mode joint or --mode cartesian)");
+        throw UsageError("--mode is required (--mode joint or --mode cartesian)");
     if (t.mocap.empty())
-        throw UsageError("track: --mocap FILE is required");
+        throw UsageError("--mocap FILE is required");
     t.options.drum_auto = !t.drum_pos_given;
     // Option values that only the model can judge (e.g. a too-long step) are
     // usage errors too: check them before reading the file.
     try {
         validate(t.options);
     } catch (const CharacterError &e) {
-        throw UsageError(std::string("track: ") + e.what());
+        throw UsageError(e.what());
     }
     // A .csv capture is stick-only (Cartesian mode): the default body holds a
     // neutral pose and its arms follow the two stick tips.
     t.stick_only = is_csv(t.mocap);
     if (t.stick_only && t.options.mode != TrackMode::cartesian)
-        throw UsageError("track: a stick-only capture (" + t.mocap + ") needs --mode cartesian");
+        throw UsageError("a stick-only capture (" + t.mocap + ") needs --mode cartesian");
     if (!t.stick_only && (!t.left_stick.empty() || !t.right_stick.empty() || t.csv_options_given))
-        throw UsageError("track: --left-stick, --right-stick, --units, --up and --rate apply "
+        throw UsageError("--left-stick, --right-stick, --units, --up and --rate apply "
                          "to stick-only .csv captures");
     if (t.stick_only && t.limits_mode != "none") {
         std::cerr << "ictusd: note: stick-only capture: no joint limits (they are learned "
@@ -296,7 +296,7 @@ void load_track_input(TrackArgs &t, TrackInput &in)
         try {
             stick_tracks = find_stick_tracks(capture, t.left_stick, t.right_stick);
         } catch (const CharacterError &e) {
-            throw UsageError(std::string("track: ") + e.what());
+            throw UsageError(e.what());
         }
         in.bvh.skeleton = default_skeleton();
         in.bvh.motion.frame_rate_hz = 100.0;
