@@ -3,24 +3,32 @@
 # with an error naming every file that breaks one.
 #
 # Daemon: areas in the order of the chain; a file of an area may include the
-# headers of its own area and of the areas before it, never after:
+# headers of its own area and of the areas listed for it below (all before it
+# in the chain, never after):
 #   base mocap character control sim gesture score perform net cli
 # ODE (<ode/...>) only in src/sim, liblo (<lo/...>) only in src/net: control
-# never sees ODE, sim and perform never see liblo. Every header lives in
-# include/ictus/<area>/, every source in src/<area>/.
+# never sees ODE, sim and perform never see liblo. Every public header lives in
+# include/ictus/<area>/, every source (and private header) in src/<area>/.
 # Externals: the DSP core (externals/core) never includes Pd (m_pd.h) nor a
-# wrapper; membrane never includes contact (contact -> membrane, one way).
+# wrapper; the membrane (and its mode table, Bessel zeros) never includes the
+# contact (contact -> membrane, one way).
 if(NOT ICTUS_ROOT)
   message(FATAL_ERROR "check_layout: -DICTUS_ROOT=<source tree> is required")
 endif()
 
 set(areas base mocap character control sim gesture score perform net cli)
+# What each area may include besides itself (docs/architecture.md).
+set(allow_base "")
+set(allow_mocap base)
+set(allow_character base mocap)
+set(allow_control base mocap character)
+set(allow_sim base mocap character control)
+set(allow_gesture base mocap character)
+set(allow_score base mocap character gesture)
+set(allow_perform base mocap character control sim gesture score)
+set(allow_net base mocap character control sim gesture score perform)
+set(allow_cli base mocap character control sim gesture score perform net)
 set(errors "")
-
-function(area_rank area out)
-  list(FIND areas "${area}" rank)
-  set(${out} ${rank} PARENT_SCOPE)
-endfunction()
 
 # The includes of a file: a list of "LINE|TARGET" ("ictus/sim/scene.hpp", "<ode/ode.h>").
 function(file_includes path out)
@@ -51,10 +59,10 @@ foreach(rel IN LISTS daemon_files)
     set(area "${CMAKE_MATCH_1}")
     set(is_source TRUE)
   else()
-    list(APPEND errors "daemon/${rel}: not in an area (headers go in include/ictus/<area>/, sources in src/<area>/)")
+    list(APPEND errors "daemon/${rel}: not in an area (public headers go in include/ictus/<area>/, sources in src/<area>/)")
     continue()
   endif()
-  area_rank("${area}" rank)
+  list(FIND areas "${area}" rank)
   if(rank LESS 0)
     list(APPEND errors "daemon/${rel}: '${area}' is not an area (${areas})")
     continue()
@@ -67,11 +75,13 @@ foreach(rel IN LISTS daemon_files)
     set(where "daemon/${rel}:${line}")
     if(target MATCHES "^[<\"]ictus/([a-z_]+)/")
       set(to "${CMAKE_MATCH_1}")
-      area_rank("${to}" to_rank)
+      list(FIND areas "${to}" to_rank)
+      list(FIND allow_${area} "${to}" allowed)
       if(to_rank LESS 0)
         list(APPEND errors "${where}: includes ${target}: '${to}' is not an area")
-      elseif(to_rank GREATER rank)
-        list(APPEND errors "${where}: ${area} includes ${target}: ${to} comes after ${area} in the chain (includes go one way down)")
+      elseif(NOT to STREQUAL area AND allowed LESS 0)
+        string(REPLACE ";" ", " may "${allow_${area}}")
+        list(APPEND errors "${where}: ${area} includes ${target}: ${area} may include only ${may} (includes go one way down the chain)")
       endif()
     elseif(target MATCHES "^[<\"]ictus/[^/]+$")
       list(APPEND errors "${where}: includes ${target}: headers are under ictus/<area>/")
@@ -103,7 +113,7 @@ foreach(rel IN LISTS core_files)
       list(APPEND errors "${where}: includes ${target}: the DSP core never sees Pd")
     elseif(target MATCHES "^\"\\.\\./|^\"pd/|ictus_pd")
       list(APPEND errors "${where}: includes ${target}: the core never includes a Pd wrapper")
-    elseif(rel MATCHES "^membrane" AND target MATCHES "contact")
+    elseif(rel MATCHES "^(membrane|mode_table|bessel)" AND target MATCHES "contact")
       list(APPEND errors "${where}: includes ${target}: contact depends on membrane, never the reverse")
     endif()
   endforeach()

@@ -3,6 +3,7 @@
 // at 1 kHz while tracking the CMU drumming clip, with a breakdown (targets,
 // control, collide, solve, check) and the real-time factor on one core.
 // usage: bench_sim_step [BVH] [seconds] [iterations] [drum raise above the lowest tips, m]
+#include "ictus/base/rotation.hpp"
 #include "ictus/mocap/bvh.hpp"
 #include "ictus/mocap/joint_limits.hpp"
 #include "ictus/sim/scene.hpp"

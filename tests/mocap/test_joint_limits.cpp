@@ -2,6 +2,7 @@
 // angles with known ranges, and Algorithm 1 recovering known axes and spreads.
 #include "mocap_test_util.hpp"
 
+#include "ictus/base/rotation.hpp"
 #include "ictus/mocap/bvh.hpp"
 #include "ictus/mocap/joint_limits.hpp"
 

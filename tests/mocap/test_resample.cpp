@@ -1,6 +1,7 @@
 // Resampling from capture rate to physics rate against analytic motions.
 #include "mocap_test_util.hpp"
 
+#include "ictus/base/rotation.hpp"
 #include "ictus/mocap/joint_limits.hpp"
 #include "ictus/mocap/motion.hpp"
 

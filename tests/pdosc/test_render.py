@@ -1,5 +1,5 @@
 """Offline: patches/ictus-render.pd plays an events file in the format of
-`ictusd render` (daemon/include/ictus/strike.hpp, docs/osc.md:
+`ictusd render` (daemon/include/ictus/sim/strike_event.hpp, docs/osc.md:
 `<delay_ms since previous line> hit <hand> <drum> <bounce> <normal_velocity_mps>
 <r_over_a> <theta_deg> <peak_force_n> <impulse_n_s> <duration_ms>
 <tangential_velocity_mps> <time_s>;`) in real pd batch mode, and each stroke

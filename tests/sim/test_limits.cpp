@@ -1,5 +1,6 @@
 // Joint limits as enforced: targets clamped into the learned region, the joint
 // stays inside, the ellipsoid clamp is the closest point, stops catch a kick.
+#include "ictus/base/rotation.hpp"
 #include "ictus/character/character_limits.hpp"
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/sim/scene.hpp"

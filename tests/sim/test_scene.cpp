@@ -1,4 +1,5 @@
 // The ODE scene: still-pose PD equilibrium against statics, divergence handling.
+#include "ictus/base/rotation.hpp"
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/sim/scene.hpp"
 #include "ictus/sim/strike_detector.hpp"

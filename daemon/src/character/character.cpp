@@ -1,6 +1,7 @@
 // The character model: CMU skeleton -> 19 ball joints, de Leva masses, sticks.
 #include "ictus/character/character.hpp"
 #include "ictus/character/anthropometry.hpp"
+#include "ictus/base/rotation.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -499,16 +500,12 @@ ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &moti
                     const int g = f + k;
                     if (g < 0 || g >= n)
                         continue;
-                    Eigen::Quaterniond d = q.conjugate() * frames_[g].local[j];
-                    if (d.w() < 0.0)
-                        d.coeffs() = -d.coeffs();
-                    const double s = d.vec().norm();
-                    const Eigen::Vector3d v =
-                        s < 1e-12 ? Eigen::Vector3d(2.0 * d.vec())
-                                  : Eigen::Vector3d(d.vec() * (2.0 * std::atan2(s, d.w()) / s));
+                    const Eigen::Vector3d v = log_map(q.conjugate() * frames_[g].local[j]);
                     sum += w[k + half] * v;
                     wsum += w[k + half];
                 }
+                // Back from the tangent space through Eigen's angle-axis (the
+                // reference outputs were measured with it; exp_map differs by rounding).
                 const Eigen::Vector3d mean = sum / wsum;
                 const double a = mean.norm();
                 const Eigen::Quaterniond e =

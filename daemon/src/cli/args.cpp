@@ -83,14 +83,14 @@ std::vector<std::string> split(const std::string &text, char separator)
     return parts;
 }
 
-Eigen::Vector3d parse_vec3(const std::string &option, const std::string &text)
+Eigen::Vector3d parse_vec3(const std::string &option, const std::string &text, double lo, double hi)
 {
     const std::vector<std::string> parts = split(text, ',');
     if (parts.size() != 3)
         throw UsageError(option + ": expected X,Y,Z, got '" + text + "'");
     Eigen::Vector3d v;
     for (int i = 0; i < 3; ++i)
-        v[i] = parse_number(option, parts[static_cast<size_t>(i)]);
+        v[i] = parse_number(option, parts[static_cast<size_t>(i)], lo, hi);
     return v;
 }
 

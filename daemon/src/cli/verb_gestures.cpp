@@ -65,124 +65,95 @@ void print_units(const GestureDatabase &db)
 
 int cmd_gestures(Args &args)
 {
-    {
-        bool list = false;
-        std::string export_path, import_path, db_path, out_path;
-        std::string grip, nuance, hand;
-        int stroke = -1;
-        double dynamics = 0.6;
-        ImportOptions io;
-        while (!args.done()) {
-            const std::string a = args.next();
-            auto value = [&]() { return args.value(a); };
-            if (a == "--help" || a == "-h") {
-                gestures_usage(std::cout);
-                return 0;
-            } else if (a == "--list") {
-                list = true;
-            } else if (a == "--export") {
-                export_path = value();
-            } else if (a == "--import") {
-                import_path = value();
-            } else if (a == "--db") {
-                db_path = value();
-            } else if (a == "--out") {
-                out_path = value();
-            } else if (a == "--grip") {
-                grip = value();
-            } else if (a == "--nuance") {
-                nuance = value();
-            } else if (a == "--hand") {
-                hand = value();
-            } else if (a == "--stroke") {
-                const double k = parse_number(a, value());
-                if (k < 0 || k != std::floor(k) || k > 1e6)
-                    throw UsageError("--stroke: expected an index >= 0");
-                stroke = static_cast<int>(k);
-            } else if (a == "--dynamics") {
-                dynamics = parse_number(a, value());
-                if (dynamics < 0.0 || dynamics > 1.0)
-                    throw UsageError("--dynamics: must be in [0, 1], got " +
-                                     std::to_string(dynamics));
-            } else if (a == "--scale") {
-                io.bvh_scale = parse_number(a, value());
-                if (!(io.bvh_scale > 0.0))
-                    throw UsageError("--scale: must be > 0");
-            } else if (a == "--skip-frames") {
-                const double k = parse_number(a, value());
-                if (k < 0 || k != std::floor(k) || k > 1e9)
-                    throw UsageError("--skip-frames: expected an integer >= 0");
-                io.bvh_skip_frames = static_cast<int>(k);
-            } else if (a == "--units") {
-                const std::string v = value();
-                if (v != "mm" && v != "m")
-                    throw UsageError("--units: expected mm or m, got '" + v + "'");
-                io.csv_mm = v == "mm";
-            } else if (a == "--up") {
-                const std::string v = value();
-                if (v != "y" && v != "z")
-                    throw UsageError("--up: expected y or z, got '" + v + "'");
-                io.csv_z_up = v == "z";
-            } else if (a == "--rate") {
-                io.csv_rate_hz = parse_number(a, value());
-                if (!(io.csv_rate_hz > 0.0))
-                    throw UsageError("--rate: must be > 0");
-            } else if (a == "--left-stick") {
-                io.left_stick = value();
-            } else if (a == "--right-stick") {
-                io.right_stick = value();
-            } else {
-                throw UsageError("unknown option '" + a + "' (see ictusd gestures --help)");
-            }
+    bool list = false;
+    std::string export_path, import_path, db_path, out_path;
+    std::string grip, nuance, hand;
+    int stroke = -1;
+    double dynamics = 0.6;
+    ImportOptions io;
+    StickCsvOptions sticks;
+    while (!args.done()) {
+        const std::string a = args.next();
+        auto value = [&]() { return args.value(a); };
+        if (a == "--help" || a == "-h") {
+            gestures_usage(std::cout);
+            return 0;
+        } else if (a == "--list") {
+            list = true;
+        } else if (a == "--export") {
+            export_path = value();
+        } else if (a == "--import") {
+            import_path = value();
+        } else if (a == "--db") {
+            db_path = value();
+        } else if (a == "--out") {
+            out_path = value();
+        } else if (a == "--grip") {
+            grip = value();
+        } else if (a == "--nuance") {
+            nuance = value();
+        } else if (a == "--hand") {
+            hand = value();
+        } else if (a == "--stroke") {
+            stroke = parse_int(a, value(), 0, 1000000);
+        } else if (a == "--dynamics") {
+            dynamics = parse_number(a, value(), 0.0, 1.0);
+        } else if (parse_bvh_option(a, args, io.bvh_scale, io.bvh_skip_frames)) {
+        } else if (parse_stick_csv_option(a, args, sticks)) {
+        } else {
+            throw UsageError("unknown option '" + a + "' (see ictusd gestures --help)");
         }
-        const int actions = list + !export_path.empty() + !import_path.empty();
-        if (actions != 1)
-            throw UsageError("give exactly one of --list, --export FILE, --import CAPTURE");
+    }
+    const int actions = list + !export_path.empty() + !import_path.empty();
+    if (actions != 1)
+        throw UsageError("give exactly one of --list, --export FILE, --import CAPTURE");
 
-        if (!export_path.empty()) {
-            const GestureDatabase db = GestureDatabase::builtin();
-            db.save_json(export_path);
-            std::cout << "wrote " << db.units().size() << " units to " << export_path << "\n";
-            return 0;
-        }
-        if (list) {
-            const GestureDatabase db =
-                db_path.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(db_path);
-            print_units(db);
-            return 0;
-        }
-        // --import
-        if (grip.empty() || nuance.empty() || hand.empty() || out_path.empty())
-            throw UsageError("--import needs --grip, --nuance, --hand and --out");
-        Grip g;
-        Nuance n;
-        Side h;
-        try {
-            g = grip_from_string(grip);
-            n = nuance_from_string(nuance);
-            h = side_from_string(hand);
-        } catch (const std::runtime_error &e) {
-            throw UsageError(e.what());
-        }
-        GestureDatabase db =
-            db_path.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(db_path);
-        const std::vector<GestureUnit> units = import_capture(import_path, g, n, h, io);
-        if (stroke >= static_cast<int>(units.size()))
-            throw UsageError("--stroke " + std::to_string(stroke) + ": the capture has " +
-                             std::to_string(units.size()) + " strokes");
-        const GestureUnit &picked = stroke >= 0 ? units[stroke] : representative_unit(units);
-        GestureUnit chosen = picked;
-        chosen.dynamics = dynamics;
-        std::cout << import_path << ": " << units.size() << " strokes; importing stroke "
-                  << (&picked - units.data()) << " (strike at "
-                  << chosen.capture_time_s + chosen.strike_time_s() << " s, impact "
-                  << chosen.impact_speed_mps() << " m/s, preparation "
-                  << chosen.preparation_height_m() << " m)\n";
-        db.add(chosen);
-        db.save_json(out_path);
-        std::cout << "wrote " << db.units().size() << " units to " << out_path << "\n";
+    if (!export_path.empty()) {
+        const GestureDatabase db = GestureDatabase::builtin();
+        db.save_json(export_path);
+        std::cout << "wrote " << db.units().size() << " units to " << export_path << "\n";
         return 0;
     }
+    if (list) {
+        const GestureDatabase db =
+            db_path.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(db_path);
+        print_units(db);
+        return 0;
+    }
+    // --import
+    if (grip.empty() || nuance.empty() || hand.empty() || out_path.empty())
+        throw UsageError("--import needs --grip, --nuance, --hand and --out");
+    Grip g;
+    Nuance n;
+    Side h;
+    try {
+        g = grip_from_string(grip);
+        n = nuance_from_string(nuance);
+        h = side_from_string(hand);
+    } catch (const std::runtime_error &e) {
+        throw UsageError(e.what());
+    }
+    GestureDatabase db =
+        db_path.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(db_path);
+    io.csv = sticks.csv;
+    io.left_stick = sticks.left_stick;
+    io.right_stick = sticks.right_stick;
+    const std::vector<GestureUnit> units = import_capture(import_path, g, n, h, io);
+    if (stroke >= static_cast<int>(units.size()))
+        throw UsageError("--stroke " + std::to_string(stroke) + ": the capture has " +
+                         std::to_string(units.size()) + " strokes");
+    const GestureUnit &picked = stroke >= 0 ? units[stroke] : representative_unit(units);
+    GestureUnit chosen = picked;
+    chosen.dynamics = dynamics;
+    std::cout << import_path << ": " << units.size() << " strokes; importing stroke "
+              << (&picked - units.data()) << " (strike at "
+              << chosen.capture_time_s + chosen.strike_time_s() << " s, impact "
+              << chosen.impact_speed_mps() << " m/s, preparation " << chosen.preparation_height_m()
+              << " m)\n";
+    db.add(chosen);
+    db.save_json(out_path);
+    std::cout << "wrote " << db.units().size() << " units to " << out_path << "\n";
+    return 0;
 }
 
 } // namespace cli

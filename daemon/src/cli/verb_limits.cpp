@@ -1,6 +1,5 @@
 // `ictusd limits`: joint limits learned from a clip (Euler statistics and
-// Algorithm 1), printed and written as JSON; and the clip options it shares
-// with `ictusd track` (verbs.hpp).
+// Algorithm 1), printed and written as JSON.
 #include "ictus/character/character_limits.hpp"
 #include "ictus/cli/verbs.hpp"
 #include "ictus/mocap/joint_limits.hpp"
@@ -36,46 +35,6 @@ void limits_usage(std::ostream &out)
            "  ictusd limits ../shared/data/cmu/80_13.bvh --out limits.json\n";
 }
 } // namespace
-
-bool parse_clip_option(const std::string &a, Args &args, ClipOptions &clip)
-{
-    if (a == "--scale") {
-        clip.scale = parse_positive(a, args.value(a));
-    } else if (a == "--skip-frames") {
-        clip.skip = parse_int(a, args.value(a), 0, 100000000);
-    } else if (a == "--smooth-hz") {
-        clip.filter.smooth_cutoff_hz = parse_number(a, args.value(a));
-        if (clip.filter.smooth_cutoff_hz < 0.0)
-            throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
-    } else if (a == "--despike-deg") {
-        clip.filter.spike_threshold_rad = parse_number(a, args.value(a)) * M_PI / 180.0;
-        if (clip.filter.spike_threshold_rad < 0.0)
-            throw UsageError("--despike-deg: expected a number >= 0 (0: off)");
-    } else {
-        return false;
-    }
-    return true;
-}
-
-double parse_min_half_width_deg(const std::string &option, const std::string &text)
-{
-    const double w = parse_number(option, text);
-    if (w < 0.0 || w >= 180.0)
-        throw UsageError(option + ": expected 0 <= deg < 180, got '" + text + "'");
-    return w;
-}
-
-BvhFile load_bvh(const std::string &path, double scale, int skip)
-{
-    BvhOptions o;
-    o.scale = scale;
-    o.skip_frames = skip;
-    MocapWarnings warnings;
-    BvhFile bvh = read_bvh(path, o, &warnings);
-    for (const std::string &w : warnings)
-        std::cerr << "ictusd: warning: " << w << "\n";
-    return bvh;
-}
 
 int cmd_limits(Args &args)
 {

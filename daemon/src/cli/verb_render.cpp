@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 namespace ictus
@@ -49,11 +50,11 @@ void render_usage(std::ostream &out)
            "                      targets from the IK of the tip targets)\n"
            "  --strike-depth M    the target dips this far below the first contact (0.004)\n"
            "  --advance S         tip targets sampled S ahead: the tracking lag (default 0)\n"
-           "  --rebound S         the target's rebound after a beat, time constant (0.015; 0: "
-           "off)\n"
+           "  --rebound S         the target's rebound after a beat, time constant (default\n"
+           "                      0.1; 0: off)\n"
+           "  --ik-gain G         Algorithm 2's gain on the tip error (default 4)\n"
+           "  --ik-velocity-gain S  tip velocity error term, s (default 0)\n"
            "  --lead-in S         time before the score's first beat (default 1)\n"
-           "  --grip G            the sticks' grip (default: the score's first note's)\n"
-           "  --drum-pos X,Y,Z    membrane centre (default: in front of the shoulders)\n"
            "\n"
            "common options (run and render):\n"
            "  --mocap FILE        BVH file with CMU joint names (clip mode)\n"
@@ -61,10 +62,12 @@ void render_usage(std::ostream &out)
            "  --skip-frames N     frames dropped at the start (default 1)\n"
            "  --duration S        simulated seconds (render default: the clip's or plan's length)\n"
            "  --step S            physics step (default 0.001)\n"
-           "  --grip G            french | german\n"
+           "  --grip G            french | german (default: a score's first note's, else\n"
+           "                      french)\n"
            "  --tempo BPM         clip playback tempo (default 120; a score sets its own)\n"
            "  --clip-bpm BPM      tempo at which the clip plays at its own speed (default 120)\n"
-           "  --drum-pos X,Y,Z    membrane centre (default: under the clip's lowest tips)\n"
+           "  --drum-pos X,Y,Z    membrane centre, m (default: a clip's, where its fast strokes\n"
+           "                      turn around (median); a score's, in front of the shoulders)\n"
            "  --drum-radius M     (default 0.178)\n"
            "  --drum-tension N/M  (default 3000)\n"
            "  --drum-density KG/M2  for the sound (default 0.26)\n"
@@ -204,83 +207,6 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
 
 } // namespace
 
-// Options shared by run and render. Returns false when `a` is not one of them.
-bool parse_performance_option(const std::string &a, Args &args, PerformanceOptions &o,
-                              double &duration)
-{
-    auto value = [&]() { return args.value(a); };
-    if (a == "--mocap")
-        o.mocap = value();
-    else if (a == "--scale")
-        o.scale_m_per_unit = parse_number(a, value(), 1e-6, 1e3);
-    else if (a == "--skip-frames")
-        o.skip_frames = static_cast<int>(parse_number(a, value(), 0, 1e8));
-    else if (a == "--duration")
-        duration = parse_number(a, value(), 1e-3, 1e7);
-    else if (a == "--step")
-        o.scene.step_s = parse_number(a, value(), 1e-5, 0.01);
-    else if (a == "--grip") {
-        const std::string g = value();
-        if (g != "french" && g != "german")
-            throw UsageError("--grip: expected french or german, got '" + g + "'");
-        o.character.grip = grip_from_string(g);
-        o.score.grip_given = true;
-    } else if (a == "--score") {
-        const std::string path = value();
-        std::ifstream in(path, std::ios::binary);
-        if (!in)
-            throw UsageError("--score: cannot read '" + path + "'");
-        std::ostringstream text;
-        text << in.rdbuf();
-        o.score.score_text = text.str();
-        o.score.score_name = path;
-        if (o.score.score_text.empty())
-            throw UsageError("--score: '" + path + "' is empty");
-    } else if (a == "--gestures")
-        o.score.gestures = value();
-    else if (a == "--mode") {
-        const std::string m = value();
-        if (m != "joint" && m != "cartesian")
-            throw UsageError("--mode: expected joint or cartesian, got '" + m + "'");
-        o.score.mode = track_mode_from_string(m);
-    } else if (a == "--strike-depth")
-        o.score.plan.strike_depth_m = parse_number(a, value(), -0.05, 0.05);
-    else if (a == "--advance")
-        o.score.time_advance_s = parse_number(a, value(), 0, 0.1);
-    else if (a == "--ik-gain")
-        o.score.cartesian.gain = parse_number(a, value(), 0.1, 100);
-    else if (a == "--ik-velocity-gain")
-        o.score.cartesian.velocity_gain_s = parse_number(a, value(), 0, 1);
-    else if (a == "--rebound")
-        o.score.rebound_s = parse_number(a, value(), 0, 0.5);
-    else if (a == "--lead-in")
-        o.score.plan.lead_in_s = parse_number(a, value(), 0.2, 60);
-    else if (a == "--tempo")
-        o.tempo_bpm = parse_number(a, value(), 20, 400);
-    else if (a == "--clip-bpm")
-        o.clip_bpm = parse_number(a, value(), 20, 400);
-    else if (a == "--drum-pos") {
-        const std::vector<std::string> p = split(value(), ',');
-        if (p.size() != 3)
-            throw UsageError("--drum-pos: expected X,Y,Z");
-        for (int k = 0; k < 3; ++k)
-            o.scene.drum.center_m[k] = parse_number(a, p[k], -100, 100);
-        o.drum_auto = false;
-    } else if (a == "--drum-radius")
-        o.scene.drum.radius_m = parse_number(a, value(), 0.05, 1.0);
-    else if (a == "--drum-tension")
-        o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
-    else if (a == "--drum-density")
-        o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
-    else if (a == "--bounce-height")
-        o.strikes.bounce_height_m = parse_number(a, value(), 0, 1);
-    else if (a == "--bounce-window")
-        o.strikes.bounce_window_s = parse_number(a, value(), 0, 10);
-    else
-        return false;
-    return true;
-}
-
 int cmd_render(Args &args)
 {
     PerformanceOptions o;
@@ -316,8 +242,16 @@ int cmd_render(Args &args)
         perf.start_score();
     if (duration <= 0.0)
         duration = perf.clip_duration_s();
-    // tips.csv rows, kept in memory until the end (about 100 bytes a row).
-    std::ostringstream tips;
+    // Every output is opened now (an unwritable folder is found before the
+    // run), kept in memory while the physics runs and written at the end.
+    OutputFile strikes_csv(out_dir + "/strikes.csv"), events_txt(out_dir + "/events.txt"),
+        render_json(out_dir + "/render.json");
+    std::unique_ptr<OutputFile> tips_csv, notes_csv;
+    if (score_mode) {
+        tips_csv = std::make_unique<OutputFile>(out_dir + "/tips.csv");
+        notes_csv = std::make_unique<OutputFile>(out_dir + "/notes.csv");
+    }
+    std::ostringstream tips; // about 100 bytes a row
     if (score_mode)
         write_tips_header(tips);
     const auto wall0 = std::chrono::steady_clock::now();
@@ -331,7 +265,7 @@ int cmd_render(Args &args)
     std::unique_ptr<BvhRecorder> bvh;
     BodyFrames frames;
     if (bvh_every) {
-        bvh.reset(new BvhRecorder(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h)));
+        bvh = std::make_unique<BvhRecorder>(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h));
         perf.scene().body_frames(frames);
         bvh->record(frames);
     }
@@ -344,7 +278,7 @@ int cmd_render(Args &args)
             break;
         }
         const int k = perf.step(ev);
-        log.add(ev, k, perf.detector().first_open_seq());
+        log.add(ev, k);
         if (tips_every && (n + 1) % tips_every == 0)
             write_tips_row(tips, perf);
         if (bvh && (n + 1) % bvh_every == 0) {
@@ -354,19 +288,16 @@ int cmd_render(Args &args)
     }
     StrikeEvent last;
     while (perf.flush(last))
-        log.add_flushed(last);
+        log.add(&last, 1);
     log.finish();
     const double wall =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
-    auto write = [&](const std::string &name, const std::function<bool(std::ostream &)> &fill) {
-        std::ofstream out(out_dir + "/" + name);
-        if (!fill(out) || !out)
-            throw std::runtime_error("--out: cannot write '" + out_dir + "/" + name + "'");
-    };
     const long strikes = static_cast<long>(log.strikes().size()), bounces = log.bounces();
-    write("strikes.csv", [&](std::ostream &out) { return log.write_csv(out); });
-    write("events.txt", [&](std::ostream &out) { return log.write_events(out); });
+    log.write_csv(strikes_csv.stream());
+    strikes_csv.close();
+    log.write_events(events_txt.stream());
+    events_txt.close();
     if (bvh)
         bvh->write(out_dir + "/performance.bvh");
     nlohmann::json j;
@@ -387,15 +318,14 @@ int cmd_render(Args &args)
     if (score_mode) {
         const GesturePlan &plan = *perf.plan();
         const MatchSummary m = match_strikes(plan.notes, log.strikes(), perf.plan_origin_s());
-        write("notes.csv", [&](std::ostream &out) {
-            write_notes_csv(out, plan, m, perf.plan_origin_s());
-            return true;
-        });
-        write("tips.csv", [&](std::ostream &out) { return static_cast<bool>(out << tips.str()); });
+        write_notes_csv(notes_csv->stream(), plan, m, perf.plan_origin_s());
+        notes_csv->close();
+        tips_csv->stream() << tips.str();
+        tips_csv->close();
         j["performance"] = performance_json(o, perf, m);
     }
-    write("render.json",
-          [&](std::ostream &out) { return static_cast<bool>(out << j.dump(2) << "\n"); });
+    render_json.stream() << j.dump(2) << "\n";
+    render_json.close();
     std::cout << "render: " << perf.time_s() << " s simulated in " << wall << " s ("
               << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes << " strikes ("
               << bounces << " bounces), wrote " << out_dir

@@ -8,7 +8,9 @@
 #include "ictus/net/osc_sender.hpp"
 #include "ictus/net/osc_server.hpp"
 #include "ictus/perform/strike_log.hpp"
+#include "ictus/sim/strike_event.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -16,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <thread>
 
 namespace ictus
@@ -59,6 +62,53 @@ void run_usage(std::ostream &out)
            "             --allow 10.0.0.2 --lookahead 0.05\n"
            "  oscsend localhost 9001 /ictus/tempo f 96\n";
 }
+
+// strikes.csv of a run, written by a thread of its own: the physics thread
+// only posts (never blocks, never touches the file). Stopped and joined on
+// every way out of cmd_run.
+class CsvWriter
+{
+  public:
+    explicit CsvWriter(std::ostream *out) : out_(out), thread_([this] { loop(); }) {}
+    ~CsvWriter() { stop(); }
+    CsvWriter(const CsvWriter &) = delete;
+    CsvWriter &operator=(const CsvWriter &) = delete;
+    void post(const StrikeEvent &e)
+    {
+        if (out_ && !queue_.push(e))
+            ++dropped_;
+    }
+    void stop()
+    {
+        running_ = false;
+        if (thread_.joinable())
+            thread_.join();
+    }
+    long written() const { return written_; }
+    long dropped() const { return dropped_; }
+
+  private:
+    void loop()
+    {
+        StrikeEvent e;
+        for (;;) {
+            const bool running = running_.load();
+            while (queue_.pop(e)) {
+                write_strike_csv_row(*out_, e);
+                ++written_;
+            }
+            if (!running)
+                return;
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+    }
+    std::ostream *out_;
+    SpscQueue<StrikeEvent, 1024> queue_;
+    std::atomic<bool> running_{true};
+    long written_ = 0; // the writer thread's; read after stop()
+    long dropped_ = 0; // the physics thread's
+    std::thread thread_;
+};
 
 } // namespace
 
@@ -104,44 +154,31 @@ int cmd_run(Args &args)
     }
     if (!o.mocap.empty() && !o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
-    std::ofstream csv;
+    std::unique_ptr<OutputFile> csv;
     if (!out_dir.empty()) {
         std::error_code ec;
         std::filesystem::create_directories(out_dir, ec);
-        csv.open(out_dir + "/strikes.csv");
-        if (ec || !csv)
-            throw std::runtime_error("--out: cannot write '" + out_dir + "/strikes.csv'");
-        write_strikes_csv_header(csv);
+        if (ec)
+            throw std::runtime_error("--out: cannot create '" + out_dir + "': " + ec.message());
+        csv = std::make_unique<OutputFile>(out_dir + "/strikes.csv");
+        write_strikes_csv_header(csv->stream());
     }
 
     Performance perf(o);
+    if (paused) {
+        Command stop;
+        stop.kind = CommandKind::stop;
+        perf.apply(stop);
+    } else if (perf.score_mode()) {
+        perf.start_score(); // a score that cannot be played ends here, exit 1
+    }
     LiveStatus status;
     status.tempo_bpm = o.tempo_bpm;
     OscServer server(io, &status);
     OscSender sender(so);
     // strikes.csv is written by a thread of its own: the physics thread
     // never touches a file.
-    SpscQueue<StrikeEvent, 1024> to_csv;
-    std::atomic<bool> csv_running{true};
-    std::thread csv_thread([&]() {
-        StrikeEvent e;
-        for (;;) {
-            const bool running = csv_running.load();
-            while (to_csv.pop(e))
-                if (csv.is_open())
-                    write_strike_csv_row(csv, e);
-            if (!running)
-                return;
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        }
-    });
-    if (paused) {
-        Command stop;
-        stop.kind = CommandKind::stop;
-        perf.apply(stop);
-    } else if (perf.score_mode()) {
-        perf.start_score();
-    }
+    CsvWriter writer(csv ? &csv->stream() : nullptr);
     std::cerr << "ictusd run: commands on " << io.bind_address << ":" << server.port()
               << ", strikes and poses to " << so.target_url << "\n";
     g_interrupted = 0;
@@ -159,7 +196,7 @@ int cmd_run(Args &args)
     sender.set_epoch(ntp_now());
     // strikes.csv in onset order, as track and render write it.
     StrikeOrder order;
-    auto to_file = [&](const StrikeEvent &e) { to_csv.push(e); };
+    auto to_file = [&](const StrikeEvent &e) { writer.post(e); };
     StrikeEvent ev[2];
     long n = 0;
     for (; steps < 0 || n < steps; ++n) {
@@ -214,15 +251,20 @@ int cmd_run(Args &args)
     order.flush(to_file);
     sender.stop();
     server.stop();
-    csv_running = false;
-    csv_thread.join();
+    writer.stop();
+    if (csv)
+        csv->close();
     const OscSenderCounters sc = sender.counters();
     const OscServerCounters rc = server.counters();
     std::cout << "run: " << perf.time_s() << " s simulated, " << sc.strikes_sent
               << " strikes sent (" << sc.strikes_dropped << " dropped), " << sc.poses_sent
               << " poses, " << sc.send_errors << " send errors; " << rc.packets << " packets in, "
               << rc.accepted << " accepted, " << rc.errors() << " errors, " << rc.refused_peers
-              << " refused; " << status.overruns.load() << " overruns\n";
+              << " refused; " << status.overruns.load() << " overruns";
+    if (csv)
+        std::cout << "; strikes.csv: " << writer.written() << " rows, " << writer.dropped()
+                  << " dropped (queue full), " << order.early() << " out of order";
+    std::cout << "\n";
     return g_interrupted ? 130 : 0;
 }
 

@@ -11,12 +11,14 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 namespace ictus
 {
@@ -94,9 +96,7 @@ struct TrackArgs {
     CharacterOptions character;
     TrackOptions options;
     bool drum_pos_given = false;
-    std::string left_stick, right_stick;
-    MarkerCsvOptions csv_options;
-    bool csv_options_given = false;
+    StickCsvOptions sticks;
     bool stick_only = false; // a .csv capture: stick tips only (Cartesian mode)
 };
 
@@ -121,38 +121,16 @@ TrackArgs parse_track_args(Args &args)
             return t;
         } else if (a == "--mode") {
             t.mode = args.value(a);
-            try {
-                t.options.mode = track_mode_from_string(t.mode);
-            } catch (const CharacterError &e) {
-                throw UsageError(std::string("--") + e.what());
-            }
+            t.options.mode = parse_track_mode(a, t.mode);
         } else if (a == "--ik-gain") {
             t.options.cartesian.gain = parse_positive(a, args.value(a));
-        } else if (a == "--left-stick") {
-            t.left_stick = args.value(a);
-        } else if (a == "--right-stick") {
-            t.right_stick = args.value(a);
-        } else if (a == "--units") {
-            const std::string v = args.value(a);
-            if (v != "mm" && v != "m")
-                throw UsageError("--units: expected mm or m, got '" + v + "'");
-            t.csv_options.units =
-                v == "mm" ? MarkerCsvOptions::Units::mm : MarkerCsvOptions::Units::m;
-            t.csv_options_given = true;
-        } else if (a == "--up") {
-            const std::string v = args.value(a);
-            if (v != "y" && v != "z")
-                throw UsageError("--up: expected y or z, got '" + v + "'");
-            t.csv_options.up = v == "z" ? MarkerCsvOptions::Up::z : MarkerCsvOptions::Up::y;
-            t.csv_options_given = true;
-        } else if (a == "--rate") {
-            t.csv_options.rate_hz = parse_positive(a, args.value(a));
-            t.csv_options_given = true;
+        } else if (parse_stick_csv_option(a, args, t.sticks)) {
         } else if (a == "--drum") {
             const std::string v = args.value(a);
             if (v != "auto") {
                 try {
-                    t.options.scene.drum.center_m = parse_vec3(a, v);
+                    t.options.scene.drum.center_m =
+                        parse_vec3(a, v, -kMaxDrumDistance_m, kMaxDrumDistance_m);
                 } catch (const UsageError &) {
                     throw UsageError("--drum: expected auto or X,Y,Z (m), got '" + v + "'");
                 }
@@ -193,12 +171,7 @@ TrackArgs parse_track_args(Args &args)
         } else if (a == "--body-mass") {
             t.character.body_mass_kg = parse_positive(a, args.value(a));
         } else if (a == "--grip") {
-            const std::string g = args.value(a);
-            try {
-                t.character.grip = grip_from_string(g);
-            } catch (const CharacterError &e) {
-                throw UsageError(std::string("--") + e.what());
-            }
+            t.character.grip = parse_grip(a, args.value(a));
         } else if (a == "--stick-length") {
             t.character.stick.length_m = parse_positive(a, args.value(a));
         } else if (a == "--stick-mass") {
@@ -206,7 +179,8 @@ TrackArgs parse_track_args(Args &args)
         } else if (a == "--stick-tip-radius") {
             t.character.stick.tip_radius_m = parse_positive(a, args.value(a));
         } else if (a == "--drum-pos") {
-            t.options.scene.drum.center_m = parse_vec3(a, args.value(a));
+            t.options.scene.drum.center_m =
+                parse_vec3(a, args.value(a), -kMaxDrumDistance_m, kMaxDrumDistance_m);
             t.drum_pos_given = true;
         } else if (a == "--drum-radius") {
             t.options.scene.drum.radius_m = parse_positive(a, args.value(a));
@@ -260,7 +234,7 @@ TrackArgs parse_track_args(Args &args)
     t.stick_only = is_csv(t.mocap);
     if (t.stick_only && t.options.mode != TrackMode::cartesian)
         throw UsageError("a stick-only capture (" + t.mocap + ") needs --mode cartesian");
-    if (!t.stick_only && (!t.left_stick.empty() || !t.right_stick.empty() || t.csv_options_given))
+    if (!t.stick_only && t.sticks.given)
         throw UsageError("--left-stick, --right-stick, --units, --up and --rate apply "
                          "to stick-only .csv captures");
     if (t.stick_only && t.limits_mode != "none") {
@@ -275,6 +249,9 @@ TrackArgs parse_track_args(Args &args)
 // motion (cleaned, and raw for the errors), limits, gains, the stick tips of a
 // stick-only capture. Members refer to one another: built in place, never moved.
 struct TrackInput {
+    TrackInput() = default;
+    TrackInput(const TrackInput &) = delete;
+    TrackInput &operator=(const TrackInput &) = delete;
     BvhFile bvh;
     std::unique_ptr<CharacterModel> model;
     std::unique_ptr<ReferenceMotion> raw, reference;
@@ -290,11 +267,11 @@ void load_track_input(TrackArgs &t, TrackInput &in)
     std::array<int, 2> stick_tracks = {-1, -1};
     if (t.stick_only) {
         MocapWarnings warnings;
-        capture = read_marker_csv(t.mocap, t.csv_options, &warnings);
+        capture = read_marker_csv(t.mocap, t.sticks.csv, &warnings);
         for (const std::string &w : warnings)
             std::cerr << "ictusd: warning: " << w << "\n";
         try {
-            stick_tracks = find_stick_tracks(capture, t.left_stick, t.right_stick);
+            stick_tracks = find_stick_tracks(capture, t.sticks.left_stick, t.sticks.right_stick);
         } catch (const CharacterError &e) {
             throw UsageError(e.what());
         }
@@ -379,7 +356,7 @@ TrackSummary run_tracking(TrackArgs &t, const TrackInput &in, std::ostream *csv,
             detector.set_membrane(membrane_of(scene));
             StrikeEvent out[2];
             const int n = detect_strikes(detector, scene, out);
-            log.add(out, n, detector.first_open_seq());
+            log.add(out, n);
         };
     Progress progress(!t.quiet);
     TrackSummary summary = track_joint_space(
@@ -387,7 +364,7 @@ TrackSummary run_tracking(TrackArgs &t, const TrackInput &in, std::ostream *csv,
         &in.gains, in.raw.get());
     StrikeEvent e;
     while (detector.flush(e))
-        log.add_flushed(e);
+        log.add(&e, 1);
     log.finish();
     t.options.on_step = nullptr;
     return summary;
@@ -424,15 +401,13 @@ int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary
         j["ik"]["integral_per_s"] = options.cartesian.integral_per_s;
     }
     if (!t.out_dir.empty()) {
-        const std::string strikes_path = t.out_dir + "/strikes.csv";
-        std::ofstream strikes(strikes_path);
-        if (!log.write_csv(strikes))
-            throw std::runtime_error("--out: cannot write '" + strikes_path + "'");
+        OutputFile strikes(t.out_dir + "/strikes.csv");
+        log.write_csv(strikes.stream());
+        strikes.close();
         j["strikes"] = static_cast<long>(log.strikes().size());
-        std::ofstream js(t.out_dir + "/summary.json");
-        js << j.dump(2) << "\n";
-        if (!js)
-            throw std::runtime_error("--out: cannot write '" + t.out_dir + "/summary.json'");
+        OutputFile js(t.out_dir + "/summary.json");
+        js.stream() << j.dump(2) << "\n";
+        js.close();
     }
     std::cout << "mode " << summary.mode << ", " << summary.duration_s
               << " s simulated, realtime factor " << summary.realtime_factor << "\n"

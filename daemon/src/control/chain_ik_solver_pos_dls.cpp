@@ -1,5 +1,6 @@
 // chain_ik_solver_pos_dls.cpp -- damped-least-squares IK (paper eq. 2, Wampler 1986).
 #include "ictus/control/chain_ik_solver_pos_dls.hpp"
+#include "ictus/base/rotation.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

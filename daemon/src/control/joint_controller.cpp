@@ -1,5 +1,6 @@
 // Joint-space PD (eq. 1) as ODE motor rows; default gains and torque limits.
 #include "ictus/control/joint_controller.hpp"
+#include "ictus/base/rotation.hpp"
 
 #include <cmath>
 #include <cstring>

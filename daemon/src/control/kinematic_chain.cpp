@@ -1,4 +1,4 @@
-// kinematic_chain.cpp -- forward kinematics of ball-joint chains (see kinematics.hpp).
+// kinematic_chain.cpp -- forward kinematics of ball-joint chains (see kinematic_chain.hpp).
 #include "ictus/control/kinematic_chain.hpp"
 
 #include <cmath>

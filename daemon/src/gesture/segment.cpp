@@ -231,11 +231,7 @@ std::vector<GestureUnit> import_capture(const std::string &path, Grip g, Nuance 
                     right += frames.origin_m[rs] - frames.origin_m[ls];
             }
         } else if (ends_with(path, ".csv")) {
-            MarkerCsvOptions mo;
-            mo.units = opts.csv_mm ? MarkerCsvOptions::Units::mm : MarkerCsvOptions::Units::m;
-            mo.up = opts.csv_z_up ? MarkerCsvOptions::Up::z : MarkerCsvOptions::Up::y;
-            mo.rate_hz = opts.csv_rate_hz;
-            const MarkerCapture cap = read_marker_csv(path, mo);
+            const MarkerCapture cap = read_marker_csv(path, opts.csv);
             const auto tracks = find_stick_tracks(cap, opts.left_stick, opts.right_stick);
             time_s = cap.time_s;
             tip = cap.tracks[tracks[static_cast<int>(h)]].position_m;

@@ -1,4 +1,4 @@
-// OSC out: strike bundles and the pose stream (osc_link.hpp, docs/osc.md).
+// OSC out: strike bundles and the pose stream (osc_sender.hpp, docs/osc.md).
 #include "ictus/net/osc_sender.hpp"
 
 #include <lo/lo.h>

@@ -1,4 +1,4 @@
-// OSC in: Pd (or anything that speaks OSC) controls the daemon (osc_link.hpp,
+// OSC in: Pd (or anything that speaks OSC) controls the daemon (osc_server.hpp,
 // docs/osc.md). A plain UDP socket of our own, so that the bind address, the
 // peer allow-list and the packet size are checked before any parsing; liblo
 // deserialises and validates each message; handlers check the type tags and

@@ -1,5 +1,5 @@
-// The physics side of `ictusd run` and `ictusd render` (verbs_osc.hpp): the
-// character tracks the clip in joint space (eq. 1, the sim helper's Scene) or
+// The physics side of `ictusd run` and `ictusd render` (performance.hpp): the
+// character tracks the clip in joint space (eq. 1, a Tracker in joint mode) or
 // performs a score's gesture plan (Tracker: Algorithm 2 or joint targets from
 // IK), and the interaction manager watches the stick tips against the drum.
 // Score mode is described in docs/perform.md.

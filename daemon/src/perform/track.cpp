@@ -1,5 +1,6 @@
 // Joint-space tracking run (ID mode, eq. 1).
 #include "ictus/perform/track.hpp"
+#include "ictus/base/rotation.hpp"
 
 #include "ictus/perform/tracker.hpp"
 

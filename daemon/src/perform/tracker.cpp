@@ -1,6 +1,7 @@
 // The per-step controller: eq. 1 toward a reference pose, Algorithm 2 for the
 // arms toward stick-tip targets (tracker.hpp).
 #include "ictus/perform/tracker.hpp"
+#include "ictus/base/rotation.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,5 +1,6 @@
 // The ODE scene: one owner for the world, space, contact group and bodies.
 #include "ictus/sim/scene.hpp"
+#include "ictus/base/rotation.hpp"
 
 #include <ode/ode.h>
 

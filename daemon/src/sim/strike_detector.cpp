@@ -1,4 +1,4 @@
-// The interaction manager's strike detection (strike.hpp).
+// The interaction manager's strike detection (strike_detector.hpp).
 #include "ictus/sim/strike_detector.hpp"
 
 #include "ictus/sim/scene.hpp"

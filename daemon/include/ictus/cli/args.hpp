@@ -28,8 +28,9 @@ double parse_number(const std::string &option, const std::string &text);
 double parse_number(const std::string &option, const std::string &text, double lo, double hi);
 double parse_positive(const std::string &option, const std::string &text);
 int parse_int(const std::string &option, const std::string &text, int lo, int hi);
-// "X,Y,Z" (each a number).
-Eigen::Vector3d parse_vec3(const std::string &option, const std::string &text);
+// "X,Y,Z", each a number in [lo, hi].
+Eigen::Vector3d parse_vec3(const std::string &option, const std::string &text, double lo,
+                           double hi);
 std::vector<std::string> split(const std::string &text, char separator);
 
 // The argv walker: options with one value, flags, positional arguments.

@@ -15,7 +15,6 @@
 // force bounded by dParamFMax = tau_max. See docs/character.md.
 #pragma once
 
-#include "ictus/base/rotation.hpp"
 #include "ictus/character/character.hpp"
 
 #include <Eigen/Core>

@@ -1,4 +1,4 @@
-// kinematics.hpp -- kinematic chains of ball joints (torso -> clavicle -> shoulder -> elbow
+// kinematic_chain.hpp -- kinematic chains of ball joints (torso -> clavicle -> shoulder -> elbow
 // -> wrist -> stick tip): forward kinematics and the geometric Jacobian of the tip that the
 // Cartesian tracking mode inverts (paper eq. 2, Algorithm 2). Lengths in metres, rotations
 // as unit quaternions, angular quantities in radians. Fixed capacity: nothing here allocates.

@@ -8,6 +8,7 @@
 
 #include "ictus/character/character.hpp"
 #include "ictus/mocap/bvh.hpp"
+#include "ictus/mocap/marker_csv.hpp"
 
 #include <Eigen/Core>
 #include <stdexcept>
@@ -147,9 +148,7 @@ std::vector<GestureUnit> segment_strokes(const std::vector<double> &time_s,
 struct ImportOptions {
     double bvh_scale = kCmuBvhScale_m; // metres per BVH unit
     int bvh_skip_frames = 1;
-    bool csv_mm = false;   // CSV lengths in mm
-    bool csv_z_up = false; // CSV z-up
-    double csv_rate_hz = 0.0;
+    MarkerCsvOptions csv;                // how a stick-only .csv is read (units, up axis, rate)
     std::string left_stick, right_stick; // CSV object names ("" = automatic)
     SegmentOptions segment;
 };

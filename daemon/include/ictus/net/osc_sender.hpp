@@ -34,9 +34,6 @@ NtpTime ntp_now();
 NtpTime ntp_add_seconds(NtpTime t, double seconds);
 double ntp_diff_seconds(NtpTime a, NtpTime b); // a - b
 
-// ---- out --------------------------------------------------------------------
-
-// A snapshot of the scene for graphics (world frame, y up, metres).
 struct OscSenderOptions {
     std::string target_url = "osc.udp://127.0.0.1:9000";
     // Strike bundles carry the timetag epoch + time_s + lookahead_s. A

@@ -18,6 +18,7 @@
 #include "ictus/score/score.hpp"
 #include "ictus/sim/strike_detector.hpp"
 #include "ictus/perform/track.hpp"
+#include "ictus/perform/tracker.hpp"
 
 #include <memory>
 #include <string>
@@ -58,7 +59,7 @@ struct PerformanceOptions {
     CharacterOptions character;
     SceneOptions scene;
     GainOptions gains;
-    bool drum_auto = true; // drum under the clip's lowest tips
+    bool drum_auto = true; // clip: where its fast strokes turn around; score: before the shoulders
     double ramp_s = 0.25;
     double clip_bpm = 120.0; // tempo at which the clip plays at its own speed
     double tempo_bpm = 120.0;

@@ -1,15 +1,17 @@
-// strike_log.hpp -- the one way strikes reach a file. The detector reports a
-// strike when its contact ends, so a long contact of one hand can end after a
-// later, shorter one of the other: StrikeOrder puts them back in onset order
-// (seq) without allocating, and StrikeLog keeps a run's strikes for the
-// offline verbs. `track`, `render` and `run` all write strikes.csv through
-// these, in the same order (docs/osc.md).
+// strike_log.hpp -- the one way strikes reach a file, in onset order (seq).
+// The detector reports a strike when its contact ends, so a strike of one
+// hand can end after later ones of the other (a stick resting on the head
+// while the other plays). StrikeLog (track, render) keeps a run's strikes in
+// memory and sorts them at the end; StrikeOrder (run's physics thread, no
+// allocation) holds each strike until every earlier contact has ended. Both
+// feed write_strike_csv_row (sim/strike_event.hpp). docs/osc.md.
 #pragma once
 
-#include "ictus/sim/strike_detector.hpp"
+#include "ictus/sim/strike_event.hpp"
 
 #include <array>
 #include <iosfwd>
+#include <limits>
 #include <vector>
 
 namespace ictus
@@ -18,75 +20,77 @@ namespace ictus
 class StrikeOrder
 {
   public:
-    // A strike the detector just reported. Held until release() or flush();
-    // if kCapacity already wait (never with two hands: at most one strike
-    // waits for the other hand's contact), the lowest is let go first.
+    static constexpr int kCapacity = 256;
+    // A strike the detector just reported; held until release() or flush().
+    // When kCapacity strikes already wait (256 strikes of one hand while the
+    // other rests on the head), the lowest is let go early and counted.
     template <typename Emit> void push(const StrikeEvent &event, Emit &&emit)
     {
         if (held_ == kCapacity) {
             const int k = lowest();
-            emit(pending_[k]);
+            emit(pending_[static_cast<size_t>(k)]);
             remove(k);
+            ++early_;
         }
-        pending_[held_++] = event;
+        pending_[static_cast<size_t>(held_++)] = event;
     }
     // Emits, in seq order, every held strike numbered below `first_open_seq`
-    // (StrikeDetector::first_open_seq(): all those before it have ended).
+    // (StrikeDetector::first_open_seq(): all strikes before it have ended).
     template <typename Emit> void release(long first_open_seq, Emit &&emit)
     {
         for (;;) {
             const int k = lowest();
-            if (k < 0 || pending_[k].seq >= first_open_seq)
+            if (k < 0 || pending_[static_cast<size_t>(k)].seq >= first_open_seq)
                 return;
-            emit(pending_[k]);
+            emit(pending_[static_cast<size_t>(k)]);
             remove(k);
         }
     }
     // Emits everything held, in seq order (end of a run).
-    template <typename Emit> void flush(Emit &&emit) { release(kNoLimit, emit); }
+    template <typename Emit> void flush(Emit &&emit)
+    {
+        release(std::numeric_limits<long>::max(), emit);
+    }
     int held() const { return held_; }
+    long early() const { return early_; } // let go before an earlier contact ended
 
   private:
-    static constexpr int kCapacity = 16;
-    static constexpr long kNoLimit = 0x7fffffffffffffffL;
     int lowest() const
     {
         int k = -1;
         for (int i = 0; i < held_; ++i)
-            if (k < 0 || pending_[i].seq < pending_[k].seq)
+            if (k < 0 ||
+                pending_[static_cast<size_t>(i)].seq < pending_[static_cast<size_t>(k)].seq)
                 k = i;
         return k;
     }
     void remove(int k)
     {
         for (int i = k; i + 1 < held_; ++i)
-            pending_[i] = pending_[i + 1];
+            pending_[static_cast<size_t>(i)] = pending_[static_cast<size_t>(i + 1)];
         --held_;
     }
     std::array<StrikeEvent, kCapacity> pending_{};
     int held_ = 0;
+    long early_ = 0;
 };
 
-// A run's strikes in onset order, kept in memory (a few per second) and
-// written when the run ends, so that the physics loop never writes a file.
+// A run's strikes, kept in memory (a few per second) and written when the run
+// ends, so that the physics loop never writes a file.
 class StrikeLog
 {
   public:
-    // After each physics step: the n strikes that step ended, and the
-    // detector's first_open_seq() after it.
-    void add(const StrikeEvent *events, int n, long first_open_seq);
-    // A strike that StrikeDetector::flush() ended (end of a run); then finish().
-    void add_flushed(const StrikeEvent &event);
-    // Takes in every strike still held, in order.
+    // The strikes a physics step (or StrikeDetector::flush()) ended.
+    void add(const StrikeEvent *events, int n);
+    // Puts them in onset order (seq); then strikes() and the writers.
     void finish();
     const std::vector<StrikeEvent> &strikes() const { return strikes_; }
     long bounces() const;
-    // strikes.csv and the events file (sim/strike_event.hpp); false on a write error.
-    bool write_csv(std::ostream &out) const;
-    bool write_events(std::ostream &out) const;
+    // strikes.csv and the events file (sim/strike_event.hpp) into `out`.
+    void write_csv(std::ostream &out) const;
+    void write_events(std::ostream &out) const;
 
   private:
-    StrikeOrder order_;
     std::vector<StrikeEvent> strikes_;
 };
 

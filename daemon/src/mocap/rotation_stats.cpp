@@ -1,6 +1,6 @@
-// rotation.cpp -- the sign-robust mean rotation and the named Tait-Bryan orders
-// (joint_limits.hpp) over base/rotation.hpp.
-#include "ictus/mocap/joint_limits.hpp"
+// rotation_stats.cpp -- the sign-robust mean rotation and the named Tait-Bryan orders
+// (rotation_stats.hpp) over base/rotation.hpp.
+#include "ictus/mocap/rotation_stats.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

@@ -1,0 +1,74 @@
+// options.hpp -- the option groups several of ictusd's verbs share, parsed
+// once (options.cpp): how a BVH clip is read (track, limits, run, render,
+// gestures), how a stick-only CSV is read (track, gestures), the performance
+// options of run and render; and a verb's output file, checked when closed.
+#pragma once
+
+#include "ictus/character/character.hpp"
+#include "ictus/cli/args.hpp"
+#include "ictus/mocap/bvh.hpp"
+#include "ictus/mocap/marker_csv.hpp"
+#include "ictus/perform/performance.hpp"
+#include "ictus/perform/tracker.hpp"
+
+#include <fstream>
+#include <string>
+
+namespace ictus
+{
+namespace cli
+{
+
+// The drum may stand this far from the origin at most (--drum-pos), m.
+constexpr double kMaxDrumDistance_m = 100.0;
+
+// --scale M, --skip-frames N. Returns false when `option` is neither (nothing consumed).
+bool parse_bvh_option(const std::string &option, Args &args, double &scale_m_per_unit,
+                      int &skip_frames);
+
+// track and limits: how a BVH clip is read and its reference motion cleaned.
+struct ClipOptions {
+    double scale = kCmuBvhScale_m;
+    int skip = 1;
+    ReferenceFilter filter;
+};
+// The BVH options and --smooth-hz, --despike-deg.
+bool parse_clip_option(const std::string &option, Args &args, ClipOptions &clip);
+
+// A stick-only capture (.csv): --units, --up, --rate, --left-stick, --right-stick.
+struct StickCsvOptions {
+    MarkerCsvOptions csv;
+    std::string left_stick, right_stick; // "" = found by name
+    bool given = false;                  // any of them was given
+};
+bool parse_stick_csv_option(const std::string &option, Args &args, StickCsvOptions &o);
+
+Grip parse_grip(const std::string &option, const std::string &text);
+TrackMode parse_track_mode(const std::string &option, const std::string &text);
+// A limit's minimum half-width per axis, degrees (track --limit-min-deg, limits --min-deg).
+double parse_min_half_width_deg(const std::string &option, const std::string &text);
+
+// A BVH file, its warnings printed to stderr.
+BvhFile load_bvh(const std::string &path, double scale, int skip);
+
+// run and render: the motion source, the character, the drum, score mode.
+// Returns false when `option` is not one of them.
+bool parse_performance_option(const std::string &option, Args &args, PerformanceOptions &o,
+                              double &duration_s);
+
+// An output file of a verb: opened (and so checked) before the work, written
+// at the end, and checked again when closed (a full disk shows there).
+class OutputFile
+{
+  public:
+    explicit OutputFile(const std::string &path); // throws naming the path
+    std::ostream &stream() { return out_; }
+    void close(); // throws naming the path on a write error
+
+  private:
+    std::string path_;
+    std::ofstream out_;
+};
+
+} // namespace cli
+} // namespace ictus

@@ -1,0 +1,196 @@
+// options.cpp -- the option groups several verbs share (options.hpp): how a
+// BVH clip is read, how a stick-only CSV is read, the performance options of
+// run and render, the grip and the mode; and the output files of a verb.
+#include "ictus/cli/options.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace ictus
+{
+namespace cli
+{
+
+namespace
+{
+// "grip: expected ..." -> ": expected ...": the model's message under the option's name.
+std::string after_name(const std::string &message)
+{
+    const size_t colon = message.find(':');
+    return colon == std::string::npos ? ": " + message : message.substr(colon);
+}
+} // namespace
+
+bool parse_bvh_option(const std::string &a, Args &args, double &scale_m_per_unit, int &skip_frames)
+{
+    if (a == "--scale")
+        scale_m_per_unit = parse_positive(a, args.value(a));
+    else if (a == "--skip-frames")
+        skip_frames = parse_int(a, args.value(a), 0, 100000000);
+    else
+        return false;
+    return true;
+}
+
+bool parse_stick_csv_option(const std::string &a, Args &args, StickCsvOptions &o)
+{
+    if (a == "--left-stick") {
+        o.left_stick = args.value(a);
+    } else if (a == "--right-stick") {
+        o.right_stick = args.value(a);
+    } else if (a == "--units") {
+        const std::string v = args.value(a);
+        if (v != "mm" && v != "m")
+            throw UsageError("--units: expected mm or m, got '" + v + "'");
+        o.csv.units = v == "mm" ? MarkerCsvOptions::Units::mm : MarkerCsvOptions::Units::m;
+    } else if (a == "--up") {
+        const std::string v = args.value(a);
+        if (v != "y" && v != "z")
+            throw UsageError("--up: expected y or z, got '" + v + "'");
+        o.csv.up = v == "z" ? MarkerCsvOptions::Up::z : MarkerCsvOptions::Up::y;
+    } else if (a == "--rate") {
+        o.csv.rate_hz = parse_positive(a, args.value(a));
+    } else {
+        return false;
+    }
+    o.given = true;
+    return true;
+}
+
+Grip parse_grip(const std::string &option, const std::string &text)
+{
+    try {
+        return grip_from_string(text);
+    } catch (const CharacterError &e) {
+        throw UsageError(option + after_name(e.what()));
+    }
+}
+
+TrackMode parse_track_mode(const std::string &option, const std::string &text)
+{
+    try {
+        return track_mode_from_string(text);
+    } catch (const CharacterError &e) {
+        throw UsageError(option + after_name(e.what()));
+    }
+}
+
+bool parse_clip_option(const std::string &a, Args &args, ClipOptions &clip)
+{
+    if (parse_bvh_option(a, args, clip.scale, clip.skip)) {
+    } else if (a == "--smooth-hz") {
+        clip.filter.smooth_cutoff_hz = parse_number(a, args.value(a));
+        if (clip.filter.smooth_cutoff_hz < 0.0)
+            throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
+    } else if (a == "--despike-deg") {
+        clip.filter.spike_threshold_rad = parse_number(a, args.value(a)) * M_PI / 180.0;
+        if (clip.filter.spike_threshold_rad < 0.0)
+            throw UsageError("--despike-deg: expected a number >= 0 (0: off)");
+    } else {
+        return false;
+    }
+    return true;
+}
+
+double parse_min_half_width_deg(const std::string &option, const std::string &text)
+{
+    const double w = parse_number(option, text);
+    if (w < 0.0 || w >= 180.0)
+        throw UsageError(option + ": expected 0 <= deg < 180, got '" + text + "'");
+    return w;
+}
+
+BvhFile load_bvh(const std::string &path, double scale, int skip)
+{
+    BvhOptions o;
+    o.scale = scale;
+    o.skip_frames = skip;
+    MocapWarnings warnings;
+    BvhFile bvh = read_bvh(path, o, &warnings);
+    for (const std::string &w : warnings)
+        std::cerr << "ictusd: warning: " << w << "\n";
+    return bvh;
+}
+
+// Options shared by run and render. Returns false when `a` is not one of them.
+bool parse_performance_option(const std::string &a, Args &args, PerformanceOptions &o,
+                              double &duration)
+{
+    auto value = [&]() { return args.value(a); };
+    if (a == "--mocap")
+        o.mocap = value();
+    else if (parse_bvh_option(a, args, o.scale_m_per_unit, o.skip_frames))
+        ;
+    else if (a == "--duration")
+        duration = parse_number(a, value(), 1e-3, 1e7);
+    else if (a == "--step")
+        o.scene.step_s = parse_number(a, value(), 1e-5, 0.01);
+    else if (a == "--grip") {
+        o.character.grip = parse_grip(a, value());
+        o.score.grip_given = true;
+    } else if (a == "--score") {
+        const std::string path = value();
+        std::ifstream in(path, std::ios::binary);
+        if (!in)
+            throw UsageError("--score: cannot read '" + path + "'");
+        std::ostringstream text;
+        text << in.rdbuf();
+        o.score.score_text = text.str();
+        o.score.score_name = path;
+        if (o.score.score_text.empty())
+            throw UsageError("--score: '" + path + "' is empty");
+    } else if (a == "--gestures")
+        o.score.gestures = value();
+    else if (a == "--mode")
+        o.score.mode = parse_track_mode(a, value());
+    else if (a == "--strike-depth")
+        o.score.plan.strike_depth_m = parse_number(a, value(), -0.05, 0.05);
+    else if (a == "--advance")
+        o.score.time_advance_s = parse_number(a, value(), 0, 0.1);
+    else if (a == "--ik-gain")
+        o.score.cartesian.gain = parse_number(a, value(), 0.1, 100);
+    else if (a == "--ik-velocity-gain")
+        o.score.cartesian.velocity_gain_s = parse_number(a, value(), 0, 1);
+    else if (a == "--rebound")
+        o.score.rebound_s = parse_number(a, value(), 0, 0.5);
+    else if (a == "--lead-in")
+        o.score.plan.lead_in_s = parse_number(a, value(), 0.2, 60);
+    else if (a == "--tempo")
+        o.tempo_bpm = parse_number(a, value(), 20, 400);
+    else if (a == "--clip-bpm")
+        o.clip_bpm = parse_number(a, value(), 20, 400);
+    else if (a == "--drum-pos") {
+        o.scene.drum.center_m = parse_vec3(a, value(), -kMaxDrumDistance_m, kMaxDrumDistance_m);
+        o.drum_auto = false;
+    } else if (a == "--drum-radius")
+        o.scene.drum.radius_m = parse_number(a, value(), 0.05, 1.0);
+    else if (a == "--drum-tension")
+        o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
+    else if (a == "--drum-density")
+        o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
+    else if (a == "--bounce-height")
+        o.strikes.bounce_height_m = parse_number(a, value(), 0, 1);
+    else if (a == "--bounce-window")
+        o.strikes.bounce_window_s = parse_number(a, value(), 0, 10);
+    else
+        return false;
+    return true;
+}
+
+OutputFile::OutputFile(const std::string &path) : path_(path), out_(path, std::ios::binary)
+{
+    if (!out_)
+        throw std::runtime_error("--out: cannot write '" + path_ + "'");
+}
+
+void OutputFile::close()
+{
+    out_.close();
+    if (!out_)
+        throw std::runtime_error("--out: error writing '" + path_ + "' (disk full?)");
+}
+
+} // namespace cli
+} // namespace ictus
