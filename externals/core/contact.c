@@ -1,4 +1,5 @@
-/* contact.c -- Hunt-Crossley stick contact with an energy-consistent discretisation.
+/* contact.c -- the stick: Hunt-Crossley contact with an energy-consistent
+ * discretisation, and the stroke it plays on a membrane.
  *
  * Force law (contact.h; Hunt & Crossley, lambda in N s / m^(alpha+1)):
  *     F = k x^a + lambda x^a dx/dt   for x > 0, and F >= 0.
@@ -10,7 +11,13 @@
  * acts while the damping term is negative, i.e. while x decreases, where the spring
  * term's work is <= 0 too. With the stick and the modes on the midpoint rule the
  * discrete total energy therefore never grows (docs/membrane.md).
+ *
+ * The stick sits on one of the membrane's coupling points (membrane_internal.h):
+ * the membrane computes the shapes and folds the force into the modes; the stroke
+ * (landing, the implicit solve of the force, touch and release, the report) is
+ * here, called by the membrane through contact_point_ops.
  */
+#include "contact.h"
 #include "membrane_internal.h"
 
 #include <math.h>
@@ -18,6 +25,26 @@
 #include <string.h>
 
 #define CONTACT_FORCE_CAP 1.0e12 /* N */
+
+struct contact {
+    membrane_point point; /* first: a membrane_point * is a contact * (contact_point_ops) */
+    double mass_kg, stiffness, alpha, damping;
+    double hit_velocity; /* m/s, of the hit waiting to land (point.move_pending) */
+    /* Stroke state (double: the contact law is stiff and nonlinear). */
+    int touching, ever_touched;
+    double stick_x, stick_v; /* m, m/s, positive into the membrane */
+    double compression;      /* m */
+    double force;            /* N, during the last sample */
+    long stroke_samples;
+    double first_touch, last_release; /* samples since the stroke began (interpolated) */
+    double peak_force, impulse;
+    int report_ready;
+    contact_report report;
+    float *force_out;
+    int force_cap;
+};
+
+static const membrane_point_ops contact_point_ops;
 
 contact *contact_new(void)
 {
@@ -28,7 +55,8 @@ contact *contact_new(void)
     c->stiffness = CONTACT_DEFAULT_STIFFNESS;
     c->alpha = CONTACT_DEFAULT_ALPHA;
     c->damping = CONTACT_DEFAULT_DAMPING;
-    c->r_over_a = 0.3;
+    c->point.ops = &contact_point_ops;
+    c->point.r_over_a = 0.3;
     return c;
 }
 
@@ -36,13 +64,7 @@ void contact_free(contact *c)
 {
     if (!c)
         return;
-    if (c->owner)
-        membrane_detach_contact(c->owner, c);
-    free(c->psi);
-    free(c->psi_next);
-    free(c->gq);
-    free(c->gp);
-    free(c->wd);
+    membrane_point_free_(&c->point);
     free(c);
 }
 
@@ -93,11 +115,60 @@ double contact_get_damping(const contact *c)
     return c->damping;
 }
 
+ictus_status contact_set_param(contact *c, contact_param p, double value)
+{
+    switch (p) {
+    case CONTACT_PARAM_MASS:
+        return contact_set_mass(c, value);
+    case CONTACT_PARAM_STIFFNESS:
+        return contact_set_stiffness(c, value);
+    case CONTACT_PARAM_ALPHA:
+        return contact_set_alpha(c, value);
+    case CONTACT_PARAM_DAMPING:
+        return contact_set_damping(c, value);
+    default:
+        return ICTUS_CLAMPED;
+    }
+}
+
+double contact_get_param(const contact *c, contact_param p)
+{
+    switch (p) {
+    case CONTACT_PARAM_MASS:
+        return contact_get_mass(c);
+    case CONTACT_PARAM_STIFFNESS:
+        return contact_get_stiffness(c);
+    case CONTACT_PARAM_ALPHA:
+        return contact_get_alpha(c);
+    case CONTACT_PARAM_DAMPING:
+        return contact_get_damping(c);
+    default:
+        return 0.0;
+    }
+}
+
+ictus_range contact_param_range(contact_param p)
+{
+    static const ictus_range ranges[CONTACT_PARAM_COUNT] = {
+        [CONTACT_PARAM_MASS] = {CONTACT_MASS_MIN, CONTACT_MASS_MAX, CONTACT_DEFAULT_MASS},
+        [CONTACT_PARAM_STIFFNESS] = {CONTACT_STIFFNESS_MIN, CONTACT_STIFFNESS_MAX,
+                                     CONTACT_DEFAULT_STIFFNESS},
+        [CONTACT_PARAM_ALPHA] = {CONTACT_ALPHA_MIN, CONTACT_ALPHA_MAX, CONTACT_DEFAULT_ALPHA},
+        [CONTACT_PARAM_DAMPING] = {CONTACT_DAMPING_MIN, CONTACT_DAMPING_MAX,
+                                   CONTACT_DEFAULT_DAMPING},
+    };
+    const ictus_range none = {0.0, 0.0, 0.0};
+    if ((int)p < 0 || p >= CONTACT_PARAM_COUNT)
+        return none;
+    return ranges[p];
+}
+
 ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, double theta_deg,
                          int sample_offset)
 {
     ictus_status s = ictus_clamp(&velocity_mps, 0.0, CONTACT_VELOCITY_MAX, 1.0);
-    if (ictus_clamp(&r_over_a, 0.0, 1.0, 0.0) != ICTUS_OK)
+    if (ictus_clamp(&r_over_a, MEMBRANE_R_OVER_A_MIN, MEMBRANE_R_OVER_A_MAX,
+                    MEMBRANE_R_OVER_A_MIN) != ICTUS_OK)
         s = ICTUS_CLAMPED;
     if (!isfinite(theta_deg)) {
         theta_deg = 0.0;
@@ -111,14 +182,7 @@ ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, doubl
         s = ICTUS_CLAMPED;
     }
     c->hit_velocity = velocity_mps;
-    c->hit_r = r_over_a;
-    c->hit_theta = theta_deg;
-    c->hit_offset = sample_offset;
-    c->hit_pending = 1;
-    /* The weights of the new point are computed here, in the message handler,
-     * so that landing the hit in the audio loop costs O(modes) only. */
-    if (c->owner)
-        membrane_mode_shapes_(c->owner, r_over_a, theta_deg, c->psi_next);
+    membrane_point_move_(&c->point, r_over_a, theta_deg, sample_offset);
     return s;
 }
 
@@ -130,7 +194,7 @@ void contact_set_force_output(contact *c, float *buffer, int capacity)
 
 int contact_is_active(const contact *c)
 {
-    return c->active || c->hit_pending;
+    return c->point.active || c->point.move_pending;
 }
 
 int contact_take_report(contact *c, contact_report *report)
@@ -233,14 +297,11 @@ static double step_force(const contact_step *st, double x1, double *dforce)
     return f;
 }
 
-double contact_force_law_(const contact *c, double x0, double x1, double dt)
-{
-    contact_step st = step_begin(c, x0, dt);
-    return step_force(&st, x1, NULL);
-}
-
-double contact_solve_(const contact *c, double x0, double x_free, double compliance, double dt,
-                      double force_guess, double *x1)
+/* Solves x1 = x_free - compliance * F(x0, x1) for the compression x1 (m) at the
+ * end of one sample of dt seconds; returns F (N). force_guess (e.g. the last
+ * sample's force, or 0) only speeds it up. */
+static double contact_solve(const contact *c, double x0, double x_free, double compliance,
+                            double dt, double force_guess, double *x1)
 {
     /* Root of r(u) = u - x_free + C F(x0, u) with r(x_free) = C F >= 0: Newton on
      * r, kept inside a bracket [lo, hi] and replaced by bisection whenever it
@@ -313,6 +374,176 @@ double contact_solve_(const contact *c, double x0, double x_free, double complia
     return f;
 }
 
+/* ---------------------------------------------------------------- the stroke
+ * Called by the membrane through contact_point_ops (membrane_internal.h). */
+
+static contact *point_contact(membrane_point *pt)
+{
+    return (contact *)pt; /* the point is the contact's first member */
+}
+
+/* A hit lands: the stick starts at the surface (compression 0) at the displacement
+ * the membrane has there, moving in at the hit's velocity. */
+static void contact_landed(membrane_point *pt, double displacement_m)
+{
+    contact *c = point_contact(pt);
+    c->stick_x = displacement_m;
+    c->stick_v = c->hit_velocity;
+    c->compression = 0.0;
+    c->force = 0.0;
+    c->point.active = 1;
+    c->touching = 0;
+    c->ever_touched = 0;
+    c->stroke_samples = 0;
+    c->first_touch = c->last_release = 0.0;
+    c->peak_force = c->impulse = 0.0;
+}
+
+static void finish_stroke(contact *c, double dt)
+{
+    c->report.duration_ms =
+        (c->ever_touched ? (c->last_release - c->first_touch) * dt * 1000.0 : 0.0);
+    c->report.peak_force_n = c->peak_force;
+    c->report.rebound_velocity_mps = c->stick_v < 0.0 ? -c->stick_v : 0.0;
+    c->report.impulse_ns = c->impulse;
+    c->report_ready = 1;
+    c->point.active = 0;
+    c->touching = 0;
+}
+
+/* Joint implicit solve of every active contact for this sample (Gauss-Seidel
+ * over contacts, up to 30 sweeps; a single contact needs none). */
+static void contact_solve_points(membrane_point *const *pts, int na, const double *w_free,
+                                 const double (*K)[MEMBRANE_MAX_POINTS], double T, int sample,
+                                 double out_extra[MEMBRANE_PICKUPS])
+{
+    double xfree[MEMBRANE_MAX_POINTS], F[MEMBRANE_MAX_POINTS] = {0}, x1[MEMBRANE_MAX_POINTS];
+    for (int i = 0; i < na; i++) {
+        contact *c = point_contact(pts[i]);
+        /* Free compression: stick coasting, membrane without this sample's force. */
+        xfree[i] = c->stick_x + T * c->stick_v - w_free[i];
+        x1[i] = xfree[i];
+    }
+    if (na == 1) {
+        /* One stick, the common case: the scalar solve is exact, nothing to sweep. */
+        contact *c = point_contact(pts[0]);
+        double C = T * T / (2.0 * c->mass_kg) + K[0][0];
+        F[0] = contact_solve(c, c->compression, xfree[0], C, T, c->force, &x1[0]);
+    } else {
+        for (int s = 0; s < 30; s++) {
+            double change = 0.0;
+            for (int i = 0; i < na; i++) {
+                contact *c = point_contact(pts[i]);
+                double xf = xfree[i];
+                for (int j = 0; j < na; j++)
+                    if (j != i)
+                        xf -= K[i][j] * F[j];
+                double C = T * T / (2.0 * c->mass_kg) + K[i][i];
+                double Fi = contact_solve(c, c->compression, xf, C, T, c->force, &x1[i]);
+                change += fabs(Fi - F[i]);
+                F[i] = Fi;
+            }
+            if (change <= 1.0e-12 * (1.0 + fabs(F[0])))
+                break;
+        }
+    }
+    for (int i = 0; i < na; i++) {
+        contact *c = point_contact(pts[i]);
+        double Fi = F[i];
+        /* Midpoint rule for the stick: m (v+ - v) = -T F, x+ = x + T (v + v+) / 2. */
+        double v1 = c->stick_v - T * Fi / c->mass_kg;
+        c->stick_x += 0.5 * T * (c->stick_v + v1);
+        c->stick_v = v1;
+        double xw = x1[i], xprev = c->compression;
+        c->force = Fi;
+        c->point.force_pending = Fi;
+        c->stroke_samples++;
+        double t_end = (double)c->stroke_samples, t_start = t_end - 1.0;
+        /* Touching = compressed at the end of the sample; the sample in which x
+         * crosses zero (force may still be > 0 in it) holds the interpolated
+         * touch or release instant. */
+        int now_touching = xw > 0.0;
+        if (now_touching && !c->touching) {
+            /* Touch: interpolate where the compression crossed zero. */
+            double t = xprev < 0.0 && xw > 0.0 ? t_start + (-xprev) / (xw - xprev) : t_start;
+            if (!c->ever_touched)
+                c->first_touch = t;
+            c->ever_touched = 1;
+        } else if (!now_touching && c->touching) {
+            c->last_release = xprev > 0.0 && xw < 0.0 ? t_start + xprev / (xprev - xw) : t_end;
+        }
+        c->touching = now_touching;
+        c->compression = xw;
+        if (Fi > c->peak_force)
+            c->peak_force = Fi;
+        c->impulse += Fi * T;
+        for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+            out_extra[j] += Fi * c->point.pick_coupling[j];
+        /* Release: away from the surface and moving away, and either clear of it
+         * (5 mm) or 50 ms after the last touch; before the first touch the stroke
+         * waits (a stick moving away from the start never touches: 50 ms). */
+        if (!c->touching) {
+            double since = c->stroke_samples - (c->ever_touched ? c->last_release : 0.0);
+            int moving_away = c->stick_v <= 0.0;
+            if ((c->ever_touched && moving_away && (-xw > 0.005 || since * T > 0.05)) ||
+                (!c->ever_touched && moving_away && since * T > 0.05))
+                finish_stroke(c, T);
+        }
+        /* The force outlet reads 0 from the sample the stroke ends in. */
+        if (c->force_out && sample < c->force_cap)
+            c->force_out[sample] = c->point.active ? (float)Fi : 0.0f;
+    }
+}
+
+/* Samples without a stroke carry no force: the solve overwrites the others. */
+static void contact_block_begin(membrane_point *pt, int n)
+{
+    contact *c = point_contact(pt);
+    int have = n < c->force_cap ? n : c->force_cap;
+    if (c->force_out && have > 0)
+        memset(c->force_out, 0, sizeof(float) * (size_t)have);
+}
+
+static void contact_cleared(membrane_point *pt)
+{
+    contact *c = point_contact(pt);
+    c->point.active = c->touching = 0;
+    c->force = 0.0;
+    c->stick_v = c->stick_x = c->compression = 0.0;
+}
+
+static void contact_detached(membrane_point *pt)
+{
+    contact *c = point_contact(pt);
+    c->point.active = c->touching = 0;
+    c->force = 0.0;
+}
+
+static const membrane_point_ops contact_point_ops = {
+    contact_landed, contact_solve_points, contact_block_begin, contact_cleared, contact_detached,
+};
+
+ictus_status membrane_attach_contact(membrane *m, contact *c)
+{
+    if (!m || !c)
+        return ICTUS_CLAMPED;
+    if (c->point.owner == m)
+        return ICTUS_OK;
+    ictus_status s = membrane_point_attach_(m, &c->point);
+    if (s == ICTUS_OK) {
+        /* A stroke in progress elsewhere is over; a hit not yet landed will land here. */
+        c->point.active = c->touching = 0;
+        c->force = 0.0;
+    }
+    return s;
+}
+
+void membrane_detach_contact(membrane *m, contact *c)
+{
+    if (c)
+        membrane_point_detach_(m, &c->point);
+}
+
 int contact_simulate_rigid(const contact *c, double velocity_mps, double sample_rate_hz,
                            double max_seconds, contact_report *report)
 {
@@ -326,7 +557,7 @@ int contact_simulate_rigid(const contact *c, double velocity_mps, double sample_
     long steps = (long)(max_seconds * sample_rate_hz);
     for (long s = 0; s < steps; s++) {
         double x1;
-        double f = contact_solve_(c, x, x + T * v, C, T, last_force, &x1);
+        double f = contact_solve(c, x, x + T * v, C, T, last_force, &x1);
         last_force = f;
         double v1 = v - T * f / c->mass_kg;
         if (f > peak)

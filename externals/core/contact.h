@@ -14,7 +14,9 @@
  * therefore never rebounds faster than it came in, by construction.
  *
  * A contact does nothing on its own: attach it to a membrane
- * (membrane_attach_contact), then contact_hit() starts a stroke.
+ * (membrane_attach_contact), then contact_hit() starts a stroke. The contact is
+ * one of the membrane's coupling points (membrane_internal.h): the membrane folds
+ * its force into the modes, contact.c computes the force and runs the stroke.
  */
 #ifndef ICTUS_CONTACT_H
 #define ICTUS_CONTACT_H
@@ -27,13 +29,16 @@ extern "C" {
 
 #define CONTACT_MASS_MIN      1.0e-4 /* kg */
 #define CONTACT_MASS_MAX      10.0
-#define CONTACT_STIFFNESS_MIN 1.0    /* N/m^alpha */
+#define CONTACT_STIFFNESS_MIN 1.0 /* N/m^alpha */
 #define CONTACT_STIFFNESS_MAX 1.0e12
 #define CONTACT_ALPHA_MIN     1.0
 #define CONTACT_ALPHA_MAX     4.0
-#define CONTACT_DAMPING_MIN   0.0    /* lambda, N s / m^(alpha+1) */
+#define CONTACT_DAMPING_MIN   0.0 /* lambda, N s / m^(alpha+1) */
 #define CONTACT_DAMPING_MAX   1.0e13
-#define CONTACT_VELOCITY_MAX  50.0   /* m/s, |hit velocity| */
+#define CONTACT_VELOCITY_MAX  50.0 /* m/s, |hit velocity| */
+
+/* Contacts attached to one membrane at once: each is one of its coupling points. */
+#define MEMBRANE_MAX_CONTACTS MEMBRANE_MAX_POINTS
 
 /* Defaults: a 50 g snare stick with a felt-free wooden tip on Mylar. */
 #define CONTACT_DEFAULT_MASS      0.05
@@ -41,12 +46,23 @@ extern "C" {
 #define CONTACT_DEFAULT_ALPHA     1.5
 #define CONTACT_DEFAULT_DAMPING   5.0e6 /* mu = lambda / k = 0.5 s/m */
 
+/* The one-number parameters, for the table-driven access below. */
+typedef enum contact_param {
+    CONTACT_PARAM_MASS,      /* contact_set_mass */
+    CONTACT_PARAM_STIFFNESS, /* contact_set_stiffness */
+    CONTACT_PARAM_ALPHA,     /* contact_set_alpha */
+    CONTACT_PARAM_DAMPING,   /* contact_set_damping */
+    CONTACT_PARAM_COUNT
+} contact_param;
+
+typedef struct contact contact;
+
 /* What a finished stroke reports (on release: the stick leaves the membrane). */
 typedef struct contact_report {
-    double duration_ms;         /* first touch to release */
-    double peak_force_n;        /* largest contact force */
+    double duration_ms;          /* first touch to release */
+    double peak_force_n;         /* largest contact force */
     double rebound_velocity_mps; /* stick velocity away from the membrane at release (>= 0) */
-    double impulse_ns;          /* integral of the force */
+    double impulse_ns;           /* integral of the force */
 } contact_report;
 
 /* Allocates. Returns NULL when memory cannot be had. */
@@ -61,6 +77,18 @@ double contact_get_mass(const contact *c);
 double contact_get_stiffness(const contact *c);
 double contact_get_alpha(const contact *c);
 double contact_get_damping(const contact *c);
+
+/* Table-driven access, as membrane_set_param() and its kin (membrane.h). */
+ictus_status contact_set_param(contact *c, contact_param p, double value);
+double contact_get_param(const contact *c, contact_param p);
+ictus_range contact_param_range(contact_param p);
+
+/* Attach / detach a contact (at most MEMBRANE_MAX_CONTACTS per membrane). A contact
+ * is solved jointly with the modes, sample by sample. Attaching an attached contact
+ * does nothing; attaching it to another membrane detaches it first. Returns
+ * ICTUS_ENOMEM when the table is full or memory cannot be had (allocates). */
+ictus_status membrane_attach_contact(membrane *m, contact *c);
+void membrane_detach_contact(membrane *m, contact *c);
 
 /* Starts a stroke: the stick arrives at the membrane surface at (r/a, theta)
  * moving into it at velocity_mps (> 0), `sample_offset` samples into the next

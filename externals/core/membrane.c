@@ -1,7 +1,11 @@
-/* membrane.c -- modal circular membrane (see membrane.h, docs/membrane.md). */
+/* membrane.c -- modal circular membrane (see membrane.h, docs/membrane.md): the
+ * coefficients, the strike queue, the coupling points' mode-space side and the
+ * processing loop. The table of modes is in mode_table.c, the modal update in
+ * membrane_kernel.inc, and the stick's stroke in contact.c, which the membrane only
+ * calls through membrane_point_ops (membrane_internal.h). */
 #define _POSIX_C_SOURCE 200112L
 #include "membrane_internal.h"
-#include "bessel_internal.h"
+#include "mode_table.h"
 
 #include <float.h>
 #include <math.h>
@@ -20,13 +24,6 @@
 #define STRIKE_QUEUE  64
 #define FADE_S        0.03 /* s: ring-out of modes dropped by membrane_set_modes() */
 #define IMPULSE_CACHE 4
-/* hf_damping range: ratio of the air-like to the viscous decay rate at 1 kHz. */
-#define MEMBRANE_HF_MAX     1000.0
-#define MEMBRANE_DEFAULT_HF 1.0
-#define MEMBRANE_GAIN_MAX   1.0e6
-/* Output gain: a forte hit (0.05 kg stick at 5 m/s, default head, r/a = 0.3) peaks
- * near 0.5 full scale with this gain (measured by tests/core, docs/membrane.md). */
-#define MEMBRANE_DEFAULT_GAIN 0.16
 
 typedef struct pending_strike {
     double r_over_a, theta_deg, impulse_ns;
@@ -49,9 +46,9 @@ struct membrane {
     long fade_left;
     int count;    /* modes rounded up to MEMBRANE_PAD: the kernel's loop length */
     int capacity; /* floats allocated per array */
-    /* Mode table (double), capacity entries; entries >= modes are padding. */
-    double *mode_j, *mode_norm, *omega_model;
-    int *mode_m, *mode_n, *mode_sin;
+    /* Mode table, capacity entries; entries >= modes are padding. */
+    mode_table table;
+    double *omega_model; /* model stiffness w' per mode (0: silent) */
     /* SoA float state and coefficients (see membrane_kernel.inc). */
     float *q, *p, *c1, *c2, *c3, *eq, *ep, *dm;
     float *psi_strike, *psi_pick[MEMBRANE_PICKUPS];
@@ -66,8 +63,8 @@ struct membrane {
     long dropped;
     impulse_shape impulse_cache[IMPULSE_CACHE];
     int impulse_next;
-    contact *contacts[MEMBRANE_MAX_CONTACTS];
-    int contact_count;
+    membrane_point *points[MEMBRANE_MAX_POINTS];
+    int point_count;
     void (*kernel)(membrane_kernel_args *);
 };
 
@@ -75,7 +72,8 @@ struct membrane {
 
 static ictus_status clamp_point(double *r_over_a, double *theta_deg)
 {
-    ictus_status s = ictus_clamp(r_over_a, 0.0, 1.0, 0.0);
+    ictus_status s =
+        ictus_clamp(r_over_a, MEMBRANE_R_OVER_A_MIN, MEMBRANE_R_OVER_A_MAX, MEMBRANE_R_OVER_A_MIN);
     if (!isfinite(*theta_deg)) {
         *theta_deg = 0.0;
         return ICTUS_CLAMPED;
@@ -101,36 +99,17 @@ static int padded(int n)
     return (n + MEMBRANE_PAD - 1) / MEMBRANE_PAD * MEMBRANE_PAD;
 }
 
-int membrane_capacity_(const membrane *m)
+/* Shapes of the sounding modes (the fading ones included) at a point; see mode_table.h. */
+static void mode_shapes(const membrane *m, double r_over_a, double theta_deg, float *psi)
 {
-    return m->capacity;
-}
-
-/* Mass-normalised shape of every mode at a point:
- *     psi_k = J_m(j r/a) {cos, sin}(m theta) / sqrt(pi J_{m+1}(j)^2 / eps_m),
- * eps_0 = 1, eps_m = 2, so that b_k = psi_k / sqrt(sigma a^2) = phi_k / sqrt(M_k). */
-void membrane_mode_shapes_(const membrane *m, double r_over_a, double theta_deg, float *psi)
-{
-    double theta = theta_deg * (M_PI / 180.0);
-    double radial = 0.0;
-    for (int k = 0; k < m->capacity; k++) {
-        if (k >= m->fading_modes) {
-            psi[k] = 0.0f;
-            continue;
-        }
-        /* cos and sin partners are adjacent and share J_m(j r/a). */
-        if (!(k > 0 && m->mode_j[k] == m->mode_j[k - 1] && m->mode_m[k] == m->mode_m[k - 1]))
-            radial = ictus_bessel_j(m->mode_m[k], m->mode_j[k] * r_over_a);
-        double angular = m->mode_sin[k] ? sin(m->mode_m[k] * theta) : cos(m->mode_m[k] * theta);
-        psi[k] = (float)(radial * angular * m->mode_norm[k]);
-    }
+    mode_table_shapes(&m->table, m->fading_modes, r_over_a, theta_deg, psi);
 }
 
 /* Damping law sigma_k = s0 + s1 w_k^2 with s0 + s1 w_1^2 = ln(1000)/t60 and
  * s1 w_ref^2 = hf * s0 at w_ref = 2 pi 1 kHz. */
 static double mode_decay_rate(const membrane *m, double omega)
 {
-    double omega1 = m->mode_j[0] * sqrt(m->tension / m->density) / m->radius;
+    double omega1 = m->table.j[0] * sqrt(m->tension / m->density) / m->radius;
     double w_ref = 2.0 * M_PI * 1000.0;
     double rate1 = log(1000.0) / m->t60;
     double s0 = rate1 / (1.0 + m->hf_damping * (omega1 / w_ref) * (omega1 / w_ref));
@@ -151,7 +130,7 @@ static void update_coefficients(membrane *m, int rescale)
     for (int k = 0; k < m->capacity; k++) {
         double old_omega = m->omega_model[k];
         int fading = k >= m->modes;
-        double freq = (k < m->fading_modes) ? m->mode_j[k] * c / (2.0 * M_PI * m->radius) : 0.0;
+        double freq = (k < m->fading_modes) ? m->table.j[k] * c / (2.0 * M_PI * m->radius) : 0.0;
         if (k >= m->fading_modes || freq >= 0.95 * 0.5 * m->sample_rate || freq <= 0.0) {
             /* Silent: frozen at zero, no input, no output. */
             m->c1[k] = m->c2[k] = m->c3[k] = m->eq[k] = m->ep[k] = m->dm[k] = 0.0f;
@@ -177,7 +156,7 @@ static void update_coefficients(membrane *m, int rescale)
         m->eq[k] = (float)(scale * T * h * wm / D);
         m->ep[k] = (float)(scale * T / D);
         m->dm[k] = (float)(scale / wm);
-        if (fading) /* ringing out: no input, invisible to the contacts */
+        if (fading) /* ringing out: no input, invisible to the coupling points */
             m->eq[k] = m->ep[k] = m->dm[k] = 0.0f;
         if (rescale && old_omega > 0.0) {
             /* y = q / (sqrt(M) w'), y' = p / sqrt(M), sqrt(M) proportional to 1/scale. */
@@ -191,40 +170,20 @@ static void update_coefficients(membrane *m, int rescale)
     }
 }
 
-static void refresh_contact_couplings(membrane *m);
-static void flush_contacts(membrane *m);
+static void refresh_point_couplings(membrane *m);
+static void flush_points(membrane *m);
 
 /* Builds the mode table for `modes` modes; keeps the state of modes that exist
  * in both the old and new table (the order is a prefix property of the sort). */
 static ictus_status build_modes(membrane *m, int modes)
 {
     int need = padded(modes);
-    if (need > m->capacity || !m->mode_j) {
-        /* Enough Bessel zeros: Weyl's law gives about x^2/4 modes below j = x. */
-        double x_max = 2.0 * sqrt((double)need) + 4.0;
-        ictus_bessel_zero_entry *zeros = NULL;
-        int count = 0, table = 0;
-        for (;;) {
-            free(zeros);
-            count = ictus_bessel_zeros_below(x_max, &zeros);
-            if (count < 0)
-                return ICTUS_ENOMEM;
-            table = 0;
-            for (int i = 0; i < count; i++)
-                table += zeros[i].m ? 2 : 1;
-            if (table >= need)
-                break;
-            x_max *= 1.15;
-        }
+    if (need > m->capacity || !m->table.j) {
         int cap = need;
-        double *mj = malloc(sizeof(double) * (size_t)cap);
-        double *mnorm = malloc(sizeof(double) * (size_t)cap);
+        mode_table table = {0};
         double *om = calloc((size_t)cap, sizeof(double));
-        int *mm = malloc(sizeof(int) * (size_t)cap);
-        int *mn = malloc(sizeof(int) * (size_t)cap);
-        int *ms = malloc(sizeof(int) * (size_t)cap);
         float *arrays[13];
-        int ok = mj && mnorm && om && mm && mn && ms;
+        int ok = om != NULL;
         for (int i = 0; i < 13; i++) {
             arrays[i] = alloc_floats(cap);
             ok = ok && arrays[i];
@@ -234,52 +193,42 @@ static ictus_status build_modes(membrane *m, int modes)
             impulse[i] = alloc_floats(cap);
             ok = ok && impulse[i];
         }
-        float *cpsi[MEMBRANE_MAX_CONTACTS][5];
-        for (int i = 0; i < MEMBRANE_MAX_CONTACTS; i++) {
+        float *ppsi[MEMBRANE_MAX_POINTS][5];
+        for (int i = 0; i < MEMBRANE_MAX_POINTS; i++) {
             for (int j = 0; j < 5; j++) {
-                cpsi[i][j] = NULL;
-                if (i < m->contact_count) {
-                    cpsi[i][j] = alloc_floats(cap);
-                    ok = ok && cpsi[i][j];
+                ppsi[i][j] = NULL;
+                if (i < m->point_count) {
+                    ppsi[i][j] = alloc_floats(cap);
+                    ok = ok && ppsi[i][j];
                 }
             }
         }
+        /* The table last: it computes the Bessel zeros in scratch memory that it
+         * frees, and state arrays allocated after that landed at heap offsets
+         * that cost ~5 % in bench_membrane_core (contact, 1024 modes). */
+        ok = ok && mode_table_build(&table, cap) == ICTUS_OK;
         if (!ok) {
-            free(zeros);
-            free(mj), free(mnorm), free(om), free(mm), free(mn), free(ms);
+            mode_table_free(&table);
+            free(om);
             for (int i = 0; i < 13; i++)
                 free(arrays[i]);
             for (int i = 0; i < IMPULSE_CACHE; i++)
                 free(impulse[i]);
-            for (int i = 0; i < MEMBRANE_MAX_CONTACTS; i++)
+            for (int i = 0; i < MEMBRANE_MAX_POINTS; i++)
                 for (int j = 0; j < 5; j++)
-                    free(cpsi[i][j]);
+                    free(ppsi[i][j]);
             return ICTUS_ENOMEM;
         }
-        int k = 0;
-        for (int i = 0; i < count && k < cap; i++) {
-            double v[3];
-            ictus_bessel_j3(zeros[i].m, zeros[i].j, v);
-            double eps = zeros[i].m ? 2.0 : 1.0;
-            for (int s = 0; s < (zeros[i].m ? 2 : 1) && k < cap; s++, k++) {
-                mj[k] = zeros[i].j;
-                mm[k] = zeros[i].m;
-                mn[k] = zeros[i].n;
-                ms[k] = s;
-                mnorm[k] = sqrt(eps / M_PI) / fabs(v[2]);
-            }
-        }
-        free(zeros);
         /* Keep the state of the modes we had (same index = same mode). */
-        flush_contacts(m);
+        flush_points(m);
         int keep = m->capacity < cap ? m->capacity : cap;
         if (m->q) {
             memcpy(arrays[0], m->q, sizeof(float) * (size_t)keep);
             memcpy(arrays[1], m->p, sizeof(float) * (size_t)keep);
             memcpy(om, m->omega_model, sizeof(double) * (size_t)keep);
         }
-        free(m->mode_j), free(m->mode_norm), free(m->omega_model);
-        free(m->mode_m), free(m->mode_n), free(m->mode_sin);
+        mode_table_free(&m->table);
+        free(m->omega_model);
         free(m->q), free(m->p), free(m->c1), free(m->c2), free(m->c3);
         free(m->eq), free(m->ep), free(m->dm), free(m->psi_strike);
         for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
@@ -287,8 +236,8 @@ static ictus_status build_modes(membrane *m, int modes)
             free(m->psi_pick_old[i]);
             m->pick_fade_left[i] = 0;
         }
-        m->mode_j = mj, m->mode_norm = mnorm, m->omega_model = om;
-        m->mode_m = mm, m->mode_n = mn, m->mode_sin = ms;
+        m->table = table;
+        m->omega_model = om;
         m->q = arrays[0], m->p = arrays[1], m->c1 = arrays[2], m->c2 = arrays[3];
         m->c3 = arrays[4], m->eq = arrays[5], m->ep = arrays[6], m->dm = arrays[7];
         m->psi_strike = arrays[8];
@@ -301,19 +250,19 @@ static ictus_status build_modes(membrane *m, int modes)
             m->impulse_cache[i].psi = impulse[i];
             m->impulse_cache[i].valid = 0;
         }
-        for (int i = 0; i < m->contact_count; i++) {
-            contact *c = m->contacts[i];
-            free(c->psi), free(c->psi_next), free(c->gq), free(c->gp), free(c->wd);
-            c->psi = cpsi[i][0];
-            c->psi_next = cpsi[i][1];
-            c->gq = cpsi[i][2];
-            c->gp = cpsi[i][3];
-            c->wd = cpsi[i][4];
-            c->psi_cap = cap;
+        for (int i = 0; i < m->point_count; i++) {
+            membrane_point *pt = m->points[i];
+            free(pt->psi), free(pt->psi_next), free(pt->gq), free(pt->gp), free(pt->wd);
+            pt->psi = ppsi[i][0];
+            pt->psi_next = ppsi[i][1];
+            pt->gq = ppsi[i][2];
+            pt->gp = ppsi[i][3];
+            pt->wd = ppsi[i][4];
+            pt->psi_cap = cap;
         }
         m->capacity = cap;
     } else {
-        flush_contacts(m);
+        flush_points(m);
         for (int i = 0; i < IMPULSE_CACHE; i++)
             m->impulse_cache[i].valid = 0;
     }
@@ -333,35 +282,35 @@ static ictus_status build_modes(membrane *m, int modes)
     for (int k = m->fading_modes; k < m->capacity; k++)
         m->q[k] = m->p[k] = 0.0f;
     update_coefficients(m, 1);
-    membrane_mode_shapes_(m, m->strike_r, m->strike_theta, m->psi_strike);
+    mode_shapes(m, m->strike_r, m->strike_theta, m->psi_strike);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++)
-        membrane_mode_shapes_(m, m->pick_r[i], m->pick_theta[i], m->psi_pick[i]);
-    for (int i = 0; i < m->contact_count; i++) {
-        contact *c = m->contacts[i];
-        membrane_mode_shapes_(m, c->r_over_a, c->theta_deg, c->psi);
-        if (c->hit_pending)
-            membrane_mode_shapes_(m, c->hit_r, c->hit_theta, c->psi_next);
+        mode_shapes(m, m->pick_r[i], m->pick_theta[i], m->psi_pick[i]);
+    for (int i = 0; i < m->point_count; i++) {
+        membrane_point *pt = m->points[i];
+        mode_shapes(m, pt->r_over_a, pt->theta_deg, pt->psi);
+        if (pt->move_pending)
+            mode_shapes(m, pt->move_r, pt->move_theta, pt->psi_next);
     }
-    refresh_contact_couplings(m);
+    refresh_point_couplings(m);
     return ICTUS_OK;
 }
 
-/* Adds each contact's force of the last sample, not yet in the modal state, to
+/* Adds each point's force of the last sample, not yet in the modal state, to
  * the state (message-time only: before coefficients or shapes change). */
-static void flush_contacts(membrane *m)
+static void flush_points(membrane *m)
 {
     if (!m->q)
         return;
-    for (int i = 0; i < m->contact_count; i++) {
-        contact *c = m->contacts[i];
-        if (c->force_pending != 0.0 && c->psi) {
+    for (int i = 0; i < m->point_count; i++) {
+        membrane_point *pt = m->points[i];
+        if (pt->force_pending != 0.0 && pt->psi) {
             for (int k = 0; k < m->count; k++) {
-                float u = (float)c->force_pending * c->psi[k];
+                float u = (float)pt->force_pending * pt->psi[k];
                 m->q[k] += m->eq[k] * u;
                 m->p[k] += m->ep[k] * u;
             }
         }
-        c->force_pending = 0.0;
+        pt->force_pending = 0.0;
     }
 }
 
@@ -373,27 +322,27 @@ static double dot_psi(const membrane *m, const float *a, const float *b, const f
     return s;
 }
 
-static void contact_couplings(membrane *m, contact *c)
+static void point_couplings(membrane *m, membrane_point *pt)
 {
-    /* w_c changes by K F over a sample: K = sum psi dm psi eq (docs/membrane.md). */
+    /* w changes by K F over a sample: K = sum psi dm psi eq (docs/membrane.md). */
     double K = 0.0;
     for (int k = 0; k < m->count; k++)
-        K += (double)c->psi[k] * c->psi[k] * m->dm[k] * m->eq[k];
+        K += (double)pt->psi[k] * pt->psi[k] * m->dm[k] * m->eq[k];
     for (int k = 0; k < m->capacity; k++) {
-        c->gq[k] = m->eq[k] * c->psi[k];
-        c->gp[k] = m->ep[k] * c->psi[k];
-        c->wd[k] = m->dm[k] * c->psi[k];
+        pt->gq[k] = m->eq[k] * pt->psi[k];
+        pt->gp[k] = m->ep[k] * pt->psi[k];
+        pt->wd[k] = m->dm[k] * pt->psi[k];
     }
-    c->self_compliance = K;
+    pt->self_compliance = K;
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-        c->pick_coupling[j] = dot_psi(m, m->psi_pick[j], c->psi, m->ep);
+        pt->pick_coupling[j] = dot_psi(m, m->psi_pick[j], pt->psi, m->ep);
 }
 
-static void refresh_contact_couplings(membrane *m)
+static void refresh_point_couplings(membrane *m)
 {
-    for (int i = 0; i < m->contact_count; i++)
-        if (m->contacts[i]->psi)
-            contact_couplings(m, m->contacts[i]);
+    for (int i = 0; i < m->point_count; i++)
+        if (m->points[i]->psi)
+            point_couplings(m, m->points[i]);
 }
 
 /* ---------------------------------------------------------------- lifetime */
@@ -409,7 +358,7 @@ membrane *membrane_new(double sample_rate_hz)
     m->tension = MEMBRANE_DEFAULT_TENSION;
     m->density = MEMBRANE_DEFAULT_DENSITY;
     m->t60 = MEMBRANE_DEFAULT_T60;
-    m->hf_damping = MEMBRANE_DEFAULT_HF;
+    m->hf_damping = MEMBRANE_DEFAULT_HF_DAMPING;
     m->output_gain = MEMBRANE_DEFAULT_GAIN;
     m->gain_smoothed = MEMBRANE_DEFAULT_GAIN;
     m->strike_r = 0.3;
@@ -433,10 +382,10 @@ void membrane_free(membrane *m)
 {
     if (!m)
         return;
-    while (m->contact_count > 0)
-        membrane_detach_contact(m, m->contacts[m->contact_count - 1]);
-    free(m->mode_j), free(m->mode_norm), free(m->omega_model);
-    free(m->mode_m), free(m->mode_n), free(m->mode_sin);
+    while (m->point_count > 0)
+        membrane_point_detach_(m, m->points[m->point_count - 1]);
+    mode_table_free(&m->table);
+    free(m->omega_model);
     free(m->q), free(m->p), free(m->c1), free(m->c2), free(m->c3);
     free(m->eq), free(m->ep), free(m->dm), free(m->psi_strike);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
@@ -462,9 +411,9 @@ const char *membrane_kernel_name(const membrane *m)
 
 static ictus_status physics_changed(membrane *m, ictus_status s)
 {
-    flush_contacts(m);
+    flush_points(m);
     update_coefficients(m, 1);
-    refresh_contact_couplings(m);
+    refresh_point_couplings(m);
     return s;
 }
 
@@ -499,16 +448,29 @@ ictus_status membrane_set_density(membrane *m, double d)
     return physics_changed(m, s);
 }
 
+/* The mass range is the density range times the area, pi a^2. */
+static ictus_range mass_range(const membrane *m)
+{
+    const double a = m->radius;
+    ictus_range r;
+    r.min = MEMBRANE_DENSITY_MIN * M_PI * a * a;
+    r.max = MEMBRANE_DENSITY_MAX * M_PI * a * a;
+    r.def = MEMBRANE_DEFAULT_DENSITY * M_PI * a * a;
+    return r;
+}
+
 ictus_status membrane_set_mass(membrane *m, double mass_kg)
 {
-    double area = M_PI * m->radius * m->radius;
-    double d = mass_kg / area;
-    ictus_status s = ICTUS_OK;
-    if (isnan(d)) {
-        d = MEMBRANE_DEFAULT_DENSITY;
-        s = ICTUS_CLAMPED;
+    if (isnan(mass_kg)) {
+        membrane_set_density(m, MEMBRANE_DEFAULT_DENSITY);
+        return ICTUS_CLAMPED;
     }
-    ictus_status s2 = membrane_set_density(m, d);
+    /* Clamped as a mass first, so that the density the limits give is the one a
+     * caller passing the limit itself would get. */
+    ictus_range range = mass_range(m);
+    ictus_status s = ictus_clamp(&mass_kg, range.min, range.max, range.def);
+    double area = M_PI * m->radius * m->radius;
+    ictus_status s2 = membrane_set_density(m, mass_kg / area);
     return s != ICTUS_OK ? s : s2;
 }
 
@@ -537,7 +499,8 @@ ictus_status membrane_set_t60(membrane *m, double t60)
 
 ictus_status membrane_set_hf_damping(membrane *m, double control)
 {
-    ictus_status s = ictus_clamp(&control, 0.0, MEMBRANE_HF_MAX, MEMBRANE_DEFAULT_HF);
+    ictus_status s = ictus_clamp(&control, MEMBRANE_HF_DAMPING_MIN, MEMBRANE_HF_DAMPING_MAX,
+                                 MEMBRANE_DEFAULT_HF_DAMPING);
     m->hf_damping = control;
     return physics_changed(m, s);
 }
@@ -550,11 +513,11 @@ ictus_status membrane_set_pickup(membrane *m, int index, double r_over_a, double
     m->pick_r[index] = r_over_a;
     m->pick_theta[index] = theta_deg;
     memcpy(m->psi_pick_old[index], m->psi_pick[index], sizeof(float) * (size_t)m->capacity);
-    membrane_mode_shapes_(m, r_over_a, theta_deg, m->psi_pick[index]);
+    mode_shapes(m, r_over_a, theta_deg, m->psi_pick[index]);
     /* 5 ms linear crossfade from the old point, when there is something to hear. */
     m->pick_fade_len = (int)(0.005 * m->sample_rate) + 1;
     m->pick_fade_left[index] = membrane_energy(m) > 0.0 ? m->pick_fade_len : 0;
-    refresh_contact_couplings(m);
+    refresh_point_couplings(m);
     return s;
 }
 
@@ -563,7 +526,7 @@ ictus_status membrane_set_strike_point(membrane *m, double r_over_a, double thet
     ictus_status s = clamp_point(&r_over_a, &theta_deg);
     m->strike_r = r_over_a;
     m->strike_theta = theta_deg;
-    membrane_mode_shapes_(m, r_over_a, theta_deg, m->psi_strike);
+    mode_shapes(m, r_over_a, theta_deg, m->psi_strike);
     return s;
 }
 
@@ -583,7 +546,7 @@ static impulse_shape *make_impulse_shape(membrane *m, double r, double theta)
         return s;
     s = &m->impulse_cache[m->impulse_next];
     m->impulse_next = (m->impulse_next + 1) % IMPULSE_CACHE;
-    membrane_mode_shapes_(m, r, theta, s->psi);
+    mode_shapes(m, r, theta, s->psi);
     s->r_over_a = r;
     s->theta_deg = theta;
     s->valid = 1;
@@ -595,7 +558,7 @@ ictus_status membrane_strike(membrane *m, double r_over_a, double theta_deg, dou
 {
     ictus_status s = clamp_point(&r_over_a, &theta_deg);
     /* An impulse beyond 1e3 N s is no drum stroke; clamp rather than overflow floats. */
-    if (ictus_clamp(&impulse_ns, -1.0e3, 1.0e3, 0.0) != ICTUS_OK)
+    if (ictus_clamp(&impulse_ns, -MEMBRANE_IMPULSE_MAX, MEMBRANE_IMPULSE_MAX, 0.0) != ICTUS_OK)
         s = ICTUS_CLAMPED;
     if (sample_offset < 0) {
         sample_offset = 0;
@@ -623,33 +586,114 @@ void membrane_clear(membrane *m)
     m->queued = 0;
     if (m->fade_left > 0)
         m->fade_left = 1; /* nothing left to ring out: end the fade next block */
-    for (int i = 0; i < m->contact_count; i++) {
-        contact *c = m->contacts[i];
-        c->active = c->touching = c->hit_pending = 0;
-        c->force = c->force_pending = 0.0;
-        c->stick_v = c->stick_x = c->compression = 0.0;
+    for (int i = 0; i < m->point_count; i++) {
+        membrane_point *pt = m->points[i];
+        pt->move_pending = 0;
+        pt->force_pending = 0.0;
+        pt->ops->cleared(pt);
     }
 }
 
 ictus_status membrane_set_output_gain(membrane *m, double gain)
 {
     ictus_status s =
-        ictus_clamp(&gain, -MEMBRANE_GAIN_MAX, MEMBRANE_GAIN_MAX, MEMBRANE_DEFAULT_GAIN);
+        ictus_clamp(&gain, MEMBRANE_GAIN_MIN, MEMBRANE_GAIN_MAX, MEMBRANE_DEFAULT_GAIN);
     m->output_gain = gain;
     return s;
 }
 
-ictus_status membrane_attach_contact(membrane *m, contact *c)
+/* ---------------------------------------------------------------- parameter table */
+
+ictus_status membrane_set_param(membrane *m, membrane_param p, double value)
 {
-    if (!m || !c)
+    switch (p) {
+    case MEMBRANE_PARAM_RADIUS:
+        return membrane_set_radius(m, value);
+    case MEMBRANE_PARAM_TENSION:
+        return membrane_set_tension(m, value);
+    case MEMBRANE_PARAM_DENSITY:
+        return membrane_set_density(m, value);
+    case MEMBRANE_PARAM_MASS:
+        return membrane_set_mass(m, value);
+    case MEMBRANE_PARAM_MODES: {
+        /* Clamped before the conversion to int, which is undefined out of range. */
+        double count = floor(value + 0.5);
+        ictus_status s =
+            ictus_clamp(&count, MEMBRANE_MODES_MIN, MEMBRANE_MODES_MAX, MEMBRANE_DEFAULT_MODES);
+        ictus_status b = membrane_set_modes(m, (int)count);
+        return b != ICTUS_OK ? b : s;
+    }
+    case MEMBRANE_PARAM_T60:
+        return membrane_set_t60(m, value);
+    case MEMBRANE_PARAM_HF_DAMPING:
+        return membrane_set_hf_damping(m, value);
+    case MEMBRANE_PARAM_GAIN:
+        return membrane_set_output_gain(m, value);
+    default:
         return ICTUS_CLAMPED;
-    for (int i = 0; i < m->contact_count; i++)
-        if (m->contacts[i] == c)
+    }
+}
+
+double membrane_get_param(const membrane *m, membrane_param p)
+{
+    switch (p) {
+    case MEMBRANE_PARAM_RADIUS:
+        return membrane_get_radius(m);
+    case MEMBRANE_PARAM_TENSION:
+        return membrane_get_tension(m);
+    case MEMBRANE_PARAM_DENSITY:
+        return membrane_get_density(m);
+    case MEMBRANE_PARAM_MASS:
+        return membrane_get_mass(m);
+    case MEMBRANE_PARAM_MODES:
+        return membrane_get_modes(m);
+    case MEMBRANE_PARAM_T60:
+        return membrane_get_t60(m);
+    case MEMBRANE_PARAM_HF_DAMPING:
+        return membrane_get_hf_damping(m);
+    case MEMBRANE_PARAM_GAIN:
+        return membrane_get_output_gain(m);
+    default:
+        return 0.0;
+    }
+}
+
+ictus_range membrane_param_range(const membrane *m, membrane_param p)
+{
+    static const ictus_range ranges[MEMBRANE_PARAM_COUNT] = {
+        [MEMBRANE_PARAM_RADIUS] = {MEMBRANE_RADIUS_MIN, MEMBRANE_RADIUS_MAX,
+                                   MEMBRANE_DEFAULT_RADIUS},
+        [MEMBRANE_PARAM_TENSION] = {MEMBRANE_TENSION_MIN, MEMBRANE_TENSION_MAX,
+                                    MEMBRANE_DEFAULT_TENSION},
+        [MEMBRANE_PARAM_DENSITY] = {MEMBRANE_DENSITY_MIN, MEMBRANE_DENSITY_MAX,
+                                    MEMBRANE_DEFAULT_DENSITY},
+        [MEMBRANE_PARAM_MODES] = {MEMBRANE_MODES_MIN, MEMBRANE_MODES_MAX, MEMBRANE_DEFAULT_MODES},
+        [MEMBRANE_PARAM_T60] = {MEMBRANE_T60_MIN, MEMBRANE_T60_MAX, MEMBRANE_DEFAULT_T60},
+        [MEMBRANE_PARAM_HF_DAMPING] = {MEMBRANE_HF_DAMPING_MIN, MEMBRANE_HF_DAMPING_MAX,
+                                       MEMBRANE_DEFAULT_HF_DAMPING},
+        [MEMBRANE_PARAM_GAIN] = {MEMBRANE_GAIN_MIN, MEMBRANE_GAIN_MAX, MEMBRANE_DEFAULT_GAIN},
+    };
+    const ictus_range none = {0.0, 0.0, 0.0};
+    if (p == MEMBRANE_PARAM_MASS)
+        return mass_range(m);
+    if ((int)p < 0 || p >= MEMBRANE_PARAM_COUNT)
+        return none;
+    return ranges[p];
+}
+
+/* ---------------------------------------------------------------- coupling points */
+
+ictus_status membrane_point_attach_(membrane *m, membrane_point *pt)
+{
+    if (!m || !pt)
+        return ICTUS_CLAMPED;
+    for (int i = 0; i < m->point_count; i++)
+        if (m->points[i] == pt)
             return ICTUS_OK;
-    if (m->contact_count >= MEMBRANE_MAX_CONTACTS)
+    if (m->point_count >= MEMBRANE_MAX_POINTS)
         return ICTUS_ENOMEM;
-    if (c->owner)
-        membrane_detach_contact(c->owner, c);
+    if (pt->owner)
+        membrane_point_detach_(pt->owner, pt);
     float *arr[5];
     int ok = 1;
     for (int j = 0; j < 5; j++) {
@@ -661,53 +705,75 @@ ictus_status membrane_attach_contact(membrane *m, contact *c)
             free(arr[j]);
         return ICTUS_ENOMEM;
     }
-    free(c->psi), free(c->psi_next), free(c->gq), free(c->gp), free(c->wd);
-    c->psi = arr[0];
-    c->psi_next = arr[1];
-    c->gq = arr[2];
-    c->gp = arr[3];
-    c->wd = arr[4];
-    c->psi_cap = m->capacity;
-    c->owner = m;
-    c->slot = m->contact_count;
-    m->contacts[m->contact_count++] = c;
-    c->active = c->touching = 0;
-    c->force = c->force_pending = 0.0;
-    membrane_mode_shapes_(m, c->r_over_a, c->theta_deg, c->psi);
-    if (c->hit_pending)
-        membrane_mode_shapes_(m, c->hit_r, c->hit_theta, c->psi_next);
-    contact_couplings(m, c);
+    free(pt->psi), free(pt->psi_next), free(pt->gq), free(pt->gp), free(pt->wd);
+    pt->psi = arr[0];
+    pt->psi_next = arr[1];
+    pt->gq = arr[2];
+    pt->gp = arr[3];
+    pt->wd = arr[4];
+    pt->psi_cap = m->capacity;
+    pt->owner = m;
+    pt->slot = m->point_count;
+    m->points[m->point_count++] = pt;
+    pt->force_pending = 0.0;
+    mode_shapes(m, pt->r_over_a, pt->theta_deg, pt->psi);
+    if (pt->move_pending)
+        mode_shapes(m, pt->move_r, pt->move_theta, pt->psi_next);
+    point_couplings(m, pt);
     return ICTUS_OK;
 }
 
-void membrane_detach_contact(membrane *m, contact *c)
+void membrane_point_detach_(membrane *m, membrane_point *pt)
 {
-    if (!m || !c)
+    if (!m || !pt)
         return;
-    for (int i = 0; i < m->contact_count; i++) {
-        if (m->contacts[i] != c)
+    for (int i = 0; i < m->point_count; i++) {
+        if (m->points[i] != pt)
             continue;
-        flush_contacts(m);
-        for (int j = i; j + 1 < m->contact_count; j++) {
-            m->contacts[j] = m->contacts[j + 1];
-            m->contacts[j]->slot = j;
+        flush_points(m);
+        for (int j = i; j + 1 < m->point_count; j++) {
+            m->points[j] = m->points[j + 1];
+            m->points[j]->slot = j;
         }
-        m->contact_count--;
-        c->owner = NULL;
-        c->active = c->touching = 0;
-        c->force = c->force_pending = 0.0;
+        m->point_count--;
+        pt->owner = NULL;
+        pt->force_pending = 0.0;
+        pt->ops->detached(pt);
         return;
     }
+}
+
+void membrane_point_free_(membrane_point *pt)
+{
+    if (!pt)
+        return;
+    if (pt->owner)
+        membrane_point_detach_(pt->owner, pt);
+    free(pt->psi), free(pt->psi_next), free(pt->gq), free(pt->gp), free(pt->wd);
+    pt->psi = pt->psi_next = pt->gq = pt->gp = pt->wd = NULL;
+    pt->psi_cap = 0;
+}
+
+void membrane_point_move_(membrane_point *pt, double r_over_a, double theta_deg, int sample_offset)
+{
+    pt->move_r = r_over_a;
+    pt->move_theta = theta_deg;
+    pt->move_offset = sample_offset;
+    pt->move_pending = 1;
+    /* The weights of the new point are computed here, in the message handler,
+     * so that landing in the audio loop costs O(modes) only. */
+    if (pt->owner)
+        mode_shapes(pt->owner, r_over_a, theta_deg, pt->psi_next);
 }
 
 /* ---------------------------------------------------------------- process */
 
 /* Adds an input impulse (force F over one sample along shape psi) after the
  * step: linear, so it equals passing it through the step's input. Updates the
- * pickup sums and contact displacements of this sample too. */
+ * pickup sums and coupling-point displacements of this sample too. */
 static void add_input(membrane *m, const float *psi, double force, membrane_kernel_args *a)
 {
-    double dpick[MEMBRANE_PICKUPS] = {0}, dw[MEMBRANE_MAX_CONTACTS] = {0};
+    double dpick[MEMBRANE_PICKUPS] = {0}, dw[MEMBRANE_MAX_POINTS] = {0};
     for (int k = 0; k < m->count; k++) {
         float u = (float)force * psi[k];
         float dq = m->eq[k] * u, dp = m->ep[k] * u;
@@ -715,16 +781,16 @@ static void add_input(membrane *m, const float *psi, double force, membrane_kern
         m->p[k] += dp;
         for (int j = 0; j < MEMBRANE_PICKUPS; j++)
             dpick[j] += (double)m->psi_pick[j][k] * dp;
-        for (int c = 0; c < a->contacts; c++)
-            dw[c] += (double)a->contact_wd[c][k] * dq;
+        for (int c = 0; c < a->points; c++)
+            dw[c] += (double)a->point_wd[c][k] * dq;
     }
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
         a->pick_sum[j] += dpick[j];
-    for (int c = 0; c < a->contacts; c++)
-        a->contact_w[c] += dw[c];
+    for (int c = 0; c < a->points; c++)
+        a->point_w[c] += dw[c];
 }
 
-static double contact_point_displacement(const membrane *m, const float *psi)
+static double point_displacement(const membrane *m, const float *psi)
 {
     double w = 0.0;
     for (int k = 0; k < m->count; k++)
@@ -732,125 +798,39 @@ static double contact_point_displacement(const membrane *m, const float *psi)
     return w;
 }
 
-/* A hit lands: the previous stroke's pending force goes into the state, the new
- * shapes take over, and the stick starts at the surface (compression 0). */
-static void land_hit(membrane *m, contact *c)
+/* A pending move lands: the last force at the old place goes into the state, the
+ * new shapes take over, and the point's object is told (a stick starts its stroke
+ * at the surface there, contact.c). */
+static void land_point(membrane *m, membrane_point *pt)
 {
-    if (c->force_pending != 0.0) {
+    if (pt->force_pending != 0.0) {
         for (int k = 0; k < m->count; k++) {
-            float u = (float)c->force_pending * c->psi[k];
+            float u = (float)pt->force_pending * pt->psi[k];
             m->q[k] += m->eq[k] * u;
             m->p[k] += m->ep[k] * u;
         }
     }
-    float *t = c->psi;
-    c->psi = c->psi_next;
-    c->psi_next = t;
-    c->r_over_a = c->hit_r;
-    c->theta_deg = c->hit_theta;
-    c->hit_pending = 0;
-    contact_couplings(m, c);
-    c->stick_x = contact_point_displacement(m, c->psi);
-    c->stick_v = c->hit_velocity;
-    c->compression = 0.0;
-    c->force = c->force_pending = 0.0;
-    c->active = 1;
-    c->touching = 0;
-    c->ever_touched = 0;
-    c->stroke_samples = 0;
-    c->first_touch = c->last_release = 0.0;
-    c->peak_force = c->impulse = 0.0;
+    float *t = pt->psi;
+    pt->psi = pt->psi_next;
+    pt->psi_next = t;
+    pt->r_over_a = pt->move_r;
+    pt->theta_deg = pt->move_theta;
+    pt->move_pending = 0;
+    point_couplings(m, pt);
+    pt->force_pending = 0.0;
+    pt->ops->landed(pt, point_displacement(m, pt->psi));
 }
 
-static void finish_stroke(contact *c, double dt)
+/* The first sample after `after` on which a pending move lands in a block of n, or n. */
+static int next_move(const membrane *m, int after, int n)
 {
-    c->report.duration_ms =
-        (c->ever_touched ? (c->last_release - c->first_touch) * dt * 1000.0 : 0.0);
-    c->report.peak_force_n = c->peak_force;
-    c->report.rebound_velocity_mps = c->stick_v < 0.0 ? -c->stick_v : 0.0;
-    c->report.impulse_ns = c->impulse;
-    c->report_ready = 1;
-    c->active = 0;
-    c->touching = 0;
-}
-
-/* Joint implicit solve of every active contact for this sample (Gauss-Seidel
- * over contacts; exact in one sweep for a single contact). */
-static void solve_contacts(membrane *m, membrane_kernel_args *a, contact **act, int na,
-                           double K[MEMBRANE_MAX_CONTACTS][MEMBRANE_MAX_CONTACTS], int sample,
-                           double out_extra[MEMBRANE_PICKUPS])
-{
-    const double T = 1.0 / m->sample_rate;
-    double xfree[MEMBRANE_MAX_CONTACTS], F[MEMBRANE_MAX_CONTACTS], x1[MEMBRANE_MAX_CONTACTS];
-    for (int i = 0; i < na; i++) {
-        contact *c = act[i];
-        /* Free compression: stick coasting, membrane without this sample's force. */
-        xfree[i] = c->stick_x + T * c->stick_v - a->contact_w[i];
-        F[i] = 0.0;
-        x1[i] = xfree[i];
+    int next = n;
+    for (int c = 0; c < m->point_count; c++) {
+        const membrane_point *pt = m->points[c];
+        if (pt->move_pending && pt->move_offset > after && pt->move_offset < next)
+            next = pt->move_offset;
     }
-    int sweeps = na == 1 ? 1 : 30;
-    for (int s = 0; s < sweeps; s++) {
-        double change = 0.0;
-        for (int i = 0; i < na; i++) {
-            contact *c = act[i];
-            double xf = xfree[i];
-            for (int j = 0; j < na; j++)
-                if (j != i)
-                    xf -= K[i][j] * F[j];
-            double C = T * T / (2.0 * c->mass_kg) + K[i][i];
-            double Fi = contact_solve_(c, c->compression, xf, C, T, c->force, &x1[i]);
-            change += fabs(Fi - F[i]);
-            F[i] = Fi;
-        }
-        if (change <= 1.0e-12 * (1.0 + fabs(F[0])))
-            break;
-    }
-    for (int i = 0; i < na; i++) {
-        contact *c = act[i];
-        double Fi = F[i];
-        /* Midpoint rule for the stick: m (v+ - v) = -T F, x+ = x + T (v + v+) / 2. */
-        double v1 = c->stick_v - T * Fi / c->mass_kg;
-        c->stick_x += 0.5 * T * (c->stick_v + v1);
-        c->stick_v = v1;
-        double xw = x1[i], xprev = c->compression;
-        c->force = Fi;
-        c->force_pending = Fi;
-        c->stroke_samples++;
-        double t_end = (double)c->stroke_samples, t_start = t_end - 1.0;
-        /* Touching = compressed at the end of the sample; the sample in which x
-         * crosses zero (force may still be > 0 in it) holds the interpolated
-         * touch or release instant. */
-        int now_touching = xw > 0.0;
-        if (now_touching && !c->touching) {
-            /* Touch: interpolate where the compression crossed zero. */
-            double t = xprev < 0.0 && xw > 0.0 ? t_start + (-xprev) / (xw - xprev) : t_start;
-            if (!c->ever_touched)
-                c->first_touch = t;
-            c->ever_touched = 1;
-        } else if (!now_touching && c->touching) {
-            c->last_release = xprev > 0.0 && xw < 0.0 ? t_start + xprev / (xprev - xw) : t_end;
-        }
-        c->touching = now_touching;
-        c->compression = xw;
-        if (Fi > c->peak_force)
-            c->peak_force = Fi;
-        c->impulse += Fi * T;
-        for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-            out_extra[j] += Fi * c->pick_coupling[j];
-        if (c->force_out && sample < c->force_cap)
-            c->force_out[sample] = (float)Fi;
-        /* Release: away from the surface and moving away, and either clear of it
-         * (5 mm) or 50 ms after the last touch; before the first touch the stroke
-         * waits (a stick moving away from the start never touches: 50 ms). */
-        if (!c->touching) {
-            double since = c->stroke_samples - (c->ever_touched ? c->last_release : 0.0);
-            int moving_away = c->stick_v <= 0.0;
-            if ((c->ever_touched && moving_away && (-xw > 0.005 || since * T > 0.05)) ||
-                (!c->ever_touched && moving_away && since * T > 0.05))
-                finish_stroke(c, T);
-        }
-    }
+    return next;
 }
 
 void membrane_process(membrane *m, const float *force_in, float *const *out, int n)
@@ -873,39 +853,39 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
     a.psi_strike = m->psi_strike;
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
         a.psi_pick[j] = m->psi_pick[j];
+    for (int c = 0; c < m->point_count; c++)
+        m->points[c]->ops->block_begin(m->points[c], n);
+    int next_landing = next_move(m, -1, n);
 
     for (int i = 0; i < n; i++) {
         float fin = force_in ? force_in[i] : 0.0f;
         if (!isfinite(fin))
             fin = 0.0f;
-        /* Hits landing now. */
-        for (int c = 0; c < m->contact_count; c++) {
-            contact *ct = m->contacts[c];
-            if (ct->hit_pending && ct->hit_offset == i)
-                land_hit(m, ct);
+        /* Points landing now. */
+        if (i == next_landing) {
+            for (int c = 0; c < m->point_count; c++) {
+                membrane_point *pt = m->points[c];
+                if (pt->move_pending && pt->move_offset == i)
+                    land_point(m, pt);
+            }
+            next_landing = next_move(m, i, n);
         }
-        contact *act[MEMBRANE_MAX_CONTACTS];
+        /* The kernel folds in the force of every point that is active, or whose
+         * stroke just ended with its last force still to go in. */
+        membrane_point *act[MEMBRANE_MAX_POINTS];
         int na = 0;
-        for (int c = 0; c < m->contact_count; c++) {
-            contact *ct = m->contacts[c];
-            if (ct->active) {
-                act[na] = ct;
-                a.contact_gq[na] = ct->gq;
-                a.contact_gp[na] = ct->gp;
-                a.contact_wd[na] = ct->wd;
-                a.contact_force_pending[na] = (float)ct->force_pending;
-                na++;
-            } else if (ct->force_pending != 0.0) {
-                /* A stroke just ended: its last force still has to go in. */
-                act[na] = ct;
-                a.contact_gq[na] = ct->gq;
-                a.contact_gp[na] = ct->gp;
-                a.contact_wd[na] = ct->wd;
-                a.contact_force_pending[na] = (float)ct->force_pending;
+        for (int c = 0; c < m->point_count; c++) {
+            membrane_point *pt = m->points[c];
+            if (pt->active || pt->force_pending != 0.0) {
+                act[na] = pt;
+                a.point_gq[na] = pt->gq;
+                a.point_gp[na] = pt->gp;
+                a.point_wd[na] = pt->wd;
+                a.point_force_pending[na] = (float)pt->force_pending;
                 na++;
             }
         }
-        a.contacts = na;
+        a.points = na;
         a.strike_force = fin;
         m->kernel(&a);
         for (int c = 0; c < na; c++)
@@ -924,13 +904,13 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
         int nact = 0;
         for (int c = 0; c < na; c++) {
             if (act[c]->active) {
-                /* Compact to the active contacts; c >= nact, so in-place is safe. */
-                a.contact_w[nact] = a.contact_w[c];
+                /* Compact to the active points; c >= nact, so in-place is safe. */
+                a.point_w[nact] = a.point_w[c];
                 act[nact++] = act[c];
             }
         }
         if (nact > 0) {
-            double K[MEMBRANE_MAX_CONTACTS][MEMBRANE_MAX_CONTACTS];
+            double K[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
             for (int r = 0; r < nact; r++) {
                 K[r][r] = act[r]->self_compliance;
                 /* Cross-compliance between two sticks on the same head (rare: only
@@ -944,12 +924,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
                     K[r][c] = s;
                 }
             }
-            solve_contacts(m, &a, act, nact, K, i, extra);
-        }
-        for (int c = 0; c < m->contact_count; c++) {
-            contact *ct = m->contacts[c];
-            if (!ct->active && ct->force_out && i < ct->force_cap)
-                ct->force_out[i] = 0.0f;
+            act[0]->ops->solve(act, nact, a.point_w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
+                               extra);
         }
         double y[MEMBRANE_PICKUPS];
         int finite = 1;
@@ -963,7 +939,7 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             y[j] = out_scale * (a.pick_sum[j] + extra[j]);
             if (m->pick_fade_left[j] > 0) {
                 /* Crossfade from a moved pickup: one more dot product per sample for
-                 * 5 ms (the contact's direct term uses the new point throughout). */
+                 * 5 ms (the points' direct term uses the new place throughout). */
                 double old = 0.0;
                 for (int k = 0; k < m->count; k++)
                     old += (double)m->psi_pick_old[j][k] * m->p[k];
@@ -984,7 +960,7 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
                 out[j][i] = (float)y[j];
         }
     }
-    /* Carry pending strikes and hits past this block. */
+    /* Carry pending strikes and moves past this block. */
     int kept = 0;
     for (int s = 0; s < m->queued; s++) {
         if (m->queue[s].offset >= n) {
@@ -994,9 +970,9 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
         }
     }
     m->queued = kept;
-    for (int c = 0; c < m->contact_count; c++)
-        if (m->contacts[c]->hit_pending)
-            m->contacts[c]->hit_offset -= n;
+    for (int c = 0; c < m->point_count; c++)
+        if (m->points[c]->move_pending)
+            m->points[c]->move_offset -= n;
     if (m->fade_left > 0) {
         m->fade_left -= n;
         if (m->fade_left <= 0) {
@@ -1060,27 +1036,27 @@ int membrane_get_mode(const membrane *m, int k, double *freq_hz, double *t60_s, 
 {
     if (k < 0 || k >= m->modes)
         return 0;
-    double omega = m->mode_j[k] * sqrt(m->tension / m->density) / m->radius;
+    double omega = m->table.j[k] * sqrt(m->tension / m->density) / m->radius;
     if (freq_hz)
         *freq_hz = omega / (2.0 * M_PI);
     if (t60_s)
         *t60_s = log(1000.0) / mode_decay_rate(m, omega);
     if (bessel_m)
-        *bessel_m = m->mode_m[k];
+        *bessel_m = m->table.m[k];
     if (bessel_n)
-        *bessel_n = m->mode_n[k];
+        *bessel_n = m->table.n[k];
     if (sin_partner)
-        *sin_partner = m->mode_sin[k];
+        *sin_partner = m->table.sin[k];
     return 1;
 }
 
-/* State including the contact forces not yet folded in (see the kernel). */
+/* State including the coupling-point forces not yet folded in (see the kernel). */
 static void effective_state(const membrane *m, int k, double *q, double *p)
 {
     double u = 0.0;
-    for (int i = 0; i < m->contact_count; i++)
-        if (m->contacts[i]->force_pending != 0.0)
-            u += m->contacts[i]->force_pending * m->contacts[i]->psi[k];
+    for (int i = 0; i < m->point_count; i++)
+        if (m->points[i]->force_pending != 0.0)
+            u += m->points[i]->force_pending * m->points[i]->psi[k];
     *q = m->q[k] + (double)m->eq[k] * u;
     *p = m->p[k] + (double)m->ep[k] * u;
 }
@@ -1094,8 +1070,7 @@ static double point_sum(const membrane *m, double r_over_a, double theta_deg, in
     for (int k = 0; k < m->modes; k++) {
         if (m->omega_model[k] <= 0.0)
             continue;
-        double psi = ictus_bessel_j(m->mode_m[k], m->mode_j[k] * r_over_a) * m->mode_norm[k] *
-                     (m->mode_sin[k] ? sin(m->mode_m[k] * theta) : cos(m->mode_m[k] * theta));
+        double psi = mode_table_shape(&m->table, k, r_over_a, theta);
         double q, p;
         effective_state(m, k, &q, &p);
         s += velocity ? psi * p * m->mass_scale : psi * q * m->mass_scale / m->omega_model[k];

@@ -8,8 +8,9 @@
  * angles of the strike and of the pickups matter. Mode shapes:
  *     phi(r, theta) = J_m(j_mn r / a) * {cos, sin}(m theta).
  * Each mode is a damped oscillator driven by the force at the strike point and
- * by every attached contact (see contact.h); the state of all of them advances
- * together sample by sample in membrane_process().
+ * by the objects attached to the membrane at coupling points (the sticks of
+ * contact.h); the state of all of them advances together sample by sample in
+ * membrane_process().
  *
  * Damping law (documented in docs/membrane.md):
  *     sigma_k = sigma0 + sigma1 * omega_k^2     (decay rate, 1/s; T60 = ln(1000)/sigma_k)
@@ -32,36 +33,66 @@ extern "C" {
  * because memory could not be had (state unchanged). NaN counts as out of
  * range and is replaced by the parameter's default. */
 typedef enum {
-    ICTUS_OK = 0,
-    ICTUS_CLAMPED = 1,
-    ICTUS_ENOMEM = 2
+    ICTUS_OK = 0,      /* taken as given */
+    ICTUS_CLAMPED = 1, /* clamped or NaN replaced (also: no such pickup, strike queue full) */
+    ICTUS_ENOMEM = 2   /* refused: memory could not be had, state unchanged */
 } ictus_status;
 
-/* Legal ranges (SI units). Setters clamp into them. */
-#define MEMBRANE_RADIUS_MIN     0.01   /* m */
-#define MEMBRANE_RADIUS_MAX     2.0    /* m */
-#define MEMBRANE_TENSION_MIN    1.0    /* N/m */
-#define MEMBRANE_TENSION_MAX    1.0e5  /* N/m */
-#define MEMBRANE_DENSITY_MIN    0.01   /* kg/m^2 */
-#define MEMBRANE_DENSITY_MAX    20.0   /* kg/m^2 */
+/* Legal ranges (SI units). Setters clamp into them and say so (ICTUS_CLAMPED);
+ * membrane_param_range() gives the same numbers at run time. */
+#define MEMBRANE_RADIUS_MIN     0.01  /* m */
+#define MEMBRANE_RADIUS_MAX     2.0   /* m */
+#define MEMBRANE_TENSION_MIN    1.0   /* N/m */
+#define MEMBRANE_TENSION_MAX    1.0e5 /* N/m */
+#define MEMBRANE_DENSITY_MIN    0.01  /* kg/m^2 */
+#define MEMBRANE_DENSITY_MAX    20.0  /* kg/m^2 */
 #define MEMBRANE_MODES_MIN      1
 #define MEMBRANE_MODES_MAX      4096
-#define MEMBRANE_T60_MIN        0.005  /* s */
-#define MEMBRANE_T60_MAX        60.0   /* s */
+#define MEMBRANE_T60_MIN        0.005 /* s */
+#define MEMBRANE_T60_MAX        60.0  /* s */
+#define MEMBRANE_HF_DAMPING_MIN 0.0   /* docs/membrane.md */
+#define MEMBRANE_HF_DAMPING_MAX 1000.0
+#define MEMBRANE_GAIN_MIN       -1.0e6 /* s/m; negative inverts */
+#define MEMBRANE_GAIN_MAX       1.0e6
+#define MEMBRANE_R_OVER_A_MIN   0.0 /* points: pickups, strikes, contacts */
+#define MEMBRANE_R_OVER_A_MAX   1.0
+#define MEMBRANE_IMPULSE_MAX    1.0e3  /* N s, |strike impulse| */
 #define MEMBRANE_PICKUPS        2      /* pickups (outputs) per membrane */
-#define MEMBRANE_MAX_CONTACTS   4      /* contacts attached at once */
+#define MEMBRANE_MAX_POINTS     4      /* coupling points (contacts) attached at once */
 #define MEMBRANE_SR_MIN         1000.0 /* Hz */
 #define MEMBRANE_SR_MAX         768000.0
 
 /* Defaults: a 14-inch Mylar head (radius 0.178 m, 0.262 kg/m^2) at 3000 N/m. */
-#define MEMBRANE_DEFAULT_RADIUS  0.178
-#define MEMBRANE_DEFAULT_TENSION 3000.0
-#define MEMBRANE_DEFAULT_DENSITY 0.262
-#define MEMBRANE_DEFAULT_MODES   128
-#define MEMBRANE_DEFAULT_T60     1.0
+#define MEMBRANE_DEFAULT_RADIUS     0.178
+#define MEMBRANE_DEFAULT_TENSION    3000.0
+#define MEMBRANE_DEFAULT_DENSITY    0.262
+#define MEMBRANE_DEFAULT_MODES      128
+#define MEMBRANE_DEFAULT_T60        1.0
+#define MEMBRANE_DEFAULT_HF_DAMPING 1.0
+/* A forte hit (0.05 kg stick at 5 m/s, default head, r/a = 0.3) peaks near 0.5 full
+ * scale with this gain (measured by tests/core, docs/membrane.md#output-scale). */
+#define MEMBRANE_DEFAULT_GAIN 0.16
+
+/* A parameter's legal range and its default, in the units of its setter. */
+typedef struct ictus_range {
+    double min, max, def;
+} ictus_range;
+
+/* The one-number parameters, for the table-driven access below (the wrappers'
+ * parameter tables, externals/pd/ictus_pd_common.h). */
+typedef enum membrane_param {
+    MEMBRANE_PARAM_RADIUS,     /* membrane_set_radius */
+    MEMBRANE_PARAM_TENSION,    /* membrane_set_tension */
+    MEMBRANE_PARAM_DENSITY,    /* membrane_set_density */
+    MEMBRANE_PARAM_MASS,       /* membrane_set_mass */
+    MEMBRANE_PARAM_MODES,      /* membrane_set_modes; a fraction rounds to the nearest count */
+    MEMBRANE_PARAM_T60,        /* membrane_set_t60 */
+    MEMBRANE_PARAM_HF_DAMPING, /* membrane_set_hf_damping */
+    MEMBRANE_PARAM_GAIN,       /* membrane_set_output_gain */
+    MEMBRANE_PARAM_COUNT
+} membrane_param;
 
 typedef struct membrane membrane;
-typedef struct contact contact;
 
 /* Creates a membrane with the defaults above at the given sample rate (Hz).
  * Allocates. Returns NULL when memory cannot be had. */
@@ -71,7 +102,8 @@ void membrane_free(membrane *m);
 /* Sample rate of this instance (Hz); recomputes the coefficients, keeps the state. */
 ictus_status membrane_set_sample_rate(membrane *m, double sample_rate_hz);
 
-/* Physics. Mass sets the density as mass / (pi a^2); density wins if set later. */
+/* Physics. Mass sets the density as mass / (pi a^2), clamped into the density range
+ * times pi a^2; density wins if set later. */
 ictus_status membrane_set_radius(membrane *m, double radius_m);
 ictus_status membrane_set_tension(membrane *m, double tension_n_per_m);
 ictus_status membrane_set_density(membrane *m, double density_kg_per_m2);
@@ -99,22 +131,23 @@ ictus_status membrane_set_strike_point(membrane *m, double r_over_a, double thet
 ictus_status membrane_strike(membrane *m, double r_over_a, double theta_deg, double impulse_ns,
                              int sample_offset);
 
-/* Silences every mode and every attached contact at once. */
+/* Silences every mode at once, and ends the stroke of every attached contact. */
 void membrane_clear(membrane *m);
 
 /* Output gain applied to the pickups (see docs/membrane.md for the scale). */
 ictus_status membrane_set_output_gain(membrane *m, double gain);
 
-/* Attach / detach a contact (at most MEMBRANE_MAX_CONTACTS). A contact is
- * solved jointly with the modes, sample by sample. Attaching an attached
- * contact does nothing. Returns ICTUS_ENOMEM when the table is full. */
-ictus_status membrane_attach_contact(membrane *m, contact *c);
-void membrane_detach_contact(membrane *m, contact *c);
-
 /* Advances n samples. force_in (may be NULL) is a force (N) applied at the
  * strike point; out[0..MEMBRANE_PICKUPS-1] receive the pickup signals
  * (membrane velocity, see docs/membrane.md). force_in may alias an output. */
 void membrane_process(membrane *m, const float *force_in, float *const *out, int n);
+
+/* Table-driven access to the one-number parameters: the setter and getter named in
+ * the membrane_param list, and the range that setter clamps into (the mass's follows
+ * the radius). An unknown p does nothing (ICTUS_CLAMPED, 0, an empty range). */
+ictus_status membrane_set_param(membrane *m, membrane_param p, double value);
+double membrane_get_param(const membrane *m, membrane_param p);
+ictus_range membrane_param_range(const membrane *m, membrane_param p);
 
 /* Read-back, for tests, help patches and the wrappers' error messages. */
 double membrane_get_sample_rate(const membrane *m);

@@ -1,10 +1,11 @@
-/* membrane_internal.h -- shared between membrane.c, contact.c and the kernels.
- * Not public API: the layout may change at any time. */
+/* membrane_internal.h -- the membrane's internals shared with the modal kernels and
+ * with what attaches to a membrane (contact.c). Not public API: the layout may
+ * change at any time. Includes go one way: contact.c includes this file, the
+ * membrane never includes contact.h (docs/externals.md, "Layout"). */
 #ifndef ICTUS_MEMBRANE_INTERNAL_H
 #define ICTUS_MEMBRANE_INTERNAL_H
 
 #include <math.h>
-#include "contact.h"
 #include "membrane.h"
 
 /* Arrays are padded to this many floats and aligned to 64 bytes so that the
@@ -19,63 +20,87 @@ typedef struct membrane_kernel_args {
     const float *psi_strike;
     const float *psi_pick[MEMBRANE_PICKUPS];
     float strike_force; /* N, at the strike point, during this sample */
-    int contacts;       /* contacts whose displacement is wanted */
-    /* Per contact: eq * psi, ep * psi (input vectors) and dm * psi (displacement
-     * weights), precomputed when the stroke or the coefficients change. */
-    const float *contact_gq[MEMBRANE_MAX_CONTACTS], *contact_gp[MEMBRANE_MAX_CONTACTS];
-    const float *contact_wd[MEMBRANE_MAX_CONTACTS];
-    float contact_force_pending[MEMBRANE_MAX_CONTACTS]; /* last sample's forces, not yet in q, p */
-    double pick_sum[MEMBRANE_PICKUPS];                  /* out: sum psi_pick * p */
-    double contact_w[MEMBRANE_MAX_CONTACTS];            /* out: sum wd * q */
+    int points;         /* coupling points whose displacement is wanted */
+    /* Per point: eq * psi, ep * psi (input vectors) and dm * psi (displacement
+     * weights), precomputed when the point or the coefficients change. */
+    const float *point_gq[MEMBRANE_MAX_POINTS], *point_gp[MEMBRANE_MAX_POINTS];
+    const float *point_wd[MEMBRANE_MAX_POINTS];
+    float point_force_pending[MEMBRANE_MAX_POINTS]; /* last sample's forces, not yet in q, p */
+    double pick_sum[MEMBRANE_PICKUPS];              /* out: sum psi_pick * p */
+    double point_w[MEMBRANE_MAX_POINTS];            /* out: sum wd * q */
 } membrane_kernel_args;
 
 void membrane_kernel_generic(membrane_kernel_args *a);
 void membrane_kernel_avx2(membrane_kernel_args *a);
 
-struct contact {
-    double mass_kg, stiffness, alpha, damping;
-    membrane *owner;
-    int slot; /* index in owner's contact table */
-    /* Mode weights (mass-normalised shapes) at the stroke point, and at the
-     * point of a hit that has not landed yet. Owned by the contact, sized by
-     * the owner's capacity. */
-    float *psi, *psi_next;
-    float *gq, *gp, *wd; /* eq psi, ep psi, dm psi at the stroke point */
-    int psi_cap;
-    /* A hit waiting to land. */
-    int hit_pending, hit_offset;
-    double hit_velocity, hit_r, hit_theta;
-    /* Stroke state (double: the contact law is stiff and nonlinear). */
-    int active, touching, ever_touched;
-    double r_over_a, theta_deg;
-    double stick_x, stick_v; /* m, m/s, positive into the membrane */
-    double compression;      /* m */
-    double force;            /* N, during the last sample */
-    double force_pending;    /* N, not yet added to the modal state */
-    double self_compliance;  /* K = d w_c / d F over one sample (m/N) */
-    double pick_coupling[MEMBRANE_PICKUPS];
-    long stroke_samples;
-    double first_touch, last_release; /* samples since the stroke began (interpolated) */
-    double peak_force, impulse;
-    int report_ready;
-    contact_report report;
-    float *force_out;
-    int force_cap;
-};
-
 /* Benchmarks only: run the portable kernel even on an AVX2 machine. */
 void membrane_use_generic_kernel_(membrane *m);
 
-/* Internal membrane services used by contact.c. */
-int membrane_capacity_(const membrane *m);
-/* Fills psi[0 .. capacity) with the mass-normalised mode shapes at (r/a, theta). */
-void membrane_mode_shapes_(const membrane *m, double r_over_a, double theta_deg, float *psi);
-/* Discrete-gradient Hunt-Crossley force for a compression step x0 -> x1 (contact.c). */
-double contact_force_law_(const contact *c, double x0, double x1, double dt);
-/* Solves x1 = x_free - compliance * F(x0, x1) for the compression x1; returns F.
- * force_guess (e.g. the last sample's force, or 0) only speeds it up. */
-double contact_solve_(const contact *c, double x0, double x_free, double compliance, double dt,
-                      double force_guess, double *x1);
+/* ---------------------------------------------------------------- coupling points
+ *
+ * A coupling point is where an object attached to the membrane (a stick: contact.c)
+ * exchanges a force with the modes, solved implicitly sample by sample
+ * (docs/membrane.md, "The contact"). The membrane owns the mode-space side: the
+ * shapes at the point, the couplings derived from them, and folding the force into
+ * the modal state one sample late (the kernel does it). The object owns the force:
+ * the membrane calls it through membrane_point_ops at fixed places of
+ * membrane_process(), and never sees its type. */
+typedef struct membrane_point membrane_point;
+
+typedef struct membrane_point_ops {
+    /* A pending move has just landed (membrane_point_move_): the point is at its
+     * new place, displacement_m is the membrane's displacement there. */
+    void (*landed)(membrane_point *pt, double displacement_m);
+    /* Solves the forces of the `count` active points for sample `sample` together:
+     * w_free[i] is point i's displacement without this sample's forces, and
+     * K[i][j] the change of w_i per newton of F_j over the sample. Sets each
+     * point's force_pending (N, over this sample) and adds force * pick_coupling
+     * into extra (the forces' direct path to the pickups). The points of one
+     * membrane are solved by the first one's ops: they couple through the modes,
+     * so a joint solve needs them all (every point is a contact today). */
+    void (*solve)(membrane_point *const *pts, int count, const double *w_free,
+                  const double (*K)[MEMBRANE_MAX_POINTS], double dt, int sample,
+                  double extra[MEMBRANE_PICKUPS]);
+    /* A block of n samples begins (once per point per membrane_process() call). */
+    void (*block_begin)(membrane_point *pt, int n);
+    /* membrane_clear() ran: the pending move and force are gone already. */
+    void (*cleared)(membrane_point *pt);
+    /* The point has just been detached from its membrane. */
+    void (*detached)(membrane_point *pt);
+} membrane_point_ops;
+
+struct membrane_point {
+    const membrane_point_ops *ops;
+    membrane *owner; /* NULL while detached */
+    int slot;        /* index in the owner's table */
+    /* Mode weights (mass-normalised shapes) at the point and at the place of a
+     * pending move, and the couplings eq psi, ep psi, dm psi. Allocated by the
+     * membrane at its capacity (psi_cap floats each), freed by membrane_point_free_. */
+    float *psi, *psi_next, *gq, *gp, *wd;
+    int psi_cap;
+    double r_over_a, theta_deg;
+    /* A move waiting to land move_offset samples into the next membrane_process(). */
+    int move_pending, move_offset;
+    double move_r, move_theta;
+    int active;             /* set by the object: solve this point every sample */
+    double force_pending;   /* N, the last force, not yet added to the modal state */
+    double self_compliance; /* K = d w / d F over one sample (m/N) */
+    double pick_coupling[MEMBRANE_PICKUPS];
+};
+
+/* Attaches pt (ops set, arrays NULL or from an earlier attach) to m: computes its
+ * shapes and couplings; detaches it from another membrane first. ICTUS_OK when it
+ * was attached already; ICTUS_ENOMEM when m's table is full or memory cannot be had.
+ * Allocates. */
+ictus_status membrane_point_attach_(membrane *m, membrane_point *pt);
+/* Detaches pt if it is attached to m, folding its pending force into the modes. */
+void membrane_point_detach_(membrane *m, membrane_point *pt);
+/* Detaches pt from its membrane, if any, and frees its arrays. */
+void membrane_point_free_(membrane_point *pt);
+/* Asks for pt to move to (r/a, theta) `sample_offset` samples into the next
+ * membrane_process() call (later blocks when past it); the shapes of the new place
+ * are computed here, in the message handler, when pt is attached. */
+void membrane_point_move_(membrane_point *pt, double r_over_a, double theta_deg, int sample_offset);
 
 /* Clamps *v into [lo, hi]; NaN becomes `fallback`. ICTUS_CLAMPED when *v changed.
  * Every setter of the core validates through this one rule. */

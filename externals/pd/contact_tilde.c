@@ -16,56 +16,59 @@
 
 #include "ictus_pd.h"
 
+typedef struct _contact_tilde {
+    t_object x_obj;
+    t_float x_f;
+    contact *x_core;
+    t_symbol *x_name;             /* the membrane~ to play */
+    t_membrane_tilde *x_membrane; /* attached membrane~, or NULL (cleared when it goes) */
+    float *x_force;               /* force buffer the membrane's perform writes */
+    int x_force_size;
+    t_outlet *x_report_out;
+    t_clock *x_report_clock;
+    contact_report x_report; /* the last finished stroke, output from the clock */
+} t_contact_tilde;
+
 t_class *ictus_contact_tilde_class;
 
 /* ---------------- parameters ---------------- */
 
-typedef ictus_status (*t_csetter)(contact *, double);
-typedef double (*t_cgetter)(const contact *);
+static ictus_status contact_tilde_core_set(void *core, int id, double value)
+{
+    return contact_set_param((contact *)core, (contact_param)id, value);
+}
 
-typedef struct _cparam {
-    const char *p_name;
-    const char *p_unit;
-    double p_min, p_max;
-    t_csetter p_set;
-    t_cgetter p_get;
-} t_cparam;
+static double contact_tilde_core_get(const void *core, int id)
+{
+    return contact_get_param((const contact *)core, (contact_param)id);
+}
 
-static const t_cparam contact_tilde_params[] = {
-    {"mass", "kg", CONTACT_MASS_MIN, CONTACT_MASS_MAX, contact_set_mass, contact_get_mass},
-    {"stiffness", "N/m^alpha", CONTACT_STIFFNESS_MIN, CONTACT_STIFFNESS_MAX, contact_set_stiffness,
-     contact_get_stiffness},
-    {"alpha", "", CONTACT_ALPHA_MIN, CONTACT_ALPHA_MAX, contact_set_alpha, contact_get_alpha},
-    {"damping", "N s/m^(alpha+1)", CONTACT_DAMPING_MIN, CONTACT_DAMPING_MAX, contact_set_damping,
-     contact_get_damping},
+static ictus_range contact_tilde_core_range(const void *core, int id)
+{
+    (void)core;
+    return contact_param_range((contact_param)id);
+}
+
+static const t_ictus_param contact_tilde_param[] = {
+    {"mass", "kg", CONTACT_PARAM_MASS},
+    {"stiffness", "N/m^alpha", CONTACT_PARAM_STIFFNESS},
+    {"alpha", "", CONTACT_PARAM_ALPHA},
+    {"damping", "N s/m^(alpha+1)", CONTACT_PARAM_DAMPING},
 };
-#define NCPARAMS (int)(sizeof(contact_tilde_params) / sizeof(contact_tilde_params[0]))
 
-/* mass, stiffness, alpha, damping: one number each, clamped and reported. */
+static const t_ictus_params contact_tilde_params = {
+    "contact~",
+    contact_tilde_param,
+    (int)(sizeof(contact_tilde_param) / sizeof(contact_tilde_param[0])),
+    contact_tilde_core_set,
+    contact_tilde_core_get,
+    contact_tilde_core_range,
+};
+
+/* mass, stiffness, alpha, damping: one number each. */
 static void contact_tilde_setparam(t_contact_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
-    int i;
-    double value;
-    const t_cparam *p;
-    for (i = 0; i < NCPARAMS; i++)
-        if (!strcmp(s->s_name, contact_tilde_params[i].p_name))
-            break;
-    if (i == NCPARAMS)
-        return;
-    p = &contact_tilde_params[i];
-    if (argc > 1)
-        pd_error(x, "contact~: %s takes one number; extra arguments ignored", s->s_name);
-    if (!ictus_getnumber(x, "contact~", s->s_name, "value", argc, argv, 0, &value))
-        return;
-    if (value < p->p_min || value > p->p_max) {
-        double used = value < p->p_min ? p->p_min : p->p_max;
-        pd_error(x, "contact~: %s must be in [%g, %g]%s%s, got %g; using %g", p->p_name, p->p_min,
-                 p->p_max, *p->p_unit ? " " : "", p->p_unit, value, used);
-        value = used;
-    }
-    if (p->p_set(x->x_core, value) == ICTUS_CLAMPED)
-        pd_error(x, "contact~: %s %g%s%s is out of range; using %g", p->p_name, value,
-                 *p->p_unit ? " " : "", p->p_unit, p->p_get(x->x_core));
+    ictus_params_message(x, &contact_tilde_params, x->x_core, s, argc, argv);
 }
 
 /* The membrane~ whose sample clock times our messages: the attached one, else
@@ -89,6 +92,7 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
     if (!ictus_getnumber(x, "contact~", "hit", "velocity (m/s)", argc, argv, 0, &velocity) ||
         !ictus_getpoint(x, "contact~", "hit", argc, argv, 1, &r, &theta))
         return;
+    /* The core takes 0 (a stick at rest on the head); a hit from Pd must move. */
     if (!(velocity > 0) || velocity > CONTACT_VELOCITY_MAX) {
         double used = velocity > 0 ? CONTACT_VELOCITY_MAX : 0.001;
         pd_error(x, "contact~: hit: velocity must be in (0, %g] m/s, got %g; using %g",
@@ -101,7 +105,8 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
         pd_error(x, "contact~: hit: no membrane~ named '%s'; ignored", x->x_name->s_name);
         return;
     }
-    contact_hit(x->x_core, velocity, r, theta, ictus_clock_offset_now(&m->x_clock));
+    contact_hit(x->x_core, velocity, r, theta,
+                ictus_clock_offset_now(ictus_membrane_tilde_clock(m)));
 }
 
 /* set NAME: play another membrane~ (takes effect at the next DSP sort, as delread~). */
@@ -115,12 +120,15 @@ static void contact_tilde_set(t_contact_tilde *x, t_symbol *name)
     canvas_update_dsp();
 }
 
-/* The membrane~ went away mid-stroke: drop the stroke (a membrane~ created later
- * must not be hit by it) by swapping in a fresh core contact with the same
- * parameters. Called from membrane~'s free method, never from perform. */
-void ictus_contact_tilde_abandon_stroke(t_contact_tilde *x)
+/* The membrane~ went away (it detached our contact first): forget it, and drop a
+ * stroke in progress (a membrane~ created later must not be hit by it) by swapping
+ * in a fresh core contact with the same parameters. Called from membrane~'s free
+ * method, never from perform. */
+static void contact_tilde_membrane_gone(void *owner)
 {
+    t_contact_tilde *x = (t_contact_tilde *)owner;
     contact *fresh;
+    x->x_membrane = 0;
     if (!contact_is_active(x->x_core))
         return;
     fresh = contact_new();
@@ -178,8 +186,10 @@ static void contact_tilde_dsp(t_contact_tilde *x, t_signal **sp)
         if (!m)
             pd_error(x, "contact~: no membrane~ named '%s'", x->x_name->s_name);
     }
-    if (x->x_membrane && x->x_membrane != m)
+    if (x->x_membrane && x->x_membrane != m) {
         ictus_membrane_tilde_detach(x->x_membrane, x);
+        x->x_membrane = 0;
+    }
     /* The force buffer: allocated here (a dsp method, never in perform). */
     if (x->x_force_size != n) {
         float *grown =
@@ -193,9 +203,13 @@ static void contact_tilde_dsp(t_contact_tilde *x, t_signal **sp)
     if (x->x_force)
         memset(x->x_force, 0, sizeof(float) * x->x_force_size);
     contact_set_force_output(x->x_core, x->x_force, x->x_force_size);
-    if (m && !ictus_membrane_tilde_attach(m, x))
-        pd_error(x, "contact~: membrane~ '%s' already has %d contact~s; this one is silent",
-                 x->x_name->s_name, MEMBRANE_MAX_CONTACTS);
+    if (m) {
+        if (ictus_membrane_tilde_attach(m, x->x_core, x, contact_tilde_membrane_gone))
+            x->x_membrane = m;
+        else
+            pd_error(x, "contact~: membrane~ '%s' already has %d contact~s; this one is silent",
+                     x->x_name->s_name, MEMBRANE_MAX_CONTACTS);
+    }
     dsp_add(contact_tilde_perform, 3, x, sp[0]->s_vec, (t_int)n);
 }
 
@@ -245,15 +259,13 @@ static void contact_tilde_free(t_contact_tilde *x)
 
 void ictus_contact_tilde_setup(void)
 {
-    int i;
     ictus_contact_tilde_class =
         class_new(gensym("contact~"), (t_newmethod)contact_tilde_new, (t_method)contact_tilde_free,
                   sizeof(t_contact_tilde), CLASS_DEFAULT, A_GIMME, 0);
     class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_dsp, gensym("dsp"), A_CANT,
                     0);
-    for (i = 0; i < NCPARAMS; i++)
-        class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_setparam,
-                        gensym(contact_tilde_params[i].p_name), A_GIMME, 0);
+    ictus_params_addmethods(ictus_contact_tilde_class, &contact_tilde_params,
+                            (t_method)contact_tilde_setparam);
     class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_hit, gensym("hit"), A_GIMME,
                     0);
     class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_set, gensym("set"), A_DEFSYM,

@@ -7,15 +7,11 @@
  * docs/membrane.md).
  *
  * Timing: a "strike" (and a contact~ "hit") lands on the sample its logical time
- * names, for any block size. Each instance keeps its own sample counter,
- * advanced by n in perform and anchored to logical time at the first perform
- * after a dsp method, like vline~ it treats a block computed while logical time
- * is `now` as ending at `now`. A counter (not the logical time of the perform
- * call) is what makes [block~ 1] work: its 64 blocks per tick all run at the same
- * logical time. Overlap (block~ N M with M > 1) and up/down-sampling are not
- * supported (the anchor is re-taken every block and timing is block-accurate).
+ * names, for any block size, by the sample clock of ictus_pd_common.c.
+ * Attached contacts: the contact~ objects that play this membrane~ attach their core
+ * contacts to its core through ictus_membrane_tilde_attach(); this file does not know
+ * contact~ itself, it calls back whoever attached when it is deleted.
  */
-#include <math.h>
 #include <string.h>
 
 #include "ictus_pd.h"
@@ -24,192 +20,70 @@
 #error "ictus: the DSP core works on 32-bit float signals; build against a 32-bit Pd"
 #endif
 
-t_class *ictus_membrane_tilde_class;
-
+/* 10 N s is four times a 0.05 kg stick at the core's 50 m/s limit: the object takes
+ * less than the core (MEMBRANE_IMPULSE_MAX), and no pulling. */
 #define ICTUS_STRIKE_IMPULSE_MAX 10.0 /* N s */
-#define ICTUS_PI                 3.14159265358979323846
 
-/* ---------------- logical time -> sample offset ---------------- */
+/* A contact attached on behalf of an object that plays this membrane~. */
+typedef struct _membrane_tilde_attached {
+    contact *a_core;
+    void *a_owner; /* NULL: a free slot */
+    t_ictus_gonefn a_gone;
+} t_membrane_tilde_attached;
 
-int ictus_clock_offset_now(const t_ictus_clock *c)
-{
-    double offset;
-    if (!c->c_anchored || !(c->c_sr > 0))
-        return 0;
-    /* Stream index of `now`, minus the index of the next block's first sample. */
-    offset = floor(clock_gettimesince(c->c_anchor) * c->c_sr / 1000.0 + 0.5) - c->c_samples_done;
-    if (!(offset > 0))
-        return 0; /* a message from the past (cannot happen from the scheduler) */
-    /* A message always falls inside the window the next block will cover; past
-     * it, DSP has stopped since the anchor was taken (dsp 0, switch~ off): the
-     * next perform re-anchors, so the message lands at its start. Exactly at
-     * the window's end is not past it: a time in the window's last half sample
-     * rounds to the first sample of the block after, and the core carries a
-     * pending hit over (offset - n); returning 0 there started it a whole
-     * block early (found by tests/e2e: a strike at 9.483993 s, 48 kHz). */
-    if (offset > c->c_window)
-        return 0;
-    return (int)offset;
-}
+struct _membrane_tilde {
+    t_object x_obj;
+    t_float x_f; /* force (N) when the inlet gets a float */
+    membrane *x_core;
+    t_symbol *x_name; /* bound name for contact~, or &s_ */
+    t_ictus_clock x_clock;
+    t_membrane_tilde_attached x_attached[MEMBRANE_MAX_CONTACTS];
+};
 
-/* Called at the top of every perform. Samples in one scheduler tick at this
- * instance's rate: the anchor is the start of the window the first block covers,
- * max(n, tick) samples before now (a bigger block~ gathers n samples of input
- * before it runs; smaller ones run tick/n times at the same logical time). */
-static void ictus_clock_advance_check(t_ictus_clock *c, int n)
-{
-    double ms_per_sample = 1000.0 / c->c_sr;
-    double tick_samples = (double)sys_getblksize() * c->c_sr / sys_getsr();
-    double window = (n > tick_samples) ? n : tick_samples;
-    c->c_window = window;
-    if (c->c_anchored) {
-        /* The block about to run ends at samples_done + n; with small blocks the
-         * logical time may be up to one tick later. Anything else means DSP was
-         * stopped in between (switch~) or blocks overlap: re-anchor. */
-        double elapsed = clock_gettimesince(c->c_anchor) / ms_per_sample;
-        double end = c->c_samples_done + n;
-        double slack = n < tick_samples ? tick_samples - n : 0;
-        if (elapsed < end - 0.5 || elapsed > end + slack + 0.5)
-            c->c_anchored = 0;
-    }
-    if (!c->c_anchored) {
-        /* now is `window` samples after stream sample 0 */
-        c->c_anchor = clock_getsystimeafter(-window * ms_per_sample);
-        c->c_samples_done = 0;
-        c->c_anchored = 1;
-    }
-}
+t_class *ictus_membrane_tilde_class;
 
 /* ---------------- parameters ---------------- */
 
-typedef ictus_status (*t_setter)(membrane *, double);
-typedef double (*t_getter)(const membrane *);
-
-typedef struct _param {
-    const char *p_name;
-    const char *p_unit;
-    double p_min, p_max;
-    t_setter p_set;
-    t_getter p_get;
-} t_param;
-
-static ictus_status membrane_tilde_set_modes(membrane *m, double count)
+static ictus_status membrane_tilde_core_set(void *core, int id, double value)
 {
-    return membrane_set_modes(m, (int)count); /* count already clamped and rounded */
-}
-static double membrane_tilde_get_modes(const membrane *m)
-{
-    return membrane_get_modes(m);
+    return membrane_set_param((membrane *)core, (membrane_param)id, value);
 }
 
-/* hfdamp and gain have no range macros in membrane.h; these are the ranges
- * membrane.c clamps to (docs/membrane.md). Should they drift apart, the core's
- * ICTUS_CLAMPED still produces an error line below. A negative gain inverts. */
-static const t_param membrane_tilde_params[] = {
-    {"radius", "m", MEMBRANE_RADIUS_MIN, MEMBRANE_RADIUS_MAX, membrane_set_radius,
-     membrane_get_radius},
-    {"tension", "N/m", MEMBRANE_TENSION_MIN, MEMBRANE_TENSION_MAX, membrane_set_tension,
-     membrane_get_tension},
-    {"density", "kg/m^2", MEMBRANE_DENSITY_MIN, MEMBRANE_DENSITY_MAX, membrane_set_density,
-     membrane_get_density},
-    {"mass", "kg", 0, HUGE_VAL, membrane_set_mass, membrane_get_mass},
-    {"modes", "", MEMBRANE_MODES_MIN, MEMBRANE_MODES_MAX, membrane_tilde_set_modes,
-     membrane_tilde_get_modes},
-    {"t60", "s", MEMBRANE_T60_MIN, MEMBRANE_T60_MAX, membrane_set_t60, membrane_get_t60},
-    {"hfdamp", "", 0, 1000.0, membrane_set_hf_damping, membrane_get_hf_damping},
-    {"gain", "", -1.0e6, 1.0e6, membrane_set_output_gain, membrane_get_output_gain},
+static double membrane_tilde_core_get(const void *core, int id)
+{
+    return membrane_get_param((const membrane *)core, (membrane_param)id);
+}
+
+static ictus_range membrane_tilde_core_range(const void *core, int id)
+{
+    return membrane_param_range((const membrane *)core, (membrane_param)id);
+}
+
+/* gain is dimensionless to the user: output = membrane velocity x gain (docs/membrane.md). */
+static const t_ictus_param membrane_tilde_param[] = {
+    {"radius", "m", MEMBRANE_PARAM_RADIUS},        {"tension", "N/m", MEMBRANE_PARAM_TENSION},
+    {"density", "kg/m^2", MEMBRANE_PARAM_DENSITY}, {"mass", "kg", MEMBRANE_PARAM_MASS},
+    {"modes", "", MEMBRANE_PARAM_MODES},           {"t60", "s", MEMBRANE_PARAM_T60},
+    {"hfdamp", "", MEMBRANE_PARAM_HF_DAMPING},     {"gain", "", MEMBRANE_PARAM_GAIN},
 };
-#define NPARAMS (int)(sizeof(membrane_tilde_params) / sizeof(membrane_tilde_params[0]))
 
-/* Reads argv[i] as a finite number; otherwise reports it (naming the message and
- * argument) and returns 0. */
-int ictus_getnumber(void *x, const char *obj, const char *msg, const char *arg, int argc,
-                    const t_atom *argv, int i, double *value)
-{
-    if (i >= argc) {
-        pd_error(x, "%s: %s: missing %s", obj, msg, arg);
-        return 0;
-    }
-    if (argv[i].a_type != A_FLOAT) {
-        char buf[MAXPDSTRING];
-        atom_string(&argv[i], buf, sizeof(buf));
-        pd_error(x, "%s: %s: %s must be a number, got '%s'", obj, msg, arg, buf);
-        return 0;
-    }
-    *value = atom_getfloat(&argv[i]);
-    if (!isfinite(*value)) {
-        pd_error(x, "%s: %s: %s must be finite, got %g", obj, msg, arg, *value);
-        return 0;
-    }
-    return 1;
-}
+static const t_ictus_params membrane_tilde_params = {
+    "membrane~",
+    membrane_tilde_param,
+    (int)(sizeof(membrane_tilde_param) / sizeof(membrane_tilde_param[0])),
+    membrane_tilde_core_set,
+    membrane_tilde_core_get,
+    membrane_tilde_core_range,
+};
 
-static void membrane_tilde_param(t_membrane_tilde *x, const t_param *p, double value)
-{
-    ictus_status status;
-    const char *space = *p->p_unit ? " " : "";
-    double lo = p->p_min, hi = p->p_max;
-    if (!strcmp(p->p_name, "mass")) {
-        /* the mass is density times area: its range follows the radius */
-        double a = membrane_get_radius(x->x_core);
-        lo = MEMBRANE_DENSITY_MIN * ICTUS_PI * a * a;
-        hi = MEMBRANE_DENSITY_MAX * ICTUS_PI * a * a;
-    }
-    if (!strcmp(p->p_name, "modes"))
-        value = floor(value + 0.5);
-    if (value < lo || value > hi) {
-        double used = value < lo ? lo : hi;
-        if (hi == HUGE_VAL)
-            pd_error(x, "membrane~: %s must be >= %g%s%s, got %g; using %g", p->p_name, lo, space,
-                     p->p_unit, value, used);
-        else
-            pd_error(x, "membrane~: %s must be in [%g, %g]%s%s, got %g; using %g", p->p_name, lo,
-                     hi, space, p->p_unit, value, used);
-        value = used;
-    }
-    status = p->p_set(x->x_core, value);
-    if (status == ICTUS_ENOMEM)
-        pd_error(x, "membrane~: %s %g: out of memory; keeping %g", p->p_name, value,
-                 p->p_get(x->x_core));
-    else if (status == ICTUS_CLAMPED)
-        pd_error(x, "membrane~: %s %g%s%s is out of range; using %g", p->p_name, value, space,
-                 p->p_unit, p->p_get(x->x_core));
-}
+/* The creation arguments after NAME, in order. */
+static const char *const membrane_tilde_args[] = {"radius", "tension", "density", "modes"};
+#define NARGS (int)(sizeof(membrane_tilde_args) / sizeof(membrane_tilde_args[0]))
 
 /* radius, tension, density, mass, modes, t60, hfdamp, gain: one number each. */
 static void membrane_tilde_setparam(t_membrane_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
-    int i;
-    double value;
-    for (i = 0; i < NPARAMS; i++)
-        if (!strcmp(s->s_name, membrane_tilde_params[i].p_name))
-            break;
-    if (i == NPARAMS)
-        return;
-    if (argc > 1)
-        pd_error(x, "membrane~: %s takes one number; extra arguments ignored", s->s_name);
-    if (ictus_getnumber(x, "membrane~", s->s_name, "value", argc, argv, 0, &value))
-        membrane_tilde_param(x, &membrane_tilde_params[i], value);
-}
-
-/* r/a and theta (degrees) from argv[first], argv[first+1], clamped and reported. */
-int ictus_getpoint(void *x, const char *obj, const char *msg, int argc, const t_atom *argv,
-                   int first, double *r_over_a, double *theta_deg)
-{
-    if (!ictus_getnumber(x, obj, msg, "r/a", argc, argv, first, r_over_a) ||
-        !ictus_getnumber(x, obj, msg, "theta (deg)", argc, argv, first + 1, theta_deg))
-        return 0;
-    if (*r_over_a < 0 || *r_over_a > 1) {
-        double used = *r_over_a < 0 ? 0 : 1;
-        pd_error(x, "%s: %s: r/a must be in [0, 1], got %g; using %g", obj, msg, *r_over_a, used);
-        *r_over_a = used;
-    }
-    if (fabs(*theta_deg) > 1.0e6) {
-        pd_error(x, "%s: %s: theta must be in [-1e6, 1e6] deg, got %g; using 0", obj, msg,
-                 *theta_deg);
-        *theta_deg = 0;
-    }
-    return 1;
+    ictus_params_message(x, &membrane_tilde_params, x->x_core, s, argc, argv);
 }
 
 /* pickup <1|2> <r/a> <theta deg> */
@@ -245,7 +119,6 @@ static void membrane_tilde_strike(t_membrane_tilde *x, t_symbol *s, int argc, t_
     if (!ictus_getpoint(x, "membrane~", "strike", argc, argv, 0, &r, &theta) ||
         !ictus_getnumber(x, "membrane~", "strike", "impulse (N s)", argc, argv, 2, &impulse))
         return;
-    /* 10 N s is four times a 0.05 kg stick at the core's 50 m/s limit */
     if (impulse < 0 || impulse > ICTUS_STRIKE_IMPULSE_MAX) {
         double used = impulse < 0 ? 0 : ICTUS_STRIKE_IMPULSE_MAX;
         pd_error(x, "membrane~: strike: impulse must be in [0, %g] N s, got %g; using %g",
@@ -280,33 +153,40 @@ static void membrane_tilde_print(t_membrane_tilde *x)
     }
 }
 
-/* ---------------- contacts ---------------- */
+/* ---------------- attached contacts ---------------- */
 
-int ictus_membrane_tilde_attach(t_membrane_tilde *m, t_contact_tilde *c)
+int ictus_membrane_tilde_attach(t_membrane_tilde *m, contact *c, void *owner, t_ictus_gonefn gone)
 {
     int i, free_slot = -1;
     for (i = 0; i < MEMBRANE_MAX_CONTACTS; i++) {
-        if (m->x_contacts[i] == c)
+        if (m->x_attached[i].a_owner == owner)
             return 1;
-        if (!m->x_contacts[i] && free_slot < 0)
+        if (!m->x_attached[i].a_owner && free_slot < 0)
             free_slot = i;
     }
-    if (free_slot < 0 || membrane_attach_contact(m->x_core, c->x_core) != ICTUS_OK)
+    if (free_slot < 0 || membrane_attach_contact(m->x_core, c) != ICTUS_OK)
         return 0;
-    m->x_contacts[free_slot] = c;
-    c->x_membrane = m;
+    m->x_attached[free_slot].a_core = c;
+    m->x_attached[free_slot].a_owner = owner;
+    m->x_attached[free_slot].a_gone = gone;
     return 1;
 }
 
-void ictus_membrane_tilde_detach(t_membrane_tilde *m, t_contact_tilde *c)
+void ictus_membrane_tilde_detach(t_membrane_tilde *m, void *owner)
 {
     int i;
     for (i = 0; i < MEMBRANE_MAX_CONTACTS; i++)
-        if (m->x_contacts[i] == c)
-            m->x_contacts[i] = 0;
-    membrane_detach_contact(m->x_core, c->x_core);
-    if (c->x_membrane == m)
-        c->x_membrane = 0;
+        if (owner && m->x_attached[i].a_owner == owner) {
+            membrane_detach_contact(m->x_core, m->x_attached[i].a_core);
+            m->x_attached[i].a_core = 0;
+            m->x_attached[i].a_owner = 0;
+            m->x_attached[i].a_gone = 0;
+        }
+}
+
+const t_ictus_clock *ictus_membrane_tilde_clock(const t_membrane_tilde *m)
+{
+    return &m->x_clock;
 }
 
 /* ---------------- DSP ---------------- */
@@ -319,9 +199,9 @@ static t_int *membrane_tilde_perform(t_int *w)
     int n = (int)(w[5]);
     out[0] = (t_sample *)(w[3]);
     out[1] = (t_sample *)(w[4]);
-    ictus_clock_advance_check(&x->x_clock, n);
+    ictus_clock_block_begin(&x->x_clock, n);
     membrane_process(x->x_core, force_in, out, n);
-    x->x_clock.c_samples_done += n;
+    ictus_clock_block_end(&x->x_clock, n);
     return (w + 6);
 }
 
@@ -331,8 +211,7 @@ static void membrane_tilde_dsp(t_membrane_tilde *x, t_signal **sp)
     if (membrane_set_sample_rate(x->x_core, sr) != ICTUS_OK)
         pd_error(x, "membrane~: sample rate %g Hz is outside [%g, %g]; using %g", sr,
                  MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, membrane_get_sample_rate(x->x_core));
-    x->x_clock.c_sr = membrane_get_sample_rate(x->x_core);
-    x->x_clock.c_anchored = 0;
+    ictus_clock_dsp(&x->x_clock, membrane_get_sample_rate(x->x_core));
     dsp_add(membrane_tilde_perform, 5, x, sp[0]->s_vec, sp[1]->s_vec, sp[2]->s_vec,
             (t_int)sp[0]->s_n);
 }
@@ -354,27 +233,23 @@ static void *membrane_tilde_new(t_symbol *s, int argc, t_atom *argv)
     x->x_f = 0;
     x->x_name = &s_;
     memset(&x->x_clock, 0, sizeof(x->x_clock));
-    for (i = 0; i < MEMBRANE_MAX_CONTACTS; i++)
-        x->x_contacts[i] = 0;
+    memset(x->x_attached, 0, sizeof(x->x_attached));
     if (argc > 0 && argv[0].a_type == A_SYMBOL) {
         x->x_name = atom_getsymbol(&argv[0]);
         pd_bind(&x->x_obj.ob_pd, x->x_name);
         first = 1;
     }
     /* optional: radius tension density modes */
-    {
-        static const int order[] = {0, 1, 2, 4};
-        for (i = first; i < argc && i - first < 4; i++) {
-            double value;
-            const t_param *p = &membrane_tilde_params[order[i - first]];
-            if (ictus_getnumber(x, "membrane~", "creation argument", p->p_name, argc, argv, i,
-                                &value))
-                membrane_tilde_param(x, p, value);
-        }
-        if (argc - first > 4)
-            pd_error(x, "membrane~: arguments are NAME radius tension density modes; "
-                        "extra arguments ignored");
+    for (i = first; i < argc && i - first < NARGS; i++) {
+        double value;
+        const t_ictus_param *p =
+            ictus_params_find(&membrane_tilde_params, gensym(membrane_tilde_args[i - first]));
+        if (ictus_getnumber(x, "membrane~", "creation argument", p->p_name, argc, argv, i, &value))
+            ictus_params_set(x, &membrane_tilde_params, x->x_core, p, value);
     }
+    if (argc - first > NARGS)
+        pd_error(x, "membrane~: arguments are NAME radius tension density modes; "
+                    "extra arguments ignored");
     outlet_new(&x->x_obj, &s_signal);
     outlet_new(&x->x_obj, &s_signal);
     return x;
@@ -383,12 +258,14 @@ static void *membrane_tilde_new(t_symbol *s, int argc, t_atom *argv)
 static void membrane_tilde_free(t_membrane_tilde *x)
 {
     int i;
-    /* contact~ objects keep a pointer to us: detach them all so none dangles. */
+    /* The objects that attached keep a pointer to us: detach them all, then tell
+     * them, so that none dangles. */
     for (i = 0; i < MEMBRANE_MAX_CONTACTS; i++)
-        if (x->x_contacts[i]) {
-            t_contact_tilde *c = x->x_contacts[i];
-            ictus_membrane_tilde_detach(x, c);
-            ictus_contact_tilde_abandon_stroke(c);
+        if (x->x_attached[i].a_owner) {
+            void *owner = x->x_attached[i].a_owner;
+            t_ictus_gonefn gone = x->x_attached[i].a_gone;
+            ictus_membrane_tilde_detach(x, owner);
+            gone(owner);
         }
     if (x->x_name != &s_)
         pd_unbind(&x->x_obj.ob_pd, x->x_name);
@@ -397,16 +274,14 @@ static void membrane_tilde_free(t_membrane_tilde *x)
 
 void ictus_membrane_tilde_setup(void)
 {
-    int i;
     ictus_membrane_tilde_class = class_new(gensym("membrane~"), (t_newmethod)membrane_tilde_new,
                                            (t_method)membrane_tilde_free, sizeof(t_membrane_tilde),
                                            CLASS_DEFAULT, A_GIMME, 0);
     CLASS_MAINSIGNALIN(ictus_membrane_tilde_class, t_membrane_tilde, x_f);
     class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_dsp, gensym("dsp"), A_CANT,
                     0);
-    for (i = 0; i < NPARAMS; i++)
-        class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_setparam,
-                        gensym(membrane_tilde_params[i].p_name), A_GIMME, 0);
+    ictus_params_addmethods(ictus_membrane_tilde_class, &membrane_tilde_params,
+                            (t_method)membrane_tilde_setparam);
     class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_pickup, gensym("pickup"),
                     A_GIMME, 0);
     class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_position,

@@ -1,0 +1,94 @@
+/* mode_table.c -- the membrane's modes in order of frequency (see mode_table.h). */
+#include "mode_table.h"
+#include "bessel_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+void mode_table_free(mode_table *t)
+{
+    free(t->j), free(t->norm), free(t->m), free(t->n), free(t->sin);
+    t->j = t->norm = NULL;
+    t->m = t->n = t->sin = NULL;
+    t->size = 0;
+}
+
+ictus_status mode_table_build(mode_table *t, int size)
+{
+    /* Enough Bessel zeros: Weyl's law gives about x^2/4 modes below j = x. */
+    double x_max = 2.0 * sqrt((double)size) + 4.0;
+    ictus_bessel_zero_entry *zeros = NULL;
+    int count = 0, modes = 0;
+    t->j = t->norm = NULL;
+    t->m = t->n = t->sin = NULL;
+    t->size = 0;
+    for (;;) {
+        free(zeros);
+        count = ictus_bessel_zeros_below(x_max, &zeros);
+        if (count < 0)
+            return ICTUS_ENOMEM;
+        modes = 0;
+        for (int i = 0; i < count; i++)
+            modes += zeros[i].m ? 2 : 1;
+        if (modes >= size)
+            break;
+        x_max *= 1.15;
+    }
+    t->j = malloc(sizeof(double) * (size_t)size);
+    t->norm = malloc(sizeof(double) * (size_t)size);
+    t->m = malloc(sizeof(int) * (size_t)size);
+    t->n = malloc(sizeof(int) * (size_t)size);
+    t->sin = malloc(sizeof(int) * (size_t)size);
+    if (!t->j || !t->norm || !t->m || !t->n || !t->sin) {
+        free(zeros);
+        mode_table_free(t);
+        return ICTUS_ENOMEM;
+    }
+    /* Zeros come sorted by (j, m, n); an m >= 1 zero gives a cos and a sin mode. */
+    int k = 0;
+    for (int i = 0; i < count && k < size; i++) {
+        double v[3];
+        ictus_bessel_j3(zeros[i].m, zeros[i].j, v);
+        double eps = zeros[i].m ? 2.0 : 1.0;
+        for (int s = 0; s < (zeros[i].m ? 2 : 1) && k < size; s++, k++) {
+            t->j[k] = zeros[i].j;
+            t->m[k] = zeros[i].m;
+            t->n[k] = zeros[i].n;
+            t->sin[k] = s;
+            t->norm[k] = sqrt(eps / M_PI) / fabs(v[2]);
+        }
+    }
+    free(zeros);
+    t->size = size;
+    return ICTUS_OK;
+}
+
+/* Mass-normalised shape of every mode at a point:
+ *     psi_k = J_m(j r/a) {cos, sin}(m theta) / sqrt(pi J_{m+1}(j)^2 / eps_m),
+ * eps_0 = 1, eps_m = 2, so that b_k = psi_k / sqrt(sigma a^2) = phi_k / sqrt(M_k). */
+void mode_table_shapes(const mode_table *t, int live, double r_over_a, double theta_deg, float *psi)
+{
+    double theta = theta_deg * (M_PI / 180.0);
+    double radial = 0.0;
+    for (int k = 0; k < t->size; k++) {
+        if (k >= live) {
+            psi[k] = 0.0f;
+            continue;
+        }
+        /* cos and sin partners are adjacent and share J_m(j r/a). */
+        if (!(k > 0 && t->j[k] == t->j[k - 1] && t->m[k] == t->m[k - 1]))
+            radial = ictus_bessel_j(t->m[k], t->j[k] * r_over_a);
+        double angular = t->sin[k] ? sin(t->m[k] * theta) : cos(t->m[k] * theta);
+        psi[k] = (float)(radial * angular * t->norm[k]);
+    }
+}
+
+double mode_table_shape(const mode_table *t, int k, double r_over_a, double theta_rad)
+{
+    return ictus_bessel_j(t->m[k], t->j[k] * r_over_a) * t->norm[k] *
+           (t->sin[k] ? sin(t->m[k] * theta_rad) : cos(t->m[k] * theta_rad));
+}
