@@ -9,10 +9,14 @@ bash scripts/deps.sh
 jobs=$(nproc 2>/dev/null || echo 2)
 
 echo "== release build and tests (build/) =="
-bash scripts/build.sh "$root/build" -DCMAKE_BUILD_TYPE=Release -DICTUS_SANITIZE=OFF
+# Every part is named ON: the main job (scripts/main.sh) configures the same
+# build/ folder without tests, and CMake keeps cached options.
+parts=(-DICTUS_BUILD_EXTERNALS=ON -DICTUS_BUILD_DAEMON=ON -DICTUS_BUILD_TESTS=ON)
+bash scripts/build.sh "$root/build" -DCMAKE_BUILD_TYPE=Release -DICTUS_SANITIZE=OFF "${parts[@]}" \
+    -DICTUS_BUILD_BENCH=ON
 (cd build && ctest --output-on-failure -j "$jobs")
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests (build-asan/) =="
 bash scripts/build.sh "$root/build-asan" -DCMAKE_BUILD_TYPE=Debug -DICTUS_SANITIZE=ON \
-    -DICTUS_BUILD_BENCH=OFF
+    "${parts[@]}" -DICTUS_BUILD_BENCH=OFF
 (cd build-asan && ctest --output-on-failure -j "$jobs")
