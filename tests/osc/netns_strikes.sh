@@ -48,21 +48,34 @@ ip -n "$b" link set "vib$$" up
 
 ip netns exec "$b" oscdump -L 9000 >"$work/dump.txt" 2>&1 &
 dump_pid=$!
-sleep 0.3
+# oscdump listening before the daemon starts (at most 10 s).
+for _ in $(seq 100); do
+    [ -n "$(ip netns exec "$b" ss -Hlun 'sport = :9000' 2>/dev/null)" ] && break
+    sleep 0.1
+done
 
-# The command is sent from b while the daemon runs.
-# Pings from b while the daemon runs, every 0.5 s (it may take a while to load
-# the clip and bind under a sanitizer): at least one must be answered.
-(for i in 1 2 3 4 5 6 7; do sleep 0.5; ip netns exec "$b" oscsend 10.213.0.1 9001 /ictus/ping; done) &
-ping_pid=$!
 ip netns exec "$a" "$ictusd" run --mocap "$clip" --duration 4 \
     --target osc.udp://10.213.0.2:9000 --bind 10.213.0.1 --allow 10.213.0.2 --port 9001 \
-    --reply osc.udp://10.213.0.2:9000 --out "$work/run" || {
+    --reply osc.udp://10.213.0.2:9000 --out "$work/run" &
+daemon_pid=$!
+# Pings from b until one is answered or the daemon has ended (loading the clip
+# and binding may take long under a sanitizer or a loaded machine): a
+# handshake, not a fixed number of tries.
+while kill -0 "$daemon_pid" 2>/dev/null && ! grep -q ' /ictus/pong' "$work/dump.txt"; do
+    ip netns exec "$b" oscsend 10.213.0.1 9001 /ictus/ping
+    sleep 0.25
+done
+wait "$daemon_pid" || {
     echo "FAIL: ictusd run exited with $?"
     exit 1
 }
-wait "$ping_pid"
-sleep 0.5
+# oscdump may still be printing the last strikes: wait until it has them all
+# (at most 10 s).
+count=$(($(wc -l <"$work/run/strikes.csv") - 1))
+for _ in $(seq 100); do
+    [ "$(grep -c ' /ictus/strike' "$work/dump.txt")" -ge "$count" ] && break
+    sleep 0.1
+done
 
 recorded=$(tail -n +2 "$work/run/strikes.csv" | cut -d, -f1 | sort -n | tr '\n' ' ')
 received=$(awk '$2 == "/ictus/strike" { print $4 }' "$work/dump.txt" | sort -n | tr '\n' ' ')
