@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <fstream>
+#include <random>
 #include <string>
 
 using namespace ictus;
@@ -340,6 +341,54 @@ TEST_CASE("score: errors name the source and line and column and the fault",
     require_error("end now", 1, 5, "unexpected 'now'");
     // A count that would expand past the limits is refused, not expanded.
     require_error("repeat 1000\nrepeat 1000\nR\nend\nend", 3, 1, "more than 100000 notes");
+    // Repeats nested around no note or rest reach neither limit: the count of
+    // statements executed stops them (this score used to expand for ever).
+    require_error(
+        "repeat 1000\nrepeat 1000\nrepeat 1000\nrepeat 1000\ngrip german\nend\nend\nend\nend", 5, 1,
+        "more than 1000000 statements");
+}
+
+TEST_CASE("score: the statement budget refuses empty loops at any depth and admits full scores",
+          "[score][parser][errors]")
+{
+    // Seeded random nests of repeats around statements that neither play nor
+    // advance: refused with the budget's message whenever the product of the
+    // counts times the body exceeds the budget, accepted otherwise.
+    std::mt19937 rng(1311);
+    const char *idle[] = {"grip german", "grip french", "tempo 100", "beats 1/2", "dynamics p"};
+    for (int trial = 0; trial < 200; ++trial) {
+        const int depth = std::uniform_int_distribution<int>(1, 5)(rng);
+        std::string text;
+        double executed = 0.0, passes = 1.0;
+        std::vector<int> counts;
+        for (int d = 0; d < depth; ++d) {
+            const int c = std::uniform_int_distribution<int>(1, 1000)(rng);
+            counts.push_back(c);
+            text += "repeat " + std::to_string(c) + "\n";
+        }
+        const int body = std::uniform_int_distribution<int>(1, 3)(rng);
+        for (int b = 0; b < body; ++b)
+            text += std::string(idle[std::uniform_int_distribution<int>(0, 4)(rng)]) + "\n";
+        for (int d = 0; d < depth; ++d)
+            text += "end\n";
+        // Statements executed, counted independently: each level runs its
+        // 'repeat' once per pass of its parent and its 'end' once per own pass.
+        for (int d = 0; d < depth; ++d) {
+            executed += passes; // the repeat line
+            passes *= counts[d];
+            executed += passes; // its end line
+        }
+        executed += passes * body;
+        INFO("trial " << trial << ":\n" << text);
+        if (executed > static_cast<double>(kMaxScoreSteps)) {
+            REQUIRE_THROWS_WITH(parse_score(text, "nest"),
+                                Contains("more than 1000000 statements"));
+        } else {
+            REQUIRE_NOTHROW(parse_score(text, "nest"));
+        }
+    }
+    // A score at the note limit stays well inside the budget.
+    REQUIRE(parse_score("repeat 1000\nrepeat 50\nR\nL\nend\nend\n", "full").notes.size() == 100000);
 }
 
 TEST_CASE("score: nothing is produced from a faulty score", "[score][parser][errors]")

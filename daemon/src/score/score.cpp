@@ -538,6 +538,10 @@ ScoreBuilder::ScoreBuilder(std::string source_name) : state_(std::make_unique<St
 }
 ScoreBuilder::~ScoreBuilder() = default;
 ScoreBuilder::ScoreBuilder(ScoreBuilder &&) noexcept = default;
+ScoreBuilder::ScoreBuilder(const ScoreBuilder &other)
+    : state_(std::make_unique<State>(*other.state_))
+{
+}
 ScoreBuilder &ScoreBuilder::operator=(ScoreBuilder &&) noexcept = default;
 
 int ScoreBuilder::statements() const
@@ -618,8 +622,13 @@ Score ScoreBuilder::finish() const
             throw ScoreError(s.source, st.line, st.column,
                              "the score is longer than 100000 beats (check the repeat counts)");
     };
+    long steps = 0;
     for (size_t pc = 0; pc < s.statements.size(); ++pc) {
         const Statement &st = s.statements[pc];
+        if (++steps > kMaxScoreSteps)
+            throw ScoreError(s.source, st.line, st.column,
+                             "the score executes more than 1000000 statements (check the repeat "
+                             "counts: repeats nested around no note or rest)");
         switch (st.kind) {
         case Kind::note: {
             if (score.notes.size() >= static_cast<size_t>(kMaxScoreNotes))

@@ -45,6 +45,9 @@ constexpr double kMaxRadiusFraction = 0.95; // r/a: the bead must land on the he
 constexpr int kMaxRepeat = 1000;
 constexpr int kMaxScoreNotes = 100000; // after repeats are expanded
 constexpr double kMaxScoreBeats = 100000.0;
+// Statements executed while repeats are expanded: bounds the work of scores
+// whose loops hold no note or rest (e.g. nested repeats around a grip line).
+constexpr long kMaxScoreSteps = 1000000;
 
 // Defaults: a note with nothing but a hand.
 constexpr double kDefaultTempoBpm = 120.0;
@@ -121,6 +124,8 @@ class ScoreBuilder
     explicit ScoreBuilder(std::string source_name = "osc");
     ~ScoreBuilder();
     ScoreBuilder(ScoreBuilder &&) noexcept;
+    // A copy, e.g. to finish and plan elsewhere while statements keep arriving.
+    ScoreBuilder(const ScoreBuilder &other);
     ScoreBuilder &operator=(ScoreBuilder &&) noexcept;
 
     // Parses one statement (it may hold several separated by ',' or ';',
