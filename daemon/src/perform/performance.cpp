@@ -9,13 +9,19 @@
 #include "ictus/perform/track.hpp"
 #include "ictus/perform/tracker.hpp"
 #include "ictus/perform/performance.hpp"
+#include "ictus/base/spsc_queue.hpp"
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <deque>
 #include <iostream>
 #include <limits>
+#include <thread>
 
 namespace ictus
 {
@@ -86,8 +92,146 @@ struct Performance::ScoreRig {
     std::unique_ptr<Tracker> tracker;
     CharacterPose body; // the reference held by the trunk and legs (arms: IK)
     PerformerFrame frame;
+    Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero(); // where the drum goes
     TipTargets tips;
     explicit ScoreRig(const CharacterModel &m) : model(m) {}
+};
+
+// A plan ready to perform: the score it came from, the plan, and per hand and
+// note the plan time of the beat, the lead of the target's first contact
+// before it and the approach speed there (target_at).
+struct Performance::PlanState {
+    std::shared_ptr<const Score> score;
+    GesturePlan plan;
+    std::array<std::vector<double>, 2> beats, lead_s, approach_mps;
+    std::vector<double> planned_speed_mps; // [note of plan]
+};
+
+// Work for execute(): everything it needs is in the job (copies), so that it
+// can run on the worker thread while the physics thread goes on.
+struct Performance::Job {
+    enum class Kind {
+        play,      // finish `statements` (none: the current score), plan, start
+        replan,    // plan the current score on a new frame; a plan under way goes on
+        score_rig, // the character again (a grip change), from `pose`
+        clip_rig,  // clip mode: the character and its reference again, then play
+    };
+    Kind kind = Kind::play;
+    Command origin;
+    std::unique_ptr<ScoreBuilder> statements;
+    PerformerFrame frame;
+    PerformanceOptions options;
+    std::vector<Eigen::Quaterniond> pose;
+    bool supersedes(const Job &earlier) const
+    {
+        if (earlier.kind == Kind::replan)
+            return kind == Kind::replan || kind == Kind::play;
+        return earlier.kind != Kind::play && kind == earlier.kind;
+    }
+};
+
+struct Performance::Result {
+    Job::Kind kind = Job::Kind::play;
+    Command origin;
+    std::string error; // not empty: refused, nothing changes
+    std::unique_ptr<PlanState> plan;
+    std::unique_ptr<ScoreRig> score_rig;
+    std::unique_ptr<Rig> rig;
+    Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero(); // clip_rig
+};
+
+// The worker thread: takes jobs, keeps only the last of a kind that a later
+// one supersedes (a drum slider's 20 changes a second plan once), runs them
+// in order and hands the results back; the old rigs and plans the physics
+// thread has replaced are freed here too. Queues only: the physics thread
+// never waits for it.
+class Performance::Worker
+{
+  public:
+    explicit Worker(Performance &performance) : perf_(performance), thread_([this] { loop(); }) {}
+    ~Worker()
+    {
+        running_ = false;
+        thread_.join();
+        Job *j;
+        while (jobs_.pop(j))
+            delete j;
+        Result *r;
+        while (results_.pop(r))
+            delete r;
+        while (garbage_.pop(r))
+            delete r;
+    }
+    Worker(const Worker &) = delete;
+    Worker &operator=(const Worker &) = delete;
+    bool submit(std::unique_ptr<Job> job)
+    {
+        if (!jobs_.push(job.get()))
+            return false;
+        job.release();
+        outstanding_.fetch_add(1);
+        return true;
+    }
+    std::unique_ptr<Result> take()
+    {
+        Result *r = nullptr;
+        if (!results_.pop(r))
+            return nullptr;
+        outstanding_.fetch_sub(1);
+        return std::unique_ptr<Result>(r);
+    }
+    void discard(std::unique_ptr<Result> old)
+    {
+        if (garbage_.push(old.get()))
+            old.release(); // else freed here, by the caller
+    }
+    bool pending() const { return outstanding_.load() > 0; }
+
+  private:
+    void loop()
+    {
+        std::deque<Job *> queued;
+        while (running_.load()) {
+            Result *g;
+            while (garbage_.pop(g))
+                delete g;
+            Job *j;
+            while (jobs_.pop(j))
+                queued.push_back(j);
+            for (size_t i = 0; i < queued.size();) {
+                bool superseded = false;
+                for (size_t k = i + 1; k < queued.size() && !superseded; ++k)
+                    superseded = queued[k]->supersedes(*queued[i]);
+                if (superseded) {
+                    delete queued[i];
+                    queued.erase(queued.begin() + static_cast<long>(i));
+                    outstanding_.fetch_sub(1);
+                } else {
+                    ++i;
+                }
+            }
+            if (queued.empty()) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                continue;
+            }
+            std::unique_ptr<Job> job(queued.front());
+            queued.pop_front();
+            std::unique_ptr<Result> r = perf_.execute(*job);
+            while (running_.load() && !results_.push(r.get()))
+                std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            if (running_.load())
+                r.release();
+        }
+        for (Job *q : queued)
+            delete q;
+    }
+    Performance &perf_;
+    SpscQueue<Job *, 64> jobs_;
+    SpscQueue<Result *, 64> results_;
+    SpscQueue<Result *, 64> garbage_;
+    std::atomic<bool> running_{true};
+    std::atomic<long> outstanding_{0};
+    std::thread thread_;
 };
 
 Performance::Performance(const PerformanceOptions &options)
@@ -108,7 +252,8 @@ Performance::Performance(const PerformanceOptions &options)
         clip_ = std::make_unique<BvhFile>(read_bvh(options_.mocap, bo, &warnings));
         for (const std::string &w : warnings)
             std::cerr << "ictusd: warning: " << w << "\n";
-        build();
+        skeleton_ = clip_->skeleton;
+        install_clip_rig(make_clip_rig(options_));
         return;
     }
     const ScorePerformOptions &so = options_.score;
@@ -120,42 +265,62 @@ Performance::Performance(const PerformanceOptions &options)
     db_ = std::make_unique<GestureDatabase>(
         so.gestures.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(so.gestures));
     builder_ = std::make_unique<ScoreBuilder>("osc");
-    score_ = std::make_unique<Score>(
+    score_ = std::make_shared<const Score>(
         parse_score(so.score_text.empty() ? default_score_text() : so.score_text, so.score_name));
     if (!so.grip_given && !score_->notes.empty())
         options_.character.grip = score_->notes.front().grip;
-    build_score(false);
+    skeleton_ = default_skeleton();
+    install_score_rig(make_score_rig(options_, nullptr), false);
     playing_ = false;
 }
 
-Performance::~Performance() = default;
+Performance::~Performance()
+{
+    worker_.reset(); // joined before what it reads goes
+}
 
-void Performance::build()
+// Clip mode: the character, its reference and controller for `options`
+// (drum_auto: the drum centre is set in `options`). Reads only the clip.
+std::unique_ptr<Performance::Rig> Performance::make_clip_rig(PerformanceOptions &options) const
 {
     const BvhFile &bvh = *clip_;
-    const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton, options_.character);
-    const double previous_time = rig_ ? time_s() : 0.0;
-    skeleton_ = bvh.skeleton;
-    if (rig_)
-        divergences_before_ += rig_->tracker->scene().divergences();
-    rig_.reset(new Rig(model, bvh.motion));
-    Rig &r = *rig_;
-    if (options_.drum_auto)
-        options_.scene.drum.center_m =
+    const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton, options.character);
+    auto rig = std::make_unique<Rig>(model, bvh.motion);
+    Rig &r = *rig;
+    if (options.drum_auto)
+        options.scene.drum.center_m =
             strike_drum_center(r.model, r.reference, auto_drum_center(r.model, r.reference));
     const CharacterPose initial = r.reference.frame(0);
-    r.base_gains = default_gains(r.model, initial, options_.gains);
+    r.base_gains = default_gains(r.model, initial, options.gains);
     scale_gains(r.base_gains, gain_scale_, r.gains);
     // Eq. 1 on every joint: the tracker's joint mode, as `ictusd track --mode joint`.
-    r.tracker = std::make_unique<Tracker>(r.model, options_.scene, initial, r.gains,
-                                          r.limits.refs(), TrackMode::joint);
+    r.tracker = std::make_unique<Tracker>(r.model, options.scene, initial, r.gains, r.limits.refs(),
+                                          TrackMode::joint);
     r.ref_pose = initial;
     r.step_pose = initial;
+    return rig;
+}
+
+void Performance::install_clip_rig(std::unique_ptr<Rig> rig)
+{
+    const double previous_time = rig_ ? time_s() : 0.0;
+    if (rig_)
+        divergences_before_ += rig_->tracker->scene().divergences();
+    std::swap(rig_, rig);
+    // The drum may have changed while the rig was built: the live one wins.
+    rig_->tracker->scene().set_drum(options_.scene.drum);
+    scale_gains(rig_->base_gains, gain_scale_, rig_->gains);
+    rig_->tracker->scene().set_gains(rig_->gains);
     // The simulation clock keeps running across rebuilds (strike times and
     // timetags stay monotonic); the clip restarts from its beginning.
     time_offset_s_ = previous_time;
     clip_time_s_ = 0.0;
     detector_.reset(membrane_of(scene()));
+    if (rig && worker_) {
+        auto old = std::make_unique<Result>();
+        old->rig = std::move(rig);
+        worker_->discard(std::move(old));
+    }
 }
 
 // Clip mode: the live scene's drum changes at once (Scene::set_drum), and the
@@ -195,8 +360,68 @@ int Performance::divergences() const
 
 int Performance::step(StrikeEvent out[2])
 {
-    if (!rig_)
-        return step_score(out);
+    take_results();
+    const int k = rig_ ? step_clip(out) : step_score(out);
+    return guard_runaway(k);
+}
+
+bool Performance::check_gains(const double scale[2], std::string *why) const
+{
+    const std::vector<JointGains> &base = rig_ ? rig_->base_gains : score_rig_->base_gains;
+    double rate = 0.0; // the largest kp / kd after scaling, 1/s
+    for (const JointGains &g : base)
+        rate = std::max(rate, g.kp_nm_per_rad * scale[0] / (g.kd_nm_s_per_rad * scale[1]));
+    const double h = options_.scene.step_s;
+    if (rate * h <= kMaxPdRateStep)
+        return true;
+    if (why) {
+        char buf[256];
+        std::snprintf(buf, sizeof buf,
+                      "gains: stiffness x%g with damping x%g gives a PD rate kp/kd of %.0f/s, "
+                      "unstable at the %g ms step (at most %.0f/s): raise the damping to x%.3g "
+                      "or more",
+                      scale[0], scale[1], rate, 1e3 * h, kMaxPdRateStep / h,
+                      scale[1] * rate * h / kMaxPdRateStep);
+        *why = buf;
+    }
+    return false;
+}
+
+int Performance::guard_runaway(int k)
+{
+    double speed = 0.0;
+    for (int s = 0; s < 2; ++s)
+        speed = std::max(speed, scene().tip_velocity(static_cast<Side>(s)).norm());
+    if (speed > kRunawayTipSpeed_mps && time_s() >= quiet_until_s_) {
+        // No human stroke moves a stick tip this fast: the controller has
+        // gone unstable. Default gains back, strikes held back meanwhile.
+        ++runaways_;
+        gain_scale_[0] = gain_scale_[1] = 1.0;
+        if (rig_) {
+            scale_gains(rig_->base_gains, gain_scale_, rig_->gains);
+            rig_->tracker->scene().set_gains(rig_->gains);
+        } else {
+            scale_gains(score_rig_->base_gains, gain_scale_, score_rig_->gains);
+            score_rig_->tracker->scene().set_gains(score_rig_->gains);
+        }
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "runaway: a stick tip at %.1f m/s (> %g): gains back to 1 1, no strike "
+                      "sent for %g s",
+                      speed, kRunawayTipSpeed_mps, kRunawayQuiet_s);
+        Command origin = last_gains_;
+        if (origin.address[0] == '\0')
+            std::snprintf(origin.address, sizeof origin.address, "/ictus/gains");
+        refuse_later(origin, buf);
+        quiet_until_s_ = time_s() + kRunawayQuiet_s;
+    }
+    if (time_s() < quiet_until_s_)
+        return 0;
+    return k;
+}
+
+int Performance::step_clip(StrikeEvent out[2])
+{
     Rig &r = *rig_;
     const double h = options_.scene.step_s;
     if (playing_)
@@ -222,11 +447,15 @@ bool Performance::apply(const Command &c, std::string *why)
     switch (c.kind) {
     case CommandKind::play:
         if (rebuild_pending_) {
-            // Grip or drum changed while stopped or playing: the character and
-            // the drum are rebuilt at the clip's first frame (a Scene has no
-            // setters for them).
+            // The grip changed while stopped or playing: the character is
+            // rebuilt at the clip's first frame (a Scene has no setter for
+            // it), and plays when it is ready.
             rebuild_pending_ = false;
-            build();
+            auto job = std::make_unique<Job>();
+            job->kind = Job::Kind::clip_rig;
+            job->origin = c;
+            job->options = options_;
+            return submit(std::move(job), why);
         }
         playing_ = true;
         return true;
@@ -248,8 +477,12 @@ bool Performance::apply(const Command &c, std::string *why)
             return fail("mode: only joint is implemented");
         return true;
     case CommandKind::gains: {
+        const double scale[2] = {c.value, c.value2};
+        if (!check_gains(scale, why))
+            return false;
         gain_scale_[0] = c.value;
         gain_scale_[1] = c.value2;
+        last_gains_ = c;
         Rig &r = *rig_;
         scale_gains(r.base_gains, gain_scale_, r.gains);
         r.tracker->scene().set_gains(r.gains);
@@ -353,24 +586,36 @@ ScorePerformOptions::ScorePerformOptions()
     cartesian.velocity_gain_s = 0.0;
 }
 
-void Performance::build_score(bool keep_pose)
+namespace
 {
-    // The default body (stick_capture.hpp), standing with the hips 0.9 m up,
-    // pelvis welded, facing +Z.
+// The plan's frame for a drum: the shared frames of docs/perform.md, facing
+// `forward` with `right` to the performer's right, the membrane raised by the
+// tip's contact height (see contact_height_m).
+PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
+                         const Eigen::Vector3d &forward)
+{
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+    PerformerFrame f = performer_frame_for_drum(
+        drum.center_m + contact_height_m(tip_radius_m, kDefaultStickDirection) * up, drum.radius_m);
+    f.right = right;
+    f.forward = forward;
+    return f;
+}
+} // namespace
+
+// Score mode: the default body (stick_capture.hpp), standing with the hips
+// 0.9 m up, pelvis welded, facing +Z, in `pose` (joint rotations) or with the
+// arms solved to hold the sticks at the rest tips. Reads only `options`.
+std::unique_ptr<Performance::ScoreRig>
+Performance::make_score_rig(const PerformanceOptions &options,
+                            const std::vector<Eigen::Quaterniond> *pose) const
+{
     const Skeleton skeleton = default_skeleton();
     Motion motion;
     motion.frame_rate_hz = 100.0;
     motion.root_position_m.push_back(Eigen::Vector3d(0.0, 0.9, 0.0));
     motion.local_rotation.emplace_back(skeleton.joints.size(), Eigen::Quaterniond::Identity());
-    const CharacterModel model = CharacterModel::from_skeleton(skeleton, options_.character);
-    const double previous_time = score_rig_ ? time_s() : 0.0;
-    skeleton_ = skeleton;
-    std::vector<Eigen::Quaterniond> previous_local;
-    if (score_rig_) {
-        divergences_before_ += score_rig_->tracker->scene().divergences();
-        if (keep_pose)
-            score_rig_->tracker->scene().local_rotations(previous_local);
-    }
+    const CharacterModel model = CharacterModel::from_skeleton(skeleton, options.character);
     auto rig = std::make_unique<ScoreRig>(model);
     ScoreRig &r = *rig;
     r.body = model.pose_from_motion(motion, 0);
@@ -387,42 +632,72 @@ void Performance::build_score(bool keep_pose)
     left.normalize();
     const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
     const Eigen::Vector3d forward = left.cross(up);
-    if (options_.drum_auto)
-        options_.scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
-                                       options_.score.drum_forward_m * forward -
-                                       options_.score.drum_below_m * up;
-    const DrumParams &drum = options_.scene.drum;
-    // The plan's frame: the shared frames of docs/perform.md (right = -left), the membrane
-    // raised by the tip's contact height (see contact_height_m).
-    r.frame = performer_frame_for_drum(
-        drum.center_m +
-            contact_height_m(options_.character.stick.tip_radius_m, kDefaultStickDirection) * up,
-        drum.radius_m);
-    r.frame.right = -left;
-    r.frame.forward = forward;
+    SceneOptions scene = options.scene;
+    if (options.drum_auto)
+        scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
+                              options.score.drum_forward_m * forward -
+                              options.score.drum_below_m * up;
+    r.drum_center_m = scene.drum.center_m;
+    r.frame = frame_for(scene.drum, options.character.stick.tip_radius_m, -left, forward);
 
     // Start: the arms solved to hold the sticks at the rest tips (or the
-    // pose the old rig was in, when a grip or drum change rebuilds it).
+    // pose the old rig was in, when a grip change rebuilds it).
     CharacterPose initial = r.body;
-    if (keep_pose && previous_local.size() == initial.local.size())
-        initial.local = previous_local;
+    if (pose && pose->size() == initial.local.size())
+        initial.local = *pose;
     else
-        Tracker::solve_arms(model, {}, options_.score.cartesian.ik, r.frame.rest_tip_m, initial);
-    r.base_gains = default_gains(model, initial, options_.gains);
-    scale_gains(r.base_gains, gain_scale_, r.gains);
-    CartesianOptions co = options_.score.cartesian;
+        Tracker::solve_arms(model, {}, options.score.cartesian.ik, r.frame.rest_tip_m, initial);
+    r.base_gains = default_gains(model, initial, options.gains);
+    r.gains = r.base_gains; // scaled when installed
+    CartesianOptions co = options.score.cartesian;
     co.reference_has_arms = false; // the body's reference has no arm motion
-    r.tracker = std::make_unique<Tracker>(model, options_.scene, initial, r.gains,
-                                          std::vector<JointLimitRef>{}, options_.score.mode, co,
-                                          options_.gains);
+    r.tracker =
+        std::make_unique<Tracker>(model, scene, initial, r.gains, std::vector<JointLimitRef>{},
+                                  options.score.mode, co, options.gains);
     r.tips.has_position = true;
     for (int s = 0; s < 2; ++s)
         r.tips.position_m[s] = r.tracker->scene().tip_position(static_cast<Side>(s));
+    return rig;
+}
+
+void Performance::install_score_rig(std::unique_ptr<ScoreRig> rig, bool keep_pose)
+{
+    const double previous_time = score_rig_ ? time_s() : 0.0;
+    TrackMode mode = options_.score.mode;
+    if (score_rig_) {
+        divergences_before_ += score_rig_->tracker->scene().divergences();
+        mode = score_rig_->tracker->mode();
+        if (keep_pose) {
+            // Built from the pose of a while ago (background work): it starts
+            // from the pose the old rig is in now, at rest, as a rebuild in
+            // place would.
+            score_rig_->tracker->scene().local_rotations(pose_scratch_);
+            CharacterPose now = rig->body;
+            now.local = pose_scratch_;
+            rig->tracker->scene().reset(now);
+            for (int s = 0; s < 2; ++s)
+                rig->tips.position_m[s] = rig->tracker->scene().tip_position(static_cast<Side>(s));
+        }
+    }
+    std::swap(score_rig_, rig);
+    ScoreRig &r = *score_rig_;
+    // The live drum and gains win over those the rig was built with.
+    options_.scene.drum.center_m = r.drum_center_m;
+    r.tracker->scene().set_drum(options_.scene.drum);
+    r.frame = frame_for(options_.scene.drum, options_.character.stick.tip_radius_m, r.frame.right,
+                        r.frame.forward);
+    scale_gains(r.base_gains, gain_scale_, r.gains);
+    r.tracker->scene().set_gains(r.gains);
+    r.tracker->set_mode(mode);
     if (!keep_pose)
         rest_from_m_ = r.frame.rest_tip_m;
-    score_rig_ = std::move(rig);
     time_offset_s_ = previous_time;
     detector_.reset(membrane_of(scene()));
+    if (rig && worker_) {
+        auto old = std::make_unique<Result>();
+        old->score_rig = std::move(rig);
+        worker_->discard(std::move(old));
+    }
 }
 
 const PerformerFrame &Performance::performer_frame() const
@@ -446,29 +721,26 @@ Eigen::Vector3d Performance::tip_position(int hand) const
     return scene().tip_position(static_cast<Side>(hand & 1));
 }
 
-void Performance::start_score()
+std::unique_ptr<Performance::PlanState> Performance::make_plan(std::shared_ptr<const Score> score,
+                                                               const PerformerFrame &frame,
+                                                               const PlanOptions &options) const
 {
-    if (!score_rig_)
-        throw CharacterError("play: not in score mode");
-    // Planning allocates (the whole trajectory at 1 kHz): a bounded one-off
-    // on the physics thread at /ictus/play (docs/perform.md, measured there).
-    auto plan = std::make_unique<GesturePlan>(
-        plan_performance(*score_, *db_, score_rig_->frame, options_.score.plan));
-    plan_ = std::move(plan);
+    // Planning allocates (the whole trajectory at 1 kHz): the worker's job
+    // in `ictusd run`, inline in render.
+    auto ps = std::make_unique<PlanState>();
+    ps->plan = plan_performance(*score, *db_, frame, options);
+    ps->score = std::move(score);
+    const GesturePlan &plan = ps->plan;
     // Per note: its beat, how long before it the target reaches the contact
     // (the lead that target_at removes) and its approach speed there.
-    const PerformerFrame &frame = score_rig_->frame;
-    planned_speed_mps_.assign(plan_->notes.size(), 0.0);
+    ps->planned_speed_mps.assign(plan.notes.size(), 0.0);
     for (int s = 0; s < 2; ++s) {
-        beats_[s].clear();
-        lead_s_[s].clear();
-        approach_mps_[s].clear();
-        for (size_t i = 0; i < plan_->notes.size(); ++i) {
-            const PlannedNote &n = plan_->notes[i];
+        for (size_t i = 0; i < plan.notes.size(); ++i) {
+            const PlannedNote &n = plan.notes[i];
             if (static_cast<int>(n.hand) != s)
                 continue;
             auto height = [&](double t) {
-                return (plan_->tips.sample(s, t) - frame.membrane_center_m).dot(frame.up);
+                return (plan.tips.sample(s, t) - frame.membrane_center_m).dot(frame.up);
             };
             double lead = 0.0;
             constexpr double kSearch_s = 0.05, kStep_s = 1e-4;
@@ -485,16 +757,184 @@ void Performance::start_score()
             const double t_contact = n.time_s - lead;
             const double v =
                 std::max(0.0, (height(t_contact - kApproach_s) - height(t_contact)) / kApproach_s);
-            beats_[s].push_back(n.time_s);
-            lead_s_[s].push_back(lead);
-            approach_mps_[s].push_back(v);
-            planned_speed_mps_[i] = v;
+            ps->beats[s].push_back(n.time_s);
+            ps->lead_s[s].push_back(lead);
+            ps->approach_mps[s].push_back(v);
+            ps->planned_speed_mps[i] = v;
         }
     }
-    plan_active_ = true;
-    playing_ = true;
-    plan_time_s_ = 0.0;
-    plan_origin_s_ = time_s();
+    return ps;
+}
+
+void Performance::install_plan(std::unique_ptr<PlanState> plan, bool start_now)
+{
+    std::swap(plan_state_, plan);
+    plan_ = &plan_state_->plan;
+    if (start_now) {
+        plan_active_ = true;
+        playing_ = true;
+        plan_time_s_ = 0.0;
+        plan_origin_s_ = time_s();
+    }
+    // else: a plan under way goes on from where it was (the notes keep their times)
+    if (plan && worker_) {
+        auto old = std::make_unique<Result>();
+        old->plan = std::move(plan);
+        worker_->discard(std::move(old));
+    }
+}
+
+double Performance::planned_impact_speed_mps(size_t note) const
+{
+    return plan_state_ && note < plan_state_->planned_speed_mps.size()
+               ? plan_state_->planned_speed_mps[note]
+               : 0.0;
+}
+
+void Performance::start_score()
+{
+    if (!score_rig_)
+        throw CharacterError("play: not in score mode");
+    if (worker_ && worker_->pending())
+        throw CharacterError("play: background work under way; use apply()");
+    install_plan(make_plan(score_, score_rig_->frame, options_.score.plan), true);
+}
+
+// ---- background work -----------------------------------------------------------
+
+std::unique_ptr<Performance::Job> Performance::plan_job(const Command &origin, bool start_now) const
+{
+    auto job = std::make_unique<Job>();
+    job->kind = start_now ? Job::Kind::play : Job::Kind::replan;
+    job->origin = origin;
+    if (start_now && builder_->statements() > 0)
+        job->statements = std::make_unique<ScoreBuilder>(*builder_);
+    job->frame = score_rig_->frame;
+    job->options.score.plan = options_.score.plan;
+    return job;
+}
+
+std::unique_ptr<Performance::Result> Performance::execute(Job &job)
+{
+    auto r = std::make_unique<Result>();
+    r->kind = job.kind;
+    r->origin = job.origin;
+    try {
+        switch (job.kind) {
+        case Job::Kind::play:
+        case Job::Kind::replan: {
+            // A faulty score throws here: nothing changes, nothing plays.
+            std::shared_ptr<const Score> score =
+                job.statements ? std::make_shared<const Score>(job.statements->finish()) : score_;
+            r->plan = make_plan(score, job.frame, job.options.score.plan);
+            score_ = std::move(score); // the current score from now on
+            break;
+        }
+        case Job::Kind::score_rig:
+            r->score_rig = make_score_rig(job.options, &job.pose);
+            break;
+        case Job::Kind::clip_rig:
+            r->rig = make_clip_rig(job.options);
+            r->drum_center_m = job.options.scene.drum.center_m;
+            break;
+        }
+    } catch (const std::exception &e) {
+        r->error = e.what();
+        r->plan.reset();
+        r->score_rig.reset();
+        r->rig.reset();
+    }
+    return r;
+}
+
+bool Performance::submit(std::unique_ptr<Job> job, std::string *why)
+{
+    if (!worker_)
+        return install(execute(*job), why);
+    if (!worker_->submit(std::move(job))) {
+        if (why)
+            *why = "busy: 64 changes are waiting to be planned; send fewer";
+        return false;
+    }
+    return true;
+}
+
+bool Performance::install(std::unique_ptr<Result> r, std::string *why)
+{
+    if (!r->error.empty()) {
+        if (why)
+            *why = r->error;
+        return false;
+    }
+    switch (r->kind) {
+    case Job::Kind::play:
+        install_plan(std::move(r->plan), true);
+        break;
+    case Job::Kind::replan:
+        // Only a plan under way is replaced; a stopped one stays stopped
+        // (the next play plans on the frame of its time).
+        if (plan_active_)
+            install_plan(std::move(r->plan), false);
+        break;
+    case Job::Kind::score_rig:
+        install_score_rig(std::move(r->score_rig), true);
+        break;
+    case Job::Kind::clip_rig:
+        if (options_.drum_auto)
+            options_.scene.drum.center_m = r->drum_center_m;
+        install_clip_rig(std::move(r->rig));
+        playing_ = true;
+        break;
+    }
+    if (worker_)
+        worker_->discard(std::move(r));
+    return true;
+}
+
+void Performance::take_results()
+{
+    if (!worker_)
+        return;
+    while (std::unique_ptr<Result> r = worker_->take()) {
+        const Command origin = r->origin;
+        std::string why;
+        if (!install(std::move(r), &why))
+            refuse_later(origin, why);
+    }
+}
+
+void Performance::refuse_later(const Command &origin, const std::string &why)
+{
+    if (refusals_.size() >= 64)
+        refusals_.erase(refusals_.begin()); // nobody reads them: keep the newest
+    Refusal f;
+    f.peer_ipv4 = origin.peer_ipv4;
+    f.peer_port = origin.peer_port;
+    std::snprintf(f.address, sizeof f.address, "%s", origin.address);
+    std::snprintf(f.why, sizeof f.why, "%s", why.c_str());
+    refusals_.push_back(f);
+}
+
+bool Performance::pop_refusal(Refusal &out)
+{
+    if (refusals_.empty())
+        return false;
+    out = refusals_.front();
+    refusals_.erase(refusals_.begin());
+    return true;
+}
+
+void Performance::set_background_work(bool on)
+{
+    if (on && !worker_)
+        worker_ = std::make_unique<Worker>(*this);
+    else if (!on)
+        worker_.reset();
+}
+
+bool Performance::work_pending() const
+{
+    return worker_ && worker_->pending();
 }
 
 void Performance::start_rest_move()
@@ -507,7 +947,7 @@ void Performance::start_rest_move()
 Eigen::Vector3d Performance::target_at(int s, double t) const
 {
     const GesturePlan &plan = *plan_;
-    const std::vector<double> &beats = beats_[s];
+    const std::vector<double> &beats = plan_state_->beats[s];
     if (beats.empty())
         return plan.tips.sample(s, t);
     // The contact on the beat: the plan's target passes strike_depth_m below
@@ -517,7 +957,7 @@ Eigen::Vector3d Performance::target_at(int s, double t) const
     // time between the hand's beats (a rate change of well under 2 %).
     auto it = std::upper_bound(beats.begin(), beats.end(), t);
     const size_t k = static_cast<size_t>(it - beats.begin()); // beats[k-1] <= t < beats[k]
-    const std::vector<double> &lead = lead_s_[s];
+    const std::vector<double> &lead = plan_state_->lead_s[s];
     double delay;
     if (k == 0)
         delay = lead.front();
@@ -552,7 +992,7 @@ Eigen::Vector3d Performance::target_at(int s, double t) const
     const double tau = tp - beat;
     if (tau >= 20.0 * tc)
         return p;
-    return p + approach_mps_[s][j] * tau * std::exp(-tau / tc) * score_rig_->frame.up;
+    return p + plan_state_->approach_mps[s][j] * tau * std::exp(-tau / tc) * score_rig_->frame.up;
 }
 
 int Performance::step_score(StrikeEvent out[2])
@@ -605,10 +1045,9 @@ bool Performance::apply_score(const Command &c, std::string *why)
     try {
         switch (c.kind) {
         case CommandKind::play:
-            if (builder_->statements() > 0)
-                *score_ = builder_->finish(); // throws: nothing changes, nothing plays
-            start_score();
-            return true;
+            // Finished and planned by the worker (run) or here (render):
+            // a faulty score is refused, nothing changes, nothing plays.
+            return submit(plan_job(c, true), why);
         case CommandKind::stop:
             // The performance ends; the sticks go back to their rest.
             if (plan_active_)
@@ -622,42 +1061,54 @@ bool Performance::apply_score(const Command &c, std::string *why)
         case CommandKind::nuance:
             return fail("nuance: in score mode each note names its nuance (/ictus/score "
                         "\"R accent\")");
-        case CommandKind::grip:
-            // At once: the character is rebuilt in its current pose with the
-            // sticks in the new grip (the plan, in tip space, goes on).
+        case CommandKind::grip: {
+            // The character is rebuilt (by the worker, in run) in its current
+            // pose with the sticks in the new grip, and takes over from the
+            // pose it is in then; the plan, in tip space, goes on.
             options_.character.grip = grip_from_string(c.text);
-            build_score(true);
-            return true;
+            auto job = std::make_unique<Job>();
+            job->kind = Job::Kind::score_rig;
+            job->origin = c;
+            job->options = options_;
+            r.tracker->scene().local_rotations(job->pose);
+            return submit(std::move(job), why);
+        }
         case CommandKind::mode:
-            r.tracker->set_mode(track_mode_from_string(c.text));
+            options_.score.mode = track_mode_from_string(c.text);
+            r.tracker->set_mode(options_.score.mode);
             return true;
-        case CommandKind::gains:
+        case CommandKind::gains: {
+            const double scale[2] = {c.value, c.value2};
+            if (!check_gains(scale, why))
+                return false;
             gain_scale_[0] = c.value;
             gain_scale_[1] = c.value2;
+            last_gains_ = c;
             scale_gains(r.base_gains, gain_scale_, r.gains);
             r.tracker->scene().set_gains(r.gains);
             return true;
+        }
         case CommandKind::drum_radius:
         case CommandKind::drum_tension: {
+            DrumParams drum = options_.scene.drum;
             if (c.kind == CommandKind::drum_radius) {
                 if (!(c.value > options_.character.stick.tip_radius_m * 2.0))
                     return fail("drum radius: must exceed the stick tip's diameter");
-                options_.scene.drum.radius_m = c.value;
+                drum.radius_m = c.value;
             } else {
-                options_.scene.drum.tension_n_per_m = c.value;
+                drum.tension_n_per_m = c.value;
             }
-            // At once: the scene is rebuilt around the current pose; a plan
-            // under way is planned again on the new drum and goes on from
-            // where it was (the notes keep their times).
-            const TrackMode mode = r.tracker->mode();
-            build_score(true);
-            score_rig_->tracker->set_mode(mode);
-            if (plan_active_) {
-                const double t = plan_time_s_, origin = plan_origin_s_;
-                start_score();
-                plan_time_s_ = t;
-                plan_origin_s_ = origin;
-            }
+            r.tracker->scene().set_drum(drum); // throws naming the value: nothing changed
+            options_.scene.drum = drum;
+            // At once on the live scene (its contact law) and the detector;
+            // the plan's frame follows the membrane, and a plan under way
+            // (or on its way) is planned again on it and goes on from where
+            // it is (the notes keep their times). No rebuild.
+            detector_.set_membrane(membrane_of(scene()));
+            r.frame = frame_for(options_.scene.drum, options_.character.stick.tip_radius_m,
+                                r.frame.right, r.frame.forward);
+            if (plan_active_ || work_pending())
+                return submit(plan_job(c, false), why);
             return true;
         }
         case CommandKind::drum_density:

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 
 namespace ictus
 {
@@ -54,6 +55,21 @@ struct Command {
     CommandKind kind = CommandKind::play;
     double value = 0.0, value2 = 0.0;
     char text[kMaxText] = {};
+    // Who sent it and to which address, so that a refusal found later (by
+    // the physics thread or the planner) is answered to that peer as
+    // /ictus/error <address> <why>. IPv4 address and port in network byte
+    // order; peer_port 0: no peer (a command from the daemon itself).
+    std::uint32_t peer_ipv4 = 0;
+    std::uint16_t peer_port = 0;
+    char address[32] = {};
+};
+
+// A refusal on its way back to the client (see Command's peer fields).
+struct Refusal {
+    std::uint32_t peer_ipv4 = 0;
+    std::uint16_t peer_port = 0;
+    char address[32] = {};
+    char why[Command::kMaxText] = {};
 };
 
 // What the physics thread publishes for /ictus/status (atomics only).
@@ -64,6 +80,7 @@ struct LiveStatus {
     std::atomic<double> tempo_bpm{120.0};
     std::atomic<long> strikes{0};
     std::atomic<long> overruns{0}; // physics steps that started late by > 1 step
+    std::atomic<long> runaways{0}; // times the runaway guard stopped the strikes
 };
 
 } // namespace ictus

@@ -126,7 +126,7 @@ class Performance
     // Score mode.
     bool score_mode() const { return options_.mocap.empty(); }
     // The plan being performed (or last performed); nullptr before the first.
-    const GesturePlan *plan() const { return plan_ ? plan_.get() : nullptr; }
+    const GesturePlan *plan() const { return plan_; }
     bool plan_active() const { return plan_active_; }
     // Simulation time of the plan's time 0, and the plan's clock.
     double plan_origin_s() const { return plan_origin_s_; }
@@ -138,19 +138,70 @@ class Performance
     TrackMode mode() const;
     // The planned target's speed toward the head as it reaches the contact,
     // per note of plan() (m/s).
-    double planned_impact_speed_mps(size_t note) const
-    {
-        return note < planned_speed_mps_.size() ? planned_speed_mps_[note] : 0.0;
-    }
+    double planned_impact_speed_mps(size_t note) const;
     // Plans the current score and starts it now (what /ictus/play does in
     // score mode). Throws ScoreError / GestureError; on error nothing changes.
     void start_score();
 
+    // Background work. Finishing and planning a score and rebuilding the
+    // character (a grip change; a clip after one) can take 100 ms or more.
+    // With background work on (`ictusd run`), apply() hands them to a worker
+    // thread of the performance and returns at once; the result is handed
+    // over whole at the start of a later step, and the physics loop never
+    // waits for it. Off (the default: render, tests), they run inside
+    // apply(), deterministically. A drum change never rebuilds: the live
+    // scene takes it at once, and a plan under way is planned again.
+    void set_background_work(bool on);
+    bool background_work() const { return worker_ != nullptr; }
+    // Whether work handed to the worker has not come back yet.
+    bool work_pending() const;
+    // Refusals found after apply() returned (a score that fails to plan in
+    // the background, the runaway guard), oldest first, each naming the
+    // command's peer and address (Command's peer fields).
+    bool pop_refusal(Refusal &out);
+
+    // The runaway guard (docs/perform.md): a stick tip faster than this is
+    // no human stroke but a controller gone unstable. The guard then puts
+    // the gains back to their defaults, sends no strike for
+    // kRunawayQuiet_s, counts it and reports it as a refusal of the last
+    // /ictus/gains command.
+    static constexpr double kRunawayTipSpeed_mps = 25.0;
+    static constexpr double kRunawayQuiet_s = 1.0;
+    long runaways() const { return runaways_; }
+    // The largest PD rate kp / kd times the step that gains may reach: the
+    // stiffness part of eq. 1 is explicit in ODE's motor rows (a velocity
+    // target (kp / kd) e), stable only for (kp / kd) h < 2; half of that is
+    // allowed. /ictus/gains scales that break it are refused.
+    static constexpr double kMaxPdRateStep = 1.0;
+
   private:
     struct Rig;
     struct ScoreRig;
-    void build();
-    void build_score(bool keep_pose);
+    struct PlanState;
+    struct Job;
+    struct Result;
+    class Worker;
+    // Built off the live state, from copies (the worker thread may run them).
+    std::unique_ptr<Rig> make_clip_rig(PerformanceOptions &options) const;
+    std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
+                                             const std::vector<Eigen::Quaterniond> *pose) const;
+    std::unique_ptr<PlanState> make_plan(std::shared_ptr<const Score> score,
+                                         const PerformerFrame &frame,
+                                         const PlanOptions &plan) const;
+    std::unique_ptr<Result> execute(Job &job); // the worker, or inline
+    // Runs or queues a job; false with why when it was refused inline.
+    bool submit(std::unique_ptr<Job> job, std::string *why);
+    bool install(std::unique_ptr<Result> result, std::string *why);
+    void install_clip_rig(std::unique_ptr<Rig> rig);
+    void install_score_rig(std::unique_ptr<ScoreRig> rig, bool keep_pose);
+    void install_plan(std::unique_ptr<PlanState> plan, bool start_now);
+    void take_results();
+    void refuse_later(const Command &origin, const std::string &why);
+    bool check_gains(const double scale[2], std::string *why) const;
+    int guard_runaway(int k); // the strikes that may leave (0 while quiet)
+    PerformerFrame frame_for_drum(const ScoreRig &rig) const;
+    std::unique_ptr<Job> plan_job(const Command &origin, bool start_now) const;
+    int step_clip(StrikeEvent out[2]);
     int step_score(StrikeEvent out[2]);
     bool apply_score(const Command &command, std::string *why);
     void start_rest_move();
@@ -163,22 +214,28 @@ class Performance
     std::unique_ptr<Rig> rig_;
     std::unique_ptr<ScoreRig> score_rig_;
     StrikeDetector detector_;
-    // Score mode: the database, the statements received, the score and its plan.
+    // Score mode: the database (read only after construction), the
+    // statements received (physics thread), the current score (only
+    // execute() touches it: the worker's, or inline) and the plan performed.
     std::unique_ptr<GestureDatabase> db_;
     std::unique_ptr<ScoreBuilder> builder_;
-    std::unique_ptr<Score> score_;
-    std::unique_ptr<GesturePlan> plan_;
+    std::shared_ptr<const Score> score_;
+    std::unique_ptr<PlanState> plan_state_;
+    const GesturePlan *plan_ = nullptr; // &plan_state_->plan
     bool plan_active_ = false;
     double plan_origin_s_ = 0.0, plan_time_s_ = 0.0;
     // Between plans the tips move to (and hold) the rest tips.
     std::array<Eigen::Vector3d, 2> rest_from_m_;
     double rest_move_start_s_ = -1e9;
-    // Per hand, per note: plan time of the beat, the lead of the target's
-    // first contact before it, the approach speed there (target_at).
-    std::array<std::vector<double>, 2> beats_, lead_s_, approach_mps_;
-    std::vector<double> planned_speed_mps_; // [note of plan_]
+    std::vector<double> no_speeds_;
     bool playing_ = true;
     bool rebuild_pending_ = false;
+    std::unique_ptr<Worker> worker_;
+    std::vector<Refusal> refusals_; // oldest first
+    std::vector<Eigen::Quaterniond> pose_scratch_;
+    Command last_gains_; // the origin a runaway is reported to
+    long runaways_ = 0;
+    double quiet_until_s_ = -1.0; // no strike leaves before this time (runaway)
     double clip_time_s_ = 0.0;
     double time_offset_s_ = 0.0; // simulation time at the last (re)build
     double gain_scale_[2] = {1.0, 1.0};
