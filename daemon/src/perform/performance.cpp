@@ -372,6 +372,22 @@ bool Performance::check_gains(const double scale[2], std::string *why) const
     for (const JointGains &g : base)
         rate = std::max(rate, g.kp_nm_per_rad * scale[0] / (g.kd_nm_s_per_rad * scale[1]));
     const double h = options_.scene.step_s;
+    const double zeta0 = options_.gains.damping_ratio;
+    const double zeta = zeta0 * scale[1] / std::sqrt(scale[0]);
+    const double zeta_min = std::min(kMinDampingRatio, zeta0);
+    if (zeta < zeta_min * (1.0 - 1e-6)) {
+        if (why) {
+            char buf[256];
+            std::snprintf(buf, sizeof buf,
+                          "gains: stiffness x%g with damping x%g leaves a damping ratio of %.2f, "
+                          "under %.2f (the joints would ring, the controller is unstable): raise "
+                          "the damping to x%.3g or more",
+                          scale[0], scale[1], zeta, zeta_min,
+                          zeta_min / zeta0 * std::sqrt(scale[0]));
+            *why = buf;
+        }
+        return false;
+    }
     if (rate * h <= kMaxPdRateStep)
         return true;
     if (why) {

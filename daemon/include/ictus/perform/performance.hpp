@@ -161,18 +161,27 @@ class Performance
     bool pop_refusal(Refusal &out);
 
     // The runaway guard (docs/perform.md): a stick tip faster than this is
-    // no human stroke but a controller gone unstable. The guard then puts
+    // no human stroke but a controller gone unstable (the built-in strokes
+    // peak at 10-18 m/s with the default gains, up to 27 m/s with stiff,
+    // lightly damped ones; a controller past its stability bound reached
+    // 54 m/s). The guard then puts
     // the gains back to their defaults, sends no strike for
     // kRunawayQuiet_s, counts it and reports it as a refusal of the last
     // /ictus/gains command.
-    static constexpr double kRunawayTipSpeed_mps = 25.0;
+    static constexpr double kRunawayTipSpeed_mps = 40.0;
     static constexpr double kRunawayQuiet_s = 1.0;
     long runaways() const { return runaways_; }
-    // The largest PD rate kp / kd times the step that gains may reach: the
-    // stiffness part of eq. 1 is explicit in ODE's motor rows (a velocity
-    // target (kp / kd) e), stable only for (kp / kd) h < 2; half of that is
-    // allowed. /ictus/gains scales that break it are refused.
+    // What /ictus/gains scales may do (refused otherwise, naming the bound):
+    // - keep the largest PD rate kp / kd times the step under this: the
+    //   stiffness part of eq. 1 is explicit in ODE's motor rows (a velocity
+    //   target (kp / kd) e), stable only for (kp / kd) h < 2; half is allowed;
+    // - keep each joint's damping ratio zeta = kd / (2 sqrt(kp I)), scaled
+    //   as zeta x damping / sqrt(stiffness), at or above 1/sqrt(2) (or the
+    //   configured ratio, if lower): below it a second-order joint has a
+    //   resonant peak, and the strikes' impulses ring it up (measured in
+    //   docs/perform.md: tips past 25 m/s at zeta 0.5-0.6 and 2-4x stiffness).
     static constexpr double kMaxPdRateStep = 1.0;
+    static constexpr double kMinDampingRatio = 0.70710678118654752;
 
   private:
     struct Rig;

@@ -1,0 +1,408 @@
+// Live abuse of a running performance: scores that would hang the planner,
+// refusals that must reach the client, a drum slider, gains past the
+// controller's stability bound (docs/perform.md, "Live changes"). The daemon
+// is the real ictusd; the client is a raw UDP peer; waits are handshakes with
+// deadlines.
+#include "osc_test_util.hpp"
+
+#include "ictus/perform/performance.hpp"
+#include "ictus/score/score.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+
+namespace fs = std::filesystem;
+using namespace ictus;
+using osctest::Child;
+using osctest::Peer;
+
+namespace
+{
+
+using Clock = std::chrono::steady_clock;
+
+lo_message strings(std::initializer_list<const char *> args)
+{
+    lo_message m = lo_message_new();
+    for (const char *a : args)
+        lo_message_add_string(m, a);
+    return m;
+}
+
+// A daemon in score mode and a client peer that has had its pong.
+struct LiveDaemon {
+    int port = osctest::free_udp_port();
+    int dump_port = osctest::free_udp_port();
+    Peer client;
+    std::unique_ptr<Child> daemon;
+    explicit LiveDaemon(std::vector<std::string> extra = {})
+    {
+        std::vector<std::string> args = {ICTUSD_OSC_PATH,
+                                         "run",
+                                         "--paused",
+                                         "--port",
+                                         std::to_string(port),
+                                         "--target",
+                                         "osc.udp://127.0.0.1:" + std::to_string(dump_port),
+                                         "--pose-rate",
+                                         "0"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        daemon = std::make_unique<Child>(args);
+        // Ping until pong: the server is up.
+        const auto deadline = Clock::now() + std::chrono::seconds(60);
+        Peer::Message m;
+        bool pong = false;
+        while (!pong && Clock::now() < deadline) {
+            client.send(port, "/ictus/ping", lo_message_new());
+            while (client.receive(m, 200))
+                pong = pong || m.path == "/ictus/pong";
+        }
+        REQUIRE(pong);
+    }
+    // The next /ictus/error for `address`, or false at the deadline.
+    bool error_for(const std::string &address, std::string &why, double seconds = 20.0)
+    {
+        const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+        Peer::Message m;
+        while (Clock::now() < deadline)
+            if (client.receive(m, 100) && m.path == "/ictus/error" && m.strings.size() == 2 &&
+                m.strings[0] == address) {
+                why = m.strings[1];
+                return true;
+            }
+        return false;
+    }
+    bool pong_within(double seconds)
+    {
+        const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+        Peer::Message m;
+        while (Clock::now() < deadline) {
+            client.send(port, "/ictus/ping", lo_message_new());
+            while (client.receive(m, 100))
+                if (m.path == "/ictus/pong")
+                    return true;
+        }
+        return false;
+    }
+};
+
+// Sends SIGTERM and waits for the exit, up to `seconds`; the exit status, or
+// -1 when it was still running (then killed).
+int terminate_within(pid_t pid, double seconds)
+{
+    kill(pid, SIGTERM);
+    const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+    int status = 0;
+    while (Clock::now() < deadline) {
+        if (waitpid(pid, &status, WNOHANG) == pid)
+            return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+    return -1;
+}
+
+} // namespace
+
+TEST_CASE("run: repeats nested around no note are refused to the client, the daemon keeps "
+          "playing and answering, and SIGTERM ends it",
+          "[osc][live]")
+{
+    // The score of the report: repeat 1000 four deep around a grip line,
+    // sent ten times, then play. Before the statement budget the planner
+    // spun for ever on the physics thread: pings answered, nothing else.
+    const int port = osctest::free_udp_port();
+    Peer client;
+    const pid_t pid = fork();
+    if (pid == 0) {
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        const int devnull = open("/dev/null", O_WRONLY);
+        dup2(devnull, STDOUT_FILENO);
+        dup2(devnull, STDERR_FILENO);
+        execl(ICTUSD_OSC_PATH, ICTUSD_OSC_PATH, "run", "--paused", "--port",
+              std::to_string(port).c_str(), "--pose-rate", "0", "--target", "osc.udp://127.0.0.1:9",
+              static_cast<char *>(nullptr));
+        _exit(127);
+    }
+    REQUIRE(pid > 0);
+    Peer::Message m;
+    bool pong = false;
+    const auto up = Clock::now() + std::chrono::seconds(60);
+    while (!pong && Clock::now() < up) {
+        client.send(port, "/ictus/ping", lo_message_new());
+        while (client.receive(m, 200))
+            pong = pong || m.path == "/ictus/pong";
+    }
+    REQUIRE(pong);
+    for (int i = 0; i < 10; ++i) {
+        for (int d = 0; d < 4; ++d)
+            client.send(port, "/ictus/score", strings({"repeat 1000"}));
+        client.send(port, "/ictus/score", strings({"grip german"}));
+        for (int d = 0; d < 4; ++d)
+            client.send(port, "/ictus/score", strings({"end"}));
+    }
+    client.send(port, "/ictus/play", lo_message_new());
+    std::string why;
+    const auto deadline = Clock::now() + std::chrono::seconds(30);
+    bool refused = false;
+    while (!refused && Clock::now() < deadline)
+        if (client.receive(m, 100) && m.path == "/ictus/error" && m.strings.size() == 2 &&
+            m.strings[0] == "/ictus/play") {
+            refused = true;
+            why = m.strings[1];
+        }
+    INFO(why);
+    REQUIRE(refused);
+    CHECK(why.find("more than 1000000 statements") != std::string::npos);
+    // Still alive and answering: a plain score plays after a clear.
+    client.send(port, "/ictus/score/clear", lo_message_new());
+    client.send(port, "/ictus/score", strings({"R legato, L legato"}));
+    client.send(port, "/ictus/play", lo_message_new());
+    bool playing = false;
+    const auto play_deadline = Clock::now() + std::chrono::seconds(30);
+    while (!playing && Clock::now() < play_deadline) {
+        client.send(port, "/ictus/status", lo_message_new());
+        while (client.receive(m, 100))
+            if (m.path == "/ictus/reply" && !m.strings.empty() && m.strings[0] == "/ictus/status" &&
+                m.ints.size() >= 2)
+                playing = playing || m.ints[0] == 1;
+    }
+    CHECK(playing);
+    // SIGTERM is honoured (a clean stop, exit 130) within a few seconds.
+    CHECK(terminate_within(pid, 10.0) == 130);
+}
+
+TEST_CASE("run: refusals of the physics thread and of the planner reach the client as "
+          "/ictus/error",
+          "[osc][live]")
+{
+    LiveDaemon d;
+    std::string why;
+    // Score mode: the tempo is the score's (refused by the physics thread).
+    lo_message t = lo_message_new();
+    lo_message_add_float(t, 96.0f);
+    d.client.send(d.port, "/ictus/tempo", t);
+    REQUIRE(d.error_for("/ictus/tempo", why));
+    CHECK(why.find("score") != std::string::npos);
+    // Gains inside the server's ranges but past the stability bound.
+    lo_message g = lo_message_new();
+    lo_message_add_float(g, 4.0f);
+    lo_message_add_float(g, 0.05f);
+    d.client.send(d.port, "/ictus/gains", g);
+    REQUIRE(d.error_for("/ictus/gains", why));
+    CHECK(why.find("unstable") != std::string::npos);
+    // A score one hand cannot play (refused by the planner, in the background).
+    d.client.send(d.port, "/ictus/score/clear", lo_message_new());
+    d.client.send(d.port, "/ictus/score", strings({"tempo 400"}));
+    d.client.send(d.port, "/ictus/score", strings({"R 1/4, R 1/4, R 1/4"}));
+    d.client.send(d.port, "/ictus/play", lo_message_new());
+    REQUIRE(d.error_for("/ictus/play", why));
+    CHECK(why.find("line") != std::string::npos);
+    // A statement the parser refuses names its column.
+    d.client.send(d.port, "/ictus/score", strings({"R lgato"}));
+    REQUIRE(d.error_for("/ictus/score", why));
+    CHECK(why.find("lgato") != std::string::npos);
+    CHECK(d.pong_within(10.0));
+}
+
+TEST_CASE("run: a drum slider at 20 messages a second loses no strike", "[osc][live]")
+{
+    // Eight notes, one primary strike each, while /ictus/drum/radius sweeps
+    // 0.15 -> 0.30 -> 0.15 m at 20 messages per second (before, each message
+    // rebuilt the scene at rest and replanned on the physics thread: 9
+    // strikes of 32 notes were left).
+    const fs::path dir = fs::temp_directory_path() / ("ictus_live_" + std::to_string(getpid()));
+    fs::create_directories(dir);
+    const std::string score = (dir / "eight.score").string();
+    std::ofstream(score) << "tempo 100\nR legato, L legato, R accent f, L legato\n"
+                            "R legato, L accent f, R tenuto, L legato\n";
+    const int dump_port = osctest::free_udp_port();
+    Child dump({"oscdump", "-L", std::to_string(dump_port)});
+    // oscdump is listening when its port is taken.
+    {
+        const auto deadline = Clock::now() + std::chrono::seconds(20);
+        bool bound = false;
+        while (!bound && Clock::now() < deadline) {
+            const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+            sockaddr_in sa{};
+            sa.sin_family = AF_INET;
+            sa.sin_port = htons(static_cast<uint16_t>(dump_port));
+            bound = bind(fd, reinterpret_cast<sockaddr *>(&sa), sizeof sa) != 0;
+            close(fd);
+            if (!bound)
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+        REQUIRE(bound);
+    }
+    const int port = osctest::free_udp_port();
+    Peer client;
+    Child daemon({ICTUSD_OSC_PATH, "run", "--score", score, "--paused", "--port",
+                  std::to_string(port), "--target",
+                  "osc.udp://127.0.0.1:" + std::to_string(dump_port), "--pose-rate", "0"});
+    Peer::Message m;
+    bool pong = false;
+    const auto up = Clock::now() + std::chrono::seconds(60);
+    while (!pong && Clock::now() < up) {
+        client.send(port, "/ictus/ping", lo_message_new());
+        while (client.receive(m, 200))
+            pong = pong || m.path == "/ictus/pong";
+    }
+    REQUIRE(pong);
+    client.send(port, "/ictus/play", lo_message_new());
+    // The slider, until the performance is over (status: playing 0 after 1).
+    bool seen_playing = false, over = false;
+    int messages = 0;
+    const auto start = Clock::now();
+    while (!over && Clock::now() - start < std::chrono::seconds(50)) {
+        const double t = std::chrono::duration<double>(Clock::now() - start).count();
+        const double phase = std::fmod(t / 4.0, 1.0); // a 4 s triangle
+        const double radius = 0.15 + 0.15 * (phase < 0.5 ? 2.0 * phase : 2.0 - 2.0 * phase);
+        lo_message r = lo_message_new();
+        lo_message_add_float(r, static_cast<float>(radius));
+        client.send(port, "/ictus/drum/radius", r);
+        ++messages;
+        client.send(port, "/ictus/status", lo_message_new());
+        const auto next = Clock::now() + std::chrono::milliseconds(50);
+        while (client.receive(m, 10) || Clock::now() < next)
+            if (m.path == "/ictus/reply" && !m.strings.empty() && m.strings[0] == "/ictus/status" &&
+                !m.ints.empty()) {
+                seen_playing = seen_playing || m.ints[0] == 1;
+                over = over || (seen_playing && m.ints[0] == 0);
+                m.path.clear();
+            }
+    }
+    CHECK(over);
+    // The strikes oscdump received: one primary (non-bounce) strike per note,
+    // four of each hand.
+    std::string line;
+    int primary[2] = {0, 0};
+    const auto quiet = Clock::now() + std::chrono::seconds(20);
+    while (primary[0] + primary[1] < 8 && Clock::now() < quiet && dump.line(line, 2000)) {
+        std::istringstream in(line);
+        std::string tt, path, types;
+        long seq;
+        int hand, drum, bounce;
+        in >> tt >> path >> types;
+        if (path != "/ictus/strike")
+            continue;
+        in >> seq >> hand >> drum >> bounce;
+        if (!bounce)
+            ++primary[hand & 1];
+    }
+    // A moment for any extra strike, then stop the daemon.
+    while (dump.line(line, 500)) {
+        std::istringstream in(line);
+        std::string tt, path, types;
+        long seq;
+        int hand, drum, bounce;
+        in >> tt >> path >> types;
+        if (path == "/ictus/strike" && (in >> seq >> hand >> drum >> bounce) && !bounce)
+            ++primary[hand & 1];
+    }
+    std::printf("drum slider: %d radius messages, primary strikes L %d R %d\n", messages,
+                primary[0], primary[1]);
+    CHECK(messages >= 60);
+    CHECK(primary[0] == 4);
+    CHECK(primary[1] == 4);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("perform: gains are refused past the controller's stability bounds; within them no "
+          "runaway; a controller past them runs away and the guard stops the strikes",
+          "[perform][live]")
+{
+    // Two bounds (performance.hpp), computed here from the theory:
+    // - ODE's motor rows make eq. 1's damping implicit and its stiffness
+    //   explicit (a velocity target (kp/kd) e): the error decays by
+    //   (1 - (kp/kd) h) per step, stable for (kp/kd) h < 2, half allowed. The
+    //   default gains have kp/kd = w / (2 zeta) = 2 pi 30 / 2 = 94.2 /s.
+    // - A joint's damping ratio, zeta = 1 x damping / sqrt(stiffness) after
+    //   scaling, must stay >= 1/sqrt(2) (no resonant peak).
+    const double h = 0.001, base_rate = 2.0 * M_PI * 30.0 / 2.0;
+    auto stable = [&](double sk, double sd) {
+        return base_rate * sk / sd * h <= 1.0 && sd / std::sqrt(sk) >= std::sqrt(0.5) - 1e-9;
+    };
+    std::mt19937 rng(1306);
+    std::uniform_real_distribution<double> scale(0.05, 4.0);
+    const char *score = "tempo 160\nR vertical_accent ff, L vertical_accent ff, R staccato p, "
+                        "L staccato, R+L accent ff\n";
+    PerformanceOptions o;
+    o.score.score_text = score;
+    {
+        Performance perf(o);
+        int accepted = 0;
+        for (int trial = 0; trial < 200; ++trial) {
+            Command c;
+            c.kind = CommandKind::gains;
+            c.value = scale(rng);
+            c.value2 = scale(rng);
+            std::string why;
+            INFO("trial " << trial << ": x" << c.value << " x" << c.value2);
+            const bool ok = stable(c.value, c.value2);
+            accepted += ok ? 1 : 0;
+            CHECK(perf.apply(c, &why) == ok);
+            if (!ok)
+                CHECK(why.find("raise the damping") != std::string::npos);
+        }
+        CHECK(accepted > 20);
+        CHECK(accepted < 180);
+    }
+    // Gains on the damping bound, stiffness at random: the performance runs
+    // with no runaway and every tip below the guard's speed.
+    for (int trial = 0; trial < 4; ++trial) {
+        Performance perf(o);
+        perf.start_score();
+        Command c;
+        c.kind = CommandKind::gains;
+        c.value = std::uniform_real_distribution<double>(0.1, 4.0)(rng);
+        c.value2 = std::sqrt(0.5) * std::sqrt(c.value) * 1.0001;
+        REQUIRE(perf.apply(c));
+        StrikeEvent ev[2];
+        double fastest = 0.0;
+        while (perf.plan_active()) {
+            perf.step(ev);
+            for (int s = 0; s < 2; ++s)
+                fastest = std::max(fastest, perf.scene().tip_velocity(static_cast<Side>(s)).norm());
+        }
+        INFO("stiffness x" << c.value << " damping x" << c.value2);
+        CHECK(perf.runaways() == 0);
+        CHECK(fastest < Performance::kRunawayTipSpeed_mps);
+    }
+
+    // A controller built past the rate bound (damping ratio 0.03: (kp/kd) h
+    // = 3.1) oscillates and grows: the guard notices, puts the gains back,
+    // and no strike leaves for kRunawayQuiet_s.
+    PerformanceOptions bad = o;
+    bad.gains.damping_ratio = 0.03;
+    Performance wild(bad);
+    wild.start_score();
+    double first_runaway_s = -1.0;
+    std::vector<double> sent_times;
+    StrikeEvent ev[2];
+    while (wild.plan_active()) {
+        const int k = wild.step(ev);
+        for (int i = 0; i < k; ++i)
+            sent_times.push_back(ev[i].time_s);
+        if (first_runaway_s < 0.0 && wild.runaways() > 0)
+            first_runaway_s = wild.time_s();
+    }
+    REQUIRE(wild.runaways() >= 1);
+    Refusal f;
+    REQUIRE(wild.pop_refusal(f));
+    CHECK(std::string(f.address) == "/ictus/gains");
+    CHECK(std::string(f.why).find("runaway") != std::string::npos);
+    for (double t : sent_times)
+        CHECK_FALSE(
+            (t >= first_runaway_s && t < first_runaway_s + Performance::kRunawayQuiet_s - 0.05));
+}
