@@ -73,7 +73,7 @@ wait "$daemon_pid" || {
 # (at most 10 s).
 count=$(($(wc -l <"$work/run/strikes.csv") - 1))
 for _ in $(seq 100); do
-    [ "$(grep -c ' /ictus/strike' "$work/dump.txt")" -ge "$count" ] && break
+    [ "$(grep -c ' /ictus/strike ' "$work/dump.txt")" -ge "$count" ] && break
     sleep 0.1
 done
 

@@ -318,8 +318,8 @@ TEST_CASE("run: a drum slider at 20 messages a second loses no strike", "[osc][l
     fs::remove_all(dir);
 }
 
-TEST_CASE("perform: gains are refused past the controller's stability bounds; within them no "
-          "runaway; a controller past them runs away and the guard stops the strikes",
+TEST_CASE("perform: gains are refused past the controller's stability bounds, within them no "
+          "runaway, a controller past them runs away and the guard stops the strikes",
           "[perform][live]")
 {
     // Two bounds (performance.hpp), computed here from the theory:

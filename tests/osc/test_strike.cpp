@@ -137,6 +137,54 @@ TEST_CASE("strike: a bead on a linear spring gives the analytic duration, impuls
     }
 }
 
+TEST_CASE("strike: the onset is reported in the sample that crosses the head, with the fields "
+          "a sound needs, and equals the strike reported at the release",
+          "[osc][strike]")
+{
+    // ictusd run sends a strike at its onset (docs/osc.md): the detector
+    // hands the onset out once, in the update() whose sample first touches,
+    // before the release; its fields are those of the finished strike,
+    // without the contact measures.
+    const AnalyticContact a;
+    const double dt = 1e-3;
+    StrikeDetector det(flat_membrane(a.k, 0.0), continuous_samples());
+    StrikeEvent onset, end, e;
+    double onset_sample_t = -1.0, end_sample_t = -1.0;
+    int onsets = 0;
+    for (long n = 0; n * dt <= 0.2; ++n) {
+        const TipSample s = a.at(n * dt);
+        if (det.update(1, s, e)) {
+            end = e;
+            end_sample_t = s.time_s;
+        }
+        while (det.take_onset(1, e)) {
+            onset = e;
+            onset_sample_t = s.time_s;
+            ++onsets;
+        }
+        CHECK_FALSE(det.take_onset(0, e)); // the other hand never touched
+    }
+    REQUIRE(onsets == 1);
+    REQUIRE(end_sample_t > 0.0);
+    // The first sample at or past the exact contact time a.t_c.
+    CHECK(onset_sample_t == Approx(std::ceil(a.t_c / dt) * dt));
+    CHECK(onset_sample_t < end_sample_t);
+    CHECK(end_sample_t - onset_sample_t >= 0.5 * M_PI / a.omega()); // half a period later
+    CHECK(onset.seq == end.seq);
+    CHECK(onset.hand == end.hand);
+    CHECK(onset.bounce == end.bounce);
+    CHECK(onset.stroke == end.stroke);
+    CHECK(onset.time_s == end.time_s);
+    CHECK(onset.x_m == end.x_m);
+    CHECK(onset.y_m == end.y_m);
+    CHECK(onset.normal_velocity_mps == end.normal_velocity_mps);
+    CHECK(onset.normal_velocity_mps == Approx(a.v).epsilon(1e-12));
+    CHECK(onset.peak_force_n == 0.0);
+    CHECK(onset.impulse_n_s == 0.0);
+    CHECK(onset.duration_ms == 0.0);
+    CHECK(end.duration_ms > 0.0);
+}
+
 TEST_CASE("strike: membrane coordinates in all four quadrants", "[osc][strike]")
 {
     // x_m along world +X, y_m along world -Z (docs/osc.md).

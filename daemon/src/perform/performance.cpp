@@ -365,6 +365,15 @@ int Performance::step(StrikeEvent out[2])
     return guard_runaway(k);
 }
 
+int Performance::take_onsets(StrikeEvent out[2])
+{
+    int n = 0;
+    for (int hand = 0; hand < 2; ++hand)
+        if (detector_.take_onset(hand, out[n]))
+            ++n;
+    return time_s() < quiet_until_s_ ? 0 : n;
+}
+
 bool Performance::check_gains(const double scale[2], std::string *why) const
 {
     const std::vector<JointGains> &base = rig_ ? rig_->base_gains : score_rig_->base_gains;

@@ -182,6 +182,7 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
         h.peak_has_before = false;
         h.peak_has_after = false;
         h.in_contact = true;
+        h.onset_new = true;
     }
 
     if (h.in_contact && touching) {
@@ -237,6 +238,20 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
     h.previous_gap = gap;
     h.has_previous = true;
     return ended;
+}
+
+bool StrikeDetector::take_onset(int hand, StrikeEvent &out)
+{
+    Hand &h = hands_[hand & 1];
+    if (!h.onset_new)
+        return false;
+    h.onset_new = false;
+    out = h.event;
+    out.peak_force_n = 0.0;
+    out.impulse_n_s = 0.0;
+    out.duration_ms = 0.0;
+    out.force_dir = Eigen::Vector3d(0.0, -1.0, 0.0);
+    return true;
 }
 
 void StrikeDetector::finish(Hand &h, double release_time_s, StrikeEvent &out)

@@ -100,6 +100,11 @@ class Performance
     // One physics step; returns the number of strikes ended in it (<= 2),
     // written to out[0..n).
     int step(StrikeEvent out[2]);
+    // The strikes whose contact began in the last step (<= 2), at their
+    // onset: what a sound needs (time, hand, position, velocity), without
+    // force, impulse and duration, which step() reports at the release
+    // (docs/osc.md: `ictusd run` sends the one at once, the rest after).
+    int take_onsets(StrikeEvent out[2]);
     // Ends contacts still open (end of a run).
     bool flush(StrikeEvent &out) { return detector_.flush(out); }
     // Applies a command from the OSC thread. Returns false with a reason when

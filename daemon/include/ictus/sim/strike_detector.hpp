@@ -77,6 +77,11 @@ class StrikeDetector
     // Feeds one sample per hand per physics step, times increasing. Returns
     // true and fills `out` when this sample ends a contact episode of that hand.
     bool update(int hand, const TipSample &sample, StrikeEvent &out);
+    // The contact that began in the last update() of `hand`, once: the
+    // strike's onset fields (seq, hand, bounce, stroke, time, position,
+    // velocities: all a sound needs); peak force, impulse and duration are
+    // not known yet (0) and come with update()'s event at the release.
+    bool take_onset(int hand, StrikeEvent &out);
     // Ends ongoing contacts (end of a run): true and fills `out` for one of them
     // per call, release at the last sample's time.
     bool flush(StrikeEvent &out);
@@ -116,6 +121,7 @@ class StrikeDetector
         double release_time_s = 0.0;
         double max_gap_since_release = 0.0;
         long stroke = -1;
+        bool onset_new = false; // take_onset() has not seen this contact yet
     };
     void finish(Hand &h, double release_time_s, StrikeEvent &out);
     void to_membrane(const Eigen::Vector3d &world_m, double &x_m, double &y_m) const;
