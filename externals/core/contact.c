@@ -297,6 +297,12 @@ static double step_force(const contact_step *st, double x1, double *dforce)
     return f;
 }
 
+/* The residual (m) at which the solve below stops, for a trial force f (N). */
+static double residual_tol(double x0, double x_free, double compliance, double f)
+{
+    return 1.0e-12 * (fabs(x_free) + fabs(x0) + compliance * f) + 1.0e-300;
+}
+
 /* Solves x1 = x_free - compliance * F(x0, x1) for the compression x1 (m) at the
  * end of one sample of dt seconds; returns F (N). force_guess (e.g. the last
  * sample's force, or 0) only speeds it up. */
@@ -333,10 +339,12 @@ static double contact_solve(const contact *c, double x0, double x_free, double c
     }
     double dr = 1.0 + compliance * df;
     /* Residual (m) small enough that F and the compression agree to ~1e-12: far
-     * below the float rounding of the modal state the energy balance lives with. */
-    const double tol =
-        1.0e-12 * (fabs(x_free) + fabs(x0) + compliance * (f > force_guess ? f : force_guess)) +
-        1.0e-300;
+     * below the float rounding of the modal state the energy balance lives with.
+     * Scaled by the force at the trial point, not by the first trial's: F(x_free)
+     * can exceed the force at the root by many orders (1e12 N against 1 N with a
+     * 10 kg stick, lambda 1e13 on a 3 mg head), and a tolerance of C * 1e12 N let
+     * the loop stop metres away from the root. */
+    double tol = residual_tol(x0, x_free, compliance, f);
     for (int it = 0; it < 100 && fabs(r) > tol; it++) {
         double next = dr > 0.0 ? u - r / dr : -HUGE_VAL;
         if (!(next < hi) || (have_lo && !(next > lo)) || (!have_lo && !isfinite(next))) {
@@ -365,8 +373,21 @@ static double contact_solve(const contact *c, double x0, double x_free, double c
             lo = u;
             have_lo = 1;
         }
+        tol = residual_tol(x0, x_free, compliance, f);
         if (have_lo && hi - lo <= 1e-3 * tol)
             break;
+    }
+    if (have_lo && fabs(r) > tol) {
+        /* Stopped by the bracket, not by the residual: F is so steep here (lambda / dt
+         * up to 1e18) that no double u brings r below tol, and F(x0, u) at the last
+         * trial point can be far from the force at the root (1e7 N instead of 1 N,
+         * which threw the stick and the head metres apart and broke passivity). The
+         * root's compression is pinned by [lo, hi], and the force the stick and the
+         * membrane then see, (x_free - u) / C, is within (hi - lo) / C of the root's:
+         * the energy error is that times the step, not F's jump across the bracket. */
+        u = 0.5 * (lo + hi);
+        *x1 = u;
+        return (x_free - u) / compliance;
     }
     /* f = F(x0, u) at the last trial point. Report the compression the stick and membrane updates
      * will really produce. */

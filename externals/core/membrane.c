@@ -469,9 +469,13 @@ ictus_status membrane_set_mass(membrane *m, double mass_kg)
      * caller passing the limit itself would get. */
     ictus_range range = mass_range(m);
     ictus_status s = ictus_clamp(&mass_kg, range.min, range.max, range.def);
-    double area = M_PI * m->radius * m->radius;
-    ictus_status s2 = membrane_set_density(m, mass_kg / area);
-    return s != ICTUS_OK ? s : s2;
+    double density = mass_kg / (M_PI * m->radius * m->radius);
+    /* A mass in range gives a density in range but for the rounding of the division
+     * (the limit's mass / area can land an ulp outside the density's limit): pinned
+     * back, with no report; the mass said whether it was clamped. */
+    ictus_clamp(&density, MEMBRANE_DENSITY_MIN, MEMBRANE_DENSITY_MAX, MEMBRANE_DEFAULT_DENSITY);
+    membrane_set_density(m, density);
+    return s;
 }
 
 ictus_status membrane_set_modes(membrane *m, int count)
@@ -1017,6 +1021,13 @@ double membrane_get_mass(const membrane *m)
 int membrane_get_modes(const membrane *m)
 {
     return m->modes;
+}
+int membrane_get_sounding_modes(const membrane *m)
+{
+    int sounding = 0;
+    for (int k = 0; k < m->modes; k++)
+        sounding += m->omega_model[k] > 0.0;
+    return sounding;
 }
 double membrane_get_t60(const membrane *m)
 {

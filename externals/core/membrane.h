@@ -156,6 +156,9 @@ double membrane_get_tension(const membrane *m);
 double membrane_get_density(const membrane *m);
 double membrane_get_mass(const membrane *m);
 int membrane_get_modes(const membrane *m);
+/* Of those modes, how many ring: the others lie above 0.95 x Nyquist and are kept
+ * silent. 0 means the membrane makes no sound at this sample rate. */
+int membrane_get_sounding_modes(const membrane *m);
 double membrane_get_t60(const membrane *m);
 double membrane_get_hf_damping(const membrane *m);
 double membrane_get_output_gain(const membrane *m);

@@ -1,6 +1,7 @@
 /* ictus_pd_common.c -- the sample clock, the argument readers and the parameter
  * tables shared by membrane~ and contact~ (see ictus_pd_common.h). */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "ictus_pd_common.h"
@@ -130,13 +131,34 @@ const t_ictus_param *ictus_params_find(const t_ictus_params *ps, const t_symbol 
     return 0;
 }
 
+/* Whether `value`, just outside a range, is its `limit` as the user wrote it. A Pd
+ * message carries a t_float: a limit typed in a message (0.01, 1e-4) arrives as the
+ * float nearest to it, up to half a float's step away from the double the core
+ * compares with (0.01f is 0.0099999998); and the error line quotes limits with %g's
+ * six digits (the mass's, pi a^2 times the density's, are not round). Either way
+ * the user asked for the limit. */
+static int ictus_is_limit(double value, double limit)
+{
+    char typed[32], quoted[32];
+    if ((t_float)value == (t_float)limit)
+        return 1;
+    snprintf(typed, sizeof(typed), "%g", value);
+    snprintf(quoted, sizeof(quoted), "%g", limit);
+    return !strcmp(typed, quoted);
+}
+
 void ictus_params_set(void *x, const t_ictus_params *ps, void *core, const t_ictus_param *p,
                       double value)
 {
     /* The range before setting: the mass's follows the radius, not the mass. */
     ictus_range range = ps->ps_range(core, p->p_id);
-    ictus_status status = ps->ps_set(core, p->p_id, value);
     const char *space = *p->p_unit ? " " : "";
+    ictus_status status;
+    if (value < range.min && ictus_is_limit(value, range.min))
+        value = range.min;
+    else if (value > range.max && ictus_is_limit(value, range.max))
+        value = range.max;
+    status = ps->ps_set(core, p->p_id, value);
     if (status == ICTUS_ENOMEM)
         pd_error(x, "%s: %s %g: out of memory; keeping %g", ps->ps_class, p->p_name, value,
                  ps->ps_get(core, p->p_id));

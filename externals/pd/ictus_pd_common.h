@@ -67,7 +67,9 @@ typedef struct _ictus_params {
 
 /* The entry named s, or NULL. */
 const t_ictus_param *ictus_params_find(const t_ictus_params *ps, const t_symbol *s);
-/* Sets one parameter on core and reports, on x, what the core clamped or refused. */
+/* Sets one parameter on core and reports, on x, what the core clamped or refused. A
+ * value just outside the range that is its limit as a Pd float, or as the error line
+ * prints it (%g), is taken as that limit, without a word. */
 void ictus_params_set(void *x, const t_ictus_params *ps, void *core, const t_ictus_param *p,
                       double value);
 /* The A_GIMME method body for every entry's message: one number, checked and set. */

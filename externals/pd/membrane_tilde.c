@@ -38,6 +38,7 @@ struct _membrane_tilde {
     t_symbol *x_name; /* bound name for contact~, or &s_ */
     t_ictus_clock x_clock;
     t_membrane_tilde_attached x_attached[MEMBRANE_MAX_CONTACTS];
+    int x_silent; /* every mode above Nyquist: said once, when it became so */
 };
 
 t_class *ictus_membrane_tilde_class;
@@ -80,10 +81,30 @@ static const t_ictus_params membrane_tilde_params = {
 static const char *const membrane_tilde_args[] = {"radius", "tension", "density", "modes"};
 #define NARGS (int)(sizeof(membrane_tilde_args) / sizeof(membrane_tilde_args[0]))
 
+/* A head whose lowest mode lies above the core's cutoff (0.95 x Nyquist) makes no
+ * sound at all: a tiny radius, a huge tension or a low sample rate. Said once when
+ * a parameter or the sample rate takes it there, not again until it has sounded. */
+static void membrane_tilde_check_silent(t_membrane_tilde *x)
+{
+    int silent = membrane_get_sounding_modes(x->x_core) == 0;
+    if (silent && !x->x_silent) {
+        double sr = membrane_get_sample_rate(x->x_core), lowest = 0;
+        membrane_get_mode(x->x_core, 0, &lowest, 0, 0, 0, 0);
+        pd_error(x,
+                 "membrane~%s%s: all %d modes lie above Nyquist (lowest %g Hz, modes ring "
+                 "below %g Hz at sr %g Hz): silent; lower the tension, raise the density or "
+                 "enlarge the radius",
+                 x->x_name != &s_ ? " " : "", x->x_name != &s_ ? x->x_name->s_name : "",
+                 membrane_get_modes(x->x_core), lowest, 0.95 * 0.5 * sr, sr);
+    }
+    x->x_silent = silent;
+}
+
 /* radius, tension, density, mass, modes, t60, hfdamp, gain: one number each. */
 static void membrane_tilde_setparam(t_membrane_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
     ictus_params_message(x, &membrane_tilde_params, x->x_core, s, argc, argv);
+    membrane_tilde_check_silent(x);
 }
 
 /* pickup <1|2> <r/a> <theta deg> */
@@ -212,6 +233,7 @@ static void membrane_tilde_dsp(t_membrane_tilde *x, t_signal **sp)
         pd_error(x, "membrane~: sample rate %g Hz is outside [%g, %g]; using %g", sr,
                  MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, membrane_get_sample_rate(x->x_core));
     ictus_clock_dsp(&x->x_clock, membrane_get_sample_rate(x->x_core));
+    membrane_tilde_check_silent(x);
     dsp_add(membrane_tilde_perform, 5, x, sp[0]->s_vec, sp[1]->s_vec, sp[2]->s_vec,
             (t_int)sp[0]->s_n);
 }
@@ -250,6 +272,8 @@ static void *membrane_tilde_new(t_symbol *s, int argc, t_atom *argv)
     if (argc - first > NARGS)
         pd_error(x, "membrane~: arguments are NAME radius tension density modes; "
                     "extra arguments ignored");
+    x->x_silent = 0;
+    membrane_tilde_check_silent(x);
     outlet_new(&x->x_obj, &s_signal);
     outlet_new(&x->x_obj, &s_signal);
     return x;

@@ -203,3 +203,33 @@ TEST_CASE("Table-driven and named setters agree on random values", "[core][param
     contact_free(ca);
     contact_free(cb);
 }
+
+TEST_CASE("The mass's limits are taken as given at any radius", "[core][params]")
+{
+    // The mass range is the density range times pi a^2; the density a limit gives,
+    // mass / (pi a^2), could round an ulp past the density's limit, and setting the
+    // quoted limit then said ICTUS_CLAMPED (1 radius in 9, both ends).
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    membrane *m = membrane_new(48000.0);
+    REQUIRE(m);
+    membrane_set_modes(m, 4);
+    int refused = 0;
+    double first_radius = 0.0;
+    for (int i = 0; i < 2000; i++) {
+        const double a = i == 0 ? 0.01 : i == 1 ? 2.0 : 0.01 * std::pow(200.0, u01(rng));
+        REQUIRE(membrane_set_radius(m, a) == ICTUS_OK);
+        const ictus_range r = membrane_param_range(m, MEMBRANE_PARAM_MASS);
+        for (double limit : {r.min, r.max}) {
+            if (membrane_set_mass(m, limit) != ICTUS_OK && refused++ == 0)
+                first_radius = a;
+            INFO("radius " << a << " mass " << limit);
+            REQUIRE(membrane_get_density(m) >= 0.01);
+            REQUIRE(membrane_get_density(m) <= 20.0);
+            REQUIRE(membrane_get_mass(m) == Approx(limit).epsilon(1e-12));
+        }
+    }
+    INFO("first refused at radius " << first_radius);
+    CHECK(refused == 0);
+    membrane_free(m);
+}
