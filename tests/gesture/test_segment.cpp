@@ -155,7 +155,7 @@ TEST_CASE("segmentation refuses bad input and slow or shallow minima", "[gesture
     CHECK_THROWS_WITH(seg(s.time_s, wave), Catch::Contains("no strike found"));
 }
 
-TEST_CASE("import from a stick-only CSV; CSV errors name file and line", "[gesture][import]")
+TEST_CASE("import from a stick-only CSV, CSV errors name file and line", "[gesture][import]")
 {
     const Synthetic s = make_synthetic(250.0, false);
     const fs::path dir =

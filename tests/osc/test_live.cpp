@@ -39,6 +39,20 @@ lo_message strings(std::initializer_list<const char *> args)
     return m;
 }
 
+// Pings until a pong comes back (the server is up), up to `seconds`.
+bool ping_until_pong(Peer &client, int port, double seconds)
+{
+    const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+    Peer::Message m;
+    while (Clock::now() < deadline) {
+        client.send(port, "/ictus/ping", lo_message_new());
+        while (client.receive(m, 200))
+            if (m.path == "/ictus/pong")
+                return true;
+    }
+    return false;
+}
+
 // A daemon in score mode and a client peer that has had its pong.
 struct LiveDaemon {
     int port = osctest::free_udp_port();
@@ -59,15 +73,7 @@ struct LiveDaemon {
         args.insert(args.end(), extra.begin(), extra.end());
         daemon = std::make_unique<Child>(args);
         // Ping until pong: the server is up.
-        const auto deadline = Clock::now() + std::chrono::seconds(60);
-        Peer::Message m;
-        bool pong = false;
-        while (!pong && Clock::now() < deadline) {
-            client.send(port, "/ictus/ping", lo_message_new());
-            while (client.receive(m, 200))
-                pong = pong || m.path == "/ictus/pong";
-        }
-        REQUIRE(pong);
+        REQUIRE(ping_until_pong(client, port, 60.0));
     }
     // The next /ictus/error for `address`, or false at the deadline.
     bool error_for(const std::string &address, std::string &why, double seconds = 20.0)
@@ -82,18 +88,7 @@ struct LiveDaemon {
             }
         return false;
     }
-    bool pong_within(double seconds)
-    {
-        const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
-        Peer::Message m;
-        while (Clock::now() < deadline) {
-            client.send(port, "/ictus/ping", lo_message_new());
-            while (client.receive(m, 100))
-                if (m.path == "/ictus/pong")
-                    return true;
-        }
-        return false;
-    }
+    bool pong_within(double seconds) { return ping_until_pong(client, port, seconds); }
 };
 
 // Sends SIGTERM and waits for the exit, up to `seconds`; the exit status, or
@@ -136,15 +131,8 @@ TEST_CASE("run: repeats nested around no note are refused to the client, the dae
         _exit(127);
     }
     REQUIRE(pid > 0);
+    REQUIRE(ping_until_pong(client, port, 60.0));
     Peer::Message m;
-    bool pong = false;
-    const auto up = Clock::now() + std::chrono::seconds(60);
-    while (!pong && Clock::now() < up) {
-        client.send(port, "/ictus/ping", lo_message_new());
-        while (client.receive(m, 200))
-            pong = pong || m.path == "/ictus/pong";
-    }
-    REQUIRE(pong);
     for (int i = 0; i < 10; ++i) {
         for (int d = 0; d < 4; ++d)
             client.send(port, "/ictus/score", strings({"repeat 1000"}));
@@ -250,15 +238,8 @@ TEST_CASE("run: a drum slider at 20 messages a second loses no strike", "[osc][l
     Child daemon({ICTUSD_OSC_PATH, "run", "--score", score, "--paused", "--port",
                   std::to_string(port), "--target",
                   "osc.udp://127.0.0.1:" + std::to_string(dump_port), "--pose-rate", "0"});
+    REQUIRE(ping_until_pong(client, port, 60.0));
     Peer::Message m;
-    bool pong = false;
-    const auto up = Clock::now() + std::chrono::seconds(60);
-    while (!pong && Clock::now() < up) {
-        client.send(port, "/ictus/ping", lo_message_new());
-        while (client.receive(m, 200))
-            pong = pong || m.path == "/ictus/pong";
-    }
-    REQUIRE(pong);
     client.send(port, "/ictus/play", lo_message_new());
     // The slider, until the performance is over (status: playing 0 after 1).
     bool seen_playing = false, over = false;
@@ -331,7 +312,8 @@ TEST_CASE("perform: gains are refused past the controller's stability bounds, wi
     //   scaling, must stay >= 1/sqrt(2) (no resonant peak).
     const double h = 0.001, base_rate = 2.0 * M_PI * 30.0 / 2.0;
     auto stable = [&](double sk, double sd) {
-        return base_rate * sk / sd * h <= 1.0 && sd / std::sqrt(sk) >= std::sqrt(0.5) - 1e-9;
+        return base_rate * sk / sd * h <= 1.0 &&
+               sd / std::sqrt(sk) >= std::sqrt(0.5) * (1.0 - 1e-9);
     };
     std::mt19937 rng(1306);
     std::uniform_real_distribution<double> scale(0.05, 4.0);

@@ -429,7 +429,7 @@ TEST_CASE("strike: a re-contact after a lift of less than one step has the veloc
     CHECK(ev[1].time_s == Approx(0.013 + 0.001 * 0.2 / 0.7).margin(1e-12));
 }
 
-TEST_CASE("strike: every onset's normal velocity is > 0; from physics steps it is the velocity "
+TEST_CASE("strike: every onset's normal velocity is > 0, from physics steps it is the velocity "
           "that crossed, from a continuous motion within one step's change of it",
           "[osc][strike]")
 {

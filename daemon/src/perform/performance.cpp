@@ -384,7 +384,7 @@ bool Performance::check_gains(const double scale[2], std::string *why) const
     const double zeta0 = options_.gains.damping_ratio;
     const double zeta = zeta0 * scale[1] / std::sqrt(scale[0]);
     const double zeta_min = std::min(kMinDampingRatio, zeta0);
-    if (zeta < zeta_min * (1.0 - 1e-6)) {
+    if (zeta < zeta_min * (1.0 - 1e-9)) { // rounding of the scales aside
         if (why) {
             char buf[256];
             std::snprintf(buf, sizeof buf,
