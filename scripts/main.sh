@@ -62,7 +62,7 @@ fi
 # 3. the performance, offline and deterministic
 rm -f "$out"/{strikes.csv,events.txt,render.json,tips.csv,notes.csv,performance.bvh} \
     "$out"/{performance.wav,tips.png,tips.svg,pd.log}
-render=("$ictusd" render --out "$out")
+render=("$ictusd" render --out "$out" --force)
 [[ -n $score ]] && render+=(--score "$score")
 "${render[@]}"
 for f in strikes.csv events.txt render.json; do

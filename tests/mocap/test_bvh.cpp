@@ -3,8 +3,13 @@
 #include "mocap_test_util.hpp"
 
 #include "ictus/mocap/bvh.hpp"
+#include "ictus/mocap/capture_bounds.hpp"
 
+#include <array>
 #include <fstream>
+#include <iomanip>
+#include <map>
+#include <random>
 #include <sstream>
 
 using namespace ictus;
@@ -475,4 +480,267 @@ TEST_CASE("BVH: the CMU drumming file (80_13)", "[mocap][bvh][data]")
     CHECK(captured.motion.frames() == 1014);
     require_near(captured.motion.root_position_m[0], {columns[1][0], columns[1][1], columns[1][2]},
                  1e-12);
+}
+
+namespace
+{
+
+// The minimal file with several lines replaced (1-based line -> text).
+std::string minimal_bvh_with(const std::map<int, std::string> &lines)
+{
+    std::string out;
+    int n = 0;
+    for (const std::string &original : minimal_bvh_lines) {
+        ++n;
+        const auto found = lines.find(n);
+        out += (found == lines.end() ? original : found->second) + "\n";
+    }
+    return out;
+}
+
+// Parses and requires a MocapBoundError at `line` whose what() contains `expected`.
+void require_bound_error(const std::string &text, int line, const std::string &expected,
+                         const BvhOptions &options = {})
+{
+    std::istringstream in(text);
+    try {
+        parse_bvh(in, "src.bvh", options);
+    } catch (const MocapBoundError &error) {
+        const std::string what = error.what();
+        INFO("what(): " << what);
+        CHECK(what.rfind("src.bvh:" + std::to_string(line) + ": ", 0) == 0);
+        CHECK(error.line() == line);
+        CHECK(what.find(expected) != std::string::npos);
+        return;
+    } catch (const MocapError &error) {
+        FAIL("a MocapError that is not a MocapBoundError: " << error.what());
+    }
+    FAIL("no MocapBoundError (expected '" << expected << "')");
+}
+
+// The same file read with accept_out_of_bounds: no error, one warning at `line`.
+void require_bound_warning(const std::string &text, int line, const std::string &expected,
+                           BvhOptions options = {})
+{
+    options.accept_out_of_bounds = true;
+    std::istringstream in(text);
+    MocapWarnings warnings;
+    parse_bvh(in, "src.bvh", options, &warnings);
+    REQUIRE(warnings.size() == 1);
+    INFO(warnings[0]);
+    CHECK(warnings[0].rfind("src.bvh:" + std::to_string(line) + ": ", 0) == 0);
+    CHECK(warnings[0].find(expected) != std::string::npos);
+    CHECK(warnings[0].find("read anyway") != std::string::npos);
+}
+
+} // namespace
+
+// A Frame Time of 60 s, a 1e9 coordinate: the format allows them, a capture
+// of a human performer does not (capture_bounds.hpp). They became hours-long
+// runs and a drum kilometres away with no word; now refused at their line.
+TEST_CASE("BVH: values out of the physical bounds of a capture are refused at their line",
+          "[mocap][bvh][bounds]")
+{
+    SECTION("frame time")
+    {
+        require_bound_error(minimal_bvh(18, "Frame Time: 60"), 18,
+                            "expected a frame time in [0.0005, 0.5] s (a capture at 2 Hz to "
+                            "2 kHz), got '60'");
+        require_bound_error(minimal_bvh(18, "Frame Time: 1"), 18, "got '1'");
+        require_bound_error(minimal_bvh(18, "Frame Time: 0.0001"), 18, "got '0.0001'");
+        require_bound_warning(minimal_bvh(18, "Frame Time: 60"), 18, "got '60'");
+        // The bounds themselves are accepted.
+        for (const char *edge : {"Frame Time: 0.5", "Frame Time: 0.0005"}) {
+            std::istringstream in(minimal_bvh(18, edge));
+            MocapWarnings warnings;
+            CHECK_NOTHROW(parse_bvh(in, "src.bvh", {}, &warnings));
+            CHECK(warnings.empty());
+        }
+        // Beyond what the format holds at all: refused even when accepting.
+        BvhOptions accept;
+        accept.accept_out_of_bounds = true;
+        require_error(minimal_bvh(18, "Frame Time: 61"), 18,
+                      "expected a frame time in [1e-05, 60] s, got '61'", accept);
+    }
+    SECTION("duration: (Frames - 1) * Frame Time at most 3 h")
+    {
+        require_bound_error(minimal_bvh_with({{17, "Frames: 21602"}, {18, "Frame Time: 0.5"}}), 17,
+                            "expected a capture of at most 10800 s (3 h), got Frames: 21602 at "
+                            "Frame Time 0.5 s = 10800.5 s");
+        // 21601 frames are exactly 3 h: no bound error (the file is then short of lines).
+        std::istringstream in(minimal_bvh_with({{17, "Frames: 21601"}, {18, "Frame Time: 0.5"}}));
+        try {
+            parse_bvh(in, "src.bvh");
+            FAIL("no error for a truncated file");
+        } catch (const MocapBoundError &error) {
+            FAIL("a bound error at exactly 3 h: " << error.what());
+        } catch (const MocapError &error) {
+            CHECK(std::string(error.what()).find("expected 21601 motion lines") !=
+                  std::string::npos);
+        }
+    }
+    SECTION("coordinates: OFFSETs and position channels, in metres after the scale")
+    {
+        require_bound_error(minimal_bvh(8, "    OFFSET 0 1e9 0"), 8,
+                            "expected |OFFSET coordinate| * scale <= 100 m (joint Chest, scale "
+                            "1), got 1e+09 = 1e+09 m");
+        require_bound_error(minimal_bvh(12, "      OFFSET 0 0 -101"), 12, "joint Chest_End");
+        require_bound_error(minimal_bvh(4, "  OFFSET 100.5 0 0"), 4, "joint Hips");
+        require_bound_error(minimal_bvh(20, "0 1 1e9 10 0 0 0 0 5"), 20,
+                            "expected |position| * scale <= 100 m in column 2 (Hips Zposition, "
+                            "scale 1), got '1e9' = 1e+09 m");
+        require_bound_warning(minimal_bvh(20, "0 1 1e9 10 0 0 0 0 5"), 20, "Hips Zposition");
+        // The scale decides: 1000 units are 56 m at the CMU scale, 1000 m at 1.
+        BvhOptions cmu;
+        cmu.scale = kCmuBvhScale_m;
+        {
+            std::istringstream in(minimal_bvh(19, "1000 1 0 0 0 0 0 0 0"));
+            CHECK(parse_bvh(in, "src.bvh", cmu).motion.root_position_m[0].x() ==
+                  Approx(1000 * kCmuBvhScale_m));
+        }
+        require_bound_error(minimal_bvh(19, "1000 1 0 0 0 0 0 0 0"), 19, "Hips Xposition");
+        // Angles are not coordinates: any finite angle up to the format's 1e9.
+        std::istringstream angles(minimal_bvh(19, "0 1 0 1e8 0 0 0 0 -1e8"));
+        CHECK_NOTHROW(parse_bvh(angles, "src.bvh"));
+    }
+    SECTION("accepted: one warning per kind, the values kept")
+    {
+        BvhOptions accept;
+        accept.accept_out_of_bounds = true;
+        std::istringstream in(minimal_bvh_with({{8, "    OFFSET 0 500 0"},
+                                                {18, "Frame Time: 60"},
+                                                {19, "200 1 0 0 0 0 0 0 0"},
+                                                {20, "300 1 0 0 0 0 0 0 0"}}));
+        MocapWarnings warnings;
+        const BvhFile bvh = parse_bvh(in, "src.bvh", accept, &warnings);
+        REQUIRE(warnings.size() == 3);
+        CHECK(warnings[0].rfind("src.bvh:8: ", 0) == 0);
+        CHECK(warnings[1].rfind("src.bvh:18: ", 0) == 0);
+        CHECK(warnings[2].rfind("src.bvh:19: ", 0) == 0); // line 20 is the same kind
+        CHECK(bvh.frame_time_s == 60.0);
+        CHECK(bvh.skeleton.joints[1].offset_m.y() == 500.0);
+        CHECK(bvh.motion.root_position_m[1].x() == 300.0);
+    }
+}
+
+TEST_CASE("BVH: the skeleton keeps its file and the line of every OFFSET", "[mocap][bvh]")
+{
+    std::istringstream in(minimal_bvh());
+    const BvhFile bvh = parse_bvh(in, "src.bvh");
+    CHECK(bvh.skeleton.source == "src.bvh");
+    REQUIRE(bvh.skeleton.joints.size() == 3);
+    CHECK(bvh.skeleton.joints[0].offset_line == 4);
+    CHECK(bvh.skeleton.joints[1].offset_line == 8);
+    CHECK(bvh.skeleton.joints[2].offset_line == 12); // the end site
+}
+
+namespace
+{
+
+// A BVH of the minimal layout (line numbers as minimal_bvh_lines, motion from
+// line 19) with the given numbers, printed to full precision.
+struct BoundsBvh {
+    double frame_time_s = 0.01;
+    std::array<std::array<double, 3>, 3> offsets{}; // Hips, Chest, Chest_End
+    std::vector<std::array<double, 9>> frames;
+    std::string text() const
+    {
+        std::ostringstream out;
+        out << std::setprecision(17);
+        auto offset = [&](int j) {
+            return "OFFSET " + [&] {
+                std::ostringstream o;
+                o << std::setprecision(17) << offsets[j][0] << " " << offsets[j][1] << " "
+                  << offsets[j][2];
+                return o.str();
+            }();
+        };
+        out << "HIERARCHY\nROOT Hips\n{\n  " << offset(0)
+            << "\n  CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation\n"
+            << "  JOINT Chest\n  {\n    " << offset(1)
+            << "\n    CHANNELS 3 Zrotation Yrotation Xrotation\n    End Site\n    {\n      "
+            << offset(2) << "\n    }\n  }\n}\nMOTION\nFrames: " << frames.size()
+            << "\nFrame Time: " << frame_time_s << "\n";
+        for (const auto &row : frames) {
+            for (std::size_t c = 0; c < row.size(); ++c)
+                out << (c ? " " : "") << row[c];
+            out << "\n";
+        }
+        return out.str();
+    }
+};
+
+} // namespace
+
+// Property: random files inside the bounds read without a warning at any
+// scale; one value pushed out of them is refused at its own line (and read
+// with one warning when accepted). Seeded: the same files every run.
+TEST_CASE("BVH: random files inside the bounds pass, one value outside fails at its line",
+          "[mocap][bvh][bounds]")
+{
+    std::mt19937 rng(20240917);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    auto log_uniform = [&](double lo, double hi) { return lo * std::pow(hi / lo, unit(rng)); };
+    for (int trial = 0; trial < 200; ++trial) {
+        BoundsBvh file;
+        BvhOptions options;
+        options.scale = log_uniform(0.001, 1.0);
+        const double limit = kMaxCoordinate_m / options.scale; // in file units
+        auto coordinate = [&] { return (2.0 * unit(rng) - 1.0) * 0.999 * limit; };
+        file.frame_time_s = log_uniform(kMinSampleInterval_s, kMaxSampleInterval_s);
+        for (auto &offset : file.offsets)
+            for (double &x : offset)
+                x = coordinate();
+        const int frames = 2 + static_cast<int>(unit(rng) * 20);
+        for (int f = 0; f < frames; ++f) {
+            std::array<double, 9> row{};
+            for (int c = 0; c < 9; ++c)
+                row[static_cast<std::size_t>(c)] =
+                    c < 3 ? coordinate() : (2.0 * unit(rng) - 1.0) * 1e4;
+            file.frames.push_back(row);
+        }
+        INFO("trial " << trial << ", scale " << options.scale << "\n" << file.text());
+        {
+            std::istringstream in(file.text());
+            MocapWarnings warnings;
+            CHECK_NOTHROW(parse_bvh(in, "src.bvh", options, &warnings));
+            CHECK(warnings.empty());
+        }
+        // One value out of bounds, at a known line.
+        const double sign = unit(rng) < 0.5 ? -1.0 : 1.0;
+        const double outside = sign * std::min(1e9, limit * log_uniform(1.001, 1000.0));
+        int line = 0;
+        std::string expected;
+        switch (trial % 4) {
+        case 0:
+            file.frame_time_s = log_uniform(kMaxSampleInterval_s * 1.001, 60.0);
+            line = 18;
+            expected = "expected a frame time in [0.0005, 0.5] s";
+            break;
+        case 1:
+            file.frame_time_s = log_uniform(1e-5, kMinSampleInterval_s * 0.999);
+            line = 18;
+            expected = "expected a frame time in [0.0005, 0.5] s";
+            break;
+        case 2: {
+            const int joint = static_cast<int>(unit(rng) * 3);
+            file.offsets[static_cast<std::size_t>(joint)][static_cast<std::size_t>(trial % 3)] =
+                outside;
+            line = 4 + 4 * joint;
+            expected = "expected |OFFSET coordinate| * scale <= 100 m";
+            break;
+        }
+        default: {
+            const int f = static_cast<int>(unit(rng) * frames);
+            file.frames[static_cast<std::size_t>(f)][static_cast<std::size_t>(trial % 3)] = outside;
+            line = 19 + f;
+            expected =
+                "expected |position| * scale <= 100 m in column " + std::to_string(trial % 3);
+            break;
+        }
+        }
+        INFO("out of bounds at line " << line << ":\n" << file.text());
+        require_bound_error(file.text(), line, expected, options);
+        require_bound_warning(file.text(), line, expected, options);
+    }
 }

@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -309,7 +310,7 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
 }
 
 TEST_CASE("osc in: score statements, score clear and the cartesian mode pass through to the "
-          "physics thread; too-long statements and wrong type tags are refused",
+          "physics thread, too-long statements and wrong type tags are refused",
           "[osc][link]")
 {
     // oscsend (liblo's tool) sends, a plain socket receives the replies.
@@ -418,8 +419,8 @@ TEST_CASE("osc in: score statements, score clear and the cartesian mode pass thr
     CHECK(k.errors_sent == 11);
 }
 
-TEST_CASE("osc in: 10^5 random and malformed packets are counted and answered, the server "
-          "keeps answering",
+TEST_CASE("osc in: 10^5 random and malformed packets are counted, each answered or counted "
+          "unanswered (the error-reply budget), the server keeps answering",
           "[osc][link]")
 {
     ictus::LiveStatus status;
@@ -432,6 +433,7 @@ TEST_CASE("osc in: 10^5 random and malformed packets are counted and answered, t
     const int total = 100000;
     long oversized = 0, bundles = 0, wrong_tags = 0;
     std::vector<unsigned char> pkt;
+    const auto t0 = std::chrono::steady_clock::now();
     for (int i = 0; i < total; ++i) {
         pkt.clear();
         switch (i % 5) {
@@ -495,18 +497,26 @@ TEST_CASE("osc in: 10^5 random and malformed packets are counted and answered, t
     for (int w = 0; w < 5000 && server.counters().packets < static_cast<unsigned long>(total); ++w)
         std::this_thread::sleep_for(1ms);
     peer.drain();
+    const double elapsed_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const ictus::OscServerCounters k = server.counters();
     std::printf("fuzz: %lu packets, %lu malformed, %lu unknown address, %lu wrong type tags, "
-                "%lu bad values, %lu oversized, %lu bundles, %lu error replies\n",
+                "%lu bad values, %lu oversized, %lu bundles, %lu error replies, %lu unanswered "
+                "in %.2f s\n",
                 k.packets, k.malformed, k.unknown_address, k.bad_type_tags, k.bad_values,
-                k.oversized, k.bundles, k.errors_sent);
+                k.oversized, k.bundles, k.errors_sent, k.errors_unanswered, elapsed_s);
     CHECK(k.packets == static_cast<unsigned long>(total));
     CHECK(k.accepted == 0);
     CHECK(k.errors() == static_cast<unsigned long>(total)); // each counted once
     CHECK(k.oversized == static_cast<unsigned long>(oversized));
     CHECK(k.bundles == static_cast<unsigned long>(bundles));
     CHECK(k.bad_type_tags >= static_cast<unsigned long>(wrong_tags));
-    CHECK(k.errors_sent == static_cast<unsigned long>(total));
+    // One peer: its budget answers the first kErrorReplyBurst, then
+    // kErrorRepliesPerSecond; every other error is counted unanswered.
+    CHECK(k.errors_sent + k.errors_unanswered == static_cast<unsigned long>(total));
+    CHECK(k.errors_sent >= static_cast<unsigned long>(ictus::kErrorReplyBurst));
+    CHECK(k.errors_sent <=
+          ictus::kErrorReplyBurst + ictus::kErrorRepliesPerSecond * elapsed_s + 1.0);
     ictus::Command c;
     CHECK_FALSE(server.pop_command(c));
 
@@ -517,6 +527,144 @@ TEST_CASE("osc in: 10^5 random and malformed packets are counted and answered, t
     for (int i = 0; i < 20 && !pong; ++i)
         pong = peer.receive(reply, 100) && reply.path == "/ictus/pong";
     CHECK(pong);
+}
+
+namespace
+{
+// A bare UDP socket on a loopback address, for what Peer hides: the size of
+// each datagram received.
+class RawPeer
+{
+  public:
+    explicit RawPeer(const char *address)
+    {
+        fd_ = socket(AF_INET, SOCK_DGRAM, 0);
+        sockaddr_in sa{};
+        sa.sin_family = AF_INET;
+        inet_pton(AF_INET, address, &sa.sin_addr);
+        bind(fd_, reinterpret_cast<sockaddr *>(&sa), sizeof sa);
+        int big = 1 << 20;
+        setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &big, sizeof big);
+    }
+    ~RawPeer() { close(fd_); }
+    void send(int port, const void *data, size_t size)
+    {
+        sockaddr_in to{};
+        to.sin_family = AF_INET;
+        to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        to.sin_port = htons(static_cast<uint16_t>(port));
+        sendto(fd_, data, size, 0, reinterpret_cast<sockaddr *>(&to), sizeof to);
+    }
+    // The next datagram: its size (its OSC path in `path`), or -1 after timeout_ms.
+    long receive(std::string &path, int timeout_ms)
+    {
+        pollfd p{fd_, POLLIN, 0};
+        if (poll(&p, 1, timeout_ms) <= 0)
+            return -1;
+        char buf[65536];
+        const ssize_t n = recv(fd_, buf, sizeof buf - 1, 0);
+        if (n < 0)
+            return -1;
+        buf[n] = '\0';
+        path = buf;
+        return static_cast<long>(n);
+    }
+
+  private:
+    int fd_ = -1;
+};
+} // namespace
+
+// A 1-byte packet earned a 64-byte /ictus/error, and with --allow any every
+// packet was answered: the port was a 64x amplifier. Now each address has a
+// budget (kErrorReplyBurst, refilled at kErrorRepliesPerSecond): past it an
+// error is counted and not answered; another address keeps its own budget;
+// pings are answered still; and no reply grows with what it answers.
+TEST_CASE("osc in: error replies are limited per peer address, the rest counted, replies stay "
+          "small",
+          "[osc][link]")
+{
+    ictus::OscServerOptions so;
+    so.port = 0;
+    so.allow_any = true;
+    ictus::OscServer server(so, nullptr);
+    RawPeer flooder("127.0.0.1"), other("127.0.0.2");
+    const int total = 2000;
+    const unsigned char junk = 'x';
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int i = 0; i < total; ++i) {
+        flooder.send(server.port(), &junk, 1);
+        // Paced so that the kernel drops none: every packet must be counted.
+        if (i % 32 == 31 || i == total - 1)
+            for (int w = 0;
+                 w < 20000 && server.counters().packets < static_cast<unsigned long>(i + 1); ++w)
+                std::this_thread::sleep_for(100us);
+    }
+    ictus::OscServerCounters k = server.counters();
+    // Every reply sent reaches the flooder (loopback, a 1 MB buffer).
+    long replies = 0, largest = 0;
+    std::string path;
+    for (long n;
+         replies < static_cast<long>(k.errors_sent) && (n = flooder.receive(path, 2000)) >= 0;
+         ++replies) {
+        CHECK(path == "/ictus/error");
+        largest = std::max(largest, n);
+    }
+    const double elapsed_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("flood: %d one-byte packets in %.2f s, %lu error replies (largest %ld bytes), "
+                "%lu unanswered\n",
+                total, elapsed_s, k.errors_sent, largest, k.errors_unanswered);
+    CHECK(k.packets == static_cast<unsigned long>(total));
+    CHECK(k.malformed == static_cast<unsigned long>(total)); // still counted, each one
+    CHECK(k.errors_sent + k.errors_unanswered == static_cast<unsigned long>(total));
+    CHECK(k.errors_sent >= static_cast<unsigned long>(ictus::kErrorReplyBurst));
+    CHECK(k.errors_sent <=
+          ictus::kErrorReplyBurst + ictus::kErrorRepliesPerSecond * elapsed_s + 1.0);
+    CHECK(replies == static_cast<long>(k.errors_sent));
+    CHECK(largest <= 64);
+    CHECK_FALSE(flooder.receive(path, 0) >= 0); // nothing beyond the counted replies
+
+    // Another address has its own budget: answered at once.
+    other.send(server.port(), &junk, 1);
+    REQUIRE(other.receive(path, 2000) > 0);
+    CHECK(path == "/ictus/error");
+    // An unknown address of 3000 characters: the reply names it in 64 (it
+    // was over 3 kB, too long for the reply buffer, and never sent).
+    {
+        lo_message m = lo_message_new();
+        size_t size = 0;
+        const std::string long_path = "/" + std::string(2999, 'v');
+        void *data = lo_message_serialise(m, long_path.c_str(), nullptr, &size);
+        lo_message_free(m);
+        other.send(server.port(), data, size);
+        std::free(data);
+        const long n = other.receive(path, 2000);
+        REQUIRE(n > 0);
+        CHECK(path == "/ictus/error");
+        CHECK(n <= 128);
+    }
+    // The flooder is out of budget, but a ping is not an error: answered.
+    {
+        lo_message m = lo_message_new();
+        size_t size = 0;
+        void *data = lo_message_serialise(m, "/ictus/ping", nullptr, &size);
+        lo_message_free(m);
+        flooder.send(server.port(), data, size);
+        std::free(data);
+        REQUIRE(flooder.receive(path, 2000) > 0);
+        CHECK(path == "/ictus/pong");
+    }
+    // The budget refills: junk resent until it is answered again (a token
+    // every 1 / kErrorRepliesPerSecond s), within a deadline.
+    bool answered = false;
+    for (int i = 0; i < 100 && !answered; ++i) {
+        flooder.send(server.port(), &junk, 1);
+        answered = flooder.receive(path, 50) > 0 && path == "/ictus/error";
+    }
+    CHECK(answered);
+    k = server.counters();
+    CHECK(k.malformed + k.unknown_address == k.errors());
 }
 
 TEST_CASE("osc in: the allow-list refuses other peers without answering them", "[osc][link]")
@@ -543,7 +691,7 @@ TEST_CASE("osc in: the server listens on its bind address only", "[osc][link]")
     ictus::OscServerOptions so;
     so.port = 0;
     so.bind_address = "127.0.0.2";
-    so.allow = {};
+    so.allow_any = true;
     ictus::OscServer server(so, nullptr);
     Peer peer("127.0.0.1");
     peer.send(server.port(), "/ictus/ping", lo_message_new()); // to 127.0.0.1: nobody there
@@ -554,9 +702,35 @@ TEST_CASE("osc in: the server listens on its bind address only", "[osc][link]")
     so.bind_address = "localhost"; // not numeric
     CHECK_THROWS_WITH(ictus::OscServer(so, nullptr), Catch::Contains("--bind"));
     so.bind_address = "127.0.0.1";
+    so.allow_any = false;
     so.allow = {"10.0.0.300"};
     CHECK_THROWS_WITH(ictus::OscServer(so, nullptr), Catch::Contains("--allow"));
+    // An empty list is not "any" (--allow "" admitted every peer): refused.
+    so.allow = {};
+    CHECK_THROWS_WITH(ictus::OscServer(so, nullptr), Catch::Contains("--allow: empty list"));
     ictus::OscSenderOptions o;
     o.target_url = "not a url";
     CHECK_THROWS_WITH(ictus::OscSender(o), Catch::Contains("target"));
+    // What liblo takes and then fails to send to (or sends elsewhere): refused
+    // at once, naming the option and the fault.
+    const std::pair<const char *, const char *> bad_targets[] = {
+        {"osc.udp://127.0.0.1:99999", "port: expected 1 to 65535"}, // wrapped to 34463
+        {"osc.udp://127.0.0.1:0", "port: expected 1 to 65535"},
+        {"osc.udp://127.0.0.1:90x", "port: expected 1 to 65535"}, // read as 90
+        {"osc.udp://127.0.0.1", "no port"},
+        {"osc.udp://:9000", "no host"},
+        {"osc.tcp://127.0.0.1:9000", "protocol 'tcp' is not supported"},
+        {"osc.udp://[::1]:9000", "IPv6 is not supported"},
+        {"osc.udp://no-such-host.invalid:9000", "does not resolve to an IPv4 address"},
+    };
+    for (const auto &[url, why] : bad_targets) {
+        o.target_url = url;
+        CHECK_THROWS_WITH(ictus::OscSender(o),
+                          Catch::Contains("--target '" + std::string(url) + "'") &&
+                              Catch::Contains(why));
+    }
+    for (const char *url : {"osc.udp://127.0.0.1:9000", "osc.udp://localhost:65535/"}) {
+        o.target_url = url;
+        CHECK_NOTHROW(ictus::OscSender(o));
+    }
 }

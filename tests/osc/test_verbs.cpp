@@ -1,18 +1,26 @@
 // The verbs as processes: `render` twice gives the same bytes and a
 // consistent events file; `run` in real time sends every strike it records
-// to oscdump and answers oscsend. They need the CMU clip (ICTUS_DATA_DIR).
+// to oscdump and answers oscsend (these need the CMU clip, ICTUS_DATA_DIR).
+// Their options and files under stress (the built-in score, no data needed):
+// --allow, --target and --port checked up front, error replies within their
+// budget, strikes.csv whole line by line on a full disk and after SIGKILL,
+// render's --out folder and write errors.
 #include "osc_test_util.hpp"
 
 #include "ictus/perform/performance.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <sys/resource.h>
+
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -66,6 +74,124 @@ fs::path scratch(const std::string &name)
         fs::temp_directory_path() / ("ictus-osc-" + name + "-" + std::to_string(getpid()));
     fs::remove_all(p);
     return p;
+}
+
+// ictusd as a process of its own, its stdout and stderr kept apart (pipes,
+// which a file-size limit on it does not reach). file_size_limit > 0: the
+// child's RLIMIT_FSIZE in bytes, SIGXFSZ ignored, so that a write past it
+// fails (EFBIG) as one on a full disk does (ENOSPC), short write first.
+class Daemon
+{
+  public:
+    explicit Daemon(const std::vector<std::string> &args, long file_size_limit = 0)
+    {
+        int out[2], err[2];
+        REQUIRE(pipe(out) == 0);
+        REQUIRE(pipe(err) == 0);
+        pid_ = fork();
+        REQUIRE(pid_ >= 0);
+        if (pid_ == 0) {
+            prctl(PR_SET_PDEATHSIG, SIGKILL);
+            dup2(out[1], STDOUT_FILENO);
+            dup2(err[1], STDERR_FILENO);
+            for (int fd : {out[0], out[1], err[0], err[1]})
+                close(fd);
+            if (file_size_limit > 0) {
+                const rlimit limit{static_cast<rlim_t>(file_size_limit),
+                                   static_cast<rlim_t>(file_size_limit)};
+                setrlimit(RLIMIT_FSIZE, &limit);
+                signal(SIGXFSZ, SIG_IGN); // kept across exec
+            }
+            std::vector<std::string> all = {ICTUSD_OSC_PATH};
+            all.insert(all.end(), args.begin(), args.end());
+            std::vector<char *> argv;
+            for (std::string &a : all)
+                argv.push_back(a.data());
+            argv.push_back(nullptr);
+            execv(argv[0], argv.data());
+            _exit(127);
+        }
+        close(out[1]);
+        close(err[1]);
+        out_fd_ = out[0];
+        err_fd_ = err[0];
+    }
+    ~Daemon()
+    {
+        if (pid_ > 0) {
+            kill(pid_, SIGKILL);
+            waitpid(pid_, nullptr, 0);
+        }
+        for (int fd : {out_fd_, err_fd_})
+            if (fd >= 0)
+                close(fd);
+    }
+    Daemon(const Daemon &) = delete;
+    Daemon &operator=(const Daemon &) = delete;
+    pid_t pid() const { return pid_; }
+    // Reads stdout and stderr to their end, reaps: the exit status, or minus
+    // the signal that ended it.
+    int wait()
+    {
+        for (;;) {
+            pollfd p[2] = {{out_fd_, POLLIN, 0}, {err_fd_, POLLIN, 0}};
+            int open = 0;
+            for (pollfd &q : p)
+                open += q.fd >= 0;
+            if (open == 0)
+                break;
+            if (poll(p, 2, -1) < 0 && errno != EINTR)
+                break;
+            for (int i = 0; i < 2; ++i) {
+                if (p[i].fd < 0 || !(p[i].revents & (POLLIN | POLLHUP | POLLERR)))
+                    continue;
+                char buf[4096];
+                const ssize_t n = read(p[i].fd, buf, sizeof buf);
+                int &fd = i == 0 ? out_fd_ : err_fd_;
+                if (n <= 0) {
+                    close(fd);
+                    fd = -1;
+                } else {
+                    (i == 0 ? out : err).append(buf, static_cast<size_t>(n));
+                }
+            }
+        }
+        int status = 0;
+        waitpid(pid_, &status, 0);
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+    }
+    std::string out, err;
+
+  private:
+    pid_t pid_ = -1;
+    int out_fd_ = -1, err_fd_ = -1;
+};
+
+// A short score (four notes, about 3 s with its lead-in), so that render is quick.
+fs::path four_notes(const fs::path &dir)
+{
+    fs::create_directories(dir);
+    const fs::path path = dir / "four.score";
+    std::ofstream(path) << "tempo 144\ngrip german\nR accent f, L legato, R tenuto p, L staccato\n";
+    return path;
+}
+
+// strikes.csv: every line ends with its newline and has the header's columns.
+void check_whole_lines(const std::string &text, size_t &rows)
+{
+    REQUIRE(!text.empty());
+    CHECK(text.back() == '\n');
+    const std::vector<std::string> all = lines(text);
+    REQUIRE(!all.empty());
+    const auto columns = std::count(all[0].begin(), all[0].end(), ',');
+    CHECK(columns == 17);
+    for (size_t i = 1; i < all.size(); ++i) {
+        INFO("row " << i << ": " << all[i]);
+        CHECK(std::count(all[i].begin(), all[i].end(), ',') == columns);
+        CHECK(std::stol(all[i]) == static_cast<long>(i - 1)); // seq, in onset order
+    }
+    rows = all.size() - 1;
 }
 
 } // namespace
@@ -262,4 +388,245 @@ TEST_CASE("clip mode: drum radius and tension apply at once, to the scene and th
     CHECK_FALSE(perf.apply(c, &why));
     CHECK(why.find("drum radius") != std::string::npos);
     CHECK(perf.scene().drum().radius_m == 0.2);
+}
+
+// --allow "" gave an empty list, which the server took for "every peer"; and
+// --bind 0.0.0.0 --allow any opened the performance to the network without a
+// word. Now an empty list or item is a usage error, 'any' is said in full,
+// and 'any' beyond the loopback warns.
+TEST_CASE("run: --allow refuses an empty list (exit 2), 'any' beyond the loopback warns",
+          "[osc][verbs]")
+{
+    osctest::Peer sink;
+    const std::string target = "osc.udp://127.0.0.1:" + std::to_string(sink.port());
+    for (const char *allow : {"", ",", "127.0.0.1,", ",127.0.0.1", "127.0.0.1,,127.0.0.2"}) {
+        Daemon d({"run", "--allow", allow, "--duration", "0.5", "--port", "0", "--pose-rate", "0",
+                  "--target", target});
+        INFO("--allow '" << allow << "': " << d.err);
+        CHECK(d.wait() == 2);
+        CHECK(d.err.find("--allow") != std::string::npos);
+        CHECK(d.err.find("empty") != std::string::npos);
+    }
+    Daemon wide({"run", "--allow", "any", "--bind", "0.0.0.0", "--duration", "0.1", "--port", "0",
+                 "--pose-rate", "0", "--target", target});
+    CHECK(wide.wait() == 0);
+    INFO(wide.err);
+    CHECK(wide.err.find("warning: --allow any with --bind 0.0.0.0") != std::string::npos);
+    Daemon local({"run", "--allow", "any", "--duration", "0.1", "--port", "0", "--pose-rate", "0",
+                  "--target", target});
+    CHECK(local.wait() == 0);
+    CHECK(local.err.find("warning") == std::string::npos);
+}
+
+// --target osc.udp://127.0.0.1:99999 sent to port 34463, osc.tcp:// and
+// [::1] were taken and every send failed, exit 0. Now the URL is checked
+// before the clip or score loads: a usage error naming the option.
+TEST_CASE("run: --target and --port are checked up front (exit 2, naming the option)",
+          "[osc][verbs]")
+{
+    const std::pair<std::vector<std::string>, std::string> bad[] = {
+        {{"--target", "osc.udp://127.0.0.1:99999"}, "--target 'osc.udp://127.0.0.1:99999': port"},
+        {{"--target", "osc.udp://127.0.0.1:9000x"}, "--target 'osc.udp://127.0.0.1:9000x': port"},
+        {{"--target", "osc.tcp://127.0.0.1:9000"}, "protocol 'tcp' is not supported"},
+        {{"--target", "osc.udp://[::1]:9000"}, "IPv6 is not supported"},
+        {{"--target", "osc.udp://no-such-host.invalid:9000"}, "does not resolve"},
+        {{"--target", "127.0.0.1:9000"}, "--target '127.0.0.1:9000': not an OSC URL"},
+        {{"--port", "99999"}, "--port: expected an integer in [0, 65535]"},
+        {{"--port", "9001.5"}, "--port: expected an integer"},
+    };
+    for (const auto &[option, message] : bad) {
+        std::vector<std::string> args = {"run", "--duration", "0.5", "--pose-rate", "0"};
+        args.insert(args.end(), option.begin(), option.end());
+        Daemon d(args);
+        const int status = d.wait();
+        INFO(option[0] << " " << option[1] << " -> " << status << ": " << d.err);
+        CHECK(status == 2);
+        CHECK(d.err.find(message) != std::string::npos);
+    }
+}
+
+// With --allow any, each 1-byte packet earned a 64-byte error reply. Now one
+// address gets at most kErrorReplyBurst (20) + kErrorRepliesPerSecond (10)
+// per second; the rest are counted, and the summary says how many.
+TEST_CASE("run: error replies to a flooding peer stay within its budget, the rest are counted "
+          "in the summary",
+          "[osc][verbs]")
+{
+    osctest::Peer sink, flooder("127.0.0.1"), other("127.0.0.2");
+    const int port = osctest::free_udp_port();
+    Daemon d({"run", "--duration", "5", "--port", std::to_string(port), "--allow", "any",
+              "--pose-rate", "0", "--target",
+              "osc.udp://127.0.0.1:" + std::to_string(sink.port())});
+    // Ready when it answers a ping (a handshake with a deadline).
+    osctest::Peer::Message m;
+    bool pong = false;
+    for (int i = 0; i < 600 && !pong; ++i) {
+        flooder.send(port, "/ictus/ping", lo_message_new());
+        pong = flooder.receive(m, 100) && m.path == "/ictus/pong";
+    }
+    REQUIRE(pong);
+    const auto t0 = std::chrono::steady_clock::now();
+    const unsigned char junk = 'x';
+    for (int i = 0; i < 1000; ++i)
+        flooder.send_raw(port, &junk, 1);
+    // Another address: its own budget, answered although the flooder's is spent.
+    bool answered = false;
+    for (int i = 0; i < 20 && !answered; ++i) {
+        other.send_raw(port, &junk, 1);
+        answered = other.receive(m, 100) && m.path == "/ictus/error";
+    }
+    CHECK(answered);
+    REQUIRE(d.wait() == 0);
+    const double elapsed_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    long flooder_errors = 0, other_errors = answered ? 1 : 0;
+    while (flooder.receive(m, 0))
+        flooder_errors += m.path == "/ictus/error";
+    while (other.receive(m, 0))
+        other_errors += m.path == "/ictus/error";
+    INFO(d.out << d.err);
+    CHECK(flooder_errors <= 20 + 10.0 * elapsed_s + 1.0);
+    std::smatch found;
+    REQUIRE(std::regex_search(d.out, found,
+                              std::regex("(\\d+) packets in, (\\d+) accepted, (\\d+) errors "
+                                         "\\((\\d+) unanswered")));
+    const long packets = std::stol(found[1]), accepted = std::stol(found[2]),
+               errors = std::stol(found[3]), unanswered = std::stol(found[4]);
+    std::printf("run flood: %ld packets, %ld errors, %ld answered to the flooder in %.2f s, %ld "
+                "unanswered\n",
+                packets, errors, flooder_errors, elapsed_s, unanswered);
+    CHECK(errors == packets - accepted); // every junk packet counted
+    CHECK(unanswered > 0);
+    CHECK(flooder_errors + other_errors + unanswered == errors);
+}
+
+// run's strikes.csv went through a buffered stream whose errors were seen at
+// the end, if at all: on a full disk a cut line, and the run played on. Now a
+// write error stops the run at once, exit 1, naming the file and the reason;
+// the file keeps whole lines only.
+TEST_CASE("run: a full disk under strikes.csv stops the run, exit 1, naming the file and the "
+          "error, the rows written are whole",
+          "[osc][verbs]")
+{
+    const fs::path dir = scratch("run-full");
+    osctest::Peer sink;
+    const std::string target = "osc.udp://127.0.0.1:" + std::to_string(sink.port());
+    // /dev/full: ENOSPC at the first write (the header).
+    fs::create_directories(dir / "devfull");
+    fs::create_symlink("/dev/full", dir / "devfull" / "strikes.csv");
+    {
+        Daemon d({"run", "--duration", "2", "--port", "0", "--pose-rate", "0", "--target", target,
+                  "--out", (dir / "devfull").string()});
+        CHECK(d.wait() == 1);
+        INFO(d.err);
+        CHECK(d.err.find("/devfull/strikes.csv': " + std::string(std::strerror(ENOSPC))) !=
+              std::string::npos);
+    }
+    // A file-size limit of 500 bytes: the header and a few rows fit, then a
+    // short write; the run stops there, long before its 60 s.
+    {
+        const long limit = 500;
+        Daemon d({"run", "--duration", "60", "--port", "0", "--pose-rate", "0", "--target", target,
+                  "--out", (dir / "limit").string()},
+                 limit);
+        CHECK(d.wait() == 1);
+        INFO(d.out << d.err);
+        CHECK(d.err.find("/limit/strikes.csv': " + std::string(std::strerror(EFBIG))) !=
+              std::string::npos);
+        std::smatch simulated;
+        REQUIRE(std::regex_search(d.out, simulated, std::regex("run: ([0-9.e+-]+) s simulated")));
+        CHECK(std::stod(simulated[1]) < 30.0);
+        const std::string csv = slurp((dir / "limit" / "strikes.csv").string());
+        CHECK(csv.size() <= static_cast<size_t>(limit));
+        size_t rows = 0;
+        check_whole_lines(csv, rows);
+        CHECK(rows >= 1);
+    }
+    fs::remove_all(dir);
+}
+
+// After a SIGKILL the last row of strikes.csv was cut (a buffered stream).
+// Now each row is one write(2) of the whole line, made as it is released.
+TEST_CASE("run: killed with SIGKILL mid-run, strikes.csv holds whole lines only", "[osc][verbs]")
+{
+    const fs::path dir = scratch("run-kill");
+    osctest::Peer sink;
+    Daemon d({"run", "--duration", "600", "--port", "0", "--pose-rate", "0", "--target",
+              "osc.udp://127.0.0.1:" + std::to_string(sink.port()), "--out", dir.string()});
+    // Killed once the file holds the header and three rows (a deadline, not a sleep).
+    const fs::path csv = dir / "strikes.csv";
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    size_t newlines = 0;
+    while (newlines < 4 && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        const std::string text = fs::exists(csv) ? slurp(csv.string()) : "";
+        newlines = static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
+    }
+    kill(d.pid(), SIGKILL);
+    CHECK(d.wait() == -SIGKILL);
+    REQUIRE(newlines >= 4);
+    size_t rows = 0;
+    check_whole_lines(slurp(csv.string()), rows);
+    CHECK(rows >= 3);
+    fs::remove_all(dir);
+}
+
+// render --out DIR into a used folder kept an earlier render's files beside
+// the new ones (a score's notes.csv beside a clip's strikes). Now a used
+// folder is refused (exit 1, as other file errors), and --force removes
+// render's own files there, never another.
+TEST_CASE("render: --out refuses a used folder, --force replaces render's own files only",
+          "[osc][verbs]")
+{
+    const fs::path dir = scratch("render-out");
+    const std::string score = four_notes(dir).string();
+    const fs::path out = dir / "out";
+    REQUIRE(osctest::run({ICTUSD_OSC_PATH, "render", "--score", score, "--bvh-rate", "10", "--out",
+                          out.string()}) == 0);
+    for (const char *f :
+         {"strikes.csv", "events.txt", "render.json", "tips.csv", "notes.csv", "performance.bvh"})
+        REQUIRE(fs::exists(out / f));
+    std::ofstream(out / "mine.txt") << "kept\n";
+    std::ofstream(dir / "elsewhere.csv") << "the target of a link, kept\n";
+    fs::remove(out / "notes.csv");
+    fs::create_symlink(dir / "elsewhere.csv", out / "notes.csv");
+    const std::string strikes_before = slurp((out / "strikes.csv").string());
+
+    Daemon refused({"render", "--score", score, "--bvh-rate", "0", "--tips-rate", "50", "--out",
+                    out.string()});
+    CHECK(refused.wait() == 1);
+    INFO(refused.err);
+    CHECK(refused.err.find("'" + out.string() + "' is not empty") != std::string::npos);
+    CHECK(refused.err.find("--force") != std::string::npos);
+    CHECK(slurp((out / "strikes.csv").string()) == strikes_before); // nothing touched
+    CHECK(fs::exists(out / "performance.bvh"));
+
+    Daemon forced({"render", "--score", score, "--bvh-rate", "0", "--tips-rate", "50", "--out",
+                   out.string(), "--force"});
+    CHECK(forced.wait() == 0);
+    CHECK_FALSE(fs::exists(out / "performance.bvh")); // the earlier render's, not this one's
+    CHECK(slurp((out / "mine.txt").string()) == "kept\n");
+    CHECK(slurp((dir / "elsewhere.csv").string()) == "the target of a link, kept\n");
+    CHECK_FALSE(fs::is_symlink(out / "notes.csv"));
+    CHECK(lines(slurp((out / "notes.csv").string())).size() == 5); // header and four notes
+    size_t rows = 0;
+    check_whole_lines(slurp((out / "strikes.csv").string()), rows);
+
+    // An empty folder is as good as a new one.
+    fs::create_directories(dir / "empty");
+    CHECK(osctest::run({ICTUSD_OSC_PATH, "render", "--score", score, "--bvh-rate", "0", "--out",
+                        (dir / "empty").string()}) == 0);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("render: a write error names the file and the system's reason, exit 1", "[osc][verbs]")
+{
+    const fs::path dir = scratch("render-full");
+    const std::string score = four_notes(dir).string();
+    Daemon d({"render", "--score", score, "--bvh-rate", "0", "--out", (dir / "out").string()}, 300);
+    CHECK(d.wait() == 1);
+    INFO(d.err);
+    CHECK(d.err.find("/out/strikes.csv': " + std::string(std::strerror(EFBIG))) !=
+          std::string::npos);
+    fs::remove_all(dir);
 }

@@ -1,9 +1,14 @@
 // The character model: mapping, anthropometry (de Leva 1996), sticks and grips.
 #include "ictus/character/anthropometry.hpp"
 #include "ictus/character/character.hpp"
+#include "ictus/control/joint_controller.hpp"
+#include "ictus/sim/scene.hpp"
 #include "sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <random>
 
 using namespace ictus;
 
@@ -137,4 +142,134 @@ TEST_CASE("reference motion: composed rotations, slerp in time, ping-pong past t
     CHECK(Eigen::AngleAxisd(p.local[clav]).angle() * 180 / M_PI == Approx(1.5));
     ref.sample(0.5, p); // 0.1 s past the end: back at frame 3, 30 degrees
     CHECK(Eigen::AngleAxisd(p.local[elbow]).angle() * 180 / M_PI == Approx(30.0));
+}
+
+namespace
+{
+
+// Every body as ODE gets it (the hands with their sticks): mass > 0 and a
+// positive-definite inertia, what dMassCheck asserts before aborting.
+void require_physical_bodies(const CharacterModel &m)
+{
+    for (int b = 0; b < CharacterModel::kBodies; ++b) {
+        double mass;
+        Eigen::Vector3d com;
+        Eigen::Matrix3d inertia;
+        m.merged_mass(b, mass, com, inertia);
+        INFO("body " << m.bodies()[b].name);
+        CHECK(mass > 0.0);
+        const Eigen::Vector3d moments =
+            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia).eigenvalues();
+        CHECK(moments.minCoeff() > 1e-9);
+    }
+}
+
+} // namespace
+
+// A BVH with a zero OFFSET on a limb's joint built a forearm of length 0,
+// inertia 0: ODE's dMassCheck aborted the process (SIGABRT) in track, render
+// and run. Now the builder refuses it, naming the joint and its OFFSET's line.
+TEST_CASE("a limb of zero length is refused at its OFFSET, naming the joint", "[sim][character]")
+{
+    const struct {
+        const char *joint; // whose OFFSET ends the limb
+        const char *body;
+    } limbs[] = {{"LeftForeArm", "l_upper_arm"},  {"LeftHand", "l_forearm"},
+                 {"LeftLeg", "l_thigh"},          {"LeftFoot", "l_shank"},
+                 {"RightForeArm", "r_upper_arm"}, {"RightHand", "r_forearm"},
+                 {"RightLeg", "r_thigh"},         {"RightFoot", "r_shank"}};
+    for (const auto &limb : limbs) {
+        INFO(limb.joint);
+        Skeleton skel = simtest::cmu_like_skeleton();
+        const int j = skel.find(limb.joint);
+        skel.joints[j].offset_m.setZero();
+        CHECK_THROWS_WITH(CharacterModel::from_skeleton(skel),
+                          Catch::StartsWith(std::string("skeleton: joint '") + limb.joint +
+                                            "': expected the " + limb.body +
+                                            " segment to be 0.05 to 1 m (a human limb), got 0 m"));
+        // Read from a file: the file and the line of the OFFSET lead.
+        skel.source = "clip.bvh";
+        skel.joints[j].offset_line = 42;
+        CHECK_THROWS_WITH(CharacterModel::from_skeleton(skel),
+                          Catch::StartsWith(std::string("clip.bvh:42: joint '") + limb.joint));
+    }
+    // Too long: a segment of more than 1 m, the joint with the longest OFFSET named.
+    Skeleton skel = simtest::cmu_like_skeleton();
+    skel.joints[skel.find("Head_end")].offset_m *= 20.0; // 1.9 m of head
+    CHECK_THROWS_WITH(CharacterModel::from_skeleton(skel),
+                      Catch::StartsWith("skeleton: joint 'Head_end': expected the head segment to "
+                                        "be at most 1 m (a human body), got 1.9"));
+    skel = simtest::cmu_like_skeleton();
+    skel.joints[skel.find("LHipJoint")].offset_m = Eigen::Vector3d(0, -1.5, 0);
+    CHECK_THROWS_WITH(CharacterModel::from_skeleton(skel),
+                      Catch::Contains("joint 'LHipJoint': expected the l_hip joint's distance "
+                                      "from its parent to be at most 1 m"));
+    // Not a number: refused, not built.
+    skel = simtest::cmu_like_skeleton();
+    skel.joints[skel.find("LeftShoulder")].offset_m.x() = std::nan("");
+    CHECK_THROWS_AS(CharacterModel::from_skeleton(skel), CharacterError);
+}
+
+// Zero-length segments that carry no body of their own, or whose inertia
+// comes from de Leva's lengths, are legal: a zero End Site, zero fingers.
+// Property: zero each joint's OFFSET in turn: either the builder refuses it
+// naming that joint (the eight limbs), or every body is physical and the ODE
+// scene builds and steps.
+TEST_CASE("zeroing any one OFFSET either names the joint or builds a physical body",
+          "[sim][character]")
+{
+    const Skeleton good = simtest::cmu_like_skeleton();
+    int refused = 0;
+    for (std::size_t j = 1; j < good.joints.size(); ++j) {
+        Skeleton skel = good;
+        skel.joints[j].offset_m.setZero();
+        INFO("zero OFFSET on " << skel.joints[j].name);
+        try {
+            const CharacterModel m = CharacterModel::from_skeleton(skel);
+            require_physical_bodies(m);
+            CharacterPose pose = m.rest_pose();
+            pose.pelvis_position_m = Eigen::Vector3d(0, 1.0, 0);
+            Scene scene(m, SceneOptions{}, pose, default_gains(m, pose));
+            scene.set_joint_targets(
+                pose.local,
+                std::vector<Eigen::Vector3d>(CharacterModel::kJoints, Eigen::Vector3d::Zero()));
+            CHECK(scene.step() == StepResult::ok);
+        } catch (const CharacterError &e) {
+            ++refused;
+            CHECK_THAT(e.what(), Catch::StartsWith("skeleton: joint '" + skel.joints[j].name +
+                                                   "': expected the"));
+            CHECK_THAT(e.what(), Catch::Contains("a human limb"));
+        }
+    }
+    CHECK(refused == 8); // the eight limbs, nothing else
+}
+
+// Property: the hand-made skeleton at a random scale is built exactly when its
+// shortest limb (forearm, 3.6 units) is >= 0.05 m and its longest segment
+// (shank, |(2.6, -7, 0)| units) <= 1 m; every body built is physical.
+TEST_CASE("a skeleton at any scale is built exactly within the bounds of a human body",
+          "[sim][character]")
+{
+    const double shortest_limb = 3.6, longest = Eigen::Vector3d(2.6, -7.0, 0).norm();
+    std::mt19937 rng(4242);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int trial = 0; trial < 200; ++trial) {
+        const double scale = 1e-3 * std::pow(1e3, unit(rng));
+        const bool human =
+            scale * shortest_limb >= kMinLimbLength_m && scale * longest <= kMaxSegmentLength_m;
+        INFO("scale " << scale);
+        if (std::fabs(scale * shortest_limb - kMinLimbLength_m) < 1e-9 ||
+            std::fabs(scale * longest - kMaxSegmentLength_m) < 1e-9)
+            continue; // on an edge: either answer is rounding
+        if (human) {
+            const CharacterModel m =
+                CharacterModel::from_skeleton(simtest::cmu_like_skeleton(scale));
+            require_physical_bodies(m);
+        } else {
+            CHECK_THROWS_WITH(CharacterModel::from_skeleton(simtest::cmu_like_skeleton(scale)),
+                              Catch::Contains(scale * shortest_limb < kMinLimbLength_m
+                                                  ? "a human limb"
+                                                  : "check the scale, --scale"));
+        }
+    }
 }

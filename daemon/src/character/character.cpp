@@ -3,6 +3,7 @@
 #include "ictus/character/anthropometry.hpp"
 #include "ictus/base/rotation.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -98,6 +99,22 @@ bool finite_positive(double v)
     return std::isfinite(v) && v > 0.0;
 }
 
+// The four limbs: their inertia scales with their captured length.
+bool is_limb(DeLevaSegment segment)
+{
+    return segment == DeLevaSegment::upper_arm || segment == DeLevaSegment::forearm ||
+           segment == DeLevaSegment::thigh || segment == DeLevaSegment::shank;
+}
+
+// Where a joint's OFFSET was read ("FILE:LINE", "FILE", or "skeleton").
+std::string offset_place(const Skeleton &skeleton, int joint)
+{
+    if (skeleton.source.empty())
+        return "skeleton";
+    const int line = skeleton.joints[joint].offset_line;
+    return line > 0 ? skeleton.source + ":" + std::to_string(line) : skeleton.source;
+}
+
 std::string fmt(double v)
 {
     std::ostringstream s;
@@ -173,6 +190,74 @@ Eigen::Matrix3d parallel_axis(double mass_kg, const Eigen::Vector3d &d)
     return mass_kg * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
 }
 
+// One stretch of the skeleton a body is built from (the mocap joints of
+// `path`, their OFFSETs summed) against the bounds of a human body: at most
+// kMaxSegmentLength_m, and for a limb at least kMinLimbLength_m. The error
+// names the joint whose OFFSET is at fault and its line in the file: the
+// longest OFFSET of a stretch too long, the last one of a stretch too short.
+// `what`: "the l_forearm segment to be", "the l_hip joint's distance ... to be".
+void check_segment(const Skeleton &skeleton, const std::vector<int> &path, bool limb,
+                   const std::string &what)
+{
+    if (path.empty())
+        return; // no stretch between a joint and itself
+    const double length = rest_offset(skeleton, path).norm();
+    const bool too_short = limb && !(length >= kMinLimbLength_m);
+    const bool too_long = !(length <= kMaxSegmentLength_m);
+    if (!too_short && !too_long)
+        return;
+    int joint = path.back();
+    if (too_long && !too_short)
+        for (int j : path)
+            if (skeleton.joints[j].offset_m.norm() > skeleton.joints[joint].offset_m.norm())
+                joint = j;
+    const std::string bounds =
+        limb ? fmt(kMinLimbLength_m) + " to " + fmt(kMaxSegmentLength_m) + " m (a human limb)"
+             : "at most " + fmt(kMaxSegmentLength_m) + " m (a human body)";
+    const std::string summed = path.size() > 1
+                                   ? ", the OFFSETs of " + skeleton.joints[path.front()].name +
+                                         " .. " + skeleton.joints[path.back()].name + " summed"
+                                   : "";
+    throw CharacterError(offset_place(skeleton, joint) + ": joint '" + skeleton.joints[joint].name +
+                         "': expected " + what + " " + bounds + ", got " + fmt(length) +
+                         " m (its OFFSET" + summed + "; check the scale, --scale)");
+}
+
+void check_segment_lengths(const Skeleton &skeleton, const std::vector<int> &source,
+                           const std::vector<int> &distal)
+{
+    for (int b = 0; b < CharacterModel::kBodies; ++b) {
+        const MapRow &row = kMap[b];
+        check_segment(skeleton, path_between(skeleton, source[b], distal[b]), is_limb(row.segment),
+                      std::string("the ") + row.body + " segment to be");
+        if (row.parent >= 0)
+            check_segment(skeleton, path_between(skeleton, source[row.parent], source[b]), false,
+                          std::string("the ") + row.joint +
+                              " joint's distance from its parent to be");
+    }
+}
+
+// ODE refuses (dMassCheck: it aborts the process) a body whose mass is not
+// positive or whose inertia is not positive definite. The length bounds keep
+// a skeleton from building one; this is the guard for anything else.
+void check_mass(const std::string &body, double mass_kg, const Eigen::Vector3d &com_m,
+                const Eigen::Matrix3d &inertia_kg_m2)
+{
+    if (!finite_positive(mass_kg) || !com_m.allFinite() || !inertia_kg_m2.allFinite())
+        throw CharacterError("body '" + body + "': expected a finite mass > 0 and a finite " +
+                             "centre of mass and inertia, got mass " + fmt(mass_kg) + " kg");
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(inertia_kg_m2,
+                                                                Eigen::EigenvaluesOnly);
+    const Eigen::Vector3d moments = solver.eigenvalues(); // ascending
+    const double asymmetry = (inertia_kg_m2 - inertia_kg_m2.transpose()).cwiseAbs().maxCoeff();
+    if (!(moments[0] > 1e-12 * moments[2]) || !(moments[0] > 0.0) || asymmetry > 1e-9 * moments[2])
+        throw CharacterError("body '" + body +
+                             "': expected a symmetric, positive-definite inertia, got principal "
+                             "moments " +
+                             fmt(moments[0]) + ", " + fmt(moments[1]) + ", " + fmt(moments[2]) +
+                             " kg m^2 (a degenerate segment)");
+}
+
 } // namespace
 
 CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
@@ -206,6 +291,7 @@ CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
         source[b] = find_joint(skeleton, kMap[b].source);
         distal[b] = find_joint(skeleton, kMap[b].distal);
     }
+    check_segment_lengths(skeleton, source, distal);
 
     // Inertia lengths: limbs use their mocap lengths; segments whose mocap
     // length does not span the anatomical segment (trunk, head, hand, foot)
@@ -312,6 +398,13 @@ CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
         st.inertia_kg_m2 =
             s.mass_kg * s.length_m * s.length_m / 12.0 * (Eigen::Matrix3d::Identity() - aa) +
             0.5 * s.mass_kg * s.shaft_radius_m * s.shaft_radius_m * aa;
+    }
+    for (int b = 0; b < kBodies; ++b) {
+        double mass_kg;
+        Eigen::Vector3d com_m;
+        Eigen::Matrix3d inertia_kg_m2;
+        model.merged_mass(b, mass_kg, com_m, inertia_kg_m2);
+        check_mass(model.bodies_[b].name, mass_kg, com_m, inertia_kg_m2);
     }
     return model;
 }

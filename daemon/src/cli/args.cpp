@@ -4,10 +4,13 @@
 #include "ictus/net/osc_sender.hpp" // OscError: a bad --target/--bind is a usage error
 
 #include <cerrno>
+#include <csignal>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <sstream>
+
+#include <unistd.h>
 
 namespace ictus
 {
@@ -18,8 +21,17 @@ volatile std::sig_atomic_t g_interrupted = 0;
 
 namespace
 {
+// The first SIGINT / SIGTERM asks the verb to stop cleanly at its next step
+// (files closed, summary printed); a second one, if it has not stopped yet,
+// ends the process at once, whatever it is doing (async-signal-safe calls only).
 void on_interrupt(int)
 {
+    if (g_interrupted) {
+        static const char msg[] = "ictusd: interrupted again: exiting now\n";
+        const ssize_t ignored = write(2, msg, sizeof msg - 1);
+        (void)ignored;
+        _exit(130);
+    }
     g_interrupted = 1;
 }
 } // namespace

@@ -3,6 +3,7 @@
 // run and render, the grip and the mode; and the output files of a verb.
 #include "ictus/cli/options.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -88,6 +89,8 @@ bool parse_clip_option(const std::string &a, Args &args, ClipOptions &clip)
         clip.filter.spike_threshold_rad = parse_number(a, args.value(a)) * M_PI / 180.0;
         if (clip.filter.spike_threshold_rad < 0.0)
             throw UsageError("--despike-deg: expected a number >= 0 (0: off)");
+    } else if (a == "--force") {
+        clip.force = true;
     } else {
         return false;
     }
@@ -102,16 +105,59 @@ double parse_min_half_width_deg(const std::string &option, const std::string &te
     return w;
 }
 
-BvhFile load_bvh(const std::string &path, double scale, int skip)
+std::string force_help(std::size_t column)
+{
+    const std::string pad(column, ' ');
+    std::string name = "  --force";
+    name.resize(std::max(column, name.size() + 1), ' ');
+    return name + "read a capture out of the physical bounds (docs/mocap.md)\n" + pad +
+           "with a warning, not an error: a frame time or median\n" + pad +
+           "time step outside 0.0005..0.5 s (2 kHz..2 Hz; a time\n" + pad +
+           "column in ms?), a take longer than 3 h, a coordinate\n" + pad +
+           "beyond 100 m (after --scale or --units)\n";
+}
+
+namespace
+{
+// A reader's out-of-bounds error, with the way to insist.
+MocapBoundError with_force_hint(const MocapBoundError &e)
+{
+    return MocapBoundError(e.file(), e.line(), e.message() + " (--force reads it anyway)");
+}
+
+void print_warnings(const MocapWarnings &warnings)
+{
+    for (const std::string &w : warnings)
+        std::cerr << "ictusd: warning: " << w << "\n";
+}
+} // namespace
+
+BvhFile load_bvh(const std::string &path, double scale, int skip, bool force)
 {
     BvhOptions o;
     o.scale = scale;
     o.skip_frames = skip;
+    o.accept_out_of_bounds = force;
     MocapWarnings warnings;
-    BvhFile bvh = read_bvh(path, o, &warnings);
-    for (const std::string &w : warnings)
-        std::cerr << "ictusd: warning: " << w << "\n";
-    return bvh;
+    try {
+        BvhFile bvh = read_bvh(path, o, &warnings);
+        print_warnings(warnings);
+        return bvh;
+    } catch (const MocapBoundError &e) {
+        throw with_force_hint(e);
+    }
+}
+
+MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o)
+{
+    MocapWarnings warnings;
+    try {
+        MarkerCapture capture = read_marker_csv(path, o, &warnings);
+        print_warnings(warnings);
+        return capture;
+    } catch (const MocapBoundError &e) {
+        throw with_force_hint(e);
+    }
 }
 
 // Options shared by run and render. Returns false when `a` is not one of them.

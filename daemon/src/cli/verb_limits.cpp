@@ -30,6 +30,13 @@ void limits_usage(std::ostream &out)
            "                  k std (quaternion; default 3)\n"
            "  --min-deg DEG   minimum half-width per axis (default 6)\n"
            "  --smooth-hz HZ, --despike-deg DEG   reference clean-up as in track\n"
+        << force_help(18)
+        << "                  (limits: also learn from fewer than 30 frames)\n"
+           "\n"
+           "Refused (exit 1): fewer than 30 frames after --skip-frames (a spread per axis\n"
+           "estimated from n frames is off by about 1/sqrt(2(n-1)): 13 % at 30, 50 % at 3;\n"
+           "--force learns anyway, with a warning); a limb shorter than 0.05 m or a segment\n"
+           "longer than 1 m (FILE:LINE: naming the joint; docs/character.md).\n"
            "\n"
            "example:\n"
            "  ictusd limits ../shared/data/cmu/80_13.bvh --out limits.json\n";
@@ -63,7 +70,16 @@ int cmd_limits(Args &args)
     }
     if (file.empty())
         throw UsageError("FILE is required (ictusd limits FILE)");
-    const BvhFile bvh = load_bvh(file, clip.scale, clip.skip);
+    const BvhFile bvh = load_bvh(file, clip.scale, clip.skip, clip.force);
+    if (bvh.motion.frames() < kMinLimitFrames) {
+        const std::string what = file + ": " + std::to_string(bvh.motion.frames()) +
+                                 " frame(s) after --skip-frames " + std::to_string(clip.skip) +
+                                 ", fewer than the " + std::to_string(kMinLimitFrames) +
+                                 " that limits are learned from (their spreads would be noise)";
+        if (!clip.force)
+            throw std::runtime_error(what + " (--force learns from them anyway)");
+        std::cerr << "ictusd: warning: " << what << "; learning anyway (--force)\n";
+    }
     const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton);
     const ReferenceMotion reference(model, bvh.motion, clip.filter);
     const CharacterLimits limits(model, reference, lo);

@@ -3,19 +3,25 @@
 // batch render, render.json, and in score mode tips.csv, notes.csv; the
 // performance as BVH. Also the options run and render share (verbs.hpp).
 // Nothing is written while the physics runs: every output is kept in memory
-// and written at the end. docs/osc.md, docs/perform.md.
+// and written at the end, each write checked. --out is a new or empty folder
+// (--force: render's own files in a used one are replaced). docs/osc.md,
+// docs/perform.md.
 #include "ictus/character/bvh_export.hpp"
 #include "ictus/cli/verbs.hpp"
 #include "ictus/perform/strike_log.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -40,6 +46,11 @@ void render_usage(std::ostream &out)
            "simulated tips) and DIR/notes.csv (each note and its strike) are written too\n"
            "(docs/perform.md).\n"
            "\n"
+           "  --out DIR           a new or empty folder (a used one is refused, exit 1, so\n"
+           "                      that no earlier render's file passes for this one's)\n"
+           "  --force             write into a used folder: render's own files there\n"
+           "                      (strikes.csv, events.txt, render.json, tips.csv, notes.csv,\n"
+           "                      performance.bvh) are removed first, no other file\n"
            "  --tips-rate HZ      tips.csv rows per second (default 250; 0: none)\n"
            "  --bvh-rate HZ       performance.bvh frames per second (default 250; 0: none)\n"
            "\n"
@@ -79,6 +90,92 @@ void render_usage(std::ostream &out)
            "  ictusd render --out out/fig5                  (the built-in score)\n"
            "  ictusd render --score my.score --grip german --mode joint --out out/r2\n";
 }
+
+// The files render writes into --out, all it may remove (--force).
+const char *const kRenderOutputs[] = {"strikes.csv", "events.txt", "render.json",
+                                      "tips.csv",    "notes.csv",  "performance.bvh"};
+
+// --out: created, or else empty, so that no file of an earlier render (a
+// score's notes.csv beside a clip's strikes) passes for this one's. With
+// --force a used folder is taken: render's own files in it are removed, no
+// other.
+void prepare_out_dir(const std::string &dir, bool force)
+{
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec)
+        throw std::runtime_error("--out: cannot create '" + dir + "': " + ec.message());
+    std::vector<std::string> found;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+        found.push_back(it->path().filename().string());
+    if (ec)
+        throw std::runtime_error("--out: cannot read '" + dir + "': " + ec.message());
+    if (found.empty())
+        return;
+    if (!force) {
+        std::sort(found.begin(), found.end());
+        std::string shown;
+        for (size_t i = 0; i < found.size() && i < 3; ++i)
+            shown += (i ? ", " : "") + found[i];
+        if (found.size() > 3)
+            shown += ", ...";
+        throw std::runtime_error("--out: '" + dir + "' is not empty (" + shown +
+                                 "): give a new or empty folder, or --force to replace "
+                                 "render's own files in it");
+    }
+    for (const char *name : kRenderOutputs) {
+        fs::remove(fs::path(dir) / name, ec); // a symbolic link itself, never its target
+        if (ec)
+            throw std::runtime_error("--out: cannot remove '" + (fs::path(dir) / name).string() +
+                                     "': " + ec.message());
+    }
+}
+
+// An output of render: opened before the run (an unwritable folder shows at
+// once), written whole at the end. A failed or short write, or a failed
+// close, names the file and the system's reason (ENOSPC, EIO, EFBIG): exit 1.
+class RenderOutput
+{
+  public:
+    explicit RenderOutput(const std::string &path) : path_(path)
+    {
+        fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd_ < 0)
+            fail(errno);
+    }
+    ~RenderOutput()
+    {
+        if (fd_ >= 0)
+            ::close(fd_);
+    }
+    RenderOutput(const RenderOutput &) = delete;
+    RenderOutput &operator=(const RenderOutput &) = delete;
+    // The whole content, then the file is closed.
+    void write_and_close(const std::string &content)
+    {
+        std::size_t done = 0;
+        while (done < content.size()) {
+            const ssize_t n = ::write(fd_, content.data() + done, content.size() - done);
+            if (n > 0)
+                done += static_cast<std::size_t>(n);
+            else if (!(n < 0 && errno == EINTR))
+                fail(n < 0 ? errno : EIO);
+        }
+        const int fd = fd_;
+        fd_ = -1;
+        if (::close(fd) != 0)
+            fail(errno);
+    }
+
+  private:
+    [[noreturn]] void fail(int error) const
+    {
+        throw std::runtime_error("--out: cannot write '" + path_ + "': " + std::strerror(error));
+    }
+    std::string path_;
+    int fd_ = -1;
+};
 
 // tips.csv: the stick-tip targets X^T and the simulated tips, both hands.
 void write_tips_header(std::ostream &out)
@@ -212,6 +309,7 @@ int cmd_render(Args &args)
     PerformanceOptions o;
     double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0;
     std::string out_dir;
+    bool force = false;
     while (!args.done()) {
         const std::string a = args.next();
         if (a == "--help" || a == "-h") {
@@ -219,6 +317,8 @@ int cmd_render(Args &args)
             return 0;
         } else if (a == "--out") {
             out_dir = args.value(a);
+        } else if (a == "--force") {
+            force = true;
         } else if (a == "--bvh-rate") {
             bvh_rate = parse_number(a, args.value(a), 0, 1000);
         } else if (a == "--tips-rate") {
@@ -232,10 +332,7 @@ int cmd_render(Args &args)
         throw UsageError("--score and --mocap are two motion sources: give one");
     if (out_dir.empty())
         throw UsageError("--out DIR is required");
-    std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
-    if (ec)
-        throw std::runtime_error("--out: cannot create '" + out_dir + "': " + ec.message());
+    prepare_out_dir(out_dir, force);
 
     Performance perf(o);
     if (score_mode)
@@ -244,12 +341,12 @@ int cmd_render(Args &args)
         duration = perf.clip_duration_s();
     // Every output is opened now (an unwritable folder is found before the
     // run), kept in memory while the physics runs and written at the end.
-    OutputFile strikes_csv(out_dir + "/strikes.csv"), events_txt(out_dir + "/events.txt"),
+    RenderOutput strikes_csv(out_dir + "/strikes.csv"), events_txt(out_dir + "/events.txt"),
         render_json(out_dir + "/render.json");
-    std::unique_ptr<OutputFile> tips_csv, notes_csv;
+    std::unique_ptr<RenderOutput> tips_csv, notes_csv;
     if (score_mode) {
-        tips_csv = std::make_unique<OutputFile>(out_dir + "/tips.csv");
-        notes_csv = std::make_unique<OutputFile>(out_dir + "/notes.csv");
+        tips_csv = std::make_unique<RenderOutput>(out_dir + "/tips.csv");
+        notes_csv = std::make_unique<RenderOutput>(out_dir + "/notes.csv");
     }
     std::ostringstream tips; // about 100 bytes a row
     if (score_mode)
@@ -294,10 +391,12 @@ int cmd_render(Args &args)
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
     const long strikes = static_cast<long>(log.strikes().size()), bounces = log.bounces();
-    log.write_csv(strikes_csv.stream());
-    strikes_csv.close();
-    log.write_events(events_txt.stream());
-    events_txt.close();
+    std::ostringstream text;
+    log.write_csv(text);
+    strikes_csv.write_and_close(text.str());
+    text.str("");
+    log.write_events(text);
+    events_txt.write_and_close(text.str());
     if (bvh)
         bvh->write(out_dir + "/performance.bvh");
     nlohmann::json j;
@@ -318,14 +417,13 @@ int cmd_render(Args &args)
     if (score_mode) {
         const GesturePlan &plan = *perf.plan();
         const MatchSummary m = match_strikes(plan.notes, log.strikes(), perf.plan_origin_s());
-        write_notes_csv(notes_csv->stream(), plan, m, perf.plan_origin_s());
-        notes_csv->close();
-        tips_csv->stream() << tips.str();
-        tips_csv->close();
+        text.str("");
+        write_notes_csv(text, plan, m, perf.plan_origin_s());
+        notes_csv->write_and_close(text.str());
+        tips_csv->write_and_close(tips.str());
         j["performance"] = performance_json(o, perf, m);
     }
-    render_json.stream() << j.dump(2) << "\n";
-    render_json.close();
+    render_json.write_and_close(j.dump(2) + "\n");
     std::cout << "render: " << perf.time_s() << " s simulated in " << wall << " s ("
               << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes << " strikes ("
               << bounces << " bounces), wrote " << out_dir

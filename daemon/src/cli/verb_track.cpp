@@ -79,6 +79,12 @@ void track_usage(std::ostream &out)
            "  --despike-deg DEG      replace one-frame spikes larger than DEG (default 5;\n"
            "                         0: off)\n"
            "  --quiet                no progress output\n"
+        << force_help(25)
+        << "\n"
+           "Refused (exit 1, FILE:LINE: naming the joint): a limb (upper arm, forearm, thigh,\n"
+           "shank) shorter than 0.05 m or any segment longer than 1 m after --scale: no human\n"
+           "body has one (docs/character.md). Joint limits learned from fewer than 30 frames\n"
+           "are noise: a warning (use --limits none).\n"
            "\n"
            "examples:\n"
            "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n"
@@ -221,6 +227,7 @@ TrackArgs parse_track_args(Args &args)
         throw UsageError("--mode is required (--mode joint or --mode cartesian)");
     if (t.mocap.empty())
         throw UsageError("--mocap FILE is required");
+    t.sticks.csv.accept_out_of_bounds = t.clip.force;
     t.options.drum_auto = !t.drum_pos_given;
     // Option values that only the model can judge (e.g. a too-long step) are
     // usage errors too: check them before reading the file.
@@ -266,10 +273,7 @@ void load_track_input(TrackArgs &t, TrackInput &in)
     MarkerCapture capture;
     std::array<int, 2> stick_tracks = {-1, -1};
     if (t.stick_only) {
-        MocapWarnings warnings;
-        capture = read_marker_csv(t.mocap, t.sticks.csv, &warnings);
-        for (const std::string &w : warnings)
-            std::cerr << "ictusd: warning: " << w << "\n";
+        capture = load_marker_csv(t.mocap, t.sticks.csv);
         try {
             stick_tracks = find_stick_tracks(capture, t.sticks.left_stick, t.sticks.right_stick);
         } catch (const CharacterError &e) {
@@ -284,7 +288,7 @@ void load_track_input(TrackArgs &t, TrackInput &in)
                                                       Eigen::Quaterniond::Identity());
         }
     } else {
-        in.bvh = load_bvh(t.mocap, t.clip.scale, t.clip.skip);
+        in.bvh = load_bvh(t.mocap, t.clip.scale, t.clip.skip, t.clip.force);
     }
     in.model = std::make_unique<CharacterModel>(
         CharacterModel::from_skeleton(in.bvh.skeleton, t.character));
@@ -296,6 +300,10 @@ void load_track_input(TrackArgs &t, TrackInput &in)
         in.tips = place_behind_sticks(model, in.reference->frame(0), capture, stick_tracks);
         t.options.tip_reference = &in.tips;
     }
+    if (t.limits_mode != "none" && in.reference->frames() < kMinLimitFrames)
+        std::cerr << "ictusd: warning: " << t.mocap << ": joint limits learned from "
+                  << in.reference->frames() << " frame(s), fewer than " << kMinLimitFrames
+                  << ": their spreads are noise (--limits none to run without them)\n";
     CharacterLimitOptions lim;
     lim.kind = limit_kind_from_string(t.limits_mode);
     lim.k = t.limit_k;

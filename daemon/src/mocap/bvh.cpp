@@ -4,10 +4,13 @@
 // motion section line by line, so a wrong value count is reported on its line.
 #include "ictus/mocap/bvh.hpp"
 
+#include "ictus/mocap/capture_bounds.hpp"
 #include "text_lines.hpp"
 
 #include <cmath>
 #include <fstream>
+#include <set>
+#include <sstream>
 #include <string>
 
 namespace ictus
@@ -20,7 +23,9 @@ using detail::quote;
 
 constexpr std::size_t kMaxFileBytes = std::size_t{512} << 20; // 512 MiB
 constexpr int kMaxJoints = 10000;
-constexpr int kMaxDepth = 500;          // nesting; guards the recursion
+constexpr int kMaxDepth = 500; // nesting; guards the recursion
+// What the format can hold at all; the physical bounds of a capture are
+// narrower (capture_bounds.hpp) and may be accepted with a warning.
 constexpr double kMinFrameTimeS = 1e-5; // 100 kHz
 constexpr double kMaxFrameTimeS = 60.0;
 // Larger values are absurd for lengths or angles and could overflow in sums.
@@ -112,6 +117,13 @@ class Cursor
     int token_line_ = 0;
 };
 
+std::string number_text(double value)
+{
+    std::ostringstream text;
+    text << value;
+    return text.str();
+}
+
 bool channel_from_name(const std::string &name, BvhChannel &channel)
 {
     static const struct {
@@ -163,6 +175,7 @@ class BvhParser
             throw MocapError(source_, 0,
                              "expected BvhOptions::scale finite and > 0, got " +
                                  std::to_string(options_.scale));
+        bvh_.skeleton.source = source_;
         cursor_.expect("HIERARCHY");
         cursor_.expect("ROOT");
         parse_joint(-1, 0);
@@ -174,6 +187,13 @@ class BvhParser
                              "expected at least one channel in the hierarchy, got none");
         const long declared = parse_frames();
         parse_frame_time();
+        const double duration_s = static_cast<double>(declared - 1) * bvh_.frame_time_s;
+        if (duration_s > kMaxCaptureDuration_s)
+            out_of_bounds(frames_line_, "duration",
+                          "expected a capture of at most " + number_text(kMaxCaptureDuration_s) +
+                              " s (3 h), got Frames: " + std::to_string(declared) +
+                              " at Frame Time " + number_text(bvh_.frame_time_s) +
+                              " s = " + number_text(duration_s) + " s");
         parse_motion(declared);
         return std::move(bvh_);
     }
@@ -199,7 +219,7 @@ class BvhParser
         SkeletonJoint joint;
         joint.name = name;
         joint.parent = parent;
-        joint.offset_m = parse_offset() * options_.scale;
+        joint.offset_m = parse_offset(name, joint.offset_line);
         const int index = static_cast<int>(bvh_.skeleton.joints.size());
         bvh_.skeleton.joints.push_back(joint);
         bvh_.channels.emplace_back();
@@ -223,12 +243,22 @@ class BvhParser
         }
     }
 
-    Eigen::Vector3d parse_offset()
+    // OFFSET x y z of joint `name`, scaled to metres; `line` gets its line.
+    Eigen::Vector3d parse_offset(const std::string &name, int &line)
     {
         cursor_.expect("OFFSET");
+        line = cursor_.token_line();
         Eigen::Vector3d offset;
-        for (int k = 0; k < 3; ++k)
-            offset[k] = cursor_.number("an OFFSET coordinate");
+        for (int k = 0; k < 3; ++k) {
+            offset[k] = cursor_.number("an OFFSET coordinate") * options_.scale;
+            if (std::fabs(offset[k]) > kMaxCoordinate_m)
+                out_of_bounds(
+                    cursor_.token_line(), "offset",
+                    "expected |OFFSET coordinate| * scale <= " + number_text(kMaxCoordinate_m) +
+                        " m (joint " + name + ", scale " + number_text(options_.scale) + "), got " +
+                        number_text(offset[k] / options_.scale) + " = " + number_text(offset[k]) +
+                        " m");
+        }
         return offset;
     }
 
@@ -265,7 +295,7 @@ class BvhParser
         site.name = bvh_.skeleton.joints[static_cast<std::size_t>(parent)].name + "_End";
         site.parent = parent;
         site.end_site = true;
-        site.offset_m = parse_offset() * options_.scale;
+        site.offset_m = parse_offset(site.name, site.offset_line);
         cursor_.expect("}");
         if (static_cast<int>(bvh_.skeleton.joints.size()) >= kMaxJoints)
             throw MocapError(source_, cursor_.token_line(),
@@ -286,6 +316,7 @@ class BvhParser
             value_token = token.substr(7);
         else
             cursor_.fail("Frames:", token);
+        frames_line_ = cursor_.token_line();
         double frames = 0.0;
         const std::string range = "[1, " + std::to_string(options_.max_frames) + "]";
         if (!detail::parse_double(value_token, frames) || !std::isfinite(frames) ||
@@ -314,6 +345,11 @@ class BvhParser
         if (!detail::parse_double(value_token, frame_time) || !std::isfinite(frame_time) ||
             frame_time < kMinFrameTimeS || frame_time > kMaxFrameTimeS)
             cursor_.fail("a frame time in [1e-05, 60] s", value_token);
+        if (frame_time < kMinSampleInterval_s || frame_time > kMaxSampleInterval_s)
+            out_of_bounds(cursor_.token_line(), "frame time",
+                          "expected a frame time in [" + number_text(kMinSampleInterval_s) + ", " +
+                              number_text(kMaxSampleInterval_s) +
+                              "] s (a capture at 2 Hz to 2 kHz), got " + quote(value_token));
         const std::vector<std::string> extra = cursor_.rest_of_line("");
         if (!extra.empty())
             cursor_.fail("end of line after the frame time", extra.front());
@@ -343,6 +379,11 @@ class BvhParser
                              "expected BvhOptions::skip_frames in [0, " +
                                  std::to_string(declared - 1) + "], got " +
                                  std::to_string(options_.skip_frames));
+        // Columns holding a position (compared with kMaxCoordinate_m).
+        std::vector<bool> position_column;
+        for (const auto &list : bvh_.channels)
+            for (BvhChannel channel : list)
+                position_column.push_back(is_position(channel));
         std::vector<double> values(channel_count);
         long read = 0;
         long extra_lines = 0;
@@ -370,6 +411,13 @@ class BvhParser
                                      "expected a finite number (|x| <= 1e9) in column " +
                                          std::to_string(c) + " (" + channel_label(c) + "), got " +
                                          quote(tokens[c]));
+                if (position_column[c] && std::fabs(values[c] * options_.scale) > kMaxCoordinate_m)
+                    out_of_bounds(line_number, "position",
+                                  "expected |position| * scale <= " +
+                                      number_text(kMaxCoordinate_m) + " m in column " +
+                                      std::to_string(c) + " (" + channel_label(c) + ", scale " +
+                                      number_text(options_.scale) + "), got " + quote(tokens[c]) +
+                                      " = " + number_text(values[c] * options_.scale) + " m");
             }
             if (read >= options_.skip_frames)
                 add_frame(values, joint_count);
@@ -389,6 +437,18 @@ class BvhParser
             warnings_->push_back(source_ + ": non-root joints have position channels; "
                                            "forward_kinematics(Skeleton, Motion) ignores them, use "
                                            "bvh_forward_kinematics");
+    }
+
+    // A value out of the physical bounds of a capture (capture_bounds.hpp):
+    // refused, or read with a warning (the first of each kind) when accepted.
+    void out_of_bounds(int line, const std::string &kind, const std::string &message)
+    {
+        if (!options_.accept_out_of_bounds)
+            throw MocapBoundError(source_, line, message);
+        if (warnings_ && warned_.insert(kind).second)
+            warnings_->push_back(std::string(MocapError(source_, line, message).what()) +
+                                 " (read anyway: out of bounds accepted; later values of this "
+                                 "kind are not reported)");
     }
 
     std::string channel_label(std::size_t column) const
@@ -442,6 +502,8 @@ class BvhParser
     BvhFile bvh_;
     bool has_joint_translation_ = false;
     int frame_time_line_ = 0;
+    int frames_line_ = 0;
+    std::set<std::string> warned_; // kinds of out-of-bounds values warned about
 };
 
 } // namespace

@@ -1,13 +1,17 @@
 // marker_csv.cpp -- CSV of tracked objects -> MarkerCapture (y up, metres).
 #include "ictus/mocap/marker_csv.hpp"
 
+#include "ictus/mocap/capture_bounds.hpp"
 #include "text_lines.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
+#include <sstream>
 #include <string>
 
 namespace ictus
@@ -56,6 +60,13 @@ std::string lower(std::string text)
     return text;
 }
 
+std::string number_text(double value)
+{
+    std::ostringstream text;
+    text << value;
+    return text.str();
+}
+
 bool is_comment_or_blank(const std::string &line)
 {
     const std::string text = detail::trim(line);
@@ -93,6 +104,7 @@ class CsvParser
                              "expected at least one data row, got none");
         for (std::size_t k = 0; k < objects_.size(); ++k)
             fill_gaps(k);
+        check_time_bounds();
         convert_axes_and_units();
         return std::move(capture_);
     }
@@ -244,6 +256,13 @@ class CsvParser
                 const auto column = static_cast<std::size_t>(object.index[c]);
                 v[c] = cell_value(cells[column], line, column);
                 gap = gap || std::isnan(v[c]);
+                if (c < 3 && std::fabs(v[c]) * unit_m() > kMaxCoordinate_m)
+                    out_of_bounds(line, "coordinate",
+                                  "expected |coordinate| <= " + number_text(kMaxCoordinate_m) +
+                                      " m (" + number_text(kMaxCoordinate_m / unit_m()) + " " +
+                                      unit_name() + ") in column " + std::to_string(column + 1) +
+                                      " (" + object.name + "." + kComponents[c] + "), got " +
+                                      quote(cells[column]) + " " + unit_name());
             }
             missing_[k].push_back(gap);
             const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -315,9 +334,76 @@ class CsvParser
         }
     }
 
+    double unit_m() const { return options_.units == MarkerCsvOptions::Units::mm ? 1e-3 : 1.0; }
+    const char *unit_name() const
+    {
+        return options_.units == MarkerCsvOptions::Units::mm ? "mm" : "m";
+    }
+
+    // A value out of the physical bounds of a capture (capture_bounds.hpp):
+    // refused, or read with a warning (the first of each kind) when accepted.
+    void out_of_bounds(int line, const std::string &kind, const std::string &message)
+    {
+        if (!options_.accept_out_of_bounds)
+            throw MocapBoundError(source_, line, message);
+        if (warnings_ && warned_.insert(kind).second)
+            warnings_->push_back(std::string(MocapError(source_, line, message).what()) +
+                                 " (read anyway: out of bounds accepted; later values of this "
+                                 "kind are not reported)");
+    }
+
+    // The clock: the median step (robust to dropped frames) within the
+    // sampling bounds, the whole capture within kMaxCaptureDuration_s. Errors
+    // point at the first row whose step, or whose time, is out of bounds.
+    void check_time_bounds()
+    {
+        const std::vector<double> &t = capture_.time_s;
+        if (t.size() < 2)
+            return;
+        const std::string clock = time_column_ >= 0
+                                      ? std::string("time column (s)")
+                                      : "frame column / rate_hz " + number_text(options_.rate_hz);
+        std::vector<double> steps(t.size() - 1);
+        for (std::size_t i = 0; i + 1 < t.size(); ++i)
+            steps[i] = t[i + 1] - t[i];
+        std::vector<double> sorted = steps;
+        const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>((sorted.size() - 1) / 2);
+        std::nth_element(sorted.begin(), middle, sorted.end());
+        const double median = *middle;
+        // A step is the difference of two printed times: a relative 1e-6 of
+        // rounding is allowed (at 2 kHz, k/2000 - (k-1)/2000 can be 1 ulp short).
+        const double fastest = kMinSampleInterval_s * (1.0 - 1e-6);
+        const double slowest = kMaxSampleInterval_s * (1.0 + 1e-6);
+        const bool too_slow = median > slowest;
+        if (too_slow || median < fastest) {
+            std::size_t i = 0;
+            while (i + 1 < steps.size() && (too_slow ? steps[i] <= slowest : steps[i] >= fastest))
+                ++i;
+            out_of_bounds(row_lines_[i + 1], "time step",
+                          "expected a median time step in [" + number_text(kMinSampleInterval_s) +
+                              ", " + number_text(kMaxSampleInterval_s) +
+                              "] s (a capture at 2 Hz to 2 kHz) from the " + clock + ", got " +
+                              number_text(median) + " s (this row: " + number_text(steps[i]) +
+                              " s after the previous" +
+                              (too_slow ? "; a time column in ms or us?)"
+                                        : "; a time column in minutes or hours?)"));
+        }
+        const double duration = t.back() - t.front();
+        if (duration > kMaxCaptureDuration_s) {
+            std::size_t i = 1;
+            while (i + 1 < t.size() && t[i] - t.front() <= kMaxCaptureDuration_s)
+                ++i;
+            out_of_bounds(row_lines_[i], "duration",
+                          "expected a capture of at most " + number_text(kMaxCaptureDuration_s) +
+                              " s (3 h) from the " + clock + ", got " + number_text(duration) +
+                              " s (this row is " + number_text(t[i] - t.front()) +
+                              " s after the first)");
+        }
+    }
+
     void convert_axes_and_units()
     {
-        const double scale = options_.units == MarkerCsvOptions::Units::mm ? 1e-3 : 1.0;
+        const double scale = unit_m();
         // z up -> y up: a -90 deg rotation about x maps (x, y, z) to (x, z, -y),
         // a proper rotation, so the frame stays right-handed.
         const bool z_up = options_.up == MarkerCsvOptions::Up::z;
@@ -346,6 +432,7 @@ class CsvParser
     int header_line_ = 0;
     int time_column_ = -1;
     int frame_column_ = -1;
+    std::set<std::string> warned_; // kinds of out-of-bounds values warned about
 };
 
 } // namespace

@@ -1,9 +1,14 @@
 // OSC out: strike bundles and the pose stream (osc_sender.hpp, docs/osc.md).
 #include "ictus/net/osc_sender.hpp"
+#include "ictus/base/realtime.hpp"
 
 #include <lo/lo.h>
-#include <semaphore.h>
 
+#include <netdb.h>
+#include <semaphore.h>
+#include <sys/socket.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -62,6 +67,59 @@ double ntp_diff_seconds(NtpTime a, NtpTime b)
     return static_cast<double>(static_cast<std::int64_t>(a - b)) / 4294967296.0;
 }
 
+// ---- the target ---------------------------------------------------------------
+
+namespace
+{
+// --target must be osc.udp://HOST:PORT (a trailing '/' aside), checked here
+// because liblo takes more and fails later, at every send: a port past 65535
+// wraps (99999 -> 34463), "9000x" is port 9000, an IPv6 host needs an IPv6
+// socket (liblo's sending socket is IPv4), and osc.tcp:// is not what Pd
+// listens on ([netreceive -u -b], docs/pd-osc.md) and would block the sending
+// threads on a stalled peer.
+void check_target_url(const std::string &url)
+{
+    auto refuse = [&](const std::string &why) {
+        return OscError("--target '" + url + "': " + why +
+                        " (expected osc.udp://HOST:PORT, e.g. osc.udp://127.0.0.1:9000)");
+    };
+    const std::string udp = "osc.udp://";
+    if (url.compare(0, udp.size(), udp) != 0) {
+        const std::size_t scheme_end = url.find("://");
+        if (url.compare(0, 4, "osc.") == 0 && scheme_end != std::string::npos)
+            throw refuse("protocol '" + url.substr(4, scheme_end - 4) +
+                         "' is not supported: the link is UDP only");
+        throw refuse("not an OSC URL");
+    }
+    std::string rest = url.substr(udp.size());
+    if (!rest.empty() && rest.back() == '/')
+        rest.pop_back();
+    if (rest.find('[') != std::string::npos || std::count(rest.begin(), rest.end(), ':') > 1)
+        throw refuse("IPv6 is not supported: give an IPv4 address or a host name that "
+                     "resolves to one");
+    const std::size_t colon = rest.find(':');
+    if (colon == std::string::npos)
+        throw refuse("no port");
+    const std::string host = rest.substr(0, colon), port = rest.substr(colon + 1);
+    if (host.empty())
+        throw refuse("no host");
+    const bool digits =
+        !port.empty() && port.size() <= 5 &&
+        std::all_of(port.begin(), port.end(), [](char c) { return c >= '0' && c <= '9'; });
+    if (!digits || std::stoi(port) < 1 || std::stoi(port) > 65535)
+        throw refuse("port: expected 1 to 65535, got '" + port + "'");
+    addrinfo hints{};
+    hints.ai_family = AF_INET;
+    hints.ai_socktype = SOCK_DGRAM;
+    addrinfo *found = nullptr;
+    const int status = getaddrinfo(host.c_str(), port.c_str(), &hints, &found);
+    if (status != 0)
+        throw refuse("host '" + host + "' does not resolve to an IPv4 address (" +
+                     gai_strerror(status) + ")");
+    freeaddrinfo(found);
+}
+} // namespace
+
 // ---- sender -------------------------------------------------------------------
 
 struct OscSender::Impl {
@@ -82,11 +140,11 @@ OscSender::OscSender(const OscSenderOptions &options) : impl_(new Impl), options
     if (!(std::isfinite(options.lookahead_s) && options.lookahead_s >= 0.0 &&
           options.lookahead_s <= 10.0))
         throw OscError("lookahead: expected 0 to 10 s, got " + std::to_string(options.lookahead_s));
+    check_target_url(options.target_url);
     impl_->strike_target = lo_address_new_from_url(options.target_url.c_str());
     impl_->pose_target = lo_address_new_from_url(options.target_url.c_str());
     if (!impl_->strike_target || !impl_->pose_target)
-        throw OscError("target: not an OSC URL: '" + options.target_url +
-                       "' (expected e.g. osc.udp://127.0.0.1:9000)");
+        throw OscError("--target: liblo refused '" + options.target_url + "'");
     sem_init(&impl_->strike_ready, 0, 0);
     sem_init(&impl_->pose_ready, 0, 0);
     epoch_.store(ntp_now());
@@ -115,7 +173,15 @@ void OscSender::stop()
 
 bool OscSender::post_strike(const StrikeEvent &event)
 {
-    if (!strikes_.push(event))
+    if (!strikes_.push(StrikeMessage{event, false}))
+        return false;
+    sem_post(&impl_->strike_ready);
+    return true;
+}
+
+bool OscSender::post_strike_end(const StrikeEvent &event)
+{
+    if (!strikes_.push(StrikeMessage{event, true}))
         return false;
     sem_post(&impl_->strike_ready);
     return true;
@@ -141,6 +207,7 @@ OscSenderCounters OscSender::counters() const
 {
     OscSenderCounters c;
     c.strikes_sent = strikes_sent_.load();
+    c.strike_ends_sent = strike_ends_sent_.load();
     c.poses_sent = poses_sent_.load();
     c.tips_sent = tips_sent_.load();
     c.send_errors = send_errors_.load();
@@ -152,17 +219,36 @@ OscSenderCounters OscSender::counters() const
 
 void OscSender::strike_loop()
 {
-    StrikeEvent e;
+    if (options_.realtime)
+        set_realtime_priority(kStrikeSenderPriority);
+    StrikeMessage sm;
     for (;;) {
         const bool running = running_.load();
-        while (strikes_.pop(e)) {
+        while (strikes_.pop(sm)) {
+            const StrikeEvent &e = sm.event;
             // The strike sounds at its simulation time plus the lookahead, on
-            // the wall clock that simulation time 0 was anchored to.
+            // the wall clock that simulation time 0 was anchored to; its end
+            // is due at the release.
+            const double due_s = e.time_s + (sm.end ? 1e-3 * e.duration_ms : 0.0);
             lo_timetag tt = LO_TT_IMMEDIATE;
             if (options_.lookahead_s > 0.0)
-                tt = to_lo(ntp_add_seconds(epoch(), e.time_s + options_.lookahead_s));
+                tt = to_lo(ntp_add_seconds(epoch(), due_s + options_.lookahead_s));
             lo_bundle b = lo_bundle_new(tt);
             lo_message m = lo_message_new();
+            if (sm.end) {
+                lo_message_add_int32(m, static_cast<std::int32_t>(e.seq));
+                lo_message_add_int32(m, e.hand);
+                for (const double v : {e.peak_force_n, e.impulse_n_s, e.duration_ms,
+                                       e.force_dir.x(), e.force_dir.y(), e.force_dir.z()})
+                    lo_message_add_float(m, static_cast<float>(v));
+                lo_bundle_add_message(b, "/ictus/strike/end", m);
+                if (lo_send_bundle(impl_->strike_target, b) < 0)
+                    send_errors_.fetch_add(1);
+                else
+                    strike_ends_sent_.fetch_add(1);
+                lo_bundle_free_recursive(b);
+                continue;
+            }
             for (int i = 0; i < kStrikeFieldCount; ++i) {
                 const StrikeField f = static_cast<StrikeField>(i);
                 const StrikeFieldInfo &info = strike_field_info(f);

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -48,7 +49,59 @@ const char *lo_arg_string(const lo_arg *a)
 struct Counters {
     std::atomic<unsigned long> packets{0}, accepted{0}, unknown_address{0}, bad_type_tags{0},
         bad_values{0}, malformed{0}, oversized{0}, refused_peers{0}, bundles{0}, queue_full{0},
-        replies{0}, errors_sent{0}, score_lines{0};
+        replies{0}, errors_sent{0}, errors_unanswered{0}, score_lines{0};
+};
+
+// The error-reply budget (osc_server.hpp): a token bucket per address the
+// replies go to, in a small fixed table (nothing allocated on the server's
+// thread; when it is full, the address heard from longest ago gives up its
+// slot), and one bucket for all of them, which bounds the total however many
+// addresses a flood comes from.
+class ErrorReplyBudget
+{
+  public:
+    using Clock = std::chrono::steady_clock;
+    bool take(uint32_t address, Clock::time_point now)
+    {
+        Slot *slot = nullptr, *oldest = &slots_[0];
+        for (Slot &s : slots_) {
+            if (s.used && s.address == address) {
+                slot = &s;
+                break;
+            }
+            if (!s.used || (oldest->used && s.bucket.last < oldest->bucket.last))
+                oldest = &s;
+        }
+        if (!slot) {
+            slot = oldest;
+            *slot = Slot{address, true, Bucket{kErrorReplyBurst, now}};
+        }
+        return slot->bucket.take(now, kErrorRepliesPerSecond, kErrorReplyBurst) &&
+               total_.take(now, kErrorRepliesPerSecondTotal, kErrorRepliesPerSecondTotal);
+    }
+
+  private:
+    struct Bucket {
+        double tokens;
+        Clock::time_point last;
+        bool take(Clock::time_point now, double per_second, double burst)
+        {
+            tokens = std::min(
+                burst, tokens + per_second * std::chrono::duration<double>(now - last).count());
+            last = now;
+            if (tokens < 1.0)
+                return false;
+            tokens -= 1.0;
+            return true;
+        }
+    };
+    struct Slot {
+        uint32_t address;
+        bool used;
+        Bucket bucket;
+    };
+    std::array<Slot, 64> slots_{};
+    Bucket total_{kErrorRepliesPerSecondTotal, Clock::now()};
 };
 
 bool parse_ipv4(const std::string &text, in_addr &out)
@@ -64,6 +117,8 @@ struct OscServer::Impl {
     bool reply_fixed = false;
     sockaddr_in reply_to{};
     Counters counters;
+    ErrorReplyBudget error_budget;
+    sockaddr_in last_peer{}; // the last allowed peer heard from (sin_port 0: none yet)
     // Rate-limited log: at most one line per second, with the count of the
     // lines suppressed since.
     std::chrono::steady_clock::time_point last_log{};
@@ -100,7 +155,11 @@ OscServer::OscServer(const OscServerOptions &options, LiveStatus *status)
         throw OscError("--port: expected 0 to 65535, got " + std::to_string(options.port));
     if (options.max_packet_bytes < 64 || options.max_packet_bytes > 65536)
         throw OscError("max packet size: expected 64 to 65536 bytes");
-    for (const std::string &a : options.allow) {
+    // An empty list would admit every peer unnoticed (--allow ""): "any" is
+    // said with allow_any, and leaves `allow` empty.
+    if (!options.allow_any && options.allow.empty())
+        throw OscError("--allow: empty list (give numeric IPv4 addresses, or 'any')");
+    for (const std::string &a : options.allow_any ? std::vector<std::string>{} : options.allow) {
         in_addr ia;
         if (!parse_ipv4(a, ia))
             throw OscError("--allow: expected numeric IPv4 addresses, got '" + a + "'");
@@ -169,6 +228,7 @@ OscServerCounters OscServer::counters() const
     o.queue_full = c.queue_full;
     o.replies = c.replies;
     o.errors_sent = c.errors_sent;
+    o.errors_unanswered = c.errors_unanswered;
     o.score_lines = c.score_lines;
     return o;
 }
@@ -178,7 +238,8 @@ void OscServer::loop()
     pollfd pfd{impl_->fd, POLLIN, 0};
     while (running_.load()) {
         // A short poll so that stop() is seen within 50 ms.
-        if (poll(&pfd, 1, 50) <= 0)
+        send_refusals();
+        if (poll(&pfd, 1, 20) <= 0)
             continue;
         sockaddr_in peer{};
         socklen_t len = sizeof peer;
@@ -201,6 +262,7 @@ struct Reply {
     int fd;
     const sockaddr_in *to;
     Counters *counters;
+    ErrorReplyBudget *error_budget;
     void send(const char *path, lo_message m)
     {
         unsigned char buf[1024];
@@ -212,9 +274,20 @@ struct Reply {
     }
     void error(const char *address, const std::string &text)
     {
+        // Over the budget of the address it would go to: counted, unanswered.
+        if (!error_budget->take(to->sin_addr.s_addr, std::chrono::steady_clock::now())) {
+            counters->errors_unanswered++;
+            return;
+        }
+        // The address and the reason no longer than it takes to recognise
+        // them (ours are under 32 and 160 characters): an unknown address or
+        // a list of type tags may be 4 kB long, the reply never is.
+        std::string echoed(address), reason(text);
+        echoed.resize(std::min<std::size_t>(echoed.size(), 64));
+        reason.resize(std::min<std::size_t>(reason.size(), 200));
         lo_message m = lo_message_new();
-        lo_message_add_string(m, address);
-        lo_message_add_string(m, text.c_str());
+        lo_message_add_string(m, echoed.c_str());
+        lo_message_add_string(m, reason.c_str());
         send("/ictus/error", m);
         counters->errors_sent++;
     }
@@ -309,6 +382,27 @@ std::string format_range(const Spec &s, double v)
 
 } // namespace
 
+void OscServer::send_refusals()
+{
+    Impl &im = *impl_;
+    Refusal f;
+    while (refusals_.pop(f)) {
+        sockaddr_in to{};
+        to.sin_family = AF_INET;
+        to.sin_addr.s_addr = f.peer_ipv4;
+        to.sin_port = f.peer_port;
+        if (f.peer_port == 0)
+            to = im.last_peer;
+        if (im.reply_fixed)
+            to = im.reply_to;
+        if (to.sin_port == 0)
+            continue; // nobody to tell (the daemon's stderr has it)
+        Reply reply{im.fd, &to, &im.counters, &im.error_budget};
+        const std::string address(f.address, strnlen(f.address, sizeof f.address));
+        reply.error(address.c_str(), std::string(f.why, strnlen(f.why, sizeof f.why)));
+    }
+}
+
 void OscServer::handle(const unsigned char *data, std::size_t size, const void *peer_ptr)
 {
     const sockaddr_in &peer = *static_cast<const sockaddr_in *>(peer_ptr);
@@ -327,7 +421,8 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
             return;
         }
     }
-    Reply reply{im.fd, im.reply_fixed ? &im.reply_to : &peer, &c};
+    im.last_peer = peer;
+    Reply reply{im.fd, im.reply_fixed ? &im.reply_to : &peer, &c, &im.error_budget};
     if (size > options_.max_packet_bytes) {
         c.oversized++;
         im.log("oversized packet", std::to_string(size) + " bytes");
@@ -405,6 +500,9 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
         }
         Command cmd;
         cmd.kind = s.kind;
+        cmd.peer_ipv4 = peer.sin_addr.s_addr;
+        cmd.peer_port = peer.sin_port;
+        std::snprintf(cmd.address, sizeof cmd.address, "%s", s.address);
         if (s.types[0] == 'f') {
             cmd.value = lo_arg_float(argv[0]);
             if (!(std::isfinite(cmd.value) && cmd.value >= s.lo && cmd.value <= s.hi)) {
@@ -475,6 +573,18 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
     std::string shown(path, strnlen(path, 80));
     im.log("unknown address", shown);
     reply.error(path, "unknown address (see docs/osc.md)");
+}
+
+bool OscServer::dispatch_packet(const void *data, std::size_t size)
+{
+    sockaddr_in peer{};
+    peer.sin_family = AF_INET;
+    peer.sin_addr.s_addr =
+        impl_->allow.empty() ? htonl(INADDR_LOOPBACK) : impl_->allow.front().s_addr;
+    const unsigned long accepted = impl_->counters.accepted.load();
+    handle(static_cast<const unsigned char *>(data), size, &peer);
+    impl_->counters.packets++;
+    return impl_->counters.accepted.load() != accepted;
 }
 
 } // namespace ictus

@@ -50,6 +50,21 @@ struct CharacterOptions {
     Grip grip = Grip::french; // the paper's recorded gestures used the French grip
 };
 
+// The segments a body is built from, against the bounds of a human body
+// (docs/character.md), m. Limbs (upper arm, forearm, thigh, shank), whose
+// inertia m (r L)^2 scales with their captured length L, are at least
+// kMinLimbLength_m long: shorter than any human limb (a newborn's forearm is
+// about 7 cm), and at L = 0 the body is a point mass that ODE refuses by
+// aborting the process. No segment, and no joint's distance from its parent
+// joint, is longer than kMaxSegmentLength_m: the longest human segment, the
+// shank (0.43 m at de Leva's 1.74 m), is under 0.7 m even at 2.7 m stature.
+// The other bodies (pelvis, trunk, neck, head, hand, foot) may be 0 long:
+// their inertia comes from de Leva's lengths (the neck's and clavicles' from
+// at least 2 cm), as for the CMU pelvis (Hips to LowerBack: OFFSET 0), and
+// joints that carry no body (Spine1, LHipJoint, fingers, end sites) may be 0.
+constexpr double kMinLimbLength_m = 0.05;
+constexpr double kMaxSegmentLength_m = 1.0;
+
 enum class Side { left = 0, right = 1 };
 
 // One rigid body and the joint that attaches it to its parent.
@@ -101,7 +116,10 @@ class CharacterModel
 
     // Builds the character from a CMU-style skeleton (joint names as in the CMU
     // BVH files, see docs/character.md for the mapping). Throws CharacterError
-    // naming a missing joint or a bad option.
+    // naming a missing joint, a bad option, or a segment out of the bounds
+    // above ("FILE:LINE: joint 'LeftHand': expected ..." at its OFFSET when
+    // the skeleton was read from a file); every body it builds has a mass > 0
+    // and a positive-definite inertia (checked: never a degenerate ODE body).
     static CharacterModel from_skeleton(const Skeleton &skeleton,
                                         const CharacterOptions &options = {});
 

@@ -38,6 +38,16 @@ struct EulerJointLimit {
     Eigen::Quaterniond clamp(const Eigen::Quaterniond &q) const { return limit.clamp(q); }
 };
 
+// Fewest reference frames worth learning limits from. Both formulations
+// estimate a spread per axis (Algorithm 1: a 3 x 3 covariance, singular below
+// 4 samples); a sample standard deviation's relative error is about
+// 1 / sqrt(2 (n - 1)): 13 % at 30 frames (limits at k = 3 std within
+// +-0.4 std), 50 % at 3. Thirty is also ten samples per rotation axis, the
+// usual minimum for a covariance. `ictusd limits` refuses fewer (--force:
+// a warning), `ictusd track` warns. CharacterLimits itself learns from any
+// number >= 1 (the spreads are floored by min_half_width_rad).
+constexpr int kMinLimitFrames = 30;
+
 struct CharacterLimitOptions {
     LimitKind kind = LimitKind::quaternion;
     double k = 3.0;                     // standard deviations (both formulations)

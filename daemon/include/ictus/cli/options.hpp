@@ -31,8 +31,11 @@ struct ClipOptions {
     double scale = kCmuBvhScale_m;
     int skip = 1;
     ReferenceFilter filter;
+    // --force: values out of the physical bounds of a capture
+    // (mocap/capture_bounds.hpp) and, for limits, too few frames are warnings.
+    bool force = false;
 };
-// The BVH options and --smooth-hz, --despike-deg.
+// The BVH options, --smooth-hz, --despike-deg and --force.
 bool parse_clip_option(const std::string &option, Args &args, ClipOptions &clip);
 
 // A stick-only capture (.csv): --units, --up, --rate, --left-stick, --right-stick.
@@ -48,8 +51,16 @@ TrackMode parse_track_mode(const std::string &option, const std::string &text);
 // A limit's minimum half-width per axis, degrees (track --limit-min-deg, limits --min-deg).
 double parse_min_half_width_deg(const std::string &option, const std::string &text);
 
-// A BVH file, its warnings printed to stderr.
-BvhFile load_bvh(const std::string &path, double scale, int skip);
+// The --help lines of --force and the bounds it lifts (track, limits), the
+// text starting at `column` as the verb's other options.
+std::string force_help(std::size_t column);
+
+// A BVH file, its warnings printed to stderr. `force`: values out of the
+// physical bounds are read with a warning; without it their error says
+// that --force would read them.
+BvhFile load_bvh(const std::string &path, double scale, int skip, bool force = false);
+// A marker CSV (a stick-only capture) the same way; o.accept_out_of_bounds is --force.
+MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o);
 
 // run and render: the motion source, the character, the drum, score mode.
 // Returns false when `option` is not one of them.

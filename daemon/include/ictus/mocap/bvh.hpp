@@ -34,6 +34,12 @@ struct BvhOptions {
     int skip_frames = 0;
     // Refuse files that declare more frames than this (absurd sizes).
     long max_frames = 10000000;
+    // The physical bounds of a capture (capture_bounds.hpp): Frame Time in
+    // [kMinSampleInterval_s, kMaxSampleInterval_s], (Frames - 1) * Frame Time
+    // <= kMaxCaptureDuration_s, every OFFSET coordinate and position channel
+    // times `scale` within kMaxCoordinate_m. false: refused (MocapBoundError
+    // at the value's line); true: read, with a warning (the first of each kind).
+    bool accept_out_of_bounds = false;
 };
 
 // One BVH channel, in file order.
@@ -55,7 +61,9 @@ struct BvhFile {
 };
 
 // Reads a BVH file. Throws MocapError (file, line, what was expected) on
-// anything malformed; appends warnings to *warnings when given.
+// anything malformed, MocapBoundError on a value out of the physical bounds;
+// appends warnings to *warnings when given. The skeleton keeps the file name
+// and each OFFSET's line (Skeleton::source, SkeletonJoint::offset_line).
 BvhFile read_bvh(const std::string &path, const BvhOptions &options = {},
                  MocapWarnings *warnings = nullptr);
 // Same from a stream; `source_name` is used in messages.

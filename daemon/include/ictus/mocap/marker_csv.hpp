@@ -3,7 +3,9 @@
 // Header row: a `time` column (s) or a `frame` column (then options.rate_hz is
 // required), and per object NAME.x NAME.y NAME.z, optionally NAME.qw NAME.qx
 // NAME.qy NAME.qz. Comma separated; empty cells, NaN or nan mark gaps.
-// Output: MarkerCapture in metres, right-handed, y up. See docs/mocap.md.
+// Output: MarkerCapture in metres, right-handed, y up. Values out of the
+// physical bounds of a capture (capture_bounds.hpp) throw MocapBoundError
+// unless accepted. See docs/mocap.md.
 #pragma once
 
 #include "ictus/mocap/mocap_error.hpp"
@@ -33,6 +35,13 @@ struct MarkerCsvOptions {
     int max_gap_frames = 20;
     // Refuse files with more data rows than this.
     long max_frames = 10000000;
+    // The physical bounds of a capture (capture_bounds.hpp): the median time
+    // step in [kMinSampleInterval_s, kMaxSampleInterval_s] (a time column in
+    // ms or us fails it), last - first time <= kMaxCaptureDuration_s, every
+    // NAME.x|y|z within kMaxCoordinate_m (in m after `units`). false: refused
+    // (MocapBoundError at the row of the offending value); true: read, with a
+    // warning (the first of each kind). Checked after the gaps.
+    bool accept_out_of_bounds = false;
 };
 
 MarkerCapture read_marker_csv(const std::string &path, const MarkerCsvOptions &options = {},

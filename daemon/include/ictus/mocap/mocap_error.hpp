@@ -26,6 +26,16 @@ class MocapError : public std::runtime_error
     std::string message_;
 };
 
+// A value the file format allows but a capture of a human performer does not
+// (capture_bounds.hpp): a frame time, a time step, a duration or a coordinate
+// out of bounds. Same what() as MocapError; callers that let a user insist
+// (`--force`) catch it to say so, or set the reader's accept_out_of_bounds.
+class MocapBoundError : public MocapError
+{
+  public:
+    using MocapError::MocapError;
+};
+
 // Readers append human-readable warnings ("FILE:LINE: ...") here when the
 // caller passes a non-null pointer; nothing is printed by the library.
 using MocapWarnings = std::vector<std::string>;

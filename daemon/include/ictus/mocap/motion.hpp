@@ -18,10 +18,15 @@ struct SkeletonJoint {
     int parent = -1;
     Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();
     bool end_site = false;
+    // Line of the joint's OFFSET in `Skeleton::source` (1-based), 0 when the
+    // skeleton was not read from a file: errors about a segment point there.
+    int offset_line = 0;
 };
 
 struct Skeleton {
     std::vector<SkeletonJoint> joints;
+    // The file the skeleton was read from ("" when built in code).
+    std::string source;
     // Index of a joint by exact name, or -1.
     int find(const std::string &name) const;
 };

@@ -39,10 +39,13 @@ struct OscSenderOptions {
     // Strike bundles carry the timetag epoch + time_s + lookahead_s. A
     // lookahead of 0 sends them as "immediately" (timetag 1).
     double lookahead_s = 0.010;
+    // The strike thread asks for real-time scheduling (base/realtime.hpp);
+    // refused quietly (the verb says whether its own request succeeded).
+    bool realtime = false;
 };
 
 struct OscSenderCounters {
-    unsigned long strikes_sent = 0, poses_sent = 0, tips_sent = 0;
+    unsigned long strikes_sent = 0, strike_ends_sent = 0, poses_sent = 0, tips_sent = 0;
     unsigned long send_errors = 0;
     unsigned long strikes_dropped = 0, poses_dropped = 0, tips_dropped = 0; // queue full
 };
@@ -63,7 +66,12 @@ class OscSender
     void set_epoch(NtpTime epoch) { epoch_.store(epoch, std::memory_order_release); }
     NtpTime epoch() const { return epoch_.load(std::memory_order_acquire); }
 
+    // A strike at its onset (/ictus/strike: the sound's fields; peak force,
+    // impulse and duration 0), and the same strike at its release
+    // (/ictus/strike/end: seq, hand and the contact's measures), each in a
+    // bundle time-tagged epoch + its time + lookahead (docs/osc.md).
     bool post_strike(const StrikeEvent &event);
+    bool post_strike_end(const StrikeEvent &event);
     bool post_pose(const PoseSnapshot &pose);
     bool post_tip(const TipState &tip);
 
@@ -80,8 +88,13 @@ class OscSender
     OscSenderOptions options_;
     std::atomic<NtpTime> epoch_{0};
     std::atomic<bool> running_{true};
-    std::atomic<unsigned long> strikes_sent_{0}, poses_sent_{0}, tips_sent_{0}, send_errors_{0};
-    SpscQueue<StrikeEvent, 1024> strikes_;
+    std::atomic<unsigned long> strikes_sent_{0}, strike_ends_sent_{0}, poses_sent_{0},
+        tips_sent_{0}, send_errors_{0};
+    struct StrikeMessage {
+        StrikeEvent event;
+        bool end = false; // /ictus/strike/end
+    };
+    SpscQueue<StrikeMessage, 1024> strikes_;
     SpscQueue<PoseSnapshot, 16> poses_;
     SpscQueue<TipState, 1024> tips_;
     std::thread strike_thread_, pose_thread_;

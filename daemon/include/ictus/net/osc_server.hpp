@@ -21,16 +21,28 @@ namespace ictus
 struct OscServerOptions {
     std::string bind_address = "127.0.0.1";         // numeric IPv4
     int port = 9001;                                // 0: any free port
-    std::vector<std::string> allow = {"127.0.0.1"}; // peers (numeric IPv4); empty: any
-    std::string reply_url;                          // default: reply to the sender
-    std::size_t max_packet_bytes = 4096;            // larger packets are refused
+    std::vector<std::string> allow = {"127.0.0.1"}; // peers (numeric IPv4), not empty
+    bool allow_any = false;              // every peer (--allow any); `allow` is then ignored
+    std::string reply_url;               // default: reply to the sender
+    std::size_t max_packet_bytes = 4096; // larger packets are refused
 };
+
+// Error replies (/ictus/error) to one peer address: a bucket of
+// kErrorReplyBurst, refilled at kErrorRepliesPerSecond; past it an error is
+// counted (errors_unanswered) and not answered, so that junk sent to the port
+// (a 1-byte packet earns a 60-byte reply) cannot be reflected at a volume.
+// All peers together: kErrorRepliesPerSecondTotal. docs/osc.md.
+constexpr double kErrorRepliesPerSecond = 10.0;
+constexpr double kErrorReplyBurst = 20.0;
+constexpr double kErrorRepliesPerSecondTotal = 100.0;
 
 struct OscServerCounters {
     unsigned long packets = 0, accepted = 0;
     unsigned long unknown_address = 0, bad_type_tags = 0, bad_values = 0, malformed = 0,
                   oversized = 0, refused_peers = 0, bundles = 0, queue_full = 0;
     unsigned long replies = 0, errors_sent = 0;
+    // Errors counted but not answered: over the peer's error-reply budget.
+    unsigned long errors_unanswered = 0;
     unsigned long score_lines = 0;
     unsigned long errors() const
     {
@@ -51,6 +63,12 @@ class OscServer
     int port() const { return port_; }
     // Consumer side (the physics thread).
     bool pop_command(Command &command) { return commands_.pop(command); }
+    // A refusal found after the command was acknowledged (by the physics
+    // thread or the planner), sent by the server's thread as /ictus/error
+    // <address> <why> to the command's peer (no peer: the last one heard
+    // from), within the error-reply budget. Producer: one thread (the
+    // physics thread); lock-free, false when the queue is full.
+    bool post_refusal(const Refusal &refusal) { return refusals_.push(refusal); }
     OscServerCounters counters() const;
     void stop();
 
@@ -64,7 +82,19 @@ class OscServer
     int port_ = 0;
     std::atomic<bool> running_{true};
     SpscQueue<Command, 256> commands_;
+    SpscQueue<Refusal, 64> refusals_;
+    void send_refusals();
     std::thread thread_;
+
+  public:
+    // For tests and fuzzing (fuzz/fuzz_osc_server.cpp): handles one datagram on
+    // the caller's thread as if it came from the first allowed peer (127.0.0.1
+    // when any peer is allowed), counted as the server's thread counts one.
+    // Replies go to reply_url, else to that peer's port 0 (dropped by the
+    // kernel). Call it after stop(), or while nothing sends to the port: the
+    // command queue has one producer. True when the packet was accepted (a
+    // command queued or a query answered), false when refused (counters()).
+    bool dispatch_packet(const void *data, std::size_t size);
 };
 
 } // namespace ictus
