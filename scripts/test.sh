@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # README's test command: installs what is missing, builds, runs every test with CTest,
-# then builds and runs the whole suite again under AddressSanitizer + UBSan.
+# then builds and runs the whole suite again under AddressSanitizer + UBSan, then
+# runs each libFuzzer harness briefly (clang).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -14,9 +15,18 @@ echo "== release build and tests (build/) =="
 parts=(-DICTUS_BUILD_EXTERNALS=ON -DICTUS_BUILD_DAEMON=ON -DICTUS_BUILD_TESTS=ON)
 bash scripts/build.sh "$root/build" -DCMAKE_BUILD_TYPE=Release -DICTUS_SANITIZE=OFF "${parts[@]}" \
     -DICTUS_BUILD_BENCH=ON
-(cd build && ctest --output-on-failure -j "$jobs")
+(cd build && ctest --output-on-failure --no-tests=error -j "$jobs")
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests (build-asan/) =="
 bash scripts/build.sh "$root/build-asan" -DCMAKE_BUILD_TYPE=Debug -DICTUS_SANITIZE=ON \
     "${parts[@]}" -DICTUS_BUILD_BENCH=OFF
-(cd build-asan && ctest --output-on-failure -j "$jobs")
+(cd build-asan && ctest --output-on-failure --no-tests=error -j "$jobs")
+
+echo "== libFuzzer harnesses, a short run each (build-fuzz/, clang) =="
+# Only the harnesses and the libraries they fuzz; each CTest run replays its
+# seed corpus (fuzz/corpus/) and fuzzes for ICTUS_FUZZ_SECONDS. docs/fuzzing.md.
+CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DICTUS_BUILD_FUZZ=ON -DICTUS_BUILD_EXTERNALS=OFF -DICTUS_BUILD_TESTS=OFF \
+    -DICTUS_BUILD_BENCH=OFF >/dev/null
+cmake --build build-fuzz --target ictus_fuzz -j "$jobs"
+(cd build-fuzz && ctest -L fuzz --output-on-failure --no-tests=error -j "$jobs")
