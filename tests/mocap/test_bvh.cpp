@@ -744,3 +744,26 @@ TEST_CASE("BVH: random files inside the bounds pass, one value outside fails at 
         require_bound_warning(file.text(), line, expected, options);
     }
 }
+
+TEST_CASE("BVH: a hierarchy with more than 4 joints per channel is refused before its frames",
+          "[mocap][bvh]")
+{
+    // The fuzzer's input: End Sites under a one-channel root cost a rotation
+    // each per frame (1300 of them, 14000 frames: 740 MB and 35 s from 61 kB).
+    // n End Sites and 1 channel: n + 1 joints, allowed up to 4.
+    for (int sites : {1, 2, 3, 4, 10, 1300}) {
+        std::string text = "HIERARCHY\nROOT r\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n";
+        for (int k = 0; k < sites; ++k)
+            text += "End Site { OFFSET 0 0 0 }\n";
+        text += "}\nMOTION\nFrames: 2\nFrame Time: 0.01\n0\n0\n";
+        INFO(sites << " End Sites");
+        if (sites + 1 <= 4) {
+            std::istringstream in(text);
+            CHECK(parse_bvh(in, "src.bvh").skeleton.joints.size() ==
+                  static_cast<size_t>(sites + 1));
+        } else {
+            // Reported at the MOTION keyword, the hierarchy's end.
+            require_error(text, 7 + sites, "joints (End Sites included) per channel");
+        }
+    }
+}

@@ -23,6 +23,7 @@ using detail::quote;
 
 constexpr std::size_t kMaxFileBytes = std::size_t{512} << 20; // 512 MiB
 constexpr int kMaxJoints = 10000;
+constexpr long kMaxJointsPerChannel = 4;
 constexpr int kMaxDepth = 500; // nesting; guards the recursion
 // What the format can hold at all; the physical bounds of a capture are
 // narrower (capture_bounds.hpp) and may be accepted with a warning.
@@ -185,6 +186,19 @@ class BvhParser
         if (bvh_.channel_count == 0)
             throw MocapError(source_, cursor_.token_line(),
                              "expected at least one channel in the hierarchy, got none");
+        // Every joint costs a rotation per frame, channels or not: a
+        // hierarchy of End Sites and channel-less joints would make a small
+        // file ask for gigabytes (1300 End Sites under one channel, 14000
+        // frames: 740 MB, 35 s). A captured body moves its joints: at most
+        // kMaxJointsPerChannel joints per channel (CMU: 38 joints, 62 channels).
+        const auto joints = static_cast<long>(bvh_.skeleton.joints.size());
+        if (joints > kMaxJointsPerChannel * static_cast<long>(bvh_.channel_count))
+            throw MocapError(source_, cursor_.token_line(),
+                             "expected at most " + std::to_string(kMaxJointsPerChannel) +
+                                 " joints (End Sites included) per channel, got " +
+                                 std::to_string(joints) + " joints for " +
+                                 std::to_string(bvh_.channel_count) +
+                                 " channels (a hierarchy that does not move)");
         const long declared = parse_frames();
         parse_frame_time();
         const double duration_s = static_cast<double>(declared - 1) * bvh_.frame_time_s;
