@@ -148,8 +148,17 @@ ok(t0 is not None and len(rates) >= 3, "the rate meter reported (%s)" % rates)
 relayed = [sum(1 for t in pose_times if t0 + k - 1 < t <= t0 + k) for k in range(1, len(rates))]
 print("rate meter: %s, relayed in the same seconds: %s" % (rates[1:], relayed))
 ok(sum(relayed) > 10, "poses were streamed (%d relayed)" % sum(relayed))
-ok(all(abs(m - r) <= 2 for m, r in zip(rates[1:], relayed)),
-   "each second, the view's rate meter reports the frames that arrived (within 2)")
+# The meter bins by Pd's logical seconds, the relay by wall-clock ones: when
+# Pd stalls and catches up (a loaded machine, a sanitizer), frames move
+# between neighbouring bins (seen: meter 33 2 15 for relayed 20 15 15), but
+# none is lost or counted twice: the totals agree within 2, and each second
+# agrees within 2 whenever Pd kept up (no bin above the relay's rate).
+ok(abs(sum(rates[1:]) - sum(relayed)) <= 2,
+   "the view's rate meter counts the frames that arrived (%d, relayed %d, within 2)"
+   % (sum(rates[1:]), sum(relayed)))
+if max(rates[1:]) <= max(relayed) + 2:
+    ok(all(abs(m - r) <= 2 for m, r in zip(rates[1:], relayed)),
+       "each second, the view's rate meter reports the frames that arrived (within 2)")
 img = uitest.load_image(shot)
 lit = img.sum(axis=2) > 0
 ys, xs = lit.nonzero()
