@@ -9,7 +9,7 @@ late bundle: the sound would play it late. Optionally keeps the machine busy
 with stress-ng beside it (--load). Prints the distribution; docs/benchmarks.md
 ("Strike lateness") keeps the figures.
 
-usage: bench/strike_lateness.py ICTUSD [--seconds 600] [--lookahead 0.02] [--load]
+usage: bench/strike_lateness.py ICTUSD [--seconds 600] [--lookahead 0.02] [--load] [--realtime]
 """
 import argparse
 import os
@@ -71,6 +71,7 @@ def main():
     ap.add_argument("--seconds", type=float, default=600.0)
     ap.add_argument("--lookahead", type=float, default=None, help="default: ictusd's own")
     ap.add_argument("--load", action="store_true", help="stress-ng --cpu 0 beside it")
+    ap.add_argument("--realtime", action="store_true", help="ictusd run --realtime")
     args = ap.parse_args()
 
     rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -89,6 +90,8 @@ def main():
     cmd = [args.ictusd, "run", "--port", str(cmd_port), "--target",
            f"osc.udp://127.0.0.1:{port}", "--reply", f"osc.udp://127.0.0.1:{port}",
            "--pose-rate", "30"]
+    if args.realtime:
+        cmd.append("--realtime")
     if args.lookahead is not None:
         cmd += ["--lookahead", str(args.lookahead)]
     daemon = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -141,7 +144,7 @@ def main():
     margins.sort()
     late = [m for m in margins if m < 0]
     ms = lambda v: f"{1e3 * v:.2f} ms"
-    print(f"strike lateness: {args.seconds:.0f} s of ictusd run, load={'stress-ng' if args.load else 'none'}, "
+    print(f"strike lateness: {args.seconds:.0f} s of ictusd run{' --realtime' if args.realtime else ''}, load={'stress-ng' if args.load else 'none'}, "
           f"lookahead {args.lookahead if args.lookahead is not None else 'default'}")
     print(f"  strikes received {len(margins)}, ends {ends}, late {len(late)}")
     if margins:

@@ -61,8 +61,9 @@ void run_usage(std::ostream &out)
            "  --pose-rate HZ      pose stream rate (default 30; 0: off)\n"
            "  --tip-rate HZ       stick-tip state stream rate (default 0: off)\n"
            "  --paused            wait for /ictus/play\n"
-           "  --no-realtime       ordinary scheduling for the physics loop and the strike\n"
-           "                      sender (default: SCHED_FIFO when the system allows it)\n"
+           "  --realtime          SCHED_FIFO for the physics loop and the strike sender (when\n"
+           "                      the system allows it): no late strike on a busy machine, but\n"
+           "                      a physics loop slower than real time then holds a core\n"
            "  --duration S        stop after S simulated seconds (default: until SIGINT)\n"
            "  --out DIR           also write DIR/strikes.csv, each row whole as it is\n"
            "                      released; a write error (disk full) ends the run, exit 1\n"
@@ -199,7 +200,7 @@ int cmd_run(Args &args)
     so.lookahead_s = 0.02;
     OscServerOptions io;
     double duration = 0.0, pose_rate = 30.0, tip_rate = 0.0;
-    bool paused = false, realtime = true;
+    bool paused = false, realtime = false;
     std::string out_dir;
     while (!args.done()) {
         const std::string a = args.next();
@@ -231,8 +232,8 @@ int cmd_run(Args &args)
             pose_rate = parse_number(a, value(), 0, 1000);
         } else if (a == "--tip-rate") {
             tip_rate = parse_number(a, value(), 0, 1000);
-        } else if (a == "--no-realtime") {
-            realtime = false;
+        } else if (a == "--realtime") {
+            realtime = true;
         } else if (a == "--paused") {
             paused = true;
         } else if (a == "--out") {
