@@ -457,12 +457,7 @@ class BvhParser
     // refused, or read with a warning (the first of each kind) when accepted.
     void out_of_bounds(int line, const std::string &kind, const std::string &message)
     {
-        if (!options_.accept_out_of_bounds)
-            throw MocapBoundError(source_, line, message);
-        if (warnings_ && warned_.insert(kind).second)
-            warnings_->push_back(std::string(MocapError(source_, line, message).what()) +
-                                 " (read anyway: out of bounds accepted; later values of this "
-                                 "kind are not reported)");
+        bounds_.out_of_bounds(line, kind, message);
     }
 
     std::string channel_label(std::size_t column) const
@@ -517,7 +512,7 @@ class BvhParser
     bool has_joint_translation_ = false;
     int frame_time_line_ = 0;
     int frames_line_ = 0;
-    std::set<std::string> warned_; // kinds of out-of-bounds values warned about
+    BoundsReport bounds_{source_, options_.accept_out_of_bounds, warnings_};
 };
 
 } // namespace

@@ -344,12 +344,7 @@ class CsvParser
     // refused, or read with a warning (the first of each kind) when accepted.
     void out_of_bounds(int line, const std::string &kind, const std::string &message)
     {
-        if (!options_.accept_out_of_bounds)
-            throw MocapBoundError(source_, line, message);
-        if (warnings_ && warned_.insert(kind).second)
-            warnings_->push_back(std::string(MocapError(source_, line, message).what()) +
-                                 " (read anyway: out of bounds accepted; later values of this "
-                                 "kind are not reported)");
+        bounds_.out_of_bounds(line, kind, message);
     }
 
     // The clock: the median step (robust to dropped frames) within the
@@ -432,7 +427,7 @@ class CsvParser
     int header_line_ = 0;
     int time_column_ = -1;
     int frame_column_ = -1;
-    std::set<std::string> warned_; // kinds of out-of-bounds values warned about
+    BoundsReport bounds_{source_, options_.accept_out_of_bounds, warnings_};
 };
 
 } // namespace

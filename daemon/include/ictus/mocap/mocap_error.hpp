@@ -40,4 +40,23 @@ class MocapBoundError : public MocapError
 // caller passes a non-null pointer; nothing is printed by the library.
 using MocapWarnings = std::vector<std::string>;
 
+// Out-of-bounds values of a capture (capture_bounds.hpp), as every reader
+// treats them: refused with MocapBoundError, or, when the caller accepts them,
+// read with one warning per kind (the first value of that kind).
+class BoundsReport
+{
+  public:
+    BoundsReport(const std::string &source, bool accept, MocapWarnings *warnings)
+        : source_(source), accept_(accept), warnings_(warnings)
+    {
+    }
+    void out_of_bounds(int line, const std::string &kind, const std::string &message);
+
+  private:
+    const std::string &source_;
+    bool accept_;
+    MocapWarnings *warnings_;
+    std::vector<std::string> warned_; // kinds already reported (a few)
+};
+
 } // namespace ictus
