@@ -121,8 +121,8 @@ TEST_CASE("osc out: strike bundles reach oscdump with the fixed layout and timet
     for (long i = 0; i < 4; ++i) {
         DumpLine d;
         REQUIRE(next_dump(*dump, "/ictus/strike", d));
-        CHECK(d.types == "iiiifffffffffffff");
-        REQUIRE(d.args.size() == 17);
+        CHECK(d.types == "iiiiffffffffffffff");
+        REQUIRE(d.args.size() == 18);
         CHECK(std::stol(d.args[0]) == i);
         CHECK(std::stoi(d.args[1]) == i % 2);
         CHECK(std::stoi(d.args[2]) == 0);

@@ -30,6 +30,7 @@ constexpr StrikeFieldInfo kInfo[kStrikeFieldCount] = {
     {"force_dir_x", false, 4, true},
     {"force_dir_y", false, 4, true},
     {"force_dir_z", false, 4, true},
+    {"stick_mass_kg", false, 5, true},
 };
 
 // Fixed notation with a given number of decimals; -0 printed as 0 so that
@@ -64,13 +65,13 @@ void put_field(std::ostream &out, const StrikeEvent &e, StrikeField f)
 } // namespace
 
 // A hit line: what a drum patch needs first (patches/ictus-render.pd plays them).
-const StrikeField kEventsStrikeFields[11] = {
+const StrikeField kEventsStrikeFields[12] = {
     StrikeField::hand,         StrikeField::drum,
     StrikeField::bounce,       StrikeField::normal_velocity_mps,
     StrikeField::r_over_a,     StrikeField::theta_deg,
     StrikeField::peak_force_n, StrikeField::impulse_n_s,
     StrikeField::duration_ms,  StrikeField::tangential_velocity_mps,
-    StrikeField::time_s,
+    StrikeField::time_s,       StrikeField::stick_mass_kg,
 };
 
 const StrikeFieldInfo &strike_field_info(StrikeField field)
@@ -131,6 +132,8 @@ double strike_field(const StrikeEvent &e, StrikeField field)
         return e.force_dir.y();
     case StrikeField::force_dir_z:
         return e.force_dir.z();
+    case StrikeField::stick_mass_kg:
+        return e.stick_mass_kg;
     }
     return 0.0;
 }

@@ -29,6 +29,10 @@ struct StrikeEvent {
     double impulse_n_s = 0.0;             // integral of F_n over the episode
     double duration_ms = 0.0;             // onset to release (both interpolated)
     Eigen::Vector3d force_dir = Eigen::Vector3d(0.0, -1.0, 0.0); // on the membrane, world, unit
+    // The stick's effective mass at the bead along the membrane normal at the
+    // onset (the stick on its fulcrum, the grip and the hand: Scene::
+    // effective_mass_kg), kg: what a sound model's stick (contact~) weighs.
+    double stick_mass_kg = 0.0;
 };
 
 // The fields of a StrikeEvent, in strikes.csv's column order (and the OSC message's).
@@ -51,8 +55,9 @@ enum class StrikeField {
     force_dir_x,
     force_dir_y,
     force_dir_z,
+    stick_mass_kg,
 };
-constexpr int kStrikeFieldCount = static_cast<int>(StrikeField::force_dir_z) + 1;
+constexpr int kStrikeFieldCount = static_cast<int>(StrikeField::stick_mass_kg) + 1;
 
 struct StrikeFieldInfo {
     const char *name; // column name, with its unit
@@ -68,7 +73,7 @@ long strike_field_integer(const StrikeEvent &event, StrikeField field);
 // The three layouts: strikes.csv has every field in StrikeField's order; the
 // /ictus/strike OSC message those with in_osc, in the same order; the events
 // file's `hit` line these, after "hit":
-extern const StrikeField kEventsStrikeFields[11];
+extern const StrikeField kEventsStrikeFields[12];
 
 // strikes.csv: a header line and one line per event, fixed precision (so that
 // equal runs give equal bytes).
