@@ -45,6 +45,7 @@ enum class CommandKind {
     drum_density, // value = kg/m^2
     score,        // text = one score statement, e.g. "L accent 0.8" (docs/score.md)
     score_clear,  // forget the statements received so far
+    grip_firmness, // value = 0 (loose) .. 1 (firm): the notes' default grip
 };
 
 struct Command {
