@@ -93,7 +93,8 @@ double ChainIkSolverPos_dls::direction_error(const ChainFrames &frames,
 {
     if (full_rotation_) {
         // The world rotation vector turning the last frame onto the target rotation.
-        *rotation_vector = log_map(target_rotation_ * frames.joint_rotation[joints_ - 1].conjugate());
+        *rotation_vector =
+            log_map(target_rotation_ * frames.joint_rotation[joints_ - 1].conjugate());
         return rotation_vector->norm();
     }
     // The world rotation vector turning the stick onto the target direction (shortest arc).

@@ -106,7 +106,7 @@ struct Performance::PlanState {
     std::array<std::vector<double>, 2> beats, lead_s, approach_mps;
     std::array<std::vector<double>, 2> firmness; // < 0: the performance's
     std::array<size_t, 2> grip_note = {0, 0};    // the note whose grip is applied
-    std::vector<double> planned_speed_mps; // [note of plan]
+    std::vector<double> planned_speed_mps;       // [note of plan]
 };
 
 // Work for execute(): everything it needs is in the job (copies), so that it
@@ -1010,8 +1010,7 @@ Eigen::Vector3d Performance::rest_direction(int s) const
     const double yaw = 20.0 * M_PI / 180.0;
     const Eigen::Vector3d inward = s == static_cast<int>(Side::right) ? -f.right : f.right;
     const Eigen::Vector3d level = std::cos(yaw) * f.forward + std::sin(yaw) * inward;
-    return (kDefaultStickDirection.y() * f.up + kDefaultStickDirection.z() * level)
-        .normalized();
+    return (kDefaultStickDirection.y() * f.up + kDefaultStickDirection.z() * level).normalized();
 }
 
 // The plan time whose target the hand follows at plan time t (target_at's delay).

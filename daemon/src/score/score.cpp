@@ -506,8 +506,8 @@ class LineParser
             } else if (t.lower == "firmness") {
                 if (st.firmness)
                     fail(t.column, "second firmness in one note");
-                st.firmness =
-                    firmness_value(need(tk, i + 1, "'firmness' needs a value 0..1 (0 loose, 1 firm)"));
+                st.firmness = firmness_value(
+                    need(tk, i + 1, "'firmness' needs a value 0..1 (0 loose, 1 firm)"));
                 ++i;
             } else if (t.lower == "at") {
                 if (st.r_over_a)

@@ -388,8 +388,7 @@ double Scene::fulcrum_inertia_kg_m2(Side side) const
 
 void Scene::set_grip_firmness(Side side, double firmness)
 {
-    set_grip(side,
-             grip_spring(firmness, fulcrum_inertia_kg_m2(side), options_.grip_damping_ratio));
+    set_grip(side, grip_spring(firmness, fulcrum_inertia_kg_m2(side), options_.grip_damping_ratio));
 }
 
 void Scene::near_callback(void *data, dGeomID a, dGeomID b)
@@ -521,7 +520,8 @@ void Scene::apply_control()
 bool Scene::check() const
 {
     for (int b = 0; b < CharacterModel::kBodies + 2; ++b) {
-        dBodyID body = b < CharacterModel::kBodies ? body_[b] : stick_body_[b - CharacterModel::kBodies];
+        dBodyID body =
+            b < CharacterModel::kBodies ? body_[b] : stick_body_[b - CharacterModel::kBodies];
         if (!body)
             continue;
         const Eigen::Vector3d p = to_eigen3(dBodyGetPosition(body));
@@ -690,7 +690,7 @@ dBodyID Scene::tip_body(Side side) const
 Eigen::Vector3d Scene::tip_body_com(Side side) const
 {
     return stick_body_[static_cast<int>(side)] ? model_.stick(side).com_m
-                                                : com_local_[model_.hand_body(side)];
+                                               : com_local_[model_.hand_body(side)];
 }
 
 namespace
@@ -860,8 +860,7 @@ double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in) con
     const Eigen::RowVectorXd g = gs * J.bottomRows<6>();
     const double m_pivot = 1.0 / inverse_effective_mass(J, M, g);
     // The stick welded to the hand: theta' = 0.
-    const double m_rigid =
-        1.0 / inverse_effective_mass(J.leftCols<6>(), M, g.head<6>());
+    const double m_rigid = 1.0 / inverse_effective_mass(J.leftCols<6>(), M, g.head<6>());
     const double lever = a.cross(bead - p).norm();
     const double k_grip = options_.grip[s].stiffness_nm_per_rad / std::max(lever * lever, 1e-6);
     const double k_drum = drum_contact_stiffness_n_per_m();

@@ -83,7 +83,7 @@ struct SceneOptions {
     double stop_margin_rad = 0.0873; // 5 degrees
     bool rate_feedforward = true;
     StickMount sticks = StickMount::rigid;
-    std::array<GripSpring, 2> grip{}; // [side], fulcrum mount only
+    std::array<GripSpring, 2> grip{};                     // [side], fulcrum mount only
     double grip_damping_ratio = kDefaultGripDampingRatio; // set_grip_firmness()'s
 };
 // Throws CharacterError naming the first bad option.
