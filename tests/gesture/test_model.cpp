@@ -59,17 +59,19 @@ TEST_CASE("nuance names round-trip and bad names list the valid ones", "[gesture
     } catch (const GestureError &e) {
         const std::string m = e.what();
         CHECK(m.find("fortissimo") != std::string::npos);
-        for (const char *name : {"legato", "tenuto", "accent", "vertical_accent", "staccato"})
+        for (const char *name :
+             {"legato", "tenuto", "accent", "vertical_accent", "staccato", "buzz"})
             CHECK(m.find(name) != std::string::npos);
     }
     CHECK_THROWS_AS(side_from_string("middle"), GestureError);
     CHECK(side_from_string("L") == Side::left);
 }
 
-TEST_CASE("the builtin database holds 2 grips x 5 nuances x 2 hands at 250 Hz", "[gesture][db]")
+TEST_CASE("the builtin database holds 2 grips x 6 nuances x 2 hands at 250 Hz", "[gesture][db]")
 {
     const GestureDatabase db = GestureDatabase::builtin();
-    CHECK(db.units().size() == 20);
+    CHECK(db.units().size() == 2 * kNuances * 2);
+    CHECK(kNuances == 6);
     for (Grip g : kGrips)
         for (Nuance n : all_nuances())
             for (Side h : kHands) {
@@ -97,9 +99,21 @@ TEST_CASE("every unit strikes at its lowest point, at the origin, from above", "
                         REQUIRE(s > 2);
                         REQUIRE(s < u.samples() - 3);
                         CHECK(u.tip_m[s].norm() == 0.0);
+                        // The buzz presses on into the head after the strike (at most
+                        // its 2 cm press), then lifts like the others.
+                        const bool press = n == Nuance::buzz;
+                        int lift = s + 1;
+                        if (press) {
+                            while (lift < u.samples() && u.tip_m[lift].y() <= 0.0)
+                                ++lift;
+                            REQUIRE(lift < u.samples());
+                            for (int k = s + 1; k < lift; ++k)
+                                REQUIRE(u.tip_m[k].y() >= -0.02 - 1e-12);
+                            REQUIRE(u.tip_m[s + 1].y() < 0.0);
+                        }
                         for (int k = 0; k < u.samples(); ++k) {
                             REQUIRE(u.tip_m[k].allFinite());
-                            if (k != s)
+                            if (k != s && (k < s || k >= lift))
                                 REQUIRE(u.tip_m[k].y() > 0.0);
                         }
                         // Apex at both ends: the highest points of each phase.
@@ -110,7 +124,7 @@ TEST_CASE("every unit strikes at its lowest point, at the origin, from above", "
                         // Height falls monotonically to the strike, rises after.
                         for (int k = 1; k <= s; ++k)
                             REQUIRE(u.tip_m[k].y() < u.tip_m[k - 1].y());
-                        for (int k = s + 1; k < u.samples(); ++k)
+                        for (int k = lift + 1; k < u.samples(); ++k)
                             REQUIRE(u.tip_m[k].y() > u.tip_m[k - 1].y());
                         // A clear downward approach: the last sample interval
                         // before the strike falls at over half the impact speed.
@@ -133,16 +147,23 @@ TEST_CASE("units are C1 except at the strike, where the velocity reverses", "[ge
                 // velocity changes between consecutive intervals by
                 // a_max / 250 Hz: far below the impact speed. A corner (or a
                 // jump in position) changes it by the size of the corner.
+                // The buzz's press starts at the strike with a 12 ms time constant:
+                // its first 40 ms curve as fast as that (checked in its own test).
+                const int press_end = n == Nuance::buzz ? s + 10 : s;
                 double max_jump = 0.0;
                 for (int k = 0; k + 2 < u.samples(); ++k) {
-                    if (k + 1 == s)
+                    if (k + 1 >= s && k + 1 <= press_end)
                         continue; // the impact: the intervals on both sides of it
                     max_jump =
                         std::max(max_jump, (fd_velocity(u, k + 1) - fd_velocity(u, k)).norm());
                 }
                 CHECK(max_jump < 0.1 * v_impact);
-                // The corner at the strike is there, and as big as a reversal.
-                CHECK((fd_velocity(u, s) - fd_velocity(u, s - 1)).norm() > v_impact);
+                // The corner at the strike is there, and as big as a reversal (the
+                // buzz does not reverse: the hand presses on).
+                if (n != Nuance::buzz)
+                    CHECK((fd_velocity(u, s) - fd_velocity(u, s - 1)).norm() > v_impact);
+                else
+                    CHECK(fd_velocity(u, s).y() < 0.0);
                 // The interpolant is C1 across the sample boundaries too.
                 const double dt = 1.0 / u.rate_hz, eps = 1e-7;
                 for (int k = 1; k + 1 < u.samples(); ++k) {

@@ -333,7 +333,7 @@ TEST_CASE("render --score: the files, the summary, deterministic bytes", "[perfo
     CHECK(rows == 4);
     std::istringstream tips(slurp(dir / "a" / "tips.csv"));
     std::getline(tips, line);
-    CHECK(std::count(line.begin(), line.end(), ',') == 12);
+    CHECK(std::count(line.begin(), line.end(), ',') == 16);
     rows = 0;
     while (std::getline(tips, line))
         ++rows;

@@ -185,7 +185,7 @@ void check_whole_lines(const std::string &text, size_t &rows)
     const std::vector<std::string> all = lines(text);
     REQUIRE(!all.empty());
     const auto columns = std::count(all[0].begin(), all[0].end(), ',');
-    CHECK(columns == 17);
+    CHECK(columns == 18);
     for (size_t i = 1; i < all.size(); ++i) {
         INFO("row " << i << ": " << all[i]);
         CHECK(std::count(all[i].begin(), all[i].end(), ',') == columns);
@@ -230,7 +230,7 @@ TEST_CASE("render: two renders give identical bytes, the events add up to the st
         std::vector<std::string> f;
         while (std::getline(c, field, ','))
             f.push_back(field);
-        REQUIRE(f.size() == 18);
+        REQUIRE(f.size() == 19);
         CHECK(std::stol(f[0]) == static_cast<long>(i)); // seq in onset order
         CHECK(std::stoi(f[1]) == hand);
         CHECK(std::stoi(f[3]) == bounce);

@@ -319,9 +319,9 @@ TEST_CASE("score: the default score is Figure 5 - both hands with legato and acc
 TEST_CASE("score: errors name the source and line and column and the fault",
           "[score][parser][errors]")
 {
-    require_error(
-        "R legatto", 1, 3,
-        "unknown nuance 'legatto' (valid: legato, tenuto, accent, vertical_accent, staccato)");
+    require_error("R legatto", 1, 3,
+                  "unknown nuance 'legatto' (valid: legato, tenuto, accent, vertical_accent, "
+                  "staccato, buzz)");
     require_error("R\nX legato", 2, 1, "unknown statement 'X'");
     require_error("R+X", 1, 1, "unknown statement 'R+X' (expected a hand R, L, right, left, R+L");
     require_error("tempo 96\n  tempo 9x6", 2, 9, "malformed number '9x6' for tempo");

@@ -415,12 +415,12 @@ TEST_CASE("ictusd gestures is a verb of ictusd: help, export of the built-in dat
     CHECK(r.status == 0);
     CHECK(r.output.find("usage: ictusd gestures") != std::string::npos);
     // The built-in database holds one unit per grip x nuance x hand (docs/gestures.md):
-    // 2 x 5 x 2 = 20.
+    // 2 x 6 x 2 = 24.
     const std::string path = simtest::temp_path("gestures.json");
     std::remove(path.c_str());
     r = ictusd("gestures --export " + path);
     CHECK(r.status == 0);
-    CHECK(r.output.find("wrote 20 units to " + path) != std::string::npos);
+    CHECK(r.output.find("wrote 24 units to " + path) != std::string::npos);
     CHECK(std::ifstream(path).good());
     std::remove(path.c_str());
     r = ictusd("gestures --frobnicate");
@@ -469,14 +469,17 @@ CsvRows read_csv(const std::string &path)
 
 // `track` and `render --mocap` simulate the same clip in joint mode through
 // two different code paths (track_joint_space + the CLI's strike writer vs the
-// Performance of run/render): on the same drum both must log the same strikes.
+// Performance of run/render): on the same drum, with the same sticks (track's
+// are rigid in the hand; render's on their fulcrum unless --sticks rigid),
+// both must log the same strikes.
 TEST_CASE("ictusd track --out writes strikes.csv, the same strikes render finds", "[sim][cli]")
 {
     const std::string bvh = simtest::data_file("cmu/80_13.bvh");
     if (bvh.empty())
         return;
     const std::string rdir = simtest::temp_path("render-strikes");
-    const Run r = ictusd("render --mocap " + bvh + " --duration 6 --bvh-rate 0 --out " + rdir);
+    const Run r =
+        ictusd("render --mocap " + bvh + " --sticks rigid --duration 6 --bvh-rate 0 --out " + rdir);
     INFO(r.output);
     REQUIRE(r.status == 0);
     std::ifstream rj(rdir + "/render.json");

@@ -102,7 +102,6 @@ TEST_CASE("the grip holds the stick against gravity as a spring: k theta = torqu
             REQUIRE(std::fabs(torque) > 1e-3); // the test means something
             // Equilibrium: the spring's -k theta balances gravity about the axis.
             CHECK(k * scene.fulcrum_angle_rad(s) == Approx(torque).epsilon(0.03));
-            CHECK(std::fabs(scene.fulcrum_rate_rad_s(s)) < 1e-3);
         }
     }
 }
@@ -110,7 +109,9 @@ TEST_CASE("the grip holds the stick against gravity as a spring: k theta = torqu
 TEST_CASE("effective mass: a welded grip gives the one-body value, a loose one much less",
           "[sim][fulcrum]")
 {
-    Rig rig;
+    // German grip: in the T-pose the fulcrum axis is level, so the stick's pivoting moves
+    // the bead along the vertical (the French axis stands vertical there: no change).
+    Rig rig(Grip::german);
     Scene rigid(rig.model, rig.options(StickMount::rigid), rig.pose, rig.gains);
     Scene loose(rig.model, rig.options(StickMount::fulcrum), rig.pose, rig.gains);
     Scene firm(rig.model, rig.options(StickMount::fulcrum), rig.pose, rig.gains);

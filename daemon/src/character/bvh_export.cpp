@@ -115,14 +115,27 @@ BvhRecorder::BvhRecorder(const CharacterModel &model, const Skeleton &source, do
                              std::to_string(rate_hz));
 }
 
-void BvhRecorder::record(const BodyFrames &frames)
+void BvhRecorder::record(const BodyFrames &frames, const std::array<double, 2> &fulcrum_rad)
 {
     poses_.push_back(pose_from_frames(model_, frames));
+    fulcrum_rad_.push_back(fulcrum_rad);
 }
 
 void BvhRecorder::write(const std::string &path, const BvhWriteOptions &options) const
 {
-    write_bvh(path, skeleton_, motion_from_poses(model_, skeleton_, poses_, rate_hz_), options);
+    Motion motion = motion_from_poses(model_, skeleton_, poses_, rate_hz_);
+    // The sticks turned about their fulcrums (the stick joint sits at the grip
+    // point in the hand's frame).
+    for (int side = 0; side < 2; ++side) {
+        const int joint = skeleton_.find(side == 0 ? "LeftHandStick" : "RightHandStick");
+        if (joint < 0)
+            continue;
+        const Eigen::Vector3d &axis = model_.stick(static_cast<Side>(side)).fulcrum_axis;
+        for (size_t f = 0; f < motion.local_rotation.size() && f < fulcrum_rad_.size(); ++f)
+            motion.local_rotation[f][joint] =
+                Eigen::Quaterniond(Eigen::AngleAxisd(fulcrum_rad_[f][side], axis));
+    }
+    write_bvh(path, skeleton_, motion, options);
 }
 
 } // namespace ictus

@@ -64,7 +64,7 @@ void render_usage(std::ostream &out)
            "  --rebound S         the target's rebound after a beat, time constant (default\n"
            "                      0.1; 0: off)\n"
            "  --ik-gain G         Algorithm 2's gain on the tip error (default 4)\n"
-           "  --ik-velocity-gain S  tip velocity error term, s (default 0)\n"
+           "  --ik-velocity-gain S  tip velocity error term, s (default 0.03)\n"
            "  --lead-in S         time before the score's first beat (default 1)\n"
            "\n"
            "common options (run and render):\n"
@@ -383,7 +383,8 @@ int cmd_render(Args &args)
     if (bvh_every) {
         bvh = std::make_unique<BvhRecorder>(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h));
         perf.scene().body_frames(frames);
-        bvh->record(frames);
+        bvh->record(frames, {perf.scene().fulcrum_angle_rad(Side::left),
+                             perf.scene().fulcrum_angle_rad(Side::right)});
     }
     StrikeLog log;
     StrikeEvent ev[2];
@@ -399,7 +400,8 @@ int cmd_render(Args &args)
             write_tips_row(tips, perf);
         if (bvh && (n + 1) % bvh_every == 0) {
             perf.scene().body_frames(frames);
-            bvh->record(frames);
+            bvh->record(frames, {perf.scene().fulcrum_angle_rad(Side::left),
+                                 perf.scene().fulcrum_angle_rad(Side::right)});
         }
     }
     StrikeEvent last;

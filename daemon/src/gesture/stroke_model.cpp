@@ -54,7 +54,7 @@ const NuanceShape kShapes[kNuances] = {
     // legato: relaxed rebound stroke
     {1.00, 0.35, 3.0, 2.0, 0.0, 1.00, 0.00, 0.0},
     // tenuto: low, stays close to the head after the strike
-    {0.55, 0.40, 2.5, 2.0, 0.7, 0.80, 0.00, 0.0},
+    {0.55, 0.40, 2.5, 2.0, 0.5, 0.80, 0.00, 0.0},
     // accent: higher preparation, larger loop, rebound controlled lower
     {1.70, 0.40, 3.0, 2.0, 0.0, 0.75, 0.10, 0.0},
     // vertical accent: highest, lifted vertically
@@ -63,7 +63,7 @@ const NuanceShape kShapes[kNuances] = {
     {1.15, 0.30, 3.0, 4.0, 0.0, 1.00, 0.00, 0.0},
     // buzz: a legato-like downswing, then pressed into the head 2 cm over 60 %
     // of the lift time (a loose grip then bounces the stick there), lifted low
-    {0.75, 0.35, 3.0, 2.0, 0.0, 0.60, 0.00, 0.0, 0.02, 0.6},
+    {0.75, 0.35, 3.0, 2.0, 1.0, 0.60, 0.00, 0.0, 0.02, 0.6},
 };
 
 struct GripShape {

@@ -622,9 +622,6 @@ double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_wo
 PerformanceOptions::PerformanceOptions()
 {
     scene.sticks = StickMount::fulcrum;
-    // A joint pushed outside its range (the stick's reactions on the wrist)
-    // meets its stop 1 degree out (docs/perform.md, "Joint limits").
-    scene.stop_margin_rad = 1.0 * M_PI / 180.0;
 }
 
 ScorePerformOptions::ScorePerformOptions()
@@ -638,7 +635,10 @@ ScorePerformOptions::ScorePerformOptions()
     // at strike speeds (impact speeds +-20 % off the plan, not monotonic in
     // the dynamics); without it and with gain 4 they are within ~1 %.
     cartesian.gain = 4.0;
-    cartesian.velocity_gain_s = 0.0;
+    // With the sticks on their fulcrum the tip error is the held tip's (the
+    // stick's own swing is not fed back), and a small velocity term damps the
+    // hand's chatter after soft strokes (docs/perform.md, measured).
+    cartesian.velocity_gain_s = 0.03;
 }
 
 namespace
@@ -688,6 +688,9 @@ Performance::make_score_rig(const PerformanceOptions &options,
     const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
     const Eigen::Vector3d forward = left.cross(up);
     SceneOptions scene = options.scene;
+    // A joint pushed outside its range of motion (the stick's reactions on the
+    // wrist) meets its stop 1 degree out (docs/perform.md, "Joint limits").
+    scene.stop_margin_rad = std::min(scene.stop_margin_rad, 1.0 * M_PI / 180.0);
     if (options.drum_auto)
         scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
                               options.score.drum_forward_m * forward -
@@ -830,9 +833,11 @@ std::unique_ptr<Performance::PlanState> Performance::make_plan(std::shared_ptr<c
             ps->beats[s].push_back(n.time_s);
             ps->lead_s[s].push_back(lead);
             ps->approach_mps[s].push_back(v);
-            // A buzz is played with a loose grip unless the note says otherwise.
-            ps->firmness[s].push_back(
-                n.firmness >= 0.0 || n.nuance != Nuance::buzz ? n.firmness : kBuzzGripFirmness);
+            // A buzz is played with the loosest grip unless the note says otherwise.
+            double firmness = n.firmness;
+            if (firmness < 0.0 && n.nuance == Nuance::buzz)
+                firmness = kBuzzGripFirmness;
+            ps->firmness[s].push_back(firmness);
             ps->planned_speed_mps[i] = v;
         }
     }

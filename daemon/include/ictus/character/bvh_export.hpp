@@ -3,6 +3,8 @@
 // (write_bvh, bvh.hpp): any 3D tool then shows the performance without Gem.
 #pragma once
 
+#include <array>
+
 #include "ictus/mocap/bvh.hpp"
 #include "ictus/character/character.hpp"
 #include "ictus/mocap/motion.hpp"
@@ -39,9 +41,9 @@ CharacterPose pose_from_frames(const CharacterModel &model, const BodyFrames &fr
 
 // The skeleton plus the two drumsticks, so that a BVH shows them: per hand a
 // joint "<Hand>Stick" (LeftHandStick / RightHandStick) below the hand's source
-// joint at the stick's grip point, with an end site at the tip. A stick is
-// rigid in its hand (identity rotation), so its tip follows the hand frame
-// exactly as CharacterModel::tip_position. Appended after the existing joints.
+// joint at the stick's grip point, with an end site at the tip. At identity
+// the stick lies as the hand holds it at rest (CharacterModel::tip_position);
+// BvhRecorder turns it about its fulcrum. Appended after the existing joints.
 Skeleton skeleton_with_sticks(const CharacterModel &model, const Skeleton &skeleton);
 
 // Records a performance frame by frame and writes it as BVH: the source
@@ -54,8 +56,10 @@ class BvhRecorder
 {
   public:
     BvhRecorder(const CharacterModel &model, const Skeleton &source, double rate_hz);
-    // The physics' body frames (Scene::body_frames) of one frame.
-    void record(const BodyFrames &frames);
+    // The physics' body frames (Scene::body_frames) of one frame, and the
+    // sticks' fulcrum angles [side] (rad, about StickInHand::fulcrum_axis;
+    // 0: the stick as the hand holds it at rest).
+    void record(const BodyFrames &frames, const std::array<double, 2> &fulcrum_rad = {0.0, 0.0});
     int frames() const { return static_cast<int>(poses_.size()); }
     // Throws MocapError naming the path when it cannot be written.
     void write(const std::string &path, const BvhWriteOptions &options = {}) const;
@@ -65,6 +69,7 @@ class BvhRecorder
     Skeleton skeleton_; // with the sticks
     double rate_hz_;
     std::vector<CharacterPose> poses_;
+    std::vector<std::array<double, 2>> fulcrum_rad_;
 };
 
 } // namespace ictus
