@@ -115,10 +115,10 @@ BvhRecorder::BvhRecorder(const CharacterModel &model, const Skeleton &source, do
                              std::to_string(rate_hz));
 }
 
-void BvhRecorder::record(const BodyFrames &frames, const std::array<double, 2> &fulcrum_rad)
+void BvhRecorder::record(const BodyFrames &frames, const std::array<Eigen::Quaterniond, 2> &sticks)
 {
     poses_.push_back(pose_from_frames(model_, frames));
-    fulcrum_rad_.push_back(fulcrum_rad);
+    sticks_.push_back(sticks);
 }
 
 void BvhRecorder::write(const std::string &path, const BvhWriteOptions &options) const
@@ -130,10 +130,8 @@ void BvhRecorder::write(const std::string &path, const BvhWriteOptions &options)
         const int joint = skeleton_.find(side == 0 ? "LeftHandStick" : "RightHandStick");
         if (joint < 0)
             continue;
-        const Eigen::Vector3d &axis = model_.stick(static_cast<Side>(side)).fulcrum_axis;
-        for (size_t f = 0; f < motion.local_rotation.size() && f < fulcrum_rad_.size(); ++f)
-            motion.local_rotation[f][joint] =
-                Eigen::Quaterniond(Eigen::AngleAxisd(fulcrum_rad_[f][side], axis));
+        for (size_t f = 0; f < motion.local_rotation.size() && f < sticks_.size(); ++f)
+            motion.local_rotation[f][joint] = sticks_[f][side];
     }
     write_bvh(path, skeleton_, motion, options);
 }

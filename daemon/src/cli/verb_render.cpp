@@ -383,8 +383,8 @@ int cmd_render(Args &args)
     if (bvh_every) {
         bvh = std::make_unique<BvhRecorder>(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h));
         perf.scene().body_frames(frames);
-        bvh->record(frames, {perf.scene().fulcrum_angle_rad(Side::left),
-                             perf.scene().fulcrum_angle_rad(Side::right)});
+        bvh->record(frames, {perf.scene().stick_in_hand(Side::left),
+                             perf.scene().stick_in_hand(Side::right)});
     }
     StrikeLog log;
     StrikeEvent ev[2];
@@ -400,8 +400,8 @@ int cmd_render(Args &args)
             write_tips_row(tips, perf);
         if (bvh && (n + 1) % bvh_every == 0) {
             perf.scene().body_frames(frames);
-            bvh->record(frames, {perf.scene().fulcrum_angle_rad(Side::left),
-                                 perf.scene().fulcrum_angle_rad(Side::right)});
+            bvh->record(frames, {perf.scene().stick_in_hand(Side::left),
+                                 perf.scene().stick_in_hand(Side::right)});
         }
     }
     StrikeEvent last;

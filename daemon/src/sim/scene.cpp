@@ -769,6 +769,12 @@ double Scene::fulcrum_angle_rad(Side side) const
     return f ? dJointGetHingeAngle(f) : 0.0;
 }
 
+Eigen::Quaterniond Scene::stick_in_hand(Side side) const
+{
+    const Eigen::Quaterniond hand = to_eigen(dBodyGetQuaternion(body_[model_.hand_body(side)]));
+    return (hand.conjugate() * to_eigen(dBodyGetQuaternion(tip_body(side)))).normalized();
+}
+
 Eigen::Vector3d Scene::fulcrum_axis(Side side) const
 {
     const Eigen::Quaterniond q = to_eigen(dBodyGetQuaternion(body_[model_.hand_body(side)]));

@@ -57,9 +57,11 @@ class BvhRecorder
   public:
     BvhRecorder(const CharacterModel &model, const Skeleton &source, double rate_hz);
     // The physics' body frames (Scene::body_frames) of one frame, and the
-    // sticks' fulcrum angles [side] (rad, about StickInHand::fulcrum_axis;
-    // 0: the stick as the hand holds it at rest).
-    void record(const BodyFrames &frames, const std::array<double, 2> &fulcrum_rad = {0.0, 0.0});
+    // sticks' rotations in their hands' frames [side] (Scene::stick_in_hand;
+    // identity: the stick as the hand holds it at rest).
+    void record(const BodyFrames &frames,
+                const std::array<Eigen::Quaterniond, 2> &sticks = {Eigen::Quaterniond::Identity(),
+                                                                   Eigen::Quaterniond::Identity()});
     int frames() const { return static_cast<int>(poses_.size()); }
     // Throws MocapError naming the path when it cannot be written.
     void write(const std::string &path, const BvhWriteOptions &options = {}) const;
@@ -69,7 +71,7 @@ class BvhRecorder
     Skeleton skeleton_; // with the sticks
     double rate_hz_;
     std::vector<CharacterPose> poses_;
-    std::vector<std::array<double, 2>> fulcrum_rad_;
+    std::vector<std::array<Eigen::Quaterniond, 2>> sticks_;
 };
 
 } // namespace ictus

@@ -177,6 +177,9 @@ class Scene
     // the grip's axis defines) and rate; 0 with rigid sticks.
     double fulcrum_angle_rad(Side side) const;
     double fulcrum_rate_rad_s(Side side) const;
+    // The stick's rotation in its hand's frame (identity: as the hand holds
+    // it at rest; rigid sticks always): the fulcrum's turn and the joint's drift.
+    Eigen::Quaterniond stick_in_hand(Side side) const;
     // The fulcrum's axis and the stick's axis (butt to tip), unit, world.
     Eigen::Vector3d fulcrum_axis(Side side) const;
     Eigen::Vector3d stick_axis(Side side) const;
