@@ -1,0 +1,216 @@
+"""The sound's contact lasts as long as the physics' (docs/sound.md, "Contact
+duration: the sound's stick against the physics'"): through the real pd in batch
+mode (patches/ictus-render.pd, its render-reports file: contact~'s duration of
+every stroke), each stroke's contact duration in the sound is within 25 % of the
+physics' one. Two parts (--part):
+
+law    synthetic events files, no daemon: sticks of 0.01-0.05 kg at 0.5-10 m/s
+       (each line carrying its stick_mass_kg, as ictusd writes them) on the
+       physics' default drum (render.json's: radius 0.178 m, tension 3000 N/m,
+       density 0.26 kg/m^2), against the duration of the physics' contact law
+       computed here in closed form: the bead of mass m lands at v0 on the
+       spring-damper F = max(0, k d + c d') (docs/osc.md, k = 2 pi T / ln(R /
+       r_tip), r_tip 7 mm, c 10 N s/m, a massless head), the force falls to 0
+       at t_f (a damped oscillator's half-period to force zero), the bead then
+       flies free and the contact ends when it is back at the membrane plane,
+       which is where the strike detector ends it (its duration_ms: onset to
+       release, "release" = the bead above the plane).
+
+score  `ictusd render` plays the default score; its strikes.csv holds the
+       physics' duration and stick mass of every strike; the events file is
+       rendered on render.json's drum (as scripts/main.sh does) and every
+       strike's report is matched to it. Skipped (exit 77) while the daemon
+       writes no stick mass (all 0: the physics gives none yet).
+
+Per strike, not a median: the bound is a claim about every stroke the listener
+hears, and a median would hide a class of strokes (the lightest sticks, the
+softest strokes on a ringing head) that disagree. Each report is matched to its
+strike by hand and time: a contact~ reports when its stick is clear of the
+head, so a report belongs to the latest strike of its hand before it; a strike
+whose report never came (its stroke replaced by the next hit first) fails."""
+import argparse
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import e2e_util as u  # noqa: E402
+from pdrun import check, error_lines, make_workdir  # noqa: E402
+
+BOUND = 0.25           # |d_pd - d_physics| / d_physics, per strike
+TIP_RADIUS_M = 0.007   # the bead (daemon: StrikeDetectorOptions::tip_radius_m, docs/osc.md)
+DRUM = {"radius_m": 0.178, "tension_n_per_m": 3000.0, "density_kg_per_m2": 0.26,
+        "contact_damping_n_s_per_m": 10.0}  # the physics' default drum (render.json)
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--build", required=True)
+ap.add_argument("--part", choices=("law", "score"), required=True)
+args = ap.parse_args()
+build = os.path.abspath(args.build)
+work = make_workdir("ictus-e2e-contact-")
+
+
+def physics_duration_ms(m, k, c):
+    """Onset to release of a bead of mass m (kg) landing on F = max(0, k d + c d')
+    (k N/m, c N s/m) with a massless head: d = v0/wd e^(-z w0 t) sin(wd t) while
+    F > 0; F = k d + c d' = v0 e^(-z w0 t) (A sin(wd t) + c cos(wd t)) with
+    A = (k - c^2 / (2 m)) / wd is 0 first at wd t_f = pi - atan2(c, A); then
+    the bead moves at d'(t_f) < 0 with no force and is back at d = 0 after
+    d(t_f) / -d'(t_f). Independent of v0 (linear)."""
+    w0 = math.sqrt(k / m)
+    z = c / (2.0 * math.sqrt(k * m))
+    if not z < 1.0:
+        raise ValueError("overdamped contact (m %g kg): not a stroke" % m)
+    wd = w0 * math.sqrt(1.0 - z * z)
+    a = (k - c * c / (2.0 * m)) / wd
+    t_f = (math.pi - math.atan2(c, a)) / wd
+    decay = math.exp(-z * w0 * t_f)
+    d = decay * math.sin(wd * t_f) / wd                                # per unit v0
+    v = decay * (math.cos(wd * t_f) - z * w0 / wd * math.sin(wd * t_f))  # per unit v0
+    return (t_f + d / -v) * 1e3
+
+
+def force_zero_ms(m, k, c):
+    """t_f alone (the force's half-period), for the report."""
+    w0 = math.sqrt(k / m)
+    z = c / (2.0 * math.sqrt(k * m))
+    wd = w0 * math.sqrt(1.0 - z * z)
+    return (math.pi - math.atan2(c, (k - c * c / (2.0 * m)) / wd)) / wd * 1e3
+
+
+def read_reports(path):
+    """render-reports file -> [(time_ms, hand, duration_ms, peak_force_n, rebound_mps)]."""
+    with open(path) as f:
+        text = f.read()
+    rows = []
+    for n, raw in enumerate(text.split(";"), start=1):
+        words = raw.split()
+        if not words:
+            continue
+        if len(words) != 5:
+            raise ValueError("%s: report %d has %d numbers, expected 5" % (path, n, len(words)))
+        t, hand, dur, peak, reb = (float(w) for w in words)
+        rows.append((t, int(hand), dur, peak, reb))
+    return rows
+
+
+def match_reports(strikes_t_ms, strikes_hand, reports):
+    """Index of the report of each strike (None when it has none): a report goes
+    to the latest strike of its hand that started before it."""
+    owner, twice, orphans = [None] * len(strikes_t_ms), [], []
+    for r, (t, hand, _, _, _) in enumerate(reports):
+        before = [i for i in range(len(strikes_t_ms))
+                  if strikes_hand[i] == hand and strikes_t_ms[i] < t]
+        if not before:
+            orphans.append(r)
+            continue
+        i = max(before, key=lambda j: strikes_t_ms[j])
+        if owner[i] is not None:
+            twice.append(i)
+        owner[i] = r
+    check(not twice and not orphans, "at most one report per strike, none before the first "
+          "(strikes with two: %s, reports without a strike: %s)" % (twice, orphans))
+    return owner
+
+
+def render_with_reports(events_path, seconds, tag):
+    wav = os.path.join(work, "%s.wav" % tag)
+    reports = os.path.join(work, "%s-reports.txt" % tag)
+    cmd = [u.PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", "48000", "-path",
+           os.path.join(build, "ictus"), "-open", u.RENDER_PATCH,
+           "-send", "render-file %s" % events_path, "-send", "render-out %s" % wav,
+           "-send", "render-seconds %.3f" % seconds, "-send", "render-reports %s" % reports]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=u.PD_ENV)
+    log = proc.stdout + proc.stderr
+    check(proc.returncode == 0 and not error_lines(log),
+          "ictus-render ran cleanly (%s): %s" % (tag, error_lines(log)))
+    check(os.path.isfile(reports), "ictus-render wrote the contact reports (%s)" % tag)
+    return read_reports(reports)
+
+
+def judge(rows, what):
+    """rows: (label, d_physics_ms, d_pd_ms or None). Prints them, checks the bound."""
+    errors = []
+    print("%-44s %9s %9s %8s" % ("strike", "physics", "pd", "error"))
+    for label, d_phys, d_pd in rows:
+        e = None if d_pd is None else (d_pd - d_phys) / d_phys
+        errors.append(e)
+        print("%-44s %9.3f %9s %8s" % (label, d_phys, "-" if d_pd is None else "%.3f" % d_pd,
+                                        "-" if e is None else "%+.1f%%" % (100 * e)))
+    missing = [r[0] for r, e in zip(rows, errors) if e is None]
+    check(not missing, "%s: every strike has a contact~ report (missing: %s)" % (what, missing))
+    rel = np.array([abs(e) for e in errors])
+    signed = np.array(errors)
+    print("%s: %d strikes, |error| median %.1f%%, worst %.1f%%, signed %+.1f%% .. %+.1f%%"
+          % (what, len(rel), 100 * np.median(rel), 100 * rel.max(), 100 * signed.min(),
+             100 * signed.max()))
+    worst = int(np.argmax(rel))
+    check(rel.max() <= BOUND, "%s: every strike's contact~ duration within %d%% of the physics' "
+          "(worst %.1f%%: %s)" % (what, 100 * BOUND, 100 * rel.max(), rows[worst][0]))
+
+
+if args.part == "law":
+    k = 2.0 * math.pi * DRUM["tension_n_per_m"] / math.log(DRUM["radius_m"] / TIP_RADIUS_M)
+    c = DRUM["contact_damping_n_s_per_m"]
+    print("physics' contact: k = 2 pi T / ln(R / r_tip) = %.1f N/m, c = %g N s/m" % (k, c))
+    masses = (0.01, 0.02, 0.03, 0.05)
+    velocities = (0.5, 1.0, 2.0, 5.0, 10.0)
+    # one stroke a second (the head's t60 is 1 s: the previous one is 60 dB down), both
+    # hands in turn, where the default score hits (r/a 0.33-0.35) and a little around it
+    lines = ["render-drum radius %g" % DRUM["radius_m"],
+             "render-drum tension %g" % DRUM["tension_n_per_m"],
+             "render-drum density %g" % DRUM["density_kg_per_m2"]]
+    events, strikes = ["0 %s;" % l for l in lines], []
+    i = 0
+    for m in masses:
+        for v in velocities:
+            t_ms = 100.0 + 1000.0 * i
+            hand, ra, theta = i % 2, 0.30 + 0.01 * (i % 6), 20.0 * i
+            events.append("%.3f hit %d 0 0 %.4f %.5f %.2f 0 0 0 0 %.6f %.5f;"
+                          % (100.0 if i == 0 else 1000.0, hand, v, ra, theta, t_ms / 1e3, m))
+            strikes.append((t_ms, hand, m, v, ra))
+            i += 1
+    path = os.path.join(work, "law-events.txt")
+    with open(path, "w") as f:
+        f.write("\n".join(events) + "\n")
+    reports = render_with_reports(path, len(strikes) + 0.5, "law")
+    owner = match_reports([s[0] for s in strikes], [s[1] for s in strikes], reports)
+    rows = []
+    for (t_ms, hand, m, v, ra), r in zip(strikes, owner):
+        rows.append(("%.2f kg at %4.1f m/s, r/a %.2f (F=0 at %.2f ms)"
+                     % (m, v, ra, force_zero_ms(m, k, c)), physics_duration_ms(m, k, c),
+                     None if r is None else reports[r][2]))
+    judge(rows, "law")
+else:
+    ictusd = os.path.join(build, "ictusd")
+    check(os.access(ictusd, os.X_OK), "ictusd is built at %s" % ictusd)
+    out = os.path.join(work, "out")
+    proc = subprocess.run([ictusd, "render", "--out", out], capture_output=True, text=True,
+                          timeout=600)
+    check(proc.returncode == 0, "ictusd render (the default score) ran: %s" % proc.stderr[-2000:])
+    strikes = u.read_strikes(os.path.join(out, "strikes.csv"))
+    check(len(strikes) >= 8, "the default score gives strikes (%d)" % len(strikes))
+    check("stick_mass_kg" in strikes[0], "strikes.csv has the stick_mass_kg column")
+    if all(s["stick_mass_kg"] == 0 for s in strikes):
+        print("SKIPPED: every strike of the default score has stick_mass_kg 0 (the physics "
+              "does not give the stick's mass yet), so the sound plays contact~'s own stick")
+        sys.exit(77)
+    check(all(s["stick_mass_kg"] > 0 for s in strikes), "every strike carries a stick mass")
+    events = u.read_events(os.path.join(out, "events.txt"))
+    header = u.drum_lines(os.path.join(out, "render.json"))
+    path = os.path.join(work, "score-events.txt")
+    u.write_events(path, header, events)
+    seconds = strikes[-1]["time_s"] + 0.5
+    reports = render_with_reports(path, seconds, "score")
+    owner = match_reports([s["time_s"] * 1e3 for s in strikes], [s["hand"] for s in strikes],
+                          reports)
+    rows = []
+    for s, r in zip(strikes, owner):
+        rows.append(("%d hand %d%s %.4f kg at %.2f m/s, r/a %.2f"
+                     % (s["seq"], s["hand"], " bounce" if s["bounce"] else "", s["stick_mass_kg"],
+                        s["normal_velocity_mps"], s["r_over_a"]), s["duration_ms"],
+                     None if r is None else reports[r][2]))
+    judge(rows, "default score")
