@@ -360,9 +360,8 @@ TEST_CASE("strike: CSV and events lines have fixed, documented formats", "[osc][
           "0.0000,-1.0000,0.0000,0.01235\n");
     std::ostringstream ev;
     ictus::write_events_line(ev, e, 1.0);
-    CHECK(ev.str() ==
-          "250.000 hit 1 0 1 1.5000 0.28090 0.00 19.123 0.090000 7.130 0.2000 1.250000 "
-          "0.01235;\n");
+    CHECK(ev.str() == "250.000 hit 1 0 1 1.5000 0.28090 0.00 19.123 0.090000 7.130 0.2000 1.250000 "
+                      "0.01235;\n");
 }
 
 namespace

@@ -391,6 +391,10 @@ CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
         // The fulcrum sits in the fist: at the hand's CoM along the fingers,
         // 2.5 cm towards the palm.
         st.grip_m = de_leva_male(DeLevaSegment::hand).com_fraction * hand.distal_m + 0.025 * n;
+        // The stroke plane holds the stick and the hand's direction that is
+        // vertical in the grip (German: the palm normal; French: the thumb);
+        // the fulcrum turns about its normal.
+        st.fulcrum_axis = st.axis.cross(options.grip == Grip::german ? n : t).normalized();
         st.butt_m = st.grip_m - s.grip_from_butt_m * st.axis;
         st.tip_m = st.grip_m + (s.length_m - s.grip_from_butt_m) * st.axis;
         st.com_m = 0.5 * (st.butt_m + st.tip_m);

@@ -199,6 +199,8 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.cartesian.gain = parse_number(a, value(), 0.1, 100);
     else if (a == "--ik-velocity-gain")
         o.score.cartesian.velocity_gain_s = parse_number(a, value(), 0, 1);
+    else if (a == "--ik-rotation-weight")
+        o.score.cartesian.rotation_weight = parse_number(a, value(), 0, 1);
     else if (a == "--rebound")
         o.score.rebound_s = parse_number(a, value(), 0, 0.5);
     else if (a == "--lead-in")
@@ -216,6 +218,18 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
     else if (a == "--drum-density")
         o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
+    else if (a == "--sticks") {
+        const std::string v = value();
+        if (v == "fulcrum")
+            o.scene.sticks = StickMount::fulcrum;
+        else if (v == "rigid")
+            o.scene.sticks = StickMount::rigid;
+        else
+            throw UsageError("--sticks: expected fulcrum or rigid, got '" + v + "'");
+    } else if (a == "--grip-firmness")
+        o.grip_firmness = parse_number(a, value(), 0, 1);
+    else if (a == "--grip-damping")
+        o.scene.grip_damping_ratio = parse_number(a, value(), 0, 10);
     else if (a == "--bounce-height")
         o.strikes.bounce_height_m = parse_number(a, value(), 0, 1);
     else if (a == "--bounce-window")

@@ -185,6 +185,10 @@ void write_tips_header(std::ostream &out)
         for (const char *what : {"target", "sim"})
             for (const char *axis : {"x", "y", "z"})
                 out << ',' << hand << '_' << what << '_' << axis << "_m";
+    // Per hand, the tip's height where the hand holds it (the stick at its
+    // fulcrum's rest angle) and the fulcrum's angle.
+    for (const char *hand : {"left", "right"})
+        out << ',' << hand << "_held_y_m," << hand << "_fulcrum_rad";
     out << '\n';
 }
 
@@ -198,6 +202,12 @@ void write_tips_row(std::ostream &out, const Performance &perf)
             std::snprintf(buf, sizeof buf, ",%.5f,%.5f,%.5f", p.x(), p.y(), p.z());
             out << buf;
         }
+    for (int hand = 0; hand < 2; ++hand) {
+        const Side side = static_cast<Side>(hand);
+        std::snprintf(buf, sizeof buf, ",%.5f,%.5f", perf.scene().held_tip_position(side).y(),
+                      perf.scene().fulcrum_angle_rad(side));
+        out << buf;
+    }
     out << '\n';
 }
 

@@ -70,10 +70,33 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
     return solve(chain, target_tip_m, Eigen::Vector3d::UnitX(), 0.0, rotations_out);
 }
 
+IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
+                                     const Eigen::Vector3d &target_tip_m,
+                                     const Eigen::Quaterniond &target_rotation,
+                                     double rotation_weight, Eigen::Quaterniond *rotations_out)
+{
+    const double norm = target_rotation.norm();
+    if (!(target_rotation.coeffs().allFinite() && norm > 1e-12))
+        return solve(chain, target_tip_m, Eigen::Vector3d::Constant(std::nan("")), 1.0,
+                     rotations_out); // refused as invalid input
+    full_rotation_ = true;
+    target_rotation_ = Eigen::Quaterniond(target_rotation.coeffs() / norm);
+    const IkResult r =
+        solve(chain, target_tip_m, Eigen::Vector3d::UnitX(), rotation_weight, rotations_out);
+    full_rotation_ = false;
+    return r;
+}
+
 double ChainIkSolverPos_dls::direction_error(const ChainFrames &frames,
                                              const Eigen::Vector3d &target_direction,
-                                             Eigen::Vector3d *rotation_vector)
+                                             Eigen::Vector3d *rotation_vector) const
 {
+    if (full_rotation_) {
+        // The world rotation vector turning the last frame onto the target rotation.
+        *rotation_vector =
+            log_map(target_rotation_ * frames.joint_rotation[joints_ - 1].conjugate());
+        return rotation_vector->norm();
+    }
     // The world rotation vector turning the stick onto the target direction (shortest arc).
     const Eigen::Vector3d &d = frames.stick_direction;
     const Eigen::Vector3d axis = d.cross(target_direction);

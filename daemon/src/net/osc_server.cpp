@@ -343,6 +343,7 @@ const Spec kSpecs[] = {
     {"/ictus/drum/density", "f", CommandKind::drum_density, 0.01, 10.0, "drum density (kg/m^2)"},
     {"/ictus/score", "s", CommandKind::score, 0, 0, "score statement"},
     {"/ictus/score/clear", "", CommandKind::score_clear, 0, 0, ""},
+    {"/ictus/grip/firmness", "f", CommandKind::grip_firmness, 0.0, 1.0, "grip firmness (0..1)"},
 };
 
 bool one_of(const char *text, std::initializer_list<const char *> words)

@@ -104,7 +104,9 @@ struct Performance::PlanState {
     std::shared_ptr<const Score> score;
     GesturePlan plan;
     std::array<std::vector<double>, 2> beats, lead_s, approach_mps;
-    std::vector<double> planned_speed_mps; // [note of plan]
+    std::array<std::vector<double>, 2> firmness; // < 0: the performance's
+    std::array<size_t, 2> grip_note = {0, 0};    // the note whose grip is applied
+    std::vector<double> planned_speed_mps;       // [note of plan]
 };
 
 // Work for execute(): everything it needs is in the job (copies), so that it
@@ -311,6 +313,7 @@ void Performance::install_clip_rig(std::unique_ptr<Rig> rig)
     rig_->tracker->scene().set_drum(options_.scene.drum);
     scale_gains(rig_->base_gains, gain_scale_, rig_->gains);
     rig_->tracker->scene().set_gains(rig_->gains);
+    set_grips(options_.grip_firmness);
     // The simulation clock keeps running across rebuilds (strike times and
     // timetags stay monotonic); the clip restarts from its beginning.
     time_offset_s_ = previous_time;
@@ -528,6 +531,10 @@ bool Performance::apply(const Command &c, std::string *why)
         // contact stiffness 2 pi T / ln(R / r): nothing to rebuild.
         options_.drum_density_kg_per_m2 = c.value;
         return true;
+    case CommandKind::grip_firmness:
+        options_.grip_firmness = c.value;
+        set_grips(c.value);
+        return true;
     case CommandKind::score:
     case CommandKind::score_clear:
         return fail("score: the daemon plays a clip (--mocap); start it without --mocap to "
@@ -596,6 +603,11 @@ double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_wo
     return tip_radius_m * (1.0 + stick_dir_world.normalized().y());
 }
 } // namespace
+
+PerformanceOptions::PerformanceOptions()
+{
+    scene.sticks = StickMount::fulcrum;
+}
 
 ScorePerformOptions::ScorePerformOptions()
 {
@@ -713,6 +725,7 @@ void Performance::install_score_rig(std::unique_ptr<ScoreRig> rig, bool keep_pos
                         r.frame.forward);
     scale_gains(r.base_gains, gain_scale_, r.gains);
     r.tracker->scene().set_gains(r.gains);
+    set_grips(options_.grip_firmness);
     r.tracker->set_mode(mode);
     if (!keep_pose)
         rest_from_m_ = r.frame.rest_tip_m;
@@ -785,6 +798,7 @@ std::unique_ptr<Performance::PlanState> Performance::make_plan(std::shared_ptr<c
             ps->beats[s].push_back(n.time_s);
             ps->lead_s[s].push_back(lead);
             ps->approach_mps[s].push_back(v);
+            ps->firmness[s].push_back(n.firmness);
             ps->planned_speed_mps[i] = v;
         }
     }
@@ -964,9 +978,60 @@ bool Performance::work_pending() const
 
 void Performance::start_rest_move()
 {
+    set_grips(options_.grip_firmness);
     for (int s = 0; s < 2; ++s)
         rest_from_m_[s] = score_rig_->tips.position_m[s];
     rest_move_start_s_ = time_s();
+}
+
+Eigen::Vector3d Performance::direction_at(int s, double t) const
+{
+    const GesturePlan &plan = *plan_;
+    const std::vector<double> &times = plan.tips.time_s;
+    const std::vector<Eigen::Vector3d> &dir = plan.stick_dir[s];
+    if (times.empty() || dir.size() != times.size())
+        return rest_direction(s);
+    const double tp = times.front() + std::clamp(plan_time_of(s, t), 0.0, plan.tips.duration_s());
+    const size_t k = static_cast<size_t>(
+        std::min<std::ptrdiff_t>(std::upper_bound(times.begin(), times.end(), tp) - times.begin(),
+                                 static_cast<std::ptrdiff_t>(times.size()) - 1));
+    if (k == 0)
+        return dir.front();
+    const double w = (tp - times[k - 1]) / std::max(times[k] - times[k - 1], 1e-12);
+    const Eigen::Vector3d d = (1.0 - w) * dir[k - 1] + w * dir[k];
+    return d.norm() > 1e-9 ? Eigen::Vector3d(d.normalized()) : dir[k];
+}
+
+// Between plans: forward and 15 degrees down (kDefaultStickDirection), turned
+// 20 degrees toward the midline.
+Eigen::Vector3d Performance::rest_direction(int s) const
+{
+    const PerformerFrame &f = score_rig_->frame;
+    const double yaw = 20.0 * M_PI / 180.0;
+    const Eigen::Vector3d inward = s == static_cast<int>(Side::right) ? -f.right : f.right;
+    const Eigen::Vector3d level = std::cos(yaw) * f.forward + std::sin(yaw) * inward;
+    return (kDefaultStickDirection.y() * f.up + kDefaultStickDirection.z() * level).normalized();
+}
+
+// The plan time whose target the hand follows at plan time t (target_at's delay).
+double Performance::plan_time_of(int s, double t) const
+{
+    const std::vector<double> &beats = plan_state_->beats[s];
+    if (beats.empty())
+        return t;
+    auto it = std::upper_bound(beats.begin(), beats.end(), t);
+    const size_t k = static_cast<size_t>(it - beats.begin()); // beats[k-1] <= t < beats[k]
+    const std::vector<double> &lead = plan_state_->lead_s[s];
+    double delay;
+    if (k == 0)
+        delay = lead.front();
+    else if (k == beats.size())
+        delay = lead.back();
+    else {
+        const double w = (t - beats[k - 1]) / (beats[k] - beats[k - 1]);
+        delay = (1.0 - w) * lead[k - 1] + w * lead[k];
+    }
+    return t - delay;
 }
 
 Eigen::Vector3d Performance::target_at(int s, double t) const
@@ -980,25 +1045,13 @@ Eigen::Vector3d Performance::target_at(int s, double t) const
     // before (depth / speed: 4 ms for a soft 1 m/s stroke). Each note's
     // target is delayed by that lead, the delay interpolated linearly in
     // time between the hand's beats (a rate change of well under 2 %).
-    auto it = std::upper_bound(beats.begin(), beats.end(), t);
-    const size_t k = static_cast<size_t>(it - beats.begin()); // beats[k-1] <= t < beats[k]
-    const std::vector<double> &lead = plan_state_->lead_s[s];
-    double delay;
-    if (k == 0)
-        delay = lead.front();
-    else if (k == beats.size())
-        delay = lead.back();
-    else {
-        const double w = (t - beats[k - 1]) / (beats[k] - beats[k - 1]);
-        delay = (1.0 - w) * lead[k - 1] + w * lead[k];
-    }
-    const double tp = t - delay; // plan time
+    const double tp = plan_time_of(s, t);
     const Eigen::Vector3d p = plan.tips.sample(s, tp);
     double tc = options_.score.rebound_s;
     if (tc <= 0.0)
         return p;
-    // The rebound. A real stick bounces off the head at about its impact
-    // speed and the hand catches it; the units of the database lift slowly
+    // The scripted rebound (off by default, --rebound: the stick on its
+    // fulcrum rebounds by itself). The units of the database lift slowly
     // after the strike, so an arm driven down at the impact speed toward a
     // target that barely rises presses into the head for 30-70 ms
     // (docs/perform.md). After each beat the target gets an upward offset
@@ -1007,7 +1060,7 @@ Eigen::Vector3d Performance::target_at(int s, double t) const
     // impact speed, peaks v tc / e above the unit at tau = tc and fades
     // smoothly (never faster downward than 0.14 v), so the hand does not
     // strike again.
-    it = std::upper_bound(beats.begin(), beats.end(), tp);
+    auto it = std::upper_bound(beats.begin(), beats.end(), tp);
     if (it == beats.begin())
         return p;
     const size_t j = static_cast<size_t>(it - beats.begin()) - 1;
@@ -1018,6 +1071,38 @@ Eigen::Vector3d Performance::target_at(int s, double t) const
     if (tau >= 20.0 * tc)
         return p;
     return p + plan_state_->approach_mps[s][j] * tau * std::exp(-tau / tc) * score_rig_->frame.up;
+}
+
+void Performance::set_grips(double firmness)
+{
+    Scene &scene = score_rig_ ? score_rig_->tracker->scene() : rig_->tracker->scene();
+    for (int s = 0; s < 2; ++s) {
+        scene.set_grip_firmness(static_cast<Side>(s), firmness);
+        applied_firmness_[s] = firmness;
+    }
+}
+
+// Each hand holds its stick as its note asks (ScoreNote::firmness, else the
+// performance's), from halfway between the hand's previous beat and the
+// note's to halfway to its next: the grip of a stroke holds through its
+// strike and what follows it (a press).
+void Performance::apply_note_grips(double t)
+{
+    PlanState &ps = *plan_state_;
+    for (int s = 0; s < 2; ++s) {
+        const std::vector<double> &beats = ps.beats[s];
+        if (beats.empty())
+            continue;
+        size_t k = std::min(ps.grip_note[s], beats.size() - 1);
+        while (k + 1 < beats.size() && t > 0.5 * (beats[k] + beats[k + 1]))
+            ++k;
+        const double f = ps.firmness[s][k] >= 0.0 ? ps.firmness[s][k] : options_.grip_firmness;
+        if (f != applied_firmness_[s]) {
+            score_rig_->tracker->scene().set_grip_firmness(static_cast<Side>(s), f);
+            applied_firmness_[s] = f;
+        }
+        ps.grip_note[s] = k;
+    }
 }
 
 int Performance::step_score(StrikeEvent out[2])
@@ -1036,7 +1121,10 @@ int Performance::step_score(StrikeEvent out[2])
         for (int s = 0; s < 2; ++s) {
             tips.position_m[s] = target_at(s, t);
             tips.velocity_mps[s] = (target_at(s, t + dt) - target_at(s, t - dt)) / (2.0 * dt);
+            tips.stick_direction[s] = direction_at(s, t);
         }
+        tips.has_direction = true;
+        apply_note_grips(plan_time_s_);
         if (plan_time_s_ >= plan.duration_s) {
             plan_active_ = false;
             playing_ = false;
@@ -1053,10 +1141,22 @@ int Performance::step_score(StrikeEvent out[2])
             tips.position_m[s] =
                 x >= 1.0 ? r.frame.rest_tip_m[s] : Eigen::Vector3d(rest_from_m_[s] + w * d);
             tips.velocity_mps[s] = dw * d;
+            tips.stick_direction[s] = rest_direction(s);
         }
+        tips.has_direction = true;
     }
     r.tracker->step(r.body, &tips, true);
-    return detect_strikes(detector_, r.tracker->scene(), out, time_offset_s_);
+    const int n_ = detect_strikes(detector_, r.tracker->scene(), out, time_offset_s_);
+    if (std::getenv("ICTUS_DEBUG"))
+        for (int s = 0; s < 2; ++s)
+            if (detector_.in_contact(s)) {
+                const Scene &sc = r.tracker->scene();
+                const Eigen::Vector3d a = sc.fulcrum_axis(static_cast<Side>(s)),
+                                      st = sc.stick_axis(static_cast<Side>(s));
+                std::fprintf(stderr, "t %.3f hand %d axis %.2f %.2f %.2f stick %.2f %.2f %.2f\n",
+                             time_s(), s, a.x(), a.y(), a.z(), st.x(), st.y(), st.z());
+            }
+    return n_;
 }
 
 bool Performance::apply_score(const Command &c, std::string *why)
@@ -1138,6 +1238,16 @@ bool Performance::apply_score(const Command &c, std::string *why)
         }
         case CommandKind::drum_density:
             options_.drum_density_kg_per_m2 = c.value;
+            return true;
+        case CommandKind::grip_firmness:
+            // The notes without a firmness of their own take it at once.
+            options_.grip_firmness = c.value;
+            if (plan_active_) {
+                applied_firmness_[0] = applied_firmness_[1] = -1.0;
+                apply_note_grips(plan_time_s_);
+            } else {
+                set_grips(c.value);
+            }
             return true;
         case CommandKind::score:
             // Parsed now (an error names the statement and column); played at

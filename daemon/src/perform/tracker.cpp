@@ -170,7 +170,12 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
                 for (int k = 0; k < 4; ++k)
                     arm.kinematic_target[k] = target_[arm.joint[k]];
             arm.kinematic.set_rotations(arm.kinematic_target);
-            IkResult r = solver_->solve(arm.kinematic, tip_target, arm.kinematic_target);
+            Eigen::Quaterniond hand_target;
+            const bool orient = tips->has_direction && co.rotation_weight > 0.0 &&
+                                held_rotation(model, side, tips->stick_direction[s], hand_target);
+            IkResult r = orient ? solver_->solve(arm.kinematic, tip_target, hand_target,
+                                                 co.rotation_weight, arm.kinematic_target)
+                                : solver_->solve(arm.kinematic, tip_target, arm.kinematic_target);
             ik_stats_.iterations += r.iterations;
             ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
             ik_stats_.not_converged += r.status != IkStatus::converged;
@@ -188,9 +193,11 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
                 const Eigen::Vector3d sim_tip_chain = arm.feedback.tip_position();
                 if (!co.start_from_simulated)
                     arm.feedback.set_rotations(arm.kinematic_target);
-                const Eigen::Vector3d error = tip_target - scene_->tip_position(side);
+                // X^S where the hand holds the stick: on a fulcrum the stick's
+                // own swing (its rebound) is physics, not an error for the arm.
+                const Eigen::Vector3d error = tip_target - scene_->held_tip_position(side);
                 const Eigen::Vector3d velocity_error =
-                    tips->velocity_mps[s] - scene_->tip_velocity(side);
+                    tips->velocity_mps[s] - scene_->held_tip_velocity(side);
                 if (co.integral_per_s > 0.0 && integrate) {
                     arm.integral_m += co.integral_per_s * h * error;
                     const double norm = arm.integral_m.norm();
@@ -205,6 +212,11 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
                     correction *= co.correction_limit_m / correction_norm;
                 const Eigen::Vector3d ik_target =
                     sim_tip_chain + error + correction + arm.integral_m;
+                // The hands' rotation task stays in the kinematic IK: from its
+                // solution the feedback solve moves the arm only as the tip
+                // error asks (with the hand's rotation held, the gain's
+                // correction would have to come from the upper arm alone, and
+                // the loop chattered: docs/perform.md, "Holding the stick").
                 r = solver_->solve(arm.feedback, ik_target, arm.theta_target);
                 ik_stats_.iterations += r.iterations;
                 ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
@@ -231,6 +243,28 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
     scene_->set_joint_targets(target_, rate_);
     ++steps_;
     return scene_->step();
+}
+
+bool held_rotation(const CharacterModel &model, Side side, const Eigen::Vector3d &direction,
+                   Eigen::Quaterniond &out)
+{
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+    if (!(direction.allFinite() && direction.norm() > 1e-9))
+        return false;
+    const Eigen::Vector3d d = direction.normalized();
+    // French (thumb up): the fulcrum axis is stick x thumb = d x up; German
+    // (palm down): stick x palm normal = d x (-up) (character.cpp).
+    Eigen::Vector3d f = model.options().grip == Grip::french ? d.cross(up) : up.cross(d);
+    if (f.norm() < 0.2)
+        return false;
+    f.normalize();
+    const StickInHand &st = model.stick(side);
+    Eigen::Matrix3d local, world;
+    local << st.axis, st.fulcrum_axis, st.axis.cross(st.fulcrum_axis);
+    world << d, f, d.cross(f);
+    out = Eigen::Quaterniond(Eigen::Matrix3d(world * local.transpose()));
+    out.normalize();
+    return true;
 }
 
 void Tracker::solve_arms(const CharacterModel &model, const std::vector<JointLimitRef> &limits,

@@ -334,6 +334,7 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
         p.tempo_bpm = score.tempo.tempo_at_beat(n.beat);
         p.r_over_a = n.r_over_a;
         p.theta_deg = n.theta_deg;
+        p.firmness = n.firmness;
         p.strike_point_m = membrane_point(frame, n.r_over_a, n.theta_deg);
         p.tip_target_m = p.strike_point_m - opt.strike_depth_m * frame.up;
         p.line = n.line;

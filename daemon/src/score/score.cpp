@@ -140,7 +140,17 @@ struct Token {
     int column = 0;
 };
 
-enum class Kind { note, rest, tempo, grip, default_beats, default_dynamics, repeat, end };
+enum class Kind {
+    note,
+    rest,
+    tempo,
+    grip,
+    default_beats,
+    default_dynamics,
+    default_firmness,
+    repeat,
+    end
+};
 
 struct Statement {
     Kind kind = Kind::note;
@@ -153,6 +163,7 @@ struct Statement {
     std::optional<double> beats;    // note, rest, default_beats
     std::optional<double> dynamics; // note, default_dynamics
     std::optional<double> r_over_a, theta_deg;
+    std::optional<double> firmness; // note, default_firmness
     // tempo: start_bpm absent means "from the current tempo"
     std::optional<double> start_bpm;
     double end_bpm = 0.0;
@@ -441,6 +452,10 @@ class LineParser
             st.kind = Kind::default_dynamics;
             st.dynamics = dynamics_value(need(tk, 1, "'dynamics' needs a value 0..1 or pp..ff"));
             no_more(tk, 2, "the dynamics");
+        } else if (key == "firmness") {
+            st.kind = Kind::default_firmness;
+            st.firmness = firmness_value(need(tk, 1, "'firmness' needs a value 0..1"));
+            no_more(tk, 2, "the firmness");
         } else if (key == "repeat") {
             st.kind = Kind::repeat;
             const Token &n = need(tk, 1, "repeat needs a count, e.g. 'repeat 4'");
@@ -456,9 +471,17 @@ class LineParser
             fail(tk[0].column,
                  "unknown statement '" + tk[0].text +
                      "' (expected a hand R, L, right, left, R+L, or tempo, grip, rest, "
-                     "beats, dynamics, repeat, end)");
+                     "beats, dynamics, firmness, repeat, end)");
         }
         return st;
+    }
+
+    double firmness_value(const Token &t) const
+    {
+        const double f = number(t, "firmness");
+        if (!(f >= 0.0 && f <= 1.0))
+            fail(t.column, "firmness " + t.text + " is out of range (0..1: 0 loose, 1 firm)");
+        return f;
     }
 
     void note_options(const std::vector<Token> &tk, Statement &st) const
@@ -479,6 +502,12 @@ class LineParser
                 if (st.beats)
                     fail(t.column, "second duration in one note");
                 st.beats = duration(need(tk, i + 1, "'beats' needs a duration"), "note duration");
+                ++i;
+            } else if (t.lower == "firmness") {
+                if (st.firmness)
+                    fail(t.column, "second firmness in one note");
+                st.firmness = firmness_value(
+                    need(tk, i + 1, "'firmness' needs a value 0..1 (0 loose, 1 firm)"));
                 ++i;
             } else if (t.lower == "at") {
                 if (st.r_over_a)
@@ -514,7 +543,8 @@ class LineParser
             } else {
                 fail(t.column, "unexpected '" + t.text + "' in a note: expected a nuance (" +
                                    nuance_list() + "), dynamics (0..1 or " + dynamics_list() +
-                                   "), a duration (N/D or 'beats X') or 'at R/A THETA'");
+                                   "), a duration (N/D or 'beats X'), 'at R/A THETA' or "
+                                   "'firmness F'");
             }
         }
     }
@@ -611,6 +641,7 @@ Score ScoreBuilder::finish() const
     Grip grip = Grip::french;
     double default_beats = kDefaultNoteBeats;
     double default_dynamics = kDefaultDynamics;
+    double default_firmness = -1.0; // the performance's
     struct Loop {
         size_t body; // first statement of the body
         int left;    // passes still to play after this one
@@ -641,6 +672,7 @@ Score ScoreBuilder::finish() const
             n.grip = grip;
             n.dynamics = st.dynamics.value_or(default_dynamics);
             n.r_over_a = st.r_over_a.value_or(kDefaultRadiusFraction);
+            n.firmness = st.firmness.value_or(default_firmness);
             n.line = st.line;
             n.column = st.column;
             for (Side hand : {Side::right, Side::left}) {
@@ -669,6 +701,9 @@ Score ScoreBuilder::finish() const
             break;
         case Kind::default_dynamics:
             default_dynamics = *st.dynamics;
+            break;
+        case Kind::default_firmness:
+            default_firmness = *st.firmness;
             break;
         case Kind::repeat:
             loops.push_back({pc + 1, st.count - 1});

@@ -108,6 +108,31 @@ void validate(const SceneOptions &o)
     check_finite_positive("divergence joint separation bound (m)", o.max_joint_separation_m);
     if (!(std::isfinite(o.stop_margin_rad) && o.stop_margin_rad >= 0.0))
         throw CharacterError("limit stop margin: expected a finite value >= 0");
+    if (!(std::isfinite(o.grip_damping_ratio) && o.grip_damping_ratio >= 0.0 &&
+          o.grip_damping_ratio <= 10.0))
+        throw CharacterError("grip damping ratio: expected 0..10");
+    for (const GripSpring &g : o.grip) {
+        check_finite_positive("grip stiffness (N m/rad)", g.stiffness_nm_per_rad, 1e6);
+        if (!(std::isfinite(g.damping_nm_s_per_rad) && g.damping_nm_s_per_rad >= 0.0 &&
+              g.damping_nm_s_per_rad <= 1e4))
+            throw CharacterError("grip damping (N m s/rad): expected a finite value in [0, 1e4]");
+    }
+}
+
+GripSpring grip_spring(double firmness, double stick_inertia_kg_m2, double damping_ratio)
+{
+    if (!(std::isfinite(damping_ratio) && damping_ratio >= 0.0 && damping_ratio <= 10.0))
+        throw CharacterError("grip damping ratio: expected 0..10, got " +
+                             std::to_string(damping_ratio));
+    if (!(std::isfinite(firmness) && firmness >= 0.0 && firmness <= 1.0))
+        throw CharacterError("grip firmness: expected 0..1, got " + std::to_string(firmness));
+    if (!(std::isfinite(stick_inertia_kg_m2) && stick_inertia_kg_m2 > 0.0))
+        throw CharacterError("grip firmness: the stick's inertia must be > 0");
+    GripSpring g;
+    g.stiffness_nm_per_rad = 2.0 * std::exp2(7.0 * firmness);
+    g.damping_nm_s_per_rad =
+        2.0 * damping_ratio * std::sqrt(g.stiffness_nm_per_rad * stick_inertia_kg_m2);
+    return g;
 }
 
 Scene::Scene(const CharacterModel &model, const SceneOptions &options, const CharacterPose &initial,
@@ -190,11 +215,19 @@ void Scene::build(const CharacterPose &initial)
 
     BodyFrames frames;
     model_.forward(initial, frames);
+    const bool fulcrum = options_.sticks == StickMount::fulcrum;
     for (int b = 0; b < CharacterModel::kBodies; ++b) {
         double m;
         Eigen::Vector3d c;
         Eigen::Matrix3d inertia;
-        model_.merged_mass(b, m, c, inertia);
+        if (fulcrum) { // the sticks are bodies of their own
+            const BodySpec &spec = model_.bodies()[b];
+            m = spec.mass_kg;
+            c = spec.com_m;
+            inertia = spec.inertia_kg_m2;
+        } else {
+            model_.merged_mass(b, m, c, inertia);
+        }
         com_local_[b] = c;
         dBodyID body = dBodyCreate(world_);
         dMass mass;
@@ -229,11 +262,34 @@ void Scene::build(const CharacterPose &initial)
         dJointSetFeedback(motor_[j], reinterpret_cast<dJointFeedback *>(&feedback_[j]));
     }
 
-    // Sticks: geometry on the hand bodies (mass already merged into them).
+    // Sticks: on a fulcrum, bodies of their own whose frame is the hand's at
+    // the rest angle; rigid, geometry on the hand bodies (mass merged).
     const StickParams &sp = model_.options().stick;
     for (int side = 0; side < 2; ++side) {
         const int hb = model_.hand_body(static_cast<Side>(side));
         const StickInHand &st = model_.stick(static_cast<Side>(side));
+        if (fulcrum) {
+            dBodyID body = dBodyCreate(world_);
+            const Eigen::Matrix3d &in = st.inertia_kg_m2;
+            dMass mass;
+            dMassSetParameters(&mass, sp.mass_kg, 0, 0, 0, in(0, 0), in(1, 1), in(2, 2), in(0, 1),
+                               in(0, 2), in(1, 2));
+            dBodySetMass(body, &mass);
+            const Eigen::Vector3d p = frames.origin_m[hb] + frames.rotation[hb] * st.com_m;
+            dBodySetPosition(body, p.x(), p.y(), p.z());
+            dQuaternion q;
+            to_ode(frames.rotation[hb], q);
+            dBodySetQuaternion(body, q);
+            stick_body_[side] = body;
+            const Eigen::Vector3d anchor = frames.origin_m[hb] + frames.rotation[hb] * st.grip_m;
+            const Eigen::Vector3d axis = frames.rotation[hb] * st.fulcrum_axis;
+            fulcrum_[side] = dJointCreateHinge(world_, nullptr);
+            dJointAttach(fulcrum_[side], body, body_[hb]);
+            dJointSetHingeAnchor(fulcrum_[side], anchor.x(), anchor.y(), anchor.z());
+            dJointSetHingeAxis(fulcrum_[side], axis.x(), axis.y(), axis.z());
+            apply_grip(side);
+        }
+        const Eigen::Vector3d origin = fulcrum ? st.com_m : com_local_[hb];
         const double tip_r = sp.tip_radius_m;
         const Eigen::Vector3d tip_centre = st.tip_m - tip_r * st.axis;
         const double shaft_len =
@@ -241,14 +297,14 @@ void Scene::build(const CharacterPose &initial)
         stick_shaft_[side] = dCreateCapsule(space_, sp.shaft_radius_m, shaft_len);
         stick_tip_[side] = dCreateSphere(space_, tip_r);
         for (dGeomID g : {stick_shaft_[side], stick_tip_[side]}) {
-            dGeomSetBody(g, body_[hb]);
+            dGeomSetBody(g, fulcrum ? stick_body_[side] : body_[hb]);
             dGeomSetCategoryBits(g, kStickCategory);
             dGeomSetCollideBits(g, kDrumCategory);
         }
-        const Eigen::Vector3d shaft_mid = 0.5 * (st.butt_m + tip_centre) - com_local_[hb];
+        const Eigen::Vector3d shaft_mid = 0.5 * (st.butt_m + tip_centre) - origin;
         dGeomSetOffsetPosition(stick_shaft_[side], shaft_mid.x(), shaft_mid.y(), shaft_mid.z());
         set_rotation(stick_shaft_[side], z_onto(st.axis), true);
-        const Eigen::Vector3d tip_off = tip_centre - com_local_[hb];
+        const Eigen::Vector3d tip_off = tip_centre - origin;
         dGeomSetOffsetPosition(stick_tip_[side], tip_off.x(), tip_off.y(), tip_off.z());
     }
 
@@ -293,6 +349,46 @@ void Scene::set_drum(const DrumParams &drum)
         throw CharacterError("drum radius: must exceed the stick tip radius");
     options_.drum = drum;
     place_drum();
+}
+
+// The grip's spring-damper as the fulcrum's soft stop at 0 rad: with lo ==
+// hi ODE makes the stop row two-sided, and its ERP / CFM from k and c (ODE
+// manual: ERP = h k / (h k + c), CFM = 1 / (h k + c)) make it the implicit
+// spring-damper torque -k theta - c theta', stable at any stiffness.
+void Scene::apply_grip(int side)
+{
+    if (!fulcrum_[side])
+        return;
+    const GripSpring &g = options_.grip[side];
+    const double h = options_.step_s;
+    const double hk = h * g.stiffness_nm_per_rad;
+    dJointSetHingeParam(fulcrum_[side], dParamLoStop, 0.0);
+    dJointSetHingeParam(fulcrum_[side], dParamHiStop, 0.0);
+    dJointSetHingeParam(fulcrum_[side], dParamStopERP, hk / (hk + g.damping_nm_s_per_rad));
+    dJointSetHingeParam(fulcrum_[side], dParamStopCFM, 1.0 / (hk + g.damping_nm_s_per_rad));
+    dJointSetHingeParam(fulcrum_[side], dParamBounce, 0.0);
+}
+
+void Scene::set_grip(Side side, const GripSpring &grip)
+{
+    SceneOptions candidate = options_;
+    candidate.grip[static_cast<int>(side)] = grip;
+    validate(candidate);
+    options_.grip[static_cast<int>(side)] = grip;
+    apply_grip(static_cast<int>(side));
+}
+
+double Scene::fulcrum_inertia_kg_m2(Side side) const
+{
+    const StickInHand &st = model_.stick(side);
+    const Eigen::Vector3d &a = st.fulcrum_axis;
+    const double d = a.cross(st.com_m - st.grip_m).norm();
+    return a.dot(st.inertia_kg_m2 * a) + model_.options().stick.mass_kg * d * d;
+}
+
+void Scene::set_grip_firmness(Side side, double firmness)
+{
+    set_grip(side, grip_spring(firmness, fulcrum_inertia_kg_m2(side), options_.grip_damping_ratio));
 }
 
 void Scene::near_callback(void *data, dGeomID a, dGeomID b)
@@ -423,11 +519,15 @@ void Scene::apply_control()
 
 bool Scene::check() const
 {
-    for (int b = 0; b < CharacterModel::kBodies; ++b) {
-        const Eigen::Vector3d p = to_eigen3(dBodyGetPosition(body_[b]));
-        const Eigen::Vector3d v = to_eigen3(dBodyGetLinearVel(body_[b]));
-        const Eigen::Vector3d w = to_eigen3(dBodyGetAngularVel(body_[b]));
-        const Eigen::Quaterniond q = to_eigen(dBodyGetQuaternion(body_[b]));
+    for (int b = 0; b < CharacterModel::kBodies + 2; ++b) {
+        dBodyID body =
+            b < CharacterModel::kBodies ? body_[b] : stick_body_[b - CharacterModel::kBodies];
+        if (!body)
+            continue;
+        const Eigen::Vector3d p = to_eigen3(dBodyGetPosition(body));
+        const Eigen::Vector3d v = to_eigen3(dBodyGetLinearVel(body));
+        const Eigen::Vector3d w = to_eigen3(dBodyGetAngularVel(body));
+        const Eigen::Quaterniond q = to_eigen(dBodyGetQuaternion(body));
         if (!p.allFinite() || !v.allFinite() || !w.allFinite() || !q.coeffs().allFinite())
             return false;
         if (v.norm() > options_.max_linear_speed_mps || w.norm() > options_.max_angular_speed_rad_s)
@@ -441,6 +541,16 @@ bool Scene::check() const
             std::sqrt((a1[0] - a2[0]) * (a1[0] - a2[0]) + (a1[1] - a2[1]) * (a1[1] - a2[1]) +
                       (a1[2] - a2[2]) * (a1[2] - a2[2]));
         if (!(d <= options_.max_joint_separation_m))
+            return false;
+    }
+    for (dJointID f : fulcrum_) {
+        if (!f)
+            continue;
+        dVector3 a1, a2;
+        dJointGetHingeAnchor(f, a1);
+        dJointGetHingeAnchor2(f, a2);
+        const Eigen::Vector3d d = to_eigen3(a1) - to_eigen3(a2);
+        if (!(d.norm() <= options_.max_joint_separation_m))
             return false;
     }
     return true;
@@ -528,6 +638,22 @@ void Scene::reset(const CharacterPose &pose_in)
         dBodySetForce(body_[b], 0, 0, 0);
         dBodySetTorque(body_[b], 0, 0, 0);
     }
+    for (int side = 0; side < 2; ++side) {
+        dBodyID stick = stick_body_[side];
+        if (!stick)
+            continue;
+        const int hb = model_.hand_body(static_cast<Side>(side));
+        const Eigen::Vector3d p =
+            frames.origin_m[hb] + frames.rotation[hb] * model_.stick(static_cast<Side>(side)).com_m;
+        dBodySetPosition(stick, p.x(), p.y(), p.z());
+        dQuaternion q;
+        to_ode(frames.rotation[hb], q);
+        dBodySetQuaternion(stick, q);
+        dBodySetLinearVel(stick, 0, 0, 0);
+        dBodySetAngularVel(stick, 0, 0, 0);
+        dBodySetForce(stick, 0, 0, 0);
+        dBodySetTorque(stick, 0, 0, 0);
+    }
     dJointGroupEmpty(contacts_);
     drum_contact_ = {};
     weld_feedback_ = Feedback{};
@@ -555,38 +681,191 @@ void Scene::local_rotations(std::vector<Eigen::Quaterniond> &local) const
     }
 }
 
+dBodyID Scene::tip_body(Side side) const
+{
+    dBodyID stick = stick_body_[static_cast<int>(side)];
+    return stick ? stick : body_[model_.hand_body(side)];
+}
+
+Eigen::Vector3d Scene::tip_body_com(Side side) const
+{
+    return stick_body_[static_cast<int>(side)] ? model_.stick(side).com_m
+                                               : com_local_[model_.hand_body(side)];
+}
+
+namespace
+{
+// A point fixed in a body, given in the hand frame (`rel`: relative to the
+// body's CoM), and its velocity.
+Eigen::Vector3d point_of(dBodyID body, const Eigen::Vector3d &rel)
+{
+    dVector3 out;
+    dBodyGetRelPointPos(body, rel.x(), rel.y(), rel.z(), out);
+    return to_eigen3(out);
+}
+Eigen::Vector3d velocity_of(dBodyID body, const Eigen::Vector3d &rel)
+{
+    dVector3 out;
+    dBodyGetRelPointVel(body, rel.x(), rel.y(), rel.z(), out);
+    return to_eigen3(out);
+}
+} // namespace
+
 Eigen::Vector3d Scene::tip_position(Side side) const
 {
-    const int hb = model_.hand_body(side);
-    const Eigen::Vector3d rel = model_.stick(side).tip_m - com_local_[hb];
-    dVector3 out;
-    dBodyGetRelPointPos(body_[hb], rel.x(), rel.y(), rel.z(), out);
-    return to_eigen3(out);
+    return point_of(tip_body(side), model_.stick(side).tip_m - tip_body_com(side));
+}
+
+Eigen::Vector3d Scene::tip_velocity(Side side) const
+{
+    return velocity_of(tip_body(side), model_.stick(side).tip_m - tip_body_com(side));
 }
 
 // The bead's centre (the tip minus one bead radius along the stick), relative
-// to the hand body's centre of mass, in its frame: what ODE's point queries take.
+// to the tip body's centre of mass, in its frame: what ODE's point queries take.
 Eigen::Vector3d Scene::bead_rel_com(Side side) const
 {
-    const int hb = model_.hand_body(side);
     const StickInHand &st = model_.stick(side);
-    return st.tip_m - model_.options().stick.tip_radius_m * st.axis - com_local_[hb];
+    return st.tip_m - model_.options().stick.tip_radius_m * st.axis - tip_body_com(side);
 }
 
 Eigen::Vector3d Scene::bead_position(Side side) const
 {
-    const Eigen::Vector3d rel = bead_rel_com(side);
-    dVector3 out;
-    dBodyGetRelPointPos(body_[model_.hand_body(side)], rel.x(), rel.y(), rel.z(), out);
-    return to_eigen3(out);
+    return point_of(tip_body(side), bead_rel_com(side));
 }
 
 Eigen::Vector3d Scene::bead_velocity(Side side) const
 {
-    const Eigen::Vector3d rel = bead_rel_com(side);
-    dVector3 out;
-    dBodyGetRelPointVel(body_[model_.hand_body(side)], rel.x(), rel.y(), rel.z(), out);
-    return to_eigen3(out);
+    return velocity_of(tip_body(side), bead_rel_com(side));
+}
+
+Eigen::Vector3d Scene::held_tip_position(Side side) const
+{
+    const int hb = model_.hand_body(side);
+    return point_of(body_[hb], model_.stick(side).tip_m - com_local_[hb]);
+}
+
+Eigen::Vector3d Scene::held_tip_velocity(Side side) const
+{
+    const int hb = model_.hand_body(side);
+    return velocity_of(body_[hb], model_.stick(side).tip_m - com_local_[hb]);
+}
+
+Eigen::Vector3d Scene::held_bead_position(Side side) const
+{
+    const int hb = model_.hand_body(side);
+    const StickInHand &st = model_.stick(side);
+    return point_of(body_[hb],
+                    st.tip_m - model_.options().stick.tip_radius_m * st.axis - com_local_[hb]);
+}
+
+double Scene::fulcrum_angle_rad(Side side) const
+{
+    dJointID f = fulcrum_[static_cast<int>(side)];
+    return f ? dJointGetHingeAngle(f) : 0.0;
+}
+
+Eigen::Vector3d Scene::fulcrum_axis(Side side) const
+{
+    const Eigen::Quaterniond q = to_eigen(dBodyGetQuaternion(body_[model_.hand_body(side)]));
+    return q * model_.stick(side).fulcrum_axis;
+}
+
+Eigen::Vector3d Scene::stick_axis(Side side) const
+{
+    return to_eigen(dBodyGetQuaternion(tip_body(side))) * model_.stick(side).axis;
+}
+
+double Scene::fulcrum_rate_rad_s(Side side) const
+{
+    dJointID f = fulcrum_[static_cast<int>(side)];
+    return f ? dJointGetHingeAngleRate(f) : 0.0;
+}
+
+namespace
+{
+// The inverse of the effective mass at a point p along n of a set of rigid
+// bodies whose velocities are J u for the generalised velocities u:
+// n^T G (J^T M J)^-1 G^T n, G the point's velocity row in u.
+double inverse_effective_mass(const Eigen::MatrixXd &J, const Eigen::MatrixXd &M,
+                              const Eigen::RowVectorXd &g)
+{
+    const Eigen::MatrixXd Mu = J.transpose() * M * J;
+    return g * Mu.ldlt().solve(g.transpose());
+}
+
+Eigen::Matrix3d skew(const Eigen::Vector3d &v)
+{
+    Eigen::Matrix3d m;
+    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+    return m;
+}
+
+// A body's world mass matrix (diag m, world inertia about its CoM).
+void body_mass(dBodyID body, Eigen::Matrix<double, 6, 6> &out)
+{
+    dMass mass;
+    dBodyGetMass(body, &mass);
+    Eigen::Matrix3d local;
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k)
+            local(i, k) = mass.I[i * 4 + k];
+    const Eigen::Matrix3d r = to_eigen(dBodyGetQuaternion(body)).toRotationMatrix();
+    out.setZero();
+    out.topLeftCorner<3, 3>() = mass.mass * Eigen::Matrix3d::Identity();
+    out.bottomRightCorner<3, 3>() = r * local * r.transpose();
+}
+} // namespace
+
+double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in) const
+{
+    const Eigen::Vector3d n = normal_in.normalized();
+    const int s = static_cast<int>(side);
+    dBodyID hand = body_[model_.hand_body(side)];
+    const Eigen::Vector3d ch = to_eigen3(dBodyGetPosition(hand));
+    const Eigen::Vector3d bead = bead_position(side);
+    Eigen::Matrix<double, 6, 6> mh;
+    body_mass(hand, mh);
+    if (!stick_body_[s]) {
+        // One body: 1/m + (r x n)^T I^-1 (r x n).
+        // n . (v + w x r) = n . v + w . (r x n).
+        Eigen::RowVectorXd g(6);
+        g << n.transpose(), (bead - ch).cross(n).transpose();
+        return 1.0 / inverse_effective_mass(Eigen::MatrixXd::Identity(6, 6), mh, g);
+    }
+    dBodyID stick = stick_body_[s];
+    const Eigen::Vector3d cs = to_eigen3(dBodyGetPosition(stick));
+    dVector3 anchor, axis;
+    dJointGetHingeAnchor(fulcrum_[s], anchor);
+    dJointGetHingeAxis(fulcrum_[s], axis);
+    const Eigen::Vector3d p = to_eigen3(anchor), a = to_eigen3(axis).normalized();
+    Eigen::Matrix<double, 6, 6> ms;
+    body_mass(stick, ms);
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(12, 12);
+    M.topLeftCorner<6, 6>() = mh;
+    M.bottomRightCorner<6, 6>() = ms;
+    // u = (v_h, w_h, theta'): the hand's twist and the fulcrum's rate.
+    // Stick: w_s = w_h + a theta'; v_s = v_h + w_h x (c_s - c_h) + theta' a x (c_s - p).
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(12, 7);
+    J.block<3, 3>(0, 0).setIdentity();
+    J.block<3, 3>(3, 3).setIdentity();
+    J.block<3, 3>(6, 0).setIdentity();
+    J.block<3, 3>(6, 3) = -skew(cs - ch);
+    J.block<3, 1>(6, 6) = a.cross(cs - p);
+    J.block<3, 3>(9, 3).setIdentity();
+    J.block<3, 1>(9, 6) = a;
+    // The bead moves with the stick: n . (v_s + w_s x (b - c_s)).
+    Eigen::RowVectorXd gs(6);
+    gs << n.transpose(), (bead - cs).cross(n).transpose();
+    const Eigen::RowVectorXd g = gs * J.bottomRows<6>();
+    const double m_pivot = 1.0 / inverse_effective_mass(J, M, g);
+    // The stick welded to the hand: theta' = 0.
+    const double m_rigid = 1.0 / inverse_effective_mass(J.leftCols<6>(), M, g.head<6>());
+    const double lever = a.cross(bead - p).norm();
+    const double k_grip = options_.grip[s].stiffness_nm_per_rad / std::max(lever * lever, 1e-6);
+    const double k_drum = drum_contact_stiffness_n_per_m();
+    const double w = k_grip / (k_grip + k_drum);
+    return m_pivot + w * (m_rigid - m_pivot);
 }
 
 Eigen::Vector3d Scene::support_force_n() const
@@ -607,15 +886,6 @@ bool Scene::motor_saturated(int joint) const
         if (std::fabs(t.dot(motor_axes_[joint][i])) >= 0.999 * limit)
             return true;
     return false;
-}
-
-Eigen::Vector3d Scene::tip_velocity(Side side) const
-{
-    const int hb = model_.hand_body(side);
-    const Eigen::Vector3d rel = model_.stick(side).tip_m - com_local_[hb];
-    dVector3 out;
-    dBodyGetRelPointVel(body_[hb], rel.x(), rel.y(), rel.z(), out);
-    return to_eigen3(out);
 }
 
 double Scene::max_linear_speed_mps() const

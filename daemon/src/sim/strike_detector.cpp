@@ -167,7 +167,9 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
         e.normal_velocity_mps = -v.dot(kNormal);
         e.tangential_velocity_mps = (v - v.dot(kNormal) * kNormal).norm();
         e.bounce = h.released_once && (t_on - h.release_time_s) <= options_.bounce_window_s &&
-                   h.max_gap_since_release < options_.bounce_height_m;
+                   (h.max_gap_since_release < options_.bounce_height_m ||
+                    h.max_held_gap_since_release < options_.bounce_height_m);
+        e.stick_mass_kg = s.effective_mass_kg;
         if (!e.bounce)
             ++h.stroke;
         e.stroke = std::max(h.stroke, 0L);
@@ -229,10 +231,14 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
     }
 
     if (!h.in_contact) {
-        if (ended)
+        const double held_gap = s.held_center_m.allFinite() ? gap_m(s.held_center_m) : gap;
+        if (ended) {
             h.max_gap_since_release = std::max(gap, 0.0);
-        else
+            h.max_held_gap_since_release = std::max(held_gap, 0.0);
+        } else {
             h.max_gap_since_release = std::max(h.max_gap_since_release, gap);
+            h.max_held_gap_since_release = std::max(h.max_held_gap_since_release, held_gap);
+        }
     }
     h.previous = s;
     h.previous_gap = gap;
@@ -306,6 +312,10 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
         s.time_s = time_offset_s + scene.time_s();
         s.center_m = scene.bead_position(side);
         s.velocity_mps = scene.bead_velocity(side);
+        s.held_center_m = scene.held_bead_position(side);
+        // Only near the head, where a contact may begin (a 7 x 7 solve).
+        if (detector.gap_m(s.center_m) < 0.02)
+            s.effective_mass_kg = scene.effective_mass_kg(side, Eigen::Vector3d::UnitY());
         if (detector.update(hand, s, out[n]))
             ++n;
     }

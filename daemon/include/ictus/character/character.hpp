@@ -88,6 +88,12 @@ struct BodySpec {
 struct StickInHand {
     Eigen::Vector3d grip_m = Eigen::Vector3d::Zero(); // fulcrum point
     Eigen::Vector3d axis = Eigen::Vector3d::UnitX();  // unit, butt -> tip
+    // The fulcrum's hinge axis (unit, normal to the stick): the stick rocks
+    // in the plane the hand strikes in. German grip (palm down): across the
+    // palm (thumb to little finger); French (thumb up): along the palm
+    // normal, the stick rocking between thumb and index finger
+    // (docs/character.md, "The fulcrum").
+    Eigen::Vector3d fulcrum_axis = Eigen::Vector3d::UnitZ();
     Eigen::Vector3d butt_m = Eigen::Vector3d::Zero();
     Eigen::Vector3d tip_m = Eigen::Vector3d::Zero(); // the stick's end point
     Eigen::Vector3d com_m = Eigen::Vector3d::Zero();

@@ -86,14 +86,22 @@ class ChainIkSolverPos_dls
     IkResult solve(const KinematicChain &chain, const Eigen::Vector3d &target_tip_m,
                    const Eigen::Vector3d &target_direction, double direction_weight,
                    Eigen::Quaterniond *rotations_out);
+    // Same, with the last joint's frame (the hand, which holds the stick) turned to
+    // `target_rotation` (world) as the secondary task: the stick's direction and its roll
+    // about it (where a fulcrum's axis lies), with the direction task's tolerance and damping.
+    IkResult solve(const KinematicChain &chain, const Eigen::Vector3d &target_tip_m,
+                   const Eigen::Quaterniond &target_rotation, double rotation_weight,
+                   Eigen::Quaterniond *rotations_out);
 
   private:
     using Jacobian = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, KinematicChain::kMaxDofs>;
     using JointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, KinematicChain::kMaxDofs, 1>;
 
-    static double direction_error(const ChainFrames &frames,
-                                  const Eigen::Vector3d &target_direction,
-                                  Eigen::Vector3d *rotation_vector);
+    double direction_error(const ChainFrames &frames, const Eigen::Vector3d &target_direction,
+                           Eigen::Vector3d *rotation_vector) const;
+    // The secondary task is the last frame's whole rotation (solve with a target rotation).
+    bool full_rotation_ = false;
+    Eigen::Quaterniond target_rotation_ = Eigen::Quaterniond::Identity();
 
     int joints_;
     IkParams params_;

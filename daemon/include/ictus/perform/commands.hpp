@@ -35,16 +35,17 @@ struct TipState {
 enum class CommandKind {
     play,
     stop,
-    tempo,        // value = bpm
-    grip,         // text = french | german
-    nuance,       // text
-    mode,         // text = joint | cartesian
-    gains,        // value = stiffness scale, value2 = damping scale
-    drum_radius,  // value = m
-    drum_tension, // value = N/m
-    drum_density, // value = kg/m^2
-    score,        // text = one score statement, e.g. "L accent 0.8" (docs/score.md)
-    score_clear,  // forget the statements received so far
+    tempo,         // value = bpm
+    grip,          // text = french | german
+    nuance,        // text
+    mode,          // text = joint | cartesian
+    gains,         // value = stiffness scale, value2 = damping scale
+    drum_radius,   // value = m
+    drum_tension,  // value = N/m
+    drum_density,  // value = kg/m^2
+    score,         // text = one score statement, e.g. "L accent 0.8" (docs/score.md)
+    score_clear,   // forget the statements received so far
+    grip_firmness, // value = 0 (loose) .. 1 (firm): the notes' default grip
 };
 
 struct Command {

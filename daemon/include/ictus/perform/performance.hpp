@@ -41,9 +41,11 @@ struct ScorePerformOptions {
     // physical tip, not the target, meets the membrane on the beat.
     double time_advance_s = 0.0;
     CartesianOptions cartesian;
-    // After each beat the target rebounds off the head at the impact speed
-    // and is caught with this time constant, s (0: off; docs/perform.md).
-    double rebound_s = 0.1;
+    // A scripted rebound (off by default: the stick rebounds by itself on its
+    // fulcrum): after each beat the target gets an upward offset leaving the
+    // head at the impact speed, caught with this time constant, s
+    // (docs/perform.md, "Scripted rebound").
+    double rebound_s = 0.0;
     // The drum relative to the performer (derived from the model's shoulders,
     // facing +Z): membrane centre this far in front of and below the
     // midpoint of the shoulders.
@@ -66,6 +68,10 @@ struct PerformanceOptions {
     double drum_density_kg_per_m2 = 0.26; // for the sound only (membrane~)
     StrikeDetectorOptions strikes;
     ScorePerformOptions score; // score mode (no mocap)
+    // The grip's firmness 0..1 (Scene's grip_spring()): the notes' default,
+    // changed live by /ictus/grip/firmness; a note may give its own.
+    double grip_firmness = kDefaultGripFirmness;
+    PerformanceOptions(); // the sticks on their fulcrum (SceneOptions::sticks)
 };
 
 // How the strikes of a performance met its planned notes: per hand, each
@@ -220,6 +226,12 @@ class Performance
     bool apply_score(const Command &command, std::string *why);
     void start_rest_move();
     Eigen::Vector3d target_at(int side, double plan_time_s) const;
+    Eigen::Vector3d direction_at(int side, double plan_time_s) const;
+    Eigen::Vector3d rest_direction(int side) const;
+    double plan_time_of(int side, double plan_time_s) const;
+    void apply_note_grips(double plan_time_s);
+    void set_grips(double firmness); // both hands, now
+    double applied_firmness_[2] = {-1.0, -1.0};
     void apply_drum_now();
     PerformanceOptions options_;
     Skeleton skeleton_;

@@ -55,6 +55,8 @@ struct CartesianOptions {
     // the IK target far off the path, where the loop gain makes it a runaway
     // (measured: 0.3 m excursions at gain 3 without a cap).
     double correction_limit_m = 0.1;
+    // Weight (0..1) of the hands' rotation task (TipTargets::stick_direction).
+    double rotation_weight = 1.0;
     // Where the feedback IK starts. simulated: Theta^S, eq. 2 literally (the
     // arm's redundant directions then drift with the body: measured 30-40 deg
     // RMS at the shoulder on CMU 80_13). kinematic: the kinematic IK's solution
@@ -87,7 +89,20 @@ struct TipTargets {
                                                    Eigen::Vector3d::Zero()};
     std::array<Eigen::Vector3d, 2> acceleration_mps2 = {Eigen::Vector3d::Zero(),
                                                         Eigen::Vector3d::Zero()};
+    // The sticks' planned directions (butt to tip, world). When given, the IK
+    // also turns each hand so that its stick points there with the grip's
+    // fulcrum axis horizontal (held_rotation()), as a task below the tip's.
+    bool has_direction = false;
+    std::array<Eigen::Vector3d, 2> stick_direction = {Eigen::Vector3d::UnitZ(),
+                                                      Eigen::Vector3d::UnitZ()};
 };
+
+// The hand's world rotation that holds `side`'s stick along `direction` with
+// the fulcrum axis horizontal: the stroke plane vertical, as the grip holds
+// it (French: thumb up; German: palm down). False when the direction is
+// within ~12 degrees of the vertical (no stroke plane).
+bool held_rotation(const CharacterModel &model, Side side, const Eigen::Vector3d &direction,
+                   Eigen::Quaterniond &out);
 
 // IK statistics since construction (Cartesian mode, and joint mode with tip targets).
 struct TrackerIkStats {

@@ -64,7 +64,8 @@ struct PlannedNote {
     Eigen::Vector3d impact_velocity_mps = Eigen::Vector3d::Zero(); // planned, just before
     double r_over_a = 0.0;
     double theta_deg = 0.0;
-    int line = 0; // where the note is written
+    double firmness = -1.0; // ScoreNote::firmness
+    int line = 0;           // where the note is written
     int column = 0;
 };
 

@@ -69,7 +69,10 @@ struct ScoreNote {
     double dynamics = kDefaultDynamics; // 0 (softest) .. 1 (loudest)
     double r_over_a = kDefaultRadiusFraction;
     double theta_deg = 180.0; // membrane frame, in (-180, 180]
-    int line = 0;             // where the note was written
+    // The grip's firmness for this stroke, 0 (loose) .. 1 (clamped); < 0:
+    // the performance's own (its default, or /ictus/grip/firmness).
+    double firmness = -1.0;
+    int line = 0; // where the note was written
     int column = 0;
 };
 

@@ -35,13 +35,36 @@ struct DrumParams {
     double radius_m = 0.178;                                    // 14 in snare
     double shell_depth_m = 0.10;
     double tension_n_per_m = 3000.0;
-    double contact_damping_n_s_per_m = 10.0;
+    double contact_damping_n_s_per_m = 3.0;
     double friction = 0.3;
     // k = 2 pi T / ln(R / r_tip), N/m.
     double stiffness_n_per_m(double tip_radius_m) const;
 };
 
 enum class Stepper { quick, direct }; // dWorldQuickStep or dWorldStep
+
+// How the sticks sit in the hands (docs/character.md, "The fulcrum").
+// Rigid: each stick's mass and geometry merged into its hand body (it moves
+// as the hand does and cannot bounce by itself). Fulcrum: each stick is its
+// own body on a hinge at the grip point (StickInHand::grip_m), about the
+// grip's fulcrum axis (StickInHand::fulcrum_axis), held at 0 rad by a
+// spring-damper: the grip. The stick then rebounds off the head by itself
+// (contact and fulcrum), and the grip's firmness decides bounce vs press.
+enum class StickMount { rigid, fulcrum };
+
+// The grip's spring at the fulcrum: torque = -k theta - c theta'.
+struct GripSpring {
+    double stiffness_nm_per_rad = 12.0;
+    double damping_nm_s_per_rad = 0.02;
+};
+// Grip firmness 0..1 (the score's `firmness`, /ictus/grip/firmness) as a
+// spring: k = 2 * 2^(7 f) N m/rad (2 at 0, a loose hold, 256 at 1, the hand
+// clamped on the stick: a welded stick's press), c = 2 zeta sqrt(k I) for the
+// stick's inertia I about its fulcrum (docs/character.md, "The fulcrum").
+// Throws CharacterError outside [0, 1] or for a bad inertia or ratio.
+GripSpring grip_spring(double firmness, double stick_inertia_kg_m2, double damping_ratio);
+constexpr double kDefaultGripFirmness = 0.35;
+constexpr double kDefaultGripDampingRatio = 0.7;
 
 struct SceneOptions {
     double step_s = 0.001;
@@ -59,6 +82,9 @@ struct SceneOptions {
     bool limit_stops = true;
     double stop_margin_rad = 0.0873; // 5 degrees
     bool rate_feedforward = true;
+    StickMount sticks = StickMount::rigid;
+    std::array<GripSpring, 2> grip{};                     // [side], fulcrum mount only
+    double grip_damping_ratio = kDefaultGripDampingRatio; // set_grip_firmness()'s
 };
 // Throws CharacterError naming the first bad option.
 void validate(const SceneOptions &options);
@@ -140,6 +166,38 @@ class Scene
     // the velocity of that point, world frame.
     Eigen::Vector3d bead_position(Side side) const;
     Eigen::Vector3d bead_velocity(Side side) const;
+    // Where the hand carries the stick: the stick's end point and the bead
+    // centre as they would be at the fulcrum's rest angle (0), and their
+    // velocities. What the arms are controlled by; equal to tip_position()
+    // and bead_position() with rigid sticks.
+    Eigen::Vector3d held_tip_position(Side side) const;
+    Eigen::Vector3d held_tip_velocity(Side side) const;
+    Eigen::Vector3d held_bead_position(Side side) const;
+    // The fulcrum's angle (rad, > 0: the tip turned away from the palm side
+    // the grip's axis defines) and rate; 0 with rigid sticks.
+    double fulcrum_angle_rad(Side side) const;
+    double fulcrum_rate_rad_s(Side side) const;
+    // The fulcrum's axis and the stick's axis (butt to tip), unit, world.
+    Eigen::Vector3d fulcrum_axis(Side side) const;
+    Eigen::Vector3d stick_axis(Side side) const;
+    // The grip's spring (fulcrum mount), changed at once. Throws CharacterError
+    // for a non-finite or non-positive stiffness, or a negative damping.
+    void set_grip(Side side, const GripSpring &grip);
+    const GripSpring &grip(Side side) const { return options_.grip[static_cast<int>(side)]; }
+    // The grip as a firmness 0..1 (grip_spring()), for this scene's stick.
+    void set_grip_firmness(Side side, double firmness);
+    // The stick's moment of inertia about its fulcrum axis, kg m^2.
+    double fulcrum_inertia_kg_m2(Side side) const;
+    // The stick's effective mass at the bead along `normal` (unit, world), kg:
+    // the mass an impulse along the normal at the bead meets, from the stick,
+    // the grip and the hand at this instant (docs/character.md, "Effective
+    // mass"). The hand is taken as free of the forearm (the wrist's PD is
+    // compliant over a contact's few ms). Fulcrum mount: the stick pivoting
+    // on the hand (a loose grip), blended toward the stick welded to the hand
+    // by s = k_g / (k_g + k), k_g = k_f / l^2 the grip's stiffness seen at the
+    // bead (l its distance from the fulcrum axis) and k the drum's contact
+    // stiffness. Rigid mount: the hand and stick as one body.
+    double effective_mass_kg(Side side, const Eigen::Vector3d &normal) const;
     // The drum's action on each stick in the last step (see StickDrumContact).
     const StickDrumContact &drum_contact(Side side) const
     {
@@ -210,6 +268,13 @@ class Scene
     dxGeom *drum_ = nullptr;
     std::array<dxGeom *, 2> stick_shaft_{};
     std::array<dxGeom *, 2> stick_tip_{};
+    // Fulcrum mount: the sticks' bodies (their frame = the hand's frame at
+    // the rest angle, origin at their CoM) and their hinges.
+    std::array<dxBody *, 2> stick_body_{};
+    std::array<dxJoint *, 2> fulcrum_{};
+    void apply_grip(int side);
+    dxBody *tip_body(Side side) const;
+    Eigen::Vector3d tip_body_com(Side side) const; // its CoM in the hand frame
     double contact_erp_ = 0.0, contact_cfm_ = 0.0;
 
     double time_s_ = 0.0;

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 
 namespace ictus
 {
@@ -34,9 +35,12 @@ struct MembraneGeometry {
 };
 
 struct StrikeDetectorOptions {
-    // A new contact of the same hand is a bounce (same stroke) when the bead
-    // did not rise more than bounce_height_m above the membrane since the
-    // previous release AND it starts within bounce_window_s of that release.
+    // A new contact of the same hand is a bounce (same stroke) when it starts
+    // within bounce_window_s of the previous release AND, since that release,
+    // the bead did not rise more than bounce_height_m above the membrane OR
+    // the hand did not lift the stick by that much (the held bead,
+    // TipSample::held_center_m: a stick rebounding on its fulcrum while the
+    // hand stays down strikes again by itself).
     double bounce_height_m = 0.01;
     double bounce_window_s = 0.15;
     // How the samples were made, which decides the velocity that crossed the
@@ -58,6 +62,12 @@ struct TipSample {
     double time_s = 0.0;
     Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
     Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
+    // The bead's centre where the hand holds it (the stick at its fulcrum's
+    // rest angle); NaN: the same as center_m (a rigid stick, a trajectory).
+    Eigen::Vector3d held_center_m = Eigen::Vector3d::Constant(std::nan(""));
+    // The stick's effective mass at the bead along the normal (kg; 0: not
+    // known), copied into a strike that begins at this sample.
+    double effective_mass_kg = 0.0;
 };
 
 class StrikeDetector
@@ -120,6 +130,7 @@ class StrikeDetector
         bool released_once = false;
         double release_time_s = 0.0;
         double max_gap_since_release = 0.0;
+        double max_held_gap_since_release = 0.0;
         long stroke = -1;
         bool onset_new = false; // take_onset() has not seen this contact yet
     };
