@@ -285,6 +285,15 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
                  {"strike_depth_m", o.score.plan.strike_depth_m},
                  {"time_advance_s", o.score.time_advance_s},
                  {"lead_in_s", o.score.plan.lead_in_s}};
+    const Performance::BodyStats &b = perf.body_stats();
+    j["joint_limits"] = {{"kind", "range_of_motion"},
+                         {"max_excursion_deg", b.max_limit_excursion_deg},
+                         {"joint", b.max_limit_joint}};
+    j["trunk"] = {{"max_deg", b.trunk_max_deg}, {"rms_deg", b.trunk_rms_deg()}};
+    j["sticks"] = {{"mount", o.scene.sticks == StickMount::fulcrum ? "fulcrum" : "rigid"},
+                   {"grip_firmness", o.grip_firmness},
+                   {"grip_damping_ratio", o.scene.grip_damping_ratio},
+                   {"rebound_s", o.score.rebound_s}};
     const PerformerFrame &f = perf.performer_frame();
     j["performer"] = {{"right", {f.right.x(), f.right.y(), f.right.z()}},
                       {"forward", {f.forward.x(), f.forward.y(), f.forward.z()}}};

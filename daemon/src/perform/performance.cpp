@@ -5,6 +5,8 @@
 // Score mode is described in docs/perform.md.
 #include "ictus/mocap/bvh.hpp"
 #include "ictus/character/character_limits.hpp"
+#include "ictus/character/range_of_motion.hpp"
+#include "ictus/base/rotation.hpp"
 #include "ictus/character/stick_capture.hpp"
 #include "ictus/perform/track.hpp"
 #include "ictus/perform/tracker.hpp"
@@ -88,13 +90,16 @@ struct Performance::Rig {
 // when the grip or the drum changes (a Scene has no setters for them).
 struct Performance::ScoreRig {
     CharacterModel model;
+    RangeOfMotion range_of_motion; // the joint limits (declared before the tracker)
+    int lumbar = model.joint_index("lumbar"), thorax = model.joint_index("thorax");
     std::vector<JointGains> base_gains, gains;
     std::unique_ptr<Tracker> tracker;
-    CharacterPose body; // the reference held by the trunk and legs (arms: IK)
+    CharacterPose body;      // the reference held by the trunk and legs (arms: IK)
+    CharacterPose step_body; // body with the trunk's synergy of this step
     PerformerFrame frame;
     Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero(); // where the drum goes
     TipTargets tips;
-    explicit ScoreRig(const CharacterModel &m) : model(m) {}
+    explicit ScoreRig(const CharacterModel &m) : model(m), range_of_motion(model) {}
 };
 
 // A plan ready to perform: the score it came from, the plan, and per hand and
@@ -598,6 +603,16 @@ namespace
 // The plan's strike points are raised by it, so that the planned tip target
 // on the beat is the tip at first contact (strike_depth_m is then measured
 // from the contact, not from the plane).
+// Between plans: forward and 15 degrees down (kDefaultStickDirection), turned
+// 20 degrees toward the midline.
+Eigen::Vector3d rest_stick_direction(const PerformerFrame &f, int s)
+{
+    const double yaw = 20.0 * M_PI / 180.0;
+    const Eigen::Vector3d inward = s == static_cast<int>(Side::right) ? -f.right : f.right;
+    const Eigen::Vector3d level = std::cos(yaw) * f.forward + std::sin(yaw) * inward;
+    return (kDefaultStickDirection.y() * f.up + kDefaultStickDirection.z() * level).normalized();
+}
+
 double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_world)
 {
     return tip_radius_m * (1.0 + stick_dir_world.normalized().y());
@@ -607,6 +622,9 @@ double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_wo
 PerformanceOptions::PerformanceOptions()
 {
     scene.sticks = StickMount::fulcrum;
+    // A joint pushed outside its range (the stick's reactions on the wrist)
+    // meets its stop 1 degree out (docs/perform.md, "Joint limits").
+    scene.stop_margin_rad = 1.0 * M_PI / 180.0;
 }
 
 ScorePerformOptions::ScorePerformOptions()
@@ -682,14 +700,28 @@ Performance::make_score_rig(const PerformanceOptions &options,
     CharacterPose initial = r.body;
     if (pose && pose->size() == initial.local.size())
         initial.local = *pose;
-    else
-        Tracker::solve_arms(model, {}, options.score.cartesian.ik, r.frame.rest_tip_m, initial);
+    else {
+        const std::array<Eigen::Vector3d, 2> directions = {rest_stick_direction(r.frame, 0),
+                                                           rest_stick_direction(r.frame, 1)};
+        Tracker::solve_arms(model, r.range_of_motion.refs(), options.score.cartesian.ik,
+                            r.frame.rest_tip_m, initial, &directions);
+    }
     r.base_gains = default_gains(model, initial, options.gains);
+    // The trunk is compliant: lumbar and thorax under eq. 1 at kTrunkHz (the
+    // arms' natural frequency is options.gains'), so they sway under the arms'
+    // reactions (docs/perform.md, "The trunk").
+    const double trunk_ratio = kTrunkHz / options.gains.natural_frequency_hz;
+    if (trunk_ratio < 1.0)
+        for (int j : {r.lumbar, r.thorax}) {
+            r.base_gains[j].kp_nm_per_rad *= trunk_ratio * trunk_ratio;
+            r.base_gains[j].kd_nm_s_per_rad *= trunk_ratio;
+        }
+    r.step_body = r.body;
     r.gains = r.base_gains; // scaled when installed
     CartesianOptions co = options.score.cartesian;
     co.reference_has_arms = false; // the body's reference has no arm motion
     r.tracker =
-        std::make_unique<Tracker>(model, scene, initial, r.gains, std::vector<JointLimitRef>{},
+        std::make_unique<Tracker>(r.model, scene, initial, r.gains, r.range_of_motion.refs(),
                                   options.score.mode, co, options.gains);
     r.tips.has_position = true;
     for (int s = 0; s < 2; ++s)
@@ -1002,15 +1034,9 @@ Eigen::Vector3d Performance::direction_at(int s, double t) const
     return d.norm() > 1e-9 ? Eigen::Vector3d(d.normalized()) : dir[k];
 }
 
-// Between plans: forward and 15 degrees down (kDefaultStickDirection), turned
-// 20 degrees toward the midline.
 Eigen::Vector3d Performance::rest_direction(int s) const
 {
-    const PerformerFrame &f = score_rig_->frame;
-    const double yaw = 20.0 * M_PI / 180.0;
-    const Eigen::Vector3d inward = s == static_cast<int>(Side::right) ? -f.right : f.right;
-    const Eigen::Vector3d level = std::cos(yaw) * f.forward + std::sin(yaw) * inward;
-    return (kDefaultStickDirection.y() * f.up + kDefaultStickDirection.z() * level).normalized();
+    return rest_stick_direction(score_rig_->frame, s);
 }
 
 // The plan time whose target the hand follows at plan time t (target_at's delay).
@@ -1071,6 +1097,55 @@ Eigen::Vector3d Performance::target_at(int s, double t) const
     if (tau >= 20.0 * tc)
         return p;
     return p + plan_state_->approach_mps[s][j] * tau * std::exp(-tau / tc) * score_rig_->frame.up;
+}
+
+double Performance::BodyStats::trunk_rms_deg() const
+{
+    return steps > 0 ? std::sqrt(trunk_sum_sq_deg2 / static_cast<double>(steps)) : 0.0;
+}
+
+void Performance::measure_body()
+{
+    const ScoreRig &r = *score_rig_;
+    const Scene &scene = r.tracker->scene();
+    scene.local_rotations(pose_scratch_);
+    int joint = -1;
+    const double e = r.range_of_motion.max_excursion_rad(pose_scratch_, &joint) * 180.0 / M_PI;
+    if (e > body_stats_.max_limit_excursion_deg) {
+        body_stats_.max_limit_excursion_deg = e;
+        body_stats_.max_limit_joint = r.model.joint_name(joint);
+    }
+    // The thorax relative to the pelvis: lumbar then thorax joint.
+    const double trunk = rotation_angle_between(Eigen::Quaterniond::Identity(),
+                                                pose_scratch_[r.lumbar] * pose_scratch_[r.thorax]) *
+                         180.0 / M_PI;
+    body_stats_.trunk_max_deg = std::max(body_stats_.trunk_max_deg, trunk);
+    body_stats_.trunk_sum_sq_deg2 += trunk * trunk;
+    ++body_stats_.steps;
+}
+
+// The trunk takes part in the strokes: it leans forward as the sticks go
+// down (kTrunkLean_rad_per_m of the mean tip target's drop below the rest
+// tips) and turns the shoulder of the higher stick back (kTrunkTwist_rad_per_m
+// of the difference of the tips' heights), 40 % at the lumbar joint and 60 %
+// at the thorax; eq. 1 then follows it with the trunk's compliant gains.
+void Performance::trunk_synergy(ScoreRig &r) const
+{
+    const PerformerFrame &f = r.frame;
+    const TipTargets &tips = r.tips;
+    auto height = [&](int s) { return (tips.position_m[s] - f.membrane_center_m).dot(f.up); };
+    const double rest = 0.5 * ((f.rest_tip_m[0] - f.membrane_center_m).dot(f.up) +
+                               (f.rest_tip_m[1] - f.membrane_center_m).dot(f.up));
+    const int right = static_cast<int>(Side::right), left = static_cast<int>(Side::left);
+    const double lean = kTrunkLean_rad_per_m * (rest - 0.5 * (height(left) + height(right)));
+    const double twist = -kTrunkTwist_rad_per_m * (height(right) - height(left));
+    // Lean about the performer's left axis (forward flexion), twist about up.
+    const Eigen::Vector3d left_axis = -f.right;
+    const Eigen::Quaterniond q = Eigen::Quaterniond(Eigen::AngleAxisd(twist, f.up)) *
+                                 Eigen::Quaterniond(Eigen::AngleAxisd(lean, left_axis));
+    const Eigen::Quaterniond part = Eigen::Quaterniond::Identity().slerp(0.4, q);
+    r.step_body.local[r.lumbar] = r.body.local[r.lumbar] * part;
+    r.step_body.local[r.thorax] = r.body.local[r.thorax] * part.conjugate() * q;
 }
 
 void Performance::set_grips(double firmness)
@@ -1145,18 +1220,11 @@ int Performance::step_score(StrikeEvent out[2])
         }
         tips.has_direction = true;
     }
-    r.tracker->step(r.body, &tips, true);
-    const int n_ = detect_strikes(detector_, r.tracker->scene(), out, time_offset_s_);
-    if (std::getenv("ICTUS_DEBUG"))
-        for (int s = 0; s < 2; ++s)
-            if (detector_.in_contact(s)) {
-                const Scene &sc = r.tracker->scene();
-                const Eigen::Vector3d a = sc.fulcrum_axis(static_cast<Side>(s)),
-                                      st = sc.stick_axis(static_cast<Side>(s));
-                std::fprintf(stderr, "t %.3f hand %d axis %.2f %.2f %.2f stick %.2f %.2f %.2f\n",
-                             time_s(), s, a.x(), a.y(), a.z(), st.x(), st.y(), st.z());
-            }
-    return n_;
+    trunk_synergy(r);
+    r.tracker->step(r.step_body, &tips, true);
+    const int n = detect_strikes(detector_, r.tracker->scene(), out, time_offset_s_);
+    measure_body();
+    return n;
 }
 
 bool Performance::apply_score(const Command &c, std::string *why)

@@ -269,7 +269,7 @@ bool held_rotation(const CharacterModel &model, Side side, const Eigen::Vector3d
 
 void Tracker::solve_arms(const CharacterModel &model, const std::vector<JointLimitRef> &limits,
                          const IkParams &ik, const std::array<Eigen::Vector3d, 2> &tips,
-                         CharacterPose &pose)
+                         CharacterPose &pose, const std::array<Eigen::Vector3d, 2> *directions)
 {
     BodyFrames frames;
     model.forward(pose, frames);
@@ -283,7 +283,11 @@ void Tracker::solve_arms(const CharacterModel &model, const std::vector<JointLim
         Eigen::Quaterniond q[4];
         // Repeated calls: the solver's per-call budget is 16 steps.
         for (int call = 0; call < 20; ++call) {
-            const IkResult r = cold.solve(chain, tips[s], q);
+            Eigen::Quaterniond hand;
+            const bool orient =
+                directions && held_rotation(model, static_cast<Side>(s), (*directions)[s], hand);
+            const IkResult r =
+                orient ? cold.solve(chain, tips[s], hand, 1.0, q) : cold.solve(chain, tips[s], q);
             chain.set_rotations(q);
             if (r.status == IkStatus::converged)
                 break;

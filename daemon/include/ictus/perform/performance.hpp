@@ -134,6 +134,20 @@ class Performance
     const StrikeDetector &detector() const { return detector_; }
     int divergences() const;
 
+    // How the body moved (score mode, since the last rig was installed): how
+    // far any joint went outside its range of motion (the simulated pose:
+    // range_of_motion.hpp), and how far the trunk (thorax) turned from its
+    // rest, degrees.
+    struct BodyStats {
+        double max_limit_excursion_deg = 0.0;
+        std::string max_limit_joint;
+        long steps = 0;
+        double trunk_max_deg = 0.0;
+        double trunk_sum_sq_deg2 = 0.0;
+        double trunk_rms_deg() const;
+    };
+    const BodyStats &body_stats() const { return body_stats_; }
+
     // Score mode.
     bool score_mode() const { return options_.mocap.empty(); }
     // The plan being performed (or last performed); nullptr before the first.
@@ -230,8 +244,16 @@ class Performance
     Eigen::Vector3d rest_direction(int side) const;
     double plan_time_of(int side, double plan_time_s) const;
     void apply_note_grips(double plan_time_s);
+    void trunk_synergy(ScoreRig &rig) const;
+    // The trunk (docs/perform.md, "The trunk"): eq. 1's natural frequency of
+    // the lumbar and thorax joints, and how they follow the sticks.
+    static constexpr double kTrunkHz = 8.0;
+    static constexpr double kTrunkLean_rad_per_m = 0.15;
+    static constexpr double kTrunkTwist_rad_per_m = 0.2;
     void set_grips(double firmness); // both hands, now
     double applied_firmness_[2] = {-1.0, -1.0};
+    BodyStats body_stats_;
+    void measure_body();
     void apply_drum_now();
     PerformanceOptions options_;
     Skeleton skeleton_;

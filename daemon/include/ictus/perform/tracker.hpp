@@ -165,9 +165,12 @@ class Tracker
     // Arm rotations that put the stick tips at `tips` [side] from the pose
     // `pose` (a cold IK solve, repeated calls of the solver's budget): writes
     // them into pose.local. For a body whose arms start nowhere near the sticks.
+    // With `directions`, the hands also hold their sticks along them
+    // (held_rotation()).
     static void solve_arms(const CharacterModel &model, const std::vector<JointLimitRef> &limits,
                            const IkParams &ik, const std::array<Eigen::Vector3d, 2> &tips,
-                           CharacterPose &pose);
+                           CharacterPose &pose,
+                           const std::array<Eigen::Vector3d, 2> *directions = nullptr);
 
   private:
     struct Arm;

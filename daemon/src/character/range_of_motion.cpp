@@ -1,0 +1,188 @@
+// range_of_motion.cpp -- the normal human range of motion as swing-twist
+// limits (range_of_motion.hpp; docs/character.md, "Range of motion").
+#include "ictus/character/range_of_motion.hpp"
+#include "ictus/base/rotation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace ictus
+{
+
+namespace
+{
+
+constexpr double kDeg = M_PI / 180.0;
+
+// One row: a joint of the performer's right side (or the midline), its swing
+// axes as world axes of the rest pose (0 x: the performer's left, 1 y: up,
+// 2 z: forward), and its ranges in degrees. Positive swing about x tips a
+// vertical segment forward; about z it turns the right arm or hand down (the
+// right leg toward the midline); about y it swings the right arm forward.
+// The left side is the mirror image: its y and z ranges are negated.
+//
+// Sources (normal adult male active ranges): American Academy of Orthopaedic
+// Surgeons, "Joint motion: method of measuring and recording" (1965); Soucie
+// et al., "Range of motion measurements: reference values and a database for
+// comparison studies", Haemophilia 17 (2011) 500-507; Kapandji, "The
+// physiology of the joints" (spine, clavicle). Ranges are those of the
+// anatomical motions re-expressed about the rest (T-) pose: the shoulder's
+// 180 deg of abduction from the arm hanging at the side are -90..+90 deg
+// about z from the arm held out; a few degrees of margin on each side.
+struct Row {
+    const char *joint;
+    int u_axis, w_axis;
+    double u_lo, u_hi, w_lo, w_hi, twist; // deg; twist is +-
+};
+
+const Row kRows[] = {
+    // spine: flexion 40 (forward), extension 20, lateral bend 20, rotation 20-25 per region
+    {"lumbar", 0, 2, -20, 40, -20, 20, 20},
+    {"thorax", 0, 2, -20, 40, -20, 20, 25},
+    // neck: flexion 45, extension 45, lateral 35, rotation 50 (half of the cervical range each)
+    {"neck", 0, 2, -45, 45, -35, 35, 50},
+    {"upper_neck", 0, 2, -40, 40, -30, 30, 30},
+    {"head", 0, 2, -30, 30, -20, 20, 30},
+    // sternoclavicular: protraction / retraction 25, elevation 35, depression 10, rotation 30
+    {"r_clavicle", 1, 2, -25, 25, -35, 15, 30},
+    // glenohumeral from the arm held out: horizontal flexion 135 (forward), extension 45-60,
+    // abduction to 180 (-90 about z), adduction to the side and 20 past (+110), rotation 90-100
+    {"r_shoulder", 1, 2, -60, 135, -95, 110, 100},
+    // elbow: flexion 150; in the CMU skeleton's frames its axis lies between y and z (a
+    // drummer's elbow in CMU 80_13: u 14..120, w -69..-8 deg), so both swing axes carry it;
+    // hyperextension 10; half the forearm's pronation / supination as twist
+    {"r_elbow", 1, 2, -10, 150, -80, 30, 45},
+    // wrist: flexion 80 (down, palm down), extension 70, radial deviation 25, ulnar 35; the
+    // CMU skeleton turns the forearm's pronation / supination (80-90 each way) here
+    {"r_wrist", 1, 2, -35, 30, -75, 85, 85},
+    // hip: flexion 125 (forward: -x), extension 30, abduction 45, adduction 30, rotation 45
+    {"r_hip", 0, 2, -125, 30, -45, 30, 45},
+    // knee: flexion 145 (+x), extension 5, rotation 30 when flexed
+    {"r_knee", 0, 2, -5, 145, -10, 10, 30},
+    // ankle: plantarflexion 50 (+x), dorsiflexion 25, ab/adduction 30, inversion / eversion 35
+    {"r_ankle", 0, 1, -25, 50, -30, 30, 35},
+};
+
+double wrap(double a)
+{
+    return std::remainder(a, 2.0 * M_PI);
+}
+
+} // namespace
+
+Eigen::Vector3d SwingTwistLimit::coordinates(const Eigen::Quaterniond &q_in) const
+{
+    Eigen::Quaterniond q = q_in.normalized();
+    if (q.w() < 0.0)
+        q.coeffs() = -q.coeffs();
+    // Twist: the rotation about twist_axis closest to q; swing = q twist^-1.
+    const double along = q.vec().dot(twist_axis);
+    const double twist = wrap(2.0 * std::atan2(along, q.w()));
+    const Eigen::Quaterniond twist_q(Eigen::AngleAxisd(twist, twist_axis));
+    const Eigen::Vector3d swing = log_map((q * twist_q.conjugate()).normalized());
+    return Eigen::Vector3d(swing.dot(u), swing.dot(w), twist);
+}
+
+bool SwingTwistLimit::contains(const Eigen::Quaterniond &q, double tolerance_rad) const
+{
+    const Eigen::Vector3d c = coordinates(q);
+    return c[0] >= u_lo_rad - tolerance_rad && c[0] <= u_hi_rad + tolerance_rad &&
+           c[1] >= w_lo_rad - tolerance_rad && c[1] <= w_hi_rad + tolerance_rad &&
+           c[2] >= twist_lo_rad - tolerance_rad && c[2] <= twist_hi_rad + tolerance_rad;
+}
+
+Eigen::Quaterniond SwingTwistLimit::clamp(const Eigen::Quaterniond &q) const
+{
+    if (contains(q, 0.0))
+        return q.normalized();
+    const Eigen::Vector3d c = coordinates(q);
+    const double a = std::clamp(c[0], u_lo_rad, u_hi_rad);
+    const double b = std::clamp(c[1], w_lo_rad, w_hi_rad);
+    const double t = std::clamp(c[2], twist_lo_rad, twist_hi_rad);
+    return (exp_map(a * u + b * w) * Eigen::Quaterniond(Eigen::AngleAxisd(t, twist_axis)))
+        .normalized();
+}
+
+double SwingTwistLimit::excursion_rad(const Eigen::Quaterniond &q) const
+{
+    return rotation_angle_between(q.normalized(), clamp(q));
+}
+
+RangeOfMotion::RangeOfMotion(const CharacterModel &model)
+{
+    limits_.resize(CharacterModel::kJoints);
+    std::vector<bool> set(CharacterModel::kJoints, false);
+    for (const Row &row : kRows) {
+        for (int mirror = 0; mirror < 2; ++mirror) {
+            std::string name = row.joint;
+            if (mirror) {
+                if (name[0] != 'r')
+                    continue;
+                name[0] = 'l';
+            }
+            const int j = model.joint_index(name);
+            if (j < 0)
+                throw CharacterError("range of motion: the body has no joint '" + name + "'");
+            const BodySpec &body = model.joint_body(j);
+            SwingTwistLimit &l = limits_[j];
+            l.twist_axis =
+                body.distal_m.norm() > 1e-9 ? body.distal_m.normalized() : Eigen::Vector3d::UnitY();
+            auto across = [&](int axis) {
+                Eigen::Vector3d e = Eigen::Vector3d::Unit(axis);
+                e -= e.dot(l.twist_axis) * l.twist_axis;
+                return e.norm() > 1e-6 ? Eigen::Vector3d(e.normalized())
+                                       : Eigen::Vector3d(l.twist_axis.unitOrthogonal());
+            };
+            l.u = across(row.u_axis);
+            l.w = across(row.w_axis);
+            l.w = (l.w - l.w.dot(l.u) * l.u).normalized();
+            // Mirror (x -> -x): rotation vectors keep x and negate y and z.
+            auto range = [&](int axis, double lo, double hi, double &out_lo, double &out_hi) {
+                if (mirror && axis != 0) {
+                    out_lo = -hi * kDeg;
+                    out_hi = -lo * kDeg;
+                } else {
+                    out_lo = lo * kDeg;
+                    out_hi = hi * kDeg;
+                }
+            };
+            range(row.u_axis, row.u_lo, row.u_hi, l.u_lo_rad, l.u_hi_rad);
+            range(row.w_axis, row.w_lo, row.w_hi, l.w_lo_rad, l.w_hi_rad);
+            l.twist_lo_rad = -row.twist * kDeg;
+            l.twist_hi_rad = row.twist * kDeg;
+            set[j] = true;
+        }
+    }
+    for (int j = 0; j < CharacterModel::kJoints; ++j)
+        if (!set[j])
+            throw CharacterError("range of motion: no range for joint '" + model.joint_name(j) +
+                                 "'");
+}
+
+std::vector<JointLimitRef> RangeOfMotion::refs() const
+{
+    std::vector<JointLimitRef> refs;
+    refs.reserve(limits_.size());
+    for (const SwingTwistLimit &l : limits_)
+        refs.push_back(JointLimitRef::to(l));
+    return refs;
+}
+
+double RangeOfMotion::max_excursion_rad(const std::vector<Eigen::Quaterniond> &local,
+                                        int *joint) const
+{
+    double worst = 0.0;
+    int at = -1;
+    for (size_t j = 0; j < limits_.size() && j < local.size(); ++j) {
+        const double e = limits_[j].excursion_rad(local[j]);
+        if (e > worst) {
+            worst = e;
+            at = static_cast<int>(j);
+        }
+    }
+    if (joint)
+        *joint = at;
+    return worst;
+}
+
+} // namespace ictus
