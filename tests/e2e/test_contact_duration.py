@@ -23,10 +23,11 @@ score  `ictusd render` plays the default score; its strikes.csv holds the
        rendered on render.json's drum (as scripts/main.sh does) and every
        strike's report is matched to it. THE MEDIAN over the strikes of
        |d_pd - d_physics| / d_physics: in the physics the stick stays on its
-       fulcrum and the hand keeps moving during the contact (soft strokes and
-       bounces are pressed into the head: 8-24 ms where a free bead of their
-       mass stays 5 ms), which the strike does not carry and contact~, a free
-       stick from the onset on, cannot play; the per-strike errors are printed
+       fulcrum and the hand keeps moving during the contact (pressed strokes
+       and bounces: 12-26 ms where a free bead of their mass stays 5 ms), and
+       its 1 ms step stretches the contact, none of which the strike carries
+       or contact~, a free stick from the onset on, can play; the per-strike
+       errors are printed
        (docs/sound.md has them). Every primary strike must have a report; a
        bounce may have none when the next contact of its hand came before
        contact~'s stick was clear (the sound then plays both as one stroke).
