@@ -50,7 +50,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import e2e_util as u  # noqa: E402
 from pdrun import check, error_lines, make_workdir  # noqa: E402
 
-BOUND = 0.25           # |d_pd - d_physics| / d_physics, per strike
+BOUND = 0.25           # |d_pd - d_physics| / d_physics: per strike (law), median (score)
 TIP_RADIUS_M = 0.007   # the bead (daemon: StrikeDetectorOptions::tip_radius_m, docs/osc.md)
 # the physics' default drum (DrumParams in daemon/include/ictus/sim/scene.hpp, as
 # render.json reports it; the score part checks that they still agree)
