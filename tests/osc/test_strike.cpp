@@ -582,3 +582,47 @@ TEST_CASE("strike log: strikes reported at release come out in onset order, none
     CHECK(out_of_order_reports > 0);
     CHECK(long_rests == 10);
 }
+
+TEST_CASE("strike: a stick bouncing on its fulcrum while the hand stays down is one stroke",
+          "[osc][strike]")
+{
+    // Two contacts 40 ms apart; between them the bead flies 2 cm high (over
+    // the 1 cm bounce height). When the hand (the held bead) stayed below the
+    // head the second contact is a bounce of the same stroke; when the hand
+    // lifted the stick 2 cm it is a new stroke.
+    for (const bool hand_lifted : {false, true}) {
+        StrikeDetector det(flat_membrane(5825.0, 3.0));
+        const double r = 0.007;
+        std::vector<StrikeEvent> events;
+        StrikeEvent e;
+        for (int n = 0; n <= 120; ++n) {
+            const double t = n * 1e-3;
+            // Bead: down into the head at 1-4 ms and 40-44 ms, a 2 cm arc between.
+            double gap;
+            if (t < 0.001)
+                gap = 0.002;
+            else if (t <= 0.004 || (t >= 0.040 && t <= 0.044))
+                gap = -0.001;
+            else if (t < 0.040)
+                gap = 0.02 * std::sin(M_PI * (t - 0.004) / 0.036);
+            else
+                gap = 0.01;
+            TipSample s;
+            s.time_s = t;
+            s.center_m = Eigen::Vector3d(0.0, r + gap, 0.0);
+            s.velocity_mps = Eigen::Vector3d(0.0, gap < 0 ? -1.0 : 1.0, 0.0);
+            const double held = hand_lifted && t > 0.01 && t < 0.035 ? 0.02 : -0.005;
+            s.held_center_m = Eigen::Vector3d(0.0, r + held, 0.0);
+            s.effective_mass_kg = 0.015;
+            if (det.update(1, s, e))
+                events.push_back(e);
+        }
+        REQUIRE(events.size() == 2);
+        INFO("hand lifted: " << hand_lifted);
+        CHECK_FALSE(events[0].bounce);
+        CHECK(events[1].bounce == !hand_lifted);
+        CHECK(events[1].stroke == (hand_lifted ? 1 : 0));
+        // The effective mass at the onset rides with the strike.
+        CHECK(events[0].stick_mass_kg == 0.015);
+    }
+}

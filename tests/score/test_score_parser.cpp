@@ -155,11 +155,32 @@ TEST_CASE("score: the dynamics words rise from pp to ff and mf is the default", 
 
 TEST_CASE("score: every nuance name the gesture database uses is accepted", "[score][parser]")
 {
-    for (Nuance n : {Nuance::legato, Nuance::tenuto, Nuance::accent, Nuance::vertical_accent,
-                     Nuance::staccato}) {
+    for (int i = 0; i < kNuances; ++i) {
+        const Nuance n = static_cast<Nuance>(i);
         const Score s = parse_score(std::string("L ") + to_string(n), "n");
         CHECK(s.notes[0].nuance == n);
     }
+    CHECK(parse_score("R buzz", "n").notes[0].nuance == Nuance::buzz);
+}
+
+TEST_CASE("score: grip firmness per note and as a default, the performance's when none",
+          "[score][parser]")
+{
+    const Score s = parse_score("R, L firmness 0.8, firmness 0.2\nR, L accent firmness 1 f, "
+                                "R firmness 0\n",
+                                "t.txt");
+    REQUIRE(s.notes.size() == 5);
+    CHECK(s.notes[0].firmness < 0.0); // the performance's own
+    CHECK(s.notes[1].firmness == 0.8);
+    CHECK(s.notes[2].firmness == 0.2);
+    CHECK(s.notes[3].firmness == 1.0);
+    CHECK(s.notes[3].dynamics == 0.8);
+    CHECK(s.notes[4].firmness == 0.0);
+    require_error("R firmness 1.5", 1, 12, "firmness 1.5 is out of range");
+    require_error("R firmness", 1, 11, "'firmness' needs a value");
+    require_error("R firmness 0.5 firmness 0.4", 1, 16, "second firmness");
+    require_error("firmness -0.1", 1, 10, "out of range");
+    require_error("firmness x", 1, 10, "firmness");
 }
 
 TEST_CASE("score: tempo and grip and rest and default beats and dynamics", "[score][parser]")

@@ -43,8 +43,9 @@ const Row kRows[] = {
     {"neck", 0, 2, -45, 45, -35, 35, 50},
     {"upper_neck", 0, 2, -40, 40, -30, 30, 30},
     {"head", 0, 2, -30, 30, -20, 20, 30},
-    // sternoclavicular: protraction / retraction 25, elevation 35, depression 10, rotation 30
-    {"r_clavicle", 1, 2, -25, 25, -35, 15, 30},
+    // sternoclavicular: protraction / retraction 25, elevation 35, depression 10 (20 here:
+    // the CMU skeleton's clavicle rests some degrees above the anatomical one), rotation 30
+    {"r_clavicle", 1, 2, -25, 25, -35, 20, 30},
     // glenohumeral from the arm held out: horizontal flexion 135 (forward), extension 45-60,
     // abduction to 180 (-90 about z), adduction to the side and 20 past (+110), rotation 90-100
     {"r_shoulder", 1, 2, -60, 135, -95, 110, 100},

@@ -16,8 +16,8 @@ namespace ictus
 namespace
 {
 
-const char *const kNuanceNames[kNuances] = {"legato", "tenuto", "accent", "vertical_accent",
-                                            "staccato"};
+const char *const kNuanceNames[kNuances] = {"legato",          "tenuto",   "accent",
+                                            "vertical_accent", "staccato", "buzz"};
 
 std::string valid_nuances()
 {

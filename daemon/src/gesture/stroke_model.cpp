@@ -30,6 +30,8 @@ namespace
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kNominalPeriod_s = 0.5;    // 120 bpm: the period the shapes are set at
 constexpr double kLegatoHeightFff_m = 0.36; // legato preparation height at d = 1
+constexpr double kPressTau_s = 0.012;       // buzz: how fast the hand presses in
+constexpr double kMaxPress_s = 0.3;         // buzz: the longest press
 
 struct NuanceShape {
     double height_scale;  // preparation height relative to legato
@@ -40,6 +42,11 @@ struct NuanceShape {
     double lift_ratio;    // lift apex / preparation apex
     double draw_back;     // extra backward pivot motion per metre of height (accent loop)
     double verticality;   // fraction of the arc's backward motion cancelled
+    // Press (buzz): after the strike the tip is held into the head, down to
+    // press_depth_m below it, over press_fraction of the lift time; the lift
+    // follows.
+    double press_depth_m = 0.0;
+    double press_fraction = 0.0;
 };
 
 // Indexed by Nuance (enum order). See docs/gestures.md, table "Nuance shapes".
@@ -54,6 +61,9 @@ const NuanceShape kShapes[kNuances] = {
     {1.90, 0.40, 3.0, 2.5, 0.0, 0.90, 0.00, 0.85},
     // staccato: lifts away quickly after the hit
     {1.15, 0.30, 3.0, 4.0, 0.0, 1.00, 0.00, 0.0},
+    // buzz: a legato-like downswing, then pressed into the head 2 cm over 60 %
+    // of the lift time (a loose grip then bounces the stick there), lifted low
+    {0.75, 0.35, 3.0, 2.0, 0.0, 0.60, 0.00, 0.0, 0.02, 0.6},
 };
 
 struct GripShape {
@@ -74,7 +84,15 @@ double height(const NuanceShape &s, double H, double H_lift, double D, double L,
         const double u = std::clamp((t + D) / D, 0.0, 1.0);
         return H * (1.0 - std::pow(u, s.exponent));
     }
-    const double w = std::clamp(t / L, 0.0, 1.0);
+    // The press: the hand keeps going into the head (press_depth_m, time
+    // constant kPressTau_s), holds, and lets go over the last 30 % of it.
+    const double P = std::min(s.press_fraction * L, kMaxPress_s);
+    if (t < P) {
+        const double x = std::clamp((t - 0.7 * P) / (0.3 * P), 0.0, 1.0);
+        return -s.press_depth_m * (1.0 - std::exp(-t / kPressTau_s)) *
+               (1.0 - x * x * (3.0 - 2.0 * x));
+    }
+    const double w = std::clamp((t - P) / (L - P), 0.0, 1.0);
     const double rebound = 1.0 - std::pow(1.0 - w, s.lift_exponent);
     const double held = w * w * (3.0 - 2.0 * w);
     return H_lift * (s.lift_hold * held + (1.0 - s.lift_hold) * rebound);

@@ -534,9 +534,9 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
                     ok = one_of(text, {"french", "german"});
                     expected = "french or german";
                 } else if (s.kind == CommandKind::nuance) {
-                    ok =
-                        one_of(text, {"legato", "tenuto", "accent", "vertical_accent", "staccato"});
-                    expected = "legato, tenuto, accent, vertical_accent or staccato";
+                    ok = one_of(text, {"legato", "tenuto", "accent", "vertical_accent", "staccato",
+                                       "buzz"});
+                    expected = "legato, tenuto, accent, vertical_accent, staccato or buzz";
                 } else if (s.kind == CommandKind::mode) {
                     ok = one_of(text, {"joint", "cartesian"});
                     expected = "joint or cartesian";

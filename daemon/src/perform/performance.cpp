@@ -830,7 +830,9 @@ std::unique_ptr<Performance::PlanState> Performance::make_plan(std::shared_ptr<c
             ps->beats[s].push_back(n.time_s);
             ps->lead_s[s].push_back(lead);
             ps->approach_mps[s].push_back(v);
-            ps->firmness[s].push_back(n.firmness);
+            // A buzz is played with a loose grip unless the note says otherwise.
+            ps->firmness[s].push_back(
+                n.firmness >= 0.0 || n.nuance != Nuance::buzz ? n.firmness : kBuzzGripFirmness);
             ps->planned_speed_mps[i] = v;
         }
     }

@@ -172,8 +172,8 @@ struct Statement {
     int count = 0; // repeat
 };
 
-const Nuance kNuances[] = {Nuance::legato, Nuance::tenuto, Nuance::accent, Nuance::vertical_accent,
-                           Nuance::staccato};
+const Nuance kNuances[] = {Nuance::legato,          Nuance::tenuto,   Nuance::accent,
+                           Nuance::vertical_accent, Nuance::staccato, Nuance::buzz};
 
 std::string nuance_list()
 {

@@ -388,7 +388,11 @@ double Scene::fulcrum_inertia_kg_m2(Side side) const
 
 void Scene::set_grip_firmness(Side side, double firmness)
 {
-    set_grip(side, grip_spring(firmness, fulcrum_inertia_kg_m2(side), options_.grip_damping_ratio));
+    // A looser hold touches the stick with less of the hand: below the
+    // default firmness the damping ratio falls in proportion.
+    const double ratio =
+        options_.grip_damping_ratio * std::min(1.0, std::max(firmness, 0.0) / kDefaultGripFirmness);
+    set_grip(side, grip_spring(firmness, fulcrum_inertia_kg_m2(side), ratio));
 }
 
 void Scene::near_callback(void *data, dGeomID a, dGeomID b)

@@ -24,18 +24,21 @@ struct GestureError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// The paper's five playing variations ("nuances"). Enum order is NOT the
-// loudness order: see kLoudnessOrder.
-enum class Nuance { legato, tenuto, accent, vertical_accent, staccato };
-constexpr int kNuances = 5;
+// The paper's five playing variations ("nuances"), and the buzz (press)
+// stroke: the hand presses the stick into the head after the strike, and a
+// loose grip lets it bounce there several times (docs/gestures.md). Enum
+// order is NOT the loudness order: see kLoudnessOrder.
+enum class Nuance { legato, tenuto, accent, vertical_accent, staccato, buzz };
+constexpr int kNuances = 6;
 // Softest to loudest at equal dynamics (docs/gestures.md, "Loudness order"):
 // preparation height and impact speed grow along it.
-constexpr Nuance kLoudnessOrder[kNuances] = {Nuance::tenuto, Nuance::legato, Nuance::staccato,
+constexpr Nuance kLoudnessOrder[kNuances] = {Nuance::tenuto, Nuance::buzz,
+                                             Nuance::legato, Nuance::staccato,
                                              Nuance::accent, Nuance::vertical_accent};
 const char *to_string(Nuance n);
 // Also accepts "vertical-accent"; throws GestureError listing the valid names.
 Nuance nuance_from_string(const std::string &s);
-// Position of n in kLoudnessOrder (0 softest .. 4 loudest).
+// Position of n in kLoudnessOrder (0 softest .. 5 loudest).
 int loudness_rank(Nuance n);
 
 const char *to_string(Side side);            // "left", "right"

@@ -248,6 +248,8 @@ class Performance
     // The trunk (docs/perform.md, "The trunk"): eq. 1's natural frequency of
     // the lumbar and thorax joints, and how they follow the sticks.
     static constexpr double kTrunkHz = 8.0;
+    // The grip of a buzz note that gives none (docs/perform.md, "Buzz").
+    static constexpr double kBuzzGripFirmness = 0.0;
     static constexpr double kTrunkLean_rad_per_m = 0.15;
     static constexpr double kTrunkTwist_rad_per_m = 0.2;
     void set_grips(double firmness); // both hands, now
