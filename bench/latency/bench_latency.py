@@ -70,7 +70,7 @@ def run_once():
         reports.close()
     rec = fudi_records(reports.snapshot())
     offset = wall_of_logical(rec)
-    fire = {int(a[9]): (t, a[1]) for t, a in rec if a[0] == "fire"}
+    fire = {int(a[10]): (t, a[1]) for t, a in rec if a[0] == "fire"}
     plain = {int(a[2]): a[1] for t, a in rec if a[0] == "plain"}
     sched = np.array([(offset + fire[s][1] / 1000.0 - tag) * 1e3
                       for s, (t0, tag) in sent.items() if s in fire])

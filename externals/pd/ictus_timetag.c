@@ -385,7 +385,7 @@ static void ictus_timetag_status(t_ictus_timetag *x)
     outlet_anything(x->x_info_out, gensym("status"), 5, info);
 }
 
-/* expect ADDRESS TAGS: e.g. `expect /ictus/strike iiiifffffffffffff` (tags
+/* expect ADDRESS TAGS: e.g. `expect /ictus/strike iiiiffffffffffffff` (tags
  * without the comma; an empty symbol for none). A new rule for the same
  * address replaces the old one. */
 static void ictus_timetag_expect(t_ictus_timetag *x, t_symbol *address, t_symbol *tags)

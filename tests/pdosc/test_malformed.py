@@ -36,9 +36,11 @@ nested = message("/ictus/pong", "")
 for _ in range(10):  # deeper than ictus_timetag's limit of 8
     nested = bundle(timetag(now()), nested)
 bad.append(nested)
-# 17 arguments but not the fixed type tags of /ictus/strike (docs/osc.md)
-bad.append(message("/ictus/strike", "iiiifffffffffffff".replace("i", "f"), *range(17)))
-bad.append(message("/ictus/strike", "iiiiffffffffffffs", *range(16), "x"))
+# 18 arguments but not the fixed type tags of /ictus/strike (docs/osc.md), and the
+# 17 of the layout before stick_mass_kg
+bad.append(message("/ictus/strike", "iiiiffffffffffffff".replace("i", "f"), *range(18)))
+bad.append(message("/ictus/strike", "iiiifffffffffffffs", *range(17), "x"))
+bad.append(message("/ictus/strike", "iiiifffffffffffff", *range(17)))
 bad.append(bundle(timetag(now()), message("/ictus/strike", "ii", 1, 2)))  # 2 arguments
 # every truncation of a good strike bundle, except 16 bytes (a valid empty bundle)
 bad += [good[:n] for n in range(1, len(good)) if n != 16]
@@ -98,13 +100,13 @@ lines = [l for l in log.splitlines() if l.strip()]
 timetag_errors = [l for l in lines if "ictus_timetag: malformed OSC packet" in l]
 check(len(timetag_errors) == 5, "the first 5 malformed packets are reported by name (%d)"
       % len(timetag_errors))
-# the three new ones, and the ,q / ,iiii / ,i strikes above (caught by their tags first)
-check(sum(1 for m in malformed[:len(bad)] if m[3] == "unexpected-type-tags") == 6,
-      "strikes with other type tags than ,iiiifffffffffffff are refused (unexpected-type-tags)")
+# the four new ones, and the ,q / ,iiii / ,i strikes above (caught by their tags first)
+check(sum(1 for m in malformed[:len(bad)] if m[3] == "unexpected-type-tags") == 7,
+      "strikes with other type tags than ,iiiiffffffffffffff are refused (unexpected-type-tags)")
 others = [l for l in lines if l not in timetag_errors]
 check(not others, "nothing else in pd's log: %s" % others)
 offset = wall_of_logical(records)
-fires = {int(a[9]): a for _, a in records if a[0] == "fire" and int(a[9]) != 999}
+fires = {int(a[10]): a for _, a in records if a[0] == "fire" and int(a[10]) != 999}
 check(sorted(fires) == sorted(sent), "exactly the 10 good strikes came out: %s" % sorted(fires))
 worst = max(abs(offset + fires[s][1] / 1000.0 - sent[s]) * 1000.0 for s in sent)
 check(worst <= 1.0, "after the malformed packets, strikes start at their timetag within 1 ms "

@@ -44,7 +44,7 @@ try:
     # ictus-receive listens from 300 ms on ('listen PORT'); meanwhile
     # ictus_timetag collects clock samples (every 2 ms)
     time.sleep(0.6)
-    sent = {}  # seq -> (timetag_s, hand, velocity, r_over_a, theta)
+    sent = {}  # seq -> (timetag_s, hand, velocity, r_over_a, theta, stick_mass_kg)
     t_next = now() + LOOKAHEAD_S
     for seq in range(1, N_STRIKES + 1):
         if seq == N_STRIKES // 2 + 1:
@@ -61,8 +61,10 @@ try:
         while now() < t_next - LOOKAHEAD_S:
             time.sleep(0.0005)
         hand, vel, ra, th = seq % 2, 0.5 + 0.25 * seq, 0.01 * seq, 7.0 * seq
-        out.sendto(bundle(timetag(t_next), strike(seq, hand, vel, ra, th)), ("127.0.0.1", pd_port))
-        sent[seq] = (t_next, hand, vel, ra, th)
+        mass = 0.01 + 0.001 * seq
+        out.sendto(bundle(timetag(t_next), strike(seq, hand, vel, ra, th, stick_mass_kg=mass)),
+                   ("127.0.0.1", pd_port))
+        sent[seq] = (t_next, hand, vel, ra, th, mass)
         t_next += SPACING_S
     time.sleep(0.2)
     # a bundle 30 ms overdue: fires at once, counted as late
@@ -94,19 +96,21 @@ finally:
 records = fudi_records(reports.snapshot())
 check(proc.returncode == 0 and not error_lines(log), "pd ran cleanly: %s" % error_lines(log))
 offset = wall_of_logical(records)
-fires = {int(a[9]): (t, a) for t, a in records if a[0] == "fire"}
+fires = {int(a[10]): (t, a) for t, a in records if a[0] == "fire"}
 check(set(sent) <= set(fires), "all %d strikes came out (got %d)" % (len(sent), len(fires)))
 errors_ms, arrival_ms = [], []
-for seq, (tag, hand, vel, ra, th) in sorted(sent.items()):
+for seq, (tag, hand, vel, ra, th, mass) in sorted(sent.items()):
     t_arr, a = fires[seq]
     logical_ms = a[1]
     fields = a[2:]
-    check(len(fields) == 17, "strike %d has 17 fields" % seq)
-    # documented order: hand velocity r/a theta force bounce drum seq time x y vt J dur dx dy dz
+    check(len(fields) == 18, "strike %d has 18 fields" % seq)
+    # documented order: hand velocity r/a theta mass force bounce drum seq time x y vt J dur
+    # dx dy dz
     check(abs(fields[0] - hand) < 1e-6 and abs(fields[1] - vel) < 1e-4
           and abs(fields[2] - ra) < 1e-5 and abs(fields[3] - th) < 1e-3
-          and abs(fields[4] - 50.0) < 1e-3 and fields[5] == 0 and fields[7] == seq,
-          "strike %d fields in the documented order: %s" % (seq, fields[:8]))
+          and abs(fields[4] - mass) < 1e-7 and abs(fields[5] - 50.0) < 1e-3 and fields[6] == 0
+          and fields[8] == seq and abs(fields[17] + 1.0) < 1e-6,
+          "strike %d fields in the documented order: %s" % (seq, fields))
     latency_ms = LATENCY_MS if seq > N_STRIKES // 2 else 0.0
     errors_ms.append((offset + logical_ms / 1000.0 - tag) * 1000.0 + latency_ms)
     arrival_ms.append((t_arr - tag) * 1000.0)
