@@ -59,7 +59,7 @@ void render_usage(std::ostream &out)
            "  --gestures DB.json  gesture database (default: the built-in one)\n"
            "  --mode M            cartesian (default, Algorithm 2) | joint (eq. 1, joint\n"
            "                      targets from the IK of the tip targets)\n"
-           "  --strike-depth M    the target dips this far below the first contact (0.004)\n"
+           "  --strike-depth M    the target dips this far below the first contact (0)\n"
            "  --advance S         tip targets sampled S ahead: the tracking lag (default 0)\n"
            "  --rebound S         the target's rebound after a beat, time constant (default\n"
            "                      0.1; 0: off)\n"

@@ -628,7 +628,11 @@ ScorePerformOptions::ScorePerformOptions()
 {
     // Measured in docs/perform.md: the target dips this far below the first
     // contact on each beat, and is sampled the controller's lag ahead.
-    plan.strike_depth_m = 0.004;
+    // With the sticks on their fulcrum the stick's own inertia carries the
+    // bead into the head: the hand's target turns at the contact height
+    // (4 mm below it, as with welded sticks, left the hand pressing on after
+    // soft strokes; docs/perform.md).
+    plan.strike_depth_m = 0.0;
     time_advance_s = 0.0;
     // Algorithm 2 for strokes: `ictusd track`'s CMU-tuned velocity term
     // (c = 0.1 s) feeds the 1 kHz tip velocity back and makes the tip chatter
