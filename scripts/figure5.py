@@ -147,8 +147,26 @@ def main():
     except (OSError, KeyError, ValueError, IndexError, TypeError):
         pass
 
-    fig, (ax_score, ax_tips, ax_strikes) = plt.subplots(
-        3, 1, sharex=True, figsize=(11, 6.5), gridspec_kw={"height_ratios": [1.2, 4, 1]})
+    # The sticks' fulcrum angles (the stick turning in the hand), when tips.csv has them.
+    fulcrum = {}
+    for hand in HANDS:
+        name = "%s_fulcrum_rad" % hand
+        if name in header:
+            fulcrum[hand] = np.degrees(np.array([float(r[header.index(name)]) for r in rows]))
+    panels = [1.2, 4, 1.6, 1] if fulcrum else [1.2, 4, 1]
+    axes = plt.subplots(len(panels), 1, sharex=True, figsize=(11, 6.5 + (1.5 if fulcrum else 0)),
+                        gridspec_kw={"height_ratios": panels})[1]
+    fig = axes[0].figure
+    ax_score, ax_tips = axes[0], axes[1]
+    ax_fulcrum = axes[2] if fulcrum else None
+    ax_strikes = axes[-1]
+    if fulcrum:
+        for hand, angle in fulcrum.items():
+            ax_fulcrum.plot(t, angle, "-", color=COLOURS[hand], lw=1.0, label="%s fulcrum" % hand)
+        ax_fulcrum.axhline(0.0, color="0.5", lw=0.6)
+        ax_fulcrum.set_ylabel("fulcrum (deg)")
+        ax_fulcrum.legend(fontsize=7, ncol=2, loc="upper right")
+        ax_fulcrum.grid(alpha=0.3)
     # The score: one row per hand, the nuance written at each note; tempo above.
     for hand, row in (("right", 1), ("left", 0)):
         hn = [n for n in notes if n["hand"] == hand]

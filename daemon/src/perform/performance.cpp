@@ -110,6 +110,7 @@ struct Performance::PlanState {
     GesturePlan plan;
     std::array<std::vector<double>, 2> beats, lead_s, approach_mps;
     std::array<std::vector<double>, 2> firmness; // < 0: the performance's
+    std::array<std::vector<bool>, 2> press;      // a buzz: loose from its beat on
     std::array<size_t, 2> grip_note = {0, 0};    // the note whose grip is applied
     std::vector<double> planned_speed_mps;       // [note of plan]
 };
@@ -837,11 +838,12 @@ std::unique_ptr<Performance::PlanState> Performance::make_plan(std::shared_ptr<c
             ps->beats[s].push_back(n.time_s);
             ps->lead_s[s].push_back(lead);
             ps->approach_mps[s].push_back(v);
-            // A buzz is played with the loosest grip unless the note says otherwise.
-            double firmness = n.firmness;
-            if (firmness < 0.0 && n.nuance == Nuance::buzz)
-                firmness = kBuzzGripFirmness;
-            ps->firmness[s].push_back(firmness);
+            // A buzz's press is played with the loosest grip from its strike on
+            // (the downswing keeps the performance's grip: a loose stick lags a
+            // fast hand), unless the note gives its own.
+            const bool press = n.firmness < 0.0 && n.nuance == Nuance::buzz;
+            ps->firmness[s].push_back(press ? kBuzzGripFirmness : n.firmness);
+            ps->press[s].push_back(press);
             ps->planned_speed_mps[i] = v;
         }
     }
@@ -1182,7 +1184,9 @@ void Performance::apply_note_grips(double t)
         size_t k = std::min(ps.grip_note[s], beats.size() - 1);
         while (k + 1 < beats.size() && t > 0.5 * (beats[k] + beats[k + 1]))
             ++k;
-        const double f = ps.firmness[s][k] >= 0.0 ? ps.firmness[s][k] : options_.grip_firmness;
+        const bool before_press = ps.press[s][k] && t < beats[k];
+        const double f =
+            ps.firmness[s][k] >= 0.0 && !before_press ? ps.firmness[s][k] : options_.grip_firmness;
         if (f != applied_firmness_[s]) {
             score_rig_->tracker->scene().set_grip_firmness(static_cast<Side>(s), f);
             applied_firmness_[s] = f;

@@ -168,9 +168,7 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
         e.tangential_velocity_mps = (v - v.dot(kNormal) * kNormal).norm();
         e.bounce = h.released_once && (t_on - h.release_time_s) <= options_.bounce_window_s &&
                    (h.max_gap_since_release < options_.bounce_height_m ||
-                    h.max_held_gap_since_release < options_.bounce_height_m ||
-                    (s.held_velocity_mps.allFinite() &&
-                     -s.held_velocity_mps.dot(kNormal) < options_.held_approach_mps));
+                    h.max_held_gap_since_release < options_.bounce_height_m);
         e.stick_mass_kg = s.effective_mass_kg;
         if (!e.bounce)
             ++h.stroke;
@@ -315,7 +313,6 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
         s.center_m = scene.bead_position(side);
         s.velocity_mps = scene.bead_velocity(side);
         s.held_center_m = scene.held_bead_position(side);
-        s.held_velocity_mps = scene.held_tip_velocity(side);
         // Only near the head, where a contact may begin (a 7 x 7 solve).
         if (detector.gap_m(s.center_m) < 0.02)
             s.effective_mass_kg = scene.effective_mass_kg(side, Eigen::Vector3d::UnitY());

@@ -40,11 +40,8 @@ struct StrikeDetectorOptions {
     // the bead did not rise more than bounce_height_m above the membrane OR
     // the hand did not lift the stick by that much (the held bead,
     // TipSample::held_center_m: a stick rebounding on its fulcrum while the
-    // hand stays down strikes again by itself) OR the hand is not bringing
-    // the stick down at the onset (the held bead's speed toward the head is
-    // under held_approach_mps: the stick fell back while the hand rose).
+    // hand stays down strikes again by itself).
     double bounce_height_m = 0.01;
-    double held_approach_mps = 0.25;
     double bounce_window_s = 0.15;
     // How the samples were made, which decides the velocity that crossed the
     // membrane plane (the pre-contact velocity of a strike):
@@ -68,8 +65,6 @@ struct TipSample {
     // The bead's centre where the hand holds it (the stick at its fulcrum's
     // rest angle); NaN: the same as center_m (a rigid stick, a trajectory).
     Eigen::Vector3d held_center_m = Eigen::Vector3d::Constant(std::nan(""));
-    // Its velocity; NaN: not known (the rule below then ignores it).
-    Eigen::Vector3d held_velocity_mps = Eigen::Vector3d::Constant(std::nan(""));
     // The stick's effective mass at the bead along the normal (kg; 0: not
     // known), copied into a strike that begins at this sample.
     double effective_mass_kg = 0.0;
