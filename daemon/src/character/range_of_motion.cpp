@@ -106,6 +106,10 @@ Eigen::Quaterniond SwingTwistLimit::clamp(const Eigen::Quaterniond &q) const
 
 double SwingTwistLimit::excursion_rad(const Eigen::Quaterniond &q) const
 {
+    const Eigen::Vector3d c = coordinates(q);
+    if (c[0] >= u_lo_rad && c[0] <= u_hi_rad && c[1] >= w_lo_rad && c[1] <= w_hi_rad &&
+        c[2] >= twist_lo_rad && c[2] <= twist_hi_rad)
+        return 0.0; // inside: nothing to recompose (the usual case, every step)
     return rotation_angle_between(q.normalized(), clamp(q));
 }
 
