@@ -350,3 +350,49 @@ TEST_CASE("render --score: the files, the summary, deterministic bytes", "[perfo
                         "--out", (dir / "c").string()}) == 2);
     fs::remove_all(dir);
 }
+
+TEST_CASE("perform: grip firmness live, per note, and the buzz's loose press", "[perform]")
+{
+    PerformanceOptions o;
+    o.score.score_text = "tempo 100\nR legato, L legato firmness 0.9, R buzz, L legato\n";
+    Performance perf(o);
+    const double inertia = perf.scene().fulcrum_inertia_kg_m2(Side::left);
+    auto stiffness = [](double f) { return 2.0 * std::pow(2.0, 7.0 * f); };
+    // The performance's own grip until told otherwise.
+    CHECK(perf.scene().grip(Side::left).stiffness_nm_per_rad ==
+          Approx(stiffness(kDefaultGripFirmness)));
+    // Live: /ictus/grip/firmness sets it at once for the notes that give none.
+    Command c;
+    c.kind = CommandKind::grip_firmness;
+    c.value = 0.8;
+    REQUIRE(perf.apply(c));
+    for (Side s : {Side::left, Side::right}) {
+        CHECK(perf.scene().grip(s).stiffness_nm_per_rad == Approx(stiffness(0.8)));
+        CHECK(perf.scene().grip(s).damping_nm_s_per_rad ==
+              Approx(2.0 * 0.7 * std::sqrt(stiffness(0.8) * inertia)));
+    }
+    c.value = kDefaultGripFirmness;
+    REQUIRE(perf.apply(c));
+    // Per note: while the score plays, each hand holds its note's grip.
+    perf.start_score();
+    const std::vector<PlannedNote> notes = perf.plan()->notes;
+    REQUIRE(notes.size() == 4);
+    std::vector<double> left_k, right_k;
+    StrikeEvent ev[2];
+    const long steps = std::lround(perf.plan()->duration_s / perf.step_s());
+    for (long n = 0; n < steps; ++n) {
+        perf.step(ev);
+        const double t = perf.plan_time_s();
+        if (std::abs(t - notes[1].time_s) < 5e-4) // the left hand's firm note, at its beat
+            left_k.push_back(perf.scene().grip(Side::left).stiffness_nm_per_rad);
+        if (std::abs(t - (notes[2].time_s - 0.01)) < 5e-4) // the buzz's downswing
+            right_k.push_back(perf.scene().grip(Side::right).stiffness_nm_per_rad);
+        if (std::abs(t - (notes[2].time_s + 0.01)) < 5e-4) // the buzz's press
+            right_k.push_back(perf.scene().grip(Side::right).stiffness_nm_per_rad);
+    }
+    REQUIRE(left_k.size() == 1);
+    REQUIRE(right_k.size() == 2);
+    CHECK(left_k[0] == Approx(stiffness(0.9)));
+    CHECK(right_k[0] == Approx(stiffness(kDefaultGripFirmness)));
+    CHECK(right_k[1] == Approx(stiffness(Performance::kBuzzGripFirmness)));
+}

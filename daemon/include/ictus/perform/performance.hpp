@@ -193,6 +193,8 @@ class Performance
     // the gains back to their defaults, sends no strike for
     // kRunawayQuiet_s, counts it and reports it as a refusal of the last
     // /ictus/gains command.
+    // The grip of a buzz note that gives none (docs/perform.md, "Buzz").
+    static constexpr double kBuzzGripFirmness = 0.0;
     static constexpr double kRunawayTipSpeed_mps = 40.0;
     static constexpr double kRunawayQuiet_s = 1.0;
     long runaways() const { return runaways_; }
@@ -248,8 +250,6 @@ class Performance
     // The trunk (docs/perform.md, "The trunk"): eq. 1's natural frequency of
     // the lumbar and thorax joints, and how they follow the sticks.
     static constexpr double kTrunkHz = 8.0;
-    // The grip of a buzz note that gives none (docs/perform.md, "Buzz").
-    static constexpr double kBuzzGripFirmness = 0.0;
     static constexpr double kTrunkLean_rad_per_m = 0.15;
     static constexpr double kTrunkTwist_rad_per_m = 0.2;
     void set_grips(double firmness); // both hands, now
