@@ -7,17 +7,23 @@
 #      built-in gesture database, offline: OUT/strikes.csv, OUT/events.txt,
 #      OUT/render.json, OUT/tips.csv, OUT/notes.csv, OUT/performance.bvh
 #   4. Pd in batch mode plays the events on the drum of render.json
-#      (patches/ictus-render.pd): OUT/performance.wav (2 pickups, 48 kHz, float)
+#      (patches/ictus-render.pd): OUT/performance.wav (stereo, 48 kHz, 32-bit
+#      float, peaks below -0.5 dBFS: docs/main-job.md)
 #   5. the tip-trajectory plot (scripts/figure5.py): OUT/tips.png and .svg
 # and prints where each output is and a short summary.
 #
 # usage: scripts/main.sh [--build DIR] [--out DIR] [--score FILE] [--no-deps] [--no-build]
+#                        [--mix stereo|pickups] [--bits 16|24|32] [--gain DB]
 #        scripts/main.sh [BUILD_DIR]            (as before: the build folder)
 #   --build DIR   build folder (default build/)
 #   --out DIR     output folder (default out/)
 #   --score FILE  play this score instead of the default one (examples/scores/)
 #   --no-deps     do not run scripts/deps.sh
 #   --no-build    use the existing build in --build as it is
+#   --mix M       stereo (default: the drum in the middle, the hands panned) or
+#                 pickups (the membrane's two raw pickups)
+#   --bits N      16 or 24 (integer PCM) or 32 (float, the default)
+#   --gain DB     output gain before the soft limiter (default 0)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build
@@ -25,6 +31,9 @@ out=$root/out
 score=
 deps=1
 do_build=1
+mix=stereo
+bits=32
+gain=0
 while [[ $# -gt 0 ]]; do
     case $1 in
     --build) build=$2; shift 2 ;;
@@ -32,11 +41,20 @@ while [[ $# -gt 0 ]]; do
     --score) score=$2; shift 2 ;;
     --no-deps) deps=0; shift ;;
     --no-build) do_build=0; shift ;;
-    -h | --help) sed -n '2,24p' "$0"; exit 0 ;;
+    --mix) mix=$2; shift 2 ;;
+    --bits) bits=$2; shift 2 ;;
+    --gain) gain=$2; shift 2 ;;
+    -h | --help) sed -n '2,30p' "$0"; exit 0 ;;
     -*) echo "main.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
     *) build=$1; shift ;;
     esac
 done
+case $mix in stereo | pickups) ;; *) echo "main.sh: --mix must be stereo or pickups, got '$mix'" >&2; exit 2 ;; esac
+case $bits in 16 | 24 | 32) ;; *) echo "main.sh: --bits must be 16, 24 or 32, got '$bits'" >&2; exit 2 ;; esac
+if ! [[ $gain =~ ^-?[0-9]+([.][0-9]+)?$ ]]; then
+    echo "main.sh: --gain must be a number of dB, got '$gain'" >&2
+    exit 2
+fi
 mkdir -p "$out"
 build=$(cd "$(dirname "$build")" && pwd)/$(basename "$build")
 out=$(cd "$out" && pwd)
@@ -84,6 +102,7 @@ pd -nogui -nosound -batch -stderr -r 48000 -path "$build/ictus" \
     -open "$root/patches/ictus-render.pd" \
     -send "render-drum radius $radius" -send "render-drum tension $tension" \
     -send "render-drum density $density" \
+    -send "render-mix $mix" -send "render-bits $bits" -send "render-gain $gain" \
     -send "render-file $out/events.txt" -send "render-out $wav" \
     -send "render-seconds $seconds" >"$out/pd.log" 2>&1 || {
     cat "$out/pd.log" >&2
@@ -99,20 +118,27 @@ fi
 /usr/bin/python3 "$root/scripts/figure5.py" "$out" --out "$out/tips"
 
 # where everything is, and a summary
-/usr/bin/python3 - "$out" <<'PY'
+ICTUS_MIX=$mix /usr/bin/python3 - "$out" <<'PY'
 import json, os, sys
 sys.path.insert(0, "tests/pd")
 import numpy as np
-from pdrun import read_wav_float
+from pdrun import read_wav_any
 
 out = sys.argv[1]
 wav = os.path.join(out, "performance.wav")
-x, sr = read_wav_float(wav)
+x, sr, bits, is_float = read_wav_any(wav)
 if x.shape[0] == 0 or not np.all(np.isfinite(x)):
     sys.exit("main.sh: %s is empty or not finite" % wav)
 peak = float(np.max(np.abs(x)))
 if peak < 1e-3:
     sys.exit("main.sh: %s is silent (peak %g)" % (wav, peak))
+rms_db = [20 * np.log10(max(float(np.sqrt(np.mean(x[:, c] ** 2))), 1e-12)) for c in range(x.shape[1])]
+limiter = ""
+with open(os.path.join(out, "pd.log")) as f:
+    for line in f:
+        if line.startswith("ictus-render: peak_in_dbfs"):
+            w = line.split()
+            limiter = ", %s dBFS before the limiter (gain %s dB)" % (w[2], w[6])
 meta = json.load(open(os.path.join(out, "render.json")))
 bvh = os.path.join(out, "performance.bvh")
 frames = joints = None
@@ -125,8 +151,10 @@ if os.path.isfile(bvh):
             frames = int(line.split()[1])
 print()
 print("main job: outputs in %s" % out)
-for name, what in (("performance.wav", "%d channels, %.2f s at %d Hz, peak %.3f"
-                    % (x.shape[1], x.shape[0] / sr, sr, peak)),
+for name, what in (("performance.wav", "%d channels (%s), %.2f s at %d Hz, %d-bit %s, peak %.2f dBFS%s, "
+                    "RMS %s dBFS" % (x.shape[1], os.environ.get("ICTUS_MIX", "?"), x.shape[0] / sr, sr, bits,
+                                     "float" if is_float else "PCM", 20 * np.log10(peak), limiter,
+                                     " / ".join("%.1f" % r for r in rms_db))),
                    ("strikes.csv", "%s strikes, %s bounces" % (meta.get("strikes"), meta.get("bounces"))),
                    ("events.txt", "the strikes for Pd (qlist)"),
                    ("tips.png", "stick-tip heights, score and strikes (and tips.svg)"),
