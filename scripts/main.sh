@@ -5,7 +5,8 @@
 #   3. ictusd render: the virtual percussionist plays the default score (the
 #      paper's Figure 5: legato and accent beats under a tempo change) with the
 #      built-in gesture database, offline: OUT/strikes.csv, OUT/events.txt,
-#      OUT/render.json, OUT/tips.csv, OUT/notes.csv, OUT/performance.bvh
+#      OUT/render.json, OUT/tips.csv, OUT/notes.csv, OUT/performance.bvh,
+#      OUT/performance.mid
 #   4. Pd in batch mode plays the events on the drum of render.json
 #      (patches/ictus-render.pd): OUT/performance.wav (stereo, 48 kHz, 32-bit
 #      float, peaks below -0.5 dBFS: docs/main-job.md)
@@ -78,7 +79,7 @@ if ! "$ictusd" render --help 2>&1 | grep -q -- "--score"; then
 fi
 
 # 3. the performance, offline and deterministic
-rm -f "$out"/{strikes.csv,events.txt,render.json,tips.csv,notes.csv,performance.bvh} \
+rm -f "$out"/{strikes.csv,events.txt,render.json,tips.csv,notes.csv,performance.bvh,performance.mid} \
     "$out"/{performance.wav,tips.png,tips.svg,pd.log}
 render=("$ictusd" render --out "$out" --force)
 [[ -n $score ]] && render+=(--score "$score")
@@ -157,6 +158,9 @@ for name, what in (("performance.wav", "%d channels (%s), %.2f s at %d Hz, %d-bi
                                      " / ".join("%.1f" % r for r in rms_db))),
                    ("strikes.csv", "%s strikes, %s bounces" % (meta.get("strikes"), meta.get("bounces"))),
                    ("events.txt", "the strikes for Pd (qlist)"),
+                   ("performance.mid", "the strikes as MIDI notes, channel %s (docs/midi.md)"
+                    % meta.get("midi", {}).get("channel", "?")
+                    if os.path.isfile(os.path.join(out, "performance.mid")) else "MISSING"),
                    ("tips.png", "stick-tip heights, score and strikes (and tips.svg)"),
                    ("performance.bvh", "%s joints, %s frames" % (joints, frames)
                     if frames is not None else "MISSING"),

@@ -1,12 +1,13 @@
 // `ictusd render`: the performance offline, as fast as possible and
 // deterministic (same input, same bytes): strikes.csv, events.txt for Pd's
 // batch render, render.json, and in score mode tips.csv, notes.csv; the
-// performance as BVH. Also the options run and render share (verbs.hpp).
-// Nothing is written while the physics runs: every output is kept in memory
-// and written at the end, each write checked. --out is a new or empty folder
+// performance as BVH and the strikes as a Standard MIDI File. Also the options run and render share
+// (verbs.hpp). Nothing is written while the physics runs: every output is kept in memory and
+// written at the end, each write checked. --out is a new or empty folder
 // (--force: render's own files in a used one are replaced). docs/osc.md,
 // docs/perform.md.
 #include "ictus/character/bvh_export.hpp"
+#include "ictus/cli/midi_file.hpp"
 #include "ictus/cli/verbs.hpp"
 #include "ictus/perform/strike_log.hpp"
 
@@ -50,9 +51,12 @@ void render_usage(std::ostream &out)
            "                      that no earlier render's file passes for this one's)\n"
            "  --force             write into a used folder: render's own files there\n"
            "                      (strikes.csv, events.txt, render.json, tips.csv, notes.csv,\n"
-           "                      performance.bvh) are removed first, no other file\n"
+           "                      performance.bvh, performance.mid) are removed first, no\n"
+           "                      other file\n"
            "  --tips-rate HZ      tips.csv rows per second (default 250; 0: none)\n"
            "  --bvh-rate HZ       performance.bvh frames per second (default 250; 0: none)\n"
+           "  --midi-channel N    MIDI channel 1..16 of DIR/performance.mid, the strikes as\n"
+           "                      notes (docs/midi.md; default 1)\n"
            "\n"
            "score mode (run and render):\n"
            "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
@@ -92,8 +96,9 @@ void render_usage(std::ostream &out)
 }
 
 // The files render writes into --out, all it may remove (--force).
-const char *const kRenderOutputs[] = {"strikes.csv", "events.txt", "render.json",
-                                      "tips.csv",    "notes.csv",  "performance.bvh"};
+const char *const kRenderOutputs[] = {"strikes.csv",    "events.txt", "render.json",
+                                      "tips.csv",       "notes.csv",  "performance.bvh",
+                                      "performance.mid"};
 
 // --out: created, or else empty, so that no file of an earlier render (a
 // score's notes.csv beside a clip's strikes) passes for this one's. With
@@ -307,7 +312,7 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
 int cmd_render(Args &args)
 {
     PerformanceOptions o;
-    double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0;
+    double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0, midi_channel = 1.0;
     std::string out_dir;
     bool force = false;
     while (!args.done()) {
@@ -321,6 +326,11 @@ int cmd_render(Args &args)
             force = true;
         } else if (a == "--bvh-rate") {
             bvh_rate = parse_number(a, args.value(a), 0, 1000);
+        } else if (a == "--midi-channel") {
+            midi_channel = parse_number(a, args.value(a), 1, 16);
+            if (midi_channel != std::floor(midi_channel))
+                throw UsageError("--midi-channel: expected a whole number 1..16, got '" +
+                                 std::to_string(midi_channel) + "'");
         } else if (a == "--tips-rate") {
             tips_rate = parse_number(a, args.value(a), 0, 1000);
         } else if (!parse_performance_option(a, args, o, duration)) {
@@ -342,7 +352,7 @@ int cmd_render(Args &args)
     // Every output is opened now (an unwritable folder is found before the
     // run), kept in memory while the physics runs and written at the end.
     RenderOutput strikes_csv(out_dir + "/strikes.csv"), events_txt(out_dir + "/events.txt"),
-        render_json(out_dir + "/render.json");
+        render_json(out_dir + "/render.json"), performance_mid(out_dir + "/performance.mid");
     std::unique_ptr<RenderOutput> tips_csv, notes_csv;
     if (score_mode) {
         tips_csv = std::make_unique<RenderOutput>(out_dir + "/tips.csv");
@@ -399,6 +409,16 @@ int cmd_render(Args &args)
     events_txt.write_and_close(text.str());
     if (bvh)
         bvh->write(out_dir + "/performance.bvh");
+    // performance.mid: the score's tempo at each note (a clip: --tempo).
+    std::vector<MidiTempo> tempo;
+    if (score_mode) {
+        for (const PlannedNote &n : perf.plan()->notes)
+            tempo.push_back({perf.plan_origin_s() + n.time_s, n.tempo_bpm});
+    }
+    if (tempo.empty())
+        tempo.push_back({0.0, score_mode ? 120.0 : o.tempo_bpm});
+    performance_mid.write_and_close(
+        standard_midi_file(log.strikes(), tempo, static_cast<int>(midi_channel) - 1));
     nlohmann::json j;
     if (score_mode)
         j["score"] = o.score.score_text.empty() ? "default" : o.score.score_name;
@@ -414,6 +434,10 @@ int cmd_render(Args &args)
     if (!score_mode)
         j["tempo_bpm"] = o.tempo_bpm;
     j["drum"] = drum_json(perf);
+    j["midi"] = {{"file", "performance.mid"},
+                 {"channel", static_cast<int>(midi_channel)},
+                 {"notes", strikes},
+                 {"ticks_per_quarter", kMidiTicksPerQuarter}};
     if (score_mode) {
         const GesturePlan &plan = *perf.plan();
         const MatchSummary m = match_strikes(plan.notes, log.strikes(), perf.plan_origin_s());
@@ -427,8 +451,9 @@ int cmd_render(Args &args)
     std::cout << "render: " << perf.time_s() << " s simulated in " << wall << " s ("
               << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes << " strikes ("
               << bounces << " bounces), wrote " << out_dir
-              << (score_mode ? "/{strikes.csv,events.txt,render.json,tips.csv,notes.csv"
-                             : "/{strikes.csv,events.txt,render.json")
+              << (score_mode ? "/{strikes.csv,events.txt,render.json,performance.mid,tips.csv,"
+                               "notes.csv"
+                             : "/{strikes.csv,events.txt,render.json,performance.mid")
               << (bvh ? ",performance.bvh}\n" : "}\n");
     return interrupted ? 130 : 0;
 }
