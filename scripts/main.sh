@@ -8,8 +8,8 @@
 #      OUT/render.json, OUT/tips.csv, OUT/notes.csv, OUT/performance.bvh,
 #      OUT/performance.mid
 #   4. Pd in batch mode plays the events on the drum of render.json
-#      (patches/ictus-render.pd): OUT/performance.wav (stereo, 48 kHz, 32-bit
-#      float, peaks below -0.5 dBFS: docs/main-job.md)
+#      (ictusd render --wav, patches/ictus-render.pd): OUT/performance.wav
+#      (stereo, 48 kHz, 32-bit float, peaks below -0.5 dBFS: docs/main-job.md)
 #   5. the tip-trajectory plot (scripts/figure5.py): OUT/tips.png and .svg
 # and prints where each output is and a short summary.
 #
@@ -73,47 +73,29 @@ if [[ ! -x $ictusd || ! -d $build/ictus ]]; then
     echo "main.sh: no ictusd or Pd library in $build (run without --no-build)" >&2
     exit 1
 fi
-if ! "$ictusd" render --help 2>&1 | grep -q -- "--score"; then
-    echo "main.sh: this ictusd cannot render a score yet (no --score in 'ictusd render --help')" >&2
+if ! "$ictusd" render --help 2>&1 | grep -q -- "--wav FILE"; then
+    echo "main.sh: this ictusd cannot render a WAV (no --wav in 'ictusd render --help')" >&2
     exit 1
 fi
 
 # 3. the performance, offline and deterministic
 rm -f "$out"/{strikes.csv,events.txt,render.json,tips.csv,notes.csv,performance.bvh,performance.mid} \
     "$out"/{performance.wav,tips.png,tips.svg,pd.log}
-render=("$ictusd" render --out "$out" --force)
-[[ -n $score ]] && render+=(--score "$score")
-"${render[@]}"
-for f in strikes.csv events.txt render.json; do
-    [[ -s $out/$f ]] || { echo "main.sh: ictusd render did not write $out/$f" >&2; exit 1; }
-done
-
-# 4. the sound: the events on the drum the physics used (radius, tension,
-# density from render.json), rendered to the sample by pd in batch mode
-read -r radius tension density seconds < <(/usr/bin/python3 - "$out" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1] + "/render.json"))
-drum = d["drum"]
-print(drum["radius_m"], drum["tension_n_per_m"], drum["density_kg_per_m2"],
-      "%.3f" % (float(d["duration_s"]) + 1.5))
-PY
-)
+# 4. the sound, by the same command: the events on the drum the physics used
+# (radius, tension, density of render.json), rendered to the sample by pd in
+# batch mode (patches/ictus-render.pd; pd's output in OUT/pd.log)
 wav=$out/performance.wav
-pd -nogui -nosound -batch -stderr -r 48000 -path "$build/ictus" \
-    -open "$root/patches/ictus-render.pd" \
-    -send "render-drum radius $radius" -send "render-drum tension $tension" \
-    -send "render-drum density $density" \
-    -send "render-mix $mix" -send "render-bits $bits" -send "render-gain $gain" \
-    -send "render-file $out/events.txt" -send "render-out $wav" \
-    -send "render-seconds $seconds" >"$out/pd.log" 2>&1 || {
-    cat "$out/pd.log" >&2
-    echo "main.sh: pd failed (log: $out/pd.log)" >&2
+render=("$ictusd" render --out "$out" --force --wav "$wav" --wav-mix "$mix" --wav-bits "$bits"
+        --wav-gain "$gain")
+[[ -n $score ]] && render+=(--score "$score")
+"${render[@]}" || {
+    [[ -f $out/pd.log ]] && cat "$out/pd.log" >&2
+    echo "main.sh: ictusd render --wav failed" >&2
     exit 1
 }
-if grep -Eiq "error|couldn't" "$out/pd.log"; then
-    echo "main.sh: pd reported errors while rendering (log: $out/pd.log):" >&2
-    grep -Ei "error|couldn't" "$out/pd.log" >&2
-fi
+for f in strikes.csv events.txt render.json performance.wav; do
+    [[ -s $out/$f ]] || { echo "main.sh: ictusd render did not write $out/$f" >&2; exit 1; }
+done
 
 # 5. the figure
 /usr/bin/python3 "$root/scripts/figure5.py" "$out" --out "$out/tips"
