@@ -73,7 +73,10 @@ if [[ ! -x $ictusd || ! -d $build/ictus ]]; then
     echo "main.sh: no ictusd or Pd library in $build (run without --no-build)" >&2
     exit 1
 fi
-if ! "$ictusd" render --help 2>&1 | grep -q -- "--wav FILE"; then
+# (the whole help read first: grep -q would stop reading early, and with
+# pipefail ictusd's SIGPIPE would fail the check)
+render_help=$("$ictusd" render --help 2>&1 || true)
+if [[ $render_help != *"--wav FILE"* ]]; then
     echo "main.sh: this ictusd cannot render a WAV (no --wav in 'ictusd render --help')" >&2
     exit 1
 fi
