@@ -288,6 +288,9 @@ int cmd_run(Args &args)
     }
     LiveStatus status;
     status.tempo_bpm = o.tempo_bpm;
+    status.score = perf.score_mode() ? 1 : 0;
+    status.mode = static_cast<int>(perf.mode());
+    status.grip = static_cast<int>(perf.options().character.grip);
     OscServer server(io, &status);
     server_ptr = &server;
     // Planning and rebuilds from now on run beside the physics loop.
@@ -378,6 +381,8 @@ int cmd_run(Args &args)
         status.tempo_bpm = perf.tempo_bpm();
         status.strikes += k;
         status.runaways = perf.runaways();
+        status.mode = static_cast<int>(perf.mode());
+        status.grip = static_cast<int>(perf.options().character.grip);
     }
     StrikeEvent last;
     while (perf.flush(last)) {
