@@ -85,4 +85,6 @@ def fix(path):
 
 if __name__ == "__main__":
     for f in sys.argv[1:]:
-        print("%s: %d boxes moved, %d overlaps left" % (f, fix(f), len(pdlayout.overlaps(f, ABSTRACTIONS))))
+        moved = fix(f)
+        left = len(pdlayout.overlaps(f, ABSTRACTIONS))
+        print("%s: %d boxes moved, %d overlaps left" % (f, moved, left))

@@ -35,7 +35,8 @@ build = os.path.abspath(args.build)
 GEM_NOISE = ("gem.conf", "libDeckLinkAPI")
 
 # The name deken expects, computed here from the sources and the machine.
-version = re.search(r"project\(ictus VERSION ([0-9.]+)", open(os.path.join(REPO, "CMakeLists.txt")).read()).group(1)
+top_cmake = open(os.path.join(REPO, "CMakeLists.txt")).read()
+version = re.search(r"project\(ictus VERSION ([0-9.]+)", top_cmake).group(1)
 cpu = {"x86_64": "amd64", "amd64": "amd64", "aarch64": "arm64", "arm64": "arm64"}.get(
     platform.machine().lower(), platform.machine().lower())
 dek = os.path.join(build, "ictus[v%s](Linux-%s-32).dek" % (version, cpu))
@@ -121,7 +122,8 @@ def open_patch(path, name):
     log = proc.stdout + proc.stderr
     bad = [l for l in error_lines(log) if not any(n in l for n in GEM_NOISE)]
     check(proc.returncode == 0 and not bad,
-          "%s opens from the package without error lines%s" % (name, "" if not bad else ":\n" + "\n".join(bad)))
+          "%s opens from the package without error lines%s"
+          % (name, "" if not bad else ":\n" + "\n".join(bad)))
 
 
 # The main patch listens on UDP 9000; a copy beside it on a free port, so that
@@ -165,7 +167,8 @@ check(np.all(np.isfinite(samples)) and peak > 1e-3, "the WAV has sound (peak %.4
 onset = int(np.argmax(mono > 1e-3 * peak))
 strike_sample = round(strike_ms * sr / 1000)
 check(abs(onset - strike_sample) <= 2,
-      "the sound starts on the strike's sample %d (first sample over -60 dB: %d)" % (strike_sample, onset))
+      "the sound starts on the strike's sample %d (first sample over -60 dB: %d)"
+      % (strike_sample, onset))
 
 # `cmake --install`: the same library folder (ictusd goes to bin/ instead), relocatable.
 prefix = make_workdir("ictus-install-")

@@ -50,18 +50,21 @@ known = patch("#N canvas 0 0 600 400 12;\n"
 boxes = pdlayout.parse(known)[""]
 ok([(b.w, b.h) for b in boxes[:4]] == [(186, 20), (86, 20), (68, 35), (32, 20)],
    "object and message boxes measure as in pd-gui: %s" % [(b.w, b.h) for b in boxes[:4]])
-ok(boxes[4].visible[2:] == (343, 15), "a comment's glyphs measure as in pd-gui: %s" % (boxes[4].visible[2:],))
+ok(boxes[4].visible[2:] == (343, 15),
+   "a comment's glyphs measure as in pd-gui: %s" % (boxes[4].visible[2:],))
 ok(boxes[5].w == 30 * 7 + 4 and boxes[5].visible[2] == 20 * 7,
    "', f 30' sets a comment's box, not its glyphs: %d, %d" % (boxes[5].w, boxes[5].visible[2]))
 ok(boxes[6].h == 3 * 15 + 5 and boxes[6].visible[2] == 59 * 7,
-   "a long comment wraps at 60 characters on a space: %d lines, %d px" % ((boxes[6].h - 5) // 15, boxes[6].visible[2]))
+   "a long comment wraps at 60 characters on a space: %d lines, %d px"
+   % ((boxes[6].h - 5) // 15, boxes[6].visible[2]))
 os.remove(known)
 
 # 2. The check finds an overlap: two comments 15 px apart whose first wraps.
 bad = patch("#N canvas 0 0 600 400 12;\n#X text 20 20 " + " ".join(["word"] * 20) + ";\n"
             "#X text 20 35 next;\n#X obj 100 200 f;\n#X obj 110 205 f;\n")
 found = pdlayout.overlaps(bad)
-ok(len(found) == 2, "the check finds a wrapped comment over the next and two stacked boxes: %d" % len(found))
+ok(len(found) == 2,
+   "the check finds a wrapped comment over the next and two stacked boxes: %d" % len(found))
 os.remove(bad)
 
 # 3. Every shipped patch.
