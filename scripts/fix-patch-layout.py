@@ -34,6 +34,8 @@ def relayout(boxes, gop_area=None):
     """Moves boxes apart; those inside a graph-on-parent area stay (they are
     what the parent shows: an overlap there is fixed by hand)."""
     def frozen(b):
+        if b.kind == "label":  # an IEM GUI's label: it follows its GUI, not moved alone
+            return True
         if not gop_area:
             return False
         gx, gy, gw, gh = gop_area
@@ -72,7 +74,7 @@ def fix(path):
         before = {id(b): (b.x, b.y) for b in boxes}
         relayout(boxes, gops.get(name))
         for b in boxes:
-            if (b.x, b.y) != before[id(b)]:
+            if b.offset is not None and (b.x, b.y) != before[id(b)]:
                 moves[b.offset] = (b.x, b.y)
     for offset in sorted(moves, reverse=True):
         m = re.compile(r"#X\s+\w+\s+(-?[\d.]+)\s+(-?[\d.]+)").match(text, offset)

@@ -17,8 +17,10 @@ The numbers (docs/ui.md, "Layout of the shipped patches"):
   Object and message boxes are at least 3 columns wide.
 - Atom boxes (floatatom/symbolatom/listbox): their width in characters
   (0: 5 for a number, 10 for a symbol or list) plus the same margins, one line.
-- IEM GUIs by their size arguments: bng/tgl SIZE, nbx DIGITS*char + height,
-  hsl/vsl W H, hradio/vradio SIZE*N, vu W H; cnv is a background, never checked.
+- IEM GUIs by their size arguments: bng/tgl SIZE, nbx (g_numbox.c) DIGITS *
+  its font size * 31/36 + height/2 + 4,
+  hsl/vsl W H, hradio/vradio SIZE*N, vu W H, and their labels (anchored west at
+  their offsets, in their font size); cnv is a background, never checked.
 - Graph-on-parent subpatches and arrays by their #X coords size.
 """
 import os
@@ -164,11 +166,32 @@ def iemgui_extent(cls, args, cw, lh):
         s, n = _num(args, 0, 15), _num(args, 3, 8)
         return (s * n, s) if cls in ("hradio", "hdl") else (s, s * n)
     if cls == "nbx":
+        # g_numbox.c, my_numbox_calc_fontwidth: its own font size and style
         digits, h = _num(args, 0, 5), _num(args, 1, 14)
-        return digits * cw + h / 2 + 4, h
+        style, size = int(_num(args, 11, 0)), int(_num(args, 12, 10))
+        per_char = {1: 27, 2: 25}.get(style, 31)
+        return int(size * per_char * digits) // 36 + int(h) // 2 + 4, h
     if cls == "vu":
         return _num(args, 0, 15), _num(args, 1, 120)
     return None
+
+
+# Where an IEM GUI's label, its x y offsets and font size are among its
+# creation arguments (after the class name).
+LABEL_ARGS = {"bng": 6, "tgl": 4, "hsl": 8, "vsl": 8, "nbx": 8, "hradio": 6, "vradio": 6,
+              "hdl": 6, "vdl": 6, "vu": 3}
+
+
+def iemgui_label(cls, args, x, y):
+    """(text, x, y, w, h) of an IEM GUI's label (anchored west, centred on
+    y + its y offset, in its own font size), or None."""
+    i = LABEL_ARGS.get(cls)
+    if i is None or len(args) < i + 5 or args[i][1] in ("empty", "-"):
+        return None
+    text = args[i][1].replace("_", " ")
+    cw, lh = font_metrics(int(_num(args, i + 4, 10)))
+    lx, ly = x + _num(args, i + 1), y + _num(args, i + 2)
+    return text, lx, ly - lh // 2, len(text) * cw, lh
 
 
 class Box:
@@ -180,8 +203,11 @@ class Box:
         self.canvas, self.index, self.kind, self.offset = canvas, index, kind, offset
         self.x, self.y, self.w, self.h, self.text = x, y, w, h, text
         self.visible = visible or (x, y, w, h)
+        self.owner = None  # for a label: its IEM GUI
 
     def overlaps(self, other):
+        if self.owner is other or other.owner is self:
+            return False  # an IEM GUI and its own label
         ax, ay, aw, ah = self.visible
         bx, by, bw, bh = other.visible
         return ax < bx + bw and bx < ax + aw and ay < by + bh and by < ay + ah
@@ -284,7 +310,14 @@ def parse(path, abstraction_dirs=(), gop_areas=None):
             else:
                 width_c = int(_num(items, 4, 0)) or (5 if kind == "floatatom" else 10)
                 w, h = width_c * cw + LMARGIN + RMARGIN, lh + TMARGIN + BMARGIN
-            top[2].append(Box(top[0], top[3], kind, x, y, w, h, box_text(rest), offset=offset))
+            box = Box(top[0], top[3], kind, x, y, w, h, box_text(rest), offset=offset)
+            top[2].append(box)
+            label = iemgui_label(rest[0][1], rest[1:], x, y) if kind == "obj" and rest else None
+            if label:
+                text, lx, ly, lw, lhh = label
+                lab = Box(top[0], top[3], "label", lx, ly, lw, lhh, text)
+                lab.owner = box
+                top[2].append(lab)
             top[3] += 1
     while stack:  # the top canvas has no #X restore
         name, _, boxes, _, _ = stack.pop()
