@@ -109,7 +109,8 @@ void render_usage(std::ostream &out)
            "  ictusd render --mocap ../shared/data/cmu/80_13.bvh --duration 10 --out out/r1\n"
            "  ictusd render --out out/fig5                  (the built-in score)\n"
            "  ictusd render --out out/fig5 --wav out/fig5/performance.wav\n"
-           "  ictusd render --score my.score --grip german --mode joint --out out/r2\n";
+           "  ictusd render --score examples/scores/nuances.txt --grip german --mode joint --out "
+           "out/r2\n";
 }
 
 // The files render writes into --out, all it may remove (--force).

@@ -71,7 +71,7 @@ void run_usage(std::ostream &out)
            "\n"
            "examples:\n"
            "  ictusd run --mocap ../shared/data/cmu/80_13.bvh\n"
-           "  ictusd run --score examples/scores/figure5.score --mode cartesian\n"
+           "  ictusd run --score examples/scores/figure5.txt --mode cartesian\n"
            "  ictusd run --mocap clip.bvh --target osc.udp://10.0.0.2:9000 --bind 10.0.0.1 \\\n"
            "             --allow 10.0.0.2 --lookahead 0.05\n"
            "  oscsend localhost 9001 /ictus/tempo f 96\n";
