@@ -80,7 +80,7 @@ for path in patches:
 # 4. Help patches: "see also" as object boxes; a volume slider before [dac~].
 LIBRARY = {"membrane~", "contact~", "ictus_timetag", "ictus-receive", "ictus-drum", "ictus-sound",
            "ictus-sound-clips", "ictus-sound-synth", "ictus-sound-modal", "ictus-physics",
-           "ictus-graphics", "ictus-sound-panel", "ictus-view"}
+           "ictus-graphics", "ictus-sound-panel", "ictus-view", "ictus-midi", "ictus-status"}
 for path in sorted(glob.glob(os.path.join(REPO, "help", "*-help.pd"))):
     name = os.path.basename(path)
     subject = name[:-len("-help.pd")]
