@@ -5,19 +5,26 @@
 #   3. ictusd render: the virtual percussionist plays the default score (the
 #      paper's Figure 5: legato and accent beats under a tempo change) with the
 #      built-in gesture database, offline: OUT/strikes.csv, OUT/events.txt,
-#      OUT/render.json, OUT/tips.csv, OUT/notes.csv, OUT/performance.bvh
+#      OUT/render.json, OUT/tips.csv, OUT/notes.csv, OUT/performance.bvh,
+#      OUT/performance.mid
 #   4. Pd in batch mode plays the events on the drum of render.json
-#      (patches/ictus-render.pd): OUT/performance.wav (2 pickups, 48 kHz, float)
+#      (ictusd render --wav, patches/ictus-render.pd): OUT/performance.wav
+#      (stereo, 48 kHz, 32-bit float, peaks below -0.5 dBFS: docs/main-job.md)
 #   5. the tip-trajectory plot (scripts/figure5.py): OUT/tips.png and .svg
 # and prints where each output is and a short summary.
 #
 # usage: scripts/main.sh [--build DIR] [--out DIR] [--score FILE] [--no-deps] [--no-build]
+#                        [--mix stereo|pickups] [--bits 16|24|32] [--gain DB]
 #        scripts/main.sh [BUILD_DIR]            (as before: the build folder)
 #   --build DIR   build folder (default build/)
 #   --out DIR     output folder (default out/)
 #   --score FILE  play this score instead of the default one (examples/scores/)
 #   --no-deps     do not run scripts/deps.sh
 #   --no-build    use the existing build in --build as it is
+#   --mix M       stereo (default: the drum in the middle, the hands panned) or
+#                 pickups (the membrane's two raw pickups)
+#   --bits N      16 or 24 (integer PCM) or 32 (float, the default)
+#   --gain DB     output gain before the soft limiter (default 0)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build
@@ -25,6 +32,9 @@ out=$root/out
 score=
 deps=1
 do_build=1
+mix=stereo
+bits=32
+gain=0
 while [[ $# -gt 0 ]]; do
     case $1 in
     --build) build=$2; shift 2 ;;
@@ -32,11 +42,20 @@ while [[ $# -gt 0 ]]; do
     --score) score=$2; shift 2 ;;
     --no-deps) deps=0; shift ;;
     --no-build) do_build=0; shift ;;
-    -h | --help) sed -n '2,24p' "$0"; exit 0 ;;
+    --mix) mix=$2; shift 2 ;;
+    --bits) bits=$2; shift 2 ;;
+    --gain) gain=$2; shift 2 ;;
+    -h | --help) sed -n '2,30p' "$0"; exit 0 ;;
     -*) echo "main.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
     *) build=$1; shift ;;
     esac
 done
+case $mix in stereo | pickups) ;; *) echo "main.sh: --mix must be stereo or pickups, got '$mix'" >&2; exit 2 ;; esac
+case $bits in 16 | 24 | 32) ;; *) echo "main.sh: --bits must be 16, 24 or 32, got '$bits'" >&2; exit 2 ;; esac
+if ! [[ $gain =~ ^-?[0-9]+([.][0-9]+)?$ ]]; then
+    echo "main.sh: --gain must be a number of dB, got '$gain'" >&2
+    exit 2
+fi
 mkdir -p "$out"
 build=$(cd "$(dirname "$build")" && pwd)/$(basename "$build")
 out=$(cd "$out" && pwd)
@@ -54,65 +73,58 @@ if [[ ! -x $ictusd || ! -d $build/ictus ]]; then
     echo "main.sh: no ictusd or Pd library in $build (run without --no-build)" >&2
     exit 1
 fi
-if ! "$ictusd" render --help 2>&1 | grep -q -- "--score"; then
-    echo "main.sh: this ictusd cannot render a score yet (no --score in 'ictusd render --help')" >&2
+# (the whole help read first: grep -q would stop reading early, and with
+# pipefail ictusd's SIGPIPE would fail the check)
+render_help=$("$ictusd" render --help 2>&1 || true)
+if [[ $render_help != *"--wav FILE"* ]]; then
+    echo "main.sh: this ictusd cannot render a WAV (no --wav in 'ictusd render --help')" >&2
     exit 1
 fi
 
 # 3. the performance, offline and deterministic
-rm -f "$out"/{strikes.csv,events.txt,render.json,tips.csv,notes.csv,performance.bvh} \
+rm -f "$out"/{strikes.csv,events.txt,render.json,tips.csv,notes.csv,performance.bvh,performance.mid} \
     "$out"/{performance.wav,tips.png,tips.svg,pd.log}
-render=("$ictusd" render --out "$out" --force)
-[[ -n $score ]] && render+=(--score "$score")
-"${render[@]}"
-for f in strikes.csv events.txt render.json; do
-    [[ -s $out/$f ]] || { echo "main.sh: ictusd render did not write $out/$f" >&2; exit 1; }
-done
-
-# 4. the sound: the events on the drum the physics used (radius, tension,
-# density from render.json), rendered to the sample by pd in batch mode
-read -r radius tension density seconds < <(/usr/bin/python3 - "$out" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1] + "/render.json"))
-drum = d["drum"]
-print(drum["radius_m"], drum["tension_n_per_m"], drum["density_kg_per_m2"],
-      "%.3f" % (float(d["duration_s"]) + 1.5))
-PY
-)
+# 4. the sound, by the same command: the events on the drum the physics used
+# (radius, tension, density of render.json), rendered to the sample by pd in
+# batch mode (patches/ictus-render.pd; pd's output in OUT/pd.log)
 wav=$out/performance.wav
-pd -nogui -nosound -batch -stderr -r 48000 -path "$build/ictus" \
-    -open "$root/patches/ictus-render.pd" \
-    -send "render-drum radius $radius" -send "render-drum tension $tension" \
-    -send "render-drum density $density" \
-    -send "render-file $out/events.txt" -send "render-out $wav" \
-    -send "render-seconds $seconds" >"$out/pd.log" 2>&1 || {
-    cat "$out/pd.log" >&2
-    echo "main.sh: pd failed (log: $out/pd.log)" >&2
+render=("$ictusd" render --out "$out" --force --wav "$wav" --wav-mix "$mix" --wav-bits "$bits"
+        --wav-gain "$gain")
+[[ -n $score ]] && render+=(--score "$score")
+"${render[@]}" || {
+    [[ -f $out/pd.log ]] && cat "$out/pd.log" >&2
+    echo "main.sh: ictusd render --wav failed" >&2
     exit 1
 }
-if grep -Eiq "error|couldn't" "$out/pd.log"; then
-    echo "main.sh: pd reported errors while rendering (log: $out/pd.log):" >&2
-    grep -Ei "error|couldn't" "$out/pd.log" >&2
-fi
+for f in strikes.csv events.txt render.json performance.wav; do
+    [[ -s $out/$f ]] || { echo "main.sh: ictusd render did not write $out/$f" >&2; exit 1; }
+done
 
 # 5. the figure
 /usr/bin/python3 "$root/scripts/figure5.py" "$out" --out "$out/tips"
 
 # where everything is, and a summary
-/usr/bin/python3 - "$out" <<'PY'
+ICTUS_MIX=$mix /usr/bin/python3 - "$out" <<'PY'
 import json, os, sys
 sys.path.insert(0, "tests/pd")
 import numpy as np
-from pdrun import read_wav_float
+from pdrun import read_wav_any
 
 out = sys.argv[1]
 wav = os.path.join(out, "performance.wav")
-x, sr = read_wav_float(wav)
+x, sr, bits, is_float = read_wav_any(wav)
 if x.shape[0] == 0 or not np.all(np.isfinite(x)):
     sys.exit("main.sh: %s is empty or not finite" % wav)
 peak = float(np.max(np.abs(x)))
 if peak < 1e-3:
     sys.exit("main.sh: %s is silent (peak %g)" % (wav, peak))
+rms_db = [20 * np.log10(max(float(np.sqrt(np.mean(x[:, c] ** 2))), 1e-12)) for c in range(x.shape[1])]
+limiter = ""
+with open(os.path.join(out, "pd.log")) as f:
+    for line in f:
+        if line.startswith("ictus-render: peak_in_dbfs"):
+            w = line.split()
+            limiter = ", %s dBFS before the limiter (gain %s dB)" % (w[2], w[6])
 meta = json.load(open(os.path.join(out, "render.json")))
 bvh = os.path.join(out, "performance.bvh")
 frames = joints = None
@@ -125,10 +137,15 @@ if os.path.isfile(bvh):
             frames = int(line.split()[1])
 print()
 print("main job: outputs in %s" % out)
-for name, what in (("performance.wav", "%d channels, %.2f s at %d Hz, peak %.3f"
-                    % (x.shape[1], x.shape[0] / sr, sr, peak)),
+for name, what in (("performance.wav", "%d channels (%s), %.2f s at %d Hz, %d-bit %s, peak %.2f dBFS%s, "
+                    "RMS %s dBFS" % (x.shape[1], os.environ.get("ICTUS_MIX", "?"), x.shape[0] / sr, sr, bits,
+                                     "float" if is_float else "PCM", 20 * np.log10(peak), limiter,
+                                     " / ".join("%.1f" % r for r in rms_db))),
                    ("strikes.csv", "%s strikes, %s bounces" % (meta.get("strikes"), meta.get("bounces"))),
                    ("events.txt", "the strikes for Pd (qlist)"),
+                   ("performance.mid", "the strikes as MIDI notes, channel %s (docs/midi.md)"
+                    % meta.get("midi", {}).get("channel", "?")
+                    if os.path.isfile(os.path.join(out, "performance.mid")) else "MISSING"),
                    ("tips.png", "stick-tip heights, score and strikes (and tips.svg)"),
                    ("performance.bvh", "%s joints, %s frames" % (joints, frames)
                     if frames is not None else "MISSING"),

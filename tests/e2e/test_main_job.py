@@ -1,7 +1,8 @@
 """The README main job (docs/main-job.md)'s core steps on the default score, in this
 build (scripts/main.sh --no-deps --no-build: ictusd render --out, pd batch
 render, figure5.py), and what it leaves in its output folder:
-- performance.wav: the events rendered to the sample. The onsets found in the
+- performance.wav: the events rendered to the sample, peaking at or below
+  -0.3 dBFS, its two channels within 3 dB of each other in RMS. The onsets found in the
   signal alone match strikes.csv within 1 ms with no extra onsets (the strikes
   rendered again in passes on a drum at rest, e2e_util / docs/main-job.md), and
   the main WAV itself is finite, sounds, is silent before the first strike and
@@ -75,6 +76,14 @@ x, sr = read_wav_float(os.path.join(out, "performance.wav"))
 check(sr == 48000 and x.shape[1] == 2 and np.all(np.isfinite(x)), "performance.wav: 2 ch, 48 kHz, finite")
 check(x.shape[0] / sr > strikes[-1]["time_s"], "performance.wav lasts past the last strike")
 check(float(np.abs(x).max()) > 1e-3, "performance.wav sounds")
+# Listenable (issue 14): no sample within 0.3 dB of full scale, and a stereo
+# mix whose two channels are within 3 dB of each other in RMS.
+peak_dbfs = 20 * np.log10(float(np.abs(x).max()))
+rms_db = [20 * np.log10(float(np.sqrt(np.mean(x[:, c].astype(np.float64) ** 2)))) for c in (0, 1)]
+print("performance.wav: peak %.2f dBFS, RMS %.2f / %.2f dBFS" % (peak_dbfs, rms_db[0], rms_db[1]))
+check(peak_dbfs <= -0.3, "performance.wav peaks at or below -0.3 dBFS (%.2f)" % peak_dbfs)
+check(abs(rms_db[0] - rms_db[1]) <= 3.0, "performance.wav's channels are within 3 dB in RMS "
+      "(%.2f dB apart)" % abs(rms_db[0] - rms_db[1]))
 first = u.detect_onsets(x, sr)[0]
 want = int(np.floor(strikes[0]["time_s"] * sr + 0.5))
 check(first == want, "performance.wav is silent before the first strike, which starts on its "

@@ -1,7 +1,9 @@
 // The OSC link with real peers: liblo's oscdump receives what the sender
 // emits, oscsend drives the server, raw UDP sockets fuzz it.
+#include "ictus/character/character.hpp"
 #include "ictus/net/osc_sender.hpp"
 #include "ictus/net/osc_server.hpp"
+#include "ictus/perform/tracker.hpp"
 #include "osc_test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -302,11 +304,18 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
     // Status: the physics thread's numbers.
     status.time_s = 12.5;
     status.strikes = 42;
+    status.score = 1;
+    status.mode = static_cast<int>(ictus::TrackMode::cartesian);
+    status.grip = static_cast<int>(ictus::Grip::german);
     oscsend({"/ictus/status"});
     REQUIRE(next_dump(*dump, "/ictus/reply", d));
-    CHECK(d.types == "sfifiiiiii");
+    CHECK(d.types == "sfifiiiiiisss");
     CHECK(std::stod(d.args[1]) == Approx(12.5));
     CHECK(std::stoi(d.args[4]) == 42);
+    REQUIRE(d.args.size() == 13);
+    CHECK(d.args[10] == "\"score\""); // oscdump quotes strings
+    CHECK(d.args[11] == "\"cartesian\"");
+    CHECK(d.args[12] == "\"german\"");
 }
 
 TEST_CASE("osc in: score statements, score clear and the cartesian mode pass through to the "

@@ -136,6 +136,31 @@ def read_wav_float(path):
     return samples, sr
 
 
+def read_wav_any(path):
+    """A WAV of 32-bit float or 16-/24-bit integer PCM -> (samples [n, ch] as
+    float64, full scale 1.0, sr, bits, is_float)."""
+    import wave
+    try:
+        x, sr = read_wav_float(path)
+        return x.astype(np.float64), sr, 32, True
+    except ValueError as e:
+        if "expected 32-bit float" not in str(e):
+            raise
+    with wave.open(path, "rb") as w:
+        ch, width, sr, n = w.getnchannels(), w.getsampwidth(), w.getframerate(), w.getnframes()
+        raw = w.readframes(n)
+    if width == 2:
+        v = np.frombuffer(raw, dtype="<i2").astype(np.float64) / 32768.0
+    elif width == 3:
+        b = np.frombuffer(raw, dtype=np.uint8).reshape(-1, 3).astype(np.int32)
+        i = b[:, 0] | (b[:, 1] << 8) | (b[:, 2] << 16)
+        i = np.where(i >= 1 << 23, i - (1 << 24), i)
+        v = i.astype(np.float64) / float(1 << 23)
+    else:
+        raise ValueError("%s: %d-byte integer samples not read here" % (path, width))
+    return v.reshape(-1, ch), sr, 8 * width, False
+
+
 _workdirs = []
 _failed = [False]
 

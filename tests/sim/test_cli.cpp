@@ -1,5 +1,5 @@
-// The real ictusd binary: help, usage errors, bad values for every option,
-// malformed files, and the files `track --out` writes.
+// The real ictusd binary: help, version, usage errors, bad values for every
+// option, missing and malformed files (exit 1), and the files `track --out` writes.
 #include "sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -11,6 +11,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
+#include <regex>
+#include <set>
 #include <thread>
 
 #include <cstdio>
@@ -793,4 +796,134 @@ TEST_CASE("ictusd track and limits --help document --force and the bounds", "[si
              {"--force", "0.0005..0.5 s", "3 h", "100 m", "0.05 m", "1 m", "30 frames"})
             CHECK(r.output.find(text) != std::string::npos);
     }
+}
+
+namespace
+{
+
+// The version the top CMakeLists.txt declares, read from the source: the
+// number `ictusd --version` must print.
+std::string declared_version()
+{
+    std::ifstream in(std::string(ICTUS_SOURCE_DIR) + "/CMakeLists.txt");
+    REQUIRE(in);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::smatch m;
+    const std::string s = text.str();
+    REQUIRE(
+        std::regex_search(s, m, std::regex(R"(project\(ictus VERSION ([0-9]+\.[0-9]+\.[0-9]+))")));
+    return m[1];
+}
+
+// The options a --help text defines: a `--name` that starts an entry, i.e. at
+// the start of a line after two spaces, after ", " (`--units mm|m, --up y|z`)
+// or after three spaces in a line that holds two entries
+// (`--stick-length M  (default 0.406)   --stick-mass KG`). Mentions inside a
+// description (`(after --scale or --units)`) are not entries.
+std::vector<std::string> defined_options(const std::string &help)
+{
+    std::vector<std::string> found;
+    static const std::regex entry(R"((?:^  |, |   )(--[a-z][a-z0-9-]*))");
+    std::istringstream lines(help);
+    std::string line;
+    while (std::getline(lines, line)) {
+        // A continuation line (deeply indented description) defines nothing.
+        if (line.compare(0, 3, "  -") != 0)
+            continue;
+        for (std::sregex_iterator it(line.begin(), line.end(), entry), end; it != end; ++it)
+            found.push_back((*it)[1]);
+    }
+    return found;
+}
+
+const char *const kVerbs[] = {"track", "limits", "run", "render", "gestures"};
+
+} // namespace
+
+TEST_CASE("ictusd --version prints the project's version, for the program and each verb",
+          "[sim][cli]")
+{
+    const std::string expected = "ictusd " + declared_version() + "\n";
+    Run r = ictusd("--version");
+    CHECK(r.status == 0);
+    CHECK(r.output == expected);
+    for (const char *verb : kVerbs) {
+        r = ictusd(std::string(verb) + " --version");
+        INFO(verb);
+        CHECK(r.status == 0);
+        CHECK(r.output == expected);
+    }
+    // Among a verb's other options it is an unknown option, as any other.
+    r = ictusd("render --out /nonexistent/x --version");
+    CHECK(r.status == 2);
+    CHECK(r.output.find("unknown option '--version'") != std::string::npos);
+    // The main help names it.
+    CHECK(ictusd("--help").output.find("--version") != std::string::npos);
+}
+
+TEST_CASE("ictusd: a score or database that cannot be read is a file error (exit 1), as the "
+          "help says",
+          "[sim][cli]")
+{
+    const Run help = ictusd("--help");
+    REQUIRE(help.output.find("1 error in a file or the data, 2 usage error") != std::string::npos);
+    const std::string empty = simtest::write_temp("empty.score", "");
+    const std::string out = simtest::write_temp("unused.txt", "") + ".out";
+    struct Case {
+        std::string args, names;
+    };
+    // run stops after a hundredth of a second, on any free port, should it start at all.
+    const std::string run = "run --port 0 --pose-rate 0 --duration 0.01 ";
+    for (const Case &c : std::vector<Case>{
+             {run + "--score /nonexistent/a.score", "/nonexistent/a.score"},
+             {run + "--score " + empty, empty},
+             {run + "--gestures /nonexistent/db.json", "/nonexistent/db.json"},
+             {"render --score /nonexistent/a.score --out " + out, "/nonexistent/a.score"},
+             {"render --score " + empty + " --out " + out, empty},
+             {"render --gestures /nonexistent/db.json --out " + out, "/nonexistent/db.json"},
+             {"render --mocap /nonexistent/clip.bvh --out " + out, "/nonexistent/clip.bvh"},
+             {"limits /nonexistent/clip.bvh", "/nonexistent/clip.bvh"},
+             {"gestures --list --db /nonexistent/db.json", "/nonexistent/db.json"},
+             {"gestures --export /nonexistent/dir/db.json", "/nonexistent/dir/db.json"},
+             {"track --mode joint --quiet --mocap /nonexistent/clip.bvh", "/nonexistent/clip.bvh"},
+         }) {
+        const Run r = ictusd(c.args);
+        INFO(c.args << "\n" << r.output);
+        CHECK(r.status == 1);
+        CHECK(r.output.find(c.names) != std::string::npos);
+    }
+}
+
+TEST_CASE("ictusd: every --help lists each option once, and its examples name files that exist",
+          "[sim][cli]")
+{
+    std::vector<std::string> helps = {"--help"};
+    for (const char *verb : kVerbs)
+        helps.push_back(std::string(verb) + " --help");
+    for (const std::string &args : helps) {
+        const Run r = ictusd(args);
+        INFO(args << "\n" << r.output);
+        REQUIRE(r.status == 0);
+        const std::vector<std::string> options = defined_options(r.output);
+        if (args != "--help")
+            CHECK(options.size() >= 3); // the parser sees the entries at all
+        std::set<std::string> seen;
+        for (const std::string &o : options) {
+            INFO("option " << o);
+            CHECK(seen.insert(o).second);
+        }
+        // A path into the repository's examples/ must be there (the CMU clip
+        // under ../shared/data is data, not part of the repository).
+        static const std::regex example(R"(examples/[A-Za-z0-9_./-]+)");
+        for (std::sregex_iterator it(r.output.begin(), r.output.end(), example), end; it != end;
+             ++it) {
+            const std::string path = std::string(ICTUS_SOURCE_DIR) + "/" + it->str();
+            INFO("example file " << path);
+            CHECK(std::filesystem::is_regular_file(path));
+        }
+    }
+    // run's and render's help between them name an example score.
+    CHECK((ictusd("run --help").output + ictusd("render --help").output).find("examples/scores/") !=
+          std::string::npos);
 }

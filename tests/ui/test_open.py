@@ -68,8 +68,11 @@ for obj in ("membrane~", "contact~", "ictus_timetag", "ictus-receive", "ictus-dr
             "ictus-graphics", "ictus-sound-panel", "ictus-view"):
     ok((" %s " % obj) in objects[0].replace(";", " "), "ictus-meta.pd lists %s" % obj)
     ok(os.path.isfile(os.path.join(libdir, obj + "-help.pd")), "%s has a help patch" % obj)
-# every abstraction and external in the library folder is in the meta file
-listed = " ".join(l for l in meta.splitlines() if "OBJECTS" in l or "INTERNAL" in l).replace(";", " ") + " "
+# every abstraction, external and patch in the library folder is in the meta file
+# (top-level patches such as ictus-render.pd are listed on the PATCHES line, with .pd)
+listed = " ".join(l for l in meta.splitlines()
+                  if "OBJECTS" in l or "INTERNAL" in l or "PATCHES" in l).replace(";", " ")
+listed = listed.replace(".pd ", " ") + " "
 for f in sorted(os.listdir(libdir)):
     stem, ext = os.path.splitext(f)
     if ext not in (".pd", ".pd_linux") or stem.endswith("-help") or stem in ("ictus-meta", "ictus"):

@@ -18,7 +18,7 @@ void usage(std::ostream &out)
     out << "ictusd -- the ictus simulation daemon (a physically simulated percussionist)\n"
            "\n"
            "usage: ictusd VERB [options]\n"
-           "       ictusd --help | VERB --help\n"
+           "       ictusd --help | --version | VERB --help | VERB --version\n"
            "\n"
            "verbs:\n"
            "  track    drive the character with a motion capture, in joint space (PD, eq. 1)\n"
@@ -44,6 +44,18 @@ void usage(std::ostream &out)
            "             3 the simulation diverged (and was reset), 130 interrupted\n";
 }
 
+// The project's version (CMake's project(VERSION)), as "ictusd 0.1.0".
+void version(std::ostream &out)
+{
+    out << "ictusd " << ICTUS_VERSION << "\n";
+}
+
+bool is_verb(const std::string &word)
+{
+    return word == "track" || word == "limits" || word == "run" || word == "render" ||
+           word == "gestures";
+}
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -56,6 +68,13 @@ int main(int argc, char **argv)
     const std::string verb = argv[1];
     if (verb == "--help" || verb == "-h" || verb == "help") {
         usage(std::cout);
+        return 0;
+    }
+    // `ictusd --version`, and `ictusd VERB --version` alone (elsewhere on a
+    // verb's line it is that verb's unknown option).
+    if (verb == "--version" ||
+        (argc == 3 && is_verb(verb) && std::string(argv[2]) == "--version")) {
+        version(std::cout);
         return 0;
     }
     install_interrupt_handler();

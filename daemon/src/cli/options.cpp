@@ -177,16 +177,17 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.character.grip = parse_grip(a, value());
         o.score.grip_given = true;
     } else if (a == "--score") {
+        // A score that cannot be read is a file error (exit 1), not a usage error.
         const std::string path = value();
         std::ifstream in(path, std::ios::binary);
         if (!in)
-            throw UsageError("--score: cannot read '" + path + "'");
+            throw std::runtime_error("--score: cannot read '" + path + "'");
         std::ostringstream text;
         text << in.rdbuf();
         o.score.score_text = text.str();
         o.score.score_name = path;
         if (o.score.score_text.empty())
-            throw UsageError("--score: '" + path + "' is empty");
+            throw std::runtime_error("--score: '" + path + "' is empty");
     } else if (a == "--gestures")
         o.score.gestures = value();
     else if (a == "--mode")

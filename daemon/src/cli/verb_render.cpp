@@ -1,12 +1,14 @@
 // `ictusd render`: the performance offline, as fast as possible and
 // deterministic (same input, same bytes): strikes.csv, events.txt for Pd's
 // batch render, render.json, and in score mode tips.csv, notes.csv; the
-// performance as BVH. Also the options run and render share (verbs.hpp).
-// Nothing is written while the physics runs: every output is kept in memory
-// and written at the end, each write checked. --out is a new or empty folder
+// performance as BVH and the strikes as a Standard MIDI File. Also the options run and render share
+// (verbs.hpp). Nothing is written while the physics runs: every output is kept in memory and
+// written at the end, each write checked. --out is a new or empty folder
 // (--force: render's own files in a used one are replaced). docs/osc.md,
 // docs/perform.md.
 #include "ictus/character/bvh_export.hpp"
+#include "ictus/cli/midi_file.hpp"
+#include "ictus/cli/pd_render.hpp"
 #include "ictus/cli/verbs.hpp"
 #include "ictus/perform/strike_log.hpp"
 
@@ -40,7 +42,8 @@ void render_usage(std::ostream &out)
            "\n"
            "Plays offline, as fast as possible and deterministically (same input, same\n"
            "bytes), and writes DIR/strikes.csv, DIR/events.txt (qlist lines for a Pd batch\n"
-           "patch) and DIR/render.json (drum parameters for membrane~, summary). docs/osc.md.\n"
+           "patch), DIR/render.json (drum parameters for membrane~, summary) and\n"
+           "DIR/performance.mid (the strikes as MIDI notes, docs/midi.md). docs/osc.md.\n"
            "With --mocap the clip plays in joint space; otherwise the score (--score FILE, or\n"
            "the built-in default score) is performed and DIR/tips.csv (stick-tip targets and\n"
            "simulated tips) and DIR/notes.csv (each note and its strike) are written too\n"
@@ -50,9 +53,26 @@ void render_usage(std::ostream &out)
            "                      that no earlier render's file passes for this one's)\n"
            "  --force             write into a used folder: render's own files there\n"
            "                      (strikes.csv, events.txt, render.json, tips.csv, notes.csv,\n"
-           "                      performance.bvh) are removed first, no other file\n"
+           "                      performance.bvh, performance.mid, pd.log) are removed\n"
+           "                      first, no other file\n"
            "  --tips-rate HZ      tips.csv rows per second (default 250; 0: none)\n"
            "  --bvh-rate HZ       performance.bvh frames per second (default 250; 0: none)\n"
+           "  --midi-channel N    MIDI channel 1..16 of DIR/performance.mid, the strikes as\n"
+           "                      notes (docs/midi.md; default 1)\n"
+           "  --progress-every S  a progress line on stderr every S s of wall time (default 2;\n"
+           "                      0: none)\n"
+           "\n"
+           "the sound (Pd in batch mode, as scripts/main.sh: patches/ictus-render.pd on the\n"
+           "drum of render.json; docs/main-job.md):\n"
+           "  --wav FILE          render the strikes to FILE (Pd's log: DIR/pd.log)\n"
+           "  --wav-mix M         stereo (default: the drum in the middle, the hands panned)\n"
+           "                      | pickups (the membrane's two pickups)\n"
+           "  --wav-bits N        16 | 24 (integer PCM) | 32 (float, default)\n"
+           "  --wav-gain DB       output gain before the soft limiter (default 0)\n"
+           "  --wav-rate HZ       sample rate (default 48000)\n"
+           "  --pd BINARY         the pd program (default: pd on PATH)\n"
+           "  --pd-lib DIR        the ictus Pd library (default: ictus/ beside ictusd, or\n"
+           "                      ../lib/pd-externals/ictus from it)\n"
            "\n"
            "score mode (run and render):\n"
            "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
@@ -88,12 +108,15 @@ void render_usage(std::ostream &out)
            "examples:\n"
            "  ictusd render --mocap ../shared/data/cmu/80_13.bvh --duration 10 --out out/r1\n"
            "  ictusd render --out out/fig5                  (the built-in score)\n"
-           "  ictusd render --score my.score --grip german --mode joint --out out/r2\n";
+           "  ictusd render --out out/fig5 --wav out/fig5/performance.wav\n"
+           "  ictusd render --score examples/scores/nuances.txt --grip german --mode joint --out "
+           "out/r2\n";
 }
 
 // The files render writes into --out, all it may remove (--force).
-const char *const kRenderOutputs[] = {"strikes.csv", "events.txt", "render.json",
-                                      "tips.csv",    "notes.csv",  "performance.bvh"};
+const char *const kRenderOutputs[] = {"strikes.csv",     "events.txt", "render.json",
+                                      "tips.csv",        "notes.csv",  "performance.bvh",
+                                      "performance.mid", "pd.log"};
 
 // --out: created, or else empty, so that no file of an earlier render (a
 // score's notes.csv beside a clip's strikes) passes for this one's. With
@@ -326,9 +349,12 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
 int cmd_render(Args &args)
 {
     PerformanceOptions o;
-    double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0;
+    double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0, midi_channel = 1.0;
     std::string out_dir;
     bool force = false;
+    double progress_every = 2.0;
+    std::string wav;
+    PdRenderOptions pd;
     while (!args.done()) {
         const std::string a = args.next();
         if (a == "--help" || a == "-h") {
@@ -340,6 +366,33 @@ int cmd_render(Args &args)
             force = true;
         } else if (a == "--bvh-rate") {
             bvh_rate = parse_number(a, args.value(a), 0, 1000);
+        } else if (a == "--midi-channel") {
+            midi_channel = parse_number(a, args.value(a), 1, 16);
+            if (midi_channel != std::floor(midi_channel))
+                throw UsageError("--midi-channel: expected a whole number 1..16, got '" +
+                                 std::to_string(midi_channel) + "'");
+        } else if (a == "--progress-every") {
+            progress_every = parse_number(a, args.value(a), 0, 3600);
+        } else if (a == "--wav") {
+            wav = args.value(a);
+        } else if (a == "--wav-mix") {
+            pd.mix = args.value(a);
+            if (pd.mix != "stereo" && pd.mix != "pickups")
+                throw UsageError("--wav-mix: expected stereo or pickups, got '" + pd.mix + "'");
+        } else if (a == "--wav-bits") {
+            const double bits = parse_number(a, args.value(a));
+            if (bits != 16 && bits != 24 && bits != 32)
+                throw UsageError("--wav-bits: expected 16, 24 or 32, got '" + std::to_string(bits) +
+                                 "'");
+            pd.bits = static_cast<int>(bits);
+        } else if (a == "--wav-gain") {
+            pd.gain_db = parse_number(a, args.value(a), -120, 40);
+        } else if (a == "--wav-rate") {
+            pd.sample_rate = static_cast<int>(parse_number(a, args.value(a), 8000, 192000));
+        } else if (a == "--pd") {
+            pd.pd = args.value(a);
+        } else if (a == "--pd-lib") {
+            pd.library = args.value(a);
         } else if (a == "--tips-rate") {
             tips_rate = parse_number(a, args.value(a), 0, 1000);
         } else if (!parse_performance_option(a, args, o, duration)) {
@@ -351,6 +404,15 @@ int cmd_render(Args &args)
         throw UsageError("--score and --mocap are two motion sources: give one");
     if (out_dir.empty())
         throw UsageError("--out DIR is required");
+    if (!wav.empty()) {
+        // Pd and its library are looked for now, not after the physics.
+        find_pd_binary(pd.pd);
+        pd.library = find_pd_library(pd.library);
+        wav = std::filesystem::absolute(wav).lexically_normal().string();
+        check_pd_path("--wav", wav);
+        check_pd_path("--out", std::filesystem::absolute(out_dir).lexically_normal().string());
+        check_pd_path("--pd-lib", pd.library);
+    }
     prepare_out_dir(out_dir, force);
 
     Performance perf(o);
@@ -361,7 +423,7 @@ int cmd_render(Args &args)
     // Every output is opened now (an unwritable folder is found before the
     // run), kept in memory while the physics runs and written at the end.
     RenderOutput strikes_csv(out_dir + "/strikes.csv"), events_txt(out_dir + "/events.txt"),
-        render_json(out_dir + "/render.json");
+        render_json(out_dir + "/render.json"), performance_mid(out_dir + "/performance.mid");
     std::unique_ptr<RenderOutput> tips_csv, notes_csv;
     if (score_mode) {
         tips_csv = std::make_unique<RenderOutput>(out_dir + "/tips.csv");
@@ -389,10 +451,20 @@ int cmd_render(Args &args)
     StrikeLog log;
     StrikeEvent ev[2];
     bool interrupted = false;
+    double next_progress = progress_every;
     for (long n = 0; n < steps; ++n) {
         if (g_interrupted) {
             interrupted = true;
             break;
+        }
+        if (progress_every > 0.0 && (n & 63) == 0) {
+            const double w =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+            if (w >= next_progress) {
+                std::fprintf(stderr, "render: %.1f of %.1f s simulated (%.0f s)\n", perf.time_s(),
+                             steps * h, w);
+                next_progress = w + progress_every;
+            }
         }
         const int k = perf.step(ev);
         log.add(ev, k);
@@ -420,6 +492,16 @@ int cmd_render(Args &args)
     events_txt.write_and_close(text.str());
     if (bvh)
         bvh->write(out_dir + "/performance.bvh");
+    // performance.mid: the score's tempo at each note (a clip: --tempo).
+    std::vector<MidiTempo> tempo;
+    if (score_mode) {
+        for (const PlannedNote &n : perf.plan()->notes)
+            tempo.push_back({perf.plan_origin_s() + n.time_s, n.tempo_bpm});
+    }
+    if (tempo.empty())
+        tempo.push_back({0.0, score_mode ? 120.0 : o.tempo_bpm});
+    performance_mid.write_and_close(
+        standard_midi_file(log.strikes(), tempo, static_cast<int>(midi_channel) - 1));
     nlohmann::json j;
     if (score_mode)
         j["score"] = o.score.score_text.empty() ? "default" : o.score.score_name;
@@ -435,6 +517,10 @@ int cmd_render(Args &args)
     if (!score_mode)
         j["tempo_bpm"] = o.tempo_bpm;
     j["drum"] = drum_json(perf);
+    j["midi"] = {{"file", "performance.mid"},
+                 {"channel", static_cast<int>(midi_channel)},
+                 {"notes", strikes},
+                 {"ticks_per_quarter", kMidiTicksPerQuarter}};
     if (score_mode) {
         const GesturePlan &plan = *perf.plan();
         const MatchSummary m = match_strikes(plan.notes, log.strikes(), perf.plan_origin_s());
@@ -448,10 +534,40 @@ int cmd_render(Args &args)
     std::cout << "render: " << perf.time_s() << " s simulated in " << wall << " s ("
               << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes << " strikes ("
               << bounces << " bounces), wrote " << out_dir
-              << (score_mode ? "/{strikes.csv,events.txt,render.json,tips.csv,notes.csv"
-                             : "/{strikes.csv,events.txt,render.json")
+              << (score_mode ? "/{strikes.csv,events.txt,render.json,performance.mid,tips.csv,"
+                               "notes.csv"
+                             : "/{strikes.csv,events.txt,render.json,performance.mid")
               << (bvh ? ",performance.bvh}\n" : "}\n");
-    return interrupted ? 130 : 0;
+    if (interrupted)
+        return 130;
+    if (!wav.empty()) {
+        const DrumParams &d = perf.scene().options().drum;
+        pd.events = std::filesystem::absolute(out_dir + "/events.txt").lexically_normal().string();
+        pd.log = out_dir + "/pd.log";
+        pd.wav = wav;
+        pd.seconds = perf.time_s() + 1.5; // the last strike rings out (as scripts/main.sh)
+        pd.radius_m = d.radius_m;
+        pd.tension_n_per_m = d.tension_n_per_m;
+        pd.density_kg_per_m2 = perf.options().drum_density_kg_per_m2;
+        std::cout << "render: pd: " << pd.seconds << " s of sound into " << wav << " ..."
+                  << std::endl;
+        const PdRenderResult r = run_pd_render(pd, [&](double s) {
+            if (progress_every > 0.0)
+                std::fprintf(stderr, "render: pd still rendering (%.0f s)\n", s);
+        });
+        if (!r.errors.empty()) {
+            std::cerr << "ictusd render: pd reported errors (log: " << pd.log << "):\n" << r.errors;
+            return 1;
+        }
+        char line[512];
+        std::snprintf(line, sizeof line,
+                      "render: wrote %s in %.1f s (%s, %d-bit%s, %d Hz): peak %.2f dBFS, %.2f "
+                      "dBFS before the limiter\n",
+                      wav.c_str(), r.wall_s, pd.mix.c_str(), pd.bits, pd.bits == 32 ? " float" : "",
+                      pd.sample_rate, r.peak_out_dbfs, r.peak_in_dbfs);
+        std::cout << line;
+    }
+    return 0;
 }
 
 } // namespace cli

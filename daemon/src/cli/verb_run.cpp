@@ -71,7 +71,7 @@ void run_usage(std::ostream &out)
            "\n"
            "examples:\n"
            "  ictusd run --mocap ../shared/data/cmu/80_13.bvh\n"
-           "  ictusd run --score examples/scores/figure5.score --mode cartesian\n"
+           "  ictusd run --score examples/scores/figure5.txt --mode cartesian\n"
            "  ictusd run --mocap clip.bvh --target osc.udp://10.0.0.2:9000 --bind 10.0.0.1 \\\n"
            "             --allow 10.0.0.2 --lookahead 0.05\n"
            "  oscsend localhost 9001 /ictus/tempo f 96\n";
@@ -288,6 +288,9 @@ int cmd_run(Args &args)
     }
     LiveStatus status;
     status.tempo_bpm = o.tempo_bpm;
+    status.score = perf.score_mode() ? 1 : 0;
+    status.mode = static_cast<int>(perf.mode());
+    status.grip = static_cast<int>(perf.options().character.grip);
     OscServer server(io, &status);
     server_ptr = &server;
     // Planning and rebuilds from now on run beside the physics loop.
@@ -378,6 +381,8 @@ int cmd_run(Args &args)
         status.tempo_bpm = perf.tempo_bpm();
         status.strikes += k;
         status.runaways = perf.runaways();
+        status.mode = static_cast<int>(perf.mode());
+        status.grip = static_cast<int>(perf.options().character.grip);
     }
     StrikeEvent last;
     while (perf.flush(last)) {

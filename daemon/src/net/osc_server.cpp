@@ -4,6 +4,8 @@
 // deserialises and validates each message; handlers check the type tags and
 // the values, queue a Command for the physics thread and reply over OSC.
 #include "ictus/net/osc_server.hpp"
+#include "ictus/character/character.hpp"
+#include "ictus/perform/tracker.hpp"
 
 #include <lo/lo.h>
 
@@ -487,6 +489,11 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
         lo_message_add_int32(s, static_cast<int>(snap.errors()));
         lo_message_add_int32(s, static_cast<int>(c.refused_peers.load()));
         lo_message_add_int32(s, status_ ? static_cast<int>(status_->overruns.load()) : 0);
+        // The performance's state, by name: source, control mode, grip.
+        lo_message_add_string(s, status_ && status_->score.load() ? "score" : "clip");
+        lo_message_add_string(
+            s, to_string(static_cast<TrackMode>(status_ ? status_->mode.load() : 0)));
+        lo_message_add_string(s, to_string(static_cast<Grip>(status_ ? status_->grip.load() : 0)));
         reply.ok(path, s);
         return;
     }

@@ -82,6 +82,9 @@ struct LiveStatus {
     std::atomic<long> strikes{0};
     std::atomic<long> overruns{0}; // physics steps that started late by > 1 step
     std::atomic<long> runaways{0}; // times the runaway guard stopped the strikes
+    std::atomic<int> mode{0};      // TrackMode, as an int (/ictus/status: its name)
+    std::atomic<int> grip{0};      // Grip, as an int
+    std::atomic<int> score{0};     // 1: a score plays (score mode), 0: a clip
 };
 
 } // namespace ictus

@@ -1,0 +1,60 @@
+// `ictusd render --wav FILE`: the render's events.txt played by Pd in batch
+// mode on the same drum (patches/ictus-render.pd, docs/pd-osc.md), as
+// scripts/main.sh does it. Pd is a separate program: found on PATH (or
+// given), run as a child process, its output kept in a log.
+#pragma once
+
+#include <functional>
+#include <string>
+
+namespace ictus
+{
+namespace cli
+{
+
+struct PdRenderOptions {
+    std::string pd = "pd";   // the binary: a name looked up on PATH, or a path
+    std::string library;     // folder with the externals and ictus-render.pd ("": found)
+    std::string events;      // absolute path of events.txt
+    std::string wav;         // absolute path of the WAV to write
+    std::string log;         // where Pd's output goes (pd.log)
+    double seconds = 10.0;   // length of the WAV
+    double radius_m = 0.178; // the drum: render-drum radius / tension / density
+    double tension_n_per_m = 3000.0;
+    double density_kg_per_m2 = 0.26;
+    int sample_rate = 48000;
+    std::string mix = "stereo"; // render-mix
+    int bits = 32;              // render-bits
+    double gain_db = 0.0;       // render-gain
+};
+
+// What Pd reported at the end (ictus-render's report line), and its error lines.
+struct PdRenderResult {
+    double peak_in_dbfs = 0.0;
+    double peak_out_dbfs = 0.0;
+    std::string errors; // Pd's error lines, one a line ("" when none)
+    double wall_s = 0.0;
+};
+
+// The Pd library folder: `given` if not empty (checked), else the first of
+// <ictusd's folder>/ictus (a build tree) and <ictusd's folder>/../lib/pd-externals/ictus
+// (cmake --install) that holds ictus-render.pd. std::runtime_error naming
+// what was looked for.
+std::string find_pd_library(const std::string &given);
+
+// Pd parses a -send message into atoms: a path with a space, a comma, a
+// semicolon, a dollar, a backslash or a brace would arrive cut or changed.
+// std::runtime_error "WHAT: 'path' has ...".
+void check_pd_path(const char *what, const std::string &path);
+
+// The path of `pd` (a name is looked up on PATH); std::runtime_error when
+// there is none, saying how to get it.
+std::string find_pd_binary(const std::string &pd);
+
+// Runs Pd; `progress` is called about every 2 s of wall time while it runs
+// (elapsed seconds). Throws std::runtime_error when Pd cannot start, exits
+// with an error, is interrupted (SIGINT), times out, or writes no WAV.
+PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(double)> &progress);
+
+} // namespace cli
+} // namespace ictus

@@ -1,0 +1,217 @@
+// A Standard MIDI File of the strikes (docs/midi.md). SMF 1.0: a header chunk
+// (format 0, one track, ticks per quarter) and one track chunk of events,
+// each after a variable-length delta time; tempo as meta event FF 51
+// (microseconds per quarter note).
+#include "ictus/cli/midi_file.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+
+namespace ictus
+{
+namespace cli
+{
+
+int midi_zone(double r_over_a)
+{
+    if (r_over_a < kMidiMiddleFrom)
+        return 0;
+    return r_over_a < kMidiEdgeFrom ? 1 : 2;
+}
+
+int midi_note(int hand, double r_over_a)
+{
+    return kMidiNoteBase + 4 * (hand == 0 ? 0 : 1) + midi_zone(r_over_a);
+}
+
+int midi_velocity(double normal_velocity_mps)
+{
+    if (!(normal_velocity_mps > kMidiSpeedLo_mps)) // also NaN
+        return 1;
+    const double x = std::log(normal_velocity_mps / kMidiSpeedLo_mps) /
+                     std::log(kMidiSpeedHi_mps / kMidiSpeedLo_mps);
+    return static_cast<int>(std::clamp(std::lround(1.0 + 126.0 * x), 1L, 127L));
+}
+
+namespace
+{
+
+// The tempo map in ticks: each segment starts on a whole tick, at the time
+// the previous segments give that tick (so a reader's tick -> seconds is
+// exactly the map used here).
+struct TempoSegment {
+    long tick;
+    double time_s;
+    uint32_t us_per_quarter;
+};
+
+class TempoMap
+{
+  public:
+    explicit TempoMap(const std::vector<MidiTempo> &tempo)
+    {
+        if (tempo.empty())
+            throw std::invalid_argument("standard_midi_file: empty tempo map");
+        segments_.push_back({0, 0.0, us_per_quarter(tempo.front().bpm)});
+        for (size_t i = 1; i < tempo.size(); ++i) {
+            const uint32_t us = us_per_quarter(tempo[i].bpm);
+            if (us == segments_.back().us_per_quarter)
+                continue;
+            const long tick = std::max(tick_of(tempo[i].time_s), segments_.back().tick);
+            if (tick == segments_.back().tick) {
+                segments_.back().us_per_quarter = us;
+                continue;
+            }
+            segments_.push_back({tick, time_of(tick), us});
+        }
+    }
+    long tick_of(double time_s) const
+    {
+        const TempoSegment &s = segment_at(time_s);
+        return s.tick +
+               std::lround((time_s - s.time_s) * 1e6 / s.us_per_quarter * kMidiTicksPerQuarter);
+    }
+    const std::vector<TempoSegment> &segments() const { return segments_; }
+
+  private:
+    static uint32_t us_per_quarter(double bpm)
+    {
+        if (!(bpm >= 4.0 && bpm <= 1000.0))
+            throw std::invalid_argument("standard_midi_file: tempo " + std::to_string(bpm) +
+                                        " bpm outside 4..1000");
+        return static_cast<uint32_t>(std::lround(60e6 / bpm));
+    }
+    const TempoSegment &segment_at(double time_s) const
+    {
+        size_t k = 0;
+        while (k + 1 < segments_.size() && segments_[k + 1].time_s <= time_s)
+            ++k;
+        return segments_[k];
+    }
+    double time_of(long tick) const
+    {
+        size_t k = 0;
+        while (k + 1 < segments_.size() && segments_[k + 1].tick <= tick)
+            ++k;
+        const TempoSegment &s = segments_[k];
+        return s.time_s +
+               static_cast<double>(tick - s.tick) / kMidiTicksPerQuarter * s.us_per_quarter * 1e-6;
+    }
+    std::vector<TempoSegment> segments_;
+};
+
+struct TrackEvent {
+    long tick;
+    int order; // at one tick: meta 0, note-off 1, bounce text 2, note-on 3
+    long seq;  // then in strike order
+    std::string bytes;
+};
+
+void put_u32(std::string &out, uint32_t v)
+{
+    for (int shift = 24; shift >= 0; shift -= 8)
+        out += static_cast<char>((v >> shift) & 0xff);
+}
+
+void put_vlq(std::string &out, uint32_t v)
+{
+    char buf[5];
+    int n = 0;
+    buf[n++] = static_cast<char>(v & 0x7f);
+    while (v >>= 7)
+        buf[n++] = static_cast<char>(0x80 | (v & 0x7f));
+    while (n > 0)
+        out += buf[--n];
+}
+
+std::string meta(int type, const std::string &data)
+{
+    std::string e;
+    e += static_cast<char>(0xff);
+    e += static_cast<char>(type);
+    put_vlq(e, static_cast<uint32_t>(data.size()));
+    return e + data;
+}
+
+std::string tempo_meta(uint32_t us)
+{
+    std::string d;
+    d += static_cast<char>((us >> 16) & 0xff);
+    d += static_cast<char>((us >> 8) & 0xff);
+    d += static_cast<char>(us & 0xff);
+    return meta(0x51, d);
+}
+
+std::string channel_message(int status, int channel, int a, int b)
+{
+    std::string e;
+    e += static_cast<char>(status | channel);
+    e += static_cast<char>(a);
+    e += static_cast<char>(b);
+    return e;
+}
+
+} // namespace
+
+std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
+                               const std::vector<MidiTempo> &tempo, int channel)
+{
+    if (channel < 0 || channel > 15)
+        throw std::invalid_argument("standard_midi_file: channel must be 0..15");
+    const TempoMap map(tempo);
+    std::vector<TrackEvent> events;
+    events.push_back({0, 0, -3, meta(0x03, "ictus")});
+    events.push_back({0, 0, -2, meta(0x58, std::string("\x04\x02\x18\x08", 4))});
+    for (const TempoSegment &s : map.segments())
+        events.push_back({s.tick, 0, -1, tempo_meta(s.us_per_quarter)});
+    for (size_t i = 0; i < strikes.size(); ++i) {
+        const StrikeEvent &e = strikes[i];
+        const int note = midi_note(e.hand, e.r_over_a);
+        const long on = map.tick_of(std::max(0.0, e.time_s));
+        // The note ends after kMidiNoteLength_s, or where the same note strikes again.
+        double off_s = e.time_s + kMidiNoteLength_s;
+        for (size_t j = i + 1; j < strikes.size(); ++j)
+            if (midi_note(strikes[j].hand, strikes[j].r_over_a) == note) {
+                off_s = std::min(off_s, strikes[j].time_s);
+                break;
+            }
+        const long off = std::max(on + 1, map.tick_of(off_s));
+        const long seq = static_cast<long>(i);
+        if (e.bounce)
+            events.push_back({on, 2, seq, meta(0x01, "bounce")});
+        events.push_back(
+            {on, 3, seq,
+             channel_message(0x90, channel, note, midi_velocity(e.normal_velocity_mps))});
+        events.push_back({off, 1, seq, channel_message(0x80, channel, note, 0)});
+    }
+    std::stable_sort(events.begin(), events.end(), [](const TrackEvent &a, const TrackEvent &b) {
+        if (a.tick != b.tick)
+            return a.tick < b.tick;
+        if (a.order != b.order)
+            return a.order < b.order;
+        return a.seq < b.seq;
+    });
+    std::string track;
+    long last = 0;
+    for (const TrackEvent &e : events) {
+        put_vlq(track, static_cast<uint32_t>(e.tick - last));
+        track += e.bytes;
+        last = e.tick;
+    }
+    put_vlq(track, 0);
+    track += meta(0x2f, "");
+
+    std::string file = "MThd";
+    put_u32(file, 6);
+    file += std::string("\x00\x00\x00\x01", 4); // format 0, one track
+    file += static_cast<char>((kMidiTicksPerQuarter >> 8) & 0x7f);
+    file += static_cast<char>(kMidiTicksPerQuarter & 0xff);
+    file += "MTrk";
+    put_u32(file, static_cast<uint32_t>(track.size()));
+    return file + track;
+}
+
+} // namespace cli
+} // namespace ictus

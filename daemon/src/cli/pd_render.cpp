@@ -1,0 +1,242 @@
+// Pd in batch mode as a child process (render --wav, docs/main-job.md).
+#include "ictus/cli/pd_render.hpp"
+
+#include "ictus/cli/args.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+extern char **environ;
+
+namespace ictus
+{
+namespace cli
+{
+
+namespace fs = std::filesystem;
+
+namespace
+{
+
+std::string self_dir()
+{
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    return ec ? std::string() : exe.parent_path().string();
+}
+
+bool is_library(const fs::path &dir)
+{
+    std::error_code ec;
+    return fs::is_regular_file(dir / "ictus-render.pd", ec);
+}
+
+std::string format(const char *fmt, double v)
+{
+    char buf[64];
+    std::snprintf(buf, sizeof buf, fmt, v);
+    return buf;
+}
+
+} // namespace
+
+void check_pd_path(const char *what, const std::string &path)
+{
+    if (path.find_first_of(" \t\n,;$\\{}") != std::string::npos)
+        throw std::runtime_error(std::string(what) + ": '" + path +
+                                 "' has a space or one of , ; $ \\ { } that Pd's messages "
+                                 "cannot carry: choose another path");
+}
+
+std::string find_pd_library(const std::string &given)
+{
+    if (!given.empty()) {
+        if (!is_library(given))
+            throw std::runtime_error("--pd-lib: no ictus-render.pd in '" + given +
+                                     "' (give the folder of the Pd library, e.g. build/ictus)");
+        return fs::absolute(given).lexically_normal().string();
+    }
+    const std::string self = self_dir();
+    std::vector<fs::path> tried;
+    if (!self.empty()) {
+        tried.push_back(fs::path(self) / "ictus");
+        tried.push_back(fs::path(self) / ".." / "lib" / "pd-externals" / "ictus");
+    }
+    for (const fs::path &dir : tried)
+        if (is_library(dir))
+            return dir.lexically_normal().string();
+    std::string list;
+    for (const fs::path &dir : tried)
+        list += (list.empty() ? "" : ", ") + dir.lexically_normal().string();
+    throw std::runtime_error(
+        "--wav: the Pd library (ictus-render.pd and the externals) is not in " +
+        (list.empty() ? std::string("ictusd's folder") : list) +
+        ": build it (cmake --build build) or give --pd-lib DIR");
+}
+
+std::string find_pd_binary(const std::string &pd)
+{
+    if (pd.find('/') != std::string::npos) {
+        if (::access(pd.c_str(), X_OK) != 0)
+            throw std::runtime_error("--pd: '" + pd + "' is not an executable file");
+        return pd;
+    }
+    const char *path = std::getenv("PATH");
+    std::stringstream dirs(path ? path : "");
+    std::string dir;
+    while (std::getline(dirs, dir, ':')) {
+        const std::string candidate = (dir.empty() ? std::string(".") : dir) + "/" + pd;
+        if (::access(candidate.c_str(), X_OK) == 0 && !fs::is_directory(candidate))
+            return candidate;
+    }
+    throw std::runtime_error("--wav: no '" + pd +
+                             "' on PATH: install Pure Data (Debian: apt install puredata-core, "
+                             "or bash scripts/deps.sh) or give --pd /path/to/pd");
+}
+
+PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(double)> &progress)
+{
+    const std::string pd = find_pd_binary(o.pd);
+    const std::string lib = find_pd_library(o.library);
+    check_pd_path("--wav", o.wav);
+    check_pd_path("--out", o.events);
+    check_pd_path("--pd-lib", lib);
+    std::vector<std::string> argv = {pd,       "-nogui",  "-nosound", "-nomidi",
+                                     "-batch", "-stderr", "-r",       std::to_string(o.sample_rate),
+                                     "-path",  lib,       "-open",    lib + "/ictus-render.pd"};
+    const std::vector<std::string> sends = {
+        "render-drum radius " + format("%.9g", o.radius_m),
+        "render-drum tension " + format("%.9g", o.tension_n_per_m),
+        "render-drum density " + format("%.9g", o.density_kg_per_m2),
+        "render-mix " + o.mix,
+        "render-bits " + std::to_string(o.bits),
+        "render-gain " + format("%.9g", o.gain_db),
+        "render-file " + o.events,
+        "render-out " + o.wav,
+        "render-seconds " + format("%.3f", o.seconds)};
+    for (const std::string &s : sends) {
+        argv.push_back("-send");
+        argv.push_back(s);
+    }
+    std::error_code ec;
+    fs::remove(o.wav, ec); // so that an earlier file never passes for this one
+    if (ec)
+        throw std::runtime_error("--wav: cannot replace '" + o.wav + "': " + ec.message());
+    std::vector<char *> cargv;
+    for (std::string &a : argv)
+        cargv.push_back(a.data());
+    cargv.push_back(nullptr);
+
+    int fds[2];
+    if (::pipe2(fds, O_CLOEXEC) != 0)
+        throw std::runtime_error(std::string("--wav: pipe: ") + std::strerror(errno));
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    pid_t pid = -1;
+    const int spawned = ::posix_spawn(&pid, pd.c_str(), &actions, nullptr, cargv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(fds[1]);
+    if (spawned != 0) {
+        ::close(fds[0]);
+        throw std::runtime_error("--wav: cannot start '" + pd + "': " + std::strerror(spawned));
+    }
+
+    // Pd in batch mode renders many times faster than real time; a patch that
+    // never quits (the library half loaded) must not hang render.
+    const double timeout_s = 120.0 + 10.0 * o.seconds;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto elapsed = [&] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+    std::string output;
+    double next_progress = 2.0;
+    std::string stop_reason;
+    int status = 0;
+    bool reaped = false;
+    for (;;) {
+        pollfd p{fds[0], POLLIN, 0};
+        const int r = ::poll(&p, 1, 250);
+        if (r == 0 && ::waitpid(pid, &status, WNOHANG) == pid) {
+            reaped = true; // gone, though something it started may hold the pipe
+            break;
+        }
+        if (r > 0) {
+            char buf[4096];
+            const ssize_t n = ::read(fds[0], buf, sizeof buf);
+            if (n > 0)
+                output.append(buf, static_cast<size_t>(n));
+            else if (n == 0 || errno != EINTR)
+                break; // Pd closed its output: it is ending
+        }
+        if (g_interrupted && stop_reason.empty()) {
+            stop_reason = "interrupted";
+            ::kill(pid, SIGTERM);
+        } else if (elapsed() > timeout_s && stop_reason.empty()) {
+            stop_reason = "timed out after " + format("%.0f", timeout_s) + " s";
+            ::kill(pid, SIGKILL);
+        }
+        if (elapsed() >= next_progress) {
+            progress(elapsed());
+            next_progress += 2.0;
+        }
+    }
+    ::close(fds[0]);
+    while (!reaped && ::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+
+    PdRenderResult result;
+    result.wall_s = elapsed();
+    if (!o.log.empty()) {
+        std::ofstream log(o.log, std::ios::binary);
+        log << output;
+        if (!log.flush())
+            throw std::runtime_error("--wav: cannot write '" + o.log + "'");
+    }
+    const std::string log_note = o.log.empty() ? "" : " (log: " + o.log + ")";
+    if (!stop_reason.empty())
+        throw std::runtime_error("--wav: pd " + stop_reason + log_note);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        throw std::runtime_error("--wav: pd failed (" +
+                                 (WIFEXITED(status)
+                                      ? "exit status " + std::to_string(WEXITSTATUS(status))
+                                      : "signal " + std::to_string(WTERMSIG(status))) +
+                                 ")" + log_note);
+    std::istringstream lines(output);
+    std::string line;
+    bool reported = false;
+    while (std::getline(lines, line)) {
+        if (line.find("error") != std::string::npos || line.find("couldn't") != std::string::npos)
+            result.errors += line + "\n";
+        double in = 0.0, out = 0.0;
+        if (std::sscanf(line.c_str(), "ictus-render: peak_in_dbfs %lf peak_out_dbfs %lf", &in,
+                        &out) == 2) {
+            result.peak_in_dbfs = in;
+            result.peak_out_dbfs = out;
+            reported = true;
+        }
+    }
+    if (!reported || !fs::is_regular_file(o.wav, ec))
+        throw std::runtime_error("--wav: pd wrote no '" + o.wav + "'" + log_note + ":\n" + output);
+    return result;
+}
+
+} // namespace cli
+} // namespace ictus
