@@ -131,10 +131,10 @@ def main():
                                                              status.get("double", 0)))
     print("| extra primary strikes | %d (in %d scores) |" % (len(extra), len({s for s, _ in extra})))
     print("| bounces (tagged) | %d (in %d scores) |" % (bounces, scores_with_bounces))
-    print("| timing error \\|strike − beat\\| mean / p50 / p99 (ms) | %.2f / %.2f / %.2f |"
+    print("| timing error \\|strike − beat\\| mean / p50 / p99 (ms; notes with a strike within 50 ms) | %.2f / %.2f / %.2f |"
           % (mean(errs), pct(errs, 50), pct(errs, 99)))
     if worst_note:
-        print("| worst timing error (ms) | %+.2f (seed %d, %s %s %s at %.0f bpm) |"
+        print("| worst timing error (ms; beyond 50 ms a note counts as missed) | %+.2f (seed %d, %s %s %s at %.0f bpm) |"
               % (worst_note["error_ms"], worst_seed, worst_note["hand"], worst_note["nuance"],
                  worst_note["label"], worst_note["tempo_bpm"]))
     print("| signed timing error mean (ms) | %+.2f |" % mean(signed))

@@ -4,6 +4,7 @@
     python3 scripts/random_score.py --seed N          # print score N
     python3 scripts/random_score.py --seed N --notes  # and the notes it must give
     python3 scripts/random_score.py --seed N --ictusd build/ictusd   # nuances from that parser
+    python3 scripts/random_score.py --coverage 100    # how many of seeds 1..100 hold each form
 
 Used by tests/perform/test_random_scores.py (CTest) and bench/random_scores.py. The same seed
 and the same nuance list give the same bytes (Python's own `random.Random(seed)`, no hashing
@@ -269,8 +270,13 @@ def draw_dynamics(rng):
         return word, value
     value = round(rng.choice([rng.uniform(0.0, 1.0), 0.0, 1.0, 0.5]), 2)
     text = fmt_num(value, 2)
-    if rng.random() < 0.2 and 0.0 < value < 1.0:
+    r = rng.random()
+    if r < 0.15 and 0.0 < value < 1.0:
         text = text.lstrip("0")  # ".5"
+    elif r < 0.2 and 0.0 < value:
+        text = "%de-2" % round(value * 100)  # an exponent, as Pd may write it
+    elif r < 0.23:
+        text = "+" + text
     return text, float(text)
 
 
@@ -375,7 +381,10 @@ class Generator:
         rng = self.rng
         lo, hi = TEMPO_RANGE
         r = rng.random()
-        bpm = lambda: float(rng.randint(int(lo), int(hi)))  # noqa: E731
+        def bpm():
+            if rng.random() < 0.15:
+                return round(rng.uniform(lo, hi), 1)  # a decimal tempo: "tempo 96.5"
+            return float(rng.randint(int(lo), int(hi)))
         arrow = lambda: "->" if rng.random() < 0.8 else "to"  # noqa: E731
         if r < 0.45:
             b = bpm()
@@ -480,7 +489,10 @@ class Generator:
             if rng.random() < 0.15:
                 body.append(self.other_statement(state))
             hand = self.pick_hand(hand)
-            body.append(self.note(hand))
+            if rng.random() < 0.15 and hand != "both":  # a nested repeat of one stroke
+                body.append({"kind": "repeat", "count": 2, "body": [self.note(hand)]})
+            else:
+                body.append(self.note(hand))
         rep = {"kind": "repeat", "count": count, "body": body}
         if count_notes(rep) > notes_left:
             return None
@@ -498,7 +510,7 @@ class Generator:
         rng = self.rng
         state = State()
         out = []   # top-level statements
-        first_tempo = rng.randint(int(TEMPO_RANGE[0]), int(TEMPO_RANGE[1]))
+        first_tempo = rng.randint(int(TEMPO_RANGE[0]), int(TEMPO_RANGE[1]))  # whole bpm
         if rng.random() < 0.3:
             st = self.tempo_statement(state)  # may ramp, "tempo -> X" from the default 120
         else:
@@ -659,12 +671,85 @@ def note_features(n, notes):
     }
 
 
+# What --coverage counts: the score language's forms, as regular expressions on the text
+# (case-insensitive; one statement per match, statements split at , ; and newlines).
+COVERAGE = [
+    ("hand R / right", r"^(r|right)\b(?!\+)"), ("hand L / left", r"^(l|left)\b(?!\+)"),
+    ("R+L / L+R / both", r"^(r\+l|l\+r|both)\b"),
+    ("tempo BPM", r"^tempo [0-9.]+$"), ("tempo BPM -> BPM over B", r"^tempo [0-9.]+ (->|to) "),
+    ("tempo -> BPM over B (from the current tempo)", r"^tempo (->|to) "),
+    ("'to' for '->'", r"^tempo .*\bto\b"), ("decimal tempo", r"^tempo .*\d\.\d"),
+    ("grip french", r"^grip french$"), ("grip german", r"^grip german$"),
+    ("rest", r"^rest$"), ("rest N/D", r"^rest \d+/\d+$"), ("rest beats X", r"^rest beats "),
+    ("beats X (default duration)", r"^beats "), ("dynamics D (default)", r"^dynamics "),
+    ("repeat N ... end", r"^repeat \d+$"),
+    ("note N/D", r"^(r|l|right|left|r\+l|l\+r|both)\b.* \d+/\d+\b"),
+    ("note beats X", r"^(r|l|right|left|r\+l|l\+r|both)\b.* beats "),
+    ("note beats decimal", r"^(r|l|right|left|r\+l|l\+r|both)\b.* beats \d*\.\d"),
+    ("triplet (N/3, N/6, N/12)", r" (beats )?\d+/(3|6|12)\b"),
+    ("dotted (3/2, 3/4, 3/8, 3/16, 7/8)", r" (beats )?(3/2|3/4|3/8|3/16|7/8|6/4|6/8|6/16|6/32|14/16)\b"),
+    ("1/32", r" (beats )?(1/32|2/64)\b"), ("at R/A THETA", r" at [0-9.]+ -?[0-9.]+"),
+    ("dynamics word", r"^(r|l|right|left|r\+l|l\+r|both)\b.* (pp|p|mp|mf|f|ff)\b"),
+    ("dynamics number", r"^(r|l|right|left|r\+l|l\+r|both)\b.* [+]?[0-9]*\.?[0-9]+(e-2)?( |$)"),
+    ("dynamics .5 / 5e-2 / +0.5", r" (\.[0-9]|[0-9]+e-2|\+[0-9])"),
+    ("vertical-accent spelling", r"vertical-accent"), ("upper case", r"[A-Z]{2,}"),
+]
+
+
+def coverage(count, nuances):
+    """How many of seeds 1..count hold each form (and each nuance)."""
+    hits = {name: 0 for name, _ in COVERAGE}
+    nuance_hits = {n: 0 for n in nuances}
+    nested = separators = comments = wrapped = 0
+    for seed in range(1, count + 1):
+        sc = RandomScore(seed, nuances)
+        stmts = []
+        depth = max_depth = 0
+        for line in sc.text.split("\n"):
+            if "#" in line and not line.startswith("#"):
+                comments += 1
+            line = line.split("#")[0]
+            if ";" in line or "," in line:
+                separators += 1
+            stmts.extend(x.strip() for x in re.split(r"[,;]", line) if x.strip())
+        for st in stmts:
+            if re.match(r"^repeat", st, re.I):
+                depth += 1
+                max_depth = max(max_depth, depth)
+            elif re.match(r"^end$", st, re.I):
+                depth -= 1
+        nested += max_depth >= 2
+        wrapped += any(m["at"] and not -180.0 < m["theta_deg"] <= 180.0 for m in sc.notes)
+        for name, rx in COVERAGE:
+            flags = 0 if name == "upper case" else re.I
+            if any(re.search(rx, st, flags) for st in stmts):
+                hits[name] += 1
+        for n in nuance_hits:
+            if any(m["nuance"] == n for m in sc.notes):
+                nuance_hits[n] += 1
+    out = ["scores (seeds 1..%d) holding each form:" % count]
+    out += ["  %-50s %d" % (k, v) for k, v in hits.items()]
+    out += ["  %-50s %d" % ("at, theta outside (-180, 180]", wrapped),
+            "  %-50s %d" % ("nested repeat", nested),
+            "  %-50s %d" % ("lines with , or ; separators", separators),
+            "  %-50s %d" % ("end-of-line comments", comments)]
+    out += ["  %-50s %d" % ("nuance " + k, v) for k, v in nuance_hits.items()]
+    return "\n".join(out) + "\n"
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--seed", type=int, required=True)
+    ap.add_argument("--seed", type=int)
+    ap.add_argument("--coverage", type=int, metavar="N",
+                    help="instead: how many of seeds 1..N hold each form of the language")
     ap.add_argument("--ictusd", help="read the nuance list from this ictusd's parser")
     ap.add_argument("--notes", action="store_true", help="also print the expected notes (as comments)")
     args = ap.parse_args(argv)
+    if args.coverage:
+        sys.stdout.write(coverage(args.coverage, nuance_list(args.ictusd)))
+        return 0
+    if args.seed is None:
+        ap.error("--seed N is required (or --coverage N)")
     score = RandomScore(args.seed, nuance_list(args.ictusd))
     sys.stdout.write(score.text)
     if args.notes:

@@ -151,6 +151,9 @@ def render(ictusd, score, workdir, timeout_s=600, extra_args=()):
         res.problems.append("ictusd render " + res.crashed)
         return res
     res.render_s = time.monotonic() - t0
+    if proc.stderr.strip():  # a sanitizer's report, a warning: kept beside the render
+        with open(os.path.join(d, "stderr.txt"), "w") as f:
+            f.write(proc.stderr)
     if proc.returncode != 0:
         msg = (proc.stderr.strip() or proc.stdout.strip()).split("\n")
         if proc.returncode == 1 and any(path + ":" in l for l in msg):

@@ -79,8 +79,12 @@ def main():
     if os.path.isdir(workdir):
         shutil.rmtree(workdir)
     os.makedirs(workdir)
+    def progress(i, n, r):  # one line per score as it comes: a timeout still shows the rest
+        print("[%d/%d %.0f s] seed %d: %s" % (i, n, time.monotonic() - t0, r.seed,
+                                                "ok" if r.ok else "; ".join(r.problems)), flush=True)
+
     results, _ = render_check.run_many(args.ictusd, seeds, workdir=workdir, jobs=jobs,
-                                       nuances=nuances, keep=args.keep)
+                                       nuances=nuances, keep=args.keep, progress=progress)
     wall = time.monotonic() - t0
     notes = sum(len(r.notes) for r in results)
     failed = [r for r in results if not r.ok]
