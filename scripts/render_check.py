@@ -372,3 +372,52 @@ def _render_clean(ictusd, score, workdir, keep, extra_args):
     if not keep and r.ok:
         shutil.rmtree(os.path.join(workdir, "seed-%d" % score.seed), ignore_errors=True)
     return r
+
+
+def planted_faults(score, out):
+    """Plant one fault at a time in copies of a render that passed (`out`) and check that
+    `check` finds each (a problem naming it): returns [(fault, found, problems)]. So the test
+    shows it can fail."""
+    with open(os.path.join(out, "strikes.csv")) as f:
+        lines = f.read().rstrip("\n").split("\n")
+    header = lines[0].split(",")
+    col = {name: i for i, name in enumerate(header)}
+    rows = [l.split(",") for l in lines[1:]]
+    primaries = [i for i, r in enumerate(rows) if r[col["bounce"]] == "0"]
+    if len(primaries) < 2:
+        raise ValueError("planted_faults needs a render with two primary strikes")
+    first = primaries[0]
+    # The second primary strike of the first one's hand (its stroke number is then wrong).
+    hand = rows[first][col["hand"]]
+    second = next(i for i in primaries[1:] if rows[i][col["hand"]] == hand)
+
+    def moved(r, dt):
+        r = list(r)
+        r[col["time_s"]] = "%.6f" % (float(r[col["time_s"]]) + dt)
+        return r
+
+    last_same = max(i for i in primaries if rows[i][col["hand"]] == hand)
+    extra = moved(rows[last_same], 0.4)
+    extra[col["stroke"]] = str(int(rows[last_same][col["stroke"]]) + 1)
+    extra[col["seq"]] = str(len(rows))
+    faults = [
+        ("a note's strike removed", "missed", [r for i, r in enumerate(rows) if i != first]),
+        ("a strike 6 ms late", "off-time", [moved(r, 0.006) if i == first else r for i, r in enumerate(rows)]),
+        ("a NaN velocity", "= nan", [r[:col["normal_velocity_mps"]] + ["nan"] + r[col["normal_velocity_mps"] + 1:]
+                            if i == first else r for i, r in enumerate(rows)]),
+        ("a primary strike tagged a bounce", "bounce seq", [r[:col["bounce"]] + ["1"] + r[col["bounce"] + 1:]
+                                              if i == second else r for i, r in enumerate(rows)]),
+        ("an extra primary strike 0.4 s after the hand's last", "extra primary", rows + [extra]),
+    ]
+    found = []
+    for k, (name, sign, mutated) in enumerate(faults):
+        d = out + "-planted-%d" % k
+        shutil.rmtree(d, ignore_errors=True)
+        shutil.copytree(out, d)
+        with open(os.path.join(d, "strikes.csv"), "w") as f:
+            f.write("\n".join([lines[0]] + [",".join(r) for r in mutated]) + "\n")
+        res = Result(score)
+        check(res, d)
+        found.append((name, any(sign in p for p in res.problems), res.problems))
+        shutil.rmtree(d, ignore_errors=True)
+    return found

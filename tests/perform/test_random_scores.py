@@ -73,6 +73,8 @@ def main():
             problems.append("the %d scores do not cover every %s: %s of %s"
                             % (len(scores), name, sorted(map(str, drawn[name])), sorted(map(str, want))))
 
+    # The check finds planted faults: a render of the first seed that plays right, with one
+    # strike removed, moved, made NaN, re-tagged, or added (render_check.planted_faults).
     jobs = args.jobs or os.cpu_count() or 2
     t0 = time.monotonic()
     workdir = args.workdir or tempfile.mkdtemp(prefix="ictus-random-scores-")
@@ -109,6 +111,21 @@ def main():
         problems.append("%d of %d scores not played right (%d of %d notes, %d extra primary "
                         "strikes): seeds %s" % (len(failed), len(results), bad_notes, notes, extra,
                                                 " ".join(str(r.seed) for r in failed)))
+    good = next((r for r in results if r.ok), None)
+    if good is None:
+        problems.append("no score played right: the planted-fault check has nothing to plant in")
+    else:
+        out = os.path.join(workdir, "planted", "seed-%d" % good.seed)
+        again = render_check.render(args.ictusd, good.score, os.path.join(workdir, "planted"))
+        if not again.ok:
+            problems.append("seed %d played right once and not again: %s" % (good.seed, again.problems))
+        else:
+            for name, found, why in render_check.planted_faults(good.score, os.path.join(out, "out")):
+                print("planted fault in seed %d, %s: %s" % (good.seed, name, "found" if found else
+                                                          "NOT FOUND (%s)" % "; ".join(why)))
+                if not found:
+                    problems.append("the check did not find a planted fault: " + name)
+            shutil.rmtree(os.path.join(workdir, "planted"), ignore_errors=True)
     if not failed and not args.keep:
         shutil.rmtree(workdir, ignore_errors=True)
     for p in problems:
