@@ -186,7 +186,13 @@ def check(res, out):
         res.joint_limits_deg = v if res.joint_limits_deg is None else max(res.joint_limits_deg, v)
         if isinstance(v, (int, float)) and v > MAX_LIMIT_EXCURSION_DEG:
             res.problems.append("joint limit excursion %s = %.2f deg > %.1f" % (p, v, MAX_LIMIT_EXCURSION_DEG))
-    res.trunk = _find_keys(j, lambda k: "trunk" in k.lower())
+    res.trunk = []  # numbers under any key naming the trunk: (path, value)
+    for p, v in _find_keys(j, lambda k: "trunk" in k.lower()):
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            res.trunk.append((p, v))
+        elif isinstance(v, dict):
+            res.trunk.extend((p + q, w) for q, w in _find_keys(v, lambda k: True)
+                             if isinstance(w, (int, float)) and not isinstance(w, bool))
 
     with open(os.path.join(out, "notes.csv")) as f:
         note_rows, bad = _floats(f.read(), "notes.csv")
@@ -420,4 +426,18 @@ def planted_faults(score, out):
         check(res, d)
         found.append((name, any(sign in p for p in res.problems), res.problems))
         shutil.rmtree(d, ignore_errors=True)
+    # A joint beyond its limit, as the render.json of issue 12 reports it.
+    d = out + "-planted-limits"
+    shutil.rmtree(d, ignore_errors=True)
+    shutil.copytree(out, d)
+    with open(os.path.join(d, "render.json")) as f:
+        j = json.load(f)
+    j.setdefault("performance", {})["joint_limits"] = {"max_excursion_deg": 2.5}
+    with open(os.path.join(d, "render.json"), "w") as f:
+        json.dump(j, f)
+    res = Result(score)
+    check(res, d)
+    found.append(("a joint 2.5 deg beyond its limit", any("joint limit" in p for p in res.problems),
+                  res.problems))
+    shutil.rmtree(d, ignore_errors=True)
     return found
