@@ -226,7 +226,13 @@ def check(res, out):
                                                           e["nuance"], e["grip"], t))
             break
     per_note_by_index = {i: pn for i, pn in enumerate(per_note_json)}
-    row_index = {(r["hand"], round(float(r["time_s"]), 5)): int(r["index"]) for r in note_rows}
+    rows_by_hand = {}
+    for r in note_rows:
+        rows_by_hand.setdefault(r["hand"], []).append((float(r["time_s"]), int(r["index"])))
+
+    def row_index(hand, t):
+        near = [i for tt, i in rows_by_hand.get(hand, []) if abs(tt - t) <= PLAN_TIME_TOL_S]
+        return near[0] if near else -1
 
     # Strikes.
     strikes = []
@@ -258,7 +264,7 @@ def check(res, out):
             within = [s for s in prim if abs(s["time_s"] - t) <= TOLERANCE_MS / 1000.0]
             rec = dict(n)
             rec["plan_time_s"] = t
-            rec["index"] = row_index.get((hand, round(t, 5)), -1)
+            rec["index"] = row_index(hand, t)
             pn = per_note_by_index.get(rec["index"], {})
             rec["planned_impact_speed_mps"] = pn.get("planned_impact_speed_mps")
             best = min(near, key=lambda s: abs(s["time_s"] - t)) if near else None
