@@ -210,6 +210,11 @@ def check(res, out):
             tips = {"t": [float(r["time_s"]) for r in tip_rows],
                     "left": [float(r["left_sim_y_m"]) - plane_y for r in tip_rows],
                     "right": [float(r["right_sim_y_m"]) - plane_y for r in tip_rows]}
+            # Where the hand held the stick (the sticks on their fulcrum): the bounce rule
+            # also counts a re-contact the hand did not lift the stick 1 cm for (docs/osc.md).
+            if "left_held_y_m" in tip_rows[0]:
+                tips["held"] = {h: [float(r[h + "_held_y_m"]) - plane_y for r in tip_rows]
+                                for h in ("left", "right")}
 
     # The plan holds the generator's notes.
     expected = score.notes
@@ -308,6 +313,13 @@ def check(res, out):
         res.problems.append("%d extra primary strike(s)" % len(res.extra))
 
 
+def _held_max(tips, hand, t0, t1):
+    """Highest held-tip height (tips.csv *_held_y_m) over (t0, t1), or None."""
+    if not tips or "held" not in tips:
+        return None
+    return _tip_max({"t": tips["t"], hand: tips["held"][hand]}, hand, t0, t1)
+
+
 def _tip_max(tips, hand, t0, t1):
     """Highest sampled tip (above the membrane) strictly between t0 and t1, or None."""
     ts = tips["t"]
@@ -334,6 +346,9 @@ def check_bounce_tags(res, strikes, tips):
                 if tips:
                     high = _tip_max(tips, s["hand"], release, s["time_s"])
                     limit = BOUNCE_HEIGHT_M + TIP_OVER_BEAD_M + TIP_SLOP_M
+                    held = _held_max(tips, s["hand"], release, s["time_s"])
+                    if held is not None and held <= limit:
+                        high = None  # the hand kept the stick down: a bounce either way
                     if high is not None and high > limit:
                         res.problems.append("bounce seq %d: the tip rose %.1f mm above the head "
                                             "since the release (a bounce rises < %.0f mm)"
@@ -348,6 +363,9 @@ def check_bounce_tags(res, strikes, tips):
                 if s["time_s"] - release < BOUNCE_WINDOW_S - 1e-3:
                     high = _tip_max(tips, s["hand"], release, s["time_s"])
                     limit = BOUNCE_HEIGHT_M + TIP_OVER_BEAD_M - TIP_SLOP_M
+                    held = _held_max(tips, s["hand"], release, s["time_s"])
+                    if held is not None and high is not None:
+                        high = min(high, held)  # a primary: the tip and the hand both rose
                     if high is not None and high < limit:
                         res.problems.append("primary seq %d: the tip rose only %.1f mm above the "
                                             "head since the release %.1f ms before: an untagged "
