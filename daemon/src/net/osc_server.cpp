@@ -491,8 +491,11 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
         lo_message_add_int32(s, status_ ? static_cast<int>(status_->overruns.load()) : 0);
         // The performance's state, by name: source, control mode, grip.
         lo_message_add_string(s, status_ && status_->score.load() ? "score" : "clip");
-        lo_message_add_string(
-            s, to_string(static_cast<TrackMode>(status_ ? status_->mode.load() : 0)));
+        // (the mode by its name here: TrackMode's to_string lives with the tracker,
+        // which the OSC fuzz harness does not link)
+        const bool cartesian =
+            status_ && status_->mode.load() == static_cast<int>(TrackMode::cartesian);
+        lo_message_add_string(s, cartesian ? "cartesian" : "joint");
         lo_message_add_string(s, to_string(static_cast<Grip>(status_ ? status_->grip.load() : 0)));
         reply.ok(path, s);
         return;
