@@ -797,10 +797,13 @@ namespace
 // The inverse of the effective mass at a point p along n of a set of rigid
 // bodies whose velocities are J u for the generalised velocities u:
 // n^T G (J^T M J)^-1 G^T n, G the point's velocity row in u.
-double inverse_effective_mass(const Eigen::MatrixXd &J, const Eigen::MatrixXd &M,
-                              const Eigen::RowVectorXd &g)
+// Fixed sizes: it runs on run's physics thread, which does not allocate.
+template <int Bodies, int Dofs>
+double inverse_effective_mass(const Eigen::Matrix<double, Bodies, Dofs> &J,
+                              const Eigen::Matrix<double, Bodies, Bodies> &M,
+                              const Eigen::Matrix<double, 1, Dofs> &g)
 {
-    const Eigen::MatrixXd Mu = J.transpose() * M * J;
+    const Eigen::Matrix<double, Dofs, Dofs> Mu = J.transpose() * M * J;
     return g * Mu.ldlt().solve(g.transpose());
 }
 
@@ -839,9 +842,9 @@ double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in) con
     if (!stick_body_[s]) {
         // One body: 1/m + (r x n)^T I^-1 (r x n).
         // n . (v + w x r) = n . v + w . (r x n).
-        Eigen::RowVectorXd g(6);
+        Eigen::Matrix<double, 1, 6> g;
         g << n.transpose(), (bead - ch).cross(n).transpose();
-        return 1.0 / inverse_effective_mass(Eigen::MatrixXd::Identity(6, 6), mh, g);
+        return 1.0 / inverse_effective_mass<6, 6>(Eigen::Matrix<double, 6, 6>::Identity(), mh, g);
     }
     dBodyID stick = stick_body_[s];
     const Eigen::Vector3d cs = to_eigen3(dBodyGetPosition(stick));
@@ -851,12 +854,12 @@ double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in) con
     const Eigen::Vector3d p = to_eigen3(anchor), a = to_eigen3(axis).normalized();
     Eigen::Matrix<double, 6, 6> ms;
     body_mass(stick, ms);
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(12, 12);
+    Eigen::Matrix<double, 12, 12> M = Eigen::Matrix<double, 12, 12>::Zero();
     M.topLeftCorner<6, 6>() = mh;
     M.bottomRightCorner<6, 6>() = ms;
     // u = (v_h, w_h, theta'): the hand's twist and the fulcrum's rate.
     // Stick: w_s = w_h + a theta'; v_s = v_h + w_h x (c_s - c_h) + theta' a x (c_s - p).
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(12, 7);
+    Eigen::Matrix<double, 12, 7> J = Eigen::Matrix<double, 12, 7>::Zero();
     J.block<3, 3>(0, 0).setIdentity();
     J.block<3, 3>(3, 3).setIdentity();
     J.block<3, 3>(6, 0).setIdentity();
@@ -865,12 +868,14 @@ double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in) con
     J.block<3, 3>(9, 3).setIdentity();
     J.block<3, 1>(9, 6) = a;
     // The bead moves with the stick: n . (v_s + w_s x (b - c_s)).
-    Eigen::RowVectorXd gs(6);
+    Eigen::Matrix<double, 1, 6> gs;
     gs << n.transpose(), (bead - cs).cross(n).transpose();
-    const Eigen::RowVectorXd g = gs * J.bottomRows<6>();
-    const double m_pivot = 1.0 / inverse_effective_mass(J, M, g);
+    const Eigen::Matrix<double, 1, 7> g = gs * J.bottomRows<6>();
+    const double m_pivot = 1.0 / inverse_effective_mass<12, 7>(J, M, g);
     // The stick welded to the hand: theta' = 0.
-    const double m_rigid = 1.0 / inverse_effective_mass(J.leftCols<6>(), M, g.head<6>());
+    const Eigen::Matrix<double, 12, 6> J_rigid = J.leftCols<6>();
+    const Eigen::Matrix<double, 1, 6> g_rigid = g.head<6>();
+    const double m_rigid = 1.0 / inverse_effective_mass<12, 6>(J_rigid, M, g_rigid);
     const double lever = a.cross(bead - p).norm();
     const double k_grip = options_.grip[s].stiffness_nm_per_rad / std::max(lever * lever, 1e-6);
     const double k_drum = drum_contact_stiffness_n_per_m();
