@@ -172,6 +172,7 @@ static void update_coefficients(membrane *m, int rescale)
 
 static void refresh_point_couplings(membrane *m);
 static void flush_points(membrane *m);
+static impulse_shape *make_impulse_shape(membrane *m, double r, double theta);
 
 /* Builds the mode table for `modes` modes; keeps the state of modes that exist
  * in both the old and new table (the order is a prefix property of the sort). */
@@ -371,6 +372,11 @@ membrane *membrane_new(double sample_rate_hz)
     if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
         m->kernel = membrane_kernel_avx2;
 #endif
+    /* ICTUS_MEMBRANE_KERNEL=generic picks the portable kernel on any machine, e.g.
+     * to benchmark it inside Pd (bench/peers); read when the object is made. */
+    const char *want = getenv("ICTUS_MEMBRANE_KERNEL");
+    if (want && strcmp(want, "generic") == 0)
+        m->kernel = membrane_kernel_generic;
     if (build_modes(m, MEMBRANE_DEFAULT_MODES) != ICTUS_OK) {
         membrane_free(m);
         return NULL;
@@ -765,9 +771,15 @@ void membrane_point_move_(membrane_point *pt, double r_over_a, double theta_deg,
     pt->move_offset = sample_offset;
     pt->move_pending = 1;
     /* The weights of the new point are computed here, in the message handler,
-     * so that landing in the audio loop costs O(modes) only. */
-    if (pt->owner)
-        mode_shapes(pt->owner, r_over_a, theta_deg, pt->psi_next);
+     * so that landing in the audio loop costs O(modes) only. They come from the
+     * strikes' small cache of shapes (the same values): a stick that plays the
+     * same spot again, as a roll or a patch with a fixed position does, costs a
+     * copy instead of O(modes) Bessel functions. */
+    if (pt->owner) {
+        membrane *m = pt->owner;
+        const impulse_shape *shape = make_impulse_shape(m, r_over_a, theta_deg);
+        memcpy(pt->psi_next, shape->psi, sizeof(float) * (size_t)m->capacity);
+    }
 }
 
 /* ---------------------------------------------------------------- process */
@@ -784,7 +796,8 @@ static void add_input(membrane *m, const float *psi, double force, membrane_kern
         m->q[k] += dq;
         m->p[k] += dp;
         for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-            dpick[j] += (double)m->psi_pick[j][k] * dp;
+            if (a->psi_pick[j])
+                dpick[j] += (double)a->psi_pick[j][k] * dp;
         for (int c = 0; c < a->points; c++)
             dw[c] += (double)a->point_wd[c][k] * dq;
     }
@@ -855,7 +868,9 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
     a.q = m->q, a.p = m->p, a.c1 = m->c1, a.c2 = m->c2, a.c3 = m->c3;
     a.eq = m->eq, a.ep = m->ep, a.dm = m->dm;
     a.psi_strike = m->psi_strike;
-    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+    /* Pickups computed: both, or only the first when nothing takes the second. */
+    const int picks = (out && !out[1]) ? 1 : MEMBRANE_PICKUPS;
+    for (int j = 0; j < picks; j++)
         a.psi_pick[j] = m->psi_pick[j];
     for (int c = 0; c < m->point_count; c++)
         m->points[c]->ops->block_begin(m->points[c], n);
@@ -939,7 +954,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
                 m->gain_smoothed = m->output_gain;
         }
         const double out_scale = m->gain_smoothed * m->mass_scale;
-        for (int j = 0; j < MEMBRANE_PICKUPS; j++) {
+        y[1] = 0.0;
+        for (int j = 0; j < picks; j++) {
             y[j] = out_scale * (a.pick_sum[j] + extra[j]);
             if (m->pick_fade_left[j] > 0) {
                 /* Crossfade from a moved pickup: one more dot product per sample for
@@ -953,6 +969,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             }
             finite = finite && fabs(y[j]) <= FLT_MAX;
         }
+        if (picks < MEMBRANE_PICKUPS && m->pick_fade_left[1] > 0)
+            m->pick_fade_left[1]--; /* the skipped pickup's crossfade runs on */
         if (!finite) {
             /* Last line of defence (never reached with legal inputs in the tests):
              * a state that overflowed float is silenced rather than sent out. */
@@ -989,6 +1007,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             m->fading_modes = m->modes;
             m->count = padded(m->modes);
             m->fade_left = 0;
+            for (int i = 0; i < IMPULSE_CACHE; i++)
+                m->impulse_cache[i].valid = 0; /* shapes of the sounding modes only */
         }
     }
 #ifdef MEMBRANE_X86
