@@ -32,9 +32,10 @@ struct contact {
     double hit_velocity; /* m/s, of the hit waiting to land (point.move_pending) */
     /* Stroke state (double: the contact law is stiff and nonlinear). */
     int touching, ever_touched;
-    double stick_x, stick_v; /* m, m/s, positive into the membrane */
-    double compression;      /* m */
-    double force;            /* N, during the last sample */
+    double stick_x, stick_v;   /* m, m/s, positive into the membrane */
+    double compression;        /* m */
+    double compression_before; /* m, a sample earlier (the solve's first guess) */
+    double force;              /* N, during the last sample */
     long stroke_samples;
     double first_touch, last_release; /* samples since the stroke began (interpolated) */
     double peak_force, impulse;
@@ -324,9 +325,10 @@ static double residual_tol(double x0, double x_free, double compliance, double f
 
 /* Solves x1 = x_free - compliance * F(x0, x1) for the compression x1 (m) at the
  * end of one sample of dt seconds; returns F (N). force_guess (e.g. the last
- * sample's force, or 0) only speeds it up. */
+ * sample's force, or 0) and u_guess (a compression, or <= 0 for none) only speed
+ * it up: where the solve stops depends on the residual alone. */
 static double contact_solve(const contact *c, double x0, double x_free, double compliance,
-                            double dt, double force_guess, double *x1)
+                            double dt, double force_guess, double u_guess, double *x1)
 {
     /* Root of r(u) = u - x_free + C F(x0, u) with r(x_free) = C F >= 0: Newton on
      * r, kept inside a bracket [lo, hi] and replaced by bisection whenever it
@@ -339,6 +341,10 @@ static double contact_solve(const contact *c, double x0, double x_free, double c
         /* The force is continuous from sample to sample: start where the last
          * sample's force would put the compression (usually 2 evaluations). */
         u = x_free - compliance * force_guess;
+        /* Pressed on: the compression moves smoothly, its linear extrapolation
+         * (when given and below x_free, where r >= 0 is known) lands closer. */
+        if (u_guess > 0.0 && u_guess < x_free)
+            u = u_guess;
         f = step_force(&st, u, &df);
         r = u - x_free + compliance * f;
         if (r > 0.0) {
@@ -429,7 +435,7 @@ static void contact_landed(membrane_point *pt, double displacement_m)
     contact *c = point_contact(pt);
     c->stick_x = displacement_m;
     c->stick_v = c->hit_velocity;
-    c->compression = 0.0;
+    c->compression = c->compression_before = 0.0;
     c->force = 0.0;
     c->point.active = 1;
     c->touching = 0;
@@ -468,7 +474,10 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
         /* One stick, the common case: the scalar solve is exact, nothing to sweep. */
         contact *c = point_contact(pts[0]);
         double C = T * T / (2.0 * c->mass_kg) + K[0][0];
-        F[0] = contact_solve(c, c->compression, xfree[0], C, T, c->force, &x1[0]);
+        double ug = c->force > 0.0 && c->compression > 0.0 && c->compression_before > 0.0
+                        ? 2.0 * c->compression - c->compression_before
+                        : -1.0;
+        F[0] = contact_solve(c, c->compression, xfree[0], C, T, c->force, ug, &x1[0]);
     } else {
         for (int s = 0; s < 30; s++) {
             double change = 0.0;
@@ -479,7 +488,7 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
                     if (j != i)
                         xf -= K[i][j] * F[j];
                 double C = T * T / (2.0 * c->mass_kg) + K[i][i];
-                double Fi = contact_solve(c, c->compression, xf, C, T, c->force, &x1[i]);
+                double Fi = contact_solve(c, c->compression, xf, C, T, c->force, -1.0, &x1[i]);
                 change += fabs(Fi - F[i]);
                 F[i] = Fi;
             }
@@ -513,6 +522,7 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
             c->last_release = xprev > 0.0 && xw < 0.0 ? t_start + xprev / (xprev - xw) : t_end;
         }
         c->touching = now_touching;
+        c->compression_before = c->compression;
         c->compression = xw;
         if (Fi > c->peak_force)
             c->peak_force = Fi;
@@ -549,7 +559,7 @@ static void contact_cleared(membrane_point *pt)
     contact *c = point_contact(pt);
     c->point.active = c->touching = 0;
     c->force = 0.0;
-    c->stick_v = c->stick_x = c->compression = 0.0;
+    c->stick_v = c->stick_x = c->compression = c->compression_before = 0.0;
 }
 
 static void contact_detached(membrane_point *pt)
@@ -597,7 +607,7 @@ int contact_simulate_rigid(const contact *c, double velocity_mps, double sample_
     long steps = (long)(max_seconds * sample_rate_hz);
     for (long s = 0; s < steps; s++) {
         double x1;
-        double f = contact_solve(c, x, x + T * v, C, T, last_force, &x1);
+        double f = contact_solve(c, x, x + T * v, C, T, last_force, -1.0, &x1);
         last_force = f;
         double v1 = v - T * f / c->mass_kg;
         if (f > peak)
