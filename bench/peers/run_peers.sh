@@ -20,7 +20,8 @@ done
 venv="$build/peers/venv"
 # The peers' versions: the figures in docs/benchmarks.md were taken with these.
 peers=(mujoco==4.0.0 dm_control==1.0.50 pysdt==0.1.2)
-if [ ! -x "$venv/bin/python" ] || ! "$venv/bin/python" -c "import mujoco, pysdt" 2>/dev/null; then
+have='import importlib.util as u, sys; sys.exit(not all(u.find_spec(m) for m in ("mujoco", "dm_control", "pysdt")))'
+if [ ! -x "$venv/bin/python" ] || ! "$venv/bin/python" -c "$have" 2>/dev/null; then
     echo "run_peers.sh: installing ${peers[*]} into $venv" >&2
     /usr/bin/python3 -m venv "$venv"
     "$venv/bin/pip" install --quiet "${peers[@]}"
