@@ -142,10 +142,11 @@ def drum_round(r, results):
         empties = {}
         for s in sorted({s_ictus, s_bp}):
             empties[s] = pd_run(patch(lib, s, lambda lines: None), "empty-%d" % n)
-        cases = [("ictus avx2", lambda: pd_run(ictus_patch(lib, n, s_ictus), "ictus-%d" % n), s_ictus),
-                 ("ictus generic", lambda: pd_run(ictus_patch(lib, n, s_ictus), "generic-%d" % n,
-                                                  dict(os.environ, ICTUS_MEMBRANE_KERNEL="generic")),
+        generic = dict(os.environ, ICTUS_MEMBRANE_KERNEL="generic")
+        cases = [("ictus avx2", lambda: pd_run(ictus_patch(lib, n, s_ictus), "ictus-%d" % n),
                   s_ictus),
+                 ("ictus generic", lambda: pd_run(ictus_patch(lib, n, s_ictus), "generic-%d" % n,
+                                                  generic), s_ictus),
                  ("ictus stereo", lambda: pd_run(ictus_patch(lib, n, s_ictus, stereo=True),
                                                  "stereo-%d" % n), s_ictus)]
         if args.before:
@@ -247,21 +248,24 @@ def per_round_ratio(a, b):
     return statistics.median(pairs) if pairs else float("nan")
 
 
-print("\nDrum in Pd, ns per mode per sample (best round), and peer / ictus avx2 (median of the per-round ratios)")
-cols = ["ictus avx2", "ictus generic", "ictus stereo"] + (["before avx2"] if args.before else []) + \
-       ([] if "bp" in skip else ["bp~"]) + ([] if "sdt" in skip else ["SDT"])
+print("\nDrum in Pd, ns per mode per sample (best round), "
+      "and peer / ictus avx2 (median of the per-round ratios)")
+cols = (["ictus avx2", "ictus generic", "ictus stereo"] + (["before avx2"] if args.before else [])
+        + ([] if "bp" in skip else ["bp~"]) + ([] if "sdt" in skip else ["SDT"]))
 if "drum" not in skip:
     print("%6s " % "N" + " ".join("%14s" % c for c in cols) + "   peer / ictus avx2")
     for n in sizes:
         row = ["%14.3f" % min(results[(c, n)]) for c in cols]
         ratios = []
         for c in cols[1:]:
-            ratios.append("%s %.1fx" % (c, per_round_ratio(results[(c, n)], results[("ictus avx2", n)])))
+            ratio = per_round_ratio(results[(c, n)], results[("ictus avx2", n)])
+            ratios.append("%s %.1fx" % (c, ratio))
         print("%6d " % n + " ".join(row) + "   " + ", ".join(ratios))
 if "performer" not in skip:
     t, mj, rd = results["track"], results["mujoco"], results["render"]
     print("\nPerformer, real-time factor on CPU time (best round; all rounds)")
-    print("  ictusd track --mode joint (CMU 80_13): %.1fx  [%s]" % (max(t), ", ".join("%.1f" % v for v in t)))
+    print("  ictusd track --mode joint (CMU 80_13): %.1fx  [%s]" % (
+        max(t), ", ".join("%.1f" % v for v in t)))
     print("  MuJoCo %s CMU humanoid, root fixed: %.1fx  [%s]" % (
         mujoco_version[0], max(mj), ", ".join("%.1f" % v for v in mj)))
     print("  ratio track / MuJoCo: best %.2f, median of rounds %.2f (target >= 1.25)" % (

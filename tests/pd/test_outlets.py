@@ -29,12 +29,9 @@ def render(name, second):
     mem = p.obj("membrane~ drum 0.178 3000 0.26 400")
     con = p.obj("contact~ drum")
     wav = os.path.join(work, name + ".wav")
-    right_src = mem if second == "always" else p.obj("sig~ 0")
-    trig = recorder(p, [(mem, 0, "left"), (right_src, 0, "right")], seconds, sr, wav)
-    if second == "always":
-        # recorder connected outlet 0 of right_src; use outlet 1 of membrane~ instead
-        p.lines = [l for l in p.lines if l != "#X connect %d 0 %d 0;" % (mem, right_tw(p))]
-        p.connect(mem, 1, right_tw(p), 0)
+    # "later": [tabwrite~ right] records a [sig~ 0] until membrane~'s outlet 2 joins it
+    right = (mem, 1, "right") if second == "always" else (p.obj("sig~ 0"), 0, "right")
+    trig = recorder(p, [(mem, 0, "left"), right], seconds, sr, wav)
     for delay_ms, text in ((5.0, "hit 2 0.3 0"), (61.3, "hit 0.8 0.6 45"),
                            (150.7, "mass 1 \\, hit 1.5 0.2 100"), (260.1, "hit 3 0.7 300"),
                            (380.9, "hit 1 0.4 30")):
@@ -45,7 +42,8 @@ def render(name, second):
         p.connect(mm, 0, con, 0)
     if second == "later":
         tw = right_tw(p)
-        for delay_ms, verb in ((t_connect * 1000.0, "connect"), (t_disconnect * 1000.0, "disconnect")):
+        for delay_ms, verb in ((t_connect * 1000.0, "connect"),
+                               (t_disconnect * 1000.0, "disconnect")):
             dl = p.obj("delay %.17g" % delay_ms)
             mm = p.msg("\\; pd-test.pd %s %d 1 %d 0" % (verb, mem, tw))
             p.connect(trig, 0, dl, 0)
