@@ -13,6 +13,7 @@ mode and clear score, and what they would send never reaches the daemon (a
 ping sent after them is answered with nothing before its pong). Every wait is
 a handshake on pd's printed lines, with a deadline."""
 import argparse
+import math
 import os
 import queue
 import re
@@ -111,6 +112,20 @@ def nothing_sent_before_pong(what):
     ok(not sent, "%s: nothing reached the daemon (before the pong: %s)" % (what, sent))
 
 
+def drum_controls(radius, tension, mass):
+    """The sound panel's membrane controls (its inlet sets them as a hand would)
+    reach the daemon as the drum: radius, tension, and the density mass / (pi a^2)."""
+    move("test-sound", "radius %g" % radius)
+    reply("/ictus/drum/radius", "%g" % radius)
+    move("test-sound", "tension %g" % tension)
+    reply("/ictus/drum/tension", "%g" % tension)
+    move("test-sound", "mass %g" % mass)
+    line = wait_for(lambda l: l.startswith("ictusd: reply /ictus/drum/density "), "the density")
+    density = float(line.split()[-1])
+    want = mass / (math.pi * radius * radius)
+    ok(abs(density - want) <= 1e-5 * want, "drum density %g = mass / (pi a^2) = %g" % (density, want))
+
+
 def start_daemon(extra, log):
     env = dict(os.environ)
     env.pop("LD_PRELOAD", None)  # pd's ASan preload is not the daemon's
@@ -149,13 +164,15 @@ for r in records:
             n += 1
     elif depth == 1 and re.match(r"#X (obj|msg|text|floatatom|symbolatom|listbox) ", r):
         words = r.split()
-        if words[1] == "obj" and words[4] in ("ictus-physics", "ictus-status"):
+        if words[1] == "obj" and words[4] in ("ictus-physics", "ictus-status",
+                                              "ictus-sound-panel"):
             index[words[4]] = n
         if words[1] == "msg":
             index.setdefault("boxes", []).append(
                 (n, re.sub(r", f \d+$", "", " ".join(words[4:]))))
         n += 1
-ok("ictus-physics" in index and "ictus-status" in index and len(index["boxes"]) >= 4,
+ok("ictus-physics" in index and "ictus-status" in index and "ictus-sound-panel" in index
+   and len(index["boxes"]) >= 4,
    "the main patch has the physics and daemon panels and score boxes")
 score_boxes = [(i, t) for i, t in index["boxes"] if "R" in t.split()]
 replace_boxes = [(i, t) for i, t in score_boxes if t.startswith("clear") and "play" in t]
@@ -166,15 +183,17 @@ ok(len(replace_boxes) >= 3 and len(append_boxes) >= 1,
 extra = ["#X obj 20 1000 netreceive -u %d" % ctl_port, "#X obj 20 1030 list",
          "#X obj 20 1060 t a a", "#X obj 200 1090 list split 1", "#X obj 200 1120 symbol",
          "#X obj 20 1090 list split 1", "#X obj 20 1150 s", "#X obj 400 1000 print shown",
-         "#X obj 600 1000 print state"]
+         "#X obj 600 1000 print state", "#X obj 20 1120 list trim"]
 conns = [(0, 0, 1, 0), (1, 0, 2, 0), (2, 1, 3, 0), (3, 0, 4, 0), (4, 0, 6, 1), (2, 0, 5, 0),
-         (5, 1, 6, 0)]
+         (5, 1, 9, 0), (9, 0, 6, 0)]
 base = n
 for k, (i, _) in enumerate(score_boxes):
-    extra.append("#X obj %d 1200 r test-box-%d" % (20 + 120 * k, i))
+    extra.append("#X obj %d 1200 r test-box-%d" % (20 + 120 * k, i))  # base + 10 + k
+extra.append("#X obj 20 1250 r test-sound")
 links = [(base + a, o, base + b, i) for a, o, b, i in conns]
 links += [(index["ictus-physics"], 1, base + 7, 0), (index["ictus-status"], 2, base + 8, 0)]
-links += [(base + 9 + k, 0, i, 0) for k, (i, _) in enumerate(score_boxes)]
+links += [(base + 10 + k, 0, i, 0) for k, (i, _) in enumerate(score_boxes)]
+links += [(base + 10 + len(score_boxes), 0, index["ictus-sound-panel"], 0)]
 text = ";\n".join(records) + ";\n" + "".join(e + ";\n" for e in extra)
 text += "".join("#X connect %d %d %d %d;\n" % l for l in links)
 
@@ -239,6 +258,8 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-panels-") as work:
         reply("/ictus/nuance", "legato")
         move("ictus-physics-clear")
         reply("/ictus/score/clear")
+        drum_controls(0.2, 3500, 0.03)
+        drum_controls(0.178, 3000, 0.0261)
 
         # a score box: clear, its statements, play -- one click
         ramp = [b for b in replace_boxes if "->" in b[1]][0]
@@ -325,6 +346,9 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-panels-") as work:
             reply("/ictus/gains", 1.5, 1)
             move("ictus-physics-ks", 1)
             reply("/ictus/gains", 1, 1)
+            drum_controls(0.2, 3500, 0.03)
+            move("ictus-physics-ping")
+            wait_for(lambda l: l == "ictusd: pong", "pong (clip)")
             move("ictus-physics-play")
             reply("/ictus/play")
             state_where(lambda s: s["playing"] == 1, "the clip playing", 120)
