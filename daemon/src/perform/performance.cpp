@@ -1098,6 +1098,8 @@ bool Performance::submit(std::unique_ptr<Job> job, std::string *why)
 
 bool Performance::install(std::unique_ptr<Result> r, std::string *why)
 {
+    if (r->kind == Job::Kind::play)
+        play_pending_ = false;
     if (!r->error.empty()) {
         if (why)
             *why = r->error;
@@ -1433,6 +1435,7 @@ bool Performance::apply_score(const Command &c, std::string *why)
             auto job = plan_job(c, true);
             job->start_bpm = start_bpm_;
             start_bpm_ = 0.0;
+            play_pending_ = true; // until its plan is installed or refused
             return submit(std::move(job), why);
         }
         case CommandKind::stop:
@@ -1446,7 +1449,7 @@ bool Performance::apply_score(const Command &c, std::string *why)
             // A live scale of the score's tempo map (docs/osc.md): under way,
             // from the first beat no hand has begun to play toward; stopped,
             // the next play starts at this tempo.
-            if (!plan_active_ && !work_pending()) {
+            if (!plan_active_ && !play_pending_) {
                 start_bpm_ = c.value;
                 return true;
             }

@@ -282,6 +282,7 @@ class Performance
     std::shared_ptr<const Score> played_;    // score_ at its tempo scale (execute() only)
     double tempo_scale_ = 1.0;               // the physics thread's (Result::tempo_scale)
     double start_bpm_ = 0.0;                 // > 0: the next play starts at this tempo
+    bool play_pending_ = false;              // a play handed to the worker, not back yet
     double score_first_bpm_ = 120.0;         // the current score's own first tempo
     Nuance default_nuance_ = Nuance::legato; // /ictus/nuance: of the statements that follow
     std::unique_ptr<PlanState> plan_state_;
