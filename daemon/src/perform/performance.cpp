@@ -72,7 +72,7 @@ Eigen::Vector3d strike_drum_center(const CharacterModel &model, const ReferenceM
 // The live tempo scale (docs/osc.md, /ictus/tempo in score mode): the tempo
 // map with every tempo from `from_beat` on multiplied by `factor`, the beats
 // before it (and so every time up to it) as they were. A ramp running at
-// `from_beat` goes on, scaled, to its end. Throws ScoreError when a scaled
+// `from_beat` goes on, scaled, to its end. Throws std::runtime_error when a scaled
 // tempo leaves the score's range (20..400 bpm).
 TempoMap scale_tempo_from(const TempoMap &map, double from_beat, double factor)
 {
