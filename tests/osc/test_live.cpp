@@ -181,7 +181,7 @@ TEST_CASE("run: repeats nested around no note are refused to the client, the dae
 }
 
 TEST_CASE("run: without --autoplay the performer waits for /ictus/play: the clock runs, nothing "
-          "plays, no strike; play starts the score",
+          "plays, no strike, then play starts the score",
           "[osc][live]")
 {
     LiveDaemon d;

@@ -31,7 +31,7 @@ Command command(CommandKind kind, double value = 0.0, const char *text = "")
 } // namespace
 
 TEST_CASE("perform: /ictus/tempo in score mode scales the tempo map from the first beat not "
-          "yet begun; the strokes under way keep their times, every note is struck on its "
+          "yet begun: the strokes under way keep their times, every note is struck on its "
           "new beat",
           "[osc][perform][tempo]")
 {
