@@ -30,6 +30,7 @@ struct contact {
     membrane_point point; /* first: a membrane_point * is a contact * (contact_point_ops) */
     double mass_kg, stiffness, alpha, damping;
     double hit_velocity; /* m/s, of the hit waiting to land (point.move_pending) */
+    double hit_mass_kg;  /* the stick's mass from that hit on; 0: unchanged */
     /* Stroke state (double: the contact law is stiff and nonlinear). */
     int touching, ever_touched;
     double stick_x, stick_v;   /* m, m/s, positive into the membrane */
@@ -187,7 +188,21 @@ ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, doubl
         s = ICTUS_CLAMPED;
     }
     c->hit_velocity = velocity_mps;
+    c->hit_mass_kg = 0.0;
     membrane_point_move_(&c->point, r_over_a, theta_deg, sample_offset);
+    return s;
+}
+
+ictus_status contact_hit_mass(contact *c, double velocity_mps, double r_over_a, double theta_deg,
+                              int sample_offset, double mass_kg)
+{
+    ictus_status s = contact_hit(c, velocity_mps, r_over_a, theta_deg, sample_offset);
+    if (mass_kg != 0.0) {
+        double m = mass_kg;
+        if (ictus_clamp(&m, CONTACT_MASS_MIN, CONTACT_MASS_MAX, CONTACT_DEFAULT_MASS) != ICTUS_OK)
+            s = ICTUS_CLAMPED;
+        c->hit_mass_kg = m;
+    }
     return s;
 }
 
@@ -463,6 +478,8 @@ static void contact_landed(membrane_point *pt, double displacement_m)
     contact *c = point_contact(pt);
     c->stick_x = displacement_m;
     c->stick_v = c->hit_velocity;
+    if (c->hit_mass_kg > 0.0)
+        c->mass_kg = c->hit_mass_kg;
     c->compression = c->compression_before = 0.0;
     c->lin_valid = 0;
     c->force = 0.0;

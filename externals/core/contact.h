@@ -97,6 +97,12 @@ void membrane_detach_contact(membrane *m, contact *c);
 ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, double theta_deg,
                          int sample_offset);
 
+/* The same, and the stick's mass (kg) becomes mass_kg when the hit lands, on
+ * its sample (a stroke still under way keeps the old mass to its end). A
+ * mass_kg of 0 keeps the mass; one out of range is clamped (status says so). */
+ictus_status contact_hit_mass(contact *c, double velocity_mps, double r_over_a, double theta_deg,
+                              int sample_offset, double mass_kg);
+
 /* Force buffer: membrane_process() writes this contact's force (N), one value
  * per sample, into the buffer given here (capacity in samples; the membrane
  * writes min(n, capacity) values per call). NULL to stop writing. */

@@ -86,7 +86,7 @@ static t_membrane_tilde *contact_tilde_timing_membrane(t_contact_tilde *x)
  * message's logical time, to the sample. */
 static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
-    double velocity, r, theta;
+    double velocity, r, theta, mass = 0.0;
     t_membrane_tilde *m;
     (void)s;
     if (!ictus_getnumber(x, "contact~", "hit", "velocity (m/s)", argc, argv, 0, &velocity) ||
@@ -99,14 +99,36 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
                  CONTACT_VELOCITY_MAX, velocity, used);
         velocity = used;
     }
+    /* An optional stick mass (kg) for this stroke, set on the hit's sample: a
+     * "mass" message would change the stroke still under way from the start of
+     * the block. 0 keeps the mass. */
+    if (argc > 3) {
+        if (!ictus_getnumber(x, "contact~", "hit", "stick mass (kg)", argc, argv, 3, &mass))
+            mass = 0.0;
+        else if (mass < 0.0 ||
+                 (mass > 0.0 && (mass < CONTACT_MASS_MIN || mass > CONTACT_MASS_MAX))) {
+            double used = mass < CONTACT_MASS_MIN ? CONTACT_MASS_MIN : CONTACT_MASS_MAX;
+            if (mass < 0.0) {
+                pd_error(x,
+                         "contact~: hit: stick mass must be >= 0 kg (0: unchanged), got %g; "
+                         "the stick keeps its mass",
+                         mass);
+                mass = 0.0;
+            } else {
+                pd_error(x, "contact~: hit: stick mass must be in [%g, %g] kg, got %g; using %g",
+                         CONTACT_MASS_MIN, CONTACT_MASS_MAX, mass, used);
+                mass = used;
+            }
+        }
+    }
     m = contact_tilde_timing_membrane(x);
     if (!m) {
         /* a stroke kept for a membrane~ that may come later would start at a random time */
         pd_error(x, "contact~: hit: no membrane~ named '%s'; ignored", x->x_name->s_name);
         return;
     }
-    contact_hit(x->x_core, velocity, r, theta,
-                ictus_clock_offset_now(ictus_membrane_tilde_clock(m)));
+    contact_hit_mass(x->x_core, velocity, r, theta,
+                     ictus_clock_offset_now(ictus_membrane_tilde_clock(m)), mass);
 }
 
 /* set NAME: play another membrane~ (takes effect at the next DSP sort, as delread~). */

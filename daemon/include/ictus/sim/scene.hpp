@@ -86,6 +86,10 @@ struct SceneOptions {
     // mode: with 0.2 fast strokes left elbows up to 3 degrees past the
     // margin, docs/perform.md).
     double stop_erp = 0.2;
+    // The stick-head contact's damping is the head's own: the implicit
+    // step's numerical damping (h k) is taken back out of it (Scene::set_drum
+    // comments). Off: the plain ODE mapping.
+    bool contact_numerical_damping_compensated = true;
     bool rate_feedforward = true;
     StickMount sticks = StickMount::rigid;
     std::array<GripSpring, 2> grip{};                     // [side], fulcrum mount only
@@ -100,6 +104,18 @@ enum class StepResult { ok, diverged };
 // joints' feedback (dJointFeedback: the constraint forces ODE applied): the
 // force on the stick, N, world frame (normal and friction together). The force
 // on the membrane is its opposite. Zero when the stick did not touch the drum.
+// ODE's soft-contact parameters for a spring k (N/m) and damper c (N s/m)
+// at step h (s): ERP = h k / (h k + c'), CFM = 1 / (h k + c'), the implicit
+// Euler step of the spring-damper (ODE manual). With `compensated`,
+// c' = max(c - h k, -0.95 h k): the implicit step's own numerical damping
+// (h k) is taken back out, so the contact dissipates as the damper c alone
+// (Scene::set_drum).
+struct SoftContact {
+    double erp = 0.0;
+    double cfm = 0.0;
+};
+SoftContact soft_contact(double h_s, double k_n_per_m, double c_n_s_per_m, bool compensated);
+
 struct StickDrumContact {
     Eigen::Vector3d bead_force_n = Eigen::Vector3d::Zero();  // through the bead (tip sphere)
     Eigen::Vector3d shaft_force_n = Eigen::Vector3d::Zero(); // through the shaft (capsule)
