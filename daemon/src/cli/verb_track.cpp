@@ -50,7 +50,10 @@ void track_usage(std::ostream &out)
            "  --ik-accel-ff S2       tip acceleration feedforward, s^2 (default 0)\n"
            "  --ik-integral PER_S    integral of the tip error (default 0)\n"
            "  --ik-correction-limit M   cap on the IK target's correction (default 0.1)\n"
-           "  --ik-start kinematic|simulated   IK warm start (default kinematic; docs/ik.md)\n"
+           "  --ik-start simulated|kinematic   where the feedback IK starts: simulated, the\n"
+           "                         simulated arm (Algorithm 2, default); kinematic, the\n"
+           "                         capture-seeded IK solution (docs/ik.md)\n"
+           "  --ik-posture-weight W  null-space posture task, 0..1 per step (default 0.01)\n"
            "  --out DIR              write DIR/track.csv, DIR/strikes.csv and DIR/summary.json\n"
            "  --scale M              metres per BVH unit (default 0.056444, the CMU files)\n"
            "  --skip-frames N        frames dropped at the start (default 1: the CMU\n"
@@ -78,6 +81,10 @@ void track_usage(std::ostream &out)
            "  --smooth-hz HZ         low-pass the reference (Gaussian, default 10; 0: off)\n"
            "  --despike-deg DEG      replace one-frame spikes larger than DEG (default 5;\n"
            "                         0: off)\n"
+           "  --tip-smooth-hz HZ     low-pass of the stick tips (X^T and the errors; default:\n"
+           "                         --smooth-hz; 0: de-spiked only)\n"
+           "  --ik-iterations N      iterations of each IK solve per step (default 2; 0:\n"
+           "                         to convergence; 1: eq. 2's single step)\n"
            "  --quiet                no progress output\n"
         << force_help(25)
         << "\n"
@@ -97,6 +104,7 @@ struct TrackArgs {
     bool help = false;
     std::string mode, mocap, out_dir, limits_mode = "quaternion", gains_file;
     double limit_k = 3.0, limit_width_deg = 6.0;
+    double tip_smooth_hz = -1.0; // < 0: the reference's (--smooth-hz)
     ClipOptions clip;
     bool quiet = false;
     CharacterOptions character;
@@ -153,6 +161,14 @@ TrackArgs parse_track_args(Args &args)
             if (v != "simulated" && v != "kinematic")
                 throw UsageError("--ik-start: expected simulated or kinematic, got '" + v + "'");
             t.options.cartesian.start_from_simulated = v == "simulated";
+        } else if (a == "--tip-smooth-hz") {
+            t.tip_smooth_hz = parse_number(a, args.value(a));
+            if (!(t.tip_smooth_hz >= 0.0 && t.tip_smooth_hz <= 1000.0))
+                throw UsageError("--tip-smooth-hz: expected 0 <= HZ <= 1000, got " + args.value(a));
+        } else if (a == "--ik-iterations") {
+            t.options.cartesian.feedback_iterations = parse_int(a, args.value(a), 0, 10000);
+        } else if (a == "--ik-posture-weight") {
+            t.options.cartesian.posture_weight = parse_number(a, args.value(a));
         } else if (a == "--ik-integral") {
             t.options.cartesian.integral_per_s = parse_number(a, args.value(a));
         } else if (a == "--mocap") {
@@ -261,7 +277,7 @@ struct TrackInput {
     TrackInput &operator=(const TrackInput &) = delete;
     BvhFile bvh;
     std::unique_ptr<CharacterModel> model;
-    std::unique_ptr<ReferenceMotion> raw, reference;
+    std::unique_ptr<ReferenceMotion> raw, reference, tips_cleaned;
     TipTrajectory tips;
     std::unique_ptr<CharacterLimits> limits;
     std::vector<JointLimitRef> limit_refs;
@@ -299,6 +315,13 @@ void load_track_input(TrackArgs &t, TrackInput &in)
     if (t.stick_only) {
         in.tips = place_behind_sticks(model, in.reference->frame(0), capture, stick_tracks);
         t.options.tip_reference = &in.tips;
+    } else if (t.tip_smooth_hz >= 0.0 && t.tip_smooth_hz != t.clip.filter.smooth_cutoff_hz) {
+        // The stick tips' own clean-up (docs/mocap.md): de-spiked as the joints,
+        // low-passed at --tip-smooth-hz.
+        ReferenceFilter tip_filter = t.clip.filter;
+        tip_filter.smooth_cutoff_hz = t.tip_smooth_hz;
+        in.tips_cleaned = std::make_unique<ReferenceMotion>(model, in.bvh.motion, tip_filter);
+        t.options.tip_motion = in.tips_cleaned.get();
     }
     if (t.limits_mode != "none" && in.reference->frames() < kMinLimitFrames)
         std::cerr << "ictusd: warning: " << t.mocap << ": joint limits learned from "
@@ -402,11 +425,19 @@ int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary
     j["smooth_hz"] = t.clip.filter.smooth_cutoff_hz;
     j["despike_deg"] = t.clip.filter.spike_threshold_rad * 180.0 / M_PI;
     j["spikes_removed"] = in.reference->spikes_removed();
+    j["tip_smooth_hz"] = t.stick_only           ? 0.0
+                         : t.options.tip_motion ? t.tip_smooth_hz
+                                                : t.clip.filter.smooth_cutoff_hz;
+    j["drum_auto"] = options.drum_auto;
     j["interrupted"] = summary.interrupted;
     j["gains"] = gains_to_json(*in.model, in.gains);
     if (options.mode == TrackMode::cartesian) {
         j["ik"]["gain"] = options.cartesian.gain;
+        j["ik"]["velocity_gain_s"] = options.cartesian.velocity_gain_s;
+        j["ik"]["correction_limit_m"] = options.cartesian.correction_limit_m;
         j["ik"]["integral_per_s"] = options.cartesian.integral_per_s;
+        j["ik"]["start"] = options.cartesian.start_from_simulated ? "simulated" : "kinematic";
+        j["ik"]["posture_weight"] = options.cartesian.posture_weight;
     }
     if (!t.out_dir.empty()) {
         OutputFile strikes(t.out_dir + "/strikes.csv");

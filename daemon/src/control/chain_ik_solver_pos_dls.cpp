@@ -46,6 +46,7 @@ ChainIkSolverPos_dls::ChainIkSolverPos_dls(int joints, const IkParams &params)
     // this nor solve() touches the heap.
     jacobian_.setZero(3, 3 * joints_);
     step_.setZero(3 * joints_);
+    posture_step_.setZero(3 * joints_);
     projector_.setZero(3 * joints_, 3 * joints_);
     jacobian_solved_.setZero(3, 3 * joints_);
     direction_jacobian_.setZero(3, 3 * joints_);
@@ -84,6 +85,26 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
     const IkResult r =
         solve(chain, target_tip_m, Eigen::Vector3d::UnitX(), rotation_weight, rotations_out);
     full_rotation_ = false;
+    return r;
+}
+
+IkResult ChainIkSolverPos_dls::solve_with_posture(const KinematicChain &chain,
+                                                  const Eigen::Vector3d &target_tip_m,
+                                                  const Eigen::Quaterniond *posture,
+                                                  double posture_weight,
+                                                  Eigen::Quaterniond *rotations_out)
+{
+    bool valid = posture != nullptr && std::isfinite(posture_weight) && posture_weight >= 0.0 &&
+                 posture_weight <= 1.0;
+    for (int j = 0; valid && j < joints_; ++j)
+        valid = posture[j].coeffs().allFinite() && posture[j].norm() > 1e-12;
+    if (!valid)
+        return solve(chain, target_tip_m, Eigen::Vector3d::Constant(std::nan("")), 1.0,
+                     rotations_out); // refused as invalid input
+    posture_ = posture_weight > 0.0 ? posture : nullptr;
+    posture_weight_ = posture_weight;
+    const IkResult r = solve(chain, target_tip_m, Eigen::Vector3d::UnitX(), 0.0, rotations_out);
+    posture_ = nullptr;
     return r;
 }
 
@@ -173,8 +194,13 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
         return error_m <= params_.tolerance_m &&
                (!use_direction || result.direction_error_rad <= params_.direction_tolerance_rad);
     };
-    while (!done() && result.iterations < params_.max_iterations) {
+    // The posture task is tried once, with the first iteration (even when the tip is already
+    // within tolerance: the step is in the tip task's null space).
+    bool posture_pending = posture_ != nullptr;
+    while ((!done() || posture_pending) && result.iterations < params_.max_iterations) {
         const ChainFrames &frames = frames_[current];
+        const bool with_posture = posture_pending;
+        posture_pending = false;
         // Eq. 2 with Wampler's damped (singularity-robust) pseudo-inverse:
         // dtheta = J^T (J J^T + lambda^2 I)^-1 e. J J^T is only 3x3, so the solve is cheap.
         KinematicChain::tip_jacobian(frames, n, jacobian_);
@@ -213,6 +239,26 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
                 params_.direction_damping * params_.direction_damping;
             direction_llt_.compute(direction_jjt_);
             step_.noalias() += direction_jacobian_.transpose() * direction_llt_.solve(residual);
+        }
+        if (with_posture) {
+            // Posture task in the tip task's null space: dtheta += N w p, p_j the world rotation
+            // vector turning joint j onto posture_[j] (local q_j <- exp(R_parent^T p_j) q_j), N
+            // with the undamped pseudo-inverse (as the direction task's, so that it does not
+            // leak into the tip).
+            jjt_.noalias() = jacobian_ * jacobian_.transpose();
+            jjt_.diagonal().array() += 1e-12;
+            projector_llt_.compute(jjt_);
+            jacobian_solved_ = projector_llt_.solve(jacobian_);
+            projector_.noalias() = -jacobian_.transpose() * jacobian_solved_;
+            projector_.diagonal().array() += 1.0;
+            for (int j = 0; j < n; ++j) {
+                const Eigen::Quaterniond &parent =
+                    j == 0 ? chain.base_rotation() : frames.joint_rotation[j - 1];
+                posture_step_.segment<3>(3 * j) =
+                    posture_weight_ *
+                    (parent * log_map(posture_[j] * rotation_[current][j].conjugate()));
+            }
+            step_.noalias() += projector_ * posture_step_;
         }
 
         // Scale the whole step (keeping its direction) so no joint turns more than the bound.
@@ -261,9 +307,12 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
                 : 0.0;
         // Accept what brings the tip closer, or -- with the tip within tolerance -- turns the
         // stick closer to its target: the tip is never traded for the direction.
+        // A posture step may move the tip by second-order terms: accepted if it does not
+        // leave the tip farther than before by more than the tolerance.
         const bool accept = candidate_error_m < error_m ||
                             (use_direction && candidate_error_m <= params_.tolerance_m &&
-                             candidate_direction_error < result.direction_error_rad);
+                             candidate_direction_error < result.direction_error_rad) ||
+                            (with_posture && candidate_error_m <= error_m + params_.tolerance_m);
         limits_active = candidate_limited;
         if (accept) {
             current = candidate;
