@@ -309,11 +309,11 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
         for (const char *side : {"l", "r"})
             for (const char *what : {"ref", "target", "sim"})
                 *csv << ',' << side << "_elbow_flexion_" << what << "_deg";
-        for (const char *side : {"left", "right"})
+        for (const char *side : {"left", "right"}) {
             for (const char *axis : {"x", "y", "z"})
                 *csv << ",tip_" << side << "_raw_" << axis << "_m";
-        for (const char *side : {"l", "r"})
-            *csv << ',' << side << "_elbow_flexion_raw_deg";
+            *csv << ',' << side[0] << "_elbow_flexion_raw_deg";
+        }
         *csv << ",contacts\n";
     }
 
