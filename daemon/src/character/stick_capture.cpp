@@ -333,9 +333,43 @@ DrumFit fit_drum_to_turnarounds(const TipTrajectory &tips, double tip_radius_m)
     std::sort(impact_heights.begin(), impact_heights.end());
     const double median =
         m % 2 ? impact_heights[m / 2] : 0.5 * (impact_heights[m / 2 - 1] + impact_heights[m / 2]);
-    centre.y() = median - tip_radius_m;
+    centre.y() = median - kImpactPitchFactor * tip_radius_m;
     fit.center_m = centre;
     return fit;
+}
+
+TipTrajectory with_impact_vertices(const TipTrajectory &tips,
+                                   const std::array<std::vector<StrokeTurnaround>, 2> &impacts)
+{
+    struct Insert {
+        double t;
+        int side;
+        Eigen::Vector3d p;
+    };
+    std::vector<Insert> inserts;
+    for (int s = 0; s < 2; ++s)
+        for (const StrokeTurnaround &ta : impacts[s])
+            inserts.push_back({ta.time_s, s, ta.position_m});
+    std::sort(inserts.begin(), inserts.end(),
+              [](const Insert &a, const Insert &b) { return a.t < b.t; });
+    TipTrajectory out;
+    const double t0 = tips.time_s.empty() ? 0.0 : tips.time_s.front();
+    size_t k = 0;
+    for (size_t i = 0; i < tips.time_s.size(); ++i) {
+        const double t = tips.time_s[i] - t0;
+        for (; k < inserts.size() && inserts[k].t < t - 1e-9; ++k) {
+            if (!out.time_s.empty() && inserts[k].t + t0 <= out.time_s.back() + 1e-9)
+                continue; // coincides with the previous sample (or two impacts at once)
+            out.time_s.push_back(inserts[k].t + t0);
+            for (int s = 0; s < 2; ++s)
+                out.tip_m[s].push_back(s == inserts[k].side ? inserts[k].p
+                                                            : tips.sample(s, inserts[k].t));
+        }
+        out.time_s.push_back(tips.time_s[i]);
+        for (int s = 0; s < 2; ++s)
+            out.tip_m[s].push_back(tips.tip_m[s][i]);
+    }
+    return out;
 }
 
 Eigen::Vector3d fit_drum_to_strokes(const TipTrajectory &tips, double tip_radius_m)

@@ -225,6 +225,12 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     if (options.drum_auto)
         options.scene.drum.center_m =
             tips_in ? drum_fit.center_m : auto_drum_center(model, reference);
+    // A stick-only capture's impacts restored between its samples (X^T and the errors).
+    TipTrajectory restored;
+    if (tips_in && have_impacts) {
+        restored = with_impact_vertices(*tips_in, drum_fit.impacts);
+        tips_in = &restored;
+    }
     const double h = options.scene.step_s;
     const double duration = options.duration_s > 0.0 ? options.duration_s
                             : tips_in                ? tips_in->duration_s()
