@@ -52,6 +52,7 @@ int main(int argc, char **argv)
             o.cartesian.start_from_simulated = false;
             o.cartesian.posture_weight = 0.0;
             o.cartesian.feedback_iterations = 0;
+            o.cartesian.kinematic_iterations = 0;
         }
         TrackSummary best;
         for (int r = 0; r < runs; ++r) {

@@ -83,8 +83,9 @@ void track_usage(std::ostream &out)
            "                         0: off)\n"
            "  --tip-smooth-hz HZ     low-pass of the stick tips (X^T and the errors; default:\n"
            "                         --smooth-hz; 0: de-spiked only)\n"
-           "  --ik-iterations N      iterations of each IK solve per step (default 2; 0:\n"
-           "                         to convergence; 1: eq. 2's single step)\n"
+           "  --ik-iterations N      feedback IK iterations per step (default 2; 0: to\n"
+           "                         convergence; 1: eq. 2's single step)\n"
+           "  --ik-kinematic-iterations N   the kinematic IK's (target rates; default 1)\n"
            "  --quiet                no progress output\n"
         << force_help(25)
         << "\n"
@@ -167,6 +168,8 @@ TrackArgs parse_track_args(Args &args)
                 throw UsageError("--tip-smooth-hz: expected 0 <= HZ <= 1000, got " + args.value(a));
         } else if (a == "--ik-iterations") {
             t.options.cartesian.feedback_iterations = parse_int(a, args.value(a), 0, 10000);
+        } else if (a == "--ik-kinematic-iterations") {
+            t.options.cartesian.kinematic_iterations = parse_int(a, args.value(a), 0, 10000);
         } else if (a == "--ik-posture-weight") {
             t.options.cartesian.posture_weight = parse_number(a, args.value(a));
         } else if (a == "--ik-integral") {
@@ -438,6 +441,8 @@ int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary
         j["ik"]["integral_per_s"] = options.cartesian.integral_per_s;
         j["ik"]["start"] = options.cartesian.start_from_simulated ? "simulated" : "kinematic";
         j["ik"]["posture_weight"] = options.cartesian.posture_weight;
+        j["ik"]["feedback_iterations"] = options.cartesian.feedback_iterations;
+        j["ik"]["kinematic_iterations"] = options.cartesian.kinematic_iterations;
     }
     if (!t.out_dir.empty()) {
         OutputFile strikes(t.out_dir + "/strikes.csv");

@@ -244,13 +244,7 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
             // Posture task in the tip task's null space: dtheta += N w p, p_j the world rotation
             // vector turning joint j onto posture_[j] (local q_j <- exp(R_parent^T p_j) q_j), N
             // with the undamped pseudo-inverse (as the direction task's, so that it does not
-            // leak into the tip).
-            jjt_.noalias() = jacobian_ * jacobian_.transpose();
-            jjt_.diagonal().array() += 1e-12;
-            projector_llt_.compute(jjt_);
-            jacobian_solved_ = projector_llt_.solve(jacobian_);
-            projector_.noalias() = -jacobian_.transpose() * jacobian_solved_;
-            projector_.diagonal().array() += 1.0;
+            // leak into the tip). N p = p - J^T (J J^T)^-1 J p: a 3x3 solve, no 12x12 projector.
             for (int j = 0; j < n; ++j) {
                 const Eigen::Quaterniond &parent =
                     j == 0 ? chain.base_rotation() : frames.joint_rotation[j - 1];
@@ -258,7 +252,12 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
                     posture_weight_ *
                     (parent * log_map(posture_[j] * rotation_[current][j].conjugate()));
             }
-            step_.noalias() += projector_ * posture_step_;
+            jjt_.noalias() = jacobian_ * jacobian_.transpose();
+            jjt_.diagonal().array() += 1e-12;
+            projector_llt_.compute(jjt_);
+            const Eigen::Vector3d tip_part = projector_llt_.solve(jacobian_ * posture_step_);
+            step_.noalias() += posture_step_;
+            step_.noalias() -= jacobian_.transpose() * tip_part;
         }
 
         // Scale the whole step (keeping its direction) so no joint turns more than the bound.

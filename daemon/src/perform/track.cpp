@@ -58,6 +58,7 @@ CartesianOptions track_cartesian_defaults()
     c.start_from_simulated = true;
     c.posture_weight = 0.01;
     c.feedback_iterations = 2;
+    c.kinematic_iterations = 1;
     return c;
 }
 
@@ -361,8 +362,12 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                     before = reference_tips(model, around_pose);
                     tip_src.sample(t_next + frame_s, around_pose);
                     after = reference_tips(model, around_pose);
-                    tip_src.sample(t_next, around_pose);
-                    now = reference_tips(model, around_pose);
+                    if (options.tip_motion) {
+                        tip_src.sample(t_next, around_pose);
+                        now = reference_tips(model, around_pose);
+                    } else {
+                        now = reference_tips(model, ref_pose);
+                    }
                 }
                 for (int s = 0; s < 2; ++s) {
                     tip_targets.velocity_mps[s] = (after[s] - before[s]) / (2.0 * frame_s);

@@ -118,10 +118,12 @@ Tracker::Tracker(const CharacterModel &model, const SceneOptions &scene_options,
     if (cartesian.feedback_iterations > 0)
         feedback_ik.max_iterations = cartesian.feedback_iterations;
     feedback_solver_ = std::make_unique<ChainIkSolverPos_dls>(4, feedback_ik);
-    // The capture-free kinematic IK (posture task, no seed from the capture) is
-    // capped likewise: it only gives the target rates.
-    if (cartesian.posture_weight > 0.0 && !cartesian.reference_has_arms)
-        solver_ = std::make_unique<ChainIkSolverPos_dls>(4, feedback_ik);
+    // The kinematic IK's own cap (it only gives the target rates).
+    if (cartesian.kinematic_iterations > 0) {
+        IkParams kinematic_ik = cartesian.ik;
+        kinematic_ik.max_iterations = cartesian.kinematic_iterations;
+        solver_ = std::make_unique<ChainIkSolverPos_dls>(4, kinematic_ik);
+    }
     previous_reference_ = initial.local;
     target_ = initial.local;
     sim_local_ = initial.local;

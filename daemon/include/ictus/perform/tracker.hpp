@@ -73,6 +73,8 @@ struct CartesianOptions {
     // Iterations of the feedback IK per step (eq. 2 is one; 0: the solver's budget,
     // IkParams::max_iterations, i.e. solved to convergence).
     int feedback_iterations = 0;
+    // Likewise for the kinematic IK (it only gives the arms' target rates).
+    int kinematic_iterations = 0;
     // The reference's arm rotations are meaningful (a full-body capture): the
     // kinematic IK starts from them every step. Else (stick-only captures) it
     // continues from its own last solution.
