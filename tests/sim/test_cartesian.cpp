@@ -59,12 +59,12 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
     // Driven by the stick tips alone (the capture's arm pose seeds nothing;
     // the posture task holds the null space near the clip's mean arm pose),
     // the IK's elbow flexion stays within ~10 degrees RMS of the captured one
-    // (measured 10.7 / 11.8, docs/ik.md); the capture-seeded start, below, to
+    // (measured 10.3 / 11.9, docs/ik.md); the capture-seeded start, below, to
     // within a few degrees.
     CHECK(cart.elbow_ik_rms_deg[0] < 15.0);
     CHECK(cart.elbow_ik_rms_deg[1] < 15.0);
     // The arms do not run away in their null space: all joints within 15
-    // degrees RMS of the capture in the simulation (measured 13.3; the posture
+    // degrees RMS of the capture in the simulation (measured 13.2; the posture
     // is the clip's mean arm pose, not each frame's, docs/ik.md).
     CHECK(cart.to_json()["joint_rms_deg_all"].get<double>() < 15.0);
     // Warm-started at 1 kHz the IK needs 1-2 iterations (docs/ik.md).

@@ -53,7 +53,7 @@ void track_usage(std::ostream &out)
            "  --ik-start simulated|kinematic   where the feedback IK starts: simulated, the\n"
            "                         simulated arm (Algorithm 2, default); kinematic, the\n"
            "                         capture-seeded IK solution (docs/ik.md)\n"
-           "  --ik-posture-weight W  null-space posture task, 0..1 per step (default 0.01)\n"
+           "  --ik-posture-weight W  null-space posture task, 0..1 per step (default 0.005)\n"
            "  --out DIR              write DIR/track.csv, DIR/strikes.csv and DIR/summary.json\n"
            "  --scale M              metres per BVH unit (default 0.056444, the CMU files)\n"
            "  --skip-frames N        frames dropped at the start (default 1: the CMU\n"

@@ -201,6 +201,7 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
         const ChainFrames &frames = frames_[current];
         const bool with_posture = posture_pending;
         posture_pending = false;
+        double posture_leak_m = 0.0;
         // Eq. 2 with Wampler's damped (singularity-robust) pseudo-inverse:
         // dtheta = J^T (J J^T + lambda^2 I)^-1 e. J J^T is only 3x3, so the solve is cheap.
         KinematicChain::tip_jacobian(frames, n, jacobian_);
@@ -256,8 +257,11 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
             jjt_.diagonal().array() += 1e-12;
             projector_llt_.compute(jjt_);
             const Eigen::Vector3d tip_part = projector_llt_.solve(jacobian_ * posture_step_);
+            posture_step_.noalias() -= jacobian_.transpose() * tip_part;
             step_.noalias() += posture_step_;
-            step_.noalias() -= jacobian_.transpose() * tip_part;
+            // A null-space step moves the tip by second-order terms only: at most
+            // |dtheta|^2 / 2 times the chain's reach.
+            posture_leak_m = 0.5 * posture_step_.squaredNorm() * chain.reach_m();
         }
 
         // Scale the whole step (keeping its direction) so no joint turns more than the bound.
@@ -306,12 +310,15 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
                 : 0.0;
         // Accept what brings the tip closer, or -- with the tip within tolerance -- turns the
         // stick closer to its target: the tip is never traded for the direction.
-        // A posture step may move the tip by second-order terms: accepted if it does not
-        // leave the tip farther than before by more than the tolerance.
-        const bool accept = candidate_error_m < error_m ||
-                            (use_direction && candidate_error_m <= params_.tolerance_m &&
-                             candidate_direction_error < result.direction_error_rad) ||
-                            (with_posture && candidate_error_m <= error_m + params_.tolerance_m);
+        // A posture step may move the tip by its second-order terms: accepted if the tip
+        // ends no farther than before plus that bound (the next iterations, or the next
+        // call, take it back).
+        const bool accept =
+            candidate_error_m < error_m ||
+            (use_direction && candidate_error_m <= params_.tolerance_m &&
+             candidate_direction_error < result.direction_error_rad) ||
+            (with_posture &&
+             candidate_error_m <= error_m + std::max(params_.tolerance_m, posture_leak_m));
         limits_active = candidate_limited;
         if (accept) {
             current = candidate;

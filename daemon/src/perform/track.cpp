@@ -56,7 +56,7 @@ CartesianOptions track_cartesian_defaults()
 {
     CartesianOptions c;
     c.start_from_simulated = true;
-    c.posture_weight = 0.01;
+    c.posture_weight = 0.005;
     c.feedback_iterations = 2;
     c.kinematic_iterations = 1;
     return c;

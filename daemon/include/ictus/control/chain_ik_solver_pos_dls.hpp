@@ -97,7 +97,10 @@ class ChainIkSolverPos_dls
     // fraction `posture_weight` in [0, 1] of the way toward `posture[j]` (local rotations,
     // chain.joints() of them) as far as that does not move the tip (to first order). Once per
     // call: called every physics step from the simulated state, the arm's redundant directions
-    // relax toward the posture at that rate. 0 = the plain solve.
+    // relax toward the posture at that rate. The posture iteration is accepted when the tip
+    // ends no farther from the target than before plus the step's second-order bound
+    // |dtheta|^2 L / 2 (L the chain's reach); later iterations take that back. 0 = the plain
+    // solve.
     IkResult solve_with_posture(const KinematicChain &chain, const Eigen::Vector3d &target_tip_m,
                                 const Eigen::Quaterniond *posture, double posture_weight,
                                 Eigen::Quaterniond *rotations_out);
