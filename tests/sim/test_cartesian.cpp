@@ -140,6 +140,9 @@ TEST_CASE("Cartesian options are validated, naming the option", "[sim][track][ca
     o.cartesian.correction_limit_m = -1.0;
     CHECK_THROWS_WITH(validate(o), Catch::Contains("correction limit"));
     o = TrackOptions{};
+    o.cartesian.posture_weight = 1.5;
+    CHECK_THROWS_WITH(validate(o), Catch::Contains("ik posture weight"));
+    o = TrackOptions{};
     o.cartesian.ik.damping_m = 0.0;
     CHECK_THROWS_WITH(validate(o), Catch::Contains("ik parameters"));
     CHECK_THROWS_WITH(track_mode_from_string("foo"), Catch::Contains("joint or cartesian"));

@@ -44,7 +44,9 @@ void track_usage(std::ostream &out)
            "  --left-stick NAME, --right-stick NAME   the capture's stick-tip objects (default:\n"
            "                         named stick_l / stick_r, else containing left / right)\n"
            "  --units mm|m, --up y|z, --rate HZ   how to read the .csv (default m, y, its time)\n"
-           "  --drum auto|X,Y,Z      membrane centre (auto: under the lowest strokes)\n"
+           "  --drum auto|X,Y,Z      membrane centre (auto, default: a stick-only capture's\n"
+           "                         at its strokes' turnarounds, a BVH's under the lowest\n"
+           "                         tips; docs/mocap.md)\n"
            "  --ik-gain G            eq. 2's gain on the tip error (default 10)\n"
            "  --ik-velocity-gain S   tip velocity error term, s (default 0.1; < 0: automatic)\n"
            "  --ik-accel-ff S2       tip acceleration feedforward, s^2 (default 0)\n"
@@ -67,7 +69,7 @@ void track_usage(std::ostream &out)
            "  --grip french|german   hand-stick orientation (default french)\n"
            "  --stick-length M       (default 0.406)   --stick-mass KG (default 0.05)\n"
            "  --stick-tip-radius M   (default 0.007)\n"
-           "  --drum-pos X,Y,Z       membrane centre, m (default: under the lowest tips)\n"
+           "  --drum-pos X,Y,Z       membrane centre, m (default: --drum auto)\n"
            "  --drum-radius M        (default 0.178)   --drum-tension N/m (default 3000)\n"
            "  --gain-hz HZ           PD natural frequency (default 30)\n"
            "  --damping-ratio Z      (default 1)       --torque-scale S (default 1)\n"
@@ -96,7 +98,7 @@ void track_usage(std::ostream &out)
            "\n"
            "examples:\n"
            "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n"
-           "  ictusd track --mode cartesian --mocap ../shared/data/cmu/80_13.bvh --limit-k 4\n"
+           "  ictusd track --mode cartesian --mocap ../shared/data/cmu/80_13.bvh\n"
            "  ictusd track --mode cartesian --mocap sticks.csv --units mm --up z --drum auto\n";
 }
 
