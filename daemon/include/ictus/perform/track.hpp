@@ -38,9 +38,10 @@ struct TrackOptions {
     // targets at start-up jolts the trunk, ode-findings.md); errors are not
     // counted during it.
     double ramp_s = 0.25;
-    // Place the drum under the strokes' turnarounds (fit_drum_to_turnarounds on the tips
-    // of the capture: the stick-only capture's, else tip_motion's, the raw reference's or
-    // the reference's), else scene.drum.center_m.
+    // Place the drum automatically (else scene.drum.center_m): a stick-only capture's at its
+    // strokes' turnarounds (fit_drum_to_turnarounds), a full-body capture's under the lowest
+    // tips (auto_drum_center; docs/mocap.md, "Drum placement"). The turnarounds of the tips
+    // the errors are measured against give the contact windows in either case.
     bool drum_auto = true;
     // The cleaned capture for the stick tips (full-body captures): the Cartesian mode's
     // X^T and both modes' tip errors are the stick tips of this motion (else the

@@ -62,7 +62,8 @@ struct CartesianOptions {
     // RMS at the shoulder on CMU 80_13). kinematic: the kinematic IK's solution
     // (the capture's arm pose when it has one), so the PD also holds the arm's
     // null space where the capture has it, and the Cartesian error term of
-    // eq. 2 still corrects the tip.
+    // eq. 2 still corrects the tip. (`ictusd track`'s default is simulated, with the
+    // posture task below: track_cartesian_defaults(), docs/ik.md.)
     bool start_from_simulated = false;
     // The redundant arm's secondary task (docs/ik.md, "Posture task"): both IK solves
     // (feedback and kinematic) turn every arm joint by this fraction of its way toward the
