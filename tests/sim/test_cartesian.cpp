@@ -6,6 +6,7 @@
 #include "ictus/mocap/bvh.hpp"
 #include "ictus/character/character_limits.hpp"
 #include "ictus/perform/track.hpp"
+#include "ictus/sim/strike_detector.hpp"
 #include "sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -441,7 +442,40 @@ TEST_CASE("stick-only: synthetic strokes up to 5 m/s, drum found within 5 mm, fr
         TrackOptions o;
         o.mode = TrackMode::cartesian;
         o.tip_reference = &tips;
+        // The strikes, as `ictusd track` detects them (strikes.csv).
+        StrikeDetector detector;
+        std::vector<StrikeEvent> strikes;
+        o.on_step = [&](const Scene &scene) {
+            detector.set_membrane(membrane_of(scene));
+            StrikeEvent out[2];
+            const int n = detect_strikes(detector, scene, out);
+            strikes.insert(strikes.end(), out, out + n);
+        };
         const TrackSummary s = track_joint_space(m, ref, o);
+        // One strike per captured impact once the arms have settled from their cold start
+        // (from 1 s on: the first strokes after the 0.25 s ramp can be missed), none else.
+        for (int hand = 0; hand < 2; ++hand) {
+            const double t0 = hand == 0 ? 0.0015 : 0.5 * c.period_s + 0.013;
+            int impacts = 0, struck = 0, extra = 0;
+            for (double ti = t0; ti < 2.99; ti += c.period_s)
+                if (ti >= 1.0) {
+                    ++impacts;
+                    int n = 0;
+                    for (const StrikeEvent &e : strikes)
+                        n += e.hand == hand && !e.bounce && std::abs(e.time_s - ti) < 0.02;
+                    struck += n == 1;
+                }
+            for (const StrikeEvent &e : strikes) {
+                bool near = false;
+                for (double ti = t0; ti < 3.0; ti += c.period_s)
+                    near = near || std::abs(e.time_s - ti) < 0.02;
+                extra += e.hand == hand && !e.bounce && !near;
+            }
+            INFO(c.v_mps << " m/s, hand " << hand << ": " << struck << " of " << impacts
+                         << " impacts struck once, " << extra << " other strikes");
+            CHECK(struck == impacts);
+            CHECK(extra == 0);
+        }
         INFO(c.v_mps << " m/s: drum " << s.drum_center_m.y() << " (true " << membrane
                      << "), free flight rms mm " << s.tip_rms_free_mm[0] << " "
                      << s.tip_rms_free_mm[1] << ", contact windows " << s.tip_rms_contact_mm[0]

@@ -228,9 +228,21 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             tips_in ? drum_fit.center_m : auto_drum_center(model, reference);
     // A stick-only capture's impacts restored between its samples (X^T and the errors).
     TipTrajectory restored;
+    // X^T asks for more at an impact: the stick's end down to the membrane plane at the
+    // vertex (the fitted membrane: kImpactPitchFactor tip radii below it), so that the
+    // simulated stick's bead reaches the head whatever its pitch, as the captured one did
+    // (docs/ik.md, "Stick-only captures"). The errors stay against the capture.
+    TipTrajectory pressed;
+    const TipTrajectory *targets_in = tips_in;
     if (tips_in && have_impacts) {
         restored = with_impact_vertices(*tips_in, drum_fit.impacts);
+        std::array<std::vector<StrokeTurnaround>, 2> at_membrane = drum_fit.impacts;
+        for (auto &side : at_membrane)
+            for (StrokeTurnaround &ta : side)
+                ta.position_m.y() -= kImpactPitchFactor * model.options().stick.tip_radius_m;
+        pressed = with_impact_vertices(*tips_in, at_membrane);
         tips_in = &restored;
+        targets_in = &pressed;
     }
     const double h = options.scene.step_s;
     const double duration = options.duration_s > 0.0 ? options.duration_s
@@ -353,9 +365,9 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                 std::array<Eigen::Vector3d, 2> before, after, now;
                 if (tips_in) {
                     for (int s = 0; s < 2; ++s) {
-                        before[s] = tips_in->sample(s, t_next - frame_s);
-                        after[s] = tips_in->sample(s, t_next + frame_s);
-                        now[s] = tips_in->sample(s, t_next);
+                        before[s] = targets_in->sample(s, t_next - frame_s);
+                        after[s] = targets_in->sample(s, t_next + frame_s);
+                        now[s] = targets_in->sample(s, t_next);
                     }
                 } else {
                     tip_src.sample(t_next - frame_s, around_pose);
@@ -381,7 +393,7 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             tip_targets.has_position = tips_in != nullptr || options.tip_motion != nullptr;
             if (tips_in) {
                 for (int s = 0; s < 2; ++s)
-                    tip_targets.position_m[s] = tips_in->sample(s, t_next);
+                    tip_targets.position_m[s] = targets_in->sample(s, t_next);
             } else if (options.tip_motion) {
                 // The cleaned tips, blended in from the (ramped) reference's tips
                 // like the joint targets: X^T = tips(step pose) + w (tips(tip motion)
