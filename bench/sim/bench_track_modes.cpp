@@ -53,6 +53,7 @@ int main(int argc, char **argv)
             o.cartesian.posture_weight = 0.0;
             o.cartesian.feedback_iterations = 0;
             o.cartesian.kinematic_iterations = 0;
+            o.cartesian.correction_limit_m = 0.1;
         }
         TrackSummary best;
         for (int r = 0; r < runs; ++r) {

@@ -80,6 +80,7 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
     seeded.cartesian.posture_weight = 0.0;
     seeded.cartesian.feedback_iterations = 0;
     seeded.cartesian.kinematic_iterations = 0;
+    seeded.cartesian.correction_limit_m = 0.1;
     seeded.duration_s = 3.0;
     const TrackSummary kin =
         track_joint_space(model, reference, seeded, limits.refs(), nullptr, {}, &gains, &raw);

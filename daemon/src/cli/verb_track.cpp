@@ -51,7 +51,7 @@ void track_usage(std::ostream &out)
            "  --ik-velocity-gain S   tip velocity error term, s (default 0.1; < 0: automatic)\n"
            "  --ik-accel-ff S2       tip acceleration feedforward, s^2 (default 0)\n"
            "  --ik-integral PER_S    integral of the tip error (default 0)\n"
-           "  --ik-correction-limit M   cap on the IK target's correction (default 0.1)\n"
+           "  --ik-correction-limit M   cap on the IK target's correction (default 0.3)\n"
            "  --ik-start simulated|kinematic   where the feedback IK starts: simulated, the\n"
            "                         simulated arm (Algorithm 2, default); kinematic, the\n"
            "                         capture-seeded IK solution (docs/ik.md)\n"

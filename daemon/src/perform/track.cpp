@@ -59,6 +59,7 @@ CartesianOptions track_cartesian_defaults()
     c.posture_weight = 0.005;
     c.feedback_iterations = 2;
     c.kinematic_iterations = 1;
+    c.correction_limit_m = 0.3;
     return c;
 }
 
