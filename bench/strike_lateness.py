@@ -87,7 +87,7 @@ def main():
     load = None
     if args.load:
         load = subprocess.Popen(["stress-ng", "--cpu", "0", "--quiet"])
-    cmd = [args.ictusd, "run", "--port", str(cmd_port), "--target",
+    cmd = [args.ictusd, "run", "--autoplay", "--port", str(cmd_port), "--target",
            f"osc.udp://127.0.0.1:{port}", "--reply", f"osc.udp://127.0.0.1:{port}",
            "--pose-rate", "30"]
     if args.realtime:

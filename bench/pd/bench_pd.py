@@ -13,7 +13,8 @@ Cases, for N = 16, 256, 1024, 4096:
            with a soft tip (k 1e6) hit in at 0.5 m/s every 100 ms (each hit
            computes the mode weights at the point, O(N) Bessel values; 10 per
            second cost little)
-  roll     a 0.05 kg stick hit at 1 m/s every 5 ms (in contact 99 % of the
+  roll     a 0.05 kg stick hit at 1 m/s every 5 ms, each time at a new spot
+           (r/a 0.2 .. 0.7, so no hit reuses cached shapes) (in contact 99 % of the
            time too; 200 hits per second, so the per-hit cost shows)
   bp~      N [bp~] fed by one [noise~] (noise~ is in the empty patch too)
 Best (smallest) of R runs each. Usage: bench_pd.py BUILD_DIR [--runs R]"""
@@ -65,13 +66,22 @@ def membrane(n, hits=None):
             lines.append("#X obj 300 40 metro %g;" % period_ms)  # i+3
             lines.append("#X msg 300 70 %s;" % message)  # i+4
             lines.append("#X connect 0 0 %d 0;" % (i + 3))
-            lines.append("#X connect %d 0 %d 0;" % (i + 3, i + 4))
             lines.append("#X connect %d 0 %d 0;" % (i + 4, i + 2))
+            if "$1" in message:
+                # a new spot every hit (r/a 0.2 .. 0.7): the shapes cannot come
+                # from the cache, so each hit computes its O(N) Bessel values
+                lines.append("#X obj 300 100 random 1000;")  # i+5
+                lines.append("#X obj 300 130 expr 0.2 + $f1 / 2000;")  # i+6
+                lines.append("#X connect %d 0 %d 0;" % (i + 3, i + 5))
+                lines.append("#X connect %d 0 %d 0;" % (i + 5, i + 6))
+                lines.append("#X connect %d 0 %d 0;" % (i + 6, i + 4))
+            else:
+                lines.append("#X connect %d 0 %d 0;" % (i + 3, i + 4))
     return body
 
 
 PRESSED = ("mass 10 \\, stiffness 1e+06 \\, hit 0.5 0.3 0", 100)
-ROLL = ("hit 1 0.3 0", 5)
+ROLL = ("hit 1 \\$1 0", 5)
 
 
 def bp_bank(n):

@@ -32,9 +32,14 @@ struct contact {
     double hit_velocity; /* m/s, of the hit waiting to land (point.move_pending) */
     /* Stroke state (double: the contact law is stiff and nonlinear). */
     int touching, ever_touched;
-    double stick_x, stick_v; /* m, m/s, positive into the membrane */
-    double compression;      /* m */
-    double force;            /* N, during the last sample */
+    double stick_x, stick_v;   /* m, m/s, positive into the membrane */
+    double compression;        /* m */
+    double compression_before; /* m, a sample earlier (the solve's first guess) */
+    double force;              /* N, during the last sample */
+    /* The force law linearised at the last sample's solution (the next solve's
+     * first guess): F ~ lin_f + lin_d0 (x0 - lin_x0) + lin_d1 (x1 - lin_u). */
+    int lin_valid;
+    double lin_x0, lin_u, lin_f, lin_d0, lin_d1;
     long stroke_samples;
     double first_touch, last_release; /* samples since the stroke began (interpolated) */
     double peak_force, impulse;
@@ -235,10 +240,26 @@ static double fast_pos_pow(double x, double a, int half_steps)
     return r;
 }
 
+/* x^a and x^(a-1) for x > 0: the same x^a as fast_pos_pow() (the same products in
+ * the same order), and x^(a-1) without a division when a >= 1 is a half integer. */
+static double fast_pow_and_below(double x, double a, int half_steps, double *below)
+{
+    if (half_steps >= 2) {
+        double r = (half_steps & 1) ? sqrt(x) : 1.0;
+        for (int i = 0; i < half_steps / 2 - 1; i++)
+            r *= x;
+        *below = r;
+        return r * x;
+    }
+    double xa = fast_pos_pow(x, a, half_steps);
+    *below = xa / x;
+    return xa;
+}
+
 /* What stays fixed while one sample's equation is solved: the start compression
  * x0 and its powers, so that each trial x1 costs one pow(). */
 typedef struct contact_step {
-    double k, a, damping_over_dt, x0, x0a, v0;
+    double k, a, k_over_a1, damping_over_dt, x0, x0a, v0, dh0;
     int half_steps; /* 2a when that is a whole number, else -1 */
 } contact_step;
 
@@ -247,30 +268,36 @@ static contact_step step_begin(const contact *c, double x0, double dt)
     contact_step st;
     st.k = c->stiffness;
     st.a = c->alpha;
+    st.k_over_a1 = st.k / (st.a + 1.0); /* V(x) = k_over_a1 x^(a+1): no division per trial */
     st.damping_over_dt = c->damping / dt;
     double twice = 2.0 * st.a;
     st.half_steps = (twice == floor(twice) && twice <= 8.0) ? (int)twice : -1;
     st.x0 = x0;
     st.x0a = fast_pos_pow(x0, st.a, st.half_steps);
-    st.v0 = x0 > 0.0 ? st.k * st.x0a * x0 / (st.a + 1.0) : 0.0; /* V(x0) */
+    st.v0 = x0 > 0.0 ? st.k_over_a1 * st.x0a * x0 : 0.0; /* V(x0) */
+    st.dh0 = x0 > 0.0 ? 0.5 * st.a * st.x0a / x0 : 0.0;  /* dh/dx0 */
     return st;
 }
 
-/* Force for the step x0 -> x1 and, when dforce is not NULL, dF/dx1. */
-static double step_force(const contact_step *st, double x1, double *dforce)
+/* Force for the step x0 -> x1 and, when dforce is not NULL, dF/dx1 and
+ * dforce_x0[0] = dF/dx0 (for the next sample's first guess only). */
+static double step_force(const contact_step *st, double x1, double *dforce, double *dforce_x0)
 {
     const double k = st->k, a = st->a, x0 = st->x0;
-    const double x1a = fast_pos_pow(x1, a, st->half_steps);
+    double x1a_below = 0.0; /* x1^(a-1), for dh */
+    const double x1a = x1 > 0.0 ? fast_pow_and_below(x1, a, st->half_steps, &x1a_below) : 0.0;
     const double dx = x1 - x0;
     const double scale = fabs(x0) > fabs(x1) ? fabs(x0) : fabs(x1);
-    double spring, dspring;
+    double spring, dspring, dspring0;
     if (x0 <= 0.0 && x1 <= 0.0) {
-        spring = dspring = 0.0;
+        spring = dspring = dspring0 = 0.0;
     } else if (fabs(dx) > 1.0e-5 * scale) {
         /* Discrete gradient: the secant of V. */
-        double v1 = x1 > 0.0 ? k * x1a * x1 / (a + 1.0) : 0.0;
-        spring = (v1 - st->v0) / dx;
-        dspring = (k * x1a - spring) / dx;
+        double v1 = x1 > 0.0 ? st->k_over_a1 * x1a * x1 : 0.0;
+        double inv_dx = 1.0 / dx;
+        spring = (v1 - st->v0) * inv_dx;
+        dspring = (k * x1a - spring) * inv_dx;
+        dspring0 = (spring - k * st->x0a) * inv_dx;
     } else {
         /* The secant would cancel catastrophically: its midpoint value equals it
          * to O(dx^2/x^2) < 1e-10 relative here. */
@@ -278,22 +305,26 @@ static double step_force(const contact_step *st, double x1, double *dforce)
         double mida = fast_pos_pow(mid, a, st->half_steps);
         spring = k * mida;
         dspring = mid > 0.0 ? 0.5 * k * a * mida / mid : 0.0;
+        dspring0 = dspring;
     }
     double h = 0.5 * (st->x0a + x1a);
-    double dh = x1 > 0.0 ? 0.5 * a * x1a / x1 : 0.0;
+    double dh = x1 > 0.0 ? 0.5 * a * x1a_below : 0.0;
     double f = spring + st->damping_over_dt * h * dx;
     double df = dspring + st->damping_over_dt * (h + dh * dx);
+    double df0 = dspring0 + st->damping_over_dt * (st->dh0 * dx - h);
     /* Safety net for absurd states (e.g. 1e3 N s strikes on a 3 mg head): no
      * drumstick pushes with a teranewton, and a capped force stays finite. */
     if (!(f < CONTACT_FORCE_CAP)) {
         f = isnan(f) ? 0.0 : CONTACT_FORCE_CAP;
-        df = 0.0;
+        df = df0 = 0.0;
     } else if (f <= 0.0) {
         f = 0.0;
-        df = 0.0;
+        df = df0 = 0.0;
     }
     if (dforce)
         *dforce = isfinite(df) ? df : 0.0;
+    if (dforce_x0)
+        *dforce_x0 = isfinite(df0) ? df0 : 0.0;
     return f;
 }
 
@@ -305,22 +336,37 @@ static double residual_tol(double x0, double x_free, double compliance, double f
 
 /* Solves x1 = x_free - compliance * F(x0, x1) for the compression x1 (m) at the
  * end of one sample of dt seconds; returns F (N). force_guess (e.g. the last
- * sample's force, or 0) only speeds it up. */
+ * sample's force, or 0) and u_guess (a compression, or <= 0 for none) only speed
+ * it up: where the solve stops depends on the residual alone. */
+/* What contact_solve() leaves for the next sample's guess: the last trial point,
+ * its force and the force's derivatives there (valid = 0: none). */
+typedef struct contact_lin {
+    int valid;
+    double u, f, d0, d1;
+} contact_lin;
+
 static double contact_solve(const contact *c, double x0, double x_free, double compliance,
-                            double dt, double force_guess, double *x1)
+                            double dt, double force_guess, double u_guess, double *x1,
+                            contact_lin *lin)
 {
     /* Root of r(u) = u - x_free + C F(x0, u) with r(x_free) = C F >= 0: Newton on
      * r, kept inside a bracket [lo, hi] and replaced by bisection whenever it
      * leaves it or stalls, so it is both fast (2-4 force evaluations) and bounded. */
     contact_step st = step_begin(c, x0, dt);
-    double df, f, u, r;
+    double df, df0 = 0.0, f, u, r;
+    if (lin)
+        lin->valid = 0;
     double hi = x_free, lo = 0.0; /* r(x_free) = C F(x_free) >= 0 without evaluating it */
     int have_lo = 0;
     if (force_guess > 0.0) {
         /* The force is continuous from sample to sample: start where the last
          * sample's force would put the compression (usually 2 evaluations). */
         u = x_free - compliance * force_guess;
-        f = step_force(&st, u, &df);
+        /* Pressed on: the compression moves smoothly, its linear extrapolation
+         * (when given and below x_free, where r >= 0 is known) lands closer. */
+        if (u_guess > 0.0 && u_guess < x_free)
+            u = u_guess;
+        f = step_force(&st, u, &df, &df0);
         r = u - x_free + compliance * f;
         if (r > 0.0) {
             hi = u;
@@ -329,7 +375,7 @@ static double contact_solve(const contact *c, double x0, double x_free, double c
             have_lo = 1;
         }
     } else {
-        f = step_force(&st, x_free, &df);
+        f = step_force(&st, x_free, &df, &df0);
         if (f == 0.0) {
             *x1 = x_free; /* not touching during this sample */
             return 0.0;
@@ -355,7 +401,7 @@ static double contact_solve(const contact *c, double x0, double x_free, double c
                     d = 1.0e-12;
                 for (int i = 0; i < 200; i++) {
                     lo = x_free - d;
-                    if (lo - x_free + compliance * step_force(&st, lo, NULL) < 0.0)
+                    if (lo - x_free + compliance * step_force(&st, lo, NULL, NULL) < 0.0)
                         break;
                     d *= 4.0;
                 }
@@ -364,7 +410,7 @@ static double contact_solve(const contact *c, double x0, double x_free, double c
             next = 0.5 * (lo + hi);
         }
         u = next;
-        f = step_force(&st, u, &df);
+        f = step_force(&st, u, &df, &df0);
         r = u - x_free + compliance * f;
         dr = 1.0 + compliance * df;
         if (r > 0.0) {
@@ -389,6 +435,13 @@ static double contact_solve(const contact *c, double x0, double x_free, double c
         *x1 = u;
         return (x_free - u) / compliance;
     }
+    if (lin && f > 0.0) {
+        lin->valid = 1;
+        lin->u = u;
+        lin->f = f;
+        lin->d0 = df0;
+        lin->d1 = df;
+    }
     /* f = F(x0, u) at the last trial point. Report the compression the stick and membrane updates
      * will really produce. */
     *x1 = x_free - compliance * f;
@@ -410,7 +463,8 @@ static void contact_landed(membrane_point *pt, double displacement_m)
     contact *c = point_contact(pt);
     c->stick_x = displacement_m;
     c->stick_v = c->hit_velocity;
-    c->compression = 0.0;
+    c->compression = c->compression_before = 0.0;
+    c->lin_valid = 0;
     c->force = 0.0;
     c->point.active = 1;
     c->touching = 0;
@@ -449,7 +503,27 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
         /* One stick, the common case: the scalar solve is exact, nothing to sweep. */
         contact *c = point_contact(pts[0]);
         double C = T * T / (2.0 * c->mass_kg) + K[0][0];
-        F[0] = contact_solve(c, c->compression, xfree[0], C, T, c->force, &x1[0]);
+        double ug = -1.0;
+        if (c->force > 0.0 && c->lin_valid) {
+            /* The last sample's force law, linearised, in x1 = x_free - C F: the
+             * membrane's part of the move (x_free) is exact, the law's curvature
+             * is the error. */
+            double Cd1 = C * c->lin_d1;
+            ug = (xfree[0] - C * (c->lin_f + c->lin_d0 * (c->compression - c->lin_x0)) +
+                  Cd1 * c->lin_u) /
+                 (1.0 + Cd1);
+        } else if (c->force > 0.0 && c->compression > 0.0 && c->compression_before > 0.0) {
+            ug = 2.0 * c->compression - c->compression_before;
+        }
+        contact_lin lin = {0, 0.0, 0.0, 0.0, 0.0};
+        double x0 = c->compression;
+        F[0] = contact_solve(c, x0, xfree[0], C, T, c->force, ug, &x1[0], &lin);
+        c->lin_valid = lin.valid;
+        c->lin_x0 = x0;
+        c->lin_u = lin.u;
+        c->lin_f = lin.f;
+        c->lin_d0 = lin.d0;
+        c->lin_d1 = lin.d1;
     } else {
         for (int s = 0; s < 30; s++) {
             double change = 0.0;
@@ -460,7 +534,9 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
                     if (j != i)
                         xf -= K[i][j] * F[j];
                 double C = T * T / (2.0 * c->mass_kg) + K[i][i];
-                double Fi = contact_solve(c, c->compression, xf, C, T, c->force, &x1[i]);
+                double Fi =
+                    contact_solve(c, c->compression, xf, C, T, c->force, -1.0, &x1[i], NULL);
+                c->lin_valid = 0;
                 change += fabs(Fi - F[i]);
                 F[i] = Fi;
             }
@@ -494,6 +570,7 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
             c->last_release = xprev > 0.0 && xw < 0.0 ? t_start + xprev / (xprev - xw) : t_end;
         }
         c->touching = now_touching;
+        c->compression_before = c->compression;
         c->compression = xw;
         if (Fi > c->peak_force)
             c->peak_force = Fi;
@@ -530,7 +607,8 @@ static void contact_cleared(membrane_point *pt)
     contact *c = point_contact(pt);
     c->point.active = c->touching = 0;
     c->force = 0.0;
-    c->stick_v = c->stick_x = c->compression = 0.0;
+    c->stick_v = c->stick_x = c->compression = c->compression_before = 0.0;
+    c->lin_valid = 0;
 }
 
 static void contact_detached(membrane_point *pt)
@@ -578,7 +656,7 @@ int contact_simulate_rigid(const contact *c, double velocity_mps, double sample_
     long steps = (long)(max_seconds * sample_rate_hz);
     for (long s = 0; s < steps; s++) {
         double x1;
-        double f = contact_solve(c, x, x + T * v, C, T, last_force, &x1);
+        double f = contact_solve(c, x, x + T * v, C, T, last_force, -1.0, &x1, NULL);
         last_force = f;
         double v1 = v - T * f / c->mass_kg;
         if (f > peak)

@@ -49,8 +49,11 @@ struct membrane {
     /* Mode table, capacity entries; entries >= modes are padding. */
     mode_table table;
     double *omega_model; /* model stiffness w' per mode (0: silent) */
-    /* SoA float state and coefficients (see membrane_kernel.inc). */
-    float *q, *p, *c1, *c2, *c3, *eq, *ep, *dm;
+    /* SoA float state and coefficients (see membrane_kernel.inc): q holds the
+     * scaled displacement r = q / (h w'), h = T / 2 (the energy coordinate q is
+     * h w' r); cd = 2 / D is r's coefficient of p; ep the input gain of both. */
+    float *q, *p, *c1, *cd, *c3, *ep;
+    double coef_h; /* h of the coefficients (and of r) now in place */
     float *psi_strike, *psi_pick[MEMBRANE_PICKUPS];
     /* A moved pickup crossfades from its old shapes over a few ms (no click). */
     float *psi_pick_old[MEMBRANE_PICKUPS];
@@ -99,10 +102,19 @@ static int padded(int n)
     return (n + MEMBRANE_PAD - 1) / MEMBRANE_PAD * MEMBRANE_PAD;
 }
 
-/* Shapes of the sounding modes (the fading ones included) at a point; see mode_table.h. */
+/* Shapes of the sounding modes (the fading ones included) at a point; see mode_table.h.
+ * For the pickups, which hear the fading modes ring out. */
 static void mode_shapes(const membrane *m, double r_over_a, double theta_deg, float *psi)
 {
     mode_table_shapes(&m->table, m->fading_modes, r_over_a, theta_deg, psi);
+}
+
+/* Shapes at an input point (strikes, coupling points): zero for the fading modes,
+ * which take no input and are invisible to the points (the kernel folds a point's
+ * force in through cd, which the fading modes keep for their ring-out). */
+static void input_shapes(const membrane *m, double r_over_a, double theta_deg, float *psi)
+{
+    mode_table_shapes(&m->table, m->modes, r_over_a, theta_deg, psi);
 }
 
 /* Damping law sigma_k = s0 + s1 w_k^2 with s0 + s1 w_1^2 = ln(1000)/t60 and
@@ -124,8 +136,9 @@ static void update_coefficients(membrane *m, int rescale)
 {
     const double T = 1.0 / m->sample_rate, h = 0.5 * T;
     const double c = sqrt(m->tension / m->density);
-    const double old_scale = m->mass_scale;
+    const double old_scale = m->mass_scale, old_h = m->coef_h;
     m->mass_scale = 1.0 / sqrt(m->density * m->radius * m->radius);
+    m->coef_h = h;
     const double scale = m->mass_scale;
     for (int k = 0; k < m->capacity; k++) {
         double old_omega = m->omega_model[k];
@@ -133,7 +146,7 @@ static void update_coefficients(membrane *m, int rescale)
         double freq = (k < m->fading_modes) ? m->table.j[k] * c / (2.0 * M_PI * m->radius) : 0.0;
         if (k >= m->fading_modes || freq >= 0.95 * 0.5 * m->sample_rate || freq <= 0.0) {
             /* Silent: frozen at zero, no input, no output. */
-            m->c1[k] = m->c2[k] = m->c3[k] = m->eq[k] = m->ep[k] = m->dm[k] = 0.0f;
+            m->c1[k] = m->cd[k] = m->c3[k] = m->ep[k] = 0.0f;
             m->q[k] = m->p[k] = 0.0f;
             m->omega_model[k] = 0.0;
             continue;
@@ -150,18 +163,22 @@ static void update_coefficients(membrane *m, int rescale)
         double wm = sqrt(a * a + b * b); /* model stiffness w' */
         double sm = -a;                  /* model damping s' */
         double D = 1.0 + 2.0 * h * sm + h * h * wm * wm;
+        /* In q, p: q+ = q - c1 q + c2 p + eq u, p+ = p - c2 q - c3 p + ep u with
+         * c2 = 2 h w' / D and eq = h w' ep. With r = q / (h w') (c2 h w' = c1,
+         * c2 / (h w') = 2 / D): r+ = r - c1 r + cd p + ep u, p+ = p - c1 r - c3 p + ep u,
+         * one input gain for both, and the displacement weights dm psi q =
+         * scale h psi r need no per-mode array (docs/membrane.md). */
         m->c1[k] = (float)(2.0 * h * h * wm * wm / D);
-        m->c2[k] = (float)(2.0 * h * wm / D);
+        m->cd[k] = (float)(2.0 / D);
         m->c3[k] = (float)((2.0 * h * h * wm * wm + 4.0 * h * sm) / D);
-        m->eq[k] = (float)(scale * T * h * wm / D);
         m->ep[k] = (float)(scale * T / D);
-        m->dm[k] = (float)(scale / wm);
-        if (fading) /* ringing out: no input, invisible to the coupling points */
-            m->eq[k] = m->ep[k] = m->dm[k] = 0.0f;
+        if (fading) /* ringing out: no input (and zero input shapes, input_shapes) */
+            m->ep[k] = 0.0f;
         if (rescale && old_omega > 0.0) {
-            /* y = q / (sqrt(M) w'), y' = p / sqrt(M), sqrt(M) proportional to 1/scale. */
+            /* y = q / (sqrt(M) w'), y' = p / sqrt(M), sqrt(M) proportional to 1/scale;
+             * q = h w' r, so r scales by old_h / h (w' cancels). */
             double r = old_scale / scale;
-            m->q[k] = (float)(m->q[k] * r * wm / old_omega);
+            m->q[k] = (float)(m->q[k] * r * old_h / h);
             m->p[k] = (float)(m->p[k] * r);
         } else if (rescale) {
             m->q[k] = m->p[k] = 0.0f;
@@ -172,6 +189,7 @@ static void update_coefficients(membrane *m, int rescale)
 
 static void refresh_point_couplings(membrane *m);
 static void flush_points(membrane *m);
+static impulse_shape *make_impulse_shape(membrane *m, double r, double theta);
 
 /* Builds the mode table for `modes` modes; keeps the state of modes that exist
  * in both the old and new table (the order is a prefix property of the sort). */
@@ -182,9 +200,9 @@ static ictus_status build_modes(membrane *m, int modes)
         int cap = need;
         mode_table table = {0};
         double *om = calloc((size_t)cap, sizeof(double));
-        float *arrays[13];
+        float *arrays[11];
         int ok = om != NULL;
-        for (int i = 0; i < 13; i++) {
+        for (int i = 0; i < 11; i++) {
             arrays[i] = alloc_floats(cap);
             ok = ok && arrays[i];
         }
@@ -193,9 +211,9 @@ static ictus_status build_modes(membrane *m, int modes)
             impulse[i] = alloc_floats(cap);
             ok = ok && impulse[i];
         }
-        float *ppsi[MEMBRANE_MAX_POINTS][5];
+        float *ppsi[MEMBRANE_MAX_POINTS][2];
         for (int i = 0; i < MEMBRANE_MAX_POINTS; i++) {
-            for (int j = 0; j < 5; j++) {
+            for (int j = 0; j < 2; j++) {
                 ppsi[i][j] = NULL;
                 if (i < m->point_count) {
                     ppsi[i][j] = alloc_floats(cap);
@@ -210,12 +228,12 @@ static ictus_status build_modes(membrane *m, int modes)
         if (!ok) {
             mode_table_free(&table);
             free(om);
-            for (int i = 0; i < 13; i++)
+            for (int i = 0; i < 11; i++)
                 free(arrays[i]);
             for (int i = 0; i < IMPULSE_CACHE; i++)
                 free(impulse[i]);
             for (int i = 0; i < MEMBRANE_MAX_POINTS; i++)
-                for (int j = 0; j < 5; j++)
+                for (int j = 0; j < 2; j++)
                     free(ppsi[i][j]);
             return ICTUS_ENOMEM;
         }
@@ -229,8 +247,8 @@ static ictus_status build_modes(membrane *m, int modes)
         }
         mode_table_free(&m->table);
         free(m->omega_model);
-        free(m->q), free(m->p), free(m->c1), free(m->c2), free(m->c3);
-        free(m->eq), free(m->ep), free(m->dm), free(m->psi_strike);
+        free(m->q), free(m->p), free(m->c1), free(m->cd), free(m->c3);
+        free(m->ep), free(m->psi_strike);
         for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
             free(m->psi_pick[i]);
             free(m->psi_pick_old[i]);
@@ -238,13 +256,13 @@ static ictus_status build_modes(membrane *m, int modes)
         }
         m->table = table;
         m->omega_model = om;
-        m->q = arrays[0], m->p = arrays[1], m->c1 = arrays[2], m->c2 = arrays[3];
-        m->c3 = arrays[4], m->eq = arrays[5], m->ep = arrays[6], m->dm = arrays[7];
-        m->psi_strike = arrays[8];
-        m->psi_pick[0] = arrays[9];
-        m->psi_pick[1] = arrays[10];
-        m->psi_pick_old[0] = arrays[11];
-        m->psi_pick_old[1] = arrays[12];
+        m->q = arrays[0], m->p = arrays[1], m->c1 = arrays[2], m->cd = arrays[3];
+        m->c3 = arrays[4], m->ep = arrays[5];
+        m->psi_strike = arrays[6];
+        m->psi_pick[0] = arrays[7];
+        m->psi_pick[1] = arrays[8];
+        m->psi_pick_old[0] = arrays[9];
+        m->psi_pick_old[1] = arrays[10];
         for (int i = 0; i < IMPULSE_CACHE; i++) {
             free(m->impulse_cache[i].psi);
             m->impulse_cache[i].psi = impulse[i];
@@ -252,12 +270,9 @@ static ictus_status build_modes(membrane *m, int modes)
         }
         for (int i = 0; i < m->point_count; i++) {
             membrane_point *pt = m->points[i];
-            free(pt->psi), free(pt->psi_next), free(pt->gq), free(pt->gp), free(pt->wd);
+            free(pt->psi), free(pt->psi_next);
             pt->psi = ppsi[i][0];
             pt->psi_next = ppsi[i][1];
-            pt->gq = ppsi[i][2];
-            pt->gp = ppsi[i][3];
-            pt->wd = ppsi[i][4];
             pt->psi_cap = cap;
         }
         m->capacity = cap;
@@ -282,14 +297,14 @@ static ictus_status build_modes(membrane *m, int modes)
     for (int k = m->fading_modes; k < m->capacity; k++)
         m->q[k] = m->p[k] = 0.0f;
     update_coefficients(m, 1);
-    mode_shapes(m, m->strike_r, m->strike_theta, m->psi_strike);
+    input_shapes(m, m->strike_r, m->strike_theta, m->psi_strike);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++)
         mode_shapes(m, m->pick_r[i], m->pick_theta[i], m->psi_pick[i]);
     for (int i = 0; i < m->point_count; i++) {
         membrane_point *pt = m->points[i];
-        mode_shapes(m, pt->r_over_a, pt->theta_deg, pt->psi);
+        input_shapes(m, pt->r_over_a, pt->theta_deg, pt->psi);
         if (pt->move_pending)
-            mode_shapes(m, pt->move_r, pt->move_theta, pt->psi_next);
+            input_shapes(m, pt->move_r, pt->move_theta, pt->psi_next);
     }
     refresh_point_couplings(m);
     return ICTUS_OK;
@@ -305,9 +320,9 @@ static void flush_points(membrane *m)
         membrane_point *pt = m->points[i];
         if (pt->force_pending != 0.0 && pt->psi) {
             for (int k = 0; k < m->count; k++) {
-                float u = (float)pt->force_pending * pt->psi[k];
-                m->q[k] += m->eq[k] * u;
-                m->p[k] += m->ep[k] * u;
+                float du = m->ep[k] * ((float)pt->force_pending * pt->psi[k]);
+                m->q[k] += du;
+                m->p[k] += du;
             }
         }
         pt->force_pending = 0.0;
@@ -322,18 +337,20 @@ static double dot_psi(const membrane *m, const float *a, const float *b, const f
     return s;
 }
 
+/* The displacement per unit of sum psi r: w = sum dm psi q = scale h sum psi r. */
+static double displacement_scale(const membrane *m)
+{
+    return m->mass_scale * m->coef_h;
+}
+
 static void point_couplings(membrane *m, membrane_point *pt)
 {
-    /* w changes by K F over a sample: K = sum psi dm psi eq (docs/membrane.md). */
+    /* w changes by K F over a sample: K = sum psi dm psi eq = scale h sum psi^2 ep
+     * (docs/membrane.md). */
     double K = 0.0;
     for (int k = 0; k < m->count; k++)
-        K += (double)pt->psi[k] * pt->psi[k] * m->dm[k] * m->eq[k];
-    for (int k = 0; k < m->capacity; k++) {
-        pt->gq[k] = m->eq[k] * pt->psi[k];
-        pt->gp[k] = m->ep[k] * pt->psi[k];
-        pt->wd[k] = m->dm[k] * pt->psi[k];
-    }
-    pt->self_compliance = K;
+        K += (double)pt->psi[k] * pt->psi[k] * m->ep[k];
+    pt->self_compliance = K * displacement_scale(m);
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
         pt->pick_coupling[j] = dot_psi(m, m->psi_pick[j], pt->psi, m->ep);
 }
@@ -371,6 +388,11 @@ membrane *membrane_new(double sample_rate_hz)
     if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
         m->kernel = membrane_kernel_avx2;
 #endif
+    /* ICTUS_MEMBRANE_KERNEL=generic picks the portable kernel on any machine, e.g.
+     * to benchmark it inside Pd (bench/peers); read when the object is made. */
+    const char *want = getenv("ICTUS_MEMBRANE_KERNEL");
+    if (want && strcmp(want, "generic") == 0)
+        m->kernel = membrane_kernel_generic;
     if (build_modes(m, MEMBRANE_DEFAULT_MODES) != ICTUS_OK) {
         membrane_free(m);
         return NULL;
@@ -386,8 +408,8 @@ void membrane_free(membrane *m)
         membrane_point_detach_(m, m->points[m->point_count - 1]);
     mode_table_free(&m->table);
     free(m->omega_model);
-    free(m->q), free(m->p), free(m->c1), free(m->c2), free(m->c3);
-    free(m->eq), free(m->ep), free(m->dm), free(m->psi_strike);
+    free(m->q), free(m->p), free(m->c1), free(m->cd), free(m->c3);
+    free(m->ep), free(m->psi_strike);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
         free(m->psi_pick[i]);
         free(m->psi_pick_old[i]);
@@ -530,7 +552,7 @@ ictus_status membrane_set_strike_point(membrane *m, double r_over_a, double thet
     ictus_status s = clamp_point(&r_over_a, &theta_deg);
     m->strike_r = r_over_a;
     m->strike_theta = theta_deg;
-    mode_shapes(m, r_over_a, theta_deg, m->psi_strike);
+    input_shapes(m, r_over_a, theta_deg, m->psi_strike);
     return s;
 }
 
@@ -550,7 +572,7 @@ static impulse_shape *make_impulse_shape(membrane *m, double r, double theta)
         return s;
     s = &m->impulse_cache[m->impulse_next];
     m->impulse_next = (m->impulse_next + 1) % IMPULSE_CACHE;
-    mode_shapes(m, r, theta, s->psi);
+    input_shapes(m, r, theta, s->psi);
     s->r_over_a = r;
     s->theta_deg = theta;
     s->valid = 1;
@@ -698,31 +720,28 @@ ictus_status membrane_point_attach_(membrane *m, membrane_point *pt)
         return ICTUS_ENOMEM;
     if (pt->owner)
         membrane_point_detach_(pt->owner, pt);
-    float *arr[5];
+    float *arr[2];
     int ok = 1;
-    for (int j = 0; j < 5; j++) {
+    for (int j = 0; j < 2; j++) {
         arr[j] = alloc_floats(m->capacity);
         ok = ok && arr[j];
     }
     if (!ok) {
-        for (int j = 0; j < 5; j++)
+        for (int j = 0; j < 2; j++)
             free(arr[j]);
         return ICTUS_ENOMEM;
     }
-    free(pt->psi), free(pt->psi_next), free(pt->gq), free(pt->gp), free(pt->wd);
+    free(pt->psi), free(pt->psi_next);
     pt->psi = arr[0];
     pt->psi_next = arr[1];
-    pt->gq = arr[2];
-    pt->gp = arr[3];
-    pt->wd = arr[4];
     pt->psi_cap = m->capacity;
     pt->owner = m;
     pt->slot = m->point_count;
     m->points[m->point_count++] = pt;
     pt->force_pending = 0.0;
-    mode_shapes(m, pt->r_over_a, pt->theta_deg, pt->psi);
+    input_shapes(m, pt->r_over_a, pt->theta_deg, pt->psi);
     if (pt->move_pending)
-        mode_shapes(m, pt->move_r, pt->move_theta, pt->psi_next);
+        input_shapes(m, pt->move_r, pt->move_theta, pt->psi_next);
     point_couplings(m, pt);
     return ICTUS_OK;
 }
@@ -753,8 +772,8 @@ void membrane_point_free_(membrane_point *pt)
         return;
     if (pt->owner)
         membrane_point_detach_(pt->owner, pt);
-    free(pt->psi), free(pt->psi_next), free(pt->gq), free(pt->gp), free(pt->wd);
-    pt->psi = pt->psi_next = pt->gq = pt->gp = pt->wd = NULL;
+    free(pt->psi), free(pt->psi_next);
+    pt->psi = pt->psi_next = NULL;
     pt->psi_cap = 0;
 }
 
@@ -765,9 +784,15 @@ void membrane_point_move_(membrane_point *pt, double r_over_a, double theta_deg,
     pt->move_offset = sample_offset;
     pt->move_pending = 1;
     /* The weights of the new point are computed here, in the message handler,
-     * so that landing in the audio loop costs O(modes) only. */
-    if (pt->owner)
-        mode_shapes(pt->owner, r_over_a, theta_deg, pt->psi_next);
+     * so that landing in the audio loop costs O(modes) only. They come from the
+     * strikes' small cache of shapes (the same values): a stick that plays the
+     * same spot again, as a roll or a patch with a fixed position does, costs a
+     * copy instead of O(modes) Bessel functions. */
+    if (pt->owner) {
+        membrane *m = pt->owner;
+        const impulse_shape *shape = make_impulse_shape(m, r_over_a, theta_deg);
+        memcpy(pt->psi_next, shape->psi, sizeof(float) * (size_t)m->capacity);
+    }
 }
 
 /* ---------------------------------------------------------------- process */
@@ -780,13 +805,14 @@ static void add_input(membrane *m, const float *psi, double force, membrane_kern
     double dpick[MEMBRANE_PICKUPS] = {0}, dw[MEMBRANE_MAX_POINTS] = {0};
     for (int k = 0; k < m->count; k++) {
         float u = (float)force * psi[k];
-        float dq = m->eq[k] * u, dp = m->ep[k] * u;
+        float dq = m->ep[k] * u, dp = dq; /* r and p take the same input */
         m->q[k] += dq;
         m->p[k] += dp;
         for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-            dpick[j] += (double)m->psi_pick[j][k] * dp;
+            if (a->psi_pick[j])
+                dpick[j] += (double)a->psi_pick[j][k] * dp;
         for (int c = 0; c < a->points; c++)
-            dw[c] += (double)a->point_wd[c][k] * dq;
+            dw[c] += (double)a->point_psi[c][k] * dq; /* unscaled, as the kernel's */
     }
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
         a->pick_sum[j] += dpick[j];
@@ -798,8 +824,8 @@ static double point_displacement(const membrane *m, const float *psi)
 {
     double w = 0.0;
     for (int k = 0; k < m->count; k++)
-        w += (double)psi[k] * m->dm[k] * m->q[k];
-    return w;
+        w += (double)psi[k] * m->q[k];
+    return w * displacement_scale(m);
 }
 
 /* A pending move lands: the last force at the old place goes into the state, the
@@ -809,9 +835,9 @@ static void land_point(membrane *m, membrane_point *pt)
 {
     if (pt->force_pending != 0.0) {
         for (int k = 0; k < m->count; k++) {
-            float u = (float)pt->force_pending * pt->psi[k];
-            m->q[k] += m->eq[k] * u;
-            m->p[k] += m->ep[k] * u;
+            float du = m->ep[k] * ((float)pt->force_pending * pt->psi[k]);
+            m->q[k] += du;
+            m->p[k] += du;
         }
     }
     float *t = pt->psi;
@@ -852,10 +878,14 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
     membrane_kernel_args a;
     memset(&a, 0, sizeof(a));
     a.count = m->count;
-    a.q = m->q, a.p = m->p, a.c1 = m->c1, a.c2 = m->c2, a.c3 = m->c3;
-    a.eq = m->eq, a.ep = m->ep, a.dm = m->dm;
+    a.q = m->q, a.p = m->p, a.c1 = m->c1, a.cd = m->cd, a.c3 = m->c3;
+    a.ep = m->ep;
+    a.input_scale = (float)displacement_scale(m);
+    const double wscale = displacement_scale(m);
     a.psi_strike = m->psi_strike;
-    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+    /* Pickups computed: both, or only the first when nothing takes the second. */
+    const int picks = (out && !out[1]) ? 1 : MEMBRANE_PICKUPS;
+    for (int j = 0; j < picks; j++)
         a.psi_pick[j] = m->psi_pick[j];
     for (int c = 0; c < m->point_count; c++)
         m->points[c]->ops->block_begin(m->points[c], n);
@@ -882,9 +912,7 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             membrane_point *pt = m->points[c];
             if (pt->active || pt->force_pending != 0.0) {
                 act[na] = pt;
-                a.point_gq[na] = pt->gq;
-                a.point_gp[na] = pt->gp;
-                a.point_wd[na] = pt->wd;
+                a.point_psi[na] = pt->psi;
                 a.point_force_pending[na] = (float)pt->force_pending;
                 na++;
             }
@@ -909,7 +937,7 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
         for (int c = 0; c < na; c++) {
             if (act[c]->active) {
                 /* Compact to the active points; c >= nact, so in-place is safe. */
-                a.point_w[nact] = a.point_w[c];
+                a.point_w[nact] = a.point_w[c] * wscale;
                 act[nact++] = act[c];
             }
         }
@@ -924,8 +952,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
                         continue;
                     double s = 0.0;
                     for (int k = 0; k < m->count; k++)
-                        s += (double)act[r]->psi[k] * m->dm[k] * act[c]->psi[k] * m->eq[k];
-                    K[r][c] = s;
+                        s += (double)act[r]->psi[k] * act[c]->psi[k] * m->ep[k];
+                    K[r][c] = s * wscale;
                 }
             }
             act[0]->ops->solve(act, nact, a.point_w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
@@ -939,7 +967,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
                 m->gain_smoothed = m->output_gain;
         }
         const double out_scale = m->gain_smoothed * m->mass_scale;
-        for (int j = 0; j < MEMBRANE_PICKUPS; j++) {
+        y[1] = 0.0;
+        for (int j = 0; j < picks; j++) {
             y[j] = out_scale * (a.pick_sum[j] + extra[j]);
             if (m->pick_fade_left[j] > 0) {
                 /* Crossfade from a moved pickup: one more dot product per sample for
@@ -953,6 +982,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             }
             finite = finite && fabs(y[j]) <= FLT_MAX;
         }
+        if (picks < MEMBRANE_PICKUPS && m->pick_fade_left[1] > 0)
+            m->pick_fade_left[1]--; /* the skipped pickup's crossfade runs on */
         if (!finite) {
             /* Last line of defence (never reached with legal inputs in the tests):
              * a state that overflowed float is silenced rather than sent out. */
@@ -983,12 +1014,14 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             /* Rung out: drop them for good (no allocation, O(dropped modes)). */
             for (int k = m->modes; k < m->count; k++) {
                 m->q[k] = m->p[k] = 0.0f;
-                m->c1[k] = m->c2[k] = m->c3[k] = m->eq[k] = m->ep[k] = m->dm[k] = 0.0f;
+                m->c1[k] = m->cd[k] = m->c3[k] = m->ep[k] = 0.0f;
                 m->omega_model[k] = 0.0;
             }
             m->fading_modes = m->modes;
             m->count = padded(m->modes);
             m->fade_left = 0;
+            for (int i = 0; i < IMPULSE_CACHE; i++)
+                m->impulse_cache[i].valid = 0; /* shapes of the sounding modes only */
         }
     }
 #ifdef MEMBRANE_X86
@@ -1068,7 +1101,8 @@ static void effective_state(const membrane *m, int k, double *q, double *p)
     for (int i = 0; i < m->point_count; i++)
         if (m->points[i]->force_pending != 0.0)
             u += m->points[i]->force_pending * m->points[i]->psi[k];
-    *q = m->q[k] + (double)m->eq[k] * u;
+    /* q = h w' r (membrane_kernel.inc) */
+    *q = (m->q[k] + (double)m->ep[k] * u) * m->coef_h * m->omega_model[k];
     *p = m->p[k] + (double)m->ep[k] * u;
 }
 

@@ -139,7 +139,9 @@ ictus_status membrane_set_output_gain(membrane *m, double gain);
 
 /* Advances n samples. force_in (may be NULL) is a force (N) applied at the
  * strike point; out[0..MEMBRANE_PICKUPS-1] receive the pickup signals
- * (membrane velocity, see docs/membrane.md). force_in may alias an output. */
+ * (membrane velocity, see docs/membrane.md). force_in may alias an output.
+ * When out is not NULL but out[1] is, the second pickup is not computed at all
+ * (one dot product per mode and sample less); pickup 0 is the same either way. */
 void membrane_process(membrane *m, const float *force_in, float *const *out, int n);
 
 /* Table-driven access to the one-number parameters: the setter and getter named in

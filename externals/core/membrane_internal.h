@@ -14,20 +14,20 @@
 
 /* Arguments of one sample of the modal update (see membrane_kernel.inc). */
 typedef struct membrane_kernel_args {
-    int count; /* modes to update, a multiple of MEMBRANE_PAD */
-    float *q, *p;
-    const float *c1, *c2, *c3, *eq, *ep, *dm;
+    int count;    /* modes to update, a multiple of MEMBRANE_PAD */
+    float *q, *p; /* r = q / (h w') and p (membrane.c, update_coefficients) */
+    const float *c1, *cd, *c3, *ep;
+    float input_scale; /* scale h: ep = input_scale cd, w = input_scale sum psi r */
     const float *psi_strike;
     const float *psi_pick[MEMBRANE_PICKUPS];
     float strike_force; /* N, at the strike point, during this sample */
     int points;         /* coupling points whose displacement is wanted */
-    /* Per point: eq * psi, ep * psi (input vectors) and dm * psi (displacement
-     * weights), precomputed when the point or the coefficients change. */
-    const float *point_gq[MEMBRANE_MAX_POINTS], *point_gp[MEMBRANE_MAX_POINTS];
-    const float *point_wd[MEMBRANE_MAX_POINTS];
+    /* Per point: its mode shapes, zero for fading modes. A force F goes in as
+     * F input_scale psi cd into r and p; the displacement is input_scale sum psi r. */
+    const float *point_psi[MEMBRANE_MAX_POINTS];
     float point_force_pending[MEMBRANE_MAX_POINTS]; /* last sample's forces, not yet in q, p */
     double pick_sum[MEMBRANE_PICKUPS];              /* out: sum psi_pick * p */
-    double point_w[MEMBRANE_MAX_POINTS];            /* out: sum wd * q */
+    double point_w[MEMBRANE_MAX_POINTS];            /* out: sum psi * r (unscaled) */
 } membrane_kernel_args;
 
 void membrane_kernel_generic(membrane_kernel_args *a);
@@ -73,10 +73,10 @@ struct membrane_point {
     const membrane_point_ops *ops;
     membrane *owner; /* NULL while detached */
     int slot;        /* index in the owner's table */
-    /* Mode weights (mass-normalised shapes) at the point and at the place of a
-     * pending move, and the couplings eq psi, ep psi, dm psi. Allocated by the
-     * membrane at its capacity (psi_cap floats each), freed by membrane_point_free_. */
-    float *psi, *psi_next, *gq, *gp, *wd;
+    /* Mode weights (mass-normalised shapes, zero for fading modes) at the point and
+     * at the place of a pending move. Allocated by the membrane at its capacity
+     * (psi_cap floats each), freed by membrane_point_free_. */
+    float *psi, *psi_next;
     int psi_cap;
     double r_over_a, theta_deg;
     /* A move waiting to land move_offset samples into the next membrane_process(). */

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "ictus_pd.h"
+#include "m_imp.h" /* obj_starttraverseoutlet: is the second outlet connected? */
 
 #if PD_FLOATSIZE != 32
 #error "ictus: the DSP core works on 32-bit float signals; build against a 32-bit Pd"
@@ -219,7 +220,7 @@ static t_int *membrane_tilde_perform(t_int *w)
     t_sample *out[MEMBRANE_PICKUPS];
     int n = (int)(w[5]);
     out[0] = (t_sample *)(w[3]);
-    out[1] = (t_sample *)(w[4]);
+    out[1] = (t_sample *)(w[4]); /* NULL: nothing connected, pickup 2 not computed */
     ictus_clock_block_begin(&x->x_clock, n);
     membrane_process(x->x_core, force_in, out, n);
     ictus_clock_block_end(&x->x_clock, n);
@@ -234,8 +235,12 @@ static void membrane_tilde_dsp(t_membrane_tilde *x, t_signal **sp)
                  MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, membrane_get_sample_rate(x->x_core));
     ictus_clock_dsp(&x->x_clock, membrane_get_sample_rate(x->x_core));
     membrane_tilde_check_silent(x);
-    dsp_add(membrane_tilde_perform, 5, x, sp[0]->s_vec, sp[1]->s_vec, sp[2]->s_vec,
-            (t_int)sp[0]->s_n);
+    /* Pd rebuilds the DSP chain whenever a connection changes, so asking here is
+     * enough. An unconnected signal outlet's buffer is read by nobody. */
+    t_outlet *second;
+    int second_used = obj_starttraverseoutlet(&x->x_obj, &second, 1) != NULL;
+    dsp_add(membrane_tilde_perform, 5, x, sp[0]->s_vec, sp[1]->s_vec,
+            second_used ? sp[2]->s_vec : NULL, (t_int)sp[0]->s_n);
 }
 
 /* ---------------- life cycle ---------------- */

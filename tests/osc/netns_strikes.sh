@@ -54,7 +54,7 @@ for _ in $(seq 100); do
     sleep 0.1
 done
 
-ip netns exec "$a" "$ictusd" run --mocap "$clip" --duration 4 \
+ip netns exec "$a" "$ictusd" run --mocap "$clip" --autoplay --duration 4 \
     --target osc.udp://10.213.0.2:9000 --bind 10.213.0.1 --allow 10.213.0.2 --port 9001 \
     --reply osc.udp://10.213.0.2:9000 --out "$work/run" &
 daemon_pid=$!

@@ -279,11 +279,12 @@ TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked r
     const double seconds = 4.0;
     std::atomic<bool> done{false};
     std::thread daemon([&]() {
-        osctest::run(
-            {ICTUSD_OSC_PATH, "run", "--mocap", clip, "--duration", std::to_string(seconds),
-             "--target", "osc.udp://127.0.0.1:" + std::to_string(dump_port), "--port",
-             std::to_string(port), "--reply", "osc.udp://127.0.0.1:" + std::to_string(dump_port),
-             "--out", dir.string(), "--pose-rate", "30"});
+        osctest::run({ICTUSD_OSC_PATH, "run", "--mocap", clip, "--autoplay", "--duration",
+                      std::to_string(seconds), "--target",
+                      "osc.udp://127.0.0.1:" + std::to_string(dump_port), "--port",
+                      std::to_string(port), "--reply",
+                      "osc.udp://127.0.0.1:" + std::to_string(dump_port), "--out", dir.string(),
+                      "--pose-rate", "30"});
         done = true;
     });
     // Commands while it runs, repeated until each has been answered or the
@@ -515,8 +516,8 @@ TEST_CASE("run: a full disk under strikes.csv stops the run, exit 1, naming the 
     fs::create_directories(dir / "devfull");
     fs::create_symlink("/dev/full", dir / "devfull" / "strikes.csv");
     {
-        Daemon d({"run", "--duration", "2", "--port", "0", "--pose-rate", "0", "--target", target,
-                  "--out", (dir / "devfull").string()});
+        Daemon d({"run", "--autoplay", "--duration", "2", "--port", "0", "--pose-rate", "0",
+                  "--target", target, "--out", (dir / "devfull").string()});
         CHECK(d.wait() == 1);
         INFO(d.err);
         CHECK(d.err.find("/devfull/strikes.csv': " + std::string(std::strerror(ENOSPC))) !=
@@ -526,8 +527,8 @@ TEST_CASE("run: a full disk under strikes.csv stops the run, exit 1, naming the 
     // short write; the run stops there, long before its 60 s.
     {
         const long limit = 500;
-        Daemon d({"run", "--duration", "60", "--port", "0", "--pose-rate", "0", "--target", target,
-                  "--out", (dir / "limit").string()},
+        Daemon d({"run", "--autoplay", "--duration", "60", "--port", "0", "--pose-rate", "0",
+                  "--target", target, "--out", (dir / "limit").string()},
                  limit);
         CHECK(d.wait() == 1);
         INFO(d.out << d.err);
@@ -551,8 +552,9 @@ TEST_CASE("run: killed with SIGKILL mid-run, strikes.csv holds whole lines only"
 {
     const fs::path dir = scratch("run-kill");
     osctest::Peer sink;
-    Daemon d({"run", "--duration", "600", "--port", "0", "--pose-rate", "0", "--target",
-              "osc.udp://127.0.0.1:" + std::to_string(sink.port()), "--out", dir.string()});
+    Daemon d({"run", "--autoplay", "--duration", "600", "--port", "0", "--pose-rate", "0",
+              "--target", "osc.udp://127.0.0.1:" + std::to_string(sink.port()), "--out",
+              dir.string()});
     // Killed once the file holds the header and three rows (a deadline, not a sleep).
     const fs::path csv = dir / "strikes.csv";
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);

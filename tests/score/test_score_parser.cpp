@@ -183,6 +183,42 @@ TEST_CASE("score: grip firmness per note and as a default, the performance's whe
     require_error("firmness x", 1, 10, "firmness");
 }
 
+TEST_CASE("score: a default nuance for the notes that name none (the panel's nuance selector)",
+          "[score][parser]")
+{
+    const Score s = parse_score("R, nuance accent, L, R tenuto\nnuance vertical-accent, L\n"
+                                "nuance legato, R",
+                                "t.txt");
+    REQUIRE(s.notes.size() == 5);
+    CHECK(s.notes[0].nuance == Nuance::legato);
+    CHECK(s.notes[1].nuance == Nuance::accent);
+    CHECK(s.notes[2].nuance == Nuance::tenuto);
+    CHECK(s.notes[3].nuance == Nuance::vertical_accent);
+    CHECK(s.notes[4].nuance == Nuance::legato);
+    require_error("nuance", 1, 7, "'nuance' needs a nuance");
+    require_error("nuance legatto", 1, 8, "unknown nuance 'legatto'");
+    require_error("nuance accent tenuto", 1, 15, "unexpected 'tenuto' after the nuance");
+    // Set by the builder (/ictus/nuance), it is not a statement: the
+    // positions of errors stay those of the statements received.
+    ScoreBuilder b("osc");
+    b.add_statement("R");
+    b.set_default_nuance(Nuance::staccato);
+    b.add_statement("L, R accent");
+    CHECK(b.statements() == 2);
+    const Score built = b.finish();
+    REQUIRE(built.notes.size() == 3);
+    CHECK(built.notes[0].nuance == Nuance::legato);
+    CHECK(built.notes[1].nuance == Nuance::staccato);
+    CHECK(built.notes[2].nuance == Nuance::accent);
+    try {
+        b.add_statement("R lgato");
+        FAIL("a bad statement was accepted");
+    } catch (const ScoreError &e) {
+        CHECK(e.line() == 3);
+        CHECK(e.column() == 3);
+    }
+}
+
 TEST_CASE("score: tempo and grip and rest and default beats and dynamics", "[score][parser]")
 {
     const Score s = parse_score("tempo 60\n"

@@ -194,6 +194,10 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.mode = parse_track_mode(a, value());
     else if (a == "--strike-depth")
         o.score.plan.strike_depth_m = parse_number(a, value(), -0.05, 0.05);
+    else if (a == "--strike-aim")
+        o.score.plan.strike_aim_s = parse_number(a, value(), 0.0, 0.01);
+    else if (a == "--strike-aim-from")
+        o.score.plan.strike_aim_from_mps = parse_number(a, value(), 0.0, 20.0);
     else if (a == "--advance")
         o.score.time_advance_s = parse_number(a, value(), 0, 0.1);
     else if (a == "--ik-gain")
@@ -202,6 +206,8 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.cartesian.velocity_gain_s = parse_number(a, value(), 0, 1);
     else if (a == "--ik-rotation-weight")
         o.score.cartesian.rotation_weight = parse_number(a, value(), 0, 1);
+    else if (a == "--ik-max-joint-speed")
+        o.score.cartesian.max_joint_speed_rad_s = parse_number(a, value(), 0, 1000);
     else if (a == "--rebound")
         o.score.rebound_s = parse_number(a, value(), 0, 0.5);
     else if (a == "--lead-in")

@@ -80,11 +80,16 @@ void render_usage(std::ostream &out)
            "  --mode M            cartesian (default, Algorithm 2) | joint (eq. 1, joint\n"
            "                      targets from the IK of the tip targets)\n"
            "  --strike-depth M    the target dips this far below the first contact (0)\n"
+           "  --strike-aim S      and further by S times the planned impact speed above\n"
+           "                      --strike-aim-from V (defaults 0.0025 s, 1.5 m/s)\n"
            "  --advance S         tip targets sampled S ahead: the tracking lag (default 0)\n"
-           "  --rebound S         the target's rebound after a beat, time constant (default\n"
-           "                      0.1; 0: off)\n"
+           "  --rebound S         a scripted rebound of the target after each beat, time\n"
+           "                      constant (default 0: off, the stick rebounds by itself)\n"
            "  --ik-gain G         Algorithm 2's gain on the tip error (default 4)\n"
            "  --ik-velocity-gain S  tip velocity error term, s (default 0.03)\n"
+           "  --ik-rotation-weight W  weight of the hands' rotation task (1; 0: off)\n"
+           "  --ik-max-joint-speed R  the kinematic IK turns no arm joint faster than R\n"
+           "                      rad/s (default 30; 0: no cap)\n"
            "  --lead-in S         time before the score's first beat (default 1)\n"
            "\n"
            "common options (run and render):\n"
@@ -306,6 +311,8 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
     j["plan"] = {{"duration_s", plan.duration_s},
                  {"origin_s", perf.plan_origin_s()},
                  {"strike_depth_m", o.score.plan.strike_depth_m},
+                 {"strike_aim_s", o.score.plan.strike_aim_s},
+                 {"strike_aim_from_mps", o.score.plan.strike_aim_from_mps},
                  {"time_advance_s", o.score.time_advance_s},
                  {"lead_in_s", o.score.plan.lead_in_s}};
     const Performance::BodyStats &b = perf.body_stats();

@@ -46,6 +46,10 @@ void run_usage(std::ostream &out)
            "performed (Cartesian mode by default); /ictus/score statements replace it at the\n"
            "next /ictus/play.\n"
            "\n"
+           "The performer waits, sticks at rest (a clip: on its first frame), for\n"
+           "/ictus/play (the patch's play button, or a score box), so that nothing is over\n"
+           "before the patch is open; --autoplay starts at once.\n"
+           "\n"
            "  --target URL        where strikes and poses go: osc.udp://HOST:PORT, an IPv4\n"
            "                      address or a name that resolves to one, port 1 to 65535\n"
            "                      (default osc.udp://127.0.0.1:9000)\n"
@@ -60,7 +64,9 @@ void run_usage(std::ostream &out)
            "  --lookahead S       strike timetag = start + time + S (default 0.02; 0: immediate)\n"
            "  --pose-rate HZ      pose stream rate (default 30; 0: off)\n"
            "  --tip-rate HZ       stick-tip state stream rate (default 0: off)\n"
-           "  --paused            wait for /ictus/play\n"
+           "  --autoplay          play at once (the score or the clip), without waiting for\n"
+           "                      /ictus/play; stop it with /ictus/stop\n"
+           "  --paused            wait for /ictus/play (the default; kept for old scripts)\n"
            "  --realtime          SCHED_FIFO for the physics loop and the strike sender (when\n"
            "                      the system allows it): no late strike on a busy machine, but\n"
            "                      a physics loop slower than real time then holds a core\n"
@@ -70,7 +76,8 @@ void run_usage(std::ostream &out)
            "  common options: see ictusd render --help\n"
            "\n"
            "examples:\n"
-           "  ictusd run --mocap ../shared/data/cmu/80_13.bvh\n"
+           "  ictusd run --reply osc.udp://127.0.0.1:9000   (then press play in patches/ictus.pd)\n"
+           "  ictusd run --mocap ../shared/data/cmu/80_13.bvh --autoplay\n"
            "  ictusd run --score examples/scores/figure5.txt --mode cartesian\n"
            "  ictusd run --mocap clip.bvh --target osc.udp://10.0.0.2:9000 --bind 10.0.0.1 \\\n"
            "             --allow 10.0.0.2 --lookahead 0.05\n"
@@ -200,7 +207,7 @@ int cmd_run(Args &args)
     so.lookahead_s = 0.02;
     OscServerOptions io;
     double duration = 0.0, pose_rate = 30.0, tip_rate = 0.0;
-    bool paused = false, realtime = false;
+    bool autoplay = false, realtime = false;
     std::string out_dir;
     while (!args.done()) {
         const std::string a = args.next();
@@ -235,7 +242,9 @@ int cmd_run(Args &args)
         } else if (a == "--realtime") {
             realtime = true;
         } else if (a == "--paused") {
-            paused = true;
+            autoplay = false;
+        } else if (a == "--autoplay") {
+            autoplay = true;
         } else if (a == "--out") {
             out_dir = value();
         } else if (!parse_performance_option(a, args, o, duration)) {
@@ -279,7 +288,8 @@ int cmd_run(Args &args)
         if (server_ptr)
             server_ptr->post_refusal(f);
     };
-    if (paused) {
+    // Waits for /ictus/play unless --autoplay (docs/osc.md, "Starting").
+    if (!autoplay) {
         Command stop;
         stop.kind = CommandKind::stop;
         perf.apply(stop);

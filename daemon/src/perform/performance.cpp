@@ -23,6 +23,7 @@
 #include <deque>
 #include <iostream>
 #include <limits>
+#include <stdexcept>
 #include <thread>
 
 namespace ictus
@@ -66,6 +67,99 @@ Eigen::Vector3d strike_drum_center(const CharacterModel &model, const ReferenceM
     if (xs.size() < 4)
         return fallback;
     return Eigen::Vector3d(median(xs), median(ys), median(zs));
+}
+
+// The live tempo scale (docs/osc.md, /ictus/tempo in score mode): the tempo
+// map with every tempo from `from_beat` on multiplied by `factor`, the beats
+// before it (and so every time up to it) as they were. A ramp running at
+// `from_beat` goes on, scaled, to its end. Throws std::runtime_error when a scaled
+// tempo leaves the score's range (20..400 bpm).
+TempoMap scale_tempo_from(const TempoMap &map, double from_beat, double factor)
+{
+    const std::vector<TempoMap::Change> &changes = map.changes();
+    auto check = [&](double bpm, double beat, double scaled) {
+        if (!(scaled >= kMinTempoBpm && scaled <= kMaxTempoBpm)) {
+            char buf[200];
+            std::snprintf(buf, sizeof buf,
+                          "tempo: the score's %g bpm at beat %g would become %.4g bpm (beyond "
+                          "%g..%g)",
+                          bpm, beat, scaled, kMinTempoBpm, kMaxTempoBpm);
+            throw std::runtime_error(buf);
+        }
+    };
+    TempoMap out(changes.front().start_bpm);
+    const TempoMap::Change *running = &changes.front();
+    for (const TempoMap::Change &c : changes) {
+        if (c.beat >= from_beat)
+            break;
+        out.add(c.beat, c.start_bpm, c.end_bpm, c.ramp_beats);
+        running = &c;
+    }
+    for (const TempoMap::Change &c : changes)
+        if (c.beat <= from_beat)
+            running = &c;
+    const double here = map.tempo_at_beat(from_beat);
+    const double ramp_left = std::max(0.0, running->beat + running->ramp_beats - from_beat);
+    check(here, from_beat, factor * here);
+    check(running->end_bpm, running->beat + running->ramp_beats, factor * running->end_bpm);
+    out.add(from_beat, factor * here, factor * (ramp_left > 0.0 ? running->end_bpm : here),
+            ramp_left);
+    for (const TempoMap::Change &c : changes) {
+        if (c.beat <= from_beat)
+            continue;
+        check(c.start_bpm, c.beat, factor * c.start_bpm);
+        check(c.end_bpm, c.beat + c.ramp_beats, factor * c.end_bpm);
+        out.add(c.beat, factor * c.start_bpm, factor * c.end_bpm, c.ramp_beats);
+    }
+    return out;
+}
+
+// Where a live tempo change can start in a plan under way: the first beat
+// such that every stroke the hands have begun by plan time `now_s` keeps its
+// shape and time. A hand's stroke toward its note j is planned on the times
+// of notes j - 1, j and j + 1 (its unit is made for its period and warped
+// into the gaps, docs/score.md) and enters the hand's trajectory at the
+// start of the cross-fade window t_{j-1} + m (t_j - t_{j-1}); so a note j
+// whose window has not started can move its successors. Returns the beat
+// of the latest such first unstarted note over the hands (infinity: a hand
+// has begun its last stroke) and, in `until_s`, the earliest of those
+// windows: up to that plan time the plan with the new tempo equals the old.
+double tempo_split_beat(const Score &score, double score_start_s, double blend_margin, double now_s,
+                        double &until_s)
+{
+    double split = 0.0;
+    until_s = std::numeric_limits<double>::infinity();
+    for (Side hand : {Side::left, Side::right}) {
+        bool any = false, found = false;
+        double previous_s = 0.0;
+        for (const ScoreNote &n : score.notes) {
+            if (n.hand != hand)
+                continue;
+            const double t = score_start_s + score.note_time_s(n);
+            // The first stroke's window is the plan's start: always begun.
+            if (any) {
+                const double window_s = previous_s + blend_margin * (t - previous_s);
+                if (window_s > now_s) {
+                    split = std::max(split, n.beat);
+                    until_s = std::min(until_s, window_s);
+                    found = true;
+                    break;
+                }
+            }
+            any = true;
+            previous_s = t;
+        }
+        if (any && !found)
+            return std::numeric_limits<double>::infinity();
+    }
+    return split;
+}
+
+Score scale_score_from(const Score &score, double from_beat, double factor)
+{
+    Score out = score;
+    out.tempo = scale_tempo_from(score.tempo, from_beat, factor);
+    return out;
 }
 } // namespace
 
@@ -123,6 +217,7 @@ struct Performance::Job {
         replan,    // plan the current score on a new frame; a plan under way goes on
         score_rig, // the character again (a grip change), from `pose`
         clip_rig,  // clip mode: the character and its reference again, then play
+        tempo,     // the score under way at `bpm` from its first beat not yet under way
     };
     Kind kind = Kind::play;
     Command origin;
@@ -130,6 +225,10 @@ struct Performance::Job {
     PerformerFrame frame;
     PerformanceOptions options;
     std::vector<Eigen::Quaterniond> pose;
+    // play: the tempo scale of the score (start_bpm > 0: the scale that
+    // starts it at start_bpm); tempo: the scale so far, the bpm asked for,
+    // the plan's clock when it was asked and the plan time of beat 0.
+    double tempo_scale = 1.0, start_bpm = 0.0, bpm = 0.0, plan_now_s = 0.0, score_start_s = 0.0;
     bool supersedes(const Job &earlier) const
     {
         if (earlier.kind == Kind::replan)
@@ -146,6 +245,12 @@ struct Performance::Result {
     std::unique_ptr<ScoreRig> score_rig;
     std::unique_ptr<Rig> rig;
     Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero(); // clip_rig
+    // play, tempo: the tempo scale now in force and the score's own first
+    // tempo (play); tempo: the score the change was planned on, and the
+    // plan time until which the new plan equals the old one.
+    double tempo_scale = 1.0, first_bpm = 0.0;
+    std::shared_ptr<const Score> based_on;
+    double valid_until_s = 0.0;
 };
 
 // The worker thread: takes jobs, keeps only the last of a kind that a later
@@ -277,6 +382,7 @@ Performance::Performance(const PerformanceOptions &options)
         parse_score(so.score_text.empty() ? default_score_text() : so.score_text, so.score_name));
     if (!so.grip_given && !score_->notes.empty())
         options_.character.grip = score_->notes.front().grip;
+    score_first_bpm_ = score_->tempo.tempo_at_beat(0.0);
     skeleton_ = default_skeleton();
     install_score_rig(make_score_rig(options_, nullptr), false);
     playing_ = false;
@@ -634,6 +740,14 @@ ScorePerformOptions::ScorePerformOptions()
     // (4 mm below it, as with welded sticks, left the hand pressing on after
     // soft strokes; docs/perform.md).
     plan.strike_depth_m = 0.0;
+    // But a fast stroke's hand turns ~2 ms before its target does (the
+    // tracking lag): at 7 m/s the stick then stopped 5 mm short of the head
+    // and the note was missed. The target aims through the head by 2.5 ms
+    // of the planned impact speed above 1.5 m/s (14 mm at 7 m/s; softer
+    // strokes aimed deeper pressed on the head in joint mode). Measured on
+    // 200 random scores, docs/perform.md.
+    plan.strike_aim_s = 0.0025;
+    plan.strike_aim_from_mps = 1.5;
     time_advance_s = 0.0;
     // Algorithm 2 for strokes: `ictusd track`'s CMU-tuned velocity term
     // (c = 0.1 s) feeds the 1 kHz tip velocity back and makes the tip chatter
@@ -644,6 +758,8 @@ ScorePerformOptions::ScorePerformOptions()
     // stick's own swing is not fed back), and a small velocity term damps the
     // hand's chatter after soft strokes (docs/perform.md, measured).
     cartesian.velocity_gain_s = 0.03;
+    // The kinematic IK turns no joint faster than this (CartesianOptions).
+    cartesian.max_joint_speed_rad_s = 30.0;
 }
 
 namespace
@@ -694,8 +810,10 @@ Performance::make_score_rig(const PerformanceOptions &options,
     const Eigen::Vector3d forward = left.cross(up);
     SceneOptions scene = options.scene;
     // A joint pushed outside its range of motion (the stick's reactions on the
-    // wrist) meets its stop 1 degree out (docs/perform.md, "Joint limits").
+    // wrist) meets its stop 1 degree out, which takes the whole overshoot
+    // back in one step (docs/perform.md, "Joint limits").
     scene.stop_margin_rad = std::min(scene.stop_margin_rad, 1.0 * M_PI / 180.0);
+    scene.stop_erp = 1.0;
     if (options.drum_auto)
         scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
                               options.score.drum_forward_m * forward -
@@ -868,6 +986,18 @@ void Performance::install_plan(std::unique_ptr<PlanState> plan, bool start_now)
     }
 }
 
+double Performance::tempo_bpm() const
+{
+    if (!score_mode())
+        return options_.tempo_bpm;
+    if (plan_active_ && plan_state_ && plan_state_->score) {
+        const TempoMap &map = plan_state_->score->tempo;
+        const double beat = map.beat_at_time(std::max(0.0, plan_time_s_ - plan_->score_start_s));
+        return map.tempo_at_beat(std::max(0.0, beat));
+    }
+    return start_bpm_ > 0.0 ? start_bpm_ : score_first_bpm_ * tempo_scale_;
+}
+
 double Performance::planned_impact_speed_mps(size_t note) const
 {
     return plan_state_ && note < plan_state_->planned_speed_mps.size()
@@ -895,6 +1025,7 @@ std::unique_ptr<Performance::Job> Performance::plan_job(const Command &origin, b
         job->statements = std::make_unique<ScoreBuilder>(*builder_);
     job->frame = score_rig_->frame;
     job->options.score.plan = options_.score.plan;
+    job->tempo_scale = tempo_scale_;
     return job;
 }
 
@@ -905,13 +1036,47 @@ std::unique_ptr<Performance::Result> Performance::execute(Job &job)
     r->origin = job.origin;
     try {
         switch (job.kind) {
-        case Job::Kind::play:
-        case Job::Kind::replan: {
+        case Job::Kind::play: {
             // A faulty score throws here: nothing changes, nothing plays.
             std::shared_ptr<const Score> score =
                 job.statements ? std::make_shared<const Score>(job.statements->finish()) : score_;
-            r->plan = make_plan(score, job.frame, job.options.score.plan);
+            // Played at the live tempo scale (/ictus/tempo): its map times
+            // the scale, or the scale that starts it at start_bpm.
+            const double first = score->tempo.tempo_at_beat(0.0);
+            const double scale = job.start_bpm > 0.0 ? job.start_bpm / first : job.tempo_scale;
+            std::shared_ptr<const Score> played =
+                scale == 1.0 ? score
+                             : std::make_shared<const Score>(scale_score_from(*score, 0.0, scale));
+            r->plan = make_plan(played, job.frame, job.options.score.plan);
+            r->tempo_scale = scale;
+            r->first_bpm = first;
             score_ = std::move(score); // the current score from now on
+            played_ = std::move(played);
+            break;
+        }
+        case Job::Kind::replan:
+            // The score as it plays (at its tempo scale), on the new frame.
+            r->plan = make_plan(played_ ? played_ : score_, job.frame, job.options.score.plan);
+            break;
+        case Job::Kind::tempo: {
+            // The score as it plays, from its first beat that no hand has
+            // begun to play toward: the strokes under way keep their shape
+            // and time.
+            std::shared_ptr<const Score> base = played_ ? played_ : score_;
+            double until_s = 0.0;
+            const double split =
+                tempo_split_beat(*base, job.score_start_s, job.options.score.plan.blend_margin,
+                                 job.plan_now_s + kTempoLatency_s, until_s);
+            const double factor = job.bpm / base->tempo.tempo_at_beat(
+                                                std::isfinite(split) ? split : base->length_beats);
+            r->tempo_scale = job.tempo_scale * factor;
+            r->based_on = base;
+            if (std::isfinite(split) && split < base->length_beats) {
+                auto scaled = std::make_shared<const Score>(scale_score_from(*base, split, factor));
+                r->plan = make_plan(scaled, job.frame, job.options.score.plan);
+                r->valid_until_s = until_s;
+                played_ = std::move(scaled);
+            }
             break;
         }
         case Job::Kind::score_rig:
@@ -945,6 +1110,8 @@ bool Performance::submit(std::unique_ptr<Job> job, std::string *why)
 
 bool Performance::install(std::unique_ptr<Result> r, std::string *why)
 {
+    if (r->kind == Job::Kind::play)
+        play_pending_ = false;
     if (!r->error.empty()) {
         if (why)
             *why = r->error;
@@ -953,6 +1120,28 @@ bool Performance::install(std::unique_ptr<Result> r, std::string *why)
     switch (r->kind) {
     case Job::Kind::play:
         install_plan(std::move(r->plan), true);
+        tempo_scale_ = r->tempo_scale;
+        score_first_bpm_ = r->first_bpm;
+        break;
+    case Job::Kind::tempo:
+        if (r->plan && plan_active_) {
+            // Planned on the score under way, and in time (the plan clock
+            // has not passed the first stroke that changes).
+            if (!plan_state_ || plan_state_->score != r->based_on) {
+                if (why)
+                    *why = "tempo: the score changed while the new tempo was planned; send it "
+                           "again";
+                return false;
+            }
+            if (plan_time_s_ > r->valid_until_s) {
+                if (why)
+                    *why = "tempo: planned too late (the performance passed the stroke it would "
+                           "change); send it again";
+                return false;
+            }
+            install_plan(std::move(r->plan), false);
+        }
+        tempo_scale_ = r->tempo_scale;
         break;
     case Job::Kind::replan:
         // Only a plan under way is replaced; a stopped one stays stopped
@@ -1252,10 +1441,15 @@ bool Performance::apply_score(const Command &c, std::string *why)
     ScoreRig &r = *score_rig_;
     try {
         switch (c.kind) {
-        case CommandKind::play:
+        case CommandKind::play: {
             // Finished and planned by the worker (run) or here (render):
             // a faulty score is refused, nothing changes, nothing plays.
-            return submit(plan_job(c, true), why);
+            auto job = plan_job(c, true);
+            job->start_bpm = start_bpm_;
+            start_bpm_ = 0.0;
+            play_pending_ = true; // until its plan is installed or refused
+            return submit(std::move(job), why);
+        }
         case CommandKind::stop:
             // The performance ends; the sticks go back to their rest.
             if (plan_active_)
@@ -1263,12 +1457,26 @@ bool Performance::apply_score(const Command &c, std::string *why)
             plan_active_ = false;
             playing_ = false;
             return true;
-        case CommandKind::tempo:
-            return fail("tempo: in score mode the tempo is part of the score (/ictus/score "
-                        "\"tempo 96\")");
+        case CommandKind::tempo: {
+            // A live scale of the score's tempo map (docs/osc.md): under way,
+            // from the first beat no hand has begun to play toward; stopped,
+            // the next play starts at this tempo.
+            if (!plan_active_ && !play_pending_) {
+                start_bpm_ = c.value;
+                return true;
+            }
+            auto job = plan_job(c, false);
+            job->kind = Job::Kind::tempo;
+            job->bpm = c.value;
+            job->plan_now_s = plan_active_ ? plan_time_s_ : 0.0;
+            job->score_start_s = plan_ ? plan_->score_start_s : options_.score.plan.lead_in_s;
+            return submit(std::move(job), why);
+        }
         case CommandKind::nuance:
-            return fail("nuance: in score mode each note names its nuance (/ictus/score "
-                        "\"R accent\")");
+            // The nuance of the statements that follow and name none.
+            default_nuance_ = nuance_from_string(c.text);
+            builder_->set_default_nuance(default_nuance_);
+            return true;
         case CommandKind::grip: {
             // The character is rebuilt (by the worker, in run) in its current
             // pose with the sticks in the new grip, and takes over from the
@@ -1338,7 +1546,13 @@ bool Performance::apply_score(const Command &c, std::string *why)
             builder_->add_statement(c.text);
             return true;
         case CommandKind::score_clear:
+            // A new score: its own tempi; the selected nuance still applies
+            // to the statements that follow.
             builder_->reset();
+            if (default_nuance_ != Nuance::legato)
+                builder_->set_default_nuance(default_nuance_);
+            tempo_scale_ = 1.0;
+            start_bpm_ = 0.0;
             return true;
         }
     } catch (const std::exception &e) {

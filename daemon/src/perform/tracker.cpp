@@ -188,10 +188,12 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
                     arm.kinematic_target[k] = target_[arm.joint[k]];
             arm.kinematic.set_rotations(arm.kinematic_target);
             Eigen::Quaterniond hand_target;
-            const bool orient = tips->has_direction && co.rotation_weight > 0.0 &&
-                                held_rotation(model, side, tips->stick_direction[s], hand_target);
+            double plane = 0.0;
+            const bool orient =
+                tips->has_direction && co.rotation_weight > 0.0 &&
+                held_rotation(model, side, tips->stick_direction[s], hand_target, &plane);
             IkResult r = orient ? solver_->solve(arm.kinematic, tip_target, hand_target,
-                                                 co.rotation_weight, arm.kinematic_target)
+                                                 co.rotation_weight * plane, arm.kinematic_target)
                          : co.posture_weight > 0.0
                              ? solver_->solve_with_posture(arm.kinematic, tip_target, arm.posture,
                                                            co.posture_weight, arm.kinematic_target)
@@ -200,6 +202,18 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
             ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
             ik_stats_.not_converged += r.status != IkStatus::converged;
             ++ik_stats_.solves;
+            if (co.max_joint_speed_rad_s > 0.0 && steps_ > 0) {
+                const double cap = co.max_joint_speed_rad_s * h;
+                for (int k = 0; k < 4; ++k) {
+                    const double a =
+                        rotation_angle_between(arm.previous_kinematic[k], arm.kinematic_target[k]);
+                    if (a > cap) {
+                        arm.kinematic_target[k] =
+                            arm.previous_kinematic[k].slerp(cap / a, arm.kinematic_target[k]);
+                        ++ik_stats_.rate_capped;
+                    }
+                }
+            }
             if (cartesian) {
                 // Eq. 2 with its gain: the IK target is X^S + gain (X^T - X^S) (+ the
                 // velocity, acceleration and integral terms, capped), X^S from the
@@ -270,7 +284,7 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
 }
 
 bool held_rotation(const CharacterModel &model, Side side, const Eigen::Vector3d &direction,
-                   Eigen::Quaterniond &out)
+                   Eigen::Quaterniond &out, double *weight)
 {
     const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
     if (!(direction.allFinite() && direction.norm() > 1e-9))
@@ -279,7 +293,11 @@ bool held_rotation(const CharacterModel &model, Side side, const Eigen::Vector3d
     // French (thumb up): the fulcrum axis is stick x thumb = d x up; German
     // (palm down): stick x palm normal = d x (-up) (character.cpp).
     Eigen::Vector3d f = model.options().grip == Grip::french ? d.cross(up) : up.cross(d);
-    if (f.norm() < 0.2)
+    // |f| is the cosine of the stick's elevation: 0.5 at 60 degrees, 0.2 at 78.
+    const double x = std::clamp((f.norm() - 0.2) / (0.5 - 0.2), 0.0, 1.0);
+    if (weight)
+        *weight = x * x * (3.0 - 2.0 * x);
+    if (x <= 0.0)
         return false;
     f.normalize();
     const StickInHand &st = model.stick(side);
@@ -308,10 +326,11 @@ void Tracker::solve_arms(const CharacterModel &model, const std::vector<JointLim
         // Repeated calls: the solver's per-call budget is 16 steps.
         for (int call = 0; call < 20; ++call) {
             Eigen::Quaterniond hand;
-            const bool orient =
-                directions && held_rotation(model, static_cast<Side>(s), (*directions)[s], hand);
+            double plane = 0.0;
+            const bool orient = directions && held_rotation(model, static_cast<Side>(s),
+                                                            (*directions)[s], hand, &plane);
             const IkResult r =
-                orient ? cold.solve(chain, tips[s], hand, 1.0, q) : cold.solve(chain, tips[s], q);
+                orient ? cold.solve(chain, tips[s], hand, plane, q) : cold.solve(chain, tips[s], q);
             chain.set_rotations(q);
             if (r.status == IkStatus::converged)
                 break;

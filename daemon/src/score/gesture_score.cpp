@@ -253,6 +253,10 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("rate_hz must be 50..20000", o.rate_hz);
     if (!(std::abs(o.strike_depth_m) <= 0.1))
         bad("strike_depth_m must be within +-0.1 m", o.strike_depth_m);
+    if (!(o.strike_aim_s >= 0.0 && o.strike_aim_s <= 0.01))
+        bad("strike_aim_s must be within 0..0.01 s", o.strike_aim_s);
+    if (!(o.strike_aim_from_mps >= 0.0 && o.strike_aim_from_mps <= 20.0))
+        bad("strike_aim_from_mps must be within 0..20 m/s", o.strike_aim_from_mps);
     if (!(o.blend_margin > 0.0 && o.blend_margin < 0.5))
         bad("blend_margin must be in (0, 0.5)", o.blend_margin);
     if (!(o.idle_return_s > 0.0) || !std::isfinite(o.idle_return_s))
@@ -416,6 +420,10 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
                 after = placed[k + 1].strike_t - it.strike_t;
             it.prep_t = std::min(it.curve->prep_s, (1.0 - beta) * before);
             it.lift_t = std::min(it.curve->lift_s, (1.0 - beta) * after);
+            const Eigen::Vector3d impact = to_world * it.curve->impact_velocity();
+            it.origin -= opt.strike_aim_s *
+                         std::max(0.0, -impact.dot(frame.up) - opt.strike_aim_from_mps) * frame.up;
+            plan.notes[idx[k]].tip_target_m = it.origin;
             it.prepare();
             plan.notes[idx[k]].impact_velocity_mps = to_world * it.curve->impact_velocity();
         }

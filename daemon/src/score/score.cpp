@@ -148,6 +148,7 @@ enum class Kind {
     default_beats,
     default_dynamics,
     default_firmness,
+    default_nuance,
     repeat,
     end
 };
@@ -158,8 +159,8 @@ struct Statement {
     int column = 0;
     // note
     Side hand = Side::right;
-    bool both_hands = false; // R+L: one stroke of each hand on the same beat
-    Nuance nuance = Nuance::legato;
+    bool both_hands = false;        // R+L: one stroke of each hand on the same beat
+    std::optional<Nuance> nuance;   // note, default_nuance
     std::optional<double> beats;    // note, rest, default_beats
     std::optional<double> dynamics; // note, default_dynamics
     std::optional<double> r_over_a, theta_deg;
@@ -452,6 +453,13 @@ class LineParser
             st.kind = Kind::default_dynamics;
             st.dynamics = dynamics_value(need(tk, 1, "'dynamics' needs a value 0..1 or pp..ff"));
             no_more(tk, 2, "the dynamics");
+        } else if (key == "nuance") {
+            st.kind = Kind::default_nuance;
+            const Token &t = need(tk, 1, "'nuance' needs a nuance, e.g. 'nuance accent'");
+            st.nuance = nuance_word(t.lower);
+            if (!st.nuance)
+                fail(t.column, "unknown nuance '" + t.text + "' (valid: " + nuance_list() + ")");
+            no_more(tk, 2, "the nuance");
         } else if (key == "firmness") {
             st.kind = Kind::default_firmness;
             st.firmness = firmness_value(need(tk, 1, "'firmness' needs a value 0..1"));
@@ -471,7 +479,7 @@ class LineParser
             fail(tk[0].column,
                  "unknown statement '" + tk[0].text +
                      "' (expected a hand R, L, right, left, R+L, or tempo, grip, rest, "
-                     "beats, dynamics, firmness, repeat, end)");
+                     "beats, dynamics, firmness, nuance, repeat, end)");
         }
         return st;
     }
@@ -611,6 +619,14 @@ void ScoreBuilder::add_line(const std::string &text, int line)
     state_->open_repeats = open;
 }
 
+void ScoreBuilder::set_default_nuance(Nuance nuance)
+{
+    Statement st;
+    st.kind = Kind::default_nuance;
+    st.nuance = nuance;
+    state_->statements.push_back(st);
+}
+
 void ScoreBuilder::add_statement(const std::string &text)
 {
     const int line = ++state_->calls;
@@ -642,6 +658,7 @@ Score ScoreBuilder::finish() const
     double default_beats = kDefaultNoteBeats;
     double default_dynamics = kDefaultDynamics;
     double default_firmness = -1.0; // the performance's
+    Nuance default_nuance = Nuance::legato;
     struct Loop {
         size_t body; // first statement of the body
         int left;    // passes still to play after this one
@@ -668,7 +685,7 @@ Score ScoreBuilder::finish() const
             ScoreNote n;
             n.beat = beat;
             n.beats = st.beats.value_or(default_beats);
-            n.nuance = st.nuance;
+            n.nuance = st.nuance.value_or(default_nuance);
             n.grip = grip;
             n.dynamics = st.dynamics.value_or(default_dynamics);
             n.r_over_a = st.r_over_a.value_or(kDefaultRadiusFraction);
@@ -704,6 +721,9 @@ Score ScoreBuilder::finish() const
             break;
         case Kind::default_firmness:
             default_firmness = *st.firmness;
+            break;
+        case Kind::default_nuance:
+            default_nuance = *st.nuance;
             break;
         case Kind::repeat:
             loops.push_back({pc + 1, st.count - 1});

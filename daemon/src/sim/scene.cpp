@@ -108,6 +108,8 @@ void validate(const SceneOptions &o)
     check_finite_positive("divergence joint separation bound (m)", o.max_joint_separation_m);
     if (!(std::isfinite(o.stop_margin_rad) && o.stop_margin_rad >= 0.0))
         throw CharacterError("limit stop margin: expected a finite value >= 0");
+    if (!(o.stop_erp > 0.0 && o.stop_erp <= 1.0))
+        throw CharacterError("limit stop ERP: expected a value in (0, 1]");
     if (!(std::isfinite(o.grip_damping_ratio) && o.grip_damping_ratio >= 0.0 &&
           o.grip_damping_ratio <= 10.0))
         throw CharacterError("grip damping ratio: expected 0..10");
@@ -475,9 +477,19 @@ void Scene::apply_control()
             const Eigen::Quaterniond inside = limits_[j].clamp(current);
             const Eigen::Vector3d v = log_map(current * inside.conjugate());
             violation = v.norm();
-            if (violation > options_.stop_margin_rad) {
-                stop = true;
-                stop_axis = (qp * v).normalized();
+            if (violation > 0.0) {
+                // The stop engages one step early: the angle it sees is
+                // where the joint will be after this step at its present
+                // rate, so a fast joint does not run past the margin before
+                // the stop row exists.
+                const Eigen::Vector3d axis = (qp * v) / violation;
+                const Eigen::Vector3d w_rel = to_eigen3(dBodyGetAngularVel(body_[child])) -
+                                              to_eigen3(dBodyGetAngularVel(body_[parent]));
+                violation += std::max(0.0, w_rel.dot(axis)) * options_.step_s;
+                if (violation > options_.stop_margin_rad) {
+                    stop = true;
+                    stop_axis = axis;
+                }
             }
         }
         Eigen::Vector3d axes[3];
@@ -514,6 +526,7 @@ void Scene::apply_control()
             dJointSetAMotorAngle(m, 0, violation);
             dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
             dJointSetAMotorParam(m, dParamHiStop1, options_.stop_margin_rad);
+            dJointSetAMotorParam(m, dParamStopERP, options_.stop_erp);
         } else {
             dJointSetAMotorParam(m, dParamHiStop1, dInfinity);
             dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);

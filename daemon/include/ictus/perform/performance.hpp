@@ -124,7 +124,16 @@ class Performance
     double clip_duration_s() const;
     double step_s() const { return options_.scene.step_s; }
     bool playing() const { return playing_; }
-    double tempo_bpm() const { return options_.tempo_bpm; }
+    // Clip: the playback tempo. Score mode: the tempo being played (the
+    // score's tempo map at the plan's clock, times the live scale), and
+    // stopped, the tempo the next play starts at (/ictus/tempo, docs/osc.md).
+    double tempo_bpm() const;
+    // Score mode: the live tempo scale (/ictus/tempo), 1 until one is sent;
+    // a new score (/ictus/score/clear) plays at its own tempi again.
+    double tempo_scale() const { return tempo_scale_; }
+    // A live tempo change under way leaves alone the strokes the hands have
+    // begun, and those they begin within this time (the planner's latency).
+    static constexpr double kTempoLatency_s = 0.25;
     const PerformanceOptions &options() const { return options_; }
     const Scene &scene() const;
     // The character being simulated and the mocap skeleton it was built from
@@ -270,6 +279,12 @@ class Performance
     std::unique_ptr<GestureDatabase> db_;
     std::unique_ptr<ScoreBuilder> builder_;
     std::shared_ptr<const Score> score_;
+    std::shared_ptr<const Score> played_;    // score_ at its tempo scale (execute() only)
+    double tempo_scale_ = 1.0;               // the physics thread's (Result::tempo_scale)
+    double start_bpm_ = 0.0;                 // > 0: the next play starts at this tempo
+    bool play_pending_ = false;              // a play handed to the worker, not back yet
+    double score_first_bpm_ = 120.0;         // the current score's own first tempo
+    Nuance default_nuance_ = Nuance::legato; // /ictus/nuance: of the statements that follow
     std::unique_ptr<PlanState> plan_state_;
     const GesturePlan *plan_ = nullptr; // &plan_state_->plan
     bool plan_active_ = false;

@@ -57,6 +57,14 @@ struct CartesianOptions {
     double correction_limit_m = 0.1;
     // Weight (0..1) of the hands' rotation task (TipTargets::stick_direction).
     double rotation_weight = 1.0;
+    // Cap on how fast the kinematic IK's solution may turn any arm joint,
+    // rad/s (0: none). The DLS solve can change branch within one step where
+    // the rotation task and the limits compete (measured up to 1.2 rad in
+    // 1 ms); the PD then slams the joint through its stop. A capped solution
+    // continues from where it got to and reaches the target a few steps
+    // later. Score mode: 30 rad/s (the strokes' own joint rates stay under
+    // 20 rad/s, docs/perform.md).
+    double max_joint_speed_rad_s = 0.0;
     // Where the feedback IK starts. simulated: Theta^S, eq. 2 literally (the
     // arm's redundant directions then drift with the body: measured 30-40 deg
     // RMS at the shoulder on CMU 80_13). kinematic: the kinematic IK's solution
@@ -111,15 +119,20 @@ struct TipTargets {
 
 // The hand's world rotation that holds `side`'s stick along `direction` with
 // the fulcrum axis horizontal: the stroke plane vertical, as the grip holds
-// it (French: thumb up; German: palm down). False when the direction is
-// within ~12 degrees of the vertical (no stroke plane).
+// it (French: thumb up; German: palm down). `weight` (if given) is how far
+// the stroke plane is defined, 0..1: 1 for a stick within 60 degrees of the
+// horizontal, falling smoothly to 0 at 78 degrees, so that the rotation task
+// fades out as the stick turns towards the vertical instead of switching off
+// (a switch made the IK's solution jump by up to 1 rad in one step). False
+// when the weight is 0.
 bool held_rotation(const CharacterModel &model, Side side, const Eigen::Vector3d &direction,
-                   Eigen::Quaterniond &out);
+                   Eigen::Quaterniond &out, double *weight = nullptr);
 
 // IK statistics since construction (Cartesian mode, and joint mode with tip targets).
 struct TrackerIkStats {
     long iterations = 0;
     long solves = 0;
+    long rate_capped = 0; // joint solutions held back by max_joint_speed_rad_s
     int max_iterations = 0;
     long not_converged = 0; // solves that ended other than `converged`
     double wall_s = 0.0;    // wall time in the IK

@@ -76,6 +76,13 @@ struct PlanOptions {
     // The target passes this far below the membrane at the strike (the
     // physics helper tunes it; < 0 is above).
     double strike_depth_m = 0.0;
+    // And further by (v - strike_aim_from_mps) times this (s), v the planned
+    // impact speed: the hand aims through the head as a drummer throws the
+    // stick, so that a fast stroke still reaches it although the arm turns a
+    // little early (its tracking lag). Soft strokes aim at the head itself
+    // (deeper, they press on it).
+    double strike_aim_s = 0.0;
+    double strike_aim_from_mps = 0.0;
     // Co-articulation: the blend between two units of one hand spans the
     // middle of the gap between their strikes, leaving this fraction of the
     // gap at each end to the units alone (0 < f < 0.5).

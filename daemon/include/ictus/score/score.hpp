@@ -137,6 +137,11 @@ class ScoreBuilder
     // The statements so far as a score; throws ScoreError when a statement
     // failed or a `repeat` is still open. The builder is left as it was.
     Score finish() const;
+    // The nuance of the notes that follow and name none, as the statement
+    // `nuance N` would set it, but not counted as a statement (statements()
+    // and error positions stay those of the statements received): what
+    // /ictus/nuance does in score mode.
+    void set_default_nuance(Nuance nuance);
     int statements() const; // how many add_statement() calls so far
     bool failed() const;
     void reset(); // back to an empty score, errors forgotten

@@ -81,6 +81,11 @@ struct SceneOptions {
     // meets a one-sided stop (limits must be set, stops enabled).
     bool limit_stops = true;
     double stop_margin_rad = 0.0873; // 5 degrees
+    // The stop's error reduction per step (ODE's dParamStopERP): 0.2 is
+    // ODE's default; 1 corrects the whole overshoot in the next step (score
+    // mode: with 0.2 fast strokes left elbows up to 3 degrees past the
+    // margin, docs/perform.md).
+    double stop_erp = 0.2;
     bool rate_feedforward = true;
     StickMount sticks = StickMount::rigid;
     std::array<GripSpring, 2> grip{};                     // [side], fulcrum mount only

@@ -1,0 +1,280 @@
+"""ictus against its peers, side by side in one run (issue 16). Run through
+bench/peers/run_peers.sh, which sets up the peers' virtual environment.
+
+Every round runs each case once, ictus and peers alternating, so that the load
+of a shared machine falls on all of them alike; the table keeps the best round
+of each case and the median of the per-round ratios. Times are CPU times (user
++ sys of the process, or process time of the stepping loop for MuJoCo): on a
+shared 2-core machine wall time mostly measures the scheduler.
+
+Drum, ns per mode per sample, 48 kHz, in `pd -batch` (the CPU time of an
+otherwise identical empty patch is subtracted):
+  ictus    [membrane~ N] + [contact~]: a 10 kg stick (stiffness 1e6) hit in at
+           0.5 m/s every 100 ms at the same spot and kept pressed (in contact
+           ~100 % of the time); the first outlet listened to by [env~]; kernel
+           chosen at run time (AVX2+FMA here), and with
+           ICTUS_MEMBRANE_KERNEL=generic (the portable SSE2 kernel)
+  stereo   the same with both outlets listened to (the second pickup computed)
+  before   the same patch with another build's Pd library (--before DIR), if given
+  bp~      N vanilla [bp~ f 10] fed by one [noise~]
+  SDT      the Sound Design Toolkit's impact interactor + modal resonator
+           (peer_sdt.py, pysdt from PyPI: SDT's Pd externals are not packaged);
+           outside Pd, per-sample Python overhead removed by difference
+Performer, real-time factor (simulated s / CPU s):
+  track    `ictusd track --mode joint --mocap 80_13.bvh --quiet` (the CMU clip,
+           1 ms steps); the CPU of a 10 ms run (start-up: reading the clip,
+           learning limits) is subtracted, as MuJoCo's timing has no start-up
+  MuJoCo   dm_control's CMU humanoid, 56 DoF, root fixed, 1 ms (peer_mujoco.py)
+  render   `ictusd render` of the default score, --bvh-rate 0 --tips-rate 0
+           (start-up included)
+
+Usage: bench_peers.py BUILD --python VENV_PYTHON [--rounds R] [--sizes 64,256,...]
+       [--before DIR] [--bvh FILE] [--json FILE] [--skip drum,performer,sdt]"""
+import argparse
+import datetime
+import json
+import os
+import platform
+import re
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+SR = 48000
+
+ap = argparse.ArgumentParser()
+ap.add_argument("build")
+ap.add_argument("--python", required=True, help="the peers' venv python")
+ap.add_argument("--rounds", type=int, default=3)
+ap.add_argument("--sizes", default="64,256,1024,4096")
+ap.add_argument("--before", help="another build's Pd library folder (build/ictus) to compare")
+ap.add_argument("--bvh", default=os.path.join(ROOT, "..", "shared", "data", "cmu", "80_13.bvh"))
+ap.add_argument("--mujoco-seconds", type=float, default=20.0)
+ap.add_argument("--json", help="write every raw run here")
+ap.add_argument("--skip", default="", help="comma list of: drum, performer, sdt, bp")
+args = ap.parse_args()
+build = os.path.abspath(args.build)
+lib = os.path.join(build, "ictus")
+ictusd = os.path.join(build, "ictusd")
+skip = set(s for s in args.skip.split(",") if s)
+sizes = [int(s) for s in args.sizes.split(",")]
+work = tempfile.mkdtemp(prefix="ictus-peers-")
+raw = []
+
+
+def child_cpu():
+    u = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return u.ru_utime + u.ru_stime
+
+
+def run_cpu(cmd, env=None):
+    """Runs cmd; returns (CPU seconds of the child, stdout)."""
+    before = child_cpu()
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                       env=env, timeout=1800)
+    cpu = child_cpu() - before
+    if p.returncode != 0:
+        raise SystemExit("%s failed (%d):\n%s%s" % (" ".join(cmd), p.returncode, p.stdout,
+                                                   p.stderr[-3000:]))
+    return cpu, p.stdout + p.stderr
+
+
+# ---------------------------------------------------------------- the drum in Pd
+
+def patch(path, seconds, body):
+    lines = ["#N canvas 0 0 600 400 12;", "#X declare -path %s;" % path,
+             "#X obj 10 10 loadbang;",                          # 0
+             "#X msg 10 40 \\; pd dsp 1;",                      # 1
+             "#X obj 10 70 delay %.17g;" % (seconds * 1000.0),  # 2
+             "#X msg 10 100 \\; pd quit;",                      # 3
+             "#X obj 10 130 noise~;",                           # 4
+             "#X connect 0 0 1 0;", "#X connect 0 0 2 0;", "#X connect 2 0 3 0;"]
+    body(lines)
+    return "\n".join(lines) + "\n"
+
+
+def pd_run(text, name, env=None):
+    path = os.path.join(work, name + ".pd")
+    with open(path, "w") as f:
+        f.write(text)
+    cpu, out = run_cpu(["pd", "-nogui", "-nosound", "-batch", "-stderr", "-r", str(SR),
+                        "-open", path], env=env)
+    if "error" in out.lower() or "couldn't" in out:
+        raise SystemExit("%s: pd said:\n%s" % (name, out))
+    return cpu
+
+
+def ictus_patch(path, n, seconds, stereo=False):
+    def body(lines):
+        lines += ["#X obj 200 10 membrane~ peers-drum;",
+                  "#X msg 200 40 modes %d \\, t60 60 \\, hfdamp 0 \\, strike 0.3 0 0.01;" % n,
+                  "#X connect 0 0 6 0;", "#X connect 6 0 5 0;",
+                  "#X obj 300 10 contact~ peers-drum;",
+                  "#X obj 300 40 metro 100;",
+                  "#X msg 300 70 mass 10 \\, stiffness 1e+06 \\, hit 0.5 0.3 0;",
+                  "#X connect 0 0 8 0;", "#X connect 8 0 9 0;", "#X connect 9 0 7 0;",
+                  "#X obj 200 100 env~ 4096;", "#X connect 5 0 10 0;"]
+        if stereo:
+            lines += ["#X obj 260 100 env~ 4096;", "#X connect 5 1 11 0;"]
+    return patch(path, seconds, body)
+
+
+def bp_patch(n, seconds):
+    def body(lines):
+        for k in range(n):
+            lines.append("#X obj %d %d bp~ %g 10;" % (200 + k % 40 * 10, 10 + k // 40, 100 + 5 * k))
+            lines.append("#X connect 4 0 %d 0;" % (5 + k))
+    return patch(lib, seconds, body)
+
+
+def drum_seconds(n, mode_samples):
+    return max(1.0, min(120.0, mode_samples / (n * SR)))
+
+
+def drum_round(r, results):
+    for n in sizes:
+        s_ictus = drum_seconds(n, 1.0e9)   # ~0.2-0.5 s of CPU for ictus
+        s_bp = drum_seconds(n, 2.0e8)      # ~0.4 s for bp~
+        empties = {}
+        for s in sorted({s_ictus, s_bp}):
+            empties[s] = pd_run(patch(lib, s, lambda lines: None), "empty-%d" % n)
+        generic = dict(os.environ, ICTUS_MEMBRANE_KERNEL="generic")
+        cases = [("ictus avx2", lambda: pd_run(ictus_patch(lib, n, s_ictus), "ictus-%d" % n),
+                  s_ictus),
+                 ("ictus generic", lambda: pd_run(ictus_patch(lib, n, s_ictus), "generic-%d" % n,
+                                                  generic), s_ictus),
+                 ("ictus stereo", lambda: pd_run(ictus_patch(lib, n, s_ictus, stereo=True),
+                                                 "stereo-%d" % n), s_ictus)]
+        if args.before:
+            before = os.path.abspath(args.before)
+            cases.append(("before avx2", lambda: pd_run(ictus_patch(before, n, s_ictus),
+                                                        "before-%d" % n), s_ictus))
+        if "bp" not in skip:
+            cases.append(("bp~", lambda: pd_run(bp_patch(n, s_bp), "bp-%d" % n), s_bp))
+        for name, fn, s in cases:
+            cpu = fn()
+            ns = (cpu - empties[s]) * 1e9 / (n * SR * s)
+            results.setdefault((name, n), []).append(ns)
+            raw.append({"round": r, "case": name, "modes": n, "audio_s": s, "cpu_s": cpu,
+                        "empty_cpu_s": empties[s], "ns_per_mode_sample": ns})
+        if "sdt" not in skip:
+            sec = max(0.2, min(2.0, 2.5e7 / (n * SR)))
+            _, out = run_cpu([args.python, os.path.join(ROOT, "bench", "peers", "peer_sdt.py"),
+                              str(n), str(sec)])
+            j = json.loads(out.strip().splitlines()[-1])
+            results.setdefault(("SDT", n), []).append(j["ns_per_mode_sample"])
+            raw.append(dict(j, round=r, case="SDT"))
+
+
+# ---------------------------------------------------------------- the performer
+
+mujoco_version = [""]
+
+
+def track_round(r, results):
+    cpu, out = run_cpu([ictusd, "track", "--mode", "joint", "--mocap", args.bvh, "--quiet"])
+    m = re.search(r"([0-9.]+) s simulated, realtime factor ([0-9.]+)", out)
+    if not m:
+        raise SystemExit("ictusd track printed no realtime factor:\n" + out)
+    sim, wall_rtf = float(m.group(1)), float(m.group(2))
+    cpu0, _ = run_cpu([ictusd, "track", "--mode", "joint", "--mocap", args.bvh, "--quiet",
+                       "--duration", "0.01"])
+    rtf = sim / max(cpu - cpu0, 1e-9)
+    results.setdefault("track", []).append(rtf)
+    raw.append({"round": r, "case": "ictusd track --mode joint", "sim_s": sim, "cpu_s": cpu,
+                "startup_cpu_s": cpu0, "rtf_cpu": rtf, "rtf_wall_printed": wall_rtf})
+
+    _, out = run_cpu([args.python, os.path.join(ROOT, "bench", "peers", "peer_mujoco.py"),
+                      str(args.mujoco_seconds)])
+    j = json.loads(out.strip().splitlines()[-1])
+    if not j["finite"]:
+        raise SystemExit("MuJoCo diverged: %s" % j)
+    results.setdefault("mujoco", []).append(j["sim_s"] / j["cpu_s"])
+    mujoco_version[0] = "%s (dm_control %s)" % (j["mujoco"], j["dm_control"])
+    raw.append(dict(j, round=r, case="MuJoCo CMU humanoid", rtf_cpu=j["sim_s"] / j["cpu_s"],
+                    rtf_wall=j["sim_s"] / j["wall_s"]))
+
+    out_dir = os.path.join(work, "render-%d" % r)
+    cpu, out = run_cpu([ictusd, "render", "--out", out_dir, "--bvh-rate", "0", "--tips-rate", "0"])
+    m = re.search(r"render: ([0-9.]+) s simulated in ([0-9.]+) s \(([0-9.]+)x real time\)", out)
+    if not m:
+        raise SystemExit("ictusd render printed no speed:\n" + out)
+    sim = float(m.group(1))
+    results.setdefault("render", []).append(sim / cpu)
+    raw.append({"round": r, "case": "ictusd render", "sim_s": sim, "cpu_s": cpu,
+                "rtf_cpu": sim / cpu, "rtf_wall_printed": float(m.group(3))})
+    shutil.rmtree(out_dir, ignore_errors=True)
+
+
+# ---------------------------------------------------------------- main
+
+def loadavg():
+    with open("/proc/loadavg") as f:
+        return " ".join(f.read().split()[:3])
+
+
+def cpu_model():
+    with open("/proc/cpuinfo") as f:
+        for line in f:
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    return platform.processor()
+
+
+pd_version = subprocess.run(["pd", "-version"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True).stdout.split()[0]
+info = {"date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "machine": "%s, %d cpu, %s" % (cpu_model(), os.cpu_count(), platform.platform()),
+        "pd": pd_version, "load_before": loadavg(), "rounds": args.rounds}
+print("date: %(date)s\nmachine: %(machine)s\n%(pd)s; load before: %(load_before)s" % info,
+      flush=True)
+results = {}
+for r in range(args.rounds):
+    if "drum" not in skip:
+        drum_round(r, results)
+    if "performer" not in skip:
+        track_round(r, results)
+    print("round %d done, load %s" % (r + 1, loadavg()), flush=True)
+info["load_after"] = loadavg()
+
+
+def per_round_ratio(a, b):
+    """Median over rounds of a[r] / b[r] (both lists in round order)."""
+    pairs = [(x / y) for x, y in zip(a, b) if y > 0]
+    return statistics.median(pairs) if pairs else float("nan")
+
+
+print("\nDrum in Pd, ns per mode per sample (best round), "
+      "and peer / ictus avx2 (median of the per-round ratios)")
+cols = (["ictus avx2", "ictus generic", "ictus stereo"] + (["before avx2"] if args.before else [])
+        + ([] if "bp" in skip else ["bp~"]) + ([] if "sdt" in skip else ["SDT"]))
+if "drum" not in skip:
+    print("%6s " % "N" + " ".join("%14s" % c for c in cols) + "   peer / ictus avx2")
+    for n in sizes:
+        row = ["%14.3f" % min(results[(c, n)]) for c in cols]
+        ratios = []
+        for c in cols[1:]:
+            ratio = per_round_ratio(results[(c, n)], results[("ictus avx2", n)])
+            ratios.append("%s %.1fx" % (c, ratio))
+        print("%6d " % n + " ".join(row) + "   " + ", ".join(ratios))
+if "performer" not in skip:
+    t, mj, rd = results["track"], results["mujoco"], results["render"]
+    print("\nPerformer, real-time factor on CPU time (best round; all rounds)")
+    print("  ictusd track --mode joint (CMU 80_13): %.1fx  [%s]" % (
+        max(t), ", ".join("%.1f" % v for v in t)))
+    print("  MuJoCo %s CMU humanoid, root fixed: %.1fx  [%s]" % (
+        mujoco_version[0], max(mj), ", ".join("%.1f" % v for v in mj)))
+    print("  ratio track / MuJoCo: best %.2f, median of rounds %.2f (target >= 1.25)" % (
+        max(t) / max(mj), per_round_ratio(t, mj)))
+    print("  ictusd render, default score:          %.1fx  [%s] (target >= 25)" % (
+        max(rd), ", ".join("%.1f" % v for v in rd)))
+print("\nload after: %s" % info["load_after"])
+if args.json:
+    with open(args.json, "w") as f:
+        json.dump({"info": info, "runs": raw}, f, indent=1)
+    print("raw runs: %s" % args.json)
+shutil.rmtree(work, ignore_errors=True)
