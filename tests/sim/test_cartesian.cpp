@@ -6,10 +6,12 @@
 #include "ictus/mocap/bvh.hpp"
 #include "ictus/character/character_limits.hpp"
 #include "ictus/perform/track.hpp"
+#include "ictus/sim/strike_detector.hpp"
 #include "sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <fstream>
 #include <sstream>
 
 using namespace ictus;
@@ -27,13 +29,11 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
     const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton);
     const ReferenceMotion reference(model, bvh.motion, ReferenceFilter{});
     const ReferenceMotion raw(model, bvh.motion);
-    // Limits at 4 standard deviations: at 3 (the joint-mode default) the
-    // learned region leaves out ~1 % of this very clip's frames, which then no
-    // mode can reach (measured: 14 mm RMS Cartesian with k = 3, all of it in
-    // those frames). Both modes get the same limits and the same gains.
-    CharacterLimitOptions lo;
-    lo.k = 4.0;
-    const CharacterLimits limits(model, reference, lo);
+    // The default options throughout (limits at k = 3, Algorithm 2 from the
+    // simulated state with the posture task, docs/ik.md). Both modes get the
+    // same limits and the same gains. (Until 2026-11-24 this test used k = 4
+    // and the capture-seeded IK start, which the defaults no longer are.)
+    const CharacterLimits limits(model, reference, CharacterLimitOptions{});
     TrackOptions joint_options;
     const std::vector<JointGains> gains =
         default_gains(model, reference.frame(0), joint_options.gains);
@@ -57,18 +57,40 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
         CHECK(cart.tip_rms_mm[s] <= 5.0);
         CHECK(cart.tip_rms_mm[s] < joint.tip_rms_mm[s]);
     }
-    // The IK targets keep the arm where the capture has it: the elbow flexion
-    // of Theta^T within a few degrees of the captured one (the arm's null space
-    // is held by the kinematic start, docs/ik.md).
-    CHECK(cart.elbow_ik_rms_deg[0] < 3.0);
-    CHECK(cart.elbow_ik_rms_deg[1] < 3.0);
+    // Driven by the stick tips alone (the capture's arm pose seeds nothing;
+    // the posture task holds the null space near the clip's mean arm pose),
+    // the IK's elbow flexion stays within ~10 degrees RMS of the captured one
+    // (measured 10.3 / 11.9, docs/ik.md); the capture-seeded start, below, to
+    // within a few degrees.
+    CHECK(cart.elbow_ik_rms_deg[0] < 15.0);
+    CHECK(cart.elbow_ik_rms_deg[1] < 15.0);
+    // The arms do not run away in their null space: all joints within 15
+    // degrees RMS of the capture in the simulation (measured 13.4; the posture
+    // is the clip's mean arm pose, not each frame's, docs/ik.md).
+    CHECK(cart.to_json()["joint_rms_deg_all"].get<double>() < 15.0);
     // Warm-started at 1 kHz the IK needs 1-2 iterations (docs/ik.md).
     CHECK(cart.ik_mean_iterations < 3.0);
     CHECK(cart.ik_max_iterations <= 16);
     CHECK(cart.max_linear_speed_mps < 20.0);
+
+    // The capture-seeded variant (--ik-start kinematic) keeps Theta^T's elbow
+    // where the capture has it, by construction.
+    TrackOptions seeded = cart_options;
+    seeded.cartesian.start_from_simulated = false;
+    seeded.cartesian.posture_weight = 0.0;
+    seeded.cartesian.feedback_iterations = 0;
+    seeded.cartesian.kinematic_iterations = 0;
+    seeded.cartesian.correction_limit_m = 0.1;
+    seeded.duration_s = 3.0;
+    const TrackSummary kin =
+        track_joint_space(model, reference, seeded, limits.refs(), nullptr, {}, &gains, &raw);
+    INFO("capture-seeded: elbow rms deg " << kin.elbow_ik_rms_deg[0] << " "
+                                          << kin.elbow_ik_rms_deg[1]);
+    CHECK(kin.elbow_ik_rms_deg[0] < 3.0);
+    CHECK(kin.elbow_ik_rms_deg[1] < 3.0);
 }
 
-TEST_CASE("Cartesian tracking of a synthetic swing: tips within millimetres, IK = the motion",
+TEST_CASE("Cartesian tracking of a synthetic swing: tips within millimetres",
           "[sim][track][cartesian]")
 {
     const Skeleton skel = simtest::cmu_like_skeleton();
@@ -95,9 +117,12 @@ TEST_CASE("Cartesian tracking of a synthetic swing: tips within millimetres, IK 
     CHECK(cart.tip_rms_mm[0] < 2.0);
     CHECK(cart.tip_rms_mm[1] < 2.0);
     CHECK(cart.tip_rms_mm[1] < joint.tip_rms_mm[1]);
-    // The IK starts from the captured arm, so Theta^T's elbow is the motion's
-    // +/- 20 degree swing about the rest, up to the correction of eq. 2.
-    CHECK(cart.elbow_ik_rms_deg[1] < 2.0);
+    // Driven by the tips alone from the simulated arm (the default), Theta^T's
+    // elbow is not the motion's: the tips do not determine how the swing is
+    // shared between shoulder and elbow (measured 11 deg RMS off a 14 deg RMS
+    // flexion signal). Until 2026-11-24 this test checked < 2 deg with the
+    // capture-seeded start; that variant is checked in the CMU test above.
+    INFO("elbow flexion rms " << cart.elbow_ik_rms_deg[1] << " deg");
     const nlohmann::json j = cart.to_json();
     CHECK(j["mode"] == "cartesian");
     CHECK(j["ik"]["mean_iterations"].get<double>() >= 0.0);
@@ -116,6 +141,9 @@ TEST_CASE("Cartesian options are validated, naming the option", "[sim][track][ca
     o = TrackOptions{};
     o.cartesian.correction_limit_m = -1.0;
     CHECK_THROWS_WITH(validate(o), Catch::Contains("correction limit"));
+    o = TrackOptions{};
+    o.cartesian.posture_weight = 1.5;
+    CHECK_THROWS_WITH(validate(o), Catch::Contains("ik posture weight"));
     o = TrackOptions{};
     o.cartesian.ik.damping_m = 0.0;
     CHECK_THROWS_WITH(validate(o), Catch::Contains("ik parameters"));
@@ -206,7 +234,10 @@ TEST_CASE("stick-only: placement behind the sticks and the drum under the stroke
     // lateral position, +-0.15 m about the goal), one tip radius below.
     const double r = m.options().stick.tip_radius_m;
     const Eigen::Vector3d drum = fit_drum_to_strokes(tips, r);
-    CHECK(drum.y() == Approx(lo.y() - r).margin(1e-6));
+    // (Half a tip radius below since 2026-11-24: the tracked end of a stick 30
+    // degrees below the horizontal is r / 2 above the membrane at contact,
+    // stick_capture.hpp's kImpactPitchFactor; one radius before.)
+    CHECK(drum.y() == Approx(lo.y() - kImpactPitchFactor * r).margin(1e-6));
     CHECK(drum.x() == Approx(goal.x()).margin(1e-3));
     CHECK(drum.z() == Approx(goal.z()).margin(1e-3));
     // A flat capture has no strokes.
@@ -248,8 +279,215 @@ TEST_CASE("stick-only: the default body tracks synthetic strokes to a few millim
     for (const auto &side : tips.tip_m)
         for (const Eigen::Vector3d &p : side)
             lowest = std::min(lowest, p.y());
-    CHECK(s.drum_center_m.y() == Approx(lowest - m.options().stick.tip_radius_m).margin(1e-6));
+    CHECK(s.drum_center_m.y() ==
+          Approx(lowest - kImpactPitchFactor * m.options().stick.tip_radius_m).margin(1e-6));
     // Joint mode cannot take a stick-only capture.
     o.mode = TrackMode::joint;
     CHECK_THROWS_WITH(track_joint_space(m, ref, o), Catch::Contains("Cartesian mode"));
+}
+
+namespace
+{
+// Stick-tip height of a stroke train: an impact every period_s from t0_s at
+// speed v_mps (downwards), rebounding at rebound * v_mps, with the cubic
+// Hermite curve between impacts; the stick's end at impact_y_m at each
+// impact (a V at the impact: the capture's sampling cuts it at random).
+// The tracked point is the stick's end.
+double stroke_height(double t, double t0_s, double period_s, double v_mps, double rebound,
+                     double impact_y_m)
+{
+    const double u = (t - t0_s) / period_s;
+    const double s = u - std::floor(u);
+    const double m0 = rebound * v_mps * period_s, m1 = -v_mps * period_s;
+    return impact_y_m + m0 * (s * s * s - 2 * s * s + s) + m1 * (s * s * s - s * s);
+}
+} // namespace
+
+TEST_CASE("drum auto: the membrane at the strokes' turnarounds within 5 mm, one impact each",
+          "[sim][cartesian][drum]")
+{
+    // The bead's radius: the sticks meet the membrane 30 degrees below the
+    // horizontal, their tracked end r / 2 above it (kImpactPitchFactor).
+    const double r = 0.007;
+    struct Stroke {
+        double v_mps, period_s, rebound;
+    };
+    // Taps, legato, accents and piston-like strokes up to 8 m/s at impact.
+    const Stroke strokes[] = {{0.5, 0.2, 0.8}, {1.0, 0.2, 0.8}, {3.0, 0.25, 0.7},
+                              {5.0, 0.3, 0.6}, {8.0, 0.3, 0.5}, {8.0, 0.25, 0.3}};
+    for (double drum_y : {0.3, 0.72, 1.05})
+        for (const Stroke &k : strokes)
+            for (double rate_hz : {120.0, 250.0})
+                for (double phase : {0.0, 0.31, 0.77}) {
+                    TipTrajectory tips;
+                    const double duration = 3.0;
+                    const double t0[2] = {(0.05 + phase) / rate_hz, 0.5 * k.period_s + 0.013};
+                    for (int f = 0; f < std::lround(duration * rate_hz); ++f) {
+                        const double t = f / rate_hz;
+                        tips.time_s.push_back(t);
+                        for (int s = 0; s < 2; ++s)
+                            tips.tip_m[s].push_back(
+                                Eigen::Vector3d(s == 0 ? 0.15 : -0.15,
+                                                stroke_height(t, t0[s], k.period_s, k.v_mps,
+                                                              k.rebound, drum_y + 0.5 * r),
+                                                0.4));
+                    }
+                    const DrumFit fit = fit_drum_to_turnarounds(tips, r);
+                    INFO("drum " << drum_y << " m, " << k.v_mps << " m/s every " << k.period_s
+                                 << " s, " << rate_hz << " Hz, phase " << phase << ": fitted "
+                                 << fit.center_m.y());
+                    CHECK(std::abs(fit.center_m.y() - drum_y) <= 0.005);
+                    CHECK(std::abs(fit.center_m.x()) <= 0.005);
+                    CHECK(std::abs(fit.center_m.z() - 0.4) <= 1e-9);
+                    // One impact per captured impact: every detected impact is within a
+                    // sample of a true one, and every true impact with a whole stroke
+                    // captured before it (the first may start part-way down) and a sample
+                    // after it is detected exactly once.
+                    for (int s = 0; s < 2; ++s) {
+                        for (const StrokeTurnaround &d : fit.impacts[s]) {
+                            const double u = (d.time_s - t0[s]) / k.period_s;
+                            CHECK(std::abs(u - std::round(u)) * k.period_s <= 1.0 / rate_hz);
+                        }
+                        for (double ti = t0[s]; ti < duration; ti += k.period_s) {
+                            if (ti - k.period_s < tips.time_s.front() || ti >= tips.time_s.back())
+                                continue;
+                            int found = 0;
+                            for (const StrokeTurnaround &d : fit.impacts[s])
+                                found += std::abs(d.time_s - ti) <= 1.0 / rate_hz;
+                            CHECK(found == 1);
+                        }
+                    }
+                }
+}
+
+TEST_CASE("drum auto on the TrajOptDrums stroke: its turnaround at the paper's drum height",
+          "[sim][cartesian][drum][data]")
+{
+    const std::string xs = simtest::data_file("trajoptdrums/JointCenters_XPose_cm.csv");
+    const std::string ys = simtest::data_file("trajoptdrums/JointCenters_YPose_cm.csv");
+    if (xs.empty() || ys.empty())
+        return;
+    // Columns: time, shoulder, elbow, wrist, finger, drum bead (cm, shoulder at 0).
+    const auto read = [](const std::string &path) {
+        std::ifstream in(path);
+        std::string line;
+        std::getline(in, line); // header
+        std::vector<std::pair<double, double>> rows;
+        while (std::getline(in, line)) {
+            std::istringstream cells(line);
+            std::string cell;
+            std::vector<double> v;
+            while (std::getline(cells, cell, ',') && v.size() < 6)
+                v.push_back(std::stod(cell));
+            if (v.size() == 6)
+                rows.emplace_back(v[0], v[5] / 100.0);
+        }
+        return rows;
+    };
+    const auto x = read(xs), y = read(ys);
+    REQUIRE(x.size() == 160);
+    REQUIRE(y.size() == x.size());
+    TipTrajectory tips;
+    for (size_t i = 0; i < x.size(); ++i) {
+        tips.time_s.push_back(x[i].first);
+        for (int s = 0; s < 2; ++s)
+            tips.tip_m[s].push_back(Eigen::Vector3d(x[i].second, y[i].second, 0.0));
+    }
+    // One down-stroke at 100 bpm: one turnaround, where the original analysis
+    // puts the drum head (YD = -0.47108 m below the shoulder, README.md).
+    const std::vector<StrokeTurnaround> t = find_turnarounds(tips, 0);
+    REQUIRE(t.size() == 1);
+    INFO("turnaround at " << t[0].time_s << " s, height " << t[0].position_m.y() << " m, "
+                          << t[0].speed_in_mps << " m/s");
+    CHECK(std::abs(t[0].position_m.y() - -0.47108) <= 0.005);
+    CHECK(t[0].time_s == Approx(0.62).margin(0.01));
+    CHECK(t[0].speed_in_mps > 1.0);
+}
+
+TEST_CASE("stick-only: synthetic strokes up to 5 m/s, drum found within 5 mm, free flight to 5 mm",
+          "[sim][cartesian][drum]")
+{
+    const Skeleton skel = default_skeleton();
+    const CharacterModel m = CharacterModel::from_skeleton(skel);
+    Motion held = simtest::make_motion(
+        skel, 2, 100.0, [](int, const std::string &) { return Eigen::Quaterniond::Identity(); });
+    for (Eigen::Vector3d &p : held.root_position_m)
+        p = Eigen::Vector3d(0, 0.9, 0);
+    const ReferenceMotion ref(m, held);
+    const double r = m.options().stick.tip_radius_m;
+    struct Case {
+        double v_mps, period_s, rebound, membrane_y_m;
+    };
+    // Taps, legato, accents (measured at 8 m/s: 8.9 / 7.9 mm, docs/mocap.md).
+    for (const Case &c :
+         {Case{1.0, 0.2, 0.8, 0.2}, Case{3.0, 0.25, 0.7, 0.7}, Case{5.0, 0.3, 0.6, 0.5}}) {
+        MarkerCapture cap;
+        cap.tracks.resize(2);
+        cap.tracks[0].name = "stick_l";
+        cap.tracks[1].name = "stick_r";
+        const double rate = 250.0;
+        for (int f = 0; f < 750; ++f) {
+            const double t = f / rate;
+            cap.time_s.push_back(t);
+            for (int s = 0; s < 2; ++s)
+                cap.tracks[s].position_m.push_back(Eigen::Vector3d(
+                    s == 0 ? 0.15 : -0.15,
+                    stroke_height(t, s == 0 ? 0.0015 : 0.5 * c.period_s + 0.013, c.period_s,
+                                  c.v_mps, c.rebound, c.membrane_y_m + 0.5 * r),
+                    0.0));
+        }
+        const TipTrajectory tips = place_behind_sticks(m, ref.frame(0), cap, {0, 1});
+        // The placement is a turn about the vertical and a shift: heights move by the shift.
+        const double membrane =
+            c.membrane_y_m + tips.tip_m[0][0].y() - cap.tracks[0].position_m[0].y();
+        TrackOptions o;
+        o.mode = TrackMode::cartesian;
+        o.tip_reference = &tips;
+        // The strikes, as `ictusd track` detects them (strikes.csv).
+        StrikeDetector detector;
+        std::vector<StrikeEvent> strikes;
+        o.on_step = [&](const Scene &scene) {
+            detector.set_membrane(membrane_of(scene));
+            StrikeEvent out[2];
+            const int n = detect_strikes(detector, scene, out);
+            strikes.insert(strikes.end(), out, out + n);
+        };
+        const TrackSummary s = track_joint_space(m, ref, o);
+        // One strike per captured impact once the arms have settled from their cold start
+        // (from 1 s on: the first strokes after the 0.25 s ramp can be missed), none else.
+        for (int hand = 0; hand < 2; ++hand) {
+            const double t0 = hand == 0 ? 0.0015 : 0.5 * c.period_s + 0.013;
+            int impacts = 0, struck = 0, extra = 0;
+            for (double ti = t0; ti < 2.99; ti += c.period_s)
+                if (ti >= 1.0) {
+                    ++impacts;
+                    int n = 0;
+                    for (const StrikeEvent &e : strikes)
+                        n += e.hand == hand && !e.bounce && std::abs(e.time_s - ti) < 0.02;
+                    struck += n == 1;
+                }
+            for (const StrikeEvent &e : strikes) {
+                bool near = false;
+                for (double ti = t0; ti < 3.0; ti += c.period_s)
+                    near = near || std::abs(e.time_s - ti) < 0.02;
+                extra += e.hand == hand && !e.bounce && !near;
+            }
+            INFO(c.v_mps << " m/s, hand " << hand << ": " << struck << " of " << impacts
+                         << " impacts struck once, " << extra << " other strikes");
+            CHECK(struck == impacts);
+            CHECK(extra == 0);
+        }
+        INFO(c.v_mps << " m/s: drum " << s.drum_center_m.y() << " (true " << membrane
+                     << "), free flight rms mm " << s.tip_rms_free_mm[0] << " "
+                     << s.tip_rms_free_mm[1] << ", contact windows " << s.tip_rms_contact_mm[0]
+                     << " " << s.tip_rms_contact_mm[1] << ", impacts " << s.captured_impacts[0]
+                     << " " << s.captured_impacts[1]);
+        CHECK_FALSE(s.diverged);
+        CHECK(std::abs(s.drum_center_m.y() - membrane) <= 0.005);
+        CHECK(s.tip_rms_free_mm[0] <= 5.0);
+        CHECK(s.tip_rms_free_mm[1] <= 5.0);
+        // Every impact with a whole stroke before it is found (3 s of strokes).
+        CHECK(s.captured_impacts[0] >= static_cast<int>(3.0 / c.period_s) - 1);
+        CHECK(s.captured_impacts[1] >= static_cast<int>(3.0 / c.period_s) - 1);
+    }
 }

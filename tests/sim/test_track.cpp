@@ -123,7 +123,8 @@ TEST_CASE("track: a slow synthetic swing is followed closely, the CSV has one ro
     std::string header, line;
     std::getline(in, header);
     const long columns = std::count(header.begin(), header.end(), ',') + 1;
-    CHECK(columns == 1 + 19 * 7 + 2 * 6 + 2 * 3 + 1); // + elbow flexion ref/target/sim
+    // + elbow flexion ref/target/sim, + the raw capture's tip and elbow flexion per side
+    CHECK(columns == 1 + 19 * 7 + 2 * 6 + 2 * 3 + 2 * 4 + 1);
     CHECK(header.rfind("time_s,lumbar_ref_x_deg", 0) == 0);
     int rows = 0;
     while (std::getline(in, line)) {

@@ -177,40 +177,204 @@ TipTrajectory place_behind_sticks(const CharacterModel &model, const CharacterPo
     return tips;
 }
 
-Eigen::Vector3d fit_drum_to_strokes(const TipTrajectory &tips, double tip_radius_m)
+namespace
 {
-    std::vector<double> heights;
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    int sticks_with_strokes = 0;
-    for (int s = 0; s < 2; ++s) {
-        const std::vector<Eigen::Vector3d> &p = tips.tip_m[s];
-        double lo = 1e300, hi = -1e300;
-        for (const Eigen::Vector3d &x : p) {
-            lo = std::min(lo, x.y());
-            hi = std::max(hi, x.y());
-        }
-        const double threshold = lo + 0.25 * (hi - lo);
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        int strokes = 0;
-        for (size_t i = 1; i + 1 < p.size(); ++i)
-            if (p[i].y() <= p[i - 1].y() && p[i].y() < p[i + 1].y() && p[i].y() <= threshold) {
-                sum += p[i];
-                heights.push_back(p[i].y());
-                ++strokes;
-            }
-        if (strokes > 0) {
-            centre += sum / strokes;
-            ++sticks_with_strokes;
+// The vertex of a turnaround at sample i of heights y (times t), see find_turnarounds.
+void refine_vertex(const std::vector<double> &t, const std::vector<double> &y, size_t i,
+                   double &t_out, double &y_out)
+{
+    t_out = t[i];
+    y_out = y[i];
+    const size_t n = y.size();
+    if (i < 1 || i + 1 >= n)
+        return;
+    // Parabola through i-1, i, i+1 (Lagrange form, vertex where its derivative vanishes).
+    double tp = t[i], yp = y[i];
+    {
+        const double t0 = t[i - 1], t1 = t[i], t2 = t[i + 1];
+        const double y0 = y[i - 1], y1 = y[i], y2 = y[i + 1];
+        const double d0 = (y1 - y0) / (t1 - t0), d1 = (y2 - y1) / (t2 - t1);
+        const double a = (d1 - d0) / (t2 - t0); // half the second derivative
+        if (a > 0.0) {
+            tp = 0.5 * (t0 + t1) - d0 / (2.0 * a);
+            tp = std::min(t2, std::max(t0, tp));
+            yp = y1 + d0 * (tp - t1) + a * (tp - t0) * (tp - t1);
+            yp = std::min(yp, y1);
         }
     }
-    if (sticks_with_strokes == 0)
-        throw CharacterError("--drum auto: no strokes in the stick capture (no minima of tip "
-                             "height)");
-    // Each stick counts once, however many strokes it played.
-    centre /= sticks_with_strokes;
-    std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
-    centre.y() = heights[heights.size() / 2] - tip_radius_m;
-    return centre;
+    if (i < 2 || i + 2 >= n) {
+        t_out = tp;
+        y_out = yp;
+        return;
+    }
+    // The V: the lines through (i-2, i-1) and (i+1, i+2).
+    const double s_in = (y[i - 1] - y[i - 2]) / (t[i - 1] - t[i - 2]);
+    const double s_out = (y[i + 2] - y[i + 1]) / (t[i + 2] - t[i + 1]);
+    double tv = t[i], yv = y[i];
+    bool v_ok = false;
+    if (s_in < 0.0 && s_out > 0.0) {
+        // y[i-1] + s_in (x - t[i-1]) = y[i+1] + s_out (x - t[i+1])
+        tv = (y[i + 1] - y[i - 1] + s_in * t[i - 1] - s_out * t[i + 1]) / (s_in - s_out);
+        if (tv >= t[i - 1] && tv <= t[i + 1]) {
+            yv = y[i - 1] + s_in * (tv - t[i - 1]);
+            v_ok = yv <= y[i];
+        }
+    }
+    if (!v_ok) {
+        t_out = tp;
+        y_out = yp;
+        return;
+    }
+    // Which model predicts the samples it was not fitted to: the V predicts y[i]
+    // (the upper of its two lines there), the parabola y[i-2] and y[i+2].
+    const double v_pred =
+        std::max(y[i - 1] + s_in * (t[i] - t[i - 1]), y[i + 1] + s_out * (t[i] - t[i + 1]));
+    const double r_v = std::abs(v_pred - y[i]);
+    const double d0 = (y[i] - y[i - 1]) / (t[i] - t[i - 1]);
+    const double d1 = (y[i + 1] - y[i]) / (t[i + 1] - t[i]);
+    const double a = (d1 - d0) / (t[i + 1] - t[i - 1]);
+    const auto parabola = [&](double x) {
+        return y[i] + d0 * (x - t[i]) + a * (x - t[i - 1]) * (x - t[i]);
+    };
+    const double r_p =
+        0.5 * (std::abs(parabola(t[i - 2]) - y[i - 2]) + std::abs(parabola(t[i + 2]) - y[i + 2]));
+    if (r_v <= r_p) {
+        t_out = tv;
+        y_out = yv;
+    } else {
+        t_out = tp;
+        y_out = yp;
+    }
+}
+} // namespace
+
+std::vector<StrokeTurnaround> find_turnarounds(const TipTrajectory &tips, int side,
+                                               double min_drop_m, double min_speed_mps)
+{
+    std::vector<StrokeTurnaround> out;
+    const std::vector<Eigen::Vector3d> &p = tips.tip_m[side & 1];
+    const size_t n = std::min(p.size(), tips.time_s.size());
+    if (n < 3)
+        return out;
+    std::vector<double> t(n), y(n);
+    for (size_t i = 0; i < n; ++i) {
+        t[i] = tips.time_s[i] - tips.time_s.front();
+        y[i] = p[i].y();
+    }
+    double high = y[0];   // highest point since the last turnaround
+    double fastest = 0.0; // fastest descent since then, m/s
+    for (size_t i = 1; i + 1 < n; ++i) {
+        high = std::max(high, y[i]);
+        if (y[i] > high - 1e-12) // a new high: the descent starts again from here
+            fastest = 0.0;
+        fastest = std::max(fastest, (y[i - 1] - y[i]) / (t[i] - t[i - 1]));
+        // A stroke: a local minimum, at least min_drop_m below the highest point since
+        // the last turnaround, reached by a descent at kMinStrokeSpeed_mps or faster at
+        // some point (a resting stick's wobble is neither).
+        if (!(y[i] <= y[i - 1] && y[i] < y[i + 1] && high - y[i] >= min_drop_m &&
+              fastest >= min_speed_mps))
+            continue;
+        StrokeTurnaround ta;
+        double tv = t[i], yv = y[i];
+        refine_vertex(t, y, i, tv, yv);
+        ta.time_s = tv;
+        // The horizontal position at the vertex time (linear between the samples).
+        const size_t k = tv <= t[i] ? i - 1 : i;
+        const double w = (tv - t[k]) / (t[k + 1] - t[k]);
+        ta.position_m = (1.0 - w) * p[k] + w * p[k + 1];
+        ta.position_m.y() = yv;
+        ta.speed_in_mps = i >= 1 ? (y[i - 1] - y[i]) / (t[i] - t[i - 1]) : 0.0;
+        if (i >= 2)
+            ta.speed_in_mps =
+                std::max(ta.speed_in_mps, (y[i - 2] - y[i - 1]) / (t[i - 1] - t[i - 2]));
+        out.push_back(ta);
+        high = y[i];
+        fastest = 0.0;
+    }
+    return out;
+}
+
+DrumFit fit_drum_to_turnarounds(const TipTrajectory &tips, double tip_radius_m)
+{
+    std::array<std::vector<StrokeTurnaround>, 2> all = {find_turnarounds(tips, 0),
+                                                        find_turnarounds(tips, 1)};
+    if (all[0].empty() && all[1].empty()) // no stroke fast enough: any turnaround
+        all = {find_turnarounds(tips, 0, 0.01, 0.0), find_turnarounds(tips, 1, 0.01, 0.0)};
+    std::vector<double> heights;
+    for (const auto &side : all)
+        for (const StrokeTurnaround &ta : side)
+            heights.push_back(ta.position_m.y());
+    if (heights.empty())
+        throw CharacterError("--drum auto: no strokes in the stick capture (no turnaround of tip "
+                             "height with a descent of 1 cm or more)");
+    std::vector<double> sorted = heights;
+    std::sort(sorted.begin(), sorted.end());
+    const double quartile = sorted[(sorted.size() - 1) / 4];
+    const double top = quartile + kImpactBand_m;
+    DrumFit fit;
+    std::vector<double> impact_heights;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    int sticks = 0;
+    for (int s = 0; s < 2; ++s) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (const StrokeTurnaround &ta : all[s])
+            if (ta.position_m.y() <= top) {
+                fit.impacts[s].push_back(ta);
+                impact_heights.push_back(ta.position_m.y());
+                sum += ta.position_m;
+            }
+        if (!fit.impacts[s].empty()) {
+            centre += sum / static_cast<double>(fit.impacts[s].size());
+            ++sticks;
+        }
+    }
+    centre /= sticks; // each stick counts once, however many strokes it played
+    const size_t m = impact_heights.size();
+    std::sort(impact_heights.begin(), impact_heights.end());
+    const double median =
+        m % 2 ? impact_heights[m / 2] : 0.5 * (impact_heights[m / 2 - 1] + impact_heights[m / 2]);
+    centre.y() = median - kImpactPitchFactor * tip_radius_m;
+    fit.center_m = centre;
+    return fit;
+}
+
+TipTrajectory with_impact_vertices(const TipTrajectory &tips,
+                                   const std::array<std::vector<StrokeTurnaround>, 2> &impacts)
+{
+    struct Insert {
+        double t;
+        int side;
+        Eigen::Vector3d p;
+    };
+    std::vector<Insert> inserts;
+    for (int s = 0; s < 2; ++s)
+        for (const StrokeTurnaround &ta : impacts[s])
+            inserts.push_back({ta.time_s, s, ta.position_m});
+    std::sort(inserts.begin(), inserts.end(),
+              [](const Insert &a, const Insert &b) { return a.t < b.t; });
+    TipTrajectory out;
+    const double t0 = tips.time_s.empty() ? 0.0 : tips.time_s.front();
+    size_t k = 0;
+    for (size_t i = 0; i < tips.time_s.size(); ++i) {
+        const double t = tips.time_s[i] - t0;
+        for (; k < inserts.size() && inserts[k].t < t - 1e-9; ++k) {
+            if (!out.time_s.empty() && inserts[k].t + t0 <= out.time_s.back() + 1e-9)
+                continue; // coincides with the previous sample (or two impacts at once)
+            out.time_s.push_back(inserts[k].t + t0);
+            for (int s = 0; s < 2; ++s)
+                out.tip_m[s].push_back(s == inserts[k].side ? inserts[k].p
+                                                            : tips.sample(s, inserts[k].t));
+        }
+        out.time_s.push_back(tips.time_s[i]);
+        for (int s = 0; s < 2; ++s)
+            out.tip_m[s].push_back(tips.tip_m[s][i]);
+    }
+    return out;
+}
+
+Eigen::Vector3d fit_drum_to_strokes(const TipTrajectory &tips, double tip_radius_m)
+{
+    return fit_drum_to_turnarounds(tips, tip_radius_m).center_m;
 }
 
 } // namespace ictus

@@ -44,13 +44,18 @@ void track_usage(std::ostream &out)
            "  --left-stick NAME, --right-stick NAME   the capture's stick-tip objects (default:\n"
            "                         named stick_l / stick_r, else containing left / right)\n"
            "  --units mm|m, --up y|z, --rate HZ   how to read the .csv (default m, y, its time)\n"
-           "  --drum auto|X,Y,Z      membrane centre (auto: under the lowest strokes)\n"
+           "  --drum auto|X,Y,Z      membrane centre (auto, default: a stick-only capture's\n"
+           "                         at its strokes' turnarounds, a BVH's under the lowest\n"
+           "                         tips; docs/mocap.md)\n"
            "  --ik-gain G            eq. 2's gain on the tip error (default 10)\n"
            "  --ik-velocity-gain S   tip velocity error term, s (default 0.1; < 0: automatic)\n"
            "  --ik-accel-ff S2       tip acceleration feedforward, s^2 (default 0)\n"
            "  --ik-integral PER_S    integral of the tip error (default 0)\n"
-           "  --ik-correction-limit M   cap on the IK target's correction (default 0.1)\n"
-           "  --ik-start kinematic|simulated   IK warm start (default kinematic; docs/ik.md)\n"
+           "  --ik-correction-limit M   cap on the IK target's correction (default 0.3)\n"
+           "  --ik-start simulated|kinematic   where the feedback IK starts: simulated, the\n"
+           "                         simulated arm (Algorithm 2, default); kinematic, the\n"
+           "                         capture-seeded IK solution (docs/ik.md)\n"
+           "  --ik-posture-weight W  null-space posture task, 0..1 per step (default 0.005)\n"
            "  --out DIR              write DIR/track.csv, DIR/strikes.csv and DIR/summary.json\n"
            "  --scale M              metres per BVH unit (default 0.056444, the CMU files)\n"
            "  --skip-frames N        frames dropped at the start (default 1: the CMU\n"
@@ -64,7 +69,7 @@ void track_usage(std::ostream &out)
            "  --grip french|german   hand-stick orientation (default french)\n"
            "  --stick-length M       (default 0.406)   --stick-mass KG (default 0.05)\n"
            "  --stick-tip-radius M   (default 0.007)\n"
-           "  --drum-pos X,Y,Z       membrane centre, m (default: under the lowest tips)\n"
+           "  --drum-pos X,Y,Z       membrane centre, m (default: --drum auto)\n"
            "  --drum-radius M        (default 0.178)   --drum-tension N/m (default 3000)\n"
            "  --gain-hz HZ           PD natural frequency (default 30)\n"
            "  --damping-ratio Z      (default 1)       --torque-scale S (default 1)\n"
@@ -78,6 +83,11 @@ void track_usage(std::ostream &out)
            "  --smooth-hz HZ         low-pass the reference (Gaussian, default 10; 0: off)\n"
            "  --despike-deg DEG      replace one-frame spikes larger than DEG (default 5;\n"
            "                         0: off)\n"
+           "  --tip-smooth-hz HZ     low-pass of the stick tips (X^T and the errors; default:\n"
+           "                         --smooth-hz; 0: de-spiked only)\n"
+           "  --ik-iterations N      feedback IK iterations per step (default 2; 0: to\n"
+           "                         convergence; 1: eq. 2's single step)\n"
+           "  --ik-kinematic-iterations N   the kinematic IK's (target rates; default 1)\n"
            "  --quiet                no progress output\n"
         << force_help(25)
         << "\n"
@@ -88,7 +98,7 @@ void track_usage(std::ostream &out)
            "\n"
            "examples:\n"
            "  ictusd track --mode joint --mocap ../shared/data/cmu/80_13.bvh --out run1\n"
-           "  ictusd track --mode cartesian --mocap ../shared/data/cmu/80_13.bvh --limit-k 4\n"
+           "  ictusd track --mode cartesian --mocap ../shared/data/cmu/80_13.bvh\n"
            "  ictusd track --mode cartesian --mocap sticks.csv --units mm --up z --drum auto\n";
 }
 
@@ -97,6 +107,7 @@ struct TrackArgs {
     bool help = false;
     std::string mode, mocap, out_dir, limits_mode = "quaternion", gains_file;
     double limit_k = 3.0, limit_width_deg = 6.0;
+    double tip_smooth_hz = -1.0; // < 0: the reference's (--smooth-hz)
     ClipOptions clip;
     bool quiet = false;
     CharacterOptions character;
@@ -153,6 +164,16 @@ TrackArgs parse_track_args(Args &args)
             if (v != "simulated" && v != "kinematic")
                 throw UsageError("--ik-start: expected simulated or kinematic, got '" + v + "'");
             t.options.cartesian.start_from_simulated = v == "simulated";
+        } else if (a == "--tip-smooth-hz") {
+            t.tip_smooth_hz = parse_number(a, args.value(a));
+            if (!(t.tip_smooth_hz >= 0.0 && t.tip_smooth_hz <= 1000.0))
+                throw UsageError("--tip-smooth-hz: expected 0 <= HZ <= 1000, got " + args.value(a));
+        } else if (a == "--ik-iterations") {
+            t.options.cartesian.feedback_iterations = parse_int(a, args.value(a), 0, 10000);
+        } else if (a == "--ik-kinematic-iterations") {
+            t.options.cartesian.kinematic_iterations = parse_int(a, args.value(a), 0, 10000);
+        } else if (a == "--ik-posture-weight") {
+            t.options.cartesian.posture_weight = parse_number(a, args.value(a));
         } else if (a == "--ik-integral") {
             t.options.cartesian.integral_per_s = parse_number(a, args.value(a));
         } else if (a == "--mocap") {
@@ -261,7 +282,7 @@ struct TrackInput {
     TrackInput &operator=(const TrackInput &) = delete;
     BvhFile bvh;
     std::unique_ptr<CharacterModel> model;
-    std::unique_ptr<ReferenceMotion> raw, reference;
+    std::unique_ptr<ReferenceMotion> raw, reference, tips_cleaned;
     TipTrajectory tips;
     std::unique_ptr<CharacterLimits> limits;
     std::vector<JointLimitRef> limit_refs;
@@ -299,6 +320,13 @@ void load_track_input(TrackArgs &t, TrackInput &in)
     if (t.stick_only) {
         in.tips = place_behind_sticks(model, in.reference->frame(0), capture, stick_tracks);
         t.options.tip_reference = &in.tips;
+    } else if (t.tip_smooth_hz >= 0.0 && t.tip_smooth_hz != t.clip.filter.smooth_cutoff_hz) {
+        // The stick tips' own clean-up (docs/mocap.md): de-spiked as the joints,
+        // low-passed at --tip-smooth-hz.
+        ReferenceFilter tip_filter = t.clip.filter;
+        tip_filter.smooth_cutoff_hz = t.tip_smooth_hz;
+        in.tips_cleaned = std::make_unique<ReferenceMotion>(model, in.bvh.motion, tip_filter);
+        t.options.tip_motion = in.tips_cleaned.get();
     }
     if (t.limits_mode != "none" && in.reference->frames() < kMinLimitFrames)
         std::cerr << "ictusd: warning: " << t.mocap << ": joint limits learned from "
@@ -402,11 +430,21 @@ int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary
     j["smooth_hz"] = t.clip.filter.smooth_cutoff_hz;
     j["despike_deg"] = t.clip.filter.spike_threshold_rad * 180.0 / M_PI;
     j["spikes_removed"] = in.reference->spikes_removed();
+    j["tip_smooth_hz"] = t.stick_only           ? 0.0
+                         : t.options.tip_motion ? t.tip_smooth_hz
+                                                : t.clip.filter.smooth_cutoff_hz;
+    j["drum_auto"] = options.drum_auto;
     j["interrupted"] = summary.interrupted;
     j["gains"] = gains_to_json(*in.model, in.gains);
     if (options.mode == TrackMode::cartesian) {
         j["ik"]["gain"] = options.cartesian.gain;
+        j["ik"]["velocity_gain_s"] = options.cartesian.velocity_gain_s;
+        j["ik"]["correction_limit_m"] = options.cartesian.correction_limit_m;
         j["ik"]["integral_per_s"] = options.cartesian.integral_per_s;
+        j["ik"]["start"] = options.cartesian.start_from_simulated ? "simulated" : "kinematic";
+        j["ik"]["posture_weight"] = options.cartesian.posture_weight;
+        j["ik"]["feedback_iterations"] = options.cartesian.feedback_iterations;
+        j["ik"]["kinematic_iterations"] = options.cartesian.kinematic_iterations;
     }
     if (!t.out_dir.empty()) {
         OutputFile strikes(t.out_dir + "/strikes.csv");

@@ -49,6 +49,7 @@ ChainIkSolverPos_dls::ChainIkSolverPos_dls(int joints, const IkParams &params)
     // this nor solve() touches the heap.
     jacobian_.setZero(3, 3 * joints_);
     step_.setZero(3 * joints_);
+    posture_step_.setZero(3 * joints_);
     projector_.setZero(3 * joints_, 3 * joints_);
     jacobian_solved_.setZero(3, 3 * joints_);
     direction_jacobian_.setZero(3, 3 * joints_);
@@ -87,6 +88,26 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
     const IkResult r =
         solve(chain, target_tip_m, Eigen::Vector3d::UnitX(), rotation_weight, rotations_out);
     full_rotation_ = false;
+    return r;
+}
+
+IkResult ChainIkSolverPos_dls::solve_with_posture(const KinematicChain &chain,
+                                                  const Eigen::Vector3d &target_tip_m,
+                                                  const Eigen::Quaterniond *posture,
+                                                  double posture_weight,
+                                                  Eigen::Quaterniond *rotations_out)
+{
+    bool valid = posture != nullptr && std::isfinite(posture_weight) && posture_weight >= 0.0 &&
+                 posture_weight <= 1.0;
+    for (int j = 0; valid && j < joints_; ++j)
+        valid = posture[j].coeffs().allFinite() && posture[j].norm() > 1e-12;
+    if (!valid)
+        return solve(chain, target_tip_m, Eigen::Vector3d::Constant(std::nan("")), 1.0,
+                     rotations_out); // refused as invalid input
+    posture_ = posture_weight > 0.0 ? posture : nullptr;
+    posture_weight_ = posture_weight;
+    const IkResult r = solve(chain, target_tip_m, Eigen::Vector3d::UnitX(), 0.0, rotations_out);
+    posture_ = nullptr;
     return r;
 }
 
@@ -176,8 +197,14 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
         return error_m <= params_.tolerance_m &&
                (!use_direction || result.direction_error_rad <= params_.direction_tolerance_rad);
     };
-    while (!done() && result.iterations < params_.max_iterations) {
+    // The posture task is tried once, with the first iteration (even when the tip is already
+    // within tolerance: the step is in the tip task's null space).
+    bool posture_pending = posture_ != nullptr;
+    while ((!done() || posture_pending) && result.iterations < params_.max_iterations) {
         const ChainFrames &frames = frames_[current];
+        const bool with_posture = posture_pending;
+        posture_pending = false;
+        double posture_leak_m = 0.0;
         // Eq. 2 with Wampler's damped (singularity-robust) pseudo-inverse:
         // dtheta = J^T (J J^T + lambda^2 I)^-1 e. J J^T is only 3x3, so the solve is cheap.
         KinematicChain::tip_jacobian(frames, n, jacobian_);
@@ -216,6 +243,28 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
                 params_.direction_damping * params_.direction_damping;
             direction_llt_.compute(direction_jjt_);
             step_.noalias() += direction_jacobian_.transpose() * direction_llt_.solve(residual);
+        }
+        if (with_posture) {
+            // Posture task in the tip task's null space: dtheta += N w p, p_j the world rotation
+            // vector turning joint j onto posture_[j] (local q_j <- exp(R_parent^T p_j) q_j), N
+            // with the undamped pseudo-inverse (as the direction task's, so that it does not
+            // leak into the tip). N p = p - J^T (J J^T)^-1 J p: a 3x3 solve, no 12x12 projector.
+            for (int j = 0; j < n; ++j) {
+                const Eigen::Quaterniond &parent =
+                    j == 0 ? chain.base_rotation() : frames.joint_rotation[j - 1];
+                posture_step_.segment<3>(3 * j) =
+                    posture_weight_ *
+                    (parent * log_map(posture_[j] * rotation_[current][j].conjugate()));
+            }
+            jjt_.noalias() = jacobian_ * jacobian_.transpose();
+            jjt_.diagonal().array() += 1e-12;
+            projector_llt_.compute(jjt_);
+            const Eigen::Vector3d tip_part = projector_llt_.solve(jacobian_ * posture_step_);
+            posture_step_.noalias() -= jacobian_.transpose() * tip_part;
+            step_.noalias() += posture_step_;
+            // A null-space step moves the tip by second-order terms only: at most
+            // |dtheta|^2 / 2 times the chain's reach.
+            posture_leak_m = 0.5 * posture_step_.squaredNorm() * chain.reach_m();
         }
 
         // Scale the whole step (keeping its direction) so no joint turns more than the bound.
@@ -264,9 +313,15 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
                 : 0.0;
         // Accept what brings the tip closer, or -- with the tip within tolerance -- turns the
         // stick closer to its target: the tip is never traded for the direction.
-        const bool accept = candidate_error_m < error_m ||
-                            (use_direction && candidate_error_m <= params_.tolerance_m &&
-                             candidate_direction_error < result.direction_error_rad);
+        // A posture step may move the tip by its second-order terms: accepted if the tip
+        // ends no farther than before plus that bound (the next iterations, or the next
+        // call, take it back).
+        const bool accept =
+            candidate_error_m < error_m ||
+            (use_direction && candidate_error_m <= params_.tolerance_m &&
+             candidate_direction_error < result.direction_error_rad) ||
+            (with_posture &&
+             candidate_error_m <= error_m + std::max(params_.tolerance_m, posture_leak_m));
         limits_active = candidate_limited;
         if (accept) {
             current = candidate;

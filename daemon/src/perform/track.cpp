@@ -2,6 +2,7 @@
 #include "ictus/perform/track.hpp"
 #include "ictus/base/rotation.hpp"
 
+#include "ictus/mocap/rotation_stats.hpp"
 #include "ictus/perform/tracker.hpp"
 
 #include <algorithm>
@@ -17,13 +18,50 @@ namespace
 {
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-// Rotation angle of a local rotation, degrees: the elbow's flexion (its
-// other two axes stay within a few degrees in the captures).
-double rotation_angle_deg(const Eigen::Quaterniond &q)
+// The time from `t` to the nearest impact in `impacts` (in time order), s.
+double to_nearest_impact_s(const std::vector<StrokeTurnaround> &impacts, double t)
 {
-    return log_map(q).norm() * kRadToDeg;
+    double best = std::numeric_limits<double>::infinity();
+    auto it = std::lower_bound(impacts.begin(), impacts.end(), t,
+                               [](const StrokeTurnaround &a, double x) { return a.time_s < x; });
+    if (it != impacts.end())
+        best = std::min(best, it->time_s - t);
+    if (it != impacts.begin())
+        best = std::min(best, t - std::prev(it)->time_s);
+    return best;
 }
 } // namespace
+
+double elbow_flexion_deg(const Eigen::Vector3d &upper_arm_axis, const Eigen::Vector3d &forearm_axis,
+                         const Eigen::Quaterniond &elbow)
+{
+    const Eigen::Vector3d f = elbow * forearm_axis;
+    return std::atan2(upper_arm_axis.cross(f).norm(), upper_arm_axis.dot(f)) * kRadToDeg;
+}
+
+TipTrajectory reference_tip_trajectory(const CharacterModel &model,
+                                       const ReferenceMotion &reference)
+{
+    TipTrajectory tips;
+    for (int f = 0; f < reference.frames(); ++f) {
+        tips.time_s.push_back(f / reference.frame_rate_hz());
+        const auto p = reference_tips(model, reference.frame(f));
+        for (int s = 0; s < 2; ++s)
+            tips.tip_m[s].push_back(p[s]);
+    }
+    return tips;
+}
+
+CartesianOptions track_cartesian_defaults()
+{
+    CartesianOptions c;
+    c.start_from_simulated = true;
+    c.posture_weight = 0.005;
+    c.feedback_iterations = 2;
+    c.kinematic_iterations = 1;
+    c.correction_limit_m = 0.3;
+    return c;
+}
 
 void validate(const TrackOptions &o)
 {
@@ -49,6 +87,9 @@ void validate(const TrackOptions &o)
         throw CharacterError("ik integral: expected a finite value >= 0 /s");
     if (!(std::isfinite(c.integral_limit_m) && c.integral_limit_m >= 0.0))
         throw CharacterError("ik integral limit: expected a finite value >= 0 m");
+    if (!(std::isfinite(c.posture_weight) && c.posture_weight >= 0.0 && c.posture_weight <= 1.0))
+        throw CharacterError("ik posture weight: expected 0 <= w <= 1, got " +
+                             std::to_string(c.posture_weight));
     ChainIkSolverPos_dls probe(4);
     if (!probe.set_params(c.ik))
         throw CharacterError("ik parameters: expected finite positive values");
@@ -69,6 +110,13 @@ nlohmann::json TrackSummary::to_json() const
     j["tip_rms_raw_mm"] = {{"left", tip_rms_raw_mm[0]}, {"right", tip_rms_raw_mm[1]}};
     j["joint_rms_raw_deg_all"] = joint_rms_raw_deg_all;
     j["tip_max_mm"] = {{"left", tip_max_mm[0]}, {"right", tip_max_mm[1]}};
+    j["tip_rms_free_mm"] = {{"left", tip_rms_free_mm[0]}, {"right", tip_rms_free_mm[1]}};
+    j["tip_rms_contact_mm"] = {{"left", tip_rms_contact_mm[0]}, {"right", tip_rms_contact_mm[1]}};
+    j["tip_rms_raw_free_mm"] = {{"left", tip_rms_raw_free_mm[0]},
+                                {"right", tip_rms_raw_free_mm[1]}};
+    j["tip_rms_raw_contact_mm"] = {{"left", tip_rms_raw_contact_mm[0]},
+                                   {"right", tip_rms_raw_contact_mm[1]}};
+    j["captured_impacts"] = {{"left", captured_impacts[0]}, {"right", captured_impacts[1]}};
     nlohmann::json rms = nlohmann::json::object(), mx = nlohmann::json::object();
     nlohmann::json peak = nlohmann::json::object(), sat = nlohmann::json::object();
     double sum2 = 0.0;
@@ -153,10 +201,50 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             throw CharacterError("stick capture: expected at least two frames of both tips");
         options.cartesian.reference_has_arms = false;
     }
+    // Algorithm 2 literally: the arms are driven by the stick tips alone; the
+    // capture's arm rotations seed no IK (its clip-wide mean is the posture).
+    if (options.cartesian.start_from_simulated)
+        options.cartesian.reference_has_arms = false;
+    // The tips the errors are measured against (and the Cartesian mode's X^T):
+    // the stick-only capture, else the cleaned tip motion, else the reference.
+    const ReferenceMotion &tip_src = options.tip_motion ? *options.tip_motion : reference;
+    // The strokes' turnarounds: the drum (--drum auto) and the contact windows.
+    DrumFit drum_fit;
+    bool have_impacts = true;
+    try {
+        drum_fit =
+            fit_drum_to_turnarounds(tips_in ? *tips_in : reference_tip_trajectory(model, tip_src),
+                                    model.options().stick.tip_radius_m);
+    } catch (const CharacterError &) {
+        if (options.drum_auto && tips_in)
+            throw;
+        have_impacts = false;
+    }
+    // A stick-only capture's drum under its turnarounds. A full-body capture's
+    // under its lowest tips, out of the strokes' way: on CMU 80_13 (a drum kit)
+    // a snare at the turnarounds stands in the strokes meant for the other
+    // drums (docs/mocap.md, "Drum placement").
     if (options.drum_auto)
         options.scene.drum.center_m =
-            tips_in ? fit_drum_to_strokes(*tips_in, model.options().stick.tip_radius_m)
-                    : auto_drum_center(model, reference);
+            tips_in ? drum_fit.center_m : auto_drum_center(model, reference);
+    // A stick-only capture's impacts restored between its samples (X^T and the errors).
+    TipTrajectory restored;
+    // X^T asks for more at an impact: the stick's end down to the membrane plane at the
+    // vertex (the fitted membrane: kImpactPitchFactor tip radii below it), so that the
+    // simulated stick's bead reaches the head whatever its pitch, as the captured one did
+    // (docs/ik.md, "Stick-only captures"). The errors stay against the capture.
+    TipTrajectory pressed;
+    const TipTrajectory *targets_in = tips_in;
+    if (tips_in && have_impacts) {
+        restored = with_impact_vertices(*tips_in, drum_fit.impacts);
+        std::array<std::vector<StrokeTurnaround>, 2> at_membrane = drum_fit.impacts;
+        for (auto &side : at_membrane)
+            for (StrokeTurnaround &ta : side)
+                ta.position_m.y() -= kImpactPitchFactor * model.options().stick.tip_radius_m;
+        pressed = with_impact_vertices(*tips_in, at_membrane);
+        tips_in = &restored;
+        targets_in = &pressed;
+    }
     const double h = options.scene.step_s;
     const double duration = options.duration_s > 0.0 ? options.duration_s
                             : tips_in                ? tips_in->duration_s()
@@ -176,11 +264,38 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     Tracker tracker(model, options.scene, initial, gains, limits, options.mode, options.cartesian,
                     options.gains);
     Scene &scene = tracker.scene();
+    // The posture of the IK's null-space task: a full-body capture's mean arm
+    // pose over the clip (the centre of the learned limits, Algorithm 1's
+    // mean), a stick-only capture's first (cold-solved) arms.
+    if (!tips_in && reference.frames() > 0)
+        for (int s = 0; s < 2; ++s) {
+            Eigen::Quaterniond posture[4];
+            std::vector<Eigen::Quaterniond> series(reference.frames());
+            for (int k = 0; k < 4; ++k) {
+                const int j = model.joint_index(Tracker::kArmJoints[s][k]);
+                for (int f = 0; f < reference.frames(); ++f)
+                    series[f] = reference.frame(f).local[j];
+                posture[k] = mean_rotation(series);
+            }
+            tracker.set_posture(s, posture);
+        }
 
     const int nj = CharacterModel::kJoints;
     const bool cartesian = options.mode == TrackMode::cartesian;
     double elbow_sum2[2] = {0.0, 0.0};
-    CharacterPose around_pose;
+    CharacterPose around_pose, tip_pose;
+    Eigen::Vector3d upper_arm_axis[2], forearm_axis[2];
+    int elbow_joint[2];
+    for (int s = 0; s < 2; ++s) {
+        elbow_joint[s] = model.joint_index(Tracker::kArmJoints[s][2]);
+        upper_arm_axis[s] = model.joint_body(elbow_joint[s]).offset_m;
+        forearm_axis[s] = model.joint_body(model.joint_index(Tracker::kArmJoints[s][3])).offset_m;
+    }
+    const auto flexion = [&](int s, const Eigen::Quaterniond &q) {
+        return elbow_flexion_deg(upper_arm_axis[s], forearm_axis[s], q);
+    };
+    double split_sum2[2][2][2] = {}; // [side][raw?][contact?]
+    long split_n[2][2] = {};         // [side][contact?]
 
     TrackSummary summary;
     summary.mode = to_string(options.mode);
@@ -208,11 +323,17 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             for (const char *what : {"ref", "sim"})
                 for (const char *axis : {"x", "y", "z"})
                     *csv << ",tip_" << side << '_' << what << '_' << axis << "_m";
-        // Elbow flexion (rotation angle, deg): capture, PD target (joint mode: the
-        // capture; Cartesian mode: Theta^T from IK), simulation.
+        // Elbow flexion (the angle between upper arm and forearm, deg): cleaned
+        // capture, PD target (joint mode: the capture; Cartesian mode: Theta^T from
+        // IK), simulation. Then the raw capture's tips and elbow flexion.
         for (const char *side : {"l", "r"})
             for (const char *what : {"ref", "target", "sim"})
                 *csv << ',' << side << "_elbow_flexion_" << what << "_deg";
+        for (const char *side : {"left", "right"}) {
+            for (const char *axis : {"x", "y", "z"})
+                *csv << ",tip_" << side << "_raw_" << axis << "_m";
+            *csv << ',' << side[0] << "_elbow_flexion_raw_deg";
+        }
         *csv << ",contacts\n";
     }
 
@@ -245,16 +366,21 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                 std::array<Eigen::Vector3d, 2> before, after, now;
                 if (tips_in) {
                     for (int s = 0; s < 2; ++s) {
-                        before[s] = tips_in->sample(s, t_next - frame_s);
-                        after[s] = tips_in->sample(s, t_next + frame_s);
-                        now[s] = tips_in->sample(s, t_next);
+                        before[s] = targets_in->sample(s, t_next - frame_s);
+                        after[s] = targets_in->sample(s, t_next + frame_s);
+                        now[s] = targets_in->sample(s, t_next);
                     }
                 } else {
-                    reference.sample(t_next - frame_s, around_pose);
+                    tip_src.sample(t_next - frame_s, around_pose);
                     before = reference_tips(model, around_pose);
-                    reference.sample(t_next + frame_s, around_pose);
+                    tip_src.sample(t_next + frame_s, around_pose);
                     after = reference_tips(model, around_pose);
-                    now = reference_tips(model, ref_pose);
+                    if (options.tip_motion) {
+                        tip_src.sample(t_next, around_pose);
+                        now = reference_tips(model, around_pose);
+                    } else {
+                        now = reference_tips(model, ref_pose);
+                    }
                 }
                 for (int s = 0; s < 2; ++s) {
                     tip_targets.velocity_mps[s] = (after[s] - before[s]) / (2.0 * frame_s);
@@ -265,10 +391,22 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                 tip_targets.velocity_mps.fill(Eigen::Vector3d::Zero());
                 tip_targets.acceleration_mps2.fill(Eigen::Vector3d::Zero());
             }
-            tip_targets.has_position = tips_in != nullptr;
-            if (tips_in)
+            tip_targets.has_position = tips_in != nullptr || options.tip_motion != nullptr;
+            if (tips_in) {
                 for (int s = 0; s < 2; ++s)
-                    tip_targets.position_m[s] = tips_in->sample(s, t_next);
+                    tip_targets.position_m[s] = targets_in->sample(s, t_next);
+            } else if (options.tip_motion) {
+                // The cleaned tips, blended in from the (ramped) reference's tips
+                // like the joint targets: X^T = tips(step pose) + w (tips(tip motion)
+                // - tips(reference)).
+                const double w = ramp_weight(t_next, options.ramp_s);
+                options.tip_motion->sample(t_next, tip_pose);
+                const auto cleaned = reference_tips(model, tip_pose);
+                const auto body = reference_tips(model, ref_pose);
+                const auto blended = reference_tips(model, step_pose);
+                for (int s = 0; s < 2; ++s)
+                    tip_targets.position_m[s] = blended[s] + w * (cleaned[s] - body[s]);
+            }
         }
         tracker.step(step_pose, cartesian ? &tip_targets : nullptr, t_next >= options.ramp_s);
         if (options.on_step)
@@ -294,10 +432,12 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
             // Errors against the reference itself (not the ramped or clamped target).
             scene.local_rotations(sim_local);
             std::array<Eigen::Vector3d, 2> ref_tips;
-            if (tips_in)
+            if (tips_in) {
                 ref_tips = {tips_in->sample(0, t_next), tips_in->sample(1, t_next)};
-            else
-                ref_tips = reference_tips(model, ref_pose);
+            } else {
+                tip_src.sample(t_next, tip_pose);
+                ref_tips = reference_tips(model, tip_pose);
+            }
             std::array<Eigen::Vector3d, 2> sim_tips = {scene.tip_position(Side::left),
                                                        scene.tip_position(Side::right)};
             const bool counted = t_next >= options.ramp_s;
@@ -309,20 +449,27 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                     joint_sum2[j] += e * e;
                     joint_max[j] = std::max(joint_max[j], e);
                 }
+                bool contact[2] = {false, false};
                 for (int s = 0; s < 2; ++s) {
                     const double e = (ref_tips[s] - sim_tips[s]).norm() * 1e3;
                     tip_sum2[s] += e * e;
                     tip_max[s] = std::max(tip_max[s], e);
-                    const int elbow = model.joint_index(Tracker::kArmJoints[s][2]);
-                    const double de = rotation_angle_deg(ref_pose.local[elbow]) -
-                                      rotation_angle_deg(target[elbow]);
+                    const double de = flexion(s, ref_pose.local[elbow_joint[s]]) -
+                                      flexion(s, target[elbow_joint[s]]);
                     elbow_sum2[s] += de * de;
+                    contact[s] = have_impacts && to_nearest_impact_s(drum_fit.impacts[s], t_next) <=
+                                                     kContactWindow_s;
+                    split_sum2[s][0][contact[s]] += e * e;
+                    ++split_n[s][contact[s]];
                 }
                 if (raw_reference && !tips_in) {
                     raw_reference->sample(t_next, raw_pose);
                     const auto raw_tips = reference_tips(model, raw_pose);
-                    for (int s = 0; s < 2; ++s)
-                        raw_tip_sum2[s] += 1e6 * (raw_tips[s] - sim_tips[s]).squaredNorm();
+                    for (int s = 0; s < 2; ++s) {
+                        const double e2 = 1e6 * (raw_tips[s] - sim_tips[s]).squaredNorm();
+                        raw_tip_sum2[s] += e2;
+                        split_sum2[s][1][contact[s]] += e2;
+                    }
                     for (int j = 0; j < nj; ++j) {
                         const double e =
                             log_map(raw_pose.local[j] * sim_local[j].conjugate()).norm() *
@@ -345,10 +492,19 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
                     for (const Eigen::Vector3d &p : {ref_tips[s], sim_tips[s]})
                         *csv << ',' << p.x() << ',' << p.y() << ',' << p.z();
                 for (int s = 0; s < 2; ++s) {
-                    const int elbow = model.joint_index(Tracker::kArmJoints[s][2]);
-                    *csv << ',' << rotation_angle_deg(ref_pose.local[elbow]) << ','
-                         << rotation_angle_deg(target[elbow]) << ','
-                         << rotation_angle_deg(sim_local[elbow]);
+                    const int elbow = elbow_joint[s];
+                    *csv << ',' << flexion(s, ref_pose.local[elbow]) << ','
+                         << flexion(s, target[elbow]) << ',' << flexion(s, sim_local[elbow]);
+                }
+                if (raw_reference && !tips_in) {
+                    raw_reference->sample(t_next, raw_pose);
+                    const auto raw_tips = reference_tips(model, raw_pose);
+                    for (int s = 0; s < 2; ++s)
+                        *csv << ',' << raw_tips[s].x() << ',' << raw_tips[s].y() << ','
+                             << raw_tips[s].z() << ','
+                             << flexion(s, raw_pose.local[elbow_joint[s]]);
+                } else {
+                    *csv << ",,,,,,,,";
                 }
                 *csv << ',' << scene.contacts_last_step() << '\n';
             }
@@ -378,6 +534,15 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
         summary.tip_rms_mm[s] = std::sqrt(tip_sum2[s] / ns);
         summary.tip_max_mm[s] = tip_max[s];
         summary.tip_rms_raw_mm[s] = std::sqrt(raw_tip_sum2[s] / ns);
+        for (int c = 0; c < 2; ++c) {
+            const double m = std::max(1L, split_n[s][c]);
+            (c ? summary.tip_rms_contact_mm : summary.tip_rms_free_mm)[s] =
+                std::sqrt(split_sum2[s][0][c] / m);
+            (c ? summary.tip_rms_raw_contact_mm : summary.tip_rms_raw_free_mm)[s] =
+                std::sqrt(split_sum2[s][1][c] / m);
+        }
+        summary.captured_impacts[s] =
+            have_impacts ? static_cast<int>(drum_fit.impacts[s].size()) : 0;
     }
     summary.joint_rms_raw_deg_all = std::sqrt(raw_joint_sum2 / (ns * nj));
     if (cartesian) {

@@ -53,6 +53,7 @@ struct Tracker::Arm {
     KinematicChain feedback, kinematic;
     Eigen::Vector3d integral_m = Eigen::Vector3d::Zero();
     Eigen::Quaterniond theta_target[4], kinematic_target[4], previous_kinematic[4];
+    Eigen::Quaterniond posture[4];
 };
 
 namespace
@@ -110,9 +111,19 @@ Tracker::Tracker(const CharacterModel &model, const SceneOptions &scene_options,
         build_arm(scene_->model(), s, initial, limits, arm.joint, arm.base_body, chains);
         for (int k = 0; k < 4; ++k)
             arm.theta_target[k] = arm.kinematic_target[k] = arm.previous_kinematic[k] =
-                initial.local[arm.joint[k]];
+                arm.posture[k] = initial.local[arm.joint[k]];
     }
     solver_ = std::make_unique<ChainIkSolverPos_dls>(4, cartesian.ik);
+    IkParams feedback_ik = cartesian.ik;
+    if (cartesian.feedback_iterations > 0)
+        feedback_ik.max_iterations = cartesian.feedback_iterations;
+    feedback_solver_ = std::make_unique<ChainIkSolverPos_dls>(4, feedback_ik);
+    // The kinematic IK's own cap (it only gives the target rates).
+    if (cartesian.kinematic_iterations > 0) {
+        IkParams kinematic_ik = cartesian.ik;
+        kinematic_ik.max_iterations = cartesian.kinematic_iterations;
+        solver_ = std::make_unique<ChainIkSolverPos_dls>(4, kinematic_ik);
+    }
     previous_reference_ = initial.local;
     target_ = initial.local;
     sim_local_ = initial.local;
@@ -123,6 +134,12 @@ Tracker::Tracker(const CharacterModel &model, const SceneOptions &scene_options,
 }
 
 Tracker::~Tracker() = default;
+
+void Tracker::set_posture(int side, const Eigen::Quaterniond posture[4])
+{
+    for (int k = 0; k < 4; ++k)
+        arms_[side & 1]->posture[k] = posture[k].normalized();
+}
 
 const Eigen::Quaterniond &Tracker::kinematic_target(int side, int k) const
 {
@@ -177,7 +194,10 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
                 held_rotation(model, side, tips->stick_direction[s], hand_target, &plane);
             IkResult r = orient ? solver_->solve(arm.kinematic, tip_target, hand_target,
                                                  co.rotation_weight * plane, arm.kinematic_target)
-                                : solver_->solve(arm.kinematic, tip_target, arm.kinematic_target);
+                         : co.posture_weight > 0.0
+                             ? solver_->solve_with_posture(arm.kinematic, tip_target, arm.posture,
+                                                           co.posture_weight, arm.kinematic_target)
+                             : solver_->solve(arm.kinematic, tip_target, arm.kinematic_target);
             ik_stats_.iterations += r.iterations;
             ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
             ik_stats_.not_converged += r.status != IkStatus::converged;
@@ -231,7 +251,11 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
                 // error asks (with the hand's rotation held, the gain's
                 // correction would have to come from the upper arm alone, and
                 // the loop chattered: docs/perform.md, "Holding the stick").
-                r = solver_->solve(arm.feedback, ik_target, arm.theta_target);
+                // From Theta^S the posture task holds the arm's null space (docs/ik.md).
+                r = co.start_from_simulated && co.posture_weight > 0.0
+                        ? feedback_solver_->solve_with_posture(arm.feedback, ik_target, arm.posture,
+                                                               co.posture_weight, arm.theta_target)
+                        : feedback_solver_->solve(arm.feedback, ik_target, arm.theta_target);
                 ik_stats_.iterations += r.iterations;
                 ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
                 ik_stats_.not_converged += r.status != IkStatus::converged;

@@ -46,12 +46,50 @@ constexpr double kStickBelow_m = 0.35;
 TipTrajectory place_behind_sticks(const CharacterModel &model, const CharacterPose &pose,
                                   const MarkerCapture &capture, const std::array<int, 2> &tracks);
 
-// The drum membrane fitted to the lowest points of the strokes: per stick, the
-// local minima of tip height that lie within the lowest 25 % of that stick's
-// height range are the strike points; the membrane centre (x, z) is the mean
-// over the sticks of each stick's mean strike point (each stick counts once),
-// its height the median strike height minus one tip radius.
-// Throws CharacterError when there are no minima.
+// A stroke's turnaround: where a stick tip moving down turns back up (at the
+// drum, its impact). Found per stick as a local minimum of the height whose
+// descent from the highest point since the previous turnaround is at least
+// `min_drop_m` and that came down at kMinStrokeSpeed_mps or faster; the vertex is refined between
+// the samples (a capture at 250 Hz samples an 8 m/s impact every 32 mm): by the intersection of the
+// incoming and outgoing lines (two samples each side: an impact's V) or by the parabola through the
+// three lowest samples (a smooth turn), whichever predicts the remaining samples better
+// (docs/mocap.md, "Drum placement").
+constexpr double kMinStrokeSpeed_mps = 0.3;
+struct StrokeTurnaround {
+    double time_s = 0.0;                                  // from the first sample
+    Eigen::Vector3d position_m = Eigen::Vector3d::Zero(); // the refined vertex
+    double speed_in_mps = 0.0;                            // downward, before the turn
+};
+std::vector<StrokeTurnaround> find_turnarounds(const TipTrajectory &tips, int side,
+                                               double min_drop_m = 0.01,
+                                               double min_speed_mps = kMinStrokeSpeed_mps);
+
+// The drum under the strokes' turnarounds (`--drum auto`): the turnarounds of
+// both sticks pooled (when none came down at kMinStrokeSpeed_mps, any); the impacts are those at
+// most kImpactBand_m above the lowest quartile of their heights (turnarounds in the air, higher,
+// are not impacts); the membrane height is the median impact height minus one tip radius (the
+// bead's centre is a radius above the membrane at contact), its centre (x, z) the mean over the
+// sticks of each stick's mean impact point.
+constexpr double kImpactBand_m = 0.02;
+// The tracked point is the stick's end; its bead (radius r) touches the membrane
+// with the end r (1 + d_y) above it, d the stick's unit direction (butt to tip):
+// r for a horizontal stick, 0 for a vertical one. A stick-only capture does not
+// say d, so the membrane goes r / 2 below the impacts (a stick 30 degrees below
+// the horizontal): at most r / 2 (3.5 mm for the default bead) off at any pitch.
+constexpr double kImpactPitchFactor = 0.5;
+struct DrumFit {
+    Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+    std::array<std::vector<StrokeTurnaround>, 2> impacts; // [side], in time order
+};
+// Throws CharacterError when no stick has a turnaround.
+DrumFit fit_drum_to_turnarounds(const TipTrajectory &tips, double tip_radius_m);
+// `tips` with each impact's refined vertex inserted as a sample (its stick at the
+// vertex, the other stick interpolated there as before): linear interpolation
+// between the capture's samples cuts an impact's V short (at 250 Hz, up to 16 mm
+// at 8 m/s), so the stick would be asked to turn above the drum.
+TipTrajectory with_impact_vertices(const TipTrajectory &tips,
+                                   const std::array<std::vector<StrokeTurnaround>, 2> &impacts);
+// fit_drum_to_turnarounds(tips, tip_radius_m).center_m.
 Eigen::Vector3d fit_drum_to_strokes(const TipTrajectory &tips, double tip_radius_m);
 
 } // namespace ictus

@@ -92,6 +92,18 @@ class ChainIkSolverPos_dls
     IkResult solve(const KinematicChain &chain, const Eigen::Vector3d &target_tip_m,
                    const Eigen::Quaterniond &target_rotation, double rotation_weight,
                    Eigen::Quaterniond *rotations_out);
+    // Same, with a posture task in the null space of the tip task: the first iteration adds
+    // N (w log(posture_j q_j^-1)) (world frame, N = I - J^+ J), i.e. it turns every joint a
+    // fraction `posture_weight` in [0, 1] of the way toward `posture[j]` (local rotations,
+    // chain.joints() of them) as far as that does not move the tip (to first order). Once per
+    // call: called every physics step from the simulated state, the arm's redundant directions
+    // relax toward the posture at that rate. The posture iteration is accepted when the tip
+    // ends no farther from the target than before plus the step's second-order bound
+    // |dtheta|^2 L / 2 (L the chain's reach); later iterations take that back. 0 = the plain
+    // solve.
+    IkResult solve_with_posture(const KinematicChain &chain, const Eigen::Vector3d &target_tip_m,
+                                const Eigen::Quaterniond *posture, double posture_weight,
+                                Eigen::Quaterniond *rotations_out);
 
   private:
     using Jacobian = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, KinematicChain::kMaxDofs>;
@@ -102,6 +114,9 @@ class ChainIkSolverPos_dls
     // The secondary task is the last frame's whole rotation (solve with a target rotation).
     bool full_rotation_ = false;
     Eigen::Quaterniond target_rotation_ = Eigen::Quaterniond::Identity();
+    // The posture task of solve_with_posture (nullptr: none).
+    const Eigen::Quaterniond *posture_ = nullptr;
+    double posture_weight_ = 0.0;
 
     int joints_;
     IkParams params_;
@@ -113,7 +128,7 @@ class ChainIkSolverPos_dls
     Eigen::Matrix3d jjt_;
     Eigen::LLT<Eigen::Matrix3d> llt_;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen_;
-    JointVector step_;
+    JointVector step_, posture_step_;
     // Secondary (stick direction) task.
     using Projector = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
                                     KinematicChain::kMaxDofs, KinematicChain::kMaxDofs>;

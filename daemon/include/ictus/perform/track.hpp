@@ -20,9 +20,15 @@
 namespace ictus
 {
 
+// `ictusd track`'s Cartesian settings: Algorithm 2 as the paper states it, the
+// feedback IK started from the simulated state every step, with the posture
+// task holding the arm's null space (docs/ik.md). (The score performance keeps
+// CartesianOptions' own defaults.)
+CartesianOptions track_cartesian_defaults();
+
 struct TrackOptions {
     TrackMode mode = TrackMode::joint;
-    CartesianOptions cartesian;
+    CartesianOptions cartesian = track_cartesian_defaults();
     SceneOptions scene;
     GainOptions gains;
     // Simulated time; 0 means the reference's length (longer runs play it
@@ -32,8 +38,15 @@ struct TrackOptions {
     // targets at start-up jolts the trunk, ode-findings.md); errors are not
     // counted during it.
     double ramp_s = 0.25;
-    // Place the drum under the lowest reference stick tips (else scene.drum.center_m).
+    // Place the drum automatically (else scene.drum.center_m): a stick-only capture's at its
+    // strokes' turnarounds (fit_drum_to_turnarounds), a full-body capture's under the lowest
+    // tips (auto_drum_center; docs/mocap.md, "Drum placement"). The turnarounds of the tips
+    // the errors are measured against give the contact windows in either case.
     bool drum_auto = true;
+    // The cleaned capture for the stick tips (full-body captures): the Cartesian mode's
+    // X^T and both modes' tip errors are the stick tips of this motion (else the
+    // reference's). The reference (joint targets) may be smoothed more than this.
+    const ReferenceMotion *tip_motion = nullptr;
     // CSV rows per second of simulated time; 0: the reference's frame rate.
     double sample_rate_hz = 0.0;
     // Stick-only capture (Cartesian mode only): the tip targets and the
@@ -63,6 +76,12 @@ struct TrackSummary {
     // Against the unfiltered capture, when given (includes what the filter
     // removed: spikes and jitter no torque-limited body follows).
     double tip_rms_raw_mm[2] = {0.0, 0.0};
+    // The same RMS errors split by time: within kContactWindow_s of a captured
+    // impact of that stick (contact) and the rest (free flight); impacts are the
+    // drum fit's (fit_drum_to_turnarounds on the cleaned tips).
+    double tip_rms_free_mm[2] = {0.0, 0.0}, tip_rms_contact_mm[2] = {0.0, 0.0};
+    double tip_rms_raw_free_mm[2] = {0.0, 0.0}, tip_rms_raw_contact_mm[2] = {0.0, 0.0};
+    int captured_impacts[2] = {0, 0};
     double joint_rms_raw_deg_all = 0.0;
     std::vector<std::string> joint_names;
     std::vector<double> joint_rms_deg;
@@ -82,7 +101,7 @@ struct TrackSummary {
     int ik_max_iterations = 0;
     double ik_us_per_step = 0.0; // wall time of the IK (both arms, both solves)
     long ik_not_converged = 0;   // solves that ended other than `converged`
-    // Elbow flexion (rotation angle of the elbow's local rotation), IK target
+    // Elbow flexion (elbow_flexion_deg: the angle between upper arm and forearm), IK target
     // Theta^T vs the capture, RMS over the samples [side], degrees.
     // Not measured (null in JSON) for stick-only captures: no captured elbow.
     double elbow_ik_rms_deg[2] = {0.0, 0.0};
@@ -95,8 +114,23 @@ std::array<Eigen::Vector3d, 2> reference_tips(const CharacterModel &model,
                                               const CharacterPose &pose);
 
 // A drum centre under the lowest reference tips: x, z the mean of the two
-// tips at their lowest, y half a tip radius below the lower of them.
+// tips at their lowest, y half a tip radius below the lower of them. (The score
+// performance's clip mode; `ictusd track` fits the turnarounds instead.)
 Eigen::Vector3d auto_drum_center(const CharacterModel &model, const ReferenceMotion &reference);
+
+// The stick tips of every frame of `reference` as a trajectory (for the drum fit).
+TipTrajectory reference_tip_trajectory(const CharacterModel &model,
+                                       const ReferenceMotion &reference);
+
+// Half-width of a contact window about a captured impact, s.
+constexpr double kContactWindow_s = 0.03;
+
+// Elbow flexion proper, degrees: the angle between the upper arm's axis and the
+// forearm's (0 straight), from the elbow's local rotation `elbow` and the two
+// segments' directions in their own bodies' frames; the forearm's twist about
+// its axis does not count.
+double elbow_flexion_deg(const Eigen::Vector3d &upper_arm_axis, const Eigen::Vector3d &forearm_axis,
+                         const Eigen::Quaterniond &elbow);
 
 using ProgressFn = std::function<void(double fraction)>;
 

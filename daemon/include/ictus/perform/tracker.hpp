@@ -70,8 +70,20 @@ struct CartesianOptions {
     // RMS at the shoulder on CMU 80_13). kinematic: the kinematic IK's solution
     // (the capture's arm pose when it has one), so the PD also holds the arm's
     // null space where the capture has it, and the Cartesian error term of
-    // eq. 2 still corrects the tip.
+    // eq. 2 still corrects the tip. (`ictusd track`'s default is simulated, with the
+    // posture task below: track_cartesian_defaults(), docs/ik.md.)
     bool start_from_simulated = false;
+    // The redundant arm's secondary task (docs/ik.md, "Posture task"): both IK solves
+    // (feedback and kinematic) turn every arm joint by this fraction of its way toward the
+    // posture (Tracker::set_posture; default the initial pose) within the tip task's null
+    // space, once per step. From the simulated state the PD then pulls the arm's null space
+    // toward the posture with this fraction of its stiffness. 0: off (the score performance).
+    double posture_weight = 0.0;
+    // Iterations of the feedback IK per step (eq. 2 is one; 0: the solver's budget,
+    // IkParams::max_iterations, i.e. solved to convergence).
+    int feedback_iterations = 0;
+    // Likewise for the kinematic IK (it only gives the arms' target rates).
+    int kinematic_iterations = 0;
     // The reference's arm rotations are meaningful (a full-body capture): the
     // kinematic IK starts from them every step. Else (stick-only captures) it
     // continues from its own last solution.
@@ -165,6 +177,9 @@ class Tracker
     // The kinematic IK's last arm targets [side][clavicle, shoulder, elbow, wrist].
     const Eigen::Quaterniond &kinematic_target(int side, int k) const;
     const TrackerIkStats &ik_stats() const { return ik_stats_; }
+    // The posture of the IK's null-space task [clavicle, shoulder, elbow, wrist] of `side`
+    // (CartesianOptions::posture_weight); the initial pose's until set.
+    void set_posture(int side, const Eigen::Quaterniond posture[4]);
 
     Scene &scene() { return *scene_; }
     const Scene &scene() const { return *scene_; }
@@ -192,7 +207,7 @@ class Tracker
     double velocity_gain_s_ = 0.0;
     std::unique_ptr<Scene> scene_;
     std::array<std::unique_ptr<Arm>, 2> arms_;
-    std::unique_ptr<ChainIkSolverPos_dls> solver_;
+    std::unique_ptr<ChainIkSolverPos_dls> solver_, feedback_solver_;
     std::vector<Eigen::Quaterniond> previous_reference_, target_, sim_local_;
     std::vector<Eigen::Vector3d> rate_;
     CharacterPose target_pose_;
