@@ -90,8 +90,14 @@ TEST_CASE("the grip holds the stick against gravity as a spring: k theta = torqu
     const StickParams &sp = rig.model.options().stick;
     const double d = sp.length_m / 2 - sp.grip_from_butt_m;
     const double rod = sp.mass_kg * (sp.length_m * sp.length_m / 12.0 + d * d);
+    // The law, not QuickStep's residual: at its 15 iterations the balance
+    // came out 3-6 % off, by how ODE's random constraint order fell (the
+    // test failed in some runs of the whole binary); 200 iterations solve
+    // the constraints well enough for the statics to show.
+    SceneOptions o = rig.options(StickMount::fulcrum);
+    o.quickstep_iterations = 200;
     for (double k : {4.0, 16.0}) {
-        Scene scene(rig.model, rig.options(StickMount::fulcrum), rig.pose, rig.gains);
+        Scene scene(rig.model, o, rig.pose, rig.gains);
         CHECK(scene.fulcrum_inertia_kg_m2(Side::right) == Approx(rod).epsilon(1e-3));
         for (Side s : {Side::left, Side::right})
             scene.set_grip(s, GripSpring{k, 0.05});

@@ -207,6 +207,10 @@ void Scene::set_joint_targets(const std::vector<Eigen::Quaterniond> &local,
 
 void Scene::build(const CharacterPose &initial)
 {
+    // QuickStep reorders its constraints with ODE's one global random
+    // generator: seeded here, a scene steps the same whatever ran before it in
+    // the process (a grip rebuild in `run`, the tests of one binary).
+    dRandSetSeed(0);
     world_ = dWorldCreate();
     dWorldSetGravity(world_, 0.0, -options_.gravity_mps2, 0.0); // y up, as the mocap
     dWorldSetQuickStepNumIterations(world_, options_.quickstep_iterations);
