@@ -56,6 +56,28 @@ inline int free_udp_port()
     return ntohs(sa.sin_port);
 }
 
+// Waits until something (a peer started as a child: oscdump -L PORT) has
+// bound the UDP port, up to `deadline_s`: true when it has. A handshake
+// instead of a fixed sleep: a packet sent before the peer binds is lost.
+inline bool wait_until_bound(int port, double deadline_s = 20.0)
+{
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(deadline_s);
+    for (;;) {
+        const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+        sockaddr_in sa{};
+        sa.sin_family = AF_INET;
+        sa.sin_port = htons(static_cast<uint16_t>(port));
+        const bool bound = bind(fd, reinterpret_cast<sockaddr *>(&sa), sizeof sa) != 0;
+        close(fd);
+        if (bound)
+            return true;
+        if (std::chrono::steady_clock::now() >= deadline)
+            return false;
+        poll(nullptr, 0, 20);
+    }
+}
+
 // A child process whose stdout we read line by line; killed (SIGTERM) and
 // reaped on destruction.
 class Child

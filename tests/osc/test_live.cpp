@@ -264,21 +264,7 @@ TEST_CASE("run: a drum slider at 20 messages a second loses no strike", "[osc][l
     const int dump_port = osctest::free_udp_port();
     Child dump({"oscdump", "-L", std::to_string(dump_port)});
     // oscdump is listening when its port is taken.
-    {
-        const auto deadline = Clock::now() + std::chrono::seconds(20);
-        bool bound = false;
-        while (!bound && Clock::now() < deadline) {
-            const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-            sockaddr_in sa{};
-            sa.sin_family = AF_INET;
-            sa.sin_port = htons(static_cast<uint16_t>(dump_port));
-            bound = bind(fd, reinterpret_cast<sockaddr *>(&sa), sizeof sa) != 0;
-            close(fd);
-            if (!bound)
-                std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        }
-        REQUIRE(bound);
-    }
+    REQUIRE(osctest::wait_until_bound(dump_port));
     const int port = osctest::free_udp_port();
     Peer client;
     Child daemon({ICTUSD_OSC_PATH, "run", "--score", score, "--paused", "--port",

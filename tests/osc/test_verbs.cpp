@@ -274,7 +274,7 @@ TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked r
     const fs::path dir = scratch("run");
     const int dump_port = osctest::free_udp_port();
     Child dump({"oscdump", "-L", std::to_string(dump_port)});
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    REQUIRE(osctest::wait_until_bound(dump_port)); // before the daemon's first strike
     const int port = osctest::free_udp_port();
     const double seconds = 4.0;
     std::atomic<bool> done{false};
