@@ -35,15 +35,7 @@ W, H = 480, 360
 RATE_HZ = 30.0
 
 
-def free_udp_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
-port = free_udp_port()
+port = uitest.free_udp_port()
 work = tempfile.mkdtemp(prefix="ictus-ui-gem-")
 patch = os.path.join(work, "view.pd")
 with open(patch, "w") as f:
@@ -87,13 +79,7 @@ try:
     stream(1.5, (half, 0.0, 0.0, half))  # head turned 90 deg about +Z
     shot_b = x.screenshot(os.path.join(art, "gem-view-head-turned.png"))
 finally:
-    if pd is not None and pd.poll() is None:
-        pd.terminate()
-        try:
-            pd.wait(5)
-        except subprocess.TimeoutExpired:
-            pd.kill()
-            pd.wait()
+    uitest.stop(pd, 5)
     x.stop()
 
 text = open(log_path).read()

@@ -31,15 +31,7 @@ if not os.path.isdir("/usr/lib/pd/extra/Gem"):
 STATEMENTS = ["tempo 120", "R accent ff", "L accent 0.8", "R legato 1/2", "L legato 1/2"]
 
 
-def free_udp_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
-to_pd, to_daemon = free_udp_port(), free_udp_port()
+to_pd, to_daemon = uitest.free_udp_port(), uitest.free_udp_port()
 # the relay: ictusd -> here -> pd, stamping each pose frame on arrival
 relay = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 relay.bind(("127.0.0.1", 0))
@@ -122,13 +114,7 @@ try:
     x.screenshot(shot)
 finally:
     for p in (pd, daemon):
-        if p is not None and p.poll() is None:
-            p.terminate()
-            try:
-                p.wait(10)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait()
+        uitest.stop(p)
     x.stop()
     relaying = False
 

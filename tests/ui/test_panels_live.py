@@ -36,15 +36,7 @@ args = ap.parse_args()
 build = os.path.abspath(args.build)
 
 
-def free_udp_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
-pd_port, daemon_port, ctl_port = free_udp_port(), free_udp_port(), free_udp_port()
+pd_port, daemon_port, ctl_port = uitest.free_udp_port(), uitest.free_udp_port(), uitest.free_udp_port()
 lines = queue.Queue()
 printed = []
 
@@ -362,12 +354,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-panels-") as work:
         if daemon is not None and daemon.poll() is None:
             daemon.kill()
             daemon.wait()
-        pd.terminate()
-        try:
-            pd.wait(10)
-        except subprocess.TimeoutExpired:
-            pd.kill()
-            pd.wait()
+        uitest.stop(pd)
         log.close()
 bad = uitest.error_lines("\n".join(l for l in printed
                                    if not l.startswith("ictusd: error")

@@ -4,6 +4,7 @@ here from a standing figure, independently of the daemon."""
 import os
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -16,6 +17,27 @@ import oscpacket  # noqa: E402
 
 SKIP = 77
 REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
+
+
+def free_udp_port():
+    """A UDP port on 127.0.0.1 that was free a moment ago."""
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def stop(process, timeout_s=10):
+    """Terminates a child if it still runs (SIGTERM, then SIGKILL after timeout_s) and reaps it."""
+    if process is None or process.poll() is not None:
+        return
+    process.terminate()
+    try:
+        process.wait(timeout_s)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
 
 
 def fail(msg):
