@@ -13,14 +13,21 @@
  * logical time runs off the scheduler (the audio device, or the system clock
  * with -nosound), so the object estimates the offset
  *     O = wall - logical
- * as the minimum of samples (wall now - logical now) taken every
- * ICTUS_TIMETAG_SAMPLE_MS and on each packet: Pd never runs a logical time
- * before its wall time, only late (scheduling, polling, load), so the smallest
- * sample is the closest to the true mapping. The minimum is taken over a sliding
- * window of ICTUS_TIMETAG_BUCKETS buckets of ICTUS_TIMETAG_BUCKET_MS each, so
- * that it follows a slow drift between the audio clock and the wall clock (100
- * ppm drifts 0.2 ms over the 2 s window). A message in a bundle with timetag T
- * then takes effect at logical time T - O - latency, i.e. its delay is
+ * from samples (wall now - logical now) taken every ICTUS_TIMETAG_SAMPLE_MS and
+ * on each packet. Pd never runs a logical time before its wall time, only late
+ * (scheduling, polling, load), so every sample is an upper bound of O at its
+ * time. The two clocks may drift apart by at most ICTUS_TIMETAG_DRIFT (ms per
+ * ms: 100 ppm, more than a sound card's crystal), so a sample s taken at
+ * logical time t also bounds O now:  O(now) <= s + DRIFT * (now - t). The
+ * estimate is the tightest such bound over the samples of the last
+ * ICTUS_TIMETAG_BUCKETS buckets of ICTUS_TIMETAG_BUCKET_MS (each bucket keeps
+ * its smallest sample and when it was taken). It is never below the true O
+ * (no message fires early), it follows any drift within DRIFT, and a stretch of
+ * load that delays every sample for a while does not move it: a quiet sample a
+ * few seconds old still bounds O within DRIFT * its age (0.1 ms per second).
+ * A wall clock step forward is followed within min(step / DRIFT, window); one
+ * backwards at once. A message in a bundle with timetag T then takes effect at
+ * logical time T - O - latency, i.e. its delay is
  *     delay = T - latency - O - logical_now  (ms)
  * where `latency` (message, default 0) is the audio output latency to subtract
  * so that the sound, not the computation, lands at T. A bundle already due
@@ -47,8 +54,9 @@
 #endif
 
 #define ICTUS_TIMETAG_SAMPLE_MS  2.0   /* offset sampling period */
-#define ICTUS_TIMETAG_BUCKET_MS  500.0 /* one bucket of the sliding minimum */
-#define ICTUS_TIMETAG_BUCKETS    4     /* window = 3..4 buckets = 1.5..2 s */
+#define ICTUS_TIMETAG_BUCKET_MS  500.0 /* one bucket of the offset history */
+#define ICTUS_TIMETAG_BUCKETS    16    /* history = 15..16 buckets = 7.5..8 s */
+#define ICTUS_TIMETAG_DRIFT      1e-4  /* largest wall/logical drift, ms per ms */
 #define ICTUS_TIMETAG_MAX_BYTES  65536 /* larger than any UDP datagram */
 #define ICTUS_TIMETAG_MAX_DEPTH  8     /* nested bundles */
 #define ICTUS_TIMETAG_MAX_POSTS  5     /* malformed packets reported in full */
@@ -67,6 +75,7 @@ typedef struct _ictus_timetag {
     double x_wall_base_s;                       /* CLOCK_REALTIME seconds at creation (whole) */
     double x_logical_base;                      /* clock_getlogicaltime() at creation */
     double x_bucket_min[ICTUS_TIMETAG_BUCKETS]; /* min offset per bucket (ms) */
+    double x_bucket_at[ICTUS_TIMETAG_BUCKETS];  /* logical time of that sample (ms) */
     long x_bucket_index;                        /* index of the current bucket */
     int x_have_offset;
     double x_latency_ms;
@@ -97,34 +106,45 @@ static double ictus_timetag_logical_ms(const t_ictus_timetag *x)
     return clock_gettimesince(x->x_logical_base);
 }
 
-/* One offset sample into the sliding minimum. */
+/* One offset sample into its bucket of the history. */
 static void ictus_timetag_sample(t_ictus_timetag *x)
 {
     double logical = ictus_timetag_logical_ms(x);
     double offset = ictus_timetag_wall_ms(x) - logical;
     long bucket = (long)floor(logical / ICTUS_TIMETAG_BUCKET_MS);
-    int i;
+    int i, slot = (int)(bucket % ICTUS_TIMETAG_BUCKETS);
     if (!x->x_have_offset || bucket - x->x_bucket_index >= ICTUS_TIMETAG_BUCKETS) {
-        for (i = 0; i < ICTUS_TIMETAG_BUCKETS; i++)
+        for (i = 0; i < ICTUS_TIMETAG_BUCKETS; i++) {
             x->x_bucket_min[i] = offset;
+            x->x_bucket_at[i] = logical;
+        }
         x->x_have_offset = 1;
     } else {
         /* buckets skipped since the last sample start empty (= this sample) */
-        for (long b = x->x_bucket_index + 1; b <= bucket; b++)
+        for (long b = x->x_bucket_index + 1; b <= bucket; b++) {
             x->x_bucket_min[b % ICTUS_TIMETAG_BUCKETS] = offset;
+            x->x_bucket_at[b % ICTUS_TIMETAG_BUCKETS] = logical;
+        }
     }
     x->x_bucket_index = bucket;
-    if (offset < x->x_bucket_min[bucket % ICTUS_TIMETAG_BUCKETS])
-        x->x_bucket_min[bucket % ICTUS_TIMETAG_BUCKETS] = offset;
+    if (offset < x->x_bucket_min[slot]) {
+        x->x_bucket_min[slot] = offset;
+        x->x_bucket_at[slot] = logical;
+    }
 }
 
+/* The tightest bound of O now: min over the buckets of
+ * (smallest sample + DRIFT * its age). */
 static double ictus_timetag_offset(const t_ictus_timetag *x)
 {
-    double m = x->x_bucket_min[0];
+    double now = ictus_timetag_logical_ms(x), m = 0;
     int i;
-    for (i = 1; i < ICTUS_TIMETAG_BUCKETS; i++)
-        if (x->x_bucket_min[i] < m)
-            m = x->x_bucket_min[i];
+    for (i = 0; i < ICTUS_TIMETAG_BUCKETS; i++) {
+        double age = now - x->x_bucket_at[i];
+        double bound = x->x_bucket_min[i] + ICTUS_TIMETAG_DRIFT * (age > 0 ? age : 0);
+        if (i == 0 || bound < m)
+            m = bound;
+    }
     return m;
 }
 

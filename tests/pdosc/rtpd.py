@@ -4,6 +4,7 @@ back over UDP (FUDI text, [netsend -u]):
 
     tick <logical_ms>;            every 2 ms of logical time ([metro 2] + [timer])
     fire <logical_ms> <strike>;   when a strike comes out of ictus-receive
+    probe <logical_ms> <k>;       echo of a `probe k` sent to the FUDI port
     plain <logical_ms> <seq>;     (optional) a strike parsed by a bare [oscparse]
     pose ... / reply ... / info ...;   the other outlets
 
@@ -159,8 +160,13 @@ def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=
         p.connect(d, 0, m, 0)
         p.connect(m, 0, recv, 0)
     if fudi_in_port:
+        # FUDI in: `probe K` is echoed at once as `probe <logical_ms> K` (the
+        # test's round trip), anything else goes into ictus-receive's inlet
         nr = p.obj("netreceive -u %d" % fudi_in_port)
-        p.connect(nr, 0, recv, 0)
+        rp = p.obj("route probe")
+        p.connect(nr, 0, rp, 0)
+        stamped(rp, 0, "probe")
+        p.connect(rp, 1, recv, 0)
     end = p.obj("delay %d" % int(seconds * 1000))
     q = p.msg("\\; pd quit")
     p.connect(t, 0, end, 0)
