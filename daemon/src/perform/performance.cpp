@@ -819,6 +819,7 @@ Performance::make_score_rig(const PerformanceOptions &options,
     // back in one step (docs/perform.md, "Joint limits").
     scene.stop_margin_rad = std::min(scene.stop_margin_rad, 1.0 * M_PI / 180.0);
     scene.stop_erp = 1.0;
+    scene.stop_inelastic = true;
     if (options.drum_auto)
         scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
                               options.score.drum_forward_m * forward -

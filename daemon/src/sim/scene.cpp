@@ -488,7 +488,7 @@ void Scene::apply_control()
         // Safety net: a joint outside its limit region by more than the
         // margin meets a one-sided stop along the direction of the violation.
         bool stop = false;
-        double violation = 0.0;
+        double violation = 0.0, stop_at = options_.stop_margin_rad;
         Eigen::Vector3d stop_axis = Eigen::Vector3d::UnitX();
         if (options_.limit_stops && !limits_.empty() && limits_[j].active()) {
             const Eigen::Quaterniond current = qp.conjugate() * qc;
@@ -496,17 +496,26 @@ void Scene::apply_control()
             const Eigen::Vector3d v = log_map(current * inside.conjugate());
             violation = v.norm();
             if (violation > 0.0) {
-                // The stop engages one step early: the angle it sees is
-                // where the joint will be after this step at its present
-                // rate, so a fast joint does not run past the margin before
-                // the stop row exists.
+                // The stop engages one step early: when the joint would be
+                // past the margin after this step at its present rate, so a
+                // fast joint does not run past it before the stop row
+                // exists. Inelastic (SceneOptions::stop_inelastic): past the
+                // margin the row takes the joint back to it (at the stop
+                // ERP); short of it, the row holds the joint where it is for
+                // this step (the stop set at the present angle). Else the
+                // row sees the predicted angle.
                 const Eigen::Vector3d axis = (qp * v) / violation;
                 const Eigen::Vector3d w_rel = to_eigen3(dBodyGetAngularVel(body_[child])) -
                                               to_eigen3(dBodyGetAngularVel(body_[parent]));
-                violation += std::max(0.0, w_rel.dot(axis)) * options_.step_s;
-                if (violation > options_.stop_margin_rad) {
+                const double predicted =
+                    violation + std::max(0.0, w_rel.dot(axis)) * options_.step_s;
+                if (predicted > options_.stop_margin_rad) {
                     stop = true;
                     stop_axis = axis;
+                    if (options_.stop_inelastic)
+                        stop_at = std::min(options_.stop_margin_rad, violation);
+                    else
+                        violation = predicted;
                 }
             }
         }
@@ -543,7 +552,7 @@ void Scene::apply_control()
         if (stop) {
             dJointSetAMotorAngle(m, 0, violation);
             dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
-            dJointSetAMotorParam(m, dParamHiStop1, options_.stop_margin_rad);
+            dJointSetAMotorParam(m, dParamHiStop1, stop_at);
             dJointSetAMotorParam(m, dParamStopERP, options_.stop_erp);
         } else {
             dJointSetAMotorParam(m, dParamHiStop1, dInfinity);

@@ -86,6 +86,14 @@ struct SceneOptions {
     // mode: with 0.2 fast strokes left elbows up to 3 degrees past the
     // margin, docs/perform.md).
     double stop_erp = 0.2;
+    // How a stop engaged one step early (the joint would pass the margin
+    // within the step at its present rate) acts. false: the row sees the
+    // predicted angle, so it also reverses the step's whole travel (with ERP
+    // 1 an elastic wall: elbows thrown back at 100 rad/s). true (score mode):
+    // the row sees the present angle and holds the joint where it is for the
+    // step when it is short of the margin, or takes it back to the margin
+    // when past it (docs/perform.md, "Joint limits").
+    bool stop_inelastic = false;
     // The stick-head contact's damping is the head's own: the implicit
     // step's numerical damping (h k) is taken back out of it (Scene::set_drum
     // comments). Off: the plain ODE mapping.
