@@ -44,9 +44,9 @@ void track_usage(std::ostream &out)
            "  --left-stick NAME, --right-stick NAME   the capture's stick-tip objects (default:\n"
            "                         named stick_l / stick_r, else containing left / right)\n"
            "  --units mm|m, --up y|z, --rate HZ   how to read the .csv (default m, y, its time)\n"
-           "  --drum auto|X,Y,Z      membrane centre (auto, default: a stick-only capture's\n"
-           "                         at its strokes' turnarounds, a BVH's under the lowest\n"
-           "                         tips; docs/mocap.md)\n"
+           "  --drum auto|X,Y,Z      membrane centre (auto, default: at the strokes'\n"
+           "                         turnarounds, or under the lowest tips when the tips\n"
+           "                         pass through a drum there, e.g. a kit; docs/mocap.md)\n"
            "  --ik-gain G            eq. 2's gain on the tip error (default 10)\n"
            "  --ik-velocity-gain S   tip velocity error term, s (default 0.1; < 0: automatic)\n"
            "  --ik-accel-ff S2       tip acceleration feedforward, s^2 (default 0)\n"
@@ -398,6 +398,11 @@ TrackSummary run_tracking(TrackArgs &t, const TrackInput &in, std::ostream *csv,
     TrackSummary summary = track_joint_space(
         *in.model, *in.reference, t.options, in.limit_refs, csv, [&](double f) { progress(f); },
         &in.gains, in.raw.get());
+    if (t.options.drum_auto && summary.drum_rule == "lowest_tips" && !t.quiet)
+        std::cerr << "ictusd: note: --drum auto: the drum goes under the lowest tips: "
+                  << 100.0 * summary.drum_through_fraction
+                  << " % of a stick's samples pass through a drum at the strokes' turnarounds "
+                     "(docs/mocap.md, \"Drum placement\")\n";
     StrikeEvent e;
     while (detector.flush(e))
         log.add(&e, 1);

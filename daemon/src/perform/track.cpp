@@ -142,6 +142,8 @@ nlohmann::json TrackSummary::to_json() const
     j["contact_steps"] = contact_steps;
     j["stop_steps"] = stop_steps;
     j["drum_center_m"] = {drum_center_m.x(), drum_center_m.y(), drum_center_m.z()};
+    j["drum_rule"] = drum_rule;
+    j["drum_through_fraction"] = drum_through_fraction;
     if (mode == "cartesian") {
         j["ik"] = {{"mean_iterations", ik_mean_iterations},
                    {"max_iterations", ik_max_iterations},
@@ -209,24 +211,25 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     // the stick-only capture, else the cleaned tip motion, else the reference.
     const ReferenceMotion &tip_src = options.tip_motion ? *options.tip_motion : reference;
     // The strokes' turnarounds: the drum (--drum auto) and the contact windows.
+    // The drum at the turnarounds, for stick-only and full-body captures alike,
+    // unless the captured tips pass through it there (a drum kit: strokes for the
+    // other drums cross its place); then under the lowest tips (place_drum,
+    // docs/mocap.md, "Drum placement").
     DrumFit drum_fit;
     bool have_impacts = true;
+    DrumPlacement placement;
     try {
-        drum_fit =
-            fit_drum_to_turnarounds(tips_in ? *tips_in : reference_tip_trajectory(model, tip_src),
-                                    model.options().stick.tip_radius_m);
+        placement = place_drum(tips_in ? *tips_in : reference_tip_trajectory(model, tip_src),
+                               model.options().stick.tip_radius_m, options.scene.drum.radius_m);
+        drum_fit = placement.fit;
     } catch (const CharacterError &) {
         if (options.drum_auto && tips_in)
             throw;
         have_impacts = false;
     }
-    // A stick-only capture's drum under its turnarounds. A full-body capture's
-    // under its lowest tips, out of the strokes' way: on CMU 80_13 (a drum kit)
-    // a snare at the turnarounds stands in the strokes meant for the other
-    // drums (docs/mocap.md, "Drum placement").
     if (options.drum_auto)
         options.scene.drum.center_m =
-            tips_in ? drum_fit.center_m : auto_drum_center(model, reference);
+            have_impacts ? placement.center_m : auto_drum_center(model, reference);
     // A stick-only capture's impacts restored between its samples (X^T and the errors).
     TipTrajectory restored;
     // X^T asks for more at an impact: the stick's end down to the membrane plane at the
@@ -301,6 +304,11 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     summary.mode = to_string(options.mode);
     summary.frames = reference.frames();
     summary.drum_center_m = options.scene.drum.center_m;
+    summary.drum_rule = !options.drum_auto         ? "given"
+                        : !have_impacts            ? "lowest_tips"
+                        : placement.at_turnarounds ? "turnarounds"
+                                                   : "lowest_tips";
+    summary.drum_through_fraction = have_impacts ? placement.through_fraction : 0.0;
     for (int j = 0; j < nj; ++j)
         summary.joint_names.push_back(model.joint_name(j));
     std::vector<double> joint_sum2(nj, 0.0), joint_max(nj, 0.0);

@@ -89,6 +89,33 @@ DrumFit fit_drum_to_turnarounds(const TipTrajectory &tips, double tip_radius_m);
 // at 8 m/s), so the stick would be asked to turn above the drum.
 TipTrajectory with_impact_vertices(const TipTrajectory &tips,
                                    const std::array<std::vector<StrokeTurnaround>, 2> &impacts);
+// The drum of `--drum auto` (stick-only and full-body captures alike;
+// docs/mocap.md, "Drum placement"): the membrane at the strokes' turnarounds
+// (fit_drum_to_turnarounds), unless the captured tips pass through that drum --
+// more than kDrumThroughFraction of either stick's samples within the drum's
+// radius of its axis and more than kDrumClearance_m below its membrane, as when
+// a drum-kit capture's strokes for the other drums cross the place of the one
+// simulated drum. Then the drum goes under the lowest tips, out of the
+// strokes' way (`at_turnarounds` false). Throws CharacterError when no stick
+// has a turnaround.
+constexpr double kDrumThroughFraction = 0.01;
+constexpr double kDrumClearance_m = kImpactBand_m;
+struct DrumPlacement {
+    Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+    bool at_turnarounds = true;
+    // The larger of the two sticks' fractions of samples inside the drum at the turnarounds.
+    double through_fraction = 0.0;
+    DrumFit fit; // the turnarounds and impacts (the contact windows), in either case
+};
+DrumPlacement place_drum(const TipTrajectory &tips, double tip_radius_m, double drum_radius_m);
+// The fraction of stick `side`'s samples inside a drum of radius `radius_m` whose
+// membrane centre is `center_m`: within the radius of its vertical axis and more
+// than `clearance_m` below the membrane.
+double fraction_through_drum(const TipTrajectory &tips, int side, const Eigen::Vector3d &center_m,
+                             double radius_m, double clearance_m = kDrumClearance_m);
+// A drum under the lowest tips: (x, z) the mean of the two sticks' lowest
+// points, the membrane kImpactPitchFactor tip radii below the lower of them.
+Eigen::Vector3d drum_under_lowest_tips(const TipTrajectory &tips, double tip_radius_m);
 // fit_drum_to_turnarounds(tips, tip_radius_m).center_m.
 Eigen::Vector3d fit_drum_to_strokes(const TipTrajectory &tips, double tip_radius_m);
 
