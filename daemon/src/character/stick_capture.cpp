@@ -373,6 +373,15 @@ TipTrajectory with_impact_vertices(const TipTrajectory &tips,
     return out;
 }
 
+double impact_press_depth_m(double speed_mps, double stick_mass_kg, double stiffness_n_per_m)
+{
+    if (!(std::isfinite(speed_mps) && std::isfinite(stick_mass_kg) &&
+          std::isfinite(stiffness_n_per_m) && speed_mps > 0.0 && stick_mass_kg > 0.0 &&
+          stiffness_n_per_m > 0.0))
+        return 0.0;
+    return speed_mps * std::sqrt(stick_mass_kg / stiffness_n_per_m);
+}
+
 double fraction_through_drum(const TipTrajectory &tips, int side, const Eigen::Vector3d &center_m,
                              double radius_m, double clearance_m)
 {

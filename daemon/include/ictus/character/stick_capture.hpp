@@ -77,6 +77,13 @@ constexpr double kImpactBand_m = 0.02;
 // say d, so the membrane goes r / 2 below the impacts (a stick 30 degrees below
 // the horizontal): at most r / 2 (3.5 mm for the default bead) off at any pitch.
 constexpr double kImpactPitchFactor = 0.5;
+// How far below the membrane plane a stick-only capture's X^T asks the stick's
+// end at an impact's vertex (`ictusd track`, docs/ik.md, "Stick-only captures"):
+// the dent of a strike at `speed_mps` in a membrane of stiffness k, for the
+// stick's mass m alone: v / omega = v sqrt(m / k) (2.9 mm per m/s for the
+// default 50 g stick on the default snare, k = 5.8 kN/m).
+// 0 for a non-finite or non-positive input.
+double impact_press_depth_m(double speed_mps, double stick_mass_kg, double stiffness_n_per_m);
 struct DrumFit {
     Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
     std::array<std::vector<StrokeTurnaround>, 2> impacts; // [side], in time order
