@@ -5,6 +5,7 @@
 // with the motion that made the tips.
 #include "ictus/mocap/bvh.hpp"
 #include "ictus/character/character_limits.hpp"
+#include "ictus/character/range_of_motion.hpp"
 #include "ictus/perform/track.hpp"
 #include "ictus/sim/strike_detector.hpp"
 #include "sim_test_util.hpp"
@@ -529,10 +530,10 @@ namespace
 // One synthetic stick-only capture through `ictusd track`'s path: two sticks
 // playing stroke trains (stroke_height) on a membrane at `membrane_y_m`, placed
 // behind by place_behind_sticks, tracked in Cartesian mode with the strike
-// detector of strikes.csv. Checks: the drum within 5 mm of the true membrane,
-// free-flight tip RMS <= 5 mm, every impact from 1 s on struck exactly once and
-// no other strike (the first strokes after the 0.25 s ramp may be missed while
-// the arms settle from their cold start).
+// detector of strikes.csv, with the human range of motion as the joint limits. Checks: the drum
+// within 5 mm of the true membrane, free-flight tip RMS <= 5 mm, every impact from 1 s on struck
+// exactly once and no other strike (the first strokes after the 0.25 s ramp may be missed while the
+// arms settle from their cold start).
 struct StrokeCase {
     double v_mps, period_s, rebound, membrane_y_m, rate_hz;
     double t0_s[2];      // each stick's first impact
@@ -572,7 +573,9 @@ void check_stick_only_tracking(const CharacterModel &m, const ReferenceMotion &r
         const int n = detect_strikes(detector, scene, out);
         strikes.insert(strikes.end(), out, out + n);
     };
-    const TrackSummary s = track_joint_space(m, ref, o);
+    // The joint limits `ictusd track` gives a stick-only capture: the human range of motion.
+    const RangeOfMotion rom(m);
+    const TrackSummary s = track_joint_space(m, ref, o, rom.refs());
     INFO(c.v_mps << " m/s every " << c.period_s << " s, rebound " << c.rebound << ", " << c.rate_hz
                  << " Hz, first impacts " << c.t0_s[0] << " / " << c.t0_s[1] << " s: drum "
                  << s.drum_center_m.y() << " (true " << membrane << "), free flight rms mm "
@@ -629,8 +632,10 @@ TEST_CASE("stick-only: synthetic strokes up to 5 m/s, drum found within 5 mm, fr
         check_stick_only_tracking(m, ref, c);
     // Seeded random captures: 1-4.5 m/s at impact, a stroke every 0.2-0.35 s,
     // rebound 0.3-0.8, membranes at 0.2-0.9 m, the usual capture rates, each stick
-    // at its own phase and place. (Above ~4.5 m/s some such captures exceed 5 mm in
-    // free flight: docs/ik.md, "Stick-only captures".)
+    // at its own phase and place. (Up to 8 m/s, 12 of 14 such captures hold; the
+    // other two exceed 5 mm in free flight by their first two strokes after the
+    // ramp, 20 mm, while the arms catch up from rest: docs/ik.md, "Stick-only
+    // captures".)
     std::mt19937 rng(15);
     std::uniform_real_distribution<double> U(0.0, 1.0);
     const double rates[] = {120.0, 200.0, 240.0, 250.0};
