@@ -39,6 +39,47 @@ double elbow_flexion_deg(const Eigen::Vector3d &upper_arm_axis, const Eigen::Vec
     return std::atan2(upper_arm_axis.cross(f).norm(), upper_arm_axis.dot(f)) * kRadToDeg;
 }
 
+void drummer_arms(const CharacterModel &model, CharacterPose &pose)
+{
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+    const char *upper_arm[2] = {"l_upper_arm", "r_upper_arm"};
+    const char *forearm[2] = {"l_forearm", "r_forearm"};
+    const char *hand[2] = {"l_hand", "r_hand"};
+    BodyFrames f;
+    model.forward(pose, f);
+    Eigen::Vector3d lateral =
+        f.origin_m[model.body_index(upper_arm[0])] - f.origin_m[model.body_index(upper_arm[1])];
+    lateral.y() = 0.0;
+    if (lateral.norm() < 1e-9)
+        return;
+    lateral.normalize();
+    const Eigen::Vector3d forward = lateral.cross(up); // left x up
+    for (int s = 0; s < 2; ++s) {
+        const int shoulder = model.joint_index(Tracker::kArmJoints[s][1]);
+        const int elbow = model.joint_index(Tracker::kArmJoints[s][2]);
+        const int bu = model.body_index(upper_arm[s]), bf = model.body_index(forearm[s]),
+                  bh = model.body_index(hand[s]);
+        if (shoulder < 0 || elbow < 0 || bu < 0 || bf < 0 || bh < 0)
+            continue;
+        // The upper arm hanging, kDrummerArmOut_rad out from the vertical.
+        const Eigen::Vector3d u = (f.origin_m[bf] - f.origin_m[bu]).normalized();
+        const Eigen::Vector3d out = (s == 0 ? 1.0 : -1.0) * lateral;
+        const Eigen::Vector3d hanging =
+            (-std::cos(kDrummerArmOut_rad) * up + std::sin(kDrummerArmOut_rad) * out).normalized();
+        const Eigen::Quaterniond parent = f.rotation[model.joint_body(shoulder).parent];
+        const Eigen::Quaterniond turn_u = Eigen::Quaterniond::FromTwoVectors(u, hanging);
+        pose.local[shoulder] =
+            (parent.conjugate() * turn_u * parent * pose.local[shoulder]).normalized();
+        model.forward(pose, f);
+        // The forearm forward (the elbow bent about the lateral axis).
+        const Eigen::Vector3d fa = (f.origin_m[bh] - f.origin_m[bf]).normalized();
+        const Eigen::Quaterniond upper = f.rotation[bu];
+        const Eigen::Quaterniond turn_f = Eigen::Quaterniond::FromTwoVectors(fa, forward);
+        pose.local[elbow] = (upper.conjugate() * turn_f * upper * pose.local[elbow]).normalized();
+        model.forward(pose, f);
+    }
+}
+
 TipTrajectory reference_tip_trajectory(const CharacterModel &model,
                                        const ReferenceMotion &reference)
 {
@@ -266,10 +307,16 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     long last_sample_index = 0;
 
     CharacterPose initial = reference.frame(0);
-    if (tips_in) // The arms' first pose: a cold IK solve from the reference's arms to the first
-                 // tips.
+    if (tips_in) {
+        // The arms' first pose: a cold IK solve to the first tips from a drummer's
+        // arms (drummer_arms), not from the reference's (the default body's T-pose):
+        // from the T-pose the solve ended in a pose whose first impacts threw the
+        // sticks sideways (6.7 m/s strokes: 21 and 20 mm in the first two strokes'
+        // free flight, 2.5 after; docs/ik.md, "Stick-only captures").
+        drummer_arms(model, initial);
         Tracker::solve_arms(model, limits, options.cartesian.ik,
                             {tips_in->tip_m[0][0], tips_in->tip_m[1][0]}, initial);
+    }
     const std::vector<JointGains> gains =
         gains_in ? *gains_in : default_gains(model, initial, options.gains);
     Tracker tracker(model, options.scene, initial, gains, limits, options.mode, options.cartesian,

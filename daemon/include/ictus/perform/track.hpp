@@ -125,6 +125,12 @@ std::array<Eigen::Vector3d, 2> reference_tips(const CharacterModel &model,
 // performance's clip mode; `ictusd track` fits the turnarounds instead.)
 Eigen::Vector3d auto_drum_center(const CharacterModel &model, const ReferenceMotion &reference);
 
+// The arms of `pose` as a drummer holds them at rest: each upper arm hanging,
+// kDrummerArmOut_rad out from the vertical, the forearm forward (the body's
+// forward: its left x up). The seed of a stick-only capture's cold arm solve.
+constexpr double kDrummerArmOut_rad = 10.0 * M_PI / 180.0;
+void drummer_arms(const CharacterModel &model, CharacterPose &pose);
+
 // The stick tips of every frame of `reference` as a trajectory (for the drum fit).
 TipTrajectory reference_tip_trajectory(const CharacterModel &model,
                                        const ReferenceMotion &reference);
