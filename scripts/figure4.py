@@ -107,7 +107,7 @@ def main():
                 f"damping ratio {sc['damping_ratio']} (both modes); limits {sc['limits']} "
                 f"(k = {sc['limit_k']}); reference de-spiked at {sc['despike_deg']:.1f} deg and "
                 f"low-passed at {sc['smooth_hz']} Hz, tips at {sc['tip_smooth_hz']} Hz; drum "
-                f"{'auto' if sc['drum_auto'] else 'given'} at "
+                f"{'auto (' + sc.get('drum_rule', 'turnarounds') + ')' if sc['drum_auto'] else 'given'} at "
                 f"{', '.join(f'{x:.3f}' for x in sc['drum_center_m'])} m. Cartesian: eq. 2 gain "
                 f"{ik['gain']}, velocity term {ik['velocity_gain_s']} s, correction limit "
                 f"{ik['correction_limit_m']} m, IK start {ik['start']}, posture weight "

@@ -271,6 +271,11 @@ TEST_CASE("ictusd track: a stick-only capture runs in Cartesian mode, drum fitte
     CHECK(s.at("tip_rms_mm").at("left").get<double>() < 3.0);
     CHECK(s.at("tip_rms_mm").at("right").get<double>() < 3.0);
     CHECK(s.at("ik").at("elbow_flexion_rms_deg").is_null()); // no captured elbow
+    // No capture to learn limits from: a person's range of motion; the drum at
+    // the strokes' turnarounds (nothing passes through it there).
+    CHECK(s.at("limits") == "range_of_motion");
+    CHECK(s.at("drum_rule") == "turnarounds");
+    CHECK(s.at("drum_through_fraction").get<double>() == 0.0);
     // The sticks were moved in front of the body (it faces +z, pelvis at the
     // origin's vertical): the drum under them, ahead of the pelvis and below
     // the shoulders (~1.17 m), above the floor.
@@ -279,6 +284,14 @@ TEST_CASE("ictusd track: a stick-only capture runs in Cartesian mode, drum fitte
     CHECK(drum[1].get<double>() > 0.4);
     CHECK(drum[1].get<double>() < 1.0);
     CHECK(drum[2].get<double>() > 0.2);
+
+    // --limits none: none.
+    const std::string dir_none = simtest::temp_path("out_sticks_none");
+    const Run none = ictusd("track --mode cartesian --quiet --mocap " + csv +
+                            " --units mm --up z --limits none --duration 0.3 --out " + dir_none);
+    REQUIRE(none.status == 0);
+    std::ifstream js_none(dir_none + "/summary.json");
+    CHECK(nlohmann::json::parse(js_none).at("limits") == "none");
 
     // Bad stick options and drum values are usage errors naming the thing.
     Run bad = ictusd("track --mode cartesian --quiet --mocap " + csv +

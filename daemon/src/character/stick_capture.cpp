@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 
 namespace ictus
 {
@@ -368,6 +369,58 @@ TipTrajectory with_impact_vertices(const TipTrajectory &tips,
         out.time_s.push_back(tips.time_s[i]);
         for (int s = 0; s < 2; ++s)
             out.tip_m[s].push_back(tips.tip_m[s][i]);
+    }
+    return out;
+}
+
+double impact_press_depth_m(double speed_mps, double stick_mass_kg, double stiffness_n_per_m)
+{
+    if (!(std::isfinite(speed_mps) && std::isfinite(stick_mass_kg) &&
+          std::isfinite(stiffness_n_per_m) && speed_mps > 0.0 && stick_mass_kg > 0.0 &&
+          stiffness_n_per_m > 0.0))
+        return 0.0;
+    return speed_mps * std::sqrt(stick_mass_kg / stiffness_n_per_m);
+}
+
+double fraction_through_drum(const TipTrajectory &tips, int side, const Eigen::Vector3d &center_m,
+                             double radius_m, double clearance_m)
+{
+    const std::vector<Eigen::Vector3d> &p = tips.tip_m[side & 1];
+    if (p.empty())
+        return 0.0;
+    size_t inside = 0;
+    for (const Eigen::Vector3d &q : p)
+        inside += std::hypot(q.x() - center_m.x(), q.z() - center_m.z()) < radius_m &&
+                  q.y() < center_m.y() - clearance_m;
+    return static_cast<double>(inside) / static_cast<double>(p.size());
+}
+
+Eigen::Vector3d drum_under_lowest_tips(const TipTrajectory &tips, double tip_radius_m)
+{
+    std::array<Eigen::Vector3d, 2> lowest;
+    lowest.fill(Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()));
+    for (int s = 0; s < 2; ++s)
+        for (const Eigen::Vector3d &p : tips.tip_m[s])
+            if (p.y() < lowest[s].y())
+                lowest[s] = p;
+    if (!(lowest[0].allFinite() && lowest[1].allFinite()))
+        throw CharacterError("--drum auto: the capture has no tip positions");
+    Eigen::Vector3d c = 0.5 * (lowest[0] + lowest[1]);
+    c.y() = std::min(lowest[0].y(), lowest[1].y()) - kImpactPitchFactor * tip_radius_m;
+    return c;
+}
+
+DrumPlacement place_drum(const TipTrajectory &tips, double tip_radius_m, double drum_radius_m)
+{
+    DrumPlacement out;
+    out.fit = fit_drum_to_turnarounds(tips, tip_radius_m);
+    out.center_m = out.fit.center_m;
+    for (int s = 0; s < 2; ++s)
+        out.through_fraction = std::max(
+            out.through_fraction, fraction_through_drum(tips, s, out.center_m, drum_radius_m));
+    if (out.through_fraction > kDrumThroughFraction) {
+        out.at_turnarounds = false;
+        out.center_m = drum_under_lowest_tips(tips, tip_radius_m);
     }
     return out;
 }

@@ -3,6 +3,7 @@
 // strikes on the drum (docs/character.md, docs/ik.md). Four steps: parse the
 // command line, load the capture and build the character, run, report.
 #include "ictus/character/character_limits.hpp"
+#include "ictus/character/range_of_motion.hpp"
 #include "ictus/character/stick_capture.hpp"
 #include "ictus/cli/verbs.hpp"
 #include "ictus/mocap/marker_csv.hpp"
@@ -44,9 +45,9 @@ void track_usage(std::ostream &out)
            "  --left-stick NAME, --right-stick NAME   the capture's stick-tip objects (default:\n"
            "                         named stick_l / stick_r, else containing left / right)\n"
            "  --units mm|m, --up y|z, --rate HZ   how to read the .csv (default m, y, its time)\n"
-           "  --drum auto|X,Y,Z      membrane centre (auto, default: a stick-only capture's\n"
-           "                         at its strokes' turnarounds, a BVH's under the lowest\n"
-           "                         tips; docs/mocap.md)\n"
+           "  --drum auto|X,Y,Z      membrane centre (auto, default: at the strokes'\n"
+           "                         turnarounds, or under the lowest tips when the tips\n"
+           "                         pass through a drum there, e.g. a kit; docs/mocap.md)\n"
            "  --ik-gain G            eq. 2's gain on the tip error (default 10)\n"
            "  --ik-velocity-gain S   tip velocity error term, s (default 0.1; < 0: automatic)\n"
            "  --ik-accel-ff S2       tip acceleration feedforward, s^2 (default 0)\n"
@@ -75,7 +76,8 @@ void track_usage(std::ostream &out)
            "  --damping-ratio Z      (default 1)       --torque-scale S (default 1)\n"
            "  --gains FILE.json      per-joint overrides, e.g. {\"l_wrist\": {\"kp_nm_per_rad\":\n"
            "                         40, \"kd_nm_s_per_rad\": 0.5, \"torque_limit_nm\": 20}}\n"
-           "  --limits none|euler|quaternion   limits enforced (default quaternion)\n"
+           "  --limits none|euler|quaternion   limits enforced (default quaternion; a\n"
+           "                         stick-only capture: the human range of motion)\n"
            "  --limit-k K            limit width in standard deviations (default 3)\n"
            "  --limit-min-deg DEG    minimum half-width of a limit per axis (default 6)\n"
            "  --no-stops             clamp targets only, no safety-net stops\n"
@@ -266,9 +268,14 @@ TrackArgs parse_track_args(Args &args)
         throw UsageError("--left-stick, --right-stick, --units, --up and --rate apply "
                          "to stick-only .csv captures");
     if (t.stick_only && t.limits_mode != "none") {
-        std::cerr << "ictusd: note: stick-only capture: no joint limits (they are learned "
-                     "from a full-body capture)\n";
-        t.limits_mode = "none";
+        // No capture to learn them from: a person's (RangeOfMotion, as the score
+        // performer's body). Without limits fast strokes' impacts pumped the arms'
+        // null space until a clavicle turned 150 degrees (docs/ik.md).
+        if (!t.quiet)
+            std::cerr << "ictusd: note: stick-only capture: joint limits from the normal human "
+                         "range of motion (no capture to learn them from; --limits none: "
+                         "none)\n";
+        t.limits_mode = "range_of_motion";
     }
     return t;
 }
@@ -285,9 +292,26 @@ struct TrackInput {
     std::unique_ptr<ReferenceMotion> raw, reference, tips_cleaned;
     TipTrajectory tips;
     std::unique_ptr<CharacterLimits> limits;
+    std::unique_ptr<RangeOfMotion> rom; // a stick-only capture's limits
     std::vector<JointLimitRef> limit_refs;
     std::vector<JointGains> gains;
 };
+
+// Joint limits learned from the (cleaned) capture (Algorithm 1, CharacterLimits).
+void load_learned_limits(const TrackArgs &t, TrackInput &in)
+{
+    const CharacterModel &model = *in.model;
+    if (t.limits_mode != "none" && in.reference->frames() < kMinLimitFrames)
+        std::cerr << "ictusd: warning: " << t.mocap << ": joint limits learned from "
+                  << in.reference->frames() << " frame(s), fewer than " << kMinLimitFrames
+                  << ": their spreads are noise (--limits none to run without them)\n";
+    CharacterLimitOptions lim;
+    lim.kind = limit_kind_from_string(t.limits_mode);
+    lim.k = t.limit_k;
+    lim.min_half_width_rad = t.limit_width_deg * M_PI / 180.0;
+    in.limits = std::make_unique<CharacterLimits>(model, *in.reference, lim);
+    in.limit_refs = in.limits->refs();
+}
 
 void load_track_input(TrackArgs &t, TrackInput &in)
 {
@@ -328,16 +352,12 @@ void load_track_input(TrackArgs &t, TrackInput &in)
         in.tips_cleaned = std::make_unique<ReferenceMotion>(model, in.bvh.motion, tip_filter);
         t.options.tip_motion = in.tips_cleaned.get();
     }
-    if (t.limits_mode != "none" && in.reference->frames() < kMinLimitFrames)
-        std::cerr << "ictusd: warning: " << t.mocap << ": joint limits learned from "
-                  << in.reference->frames() << " frame(s), fewer than " << kMinLimitFrames
-                  << ": their spreads are noise (--limits none to run without them)\n";
-    CharacterLimitOptions lim;
-    lim.kind = limit_kind_from_string(t.limits_mode);
-    lim.k = t.limit_k;
-    lim.min_half_width_rad = t.limit_width_deg * M_PI / 180.0;
-    in.limits = std::make_unique<CharacterLimits>(model, *in.reference, lim);
-    in.limit_refs = in.limits->refs();
+    if (t.limits_mode == "range_of_motion") {
+        in.rom = std::make_unique<RangeOfMotion>(model);
+        in.limit_refs = in.rom->refs();
+    } else {
+        load_learned_limits(t, in);
+    }
     // Gains: inertia-scaled defaults at the first pose, then per-joint overrides.
     in.gains = default_gains(model, in.reference->frame(0), t.options.gains);
     if (!t.gains_file.empty()) {
@@ -398,6 +418,11 @@ TrackSummary run_tracking(TrackArgs &t, const TrackInput &in, std::ostream *csv,
     TrackSummary summary = track_joint_space(
         *in.model, *in.reference, t.options, in.limit_refs, csv, [&](double f) { progress(f); },
         &in.gains, in.raw.get());
+    if (t.options.drum_auto && summary.drum_rule == "lowest_tips" && !t.quiet)
+        std::cerr << "ictusd: note: --drum auto: the drum goes under the lowest tips: "
+                  << 100.0 * summary.drum_through_fraction
+                  << " % of a stick's samples pass through a drum at the strokes' turnarounds "
+                     "(docs/mocap.md, \"Drum placement\")\n";
     StrikeEvent e;
     while (detector.flush(e))
         log.add(&e, 1);

@@ -39,6 +39,47 @@ double elbow_flexion_deg(const Eigen::Vector3d &upper_arm_axis, const Eigen::Vec
     return std::atan2(upper_arm_axis.cross(f).norm(), upper_arm_axis.dot(f)) * kRadToDeg;
 }
 
+void drummer_arms(const CharacterModel &model, CharacterPose &pose)
+{
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+    const char *upper_arm[2] = {"l_upper_arm", "r_upper_arm"};
+    const char *forearm[2] = {"l_forearm", "r_forearm"};
+    const char *hand[2] = {"l_hand", "r_hand"};
+    BodyFrames f;
+    model.forward(pose, f);
+    Eigen::Vector3d lateral =
+        f.origin_m[model.body_index(upper_arm[0])] - f.origin_m[model.body_index(upper_arm[1])];
+    lateral.y() = 0.0;
+    if (lateral.norm() < 1e-9)
+        return;
+    lateral.normalize();
+    const Eigen::Vector3d forward = lateral.cross(up); // left x up
+    for (int s = 0; s < 2; ++s) {
+        const int shoulder = model.joint_index(Tracker::kArmJoints[s][1]);
+        const int elbow = model.joint_index(Tracker::kArmJoints[s][2]);
+        const int bu = model.body_index(upper_arm[s]), bf = model.body_index(forearm[s]),
+                  bh = model.body_index(hand[s]);
+        if (shoulder < 0 || elbow < 0 || bu < 0 || bf < 0 || bh < 0)
+            continue;
+        // The upper arm hanging, kDrummerArmOut_rad out from the vertical.
+        const Eigen::Vector3d u = (f.origin_m[bf] - f.origin_m[bu]).normalized();
+        const Eigen::Vector3d out = (s == 0 ? 1.0 : -1.0) * lateral;
+        const Eigen::Vector3d hanging =
+            (-std::cos(kDrummerArmOut_rad) * up + std::sin(kDrummerArmOut_rad) * out).normalized();
+        const Eigen::Quaterniond parent = f.rotation[model.joint_body(shoulder).parent];
+        const Eigen::Quaterniond turn_u = Eigen::Quaterniond::FromTwoVectors(u, hanging);
+        pose.local[shoulder] =
+            (parent.conjugate() * turn_u * parent * pose.local[shoulder]).normalized();
+        model.forward(pose, f);
+        // The forearm forward (the elbow bent about the lateral axis).
+        const Eigen::Vector3d fa = (f.origin_m[bh] - f.origin_m[bf]).normalized();
+        const Eigen::Quaterniond upper = f.rotation[bu];
+        const Eigen::Quaterniond turn_f = Eigen::Quaterniond::FromTwoVectors(fa, forward);
+        pose.local[elbow] = (upper.conjugate() * turn_f * upper * pose.local[elbow]).normalized();
+        model.forward(pose, f);
+    }
+}
+
 TipTrajectory reference_tip_trajectory(const CharacterModel &model,
                                        const ReferenceMotion &reference)
 {
@@ -142,6 +183,8 @@ nlohmann::json TrackSummary::to_json() const
     j["contact_steps"] = contact_steps;
     j["stop_steps"] = stop_steps;
     j["drum_center_m"] = {drum_center_m.x(), drum_center_m.y(), drum_center_m.z()};
+    j["drum_rule"] = drum_rule;
+    j["drum_through_fraction"] = drum_through_fraction;
     if (mode == "cartesian") {
         j["ik"] = {{"mean_iterations", ik_mean_iterations},
                    {"max_iterations", ik_max_iterations},
@@ -209,24 +252,25 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     // the stick-only capture, else the cleaned tip motion, else the reference.
     const ReferenceMotion &tip_src = options.tip_motion ? *options.tip_motion : reference;
     // The strokes' turnarounds: the drum (--drum auto) and the contact windows.
+    // The drum at the turnarounds, for stick-only and full-body captures alike,
+    // unless the captured tips pass through it there (a drum kit: strokes for the
+    // other drums cross its place); then under the lowest tips (place_drum,
+    // docs/mocap.md, "Drum placement").
     DrumFit drum_fit;
     bool have_impacts = true;
+    DrumPlacement placement;
     try {
-        drum_fit =
-            fit_drum_to_turnarounds(tips_in ? *tips_in : reference_tip_trajectory(model, tip_src),
-                                    model.options().stick.tip_radius_m);
+        placement = place_drum(tips_in ? *tips_in : reference_tip_trajectory(model, tip_src),
+                               model.options().stick.tip_radius_m, options.scene.drum.radius_m);
+        drum_fit = placement.fit;
     } catch (const CharacterError &) {
         if (options.drum_auto && tips_in)
             throw;
         have_impacts = false;
     }
-    // A stick-only capture's drum under its turnarounds. A full-body capture's
-    // under its lowest tips, out of the strokes' way: on CMU 80_13 (a drum kit)
-    // a snare at the turnarounds stands in the strokes meant for the other
-    // drums (docs/mocap.md, "Drum placement").
     if (options.drum_auto)
         options.scene.drum.center_m =
-            tips_in ? drum_fit.center_m : auto_drum_center(model, reference);
+            have_impacts ? placement.center_m : auto_drum_center(model, reference);
     // A stick-only capture's impacts restored between its samples (X^T and the errors).
     TipTrajectory restored;
     // X^T asks for more at an impact: the stick's end down to the membrane plane at the
@@ -237,10 +281,18 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     const TipTrajectory *targets_in = tips_in;
     if (tips_in && have_impacts) {
         restored = with_impact_vertices(*tips_in, drum_fit.impacts);
+        // ... and a little deeper, by the dent a strike at the captured speed makes
+        // in the simulated membrane (impact_press_depth_m): the tracked end rounds
+        // the V off by millimetres, and with the end asked to the contact height
+        // alone a third to all of the impacts at 120 Hz went unstruck.
         std::array<std::vector<StrokeTurnaround>, 2> at_membrane = drum_fit.impacts;
+        const double r_tip = model.options().stick.tip_radius_m;
         for (auto &side : at_membrane)
             for (StrokeTurnaround &ta : side)
-                ta.position_m.y() -= kImpactPitchFactor * model.options().stick.tip_radius_m;
+                ta.position_m.y() -=
+                    kImpactPitchFactor * r_tip +
+                    impact_press_depth_m(ta.speed_in_mps, model.options().stick.mass_kg,
+                                         options.scene.drum.stiffness_n_per_m(r_tip));
         pressed = with_impact_vertices(*tips_in, at_membrane);
         tips_in = &restored;
         targets_in = &pressed;
@@ -255,10 +307,16 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     long last_sample_index = 0;
 
     CharacterPose initial = reference.frame(0);
-    if (tips_in) // The arms' first pose: a cold IK solve from the reference's arms to the first
-                 // tips.
+    if (tips_in) {
+        // The arms' first pose: a cold IK solve to the first tips from a drummer's
+        // arms (drummer_arms), not from the reference's (the default body's T-pose):
+        // from the T-pose the solve ended in a pose whose first impacts threw the
+        // sticks sideways (6.7 m/s strokes: 21 and 20 mm in the first two strokes'
+        // free flight, 2.5 after; docs/ik.md, "Stick-only captures").
+        drummer_arms(model, initial);
         Tracker::solve_arms(model, limits, options.cartesian.ik,
                             {tips_in->tip_m[0][0], tips_in->tip_m[1][0]}, initial);
+    }
     const std::vector<JointGains> gains =
         gains_in ? *gains_in : default_gains(model, initial, options.gains);
     Tracker tracker(model, options.scene, initial, gains, limits, options.mode, options.cartesian,
@@ -301,6 +359,11 @@ TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotio
     summary.mode = to_string(options.mode);
     summary.frames = reference.frames();
     summary.drum_center_m = options.scene.drum.center_m;
+    summary.drum_rule = !options.drum_auto         ? "given"
+                        : !have_impacts            ? "lowest_tips"
+                        : placement.at_turnarounds ? "turnarounds"
+                                                   : "lowest_tips";
+    summary.drum_through_fraction = have_impacts ? placement.through_fraction : 0.0;
     for (int j = 0; j < nj; ++j)
         summary.joint_names.push_back(model.joint_name(j));
     std::vector<double> joint_sum2(nj, 0.0), joint_max(nj, 0.0);

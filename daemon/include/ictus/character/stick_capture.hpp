@@ -77,6 +77,13 @@ constexpr double kImpactBand_m = 0.02;
 // say d, so the membrane goes r / 2 below the impacts (a stick 30 degrees below
 // the horizontal): at most r / 2 (3.5 mm for the default bead) off at any pitch.
 constexpr double kImpactPitchFactor = 0.5;
+// How far below the membrane plane a stick-only capture's X^T asks the stick's
+// end at an impact's vertex (`ictusd track`, docs/ik.md, "Stick-only captures"):
+// the dent of a strike at `speed_mps` in a membrane of stiffness k, for the
+// stick's mass m alone: v / omega = v sqrt(m / k) (2.9 mm per m/s for the
+// default 50 g stick on the default snare, k = 5.8 kN/m).
+// 0 for a non-finite or non-positive input.
+double impact_press_depth_m(double speed_mps, double stick_mass_kg, double stiffness_n_per_m);
 struct DrumFit {
     Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
     std::array<std::vector<StrokeTurnaround>, 2> impacts; // [side], in time order
@@ -89,6 +96,33 @@ DrumFit fit_drum_to_turnarounds(const TipTrajectory &tips, double tip_radius_m);
 // at 8 m/s), so the stick would be asked to turn above the drum.
 TipTrajectory with_impact_vertices(const TipTrajectory &tips,
                                    const std::array<std::vector<StrokeTurnaround>, 2> &impacts);
+// The drum of `--drum auto` (stick-only and full-body captures alike;
+// docs/mocap.md, "Drum placement"): the membrane at the strokes' turnarounds
+// (fit_drum_to_turnarounds), unless the captured tips pass through that drum --
+// more than kDrumThroughFraction of either stick's samples within the drum's
+// radius of its axis and more than kDrumClearance_m below its membrane, as when
+// a drum-kit capture's strokes for the other drums cross the place of the one
+// simulated drum. Then the drum goes under the lowest tips, out of the
+// strokes' way (`at_turnarounds` false). Throws CharacterError when no stick
+// has a turnaround.
+constexpr double kDrumThroughFraction = 0.01;
+constexpr double kDrumClearance_m = kImpactBand_m;
+struct DrumPlacement {
+    Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+    bool at_turnarounds = true;
+    // The larger of the two sticks' fractions of samples inside the drum at the turnarounds.
+    double through_fraction = 0.0;
+    DrumFit fit; // the turnarounds and impacts (the contact windows), in either case
+};
+DrumPlacement place_drum(const TipTrajectory &tips, double tip_radius_m, double drum_radius_m);
+// The fraction of stick `side`'s samples inside a drum of radius `radius_m` whose
+// membrane centre is `center_m`: within the radius of its vertical axis and more
+// than `clearance_m` below the membrane.
+double fraction_through_drum(const TipTrajectory &tips, int side, const Eigen::Vector3d &center_m,
+                             double radius_m, double clearance_m = kDrumClearance_m);
+// A drum under the lowest tips: (x, z) the mean of the two sticks' lowest
+// points, the membrane kImpactPitchFactor tip radii below the lower of them.
+Eigen::Vector3d drum_under_lowest_tips(const TipTrajectory &tips, double tip_radius_m);
 // fit_drum_to_turnarounds(tips, tip_radius_m).center_m.
 Eigen::Vector3d fit_drum_to_strokes(const TipTrajectory &tips, double tip_radius_m);
 

@@ -38,10 +38,11 @@ struct TrackOptions {
     // targets at start-up jolts the trunk, ode-findings.md); errors are not
     // counted during it.
     double ramp_s = 0.25;
-    // Place the drum automatically (else scene.drum.center_m): a stick-only capture's at its
-    // strokes' turnarounds (fit_drum_to_turnarounds), a full-body capture's under the lowest
-    // tips (auto_drum_center; docs/mocap.md, "Drum placement"). The turnarounds of the tips
-    // the errors are measured against give the contact windows in either case.
+    // Place the drum automatically (else scene.drum.center_m): at the strokes'
+    // turnarounds, for stick-only and full-body captures alike, unless the captured
+    // tips pass through a drum there (then under the lowest tips; place_drum,
+    // docs/mocap.md, "Drum placement"). The turnarounds of the tips the errors are
+    // measured against give the contact windows in either case.
     bool drum_auto = true;
     // The cleaned capture for the stick tips (full-body captures): the Cartesian mode's
     // X^T and both modes' tip errors are the stick tips of this motion (else the
@@ -96,6 +97,12 @@ struct TrackSummary {
     long contact_steps = 0;
     long stop_steps = 0; // joint-steps during which a safety-net stop was active
     Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero();
+    // How the drum was placed: "turnarounds" (--drum auto at the strokes'
+    // turnarounds), "lowest_tips" (--drum auto, the tips pass through a drum
+    // there or have no strokes) or "given"; the fraction of samples of the
+    // more affected stick inside the drum at the turnarounds (place_drum).
+    std::string drum_rule = "given";
+    double drum_through_fraction = 0.0;
     // Cartesian mode: IK statistics over all arm solves (two per step).
     double ik_mean_iterations = 0.0;
     int ik_max_iterations = 0;
@@ -117,6 +124,12 @@ std::array<Eigen::Vector3d, 2> reference_tips(const CharacterModel &model,
 // tips at their lowest, y half a tip radius below the lower of them. (The score
 // performance's clip mode; `ictusd track` fits the turnarounds instead.)
 Eigen::Vector3d auto_drum_center(const CharacterModel &model, const ReferenceMotion &reference);
+
+// The arms of `pose` as a drummer holds them at rest: each upper arm hanging,
+// kDrummerArmOut_rad out from the vertical, the forearm forward (the body's
+// forward: its left x up). The seed of a stick-only capture's cold arm solve.
+constexpr double kDrummerArmOut_rad = 10.0 * M_PI / 180.0;
+void drummer_arms(const CharacterModel &model, CharacterPose &pose);
 
 // The stick tips of every frame of `reference` as a trajectory (for the drum fit).
 TipTrajectory reference_tip_trajectory(const CharacterModel &model,
