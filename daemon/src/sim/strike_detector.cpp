@@ -116,6 +116,13 @@ void StrikeDetector::to_membrane(const Eigen::Vector3d &world_m, double &x_m, do
     y_m = -d.z();
 }
 
+bool StrikeDetector::held_driving(const TipSample &a, const TipSample &b) const
+{
+    return a.held_center_m.allFinite() && b.held_center_m.allFinite() && b.time_s > a.time_s &&
+           -(b.held_center_m - a.held_center_m).dot(kNormal) / (b.time_s - a.time_s) >=
+               options_.driven_speed_mps;
+}
+
 bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
 {
     Hand &h = hands_[static_cast<size_t>(hand & 1)];
@@ -166,14 +173,11 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
         const Eigen::Vector3d v = approach_velocity(before, g0, s, options_.semi_implicit_samples);
         e.normal_velocity_mps = -v.dot(kNormal);
         e.tangential_velocity_mps = (v - v.dot(kNormal) * kNormal).norm();
-        // The hand's speed toward the membrane over the onset's step (the
-        // held bead; unknown for a rigid stick or a trajectory).
-        bool driven = true;
-        if (s.held_center_m.allFinite() && before.held_center_m.allFinite() &&
-            s.time_s > before.time_s)
-            driven = -(s.held_center_m - before.held_center_m).dot(kNormal) /
-                         (s.time_s - before.time_s) >=
-                     options_.driven_speed_mps;
+        // Driven: the hand moved the stick toward the membrane within the
+        // drive window, the onset's own step included (the held bead; a
+        // rigid stick or a trajectory has none: always driven).
+        const bool driven = !s.held_center_m.allFinite() || held_driving(h.previous, s) ||
+                            s.time_s - h.last_driven_s <= options_.drive_window_s + 1e-9;
         e.bounce = h.released_once && (t_on - h.release_time_s) <= options_.bounce_window_s &&
                    (h.max_gap_since_release < options_.bounce_height_m ||
                     h.max_held_gap_since_release < options_.bounce_height_m || !driven);
@@ -248,6 +252,8 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
             h.max_held_gap_since_release = std::max(h.max_held_gap_since_release, held_gap);
         }
     }
+    if (h.has_previous && held_driving(h.previous, s))
+        h.last_driven_s = s.time_s;
     h.previous = s;
     h.previous_gap = gap;
     h.has_previous = true;

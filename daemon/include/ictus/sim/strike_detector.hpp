@@ -14,6 +14,8 @@
 
 #include "ictus/sim/strike_event.hpp"
 
+#include <limits>
+
 #include <Eigen/Core>
 #include <array>
 #include <cmath>
@@ -43,12 +45,16 @@ struct StrikeDetectorOptions {
     // hand stays down strikes again by itself).
     double bounce_height_m = 0.01;
     double bounce_window_s = 0.15;
-    // ... OR the hand is not driving the stick toward the membrane at the
-    // onset: the held bead moves toward it slower than this (m/s; it may be
-    // still or rising). The stick then falls back onto the head by itself
-    // (a loose grip after a press, the stick turning down on its fulcrum as
-    // the hand lifts): the same stroke, however high it had risen.
+    // ... OR the hand has not driven the stick toward the membrane in the
+    // drive_window_s before the onset: the held bead moved toward it slower
+    // than driven_speed_mps all that time (still or rising). The stick then
+    // falls back onto the head by itself (a loose grip after a press, the
+    // stick turning down on its fulcrum as the hand lifts): the same stroke,
+    // however high it had risen. (A stroke's hand may stop just before the
+    // contact while the stick whips on: hence the window, not the onset's
+    // step alone.)
     double driven_speed_mps = 0.1;
+    double drive_window_s = 0.02;
     // How the samples were made, which decides the velocity that crossed the
     // membrane plane (the pre-contact velocity of a strike):
     // true, the Scene's physics steps: each sample's velocity is the one that
@@ -108,6 +114,9 @@ class StrikeDetector
     // whether the bead is over the membrane disk.
     double gap_m(const Eigen::Vector3d &center_m) const;
     bool over_membrane(const Eigen::Vector3d &center_m) const;
+    // Whether the held bead moved toward the membrane at driven_speed_mps or
+    // faster from a to b (false when either has none).
+    bool held_driving(const TipSample &a, const TipSample &b) const;
     bool in_contact(int hand) const { return hands_[hand].in_contact; }
     long strikes() const { return next_seq_; }
     // The smallest seq of a contact still under way (strikes() when none): every
@@ -137,6 +146,9 @@ class StrikeDetector
         double release_time_s = 0.0;
         double max_gap_since_release = 0.0;
         double max_held_gap_since_release = 0.0;
+        // When the held bead last moved toward the membrane at
+        // driven_speed_mps or faster (-inf: never, or no held bead).
+        double last_driven_s = -std::numeric_limits<double>::infinity();
         long stroke = -1;
         bool onset_new = false; // take_onset() has not seen this contact yet
     };
