@@ -99,6 +99,38 @@ bool inside(const SwingTwistLimit &l, const Eigen::Vector3d &c, double tolerance
            c[2] >= l.twist_lo_rad - tolerance_rad && c[2] <= l.twist_hi_rad + tolerance_rad;
 }
 
+// [a, b] or [b, a] within [lo, hi], with a relative slack against rounding.
+bool within(double a, double b, double lo, double hi)
+{
+    const double slack = 1e-9 * std::max(std::fabs(a), std::fabs(b));
+    return std::min(a, b) - slack >= lo && std::max(a, b) + slack <= hi;
+}
+
+// A sufficient test that q is inside, without trigonometry (most calls, every
+// step: the IK's iterations, the targets, the stops, the excursion): each
+// coordinate lies between bounds from atan's. False means "do the exact test".
+// Twist: 2 atan(x), x = along / w, lies between 2x / (1 + x^2) and 2x. Swing:
+// q twist^-1 = (r, s), r = |(w, along)|, |s|^2 = 1 - r^2; its rotation vector
+// is g s with g = 2 atan(|s| / r) / |s| in [2, 2 / r].
+bool certainly_inside(const SwingTwistLimit &l, const Eigen::Quaterniond &q_in)
+{
+    Eigen::Quaterniond q = q_in.normalized();
+    if (q.w() < 0.0)
+        q.coeffs() = -q.coeffs();
+    const double w = q.w();
+    if (!(w > 0.0))
+        return false;
+    const double along = q.vec().dot(l.twist_axis);
+    const double x = along / w;
+    if (!within(2.0 * x / (1.0 + x * x), 2.0 * x, l.twist_lo_rad, l.twist_hi_rad))
+        return false;
+    const double r = std::sqrt(w * w + along * along);
+    const Eigen::Vector3d s =
+        (w * (q.vec() - along * l.twist_axis) - along * q.vec().cross(l.twist_axis)) / r;
+    const double pu = 2.0 * s.dot(l.u), pw = 2.0 * s.dot(l.w);
+    return within(pu, pu / r, l.u_lo_rad, l.u_hi_rad) && within(pw, pw / r, l.w_lo_rad, l.w_hi_rad);
+}
+
 // The clamp of q whose coordinates are c (outside the limit).
 Eigen::Quaterniond recompose(const SwingTwistLimit &l, const Eigen::Vector3d &c)
 {
@@ -112,11 +144,14 @@ Eigen::Quaterniond recompose(const SwingTwistLimit &l, const Eigen::Vector3d &c)
 
 bool SwingTwistLimit::contains(const Eigen::Quaterniond &q, double tolerance_rad) const
 {
-    return inside(*this, coordinates(q), tolerance_rad);
+    return (tolerance_rad >= 0.0 && certainly_inside(*this, q)) ||
+           inside(*this, coordinates(q), tolerance_rad);
 }
 
 Eigen::Quaterniond SwingTwistLimit::clamp(const Eigen::Quaterniond &q) const
 {
+    if (certainly_inside(*this, q))
+        return q.normalized();
     const Eigen::Vector3d c = coordinates(q); // once: inside or out
     if (inside(*this, c, 0.0))
         return q.normalized();
@@ -125,6 +160,8 @@ Eigen::Quaterniond SwingTwistLimit::clamp(const Eigen::Quaterniond &q) const
 
 double SwingTwistLimit::excursion_rad(const Eigen::Quaterniond &q) const
 {
+    if (certainly_inside(*this, q))
+        return 0.0;
     const Eigen::Vector3d c = coordinates(q);
     if (inside(*this, c, 0.0))
         return 0.0; // inside: nothing to recompose (the usual case, every step)
