@@ -99,36 +99,38 @@ bool inside(const SwingTwistLimit &l, const Eigen::Vector3d &c, double tolerance
            c[2] >= l.twist_lo_rad - tolerance_rad && c[2] <= l.twist_hi_rad + tolerance_rad;
 }
 
-// [a, b] or [b, a] within [lo, hi], with a relative slack against rounding.
-bool within(double a, double b, double lo, double hi)
+// A sufficient test that q is inside, without trigonometry, square roots or
+// divisions (most calls, every step: the IK's iterations, the targets, the
+// stops, the excursion): false means "do the exact test". For a range
+// holding 0 only the bound on the coordinate's side matters, and |atan(x)| <=
+// |x| bounds each coordinate's magnitude. Twist: 2 atan(x), x = along / w, so
+// 2 along <= hi w (w > 0) keeps it below hi. Swing: q twist^-1 = (r, s), r^2 =
+// w^2 + along^2, r s = w (v - along a) - along v x a =: n; its rotation vector
+// is g s with g = 2 atan(|s| / r) / |s| <= 2 / r, so 2 n.u <= hi r^2 keeps
+// the u coordinate below hi. All of it holds for q unnormalised and for -q
+// (n and r^2 are quadratic in q). A relative 1e-9 of slack covers rounding.
+bool certainly_inside(const SwingTwistLimit &l, const Eigen::Quaterniond &q)
 {
-    const double slack = 1e-9 * std::max(std::fabs(a), std::fabs(b));
-    return std::min(a, b) - slack >= lo && std::max(a, b) + slack <= hi;
-}
-
-// A sufficient test that q is inside, without trigonometry (most calls, every
-// step: the IK's iterations, the targets, the stops, the excursion): each
-// coordinate lies between bounds from atan's. False means "do the exact test".
-// Twist: 2 atan(x), x = along / w, lies between 2x / (1 + x^2) and 2x. Swing:
-// q twist^-1 = (r, s), r = |(w, along)|, |s|^2 = 1 - r^2; its rotation vector
-// is g s with g = 2 atan(|s| / r) / |s| in [2, 2 / r].
-bool certainly_inside(const SwingTwistLimit &l, const Eigen::Quaterniond &q_in)
-{
-    Eigen::Quaterniond q = q_in.normalized();
-    if (q.w() < 0.0)
-        q.coeffs() = -q.coeffs();
-    const double w = q.w();
+    constexpr double kShrink = 1.0 - 1e-9;
+    auto holds_zero = [](double lo, double hi) { return lo <= 0.0 && hi >= 0.0; };
+    if (!(holds_zero(l.twist_lo_rad, l.twist_hi_rad) && holds_zero(l.u_lo_rad, l.u_hi_rad) &&
+          holds_zero(l.w_lo_rad, l.w_hi_rad)))
+        return false;
+    const double sign = q.w() < 0.0 ? -1.0 : 1.0;
+    const double w = sign * q.w(), along = sign * q.vec().dot(l.twist_axis);
     if (!(w > 0.0))
         return false;
-    const double along = q.vec().dot(l.twist_axis);
-    const double x = along / w;
-    if (!within(2.0 * x / (1.0 + x * x), 2.0 * x, l.twist_lo_rad, l.twist_hi_rad))
+    const double t = 2.0 * along;
+    if (!(t <= kShrink * l.twist_hi_rad * w && t >= kShrink * l.twist_lo_rad * w))
         return false;
-    const double r = std::sqrt(w * w + along * along);
-    const Eigen::Vector3d s =
-        (w * (q.vec() - along * l.twist_axis) - along * q.vec().cross(l.twist_axis)) / r;
-    const double pu = 2.0 * s.dot(l.u), pw = 2.0 * s.dot(l.w);
-    return within(pu, pu / r, l.u_lo_rad, l.u_hi_rad) && within(pw, pw / r, l.w_lo_rad, l.w_hi_rad);
+    const double r2 = w * w + along * along;
+    const Eigen::Vector3d &v = q.vec();
+    const Eigen::Vector3d n =
+        q.w() * (v - q.vec().dot(l.twist_axis) * l.twist_axis) -
+        q.vec().dot(l.twist_axis) * v.cross(l.twist_axis); // quadratic: no sign needed
+    const double pu = 2.0 * n.dot(l.u), pw = 2.0 * n.dot(l.w), bound = kShrink * r2;
+    return pu <= l.u_hi_rad * bound && pu >= l.u_lo_rad * bound && pw <= l.w_hi_rad * bound &&
+           pw >= l.w_lo_rad * bound;
 }
 
 // The clamp of q whose coordinates are c (outside the limit).
