@@ -64,6 +64,38 @@ TEST_CASE("limits: the ellipsoid clamp is the nearest surface point (brute force
     }
 }
 
+// The clamp's quick inside test (no atan2) must never keep a rotation that is
+// outside: rotations from known tangent vectors 1e-6 inside and outside the
+// surface, and unnormalised ones (the test is scale-free).
+TEST_CASE("limits: the ellipsoid clamp keeps what is inside and only that, at the surface",
+          "[sim][limits]")
+{
+    EllipsoidJointLimit e;
+    e.limit.mean = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized());
+    e.limit.axes = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0, 1, 1).normalized()).toRotationMatrix();
+    e.limit.sigma_rad = Eigen::Vector3d(0.4, 0.1, 0.02);
+    e.limit.k = 2.0;
+    const Eigen::Vector3d a = e.limit.k * e.limit.sigma_rad;
+    std::mt19937 rng(5);
+    std::normal_distribution<double> n(0.0, 1.0);
+    for (int trial = 0; trial < 2000; ++trial) {
+        // A point of the surface (principal coordinates), scaled just in or out.
+        const Eigen::Vector3d dir = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+        const bool out = trial % 2 == 0;
+        const double scale = (trial / 2) % 3 == 0 ? 0.3 : (out ? 1.0 + 1e-6 : 1.0 - 1e-6);
+        const Eigen::Vector3d p = scale * a.cwiseProduct(dir);
+        const bool outside = out && scale > 1.0;
+        const double length = 1.0 + 0.5 * (trial % 5); // unnormalised quaternions too
+        Eigen::Quaterniond q = e.limit.mean * exp_map(e.limit.axes * p);
+        q.coeffs() *= length * ((trial / 10) % 2 ? -1.0 : 1.0);
+        INFO("trial " << trial << ", scale " << scale);
+        const Eigen::Quaterniond c = e.clamp(q);
+        CHECK((rotation_angle_between(c, q.normalized()) > 1e-12) == outside);
+        if (!outside)
+            CHECK(c.coeffs() == q.normalized().coeffs());
+    }
+}
+
 TEST_CASE("limits: a target outside the learned region is clamped and the joint stays inside",
           "[sim][limits]")
 {
