@@ -195,6 +195,8 @@ TrackArgs parse_track_args(Args &args)
                 throw UsageError("--stepper: expected quick or direct, got '" + s + "'");
         } else if (a == "--iterations") {
             t.options.scene.quickstep_iterations = parse_int(a, args.value(a), 1, 1000);
+        } else if (a == "--sor-w") {
+            t.options.scene.quickstep_w = parse_number(a, args.value(a), 0.01, 1.99);
         } else if (a == "--body-mass") {
             t.character.body_mass_kg = parse_positive(a, args.value(a));
         } else if (a == "--grip") {
@@ -418,6 +420,7 @@ int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary
     j["step_s"] = options.scene.step_s;
     j["stepper"] = options.scene.stepper == Stepper::quick ? "quick" : "direct";
     j["quickstep_iterations"] = options.scene.quickstep_iterations;
+    j["quickstep_w"] = options.scene.quickstep_w;
     j["grip"] = to_string(t.character.grip);
     j["body_mass_kg"] = t.character.body_mass_kg;
     j["limits"] = t.limits_mode;

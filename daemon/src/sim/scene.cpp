@@ -91,6 +91,9 @@ void validate(const SceneOptions &o)
     if (o.quickstep_iterations < 1 || o.quickstep_iterations > 1000)
         throw CharacterError("QuickStep iterations: expected 1..1000, got " +
                              std::to_string(o.quickstep_iterations));
+    if (!(o.quickstep_w > 0.0 && o.quickstep_w < 2.0))
+        throw CharacterError("QuickStep over-relaxation: expected a value in (0, 2), got " +
+                             std::to_string(o.quickstep_w));
     if (!(std::isfinite(o.gravity_mps2) && o.gravity_mps2 >= 0.0))
         throw CharacterError("gravity: expected a finite value >= 0");
     check_finite_positive("drum radius (m)", o.drum.radius_m, 5.0);
@@ -214,6 +217,7 @@ void Scene::build(const CharacterPose &initial)
     world_ = dWorldCreate();
     dWorldSetGravity(world_, 0.0, -options_.gravity_mps2, 0.0); // y up, as the mocap
     dWorldSetQuickStepNumIterations(world_, options_.quickstep_iterations);
+    dWorldSetQuickStepW(world_, options_.quickstep_w);
     dWorldSetERP(world_, 0.2);
     dWorldSetCFM(world_, 1e-9);
     space_ = dSimpleSpaceCreate(nullptr); // a handful of geoms: brute force is cheapest

@@ -70,6 +70,9 @@ struct SceneOptions {
     double step_s = 0.001;
     Stepper stepper = Stepper::quick;
     int quickstep_iterations = 15;
+    // QuickStep's successive over-relaxation factor (dWorldSetQuickStepW), 0..2
+    // exclusive; ODE's default is 1.3.
+    double quickstep_w = 1.3;
     double gravity_mps2 = 9.81;
     DrumParams drum;
     // Divergence: any non-finite state, a body faster than these, or a ball
