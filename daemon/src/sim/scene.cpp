@@ -537,21 +537,32 @@ void Scene::apply_control()
         static const int kVel[3] = {dParamVel1, dParamVel2, dParamVel3};
         static const int kFMax[3] = {dParamFMax1, dParamFMax2, dParamFMax3};
         static const int kCfm[3] = {dParamCFM1, dParamCFM2, dParamCFM3};
+        // Only what changed goes to ODE (the CFM and force limits change with
+        // the gains and the stops, the velocities every step).
+        MotorParams &last = motor_params_[j];
+        const bool new_cfm = !(cmd.cfm == last.cfm);
+        last.cfm = cmd.cfm;
         for (int i = 0; i < 3; ++i) {
             dJointSetAMotorParam(m, kVel[i], cmd.velocity_world.dot(axes[i]));
-            dJointSetAMotorParam(m, kCfm[i], cmd.cfm);
+            if (new_cfm)
+                dJointSetAMotorParam(m, kCfm[i], cmd.cfm);
             // On a stopped axis only the stop acts: ODE would otherwise push
             // with the full motor force as an explicit torque.
-            dJointSetAMotorParam(m, kFMax[i], (stop && i == 0) ? 0.0 : cmd.fmax);
+            const double fmax = (stop && i == 0) ? 0.0 : cmd.fmax;
+            if (!(fmax == last.fmax[i]))
+                dJointSetAMotorParam(m, kFMax[i], fmax);
+            last.fmax[i] = fmax;
         }
         if (stop) {
             dJointSetAMotorAngle(m, 0, violation);
             dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
             dJointSetAMotorParam(m, dParamHiStop1, options_.stop_margin_rad);
             dJointSetAMotorParam(m, dParamStopERP, options_.stop_erp);
-        } else {
+            last.stops_open = false;
+        } else if (!last.stops_open) {
             dJointSetAMotorParam(m, dParamHiStop1, dInfinity);
             dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
+            last.stops_open = true;
         }
     }
 }
