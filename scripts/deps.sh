@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-    build-essential cmake pkg-config
+    build-essential cmake pkg-config ccache  # ccache: rebuilds of the same sources (scripts/build.sh)
     puredata-core puredata-dev pd-cyclone
     libode-dev libeigen3-dev liblo-dev liblo-tools nlohmann-json3-dev
     catch2

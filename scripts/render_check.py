@@ -35,6 +35,8 @@ PLAN_TIME_TOL_S = 1e-5        # notes.csv has 6 decimals
 MAX_LIMIT_EXCURSION_DEG = 2.0
 BOUNCE_WINDOW_S = 0.15        # ictusd's --bounce-window default (docs/osc.md)
 BOUNCE_HEIGHT_M = 0.01        # --bounce-height default
+DRIVEN_SPEED_MPS = 0.1        # the detector's driven_speed_mps (docs/osc.md)
+DRIVEN_SLOP_MPS = 0.3         # tips.csv's 4 ms samples against the detector's 1 ms step
 # Tip (the stick's end point) above the membrane when the bead touches it: r_tip (1 + d_y),
 # 5.2 mm for a 7 mm bead on a stick 15 deg down (docs/perform.md), 3.5..7 mm over 0..30 deg.
 TIP_OVER_BEAD_M = 0.0052
@@ -320,6 +322,18 @@ def _held_max(tips, hand, t0, t1):
     return _tip_max({"t": tips["t"], hand: tips["held"][hand]}, hand, t0, t1)
 
 
+def _held_down_speeds(tips, hand, t):
+    """The held tip's speed toward the membrane (m/s) over the tips.csv sample interval
+    that holds t and the one before it (tips.csv *_held_y_m), or None."""
+    if not tips or "held" not in tips:
+        return None
+    ts, ys = tips["t"], tips["held"][hand]
+    i = next((k for k in range(1, len(ts)) if ts[k] >= t), None)
+    if i is None or i < 2:
+        return None
+    return [-(ys[k] - ys[k - 1]) / (ts[k] - ts[k - 1]) for k in (i - 1, i)]
+
+
 def _tip_max(tips, hand, t0, t1):
     """Highest sampled tip (above the membrane) strictly between t0 and t1, or None."""
     ts = tips["t"]
@@ -349,6 +363,9 @@ def check_bounce_tags(res, strikes, tips):
                     held = _held_max(tips, s["hand"], release, s["time_s"])
                     if held is not None and held <= limit:
                         high = None  # the hand kept the stick down: a bounce either way
+                    drive = _held_down_speeds(tips, s["hand"], s["time_s"])
+                    if drive is not None and min(drive) < DRIVEN_SPEED_MPS + DRIVEN_SLOP_MPS:
+                        high = None  # the hand was not driving it down: the stick fell back
                     if high is not None and high > limit:
                         res.problems.append("bounce seq %d: the tip rose %.1f mm above the head "
                                             "since the release (a bounce rises < %.0f mm)"
@@ -366,6 +383,13 @@ def check_bounce_tags(res, strikes, tips):
                     held = _held_max(tips, s["hand"], release, s["time_s"])
                     if held is not None and high is not None:
                         high = min(high, held)  # a primary: the tip and the hand both rose
+                    drive = _held_down_speeds(tips, s["hand"], s["time_s"])
+                    if drive is not None and max(drive) < DRIVEN_SPEED_MPS - DRIVEN_SLOP_MPS:
+                        res.problems.append("primary seq %d: the hand was not driving the stick "
+                                            "down (held tip %.2f m/s toward the head) %.1f ms "
+                                            "after the release: an untagged bounce"
+                                            % (s["seq"], max(drive),
+                                               (s["time_s"] - release) * 1000))
                     if high is not None and high < limit:
                         res.problems.append("primary seq %d: the tip rose only %.1f mm above the "
                                             "head since the release %.1f ms before: an untagged "

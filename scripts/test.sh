@@ -25,8 +25,13 @@ bash scripts/build.sh "$root/build-asan" -DCMAKE_BUILD_TYPE=Debug -DICTUS_SANITI
 echo "== libFuzzer harnesses, a short run each (build-fuzz/, clang) =="
 # Only the harnesses and the libraries they fuzz; each CTest run replays its
 # seed corpus (fuzz/corpus/) and fuzzes for ICTUS_FUZZ_SECONDS. docs/fuzzing.md.
+launcher=()
+if command -v ccache >/dev/null; then
+    export CCACHE_BASEDIR="$root" CCACHE_NOHASHDIR=true
+    launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fi
 CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DICTUS_BUILD_FUZZ=ON -DICTUS_BUILD_EXTERNALS=OFF -DICTUS_BUILD_TESTS=OFF \
-    -DICTUS_BUILD_BENCH=OFF >/dev/null
+    -DICTUS_BUILD_BENCH=OFF "${launcher[@]}" >/dev/null
 cmake --build build-fuzz --target ictus_fuzz -j "$jobs"
 (cd build-fuzz && ctest -L fuzz --output-on-failure --no-tests=error -j "$jobs")

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 using namespace ictus;
 
@@ -388,4 +389,35 @@ TEST_CASE("instantiate: model units regenerated, imported units scaled, fallback
     // Others fall back to the builtin.
     REQUIRE(db.find(Grip::french, Nuance::accent, Side::right) == nullptr);
     CHECK(db.instantiate(Grip::french, Nuance::accent, Side::right, 0.6).source == "model");
+}
+
+TEST_CASE("a unit with two periods: the downswing of the one before, the lift of the one after, "
+          "the same impact speed",
+          "[gesture][model]")
+{
+    // docs/gestures.md: D = prep_fraction x min(period, 0.5 s), heights in
+    // proportion to min(1, period / 0.5 s), lift apex = lift_ratio x height,
+    // impact speed p H / D. With two periods the downswing (D, H) is the
+    // first period's unit's and the lift (its duration and apex) the second's.
+    std::mt19937 rng(2611);
+    std::uniform_real_distribution<double> period(0.1, 1.5), dyn(0.0, 1.0);
+    for (int trial = 0; trial < 60; ++trial) {
+        const Grip g = kGrips[trial % 2];
+        const Nuance n = static_cast<Nuance>(trial % kNuances);
+        const Side h = kHands[(trial / 2) % 2];
+        const double d = dyn(rng), before = period(rng), after = period(rng);
+        INFO(to_string(g) << " " << to_string(n) << " d=" << d << " before=" << before
+                          << " after=" << after);
+        const GestureUnit u = stroke_model(g, n, h, d, before, after);
+        const GestureUnit a = stroke_model(g, n, h, d, before);
+        const GestureUnit b = stroke_model(g, n, h, d, after);
+        // The downswing sample by sample, and the lift's duration and apex.
+        REQUIRE(u.strike_index == a.strike_index);
+        for (int k = 0; k <= u.strike_index; ++k)
+            REQUIRE((u.tip_m[k] - a.tip_m[k]).norm() < 1e-12);
+        CHECK(u.samples() - u.strike_index == b.samples() - b.strike_index);
+        CHECK(u.tip_m.back().y() == Approx(b.tip_m.back().y()).epsilon(1e-9));
+        CHECK(u.impact_speed_mps() == Approx(a.impact_speed_mps()).epsilon(1e-9));
+        CHECK(u.period_s == Approx(std::clamp(after, 0.1, 4.0)));
+    }
 }

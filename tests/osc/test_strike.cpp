@@ -589,8 +589,11 @@ TEST_CASE("strike: a stick bouncing on its fulcrum while the hand stays down is 
     // Two contacts 40 ms apart; between them the bead flies 2 cm high (over
     // the 1 cm bounce height). When the hand (the held bead) stayed below the
     // head the second contact is a bounce of the same stroke; when the hand
-    // lifted the stick 2 cm it is a new stroke.
-    for (const bool hand_lifted : {false, true}) {
+    // lifted the stick 2 cm and drives it down again through the onset it is
+    // a new stroke; when the hand lifted it and stays up (the stick falls back
+    // onto the head on its fulcrum by itself) it is a bounce again.
+    enum Hand { stays_down, lifts_and_drives, lifts_and_stays };
+    for (const Hand hand : {stays_down, lifts_and_drives, lifts_and_stays}) {
         StrikeDetector det(flat_membrane(5825.0, 3.0));
         const double r = 0.007;
         std::vector<StrikeEvent> events;
@@ -611,17 +614,25 @@ TEST_CASE("strike: a stick bouncing on its fulcrum while the hand stays down is 
             s.time_s = t;
             s.center_m = Eigen::Vector3d(0.0, r + gap, 0.0);
             s.velocity_mps = Eigen::Vector3d(0.0, gap < 0 ? -1.0 : 1.0, 0.0);
-            const double held = hand_lifted && t > 0.01 && t < 0.035 ? 0.02 : -0.005;
+            // The held bead: below the head, or lifted 2.5 cm by 25 ms and then
+            // either brought down at 1.25 m/s through the onset (40 ms) or held up.
+            double held = -0.005;
+            if (hand != stays_down && t > 0.005) {
+                const double up = 0.025 * std::min(1.0, (t - 0.005) / 0.02);
+                held = -0.005 + up;
+                if (hand == lifts_and_drives && t > 0.025)
+                    held = std::max(-0.005, 0.02 - 1.25 * (t - 0.025));
+            }
             s.held_center_m = Eigen::Vector3d(0.0, r + held, 0.0);
             s.effective_mass_kg = 0.015;
             if (det.update(1, s, e))
                 events.push_back(e);
         }
         REQUIRE(events.size() == 2);
-        INFO("hand lifted: " << hand_lifted);
+        INFO("hand: " << hand);
         CHECK_FALSE(events[0].bounce);
-        CHECK(events[1].bounce == !hand_lifted);
-        CHECK(events[1].stroke == (hand_lifted ? 1 : 0));
+        CHECK(events[1].bounce == (hand != lifts_and_drives));
+        CHECK(events[1].stroke == (hand == lifts_and_drives ? 1 : 0));
         // The effective mass at the onset rides with the strike.
         CHECK(events[0].stick_mass_kg == 0.015);
     }

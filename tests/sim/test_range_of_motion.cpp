@@ -61,6 +61,43 @@ TEST_CASE("range of motion: coordinates recompose, the clamp lands inside, insid
     }
 }
 
+TEST_CASE("range of motion: the IK's narrowed ranges keep a rotation the margin inside the range",
+          "[sim][limits]")
+{
+    // A rotation clamped into the narrowed ranges has every coordinate at
+    // least the margin inside the true range (or at its middle, for a range
+    // narrower than twice the margin), and a rotation inside the narrowed
+    // ranges stays as it is.
+    const CharacterModel model = CharacterModel::from_skeleton(default_skeleton());
+    const RangeOfMotion rom(model);
+    std::mt19937 rng(3141);
+    std::uniform_real_distribution<double> margin_deg(0.5, 6.0);
+    for (int trial = 0; trial < 5; ++trial) {
+        const double m = margin_deg(rng) * M_PI / 180.0;
+        const RangeOfMotion narrow(model, m);
+        for (int j = 0; j < CharacterModel::kJoints; ++j) {
+            const SwingTwistLimit &l = rom.limit(j), &n = narrow.limit(j);
+            INFO("joint " << model.joint_name(j) << " margin " << m * 180.0 / M_PI << " deg");
+            const double lo[3] = {l.u_lo_rad, l.w_lo_rad, l.twist_lo_rad};
+            const double hi[3] = {l.u_hi_rad, l.w_hi_rad, l.twist_hi_rad};
+            for (int i = 0; i < 100; ++i) {
+                const Eigen::Quaterniond q = random_rotation(rng, M_PI);
+                const Eigen::Quaterniond inside = n.clamp(q);
+                const Eigen::Vector3d c = l.coordinates(inside);
+                for (int k = 0; k < 3; ++k) {
+                    const double need = std::min(m, 0.5 * (hi[k] - lo[k]));
+                    CHECK(c[k] >= lo[k] + need - 1e-9);
+                    CHECK(c[k] <= hi[k] - need + 1e-9);
+                }
+                CHECK(l.excursion_rad(inside) == 0.0);
+                if (n.contains(q))
+                    CHECK(rotation_angle_between(q, inside) < 1e-12);
+            }
+        }
+    }
+    CHECK_THROWS_AS(RangeOfMotion(model, -0.01), CharacterError);
+}
+
 TEST_CASE("range of motion: the left side is the mirror image of the right", "[sim][limits]")
 {
     const CharacterModel model = CharacterModel::from_skeleton(default_skeleton());

@@ -221,6 +221,23 @@ RangeOfMotion::RangeOfMotion(const CharacterModel &model)
                                  "'");
 }
 
+RangeOfMotion::RangeOfMotion(const CharacterModel &model, double inner_margin_rad)
+    : RangeOfMotion(model)
+{
+    if (!(std::isfinite(inner_margin_rad) && inner_margin_rad >= 0.0))
+        throw CharacterError("range of motion: the inner margin must be finite and >= 0");
+    auto narrow = [inner_margin_rad](double &lo, double &hi) {
+        const double m = std::min(inner_margin_rad, 0.5 * (hi - lo));
+        lo += m;
+        hi -= m;
+    };
+    for (SwingTwistLimit &l : limits_) {
+        narrow(l.u_lo_rad, l.u_hi_rad);
+        narrow(l.w_lo_rad, l.w_hi_rad);
+        narrow(l.twist_lo_rad, l.twist_hi_rad);
+    }
+}
+
 std::vector<JointLimitRef> RangeOfMotion::refs() const
 {
     std::vector<JointLimitRef> refs;

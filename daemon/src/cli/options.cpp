@@ -212,6 +212,8 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.scene.quickstep_w = parse_number(a, value(), 0.01, 1.99);
     else if (a == "--ik-max-joint-speed")
         o.score.cartesian.max_joint_speed_rad_s = parse_number(a, value(), 0, 1000);
+    else if (a == "--ik-limit-margin")
+        o.score.ik_limit_margin_deg = parse_number(a, value(), 0, 10);
     else if (a == "--rebound")
         o.score.rebound_s = parse_number(a, value(), 0, 0.5);
     else if (a == "--lead-in")

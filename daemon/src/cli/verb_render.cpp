@@ -92,6 +92,8 @@ void render_usage(std::ostream &out)
            "  --sor-w W           QuickStep's over-relaxation (default 1.3, ODE's)\n"
            "  --ik-max-joint-speed R  the kinematic IK turns no arm joint faster than R\n"
            "                      rad/s (default 30; 0: no cap)\n"
+           "  --ik-limit-margin D the IK keeps the arms D degrees inside their range of\n"
+           "                      motion (default 3; stops and checks use the range)\n"
            "  --lead-in S         time before the score's first beat (default 1)\n"
            "\n"
            "common options (run and render):\n"

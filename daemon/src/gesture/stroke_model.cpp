@@ -102,25 +102,43 @@ double height(const NuanceShape &s, double H, double H_lift, double D, double L,
 
 GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double period_s)
 {
+    return stroke_model(g, n, h, dynamics, period_s, period_s);
+}
+
+GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double prep_period_s,
+                         double lift_period_s)
+{
     const NuanceShape &s = kShapes[static_cast<int>(n)];
     const GripShape &gs = g == Grip::german ? kGerman : kFrench;
     const double d = std::isfinite(dynamics) ? std::clamp(dynamics, 0.0, 1.0) : 0.6;
-    const double period = std::isfinite(period_s) ? std::clamp(period_s, 0.1, 4.0) : 0.5;
+    const auto clamp_period = [](double p) {
+        return std::isfinite(p) ? std::clamp(p, 0.1, 4.0) : 0.5;
+    };
+    const double prep_period = clamp_period(prep_period_s);
+    const double period = clamp_period(lift_period_s);
     const double rate = 250.0;
 
     // Timing: the downswing lasts prep_fraction of the period up to the
     // nominal period; at slower tempi the extra time is spent in the lift.
     // Heights shrink in proportion above the nominal tempo, so the impact
     // speed p H / D depends on the dynamics and the nuance, not the tempo.
-    const double tempo_scale = std::min(1.0, period / kNominalPeriod_s);
-    const int strike_index = std::max(
-        2,
-        static_cast<int>(std::lround(s.prep_fraction * std::min(period, kNominalPeriod_s) * rate)));
+    // The downswing is made for the time since the previous strike, the lift
+    // for the time to the next one, each with the next (previous) stroke's
+    // share: the lift of one stroke then reaches the height the next one
+    // starts from, and the first stroke after a rest is a whole one even when
+    // the next follows at once.
+    const auto downswing_samples = [&](double p) {
+        return std::max(2, static_cast<int>(std::lround(s.prep_fraction *
+                                                        std::min(p, kNominalPeriod_s) * rate)));
+    };
+    const int strike_index = downswing_samples(prep_period);
     const int lift_samples =
-        std::max(2, static_cast<int>(std::lround(period * rate)) - strike_index);
+        std::max(2, static_cast<int>(std::lround(period * rate)) - downswing_samples(period));
     const double D = strike_index / rate, L = lift_samples / rate;
-    const double H = kLegatoHeightFff_m * s.height_scale * dynamics_height_factor(d) * tempo_scale;
-    const double H_lift = s.lift_ratio * H;
+    const double H = kLegatoHeightFff_m * s.height_scale * dynamics_height_factor(d) *
+                     std::min(1.0, prep_period / kNominalPeriod_s);
+    const double H_lift = s.lift_ratio * kLegatoHeightFff_m * s.height_scale *
+                          dynamics_height_factor(d) * std::min(1.0, period / kNominalPeriod_s);
 
     // Stick at the strike (right hand): forward, yawed inward (-x), pitched down.
     const Eigen::Vector3d dir0(-std::sin(gs.inward_yaw_rad) * std::cos(gs.strike_pitch_rad),

@@ -290,8 +290,9 @@ struct Reply {
         lo_message m = lo_message_new();
         lo_message_add_string(m, echoed.c_str());
         lo_message_add_string(m, reason.c_str());
-        send("/ictus/error", m);
+        // Counted before it leaves: a peer that has the reply sees it counted.
         counters->errors_sent++;
+        send("/ictus/error", m);
     }
     void ok(const char *address, lo_message extra = nullptr)
     {
@@ -318,8 +319,8 @@ struct Reply {
             }
         }
         lo_message_free(m);
-        send("/ictus/reply", r);
         counters->replies++;
+        send("/ictus/reply", r);
     }
 };
 
@@ -467,8 +468,8 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
         }
         c.accepted++;
         lo_message pong = lo_message_new();
-        reply.send("/ictus/pong", pong);
         c.replies++;
+        reply.send("/ictus/pong", pong);
         return;
     }
     if (std::strcmp(path, "/ictus/status") == 0) {

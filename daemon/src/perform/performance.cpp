@@ -184,7 +184,9 @@ struct Performance::Rig {
 // when the grip or the drum changes (a Scene has no setters for them).
 struct Performance::ScoreRig {
     CharacterModel model;
-    RangeOfMotion range_of_motion; // the joint limits (declared before the tracker)
+    RangeOfMotion range_of_motion;    // the joint limits (declared before the tracker)
+    RangeOfMotion ik_range_of_motion; // the same, narrowed: the arms' IK's
+    std::vector<JointLimitRef> ik_limits = ik_range_of_motion.refs();
     int lumbar = model.joint_index("lumbar"), thorax = model.joint_index("thorax");
     std::vector<JointGains> base_gains, gains;
     std::unique_ptr<Tracker> tracker;
@@ -193,7 +195,10 @@ struct Performance::ScoreRig {
     PerformerFrame frame;
     Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero(); // where the drum goes
     TipTargets tips;
-    explicit ScoreRig(const CharacterModel &m) : model(m), range_of_motion(model) {}
+    ScoreRig(const CharacterModel &m, double ik_limit_margin_rad)
+        : model(m), range_of_motion(model), ik_range_of_motion(model, ik_limit_margin_rad)
+    {
+    }
 };
 
 // A plan ready to perform: the score it came from, the plan, and per hand and
@@ -792,7 +797,7 @@ Performance::make_score_rig(const PerformanceOptions &options,
     motion.root_position_m.push_back(Eigen::Vector3d(0.0, 0.9, 0.0));
     motion.local_rotation.emplace_back(skeleton.joints.size(), Eigen::Quaterniond::Identity());
     const CharacterModel model = CharacterModel::from_skeleton(skeleton, options.character);
-    auto rig = std::make_unique<ScoreRig>(model);
+    auto rig = std::make_unique<ScoreRig>(model, options.score.ik_limit_margin_deg * M_PI / 180.0);
     ScoreRig &r = *rig;
     r.body = model.pose_from_motion(motion, 0);
 
@@ -829,8 +834,8 @@ Performance::make_score_rig(const PerformanceOptions &options,
     else {
         const std::array<Eigen::Vector3d, 2> directions = {rest_stick_direction(r.frame, 0),
                                                            rest_stick_direction(r.frame, 1)};
-        Tracker::solve_arms(model, r.range_of_motion.refs(), options.score.cartesian.ik,
-                            r.frame.rest_tip_m, initial, &directions);
+        Tracker::solve_arms(model, r.ik_limits, options.score.cartesian.ik, r.frame.rest_tip_m,
+                            initial, &directions);
     }
     r.base_gains = default_gains(model, initial, options.gains);
     // The trunk is compliant: lumbar and thorax under eq. 1 at kTrunkHz (the
@@ -848,7 +853,7 @@ Performance::make_score_rig(const PerformanceOptions &options,
     co.reference_has_arms = false; // the body's reference has no arm motion
     r.tracker =
         std::make_unique<Tracker>(r.model, scene, initial, r.gains, r.range_of_motion.refs(),
-                                  options.score.mode, co, options.gains);
+                                  options.score.mode, co, options.gains, &r.ik_limits);
     r.tips.has_position = true;
     for (int s = 0; s < 2; ++s)
         r.tips.position_m[s] = r.tracker->scene().tip_position(static_cast<Side>(s));

@@ -87,7 +87,8 @@ void build_arm(const CharacterModel &model, int side, const CharacterPose &initi
 Tracker::Tracker(const CharacterModel &model, const SceneOptions &scene_options,
                  const CharacterPose &initial, const std::vector<JointGains> &gains,
                  const std::vector<JointLimitRef> &limits, TrackMode mode,
-                 const CartesianOptions &cartesian, const GainOptions &gain_options)
+                 const CartesianOptions &cartesian, const GainOptions &gain_options,
+                 const std::vector<JointLimitRef> *ik_limits)
     : mode_(mode), cartesian_(cartesian)
 {
     const int nj = CharacterModel::kJoints;
@@ -108,7 +109,8 @@ Tracker::Tracker(const CharacterModel &model, const SceneOptions &scene_options,
         arms_[s] = std::make_unique<Arm>();
         Arm &arm = *arms_[s];
         KinematicChain *chains[2] = {&arm.feedback, &arm.kinematic};
-        build_arm(scene_->model(), s, initial, limits, arm.joint, arm.base_body, chains);
+        build_arm(scene_->model(), s, initial, ik_limits ? *ik_limits : limits, arm.joint,
+                  arm.base_body, chains);
         for (int k = 0; k < 4; ++k)
             arm.theta_target[k] = arm.kinematic_target[k] = arm.previous_kinematic[k] =
                 arm.posture[k] = initial.local[arm.joint[k]];

@@ -305,21 +305,24 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
     plan.score_start_s = opt.lead_in_s;
 
     // Units are shared by notes with the same grip, nuance, hand, dynamics
-    // and period. The parametric model's units are made at the hand's own
-    // period (strike to next strike, gesture.hpp's stroke_model), so the warp
+    // and periods. The parametric model's units are made at the hand's own
+    // periods (the downswing for the time since its previous strike, the lift
+    // for the time to its next one: gesture.hpp's stroke_model), so the warp
     // has little to do; imported units come from instantiate() and are warped.
-    std::map<std::tuple<int, int, int, double, long>, std::unique_ptr<UnitCurve>> units;
-    auto unit_for = [&](Grip g, Nuance n, Side s, double dynamics,
-                        double period_s) -> const UnitCurve & {
-        const long period_us = std::lround(period_s * 1e6);
+    std::map<std::tuple<int, int, int, double, long, long>, std::unique_ptr<UnitCurve>> units;
+    auto unit_for = [&](Grip g, Nuance n, Side s, double dynamics, double prep_period_s,
+                        double lift_period_s) -> const UnitCurve & {
+        const long prep_us = std::lround(prep_period_s * 1e6);
+        const long lift_us = std::lround(lift_period_s * 1e6);
         const auto key = std::make_tuple(static_cast<int>(g), static_cast<int>(n),
-                                         static_cast<int>(s), dynamics, period_us);
+                                         static_cast<int>(s), dynamics, prep_us, lift_us);
         auto it = units.find(key);
         if (it == units.end()) {
             const GestureUnit *stored = db.find(g, n, s);
-            const GestureUnit unit = !stored || stored->source == "model"
-                                         ? stroke_model(g, n, s, dynamics, period_us * 1e-6)
-                                         : db.instantiate(g, n, s, dynamics);
+            const GestureUnit unit =
+                !stored || stored->source == "model"
+                    ? stroke_model(g, n, s, dynamics, prep_us * 1e-6, lift_us * 1e-6)
+                    : db.instantiate(g, n, s, dynamics);
             it = units.emplace(key, std::make_unique<UnitCurve>(unit)).first;
         }
         return *it->second;
@@ -372,7 +375,7 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
             // A hand with nothing to play holds its stick as at the top of a legato stroke.
             const Grip g = score.notes.empty() ? Grip::french : score.notes.front().grip;
             const UnitCurve &u = unit_for(g, Nuance::legato, static_cast<Side>(s), kDefaultDynamics,
-                                          kNominalPeriod_s);
+                                          kNominalPeriod_s, kNominalPeriod_s);
             rest.rest_dir = (to_world * u.dir(0.0)).normalized();
             items[s].push_back(rest);
             continue;
@@ -396,15 +399,18 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
             via_rest[k] = gap > opt.idle_return_s && gap > 2.0 * kNominalPeriod_s + 2.0 * tr + 0.2;
         }
         for (size_t k = 0; k < n; ++k) {
-            // The unit's period: to the hand's next strike, else from its
+            // The unit's periods: the downswing's from the hand's previous
+            // strike, else nominal (the first stroke, or one after a rest, is
+            // a whole stroke); the lift's to its next strike, else from the
             // previous one, else nominal (a lone stroke).
-            double period = kNominalPeriod_s;
-            if (k + 1 < n && !via_rest[k])
-                period = placed[k + 1].strike_t - placed[k].strike_t;
-            else if (k > 0 && !via_rest[k - 1])
-                period = placed[k].strike_t - placed[k - 1].strike_t;
+            const bool has_prev = k > 0 && !via_rest[k - 1];
+            const bool has_next = k + 1 < n && !via_rest[k];
+            const double before =
+                has_prev ? placed[k].strike_t - placed[k - 1].strike_t : kNominalPeriod_s;
+            const double after = has_next ? placed[k + 1].strike_t - placed[k].strike_t
+                                          : (has_prev ? before : kNominalPeriod_s);
             const PlannedNote &p = plan.notes[idx[k]];
-            placed[k].curve = &unit_for(p.grip, p.nuance, p.hand, p.dynamics, period);
+            placed[k].curve = &unit_for(p.grip, p.nuance, p.hand, p.dynamics, before, after);
         }
         for (size_t k = 0; k < n; ++k) {
             Item &it = placed[k];

@@ -166,9 +166,17 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
         const Eigen::Vector3d v = approach_velocity(before, g0, s, options_.semi_implicit_samples);
         e.normal_velocity_mps = -v.dot(kNormal);
         e.tangential_velocity_mps = (v - v.dot(kNormal) * kNormal).norm();
+        // The hand's speed toward the membrane over the onset's step (the
+        // held bead; unknown for a rigid stick or a trajectory).
+        bool driven = true;
+        if (s.held_center_m.allFinite() && before.held_center_m.allFinite() &&
+            s.time_s > before.time_s)
+            driven = -(s.held_center_m - before.held_center_m).dot(kNormal) /
+                         (s.time_s - before.time_s) >=
+                     options_.driven_speed_mps;
         e.bounce = h.released_once && (t_on - h.release_time_s) <= options_.bounce_window_s &&
                    (h.max_gap_since_release < options_.bounce_height_m ||
-                    h.max_held_gap_since_release < options_.bounce_height_m);
+                    h.max_held_gap_since_release < options_.bounce_height_m || !driven);
         e.stick_mass_kg = s.effective_mass_kg;
         if (!e.bounce)
             ++h.stroke;

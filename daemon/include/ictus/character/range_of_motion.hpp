@@ -44,6 +44,10 @@ class RangeOfMotion
 {
   public:
     explicit RangeOfMotion(const CharacterModel &model);
+    // The same ranges narrowed by inner_margin_rad on every side (each range
+    // keeps at least its middle): the IK's limits, so that the tracking's
+    // overshoot of a solution on the boundary stays inside the true one.
+    RangeOfMotion(const CharacterModel &model, double inner_margin_rad);
     const SwingTwistLimit &limit(int joint) const { return limits_[joint]; }
     // For Scene::set_joint_limits and the IK; refer to this object.
     std::vector<JointLimitRef> refs() const;

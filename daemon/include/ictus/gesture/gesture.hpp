@@ -115,6 +115,12 @@ double dynamics_height_factor(double dynamics);
 // The parametric stroke model behind builtin(): one unit at dynamics d,
 // nominal period (strike to next strike) period_s (clamped to [0.1, 4] s).
 GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double period_s = 0.5);
+// The same with the downswing made for prep_period_s (the time since the hand's
+// previous strike: preparation height and duration) and the lift for
+// lift_period_s (the time to its next strike: lift height and duration). The
+// impact speed depends on neither. period_s of the unit is lift_period_s.
+GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double prep_period_s,
+                         double lift_period_s);
 
 // Strike detection rule of segment_strokes (docs/gestures.md).
 struct SegmentOptions {

@@ -51,6 +51,10 @@ struct ScorePerformOptions {
     // midpoint of the shoulders.
     double drum_forward_m = 0.42;
     double drum_below_m = 0.42;
+    // The arms' IK keeps its solutions this far (deg) inside the range of
+    // motion on every side; the scene's stops and the excursion measured
+    // stay at the true limits (docs/perform.md, "Joint limits").
+    double ik_limit_margin_deg = 3.0;
     ScorePerformOptions();
 };
 

@@ -147,12 +147,14 @@ class Tracker
     // gives tip targets, the arms toward the kinematic IK of those targets:
     // "joint targets through IK", docs/perform.md). mode cartesian: Algorithm 2.
     // `gain_options` only for the automatic velocity gain (cartesian.velocity_gain_s < 0).
-    // `limits` as Scene::set_joint_limits (empty: none; they must outlive the tracker).
+    // `limits` as Scene::set_joint_limits (empty: none; they must outlive the tracker);
+    // `ik_limits` (nullptr: `limits`) those the arms' IK clamps into.
     // Throws CharacterError (a joint missing from the model, bad options).
     Tracker(const CharacterModel &model, const SceneOptions &scene_options,
             const CharacterPose &initial, const std::vector<JointGains> &gains,
             const std::vector<JointLimitRef> &limits, TrackMode mode,
-            const CartesianOptions &cartesian = {}, const GainOptions &gain_options = {});
+            const CartesianOptions &cartesian = {}, const GainOptions &gain_options = {},
+            const std::vector<JointLimitRef> *ik_limits = nullptr);
     ~Tracker();
     Tracker(const Tracker &) = delete;
     Tracker &operator=(const Tracker &) = delete;

@@ -43,6 +43,12 @@ struct StrikeDetectorOptions {
     // hand stays down strikes again by itself).
     double bounce_height_m = 0.01;
     double bounce_window_s = 0.15;
+    // ... OR the hand is not driving the stick toward the membrane at the
+    // onset: the held bead moves toward it slower than this (m/s; it may be
+    // still or rising). The stick then falls back onto the head by itself
+    // (a loose grip after a press, the stick turning down on its fulcrum as
+    // the hand lifts): the same stroke, however high it had risen.
+    double driven_speed_mps = 0.1;
     // How the samples were made, which decides the velocity that crossed the
     // membrane plane (the pre-contact velocity of a strike):
     // true, the Scene's physics steps: each sample's velocity is the one that
