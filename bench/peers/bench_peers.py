@@ -27,9 +27,12 @@ Performer, real-time factor (simulated s / CPU s):
   MuJoCo   dm_control's CMU humanoid, 56 DoF, root fixed, 1 ms (peer_mujoco.py)
   render   `ictusd render` of the default score, --bvh-rate 0 --tips-rate 0
            (start-up included)
+  before   with --before-ictusd FILE, another ictusd's track and render in the
+           same rounds (before / after a change, alternating)
 
 Usage: bench_peers.py BUILD --python VENV_PYTHON [--rounds R] [--sizes 64,256,...]
-       [--before DIR] [--bvh FILE] [--json FILE] [--skip drum,performer,sdt]"""
+       [--before DIR] [--before-ictusd FILE] [--bvh FILE] [--json FILE]
+       [--skip drum,performer,sdt]"""
 import argparse
 import datetime
 import json
@@ -52,6 +55,7 @@ ap.add_argument("--python", required=True, help="the peers' venv python")
 ap.add_argument("--rounds", type=int, default=3)
 ap.add_argument("--sizes", default="64,256,1024,4096")
 ap.add_argument("--before", help="another build's Pd library folder (build/ictus) to compare")
+ap.add_argument("--before-ictusd", help="another ictusd whose track and render run in the same rounds")
 ap.add_argument("--bvh", default=os.path.join(ROOT, "..", "shared", "data", "cmu", "80_13.bvh"))
 ap.add_argument("--mujoco-seconds", type=float, default=20.0)
 ap.add_argument("--json", help="write every raw run here")
@@ -175,18 +179,37 @@ def drum_round(r, results):
 mujoco_version = [""]
 
 
-def track_round(r, results):
-    cpu, out = run_cpu([ictusd, "track", "--mode", "joint", "--mocap", args.bvh, "--quiet"])
+def track_run(r, results, binary, key, case):
+    cpu, out = run_cpu([binary, "track", "--mode", "joint", "--mocap", args.bvh, "--quiet"])
     m = re.search(r"([0-9.]+) s simulated, realtime factor ([0-9.]+)", out)
     if not m:
         raise SystemExit("ictusd track printed no realtime factor:\n" + out)
     sim, wall_rtf = float(m.group(1)), float(m.group(2))
-    cpu0, _ = run_cpu([ictusd, "track", "--mode", "joint", "--mocap", args.bvh, "--quiet",
+    cpu0, _ = run_cpu([binary, "track", "--mode", "joint", "--mocap", args.bvh, "--quiet",
                        "--duration", "0.01"])
     rtf = sim / max(cpu - cpu0, 1e-9)
-    results.setdefault("track", []).append(rtf)
-    raw.append({"round": r, "case": "ictusd track --mode joint", "sim_s": sim, "cpu_s": cpu,
+    results.setdefault(key, []).append(rtf)
+    raw.append({"round": r, "case": case, "sim_s": sim, "cpu_s": cpu,
                 "startup_cpu_s": cpu0, "rtf_cpu": rtf, "rtf_wall_printed": wall_rtf})
+
+
+def render_run(r, results, binary, key, case):
+    out_dir = os.path.join(work, "render-%d" % r)
+    cpu, out = run_cpu([binary, "render", "--out", out_dir, "--bvh-rate", "0", "--tips-rate", "0"])
+    m = re.search(r"render: ([0-9.]+) s simulated in ([0-9.]+) s \(([0-9.]+)x real time\)", out)
+    if not m:
+        raise SystemExit("ictusd render printed no speed:\n" + out)
+    sim = float(m.group(1))
+    results.setdefault(key, []).append(sim / cpu)
+    raw.append({"round": r, "case": case, "sim_s": sim, "cpu_s": cpu,
+                "rtf_cpu": sim / cpu, "rtf_wall_printed": float(m.group(3))})
+    shutil.rmtree(out_dir, ignore_errors=True)
+
+
+def track_round(r, results):
+    if args.before_ictusd:
+        track_run(r, results, args.before_ictusd, "track_before", "before: ictusd track --mode joint")
+    track_run(r, results, ictusd, "track", "ictusd track --mode joint")
 
     _, out = run_cpu([args.python, os.path.join(ROOT, "bench", "peers", "peer_mujoco.py"),
                       str(args.mujoco_seconds)])
@@ -198,16 +221,9 @@ def track_round(r, results):
     raw.append(dict(j, round=r, case="MuJoCo CMU humanoid", rtf_cpu=j["sim_s"] / j["cpu_s"],
                     rtf_wall=j["sim_s"] / j["wall_s"]))
 
-    out_dir = os.path.join(work, "render-%d" % r)
-    cpu, out = run_cpu([ictusd, "render", "--out", out_dir, "--bvh-rate", "0", "--tips-rate", "0"])
-    m = re.search(r"render: ([0-9.]+) s simulated in ([0-9.]+) s \(([0-9.]+)x real time\)", out)
-    if not m:
-        raise SystemExit("ictusd render printed no speed:\n" + out)
-    sim = float(m.group(1))
-    results.setdefault("render", []).append(sim / cpu)
-    raw.append({"round": r, "case": "ictusd render", "sim_s": sim, "cpu_s": cpu,
-                "rtf_cpu": sim / cpu, "rtf_wall_printed": float(m.group(3))})
-    shutil.rmtree(out_dir, ignore_errors=True)
+    if args.before_ictusd:
+        render_run(r, results, args.before_ictusd, "render_before", "before: ictusd render")
+    render_run(r, results, ictusd, "render", "ictusd render")
 
 
 # ---------------------------------------------------------------- main
@@ -272,6 +288,14 @@ if "performer" not in skip:
         max(t) / max(mj), per_round_ratio(t, mj)))
     print("  ictusd render, default score:          %.1fx  [%s] (target >= 25)" % (
         max(rd), ", ".join("%.1f" % v for v in rd)))
+    if args.before_ictusd:
+        tb, rb = results["track_before"], results["render_before"]
+        print("  before (%s): track %.1fx [%s], ratio track / MuJoCo median %.2f; "
+              "render %.1fx [%s]" % (args.before_ictusd, max(tb), ", ".join("%.1f" % v for v in tb),
+                                     per_round_ratio(tb, mj), max(rb),
+                                     ", ".join("%.1f" % v for v in rb)))
+        print("  after / before, median of rounds: track %.3f, render %.3f" % (
+            per_round_ratio(t, tb), per_round_ratio(rd, rb)))
 print("\nload after: %s" % info["load_after"])
 if args.json:
     with open(args.json, "w") as f:

@@ -64,6 +64,38 @@ TEST_CASE("limits: the ellipsoid clamp is the nearest surface point (brute force
     }
 }
 
+// The clamp's quick inside test (no atan2) must never keep a rotation that is
+// outside: rotations from known tangent vectors 1e-6 inside and outside the
+// surface, and unnormalised ones (the test is scale-free).
+TEST_CASE("limits: the ellipsoid clamp keeps what is inside and only that, at the surface",
+          "[sim][limits]")
+{
+    EllipsoidJointLimit e;
+    e.limit.mean = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized());
+    e.limit.axes = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0, 1, 1).normalized()).toRotationMatrix();
+    e.limit.sigma_rad = Eigen::Vector3d(0.4, 0.1, 0.02);
+    e.limit.k = 2.0;
+    const Eigen::Vector3d a = e.limit.k * e.limit.sigma_rad;
+    std::mt19937 rng(5);
+    std::normal_distribution<double> n(0.0, 1.0);
+    for (int trial = 0; trial < 2000; ++trial) {
+        // A point of the surface (principal coordinates), scaled just in or out.
+        const Eigen::Vector3d dir = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+        const bool out = trial % 2 == 0;
+        const double scale = (trial / 2) % 3 == 0 ? 0.3 : (out ? 1.0 + 1e-6 : 1.0 - 1e-6);
+        const Eigen::Vector3d p = scale * a.cwiseProduct(dir);
+        const bool outside = out && scale > 1.0;
+        const double length = 1.0 + 0.5 * (trial % 5); // unnormalised quaternions too
+        Eigen::Quaterniond q = e.limit.mean * exp_map(e.limit.axes * p);
+        q.coeffs() *= length * ((trial / 10) % 2 ? -1.0 : 1.0);
+        INFO("trial " << trial << ", scale " << scale);
+        const Eigen::Quaterniond c = e.clamp(q);
+        CHECK((rotation_angle_between(c, q.normalized()) > 1e-12) == outside);
+        if (!outside)
+            CHECK(c.coeffs() == q.normalized().coeffs());
+    }
+}
+
 TEST_CASE("limits: a target outside the learned region is clamped and the joint stays inside",
           "[sim][limits]")
 {
@@ -160,4 +192,49 @@ TEST_CASE("limits: a kicked joint meets the safety-net stop", "[sim][limits]")
     // Stop margin 5 degrees, plus what one step at the kick's speed overshoots
     // (100 rad/s for 1 ms: 5.7 degrees) before the stop row acts.
     CHECK(stopped_deg < 5.0 + 100.0 * 0.001 * 180 / M_PI + 1.0);
+}
+
+// A joint inside its region has no violation to stop: the rotation the clamp
+// leaves as it is differs from it by rounding only, and that noise's direction
+// must not become a stop axis however fast the joint turns (the stop's
+// one-step look-ahead adds rate x step along that axis).
+TEST_CASE("limits: no stop engages on a joint inside its region, however fast it turns",
+          "[sim][limits]")
+{
+    const Skeleton skel = simtest::cmu_like_skeleton();
+    const CharacterModel m = CharacterModel::from_skeleton(skel);
+    const ReferenceMotion ref(m, swinging_elbows(skel));
+    const CharacterLimits limits(m, ref);
+    SceneOptions so;
+    so.drum.center_m = Eigen::Vector3d(0, -5, 0);
+    so.stop_margin_rad = 1.0 * M_PI / 180.0; // score mode's margin
+    std::mt19937 rng(3);
+    std::normal_distribution<double> n(0.0, 1.0);
+    int checked = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        const CharacterPose pose = ref.frame(10 + trial); // elbows somewhere in their swing
+        Scene scene(m, so, pose, default_gains(m, pose, {}));
+        scene.set_joint_limits(limits.refs());
+        const std::vector<Eigen::Vector3d> zero(CharacterModel::kJoints, Eigen::Vector3d::Zero());
+        scene.set_joint_targets(pose.local, zero);
+        REQUIRE(scene.step() == StepResult::ok);
+        // Every joint inside (the pose is the capture's own, at rest).
+        std::vector<Eigen::Quaterniond> local;
+        scene.local_rotations(local);
+        bool inside = true;
+        for (int j = 0; j < CharacterModel::kJoints; ++j)
+            inside = inside && limits.ellipsoid(j).limit.normalized_distance(local[j]) < 0.99;
+        if (!inside)
+            continue;
+        // Spin a forearm at 30 rad/s about a random axis: still inside at the
+        // next step's start, turning faster than the margin per step.
+        const Eigen::Vector3d w = 30.0 * Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+        scene.kick(m.body_index(trial % 2 ? "l_forearm" : "r_forearm"), Eigen::Vector3d::Zero(), w);
+        scene.set_joint_targets(pose.local, zero);
+        REQUIRE(scene.step() == StepResult::ok);
+        INFO("trial " << trial);
+        CHECK(scene.stops_active_last_step() == 0);
+        ++checked;
+    }
+    CHECK(checked > 20);
 }

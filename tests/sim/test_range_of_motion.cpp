@@ -146,3 +146,45 @@ TEST_CASE("range of motion: a real drummer's arms and trunk stay inside (CMU 80_
         CHECK(worst * 180.0 / M_PI < 2.0);
     }
 }
+
+// The clamp's quick inside test (bounds on atan, no trigonometry) must never
+// call a rotation inside that is not: rotations built from known coordinates
+// just inside and just outside each bound, the others anywhere in range.
+TEST_CASE("range of motion: inside and outside at the bounds, from known coordinates",
+          "[sim][limits]")
+{
+    const CharacterModel model = CharacterModel::from_skeleton(default_skeleton());
+    const RangeOfMotion rom(model);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        const SwingTwistLimit &l = rom.limit(j);
+        INFO("joint " << model.joint_name(j));
+        const double lo[3] = {l.u_lo_rad, l.w_lo_rad, l.twist_lo_rad};
+        const double hi[3] = {l.u_hi_rad, l.w_hi_rad, l.twist_hi_rad};
+        for (int i = 0; i < 400; ++i) {
+            double c[3];
+            for (int k = 0; k < 3; ++k)
+                c[k] = lo[k] + (hi[k] - lo[k]) * unit(rng);
+            const int k = i % 3;
+            const bool upper = (i / 3) % 2 == 0, out = (i / 6) % 2 == 0;
+            const double bound = upper ? hi[k] : lo[k];
+            const double nudge = 1e-6 * (out == upper ? 1.0 : -1.0);
+            c[k] = bound + nudge;
+            if (std::hypot(c[0], c[1]) >= M_PI)
+                continue; // a swing past a half turn is another rotation's coordinates
+            const Eigen::Quaterniond q = exp_map(c[0] * l.u + c[1] * l.w) *
+                                         Eigen::Quaterniond(Eigen::AngleAxisd(c[2], l.twist_axis));
+            INFO("coordinates " << c[0] << " " << c[1] << " " << c[2] << ", axis " << k
+                                << (upper ? " upper" : " lower") << (out ? " outside" : " inside"));
+            CHECK(l.contains(q, 0.0) == !out);
+            CHECK((l.excursion_rad(q) > 0.0) == out);
+            CHECK((rotation_angle_between(q, l.clamp(q)) > 1e-12) == out);
+            // Far inside: the rest pose's neighbourhood is kept as it is.
+            const Eigen::Quaterniond small =
+                exp_map(0.01 * c[0] * l.u + 0.01 * c[1] * l.w) *
+                Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * c[2], l.twist_axis));
+            CHECK(l.clamp(small).coeffs() == small.normalized().coeffs());
+        }
+    }
+}

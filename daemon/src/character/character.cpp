@@ -551,6 +551,27 @@ ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &moti
         frames_.back().pelvis_position_m = frames_.front().pelvis_position_m;
         frames_.back().pelvis_rotation = frames_.front().pelvis_rotation;
     }
+    prepare_spans();
+}
+
+void ReferenceMotion::prepare_spans()
+{
+    const int n = frames();
+    spans_.assign(static_cast<size_t>(std::max(n - 1, 0)) * CharacterModel::kJoints, SlerpSpan());
+    // Eigen's QuaternionBase::slerp, up to its use of t.
+    const double one = 1.0 - Eigen::NumTraits<double>::epsilon();
+    for (int f = 0; f + 1 < n; ++f)
+        for (int j = 0; j < CharacterModel::kJoints; ++j) {
+            SlerpSpan &s = spans_[static_cast<size_t>(f) * CharacterModel::kJoints + j];
+            const double d = frames_[f].local[j].dot(frames_[f + 1].local[j]);
+            const double abs_d = std::abs(d);
+            s.negative = d < 0.0;
+            s.linear = abs_d >= one;
+            if (!s.linear) {
+                s.theta = std::acos(abs_d);
+                s.sin_theta = std::sin(s.theta);
+            }
+        }
 }
 
 ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &motion,
@@ -614,6 +635,7 @@ ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &moti
                 frames_[f].local[j] = smoothed[f];
         }
     }
+    prepare_spans();
 }
 
 double ReferenceMotion::duration_s() const
@@ -639,8 +661,22 @@ void ReferenceMotion::sample(double time_s, CharacterPose &pose) const
     if (i >= n - 1)
         i = n - 2;
     const double a = u - i;
-    for (int j = 0; j < CharacterModel::kJoints; ++j)
-        pose.local[j] = frames_[i].local[j].slerp(a, frames_[i + 1].local[j]);
+    for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        // frames_[i].local[j].slerp(a, frames_[i + 1].local[j]), its constants kept.
+        const SlerpSpan &s = spans_[static_cast<size_t>(i) * CharacterModel::kJoints + j];
+        double scale0, scale1;
+        if (s.linear) {
+            scale0 = 1.0 - a;
+            scale1 = a;
+        } else {
+            scale0 = std::sin((1.0 - a) * s.theta) / s.sin_theta;
+            scale1 = std::sin(a * s.theta) / s.sin_theta;
+        }
+        if (s.negative)
+            scale1 = -scale1;
+        pose.local[j] = Eigen::Quaterniond(scale0 * frames_[i].local[j].coeffs() +
+                                           scale1 * frames_[i + 1].local[j].coeffs());
+    }
 }
 
 } // namespace ictus

@@ -33,9 +33,23 @@ LimitKind limit_kind_from_string(const std::string &text)
 
 Eigen::Quaterniond EllipsoidJointLimit::clamp(const Eigen::Quaterniond &q) const
 {
+    const Eigen::Vector3d a = limit.k * limit.sigma_rad; // half-axes
+    // A sufficient test for inside without the tangent's atan2 (every joint's
+    // target and state, every step): mean^-1 q = (c, s) has the tangent
+    // 2 atan(|s| / |c|) s / |s|, shorter than 2 s / |c|; so 4 sum (s.e_i /
+    // a_i)^2 <= c^2 puts it inside the ellipsoid (q need not be unit: both
+    // sides scale as |q|^2). A relative 1e-9 of slack covers rounding.
+    {
+        const Eigen::Quaterniond d = limit.mean.conjugate() * q;
+        const Eigen::Vector3d s = limit.axes.transpose() * d.vec();
+        double sum = 0.0;
+        for (int i = 0; i < 3; ++i)
+            sum += (s[i] / a[i]) * (s[i] / a[i]);
+        if (4.0 * sum <= (1.0 - 1e-9) * d.w() * d.w())
+            return q.normalized();
+    }
     const Eigen::Vector3d v = limit.tangent(q);
     const Eigen::Vector3d p = limit.axes.transpose() * v; // principal coordinates
-    const Eigen::Vector3d a = limit.k * limit.sigma_rad;  // half-axes
     double inside = 0.0;
     for (int i = 0; i < 3; ++i)
         inside += (p[i] / a[i]) * (p[i] / a[i]);

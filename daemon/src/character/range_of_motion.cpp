@@ -64,11 +64,6 @@ const Row kRows[] = {
     {"r_ankle", 0, 1, -25, 50, -30, 30, 35},
 };
 
-double wrap(double a)
-{
-    return std::remainder(a, 2.0 * M_PI);
-}
-
 } // namespace
 
 Eigen::Vector3d SwingTwistLimit::coordinates(const Eigen::Quaterniond &q_in) const
@@ -77,40 +72,102 @@ Eigen::Vector3d SwingTwistLimit::coordinates(const Eigen::Quaterniond &q_in) con
     if (q.w() < 0.0)
         q.coeffs() = -q.coeffs();
     // Twist: the rotation about twist_axis closest to q; swing = q twist^-1.
+    // With w >= 0 the twist angle 2 atan2(along, w) lies in [-pi, pi] (no
+    // wrapping), and the twist quaternion (cos, sin(twist / 2) axis) is
+    // (w, along axis) / r, r = |(w, along)|: no sine or cosine of the angle.
     const double along = q.vec().dot(twist_axis);
-    const double twist = wrap(2.0 * std::atan2(along, q.w()));
-    const Eigen::Quaterniond twist_q(Eigen::AngleAxisd(twist, twist_axis));
-    const Eigen::Vector3d swing = log_map((q * twist_q.conjugate()).normalized());
-    return Eigen::Vector3d(swing.dot(u), swing.dot(w), twist);
+    const double twist = 2.0 * std::atan2(along, q.w());
+    const double r = std::sqrt(q.w() * q.w() + along * along);
+    Eigen::Quaterniond swing = q;
+    if (r > 0.0) { // r = 0: a half turn across the axis, no twist
+        const Eigen::Vector3d t = (along / r) * twist_axis;
+        const double tw = q.w() / r;
+        // q * conj(twist_q)
+        swing.w() = q.w() * tw + q.vec().dot(t);
+        swing.vec() = tw * q.vec() - q.w() * t - q.vec().cross(t);
+    }
+    const Eigen::Vector3d v = log_map(swing.normalized());
+    return Eigen::Vector3d(v.dot(u), v.dot(w), twist);
 }
+
+namespace
+{
+bool inside(const SwingTwistLimit &l, const Eigen::Vector3d &c, double tolerance_rad)
+{
+    return c[0] >= l.u_lo_rad - tolerance_rad && c[0] <= l.u_hi_rad + tolerance_rad &&
+           c[1] >= l.w_lo_rad - tolerance_rad && c[1] <= l.w_hi_rad + tolerance_rad &&
+           c[2] >= l.twist_lo_rad - tolerance_rad && c[2] <= l.twist_hi_rad + tolerance_rad;
+}
+
+// A sufficient test that q is inside, without trigonometry, square roots or
+// divisions (most calls, every step: the IK's iterations, the targets, the
+// stops, the excursion): false means "do the exact test". For a range
+// holding 0 only the bound on the coordinate's side matters, and |atan(x)| <=
+// |x| bounds each coordinate's magnitude. Twist: 2 atan(x), x = along / w, so
+// 2 along <= hi w (w > 0) keeps it below hi. Swing: q twist^-1 = (r, s), r^2 =
+// w^2 + along^2, r s = w (v - along a) - along v x a =: n; its rotation vector
+// is g s with g = 2 atan(|s| / r) / |s| <= 2 / r, so 2 n.u <= hi r^2 keeps
+// the u coordinate below hi. All of it holds for q unnormalised and for -q
+// (n and r^2 are quadratic in q). A relative 1e-9 of slack covers rounding.
+bool certainly_inside(const SwingTwistLimit &l, const Eigen::Quaterniond &q)
+{
+    constexpr double kShrink = 1.0 - 1e-9;
+    auto holds_zero = [](double lo, double hi) { return lo <= 0.0 && hi >= 0.0; };
+    if (!(holds_zero(l.twist_lo_rad, l.twist_hi_rad) && holds_zero(l.u_lo_rad, l.u_hi_rad) &&
+          holds_zero(l.w_lo_rad, l.w_hi_rad)))
+        return false;
+    const double sign = q.w() < 0.0 ? -1.0 : 1.0;
+    const double w = sign * q.w(), along = sign * q.vec().dot(l.twist_axis);
+    if (!(w > 0.0))
+        return false;
+    const double t = 2.0 * along;
+    if (!(t <= kShrink * l.twist_hi_rad * w && t >= kShrink * l.twist_lo_rad * w))
+        return false;
+    const double r2 = w * w + along * along;
+    const Eigen::Vector3d &v = q.vec();
+    const Eigen::Vector3d n =
+        q.w() * (v - q.vec().dot(l.twist_axis) * l.twist_axis) -
+        q.vec().dot(l.twist_axis) * v.cross(l.twist_axis); // quadratic: no sign needed
+    const double pu = 2.0 * n.dot(l.u), pw = 2.0 * n.dot(l.w), bound = kShrink * r2;
+    return pu <= l.u_hi_rad * bound && pu >= l.u_lo_rad * bound && pw <= l.w_hi_rad * bound &&
+           pw >= l.w_lo_rad * bound;
+}
+
+// The clamp of q whose coordinates are c (outside the limit).
+Eigen::Quaterniond recompose(const SwingTwistLimit &l, const Eigen::Vector3d &c)
+{
+    const double a = std::clamp(c[0], l.u_lo_rad, l.u_hi_rad);
+    const double b = std::clamp(c[1], l.w_lo_rad, l.w_hi_rad);
+    const double t = std::clamp(c[2], l.twist_lo_rad, l.twist_hi_rad);
+    return (exp_map(a * l.u + b * l.w) * Eigen::Quaterniond(Eigen::AngleAxisd(t, l.twist_axis)))
+        .normalized();
+}
+} // namespace
 
 bool SwingTwistLimit::contains(const Eigen::Quaterniond &q, double tolerance_rad) const
 {
-    const Eigen::Vector3d c = coordinates(q);
-    return c[0] >= u_lo_rad - tolerance_rad && c[0] <= u_hi_rad + tolerance_rad &&
-           c[1] >= w_lo_rad - tolerance_rad && c[1] <= w_hi_rad + tolerance_rad &&
-           c[2] >= twist_lo_rad - tolerance_rad && c[2] <= twist_hi_rad + tolerance_rad;
+    return (tolerance_rad >= 0.0 && certainly_inside(*this, q)) ||
+           inside(*this, coordinates(q), tolerance_rad);
 }
 
 Eigen::Quaterniond SwingTwistLimit::clamp(const Eigen::Quaterniond &q) const
 {
-    if (contains(q, 0.0))
+    if (certainly_inside(*this, q))
         return q.normalized();
-    const Eigen::Vector3d c = coordinates(q);
-    const double a = std::clamp(c[0], u_lo_rad, u_hi_rad);
-    const double b = std::clamp(c[1], w_lo_rad, w_hi_rad);
-    const double t = std::clamp(c[2], twist_lo_rad, twist_hi_rad);
-    return (exp_map(a * u + b * w) * Eigen::Quaterniond(Eigen::AngleAxisd(t, twist_axis)))
-        .normalized();
+    const Eigen::Vector3d c = coordinates(q); // once: inside or out
+    if (inside(*this, c, 0.0))
+        return q.normalized();
+    return recompose(*this, c);
 }
 
 double SwingTwistLimit::excursion_rad(const Eigen::Quaterniond &q) const
 {
+    if (certainly_inside(*this, q))
+        return 0.0;
     const Eigen::Vector3d c = coordinates(q);
-    if (c[0] >= u_lo_rad && c[0] <= u_hi_rad && c[1] >= w_lo_rad && c[1] <= w_hi_rad &&
-        c[2] >= twist_lo_rad && c[2] <= twist_hi_rad)
+    if (inside(*this, c, 0.0))
         return 0.0; // inside: nothing to recompose (the usual case, every step)
-    return rotation_angle_between(q.normalized(), clamp(q));
+    return rotation_angle_between(q.normalized(), recompose(*this, c));
 }
 
 RangeOfMotion::RangeOfMotion(const CharacterModel &model)

@@ -208,6 +208,8 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.cartesian.rotation_weight = parse_number(a, value(), 0, 1);
     else if (a == "--iterations")
         o.scene.quickstep_iterations = static_cast<int>(parse_number(a, value(), 1, 1000));
+    else if (a == "--sor-w")
+        o.scene.quickstep_w = parse_number(a, value(), 0.01, 1.99);
     else if (a == "--ik-max-joint-speed")
         o.score.cartesian.max_joint_speed_rad_s = parse_number(a, value(), 0, 1000);
     else if (a == "--ik-limit-margin")

@@ -66,6 +66,7 @@ void track_usage(std::ostream &out)
            "  --step S               physics step, s (default 0.001)\n"
            "  --stepper quick|direct dWorldQuickStep (default) or dWorldStep\n"
            "  --iterations N         QuickStep iterations (default 15)\n"
+           "  --sor-w W              QuickStep's over-relaxation (default 1.3, ODE's)\n"
            "  --body-mass KG         body mass for de Leva's table (default 70)\n"
            "  --grip french|german   hand-stick orientation (default french)\n"
            "  --stick-length M       (default 0.406)   --stick-mass KG (default 0.05)\n"
@@ -197,6 +198,8 @@ TrackArgs parse_track_args(Args &args)
                 throw UsageError("--stepper: expected quick or direct, got '" + s + "'");
         } else if (a == "--iterations") {
             t.options.scene.quickstep_iterations = parse_int(a, args.value(a), 1, 1000);
+        } else if (a == "--sor-w") {
+            t.options.scene.quickstep_w = parse_number(a, args.value(a), 0.01, 1.99);
         } else if (a == "--body-mass") {
             t.character.body_mass_kg = parse_positive(a, args.value(a));
         } else if (a == "--grip") {
@@ -443,6 +446,7 @@ int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary
     j["step_s"] = options.scene.step_s;
     j["stepper"] = options.scene.stepper == Stepper::quick ? "quick" : "direct";
     j["quickstep_iterations"] = options.scene.quickstep_iterations;
+    j["quickstep_w"] = options.scene.quickstep_w;
     j["grip"] = to_string(t.character.grip);
     j["body_mass_kg"] = t.character.body_mass_kg;
     j["limits"] = t.limits_mode;

@@ -50,10 +50,10 @@ ChainIkSolverPos_dls::ChainIkSolverPos_dls(int joints, const IkParams &params)
     jacobian_.setZero(3, 3 * joints_);
     step_.setZero(3 * joints_);
     posture_step_.setZero(3 * joints_);
-    projector_.setZero(3 * joints_, 3 * joints_);
     jacobian_solved_.setZero(3, 3 * joints_);
     direction_jacobian_.setZero(3, 3 * joints_);
     jjt_.setZero();
+    jjt_undamped_.setZero();
     for (auto &rotations : rotation_)
         for (auto &q : rotations)
             q.setIdentity();
@@ -205,10 +205,13 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
         const bool with_posture = posture_pending;
         posture_pending = false;
         double posture_leak_m = 0.0;
+        bool projector_ready = false; // projector_llt_ holds this iteration's J J^T
         // Eq. 2 with Wampler's damped (singularity-robust) pseudo-inverse:
         // dtheta = J^T (J J^T + lambda^2 I)^-1 e. J J^T is only 3x3, so the solve is cheap.
         KinematicChain::tip_jacobian(frames, n, jacobian_);
-        jjt_.noalias() = jacobian_ * jacobian_.transpose();
+        // J J^T once per iteration (the damped solve and the projectors' share it).
+        jjt_undamped_.noalias() = jacobian_ * jacobian_.transpose();
+        jjt_ = jjt_undamped_;
         jjt_.diagonal().array() += damping_m * damping_m;
         llt_.compute(jjt_);
         const Eigen::Vector3d clamped_error =
@@ -224,18 +227,22 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
             // N uses the undamped pseudo-inverse (a 1e-6 m regulariser only): a damped one
             // leaks the secondary step into the tip by lambda^2 / sigma^2 and the two tasks
             // then fight. N stays a bounded projector even at singularities.
-            jjt_.noalias() = jacobian_ * jacobian_.transpose();
+            // J_d N = J_d - (J_d J^T) (J J^T)^-1 J, J_d J^T the sum of J's 3x3 blocks
+            // transposed: a 3x3 by 3xn product instead of N's (3n)x(3n) one.
+            jjt_ = jjt_undamped_;
             jjt_.diagonal().array() += 1e-12;
             projector_llt_.compute(jjt_);
+            projector_ready = true;
             jacobian_solved_ = projector_llt_.solve(jacobian_);
-            projector_.noalias() = -jacobian_.transpose() * jacobian_solved_;
-            projector_.diagonal().array() += 1.0;
-            direction_jacobian_.setZero();
+            Eigen::Matrix3d jd_jt = Eigen::Matrix3d::Zero();
             Eigen::Vector3d stick_turn_from_tip_step = Eigen::Vector3d::Zero();
             for (int j = 0; j < n; ++j) {
-                direction_jacobian_ += projector_.middleRows<3>(3 * j);
+                jd_jt += jacobian_.middleCols<3>(3 * j).transpose();
                 stick_turn_from_tip_step += step_.segment<3>(3 * j);
             }
+            direction_jacobian_.noalias() = -jd_jt * jacobian_solved_;
+            for (int j = 0; j < n; ++j)
+                direction_jacobian_.middleCols<3>(3 * j).diagonal().array() += 1.0;
             const Eigen::Vector3d residual =
                 secondary_weight * direction_step - stick_turn_from_tip_step;
             direction_jjt_.noalias() = direction_jacobian_ * direction_jacobian_.transpose();
@@ -256,9 +263,11 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
                     posture_weight_ *
                     (parent * log_map(posture_[j] * rotation_[current][j].conjugate()));
             }
-            jjt_.noalias() = jacobian_ * jacobian_.transpose();
-            jjt_.diagonal().array() += 1e-12;
-            projector_llt_.compute(jjt_);
+            if (!projector_ready) {
+                jjt_ = jjt_undamped_;
+                jjt_.diagonal().array() += 1e-12;
+                projector_llt_.compute(jjt_);
+            }
             const Eigen::Vector3d tip_part = projector_llt_.solve(jacobian_ * posture_step_);
             posture_step_.noalias() -= jacobian_.transpose() * tip_part;
             step_.noalias() += posture_step_;

@@ -207,8 +207,17 @@ class ReferenceMotion
     void sample(double time_s, CharacterPose &pose) const;
 
   private:
+    // What Eigen's slerp computes from the two ends alone, per frame and
+    // joint (the angle's acos and sine), so that sample() takes two sines per
+    // joint instead of three and an acos; the same arithmetic, bit for bit.
+    struct SlerpSpan {
+        double theta = 0.0, sin_theta = 1.0;
+        bool linear = true, negative = false;
+    };
+    void prepare_spans();
     double frame_rate_hz_ = 0.0;
     std::vector<CharacterPose> frames_;
+    std::vector<SlerpSpan> spans_; // [frame * kJoints + joint], frames - 1 of them
     int spikes_removed_ = 0;
 };
 

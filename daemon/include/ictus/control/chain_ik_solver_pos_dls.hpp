@@ -125,16 +125,13 @@ class ChainIkSolverPos_dls
     std::array<std::array<Eigen::Quaterniond, KinematicChain::kMaxJoints>, 2> rotation_;
     std::array<ChainFrames, 2> frames_;
     Jacobian jacobian_;
-    Eigen::Matrix3d jjt_;
+    Eigen::Matrix3d jjt_, jjt_undamped_;
     Eigen::LLT<Eigen::Matrix3d> llt_;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen_;
     JointVector step_, posture_step_;
     // Secondary (stick direction) task.
-    using Projector = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
-                                    KinematicChain::kMaxDofs, KinematicChain::kMaxDofs>;
     Eigen::LLT<Eigen::Matrix3d> projector_llt_;
     Jacobian jacobian_solved_;
-    Projector projector_;
     Jacobian direction_jacobian_;
     Eigen::Matrix3d direction_jjt_;
     Eigen::LLT<Eigen::Matrix3d> direction_llt_;

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
+#include <limits>
 #include <vector>
 
 // ODE's opaque handles, so that users of the scene need not include ode.h.
@@ -70,6 +71,9 @@ struct SceneOptions {
     double step_s = 0.001;
     Stepper stepper = Stepper::quick;
     int quickstep_iterations = 15;
+    // QuickStep's successive over-relaxation factor (dWorldSetQuickStepW), 0..2
+    // exclusive; ODE's default is 1.3.
+    double quickstep_w = 1.3;
     double gravity_mps2 = 9.81;
     DrumParams drum;
     // Divergence: any non-finite state, a body faster than these, or a ball
@@ -273,6 +277,16 @@ class Scene
     std::vector<Eigen::Vector3d> target_rate_;
     std::array<Eigen::Vector3d, CharacterModel::kBodies> com_local_; // merged, body frame
     std::array<bool, CharacterModel::kJoints> motor_axes_world_;
+    // The motor parameters last given to ODE, so that apply_control() sets only
+    // what changed (NaN: never set).
+    struct MotorParams {
+        double cfm = std::numeric_limits<double>::quiet_NaN();
+        std::array<double, 3> fmax = {std::numeric_limits<double>::quiet_NaN(),
+                                      std::numeric_limits<double>::quiet_NaN(),
+                                      std::numeric_limits<double>::quiet_NaN()};
+        bool stops_open = false; // the stop rows set to +-infinity
+    };
+    std::array<MotorParams, CharacterModel::kJoints> motor_params_{};
 
     dxWorld *world_ = nullptr;
     dxSpace *space_ = nullptr;
