@@ -145,21 +145,45 @@ print("onset - timetag (ms), per strike, before the transit (0..%.3f ms) is take
       % (rtt_ms, " ".join("%.3f" % e for e in errors_ms)))
 print("report arrival - timetag (ms): min %.3f median %.3f max %.3f"
       % (min(arrival_ms), sorted(arrival_ms)[len(arrival_ms) // 2], max(arrival_ms)))
-check(worst <= 1.0, "every strike starts at its timetag (minus 10 ms for the second half, "
-      "after 'latency 10') within 1 ms (worst %.3f ms)" % worst)
+lates = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "late"]
+# A strike pd handled after its time (the sender or pd stalled past the 60 ms
+# lookahead on a loaded machine) is not on time by design: it fires at once and
+# is reported late with its lateness (docs/pd-osc.md). Each strike more than
+# 1 ms late must be one of those, the report's lateness its own error within
+# 1 ms; and most strikes must be on time, or the run judged nothing.
+judged = [max(e - rtt_ms, 0.0) if e > 0 else -e for e in errors_ms]
+late_strikes = [(seq, e) for seq, e, j in zip(sorted(sent), errors_ms, judged) if j > 1.0]
+unexplained = []
+reported = [a[2] for a in lates]
+for seq, e in late_strikes:
+    match = [r for r in reported if abs(r - e) <= 1.0 + rtt_ms]
+    if match:
+        reported.remove(match[0])
+    else:
+        unexplained.append((seq, round(e, 3)))
+on_time = [j for j in judged if j <= 1.0]
+worst = max(on_time) if on_time else float("inf")
+if late_strikes:
+    print("strikes handled late and reported late (seq, ms): %s" % late_strikes)
+check(not unexplained and len(on_time) >= N_STRIKES - 4,
+      "every strike starts at its timetag (minus 10 ms for the second half, after 'latency 10') "
+      "within 1 ms (worst %.3f ms, %d of %d), or was handled late and reported so (%d; "
+      "unexplained: %s)" % (worst, len(on_time), N_STRIKES, len(late_strikes), unexplained))
 
 t_arr, a = fires.get(late_seq, (None, None))
 check(a is not None, "the late bundle fired")
 late_fire = offset + a[1] / 1000.0
 check(abs(late_fire - t_late_sent) < 0.010,
       "the late bundle fired on arrival (%.2f ms after sending)" % ((late_fire - t_late_sent) * 1e3))
-lates = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "late"]
 # lateness is counted against the logical time at which pd handled the packet,
-# i.e. (in this test's own mapping) the fire time minus (timetag - latency)
+# i.e. (in this test's own mapping) the fire time minus (timetag - latency); the
+# count is the running total, the strikes handled late above included
 expected_late_ms = (late_fire - t_late) * 1000.0 + LATENCY_MS
-check(len(lates) == 1 and abs(lates[0][2] - expected_late_ms) < 1.0 and lates[0][3] == 1,
-      "one late report, %.2f ms late (expected %.2f): %s" % (lates[0][2] if lates else -1,
-                                                             expected_late_ms, lates))
+last = lates[-1] if lates else None
+check(last is not None and len(lates) == len(late_strikes) + 1
+      and abs(last[2] - expected_late_ms) < 1.0 and last[3] == len(lates),
+      "the late bundle's report, %.2f ms late (expected %.2f), counted %s: %s"
+      % (last[2] if last else -1, expected_late_ms, last[3] if last else -1, lates))
 
 poses = [a[1:] for _, a in records if a[0] == "pose"]
 check(["frame", 42.0, 1.5] in poses and ["body", 3.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]
