@@ -7,6 +7,7 @@ import os
 import atexit
 import re
 import shutil
+import socket
 import subprocess
 import sys
 import tempfile
@@ -59,6 +60,15 @@ class Patch:
 
     def text(self):
         return "\n".join(self.lines) + "\n"
+
+
+def free_udp_port():
+    """A UDP port on 127.0.0.1 that was free a moment ago."""
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
 
 
 def recorder(p, tables, seconds, sr, wav_path, quit_extra=None):

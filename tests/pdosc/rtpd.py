@@ -22,16 +22,8 @@ import threading
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "pd"))
-from pdrun import PD, PD_ENV, Patch, make_workdir  # noqa: E402
+from pdrun import PD, PD_ENV, Patch, free_udp_port, make_workdir  # noqa: E402,F401
 from oscpacket import now  # noqa: E402
-
-
-def free_udp_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 class Listener:

@@ -12,20 +12,11 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "pd"))
 sys.path.insert(0, os.path.join(HERE, "..", "pdosc"))
-from pdrun import PD, PD_ENV, error_lines  # noqa: E402,F401
+from pdrun import PD, PD_ENV, error_lines, free_udp_port  # noqa: E402,F401
 import oscpacket  # noqa: E402
 
 SKIP = 77
 REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
-
-
-def free_udp_port():
-    """A UDP port on 127.0.0.1 that was free a moment ago."""
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def stop(process, timeout_s=10):
