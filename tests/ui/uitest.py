@@ -4,7 +4,6 @@ here from a standing figure, independently of the daemon."""
 import os
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import time
