@@ -31,6 +31,10 @@ void ensure_ode()
 
 constexpr unsigned long kDrumCategory = 1u;
 constexpr unsigned long kStickCategory = 2u;
+// A stick part's first contact with the drum is on the head when the contact
+// normal's upward component exceeds this (the head's own normal: 1; the rim's
+// edge met from above: > 0; the shell's side: 0, its bottom: -1).
+constexpr double kHeadNormalMin = 0.2;
 
 Eigen::Quaterniond to_eigen(const dReal *q)
 {
@@ -440,6 +444,29 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
     constexpr int kMax = 4;
     dContactGeom geoms[kMax];
     const int n = dCollide(a, b, kMax, geoms, sizeof(dContactGeom));
+    if (n <= 0 || side < 0)
+        return;
+    // The stick meets the head from above; a part that first touches the
+    // drum anywhere else (the shell's side or bottom: a clip's arm rising
+    // under a drum placed for its strokes) passes through the drum until it
+    // is clear of it. Blocked there, the hand would drive the stick against
+    // the shell with the arm's whole strength and wrench it round its fulcrum.
+    const int part = 2 * side + (bead ? 1 : 0);
+    self->part_touching_now_[static_cast<size_t>(part)] = true;
+    if (!self->part_touching_[static_cast<size_t>(part)]) {
+        int deepest = 0;
+        for (int i = 1; i < n; ++i)
+            if (geoms[i].depth > geoms[deepest].depth)
+                deepest = i;
+        // The normal points into the stick: up (the drum's axis, +y) on the
+        // head, outward and up on the rim's edge, level on the shell's side.
+        const bool from_above = geoms[deepest].normal[1] > kHeadNormalMin;
+        self->part_through_[static_cast<size_t>(part)] = !from_above;
+        if (!from_above)
+            ++self->shell_passes_;
+    }
+    if (self->part_through_[static_cast<size_t>(part)])
+        return;
     for (int i = 0; i < n; ++i) {
         dContact contact;
         contact.geom = geoms[i];
@@ -449,7 +476,7 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         contact.surface.soft_cfm = self->contact_cfm_;
         dJointID joint = dJointCreateContact(self->world_, self->contacts_, &contact);
         dJointAttach(joint, dGeomGetBody(a), dGeomGetBody(b));
-        if (side >= 0 && self->contact_slots_used_ < static_cast<int>(self->contact_slot_.size())) {
+        if (self->contact_slots_used_ < static_cast<int>(self->contact_slot_.size())) {
             ContactSlot &slot = self->contact_slot_[self->contact_slots_used_++];
             slot.feedback = Feedback{};
             slot.side = side;
@@ -633,7 +660,11 @@ StepResult Scene::step(StepTiming *timing)
         t1 = clock::now();
     contacts_last_step_ = 0;
     contact_slots_used_ = 0;
+    part_touching_now_.fill(false);
     dSpaceCollide(space_, this, &Scene::near_callback);
+    part_touching_ = part_touching_now_;
+    for (size_t p = 0; p < part_through_.size(); ++p)
+        part_through_[p] = part_through_[p] && part_touching_[p]; // clear of the drum
     if (contacts_last_step_ > 0)
         ++contact_steps_;
     if (timing)
@@ -723,6 +754,8 @@ void Scene::reset(const CharacterPose &pose_in)
     dJointGroupEmpty(contacts_);
     drum_contact_ = {};
     weld_feedback_ = Feedback{};
+    part_touching_.fill(false); // the next contact is judged afresh
+    part_through_.fill(false);
 }
 
 void Scene::body_frames(BodyFrames &frames) const

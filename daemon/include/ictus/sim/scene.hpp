@@ -183,6 +183,10 @@ class Scene
     int divergences() const { return divergences_; }
     int contacts_last_step() const { return contacts_last_step_; }
     long contact_steps() const { return contact_steps_; }
+    // Times a stick part (bead or shaft) met the drum other than from above:
+    // through the shell's side or bottom (docs/character.md, "Drum"). Such a
+    // part passes through the drum until it is clear of it.
+    long shell_passes() const { return shell_passes_; }
     int stops_active_last_step() const { return stops_active_; }
     // Motor torque of each joint in the last step (N m, on the child, world
     // frame; ODE joint feedback), and whether any axis hit its torque limit.
@@ -328,6 +332,10 @@ class Scene
     int divergences_ = 0;
     int contacts_last_step_ = 0;
     long contact_steps_ = 0;
+    // Per stick part [side * 2 + bead]: touching the drum in the last step,
+    // in this one, and passing through its shell (near_callback).
+    std::array<bool, 4> part_touching_{}, part_touching_now_{}, part_through_{};
+    long shell_passes_ = 0;
     int stops_active_ = 0;
 };
 
