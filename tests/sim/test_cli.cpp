@@ -121,6 +121,7 @@ TEST_CASE("ictusd track: every option refuses a bad value, naming it", "[sim][cl
         {"--ramp", "-1", "--ramp"},
         {"--smooth-hz", "-1", "--smooth-hz"},
         {"--despike-deg", "-1", "--despike-deg"},
+        {"--smooth-kernel", "boxcar", "--smooth-kernel"},
         {"--ik-gain", "0", "--ik-gain"},
         {"--ik-gain", "500", "ik gain"},
         {"--ik-velocity-gain", "abc", "--ik-velocity-gain"},
