@@ -151,7 +151,8 @@ TEST_CASE("reference clean-up: the Butterworth kernel has the zero-phase 2nd-ord
     // The taps' transfer function H(f) = w0 + 2 sum w_k cos(2 pi f k / fs)
     // against the response it is made from, G(f) = 1 / (1 + (f / fc)^4): the
     // taps are G's inverse Fourier transform truncated at 1e-3 of the centre
-    // tap, so H differs from G by a few 1e-3 at most.
+    // tap, so H differs from G by ~1e-3 (measured at most 1.4e-3 over these
+    // rates and cutoffs).
     for (const double fs : {100.0, 120.0, 250.0}) {
         for (const double fc : {6.0, 10.0, 15.0}) {
             const std::vector<double> w =
@@ -162,7 +163,7 @@ TEST_CASE("reference clean-up: the Butterworth kernel has the zero-phase 2nd-ord
                 for (size_t k = 1; k < w.size(); ++k)
                     h += 2.0 * w[k] * std::cos(2.0 * M_PI * f * k / fs);
                 INFO("fs " << fs << " Hz, fc " << fc << " Hz, f " << f << " Hz");
-                CHECK(h == Approx(1.0 / (1.0 + std::pow(f / fc, 4.0))).margin(5e-3));
+                CHECK(h == Approx(1.0 / (1.0 + std::pow(f / fc, 4.0))).margin(2.5e-3));
             }
         }
     }
