@@ -34,8 +34,9 @@ int main(int argc, char **argv)
         return 1;
     }
     const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton);
-    const ReferenceMotion reference(model, bvh.motion, ReferenceFilter{});
-    // The default limits (k = 3), as scripts/figure4.sh and the Cartesian test.
+    // `ictusd track`'s clean-up and default limits (k = 3), as scripts/figure4.sh
+    // and the Cartesian test.
+    const ReferenceMotion reference(model, bvh.motion, track_reference_filter());
     const CharacterLimits limits(model, reference, CharacterLimitOptions{});
     std::printf("%s, %.0f simulated s per run, best of %d runs, 1 kHz, one core\n", path.c_str(),
                 seconds, runs);

@@ -29,7 +29,8 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
     bo.skip_frames = 1;
     const BvhFile bvh = read_bvh(path, bo);
     const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton);
-    const ReferenceMotion reference(model, bvh.motion, ReferenceFilter{});
+    // `ictusd track`'s clean-up: de-spiked, Butterworth low-pass at 10 Hz.
+    const ReferenceMotion reference(model, bvh.motion, track_reference_filter());
     const ReferenceMotion raw(model, bvh.motion);
     // The default options throughout (limits at k = 3, Algorithm 2 from the
     // simulated state with the posture task, docs/ik.md). Both modes get the
@@ -58,6 +59,35 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
     for (int s = 0; s < 2; ++s) {
         CHECK(cart.tip_rms_mm[s] <= 5.0);
         CHECK(cart.tip_rms_mm[s] < joint.tip_rms_mm[s]);
+        // ... and against the raw capture as well (issue 15): with the
+        // Gaussian clean-up the right tip was 25.7 mm from the raw capture,
+        // joint space 24.0 (docs/ik.md).
+        CHECK(cart.tip_rms_raw_mm[s] < joint.tip_rms_raw_mm[s]);
+    }
+    // Where the raw-capture error comes from: the clean-up itself. The
+    // cleaned tips' distance from the raw ones, computed here from the two
+    // references' frames (FK of the hand x the grip), bounds what tracking the
+    // cleaned tips can score against the raw capture; the Butterworth keeps
+    // the strokes (4-8 Hz) the Gaussian at the same cutoff rounds off.
+    ReferenceFilter gaussian = track_reference_filter();
+    gaussian.kernel = ReferenceFilter::Kernel::gaussian;
+    const ReferenceMotion gauss_reference(model, bvh.motion, gaussian);
+    std::array<double, 2> bw_sq{}, gauss_sq{};
+    for (int f = 0; f < raw.frames(); ++f) {
+        const auto r = reference_tips(model, raw.frame(f));
+        const auto b = reference_tips(model, reference.frame(f));
+        const auto g = reference_tips(model, gauss_reference.frame(f));
+        for (int s = 0; s < 2; ++s) {
+            bw_sq[s] += (b[s] - r[s]).squaredNorm();
+            gauss_sq[s] += (g[s] - r[s]).squaredNorm();
+        }
+    }
+    for (int s = 0; s < 2; ++s) {
+        const double bw_mm = 1000.0 * std::sqrt(bw_sq[s] / raw.frames());
+        const double gauss_mm = 1000.0 * std::sqrt(gauss_sq[s] / raw.frames());
+        INFO("side " << s << ": cleaned tips from raw, Butterworth " << bw_mm << " mm, Gaussian "
+                     << gauss_mm << " mm; Cartesian vs raw " << cart.tip_rms_raw_mm[s] << " mm");
+        CHECK(bw_mm < gauss_mm);
     }
     // Driven by the stick tips alone (the capture's arm pose seeds nothing;
     // the posture task holds the null space near the clip's mean arm pose),

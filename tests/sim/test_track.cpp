@@ -28,7 +28,7 @@ Clip load_cmu(const std::string &path)
     o.skip_frames = 1; // the converter's reference pose
     BvhFile bvh = read_bvh(path, o);
     CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton);
-    ReferenceMotion reference(model, bvh.motion, ReferenceFilter{});
+    ReferenceMotion reference(model, bvh.motion, track_reference_filter()); // ictusd track's
     ReferenceMotion raw(model, bvh.motion);
     return {std::move(bvh), std::move(model), std::move(reference), std::move(raw)};
 }

@@ -574,6 +574,69 @@ void ReferenceMotion::prepare_spans()
         }
 }
 
+ReferenceFilter::Kernel reference_kernel_from_string(const std::string &text)
+{
+    if (text == "gaussian")
+        return ReferenceFilter::Kernel::gaussian;
+    if (text == "butterworth")
+        return ReferenceFilter::Kernel::butterworth;
+    throw CharacterError("smoothing kernel: expected gaussian or butterworth, got '" + text + "'");
+}
+
+const char *to_string(ReferenceFilter::Kernel kernel)
+{
+    return kernel == ReferenceFilter::Kernel::butterworth ? "butterworth" : "gaussian";
+}
+
+std::vector<double> reference_kernel_taps(ReferenceFilter::Kernel kernel, double cutoff_hz,
+                                          double frame_rate_hz)
+{
+    if (!(cutoff_hz > 0.0 && frame_rate_hz > 0.0 && std::isfinite(cutoff_hz) &&
+          std::isfinite(frame_rate_hz)))
+        throw CharacterError("smoothing kernel: cutoff and frame rate must be > 0 Hz");
+    std::vector<double> taps;
+    if (kernel == ReferenceFilter::Kernel::gaussian) {
+        const double sigma_frames = frame_rate_hz / (2.0 * M_PI * cutoff_hz);
+        const int half = static_cast<int>(std::ceil(3.0 * sigma_frames));
+        for (int k = 0; k <= half; ++k)
+            taps.push_back(std::exp(-0.5 * k * k / (sigma_frames * sigma_frames)));
+    } else {
+        // h[k] = (2 / fs) * integral over 0..fs/2 of G(f) cos(2 pi f k / fs) df,
+        // G(f) = 1 / (1 + (f / fc)^4), by the midpoint rule (G is smooth; 4096
+        // points put the quadrature error far below the truncation's 1e-3).
+        constexpr int kPoints = 4096;
+        const double df = 0.5 * frame_rate_hz / kPoints;
+        const int reach = static_cast<int>(std::ceil(4.0 * frame_rate_hz / cutoff_hz));
+        std::vector<double> g(kPoints), f(kPoints);
+        for (int i = 0; i < kPoints; ++i) {
+            f[i] = (i + 0.5) * df;
+            const double x = f[i] / cutoff_hz;
+            g[i] = 1.0 / (1.0 + x * x * x * x);
+        }
+        for (int k = 0; k <= reach; ++k) {
+            double sum = 0.0;
+            for (int i = 0; i < kPoints; ++i)
+                sum += g[i] * std::cos(2.0 * M_PI * f[i] * k / frame_rate_hz);
+            taps.push_back(2.0 / frame_rate_hz * sum * df);
+        }
+        int half = 0;
+        for (int k = 0; k <= reach; ++k)
+            if (std::fabs(taps[k]) >= 1e-3 * taps[0])
+                half = k;
+        taps.resize(static_cast<size_t>(half) + 1);
+    }
+    // The Gaussian's taps stay unnormalised (the smoothing divides by their
+    // sum, and earlier outputs were measured with these exact weights).
+    if (kernel == ReferenceFilter::Kernel::butterworth) {
+        double total = taps[0];
+        for (size_t k = 1; k < taps.size(); ++k)
+            total += 2.0 * taps[k];
+        for (double &t : taps)
+            t /= total;
+    }
+    return taps;
+}
+
 ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &motion,
                                  const ReferenceFilter &filter)
     : ReferenceMotion(model, motion)
@@ -601,11 +664,12 @@ ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &moti
         }
     }
     if (filter.smooth_cutoff_hz > 0.0 && n > 2) {
-        const double sigma_frames = frame_rate_hz_ / (2.0 * M_PI * filter.smooth_cutoff_hz);
-        const int half = static_cast<int>(std::ceil(3.0 * sigma_frames));
+        const std::vector<double> taps =
+            reference_kernel_taps(filter.kernel, filter.smooth_cutoff_hz, frame_rate_hz_);
+        const int half = static_cast<int>(taps.size()) - 1;
         std::vector<double> w(2 * half + 1);
         for (int k = -half; k <= half; ++k)
-            w[k + half] = std::exp(-0.5 * k * k / (sigma_frames * sigma_frames));
+            w[k + half] = taps[static_cast<size_t>(std::abs(k))];
         std::vector<Eigen::Quaterniond> smoothed(n);
         for (int j = 0; j < CharacterModel::kJoints; ++j) {
             for (int f = 0; f < n; ++f) {

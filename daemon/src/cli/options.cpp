@@ -85,6 +85,12 @@ bool parse_clip_option(const std::string &a, Args &args, ClipOptions &clip)
         clip.filter.smooth_cutoff_hz = parse_number(a, args.value(a));
         if (clip.filter.smooth_cutoff_hz < 0.0)
             throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
+    } else if (a == "--smooth-kernel") {
+        try {
+            clip.filter.kernel = reference_kernel_from_string(args.value(a));
+        } catch (const CharacterError &e) {
+            throw UsageError(a + after_name(e.what()));
+        }
     } else if (a == "--despike-deg") {
         clip.filter.spike_threshold_rad = parse_number(a, args.value(a)) * M_PI / 180.0;
         if (clip.filter.spike_threshold_rad < 0.0)

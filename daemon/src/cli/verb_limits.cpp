@@ -29,7 +29,8 @@ void limits_usage(std::ostream &out)
            "  --k K           limits at mean -/+ k std (Euler) and ellipsoid half-axes of\n"
            "                  k std (quaternion; default 3)\n"
            "  --min-deg DEG   minimum half-width per axis (default 6)\n"
-           "  --smooth-hz HZ, --despike-deg DEG   reference clean-up as in track\n"
+           "  --smooth-hz HZ, --smooth-kernel K, --despike-deg DEG   reference clean-up as\n"
+           "                  in track\n"
         << force_help(18)
         << "                  (limits: also learn from fewer than 30 frames)\n"
            "\n"

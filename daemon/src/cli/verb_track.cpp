@@ -83,7 +83,9 @@ void track_usage(std::ostream &out)
            "  --limit-min-deg DEG    minimum half-width of a limit per axis (default 6)\n"
            "  --no-stops             clamp targets only, no safety-net stops\n"
            "  --ramp S               blend targets in over S seconds (default 0.25)\n"
-           "  --smooth-hz HZ         low-pass the reference (Gaussian, default 10; 0: off)\n"
+           "  --smooth-hz HZ         low-pass the reference (default 10; 0: off)\n"
+           "  --smooth-kernel butterworth|gaussian   its kernel (default butterworth: the\n"
+           "                         zero-phase 2nd-order Butterworth, docs/mocap.md)\n"
            "  --despike-deg DEG      replace one-frame spikes larger than DEG (default 5;\n"
            "                         0: off)\n"
            "  --tip-smooth-hz HZ     low-pass of the stick tips (X^T and the errors; default:\n"
@@ -458,6 +460,7 @@ int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary
     j["drum_radius_m"] = options.scene.drum.radius_m;
     j["smooth_hz"] = t.clip.filter.smooth_cutoff_hz;
     j["despike_deg"] = t.clip.filter.spike_threshold_rad * 180.0 / M_PI;
+    j["smooth_kernel"] = to_string(t.clip.filter.kernel);
     j["spikes_removed"] = in.reference->spikes_removed();
     j["tip_smooth_hz"] = t.stick_only           ? 0.0
                          : t.options.tip_motion ? t.tip_smooth_hz

@@ -93,6 +93,13 @@ TipTrajectory reference_tip_trajectory(const CharacterModel &model,
     return tips;
 }
 
+ReferenceFilter track_reference_filter()
+{
+    ReferenceFilter f;
+    f.kernel = ReferenceFilter::Kernel::butterworth;
+    return f;
+}
+
 CartesianOptions track_cartesian_defaults()
 {
     CartesianOptions c;

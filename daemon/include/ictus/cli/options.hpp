@@ -9,6 +9,7 @@
 #include "ictus/mocap/bvh.hpp"
 #include "ictus/mocap/marker_csv.hpp"
 #include "ictus/perform/performance.hpp"
+#include "ictus/perform/track.hpp"
 #include "ictus/perform/tracker.hpp"
 
 #include <fstream>
@@ -30,12 +31,13 @@ bool parse_bvh_option(const std::string &option, Args &args, double &scale_m_per
 struct ClipOptions {
     double scale = kCmuBvhScale_m;
     int skip = 1;
-    ReferenceFilter filter;
+    ReferenceFilter filter =
+        track_reference_filter(); // --smooth-hz, --smooth-kernel, --despike-deg
     // --force: values out of the physical bounds of a capture
     // (mocap/capture_bounds.hpp) and, for limits, too few frames are warnings.
     bool force = false;
 };
-// The BVH options, --smooth-hz, --despike-deg and --force.
+// The BVH options, --smooth-hz, --smooth-kernel, --despike-deg and --force.
 bool parse_clip_option(const std::string &option, Args &args, ClipOptions &clip);
 
 // A stick-only capture (.csv): --units, --up, --rate, --left-stick, --right-stick.

@@ -26,6 +26,13 @@ namespace ictus
 // CartesianOptions' own defaults.)
 CartesianOptions track_cartesian_defaults();
 
+// The reference clean-up of `ictusd track` and `ictusd limits`: one-frame
+// spikes over 5 degrees replaced, then the zero-phase Butterworth low-pass at
+// 10 Hz (flat through a drummer's 4-8 Hz strokes; the Gaussian at the same
+// cutoff rounded the strokes' turnarounds off by 21-25 mm, docs/mocap.md).
+// ReferenceFilter's own default (the Gaussian) is the score performance's.
+ReferenceFilter track_reference_filter();
+
 struct TrackOptions {
     TrackMode mode = TrackMode::joint;
     CartesianOptions cartesian = track_cartesian_defaults();
