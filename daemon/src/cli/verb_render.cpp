@@ -93,7 +93,7 @@ void render_usage(std::ostream &out)
            "  --iterations N      ODE QuickStep iterations (default 15)\n"
            "  --sor-w W           QuickStep's over-relaxation (default 1.3, ODE's)\n"
            "  --ik-max-joint-speed R  the kinematic IK turns no arm joint faster than R\n"
-           "                      rad/s (default 30; 0: no cap)\n"
+           "                      rad/s (default 35; 0: no cap)\n"
            "  --ik-limit-margin D the IK keeps the arms D degrees inside their range of\n"
            "                      motion (default 3; stops and checks use the range)\n"
            "  --lead-in S         time before the score's first beat (default 1)\n"

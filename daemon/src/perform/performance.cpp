@@ -763,8 +763,9 @@ ScorePerformOptions::ScorePerformOptions()
     // stick's own swing is not fed back), and a small velocity term damps the
     // hand's chatter after soft strokes (docs/perform.md, measured).
     cartesian.velocity_gain_s = 0.03;
-    // The kinematic IK turns no joint faster than this (CartesianOptions).
-    cartesian.max_joint_speed_rad_s = 30.0;
+    // The kinematic IK turns no joint faster than this (CartesianOptions):
+    // the 99th percentile of the strokes' own joint rates (docs/perform.md).
+    cartesian.max_joint_speed_rad_s = 35.0;
 }
 
 namespace
