@@ -275,6 +275,31 @@ void Scene::build(const CharacterPose &initial)
         dJointSetAMotorNumAxes(motor_[j], 3);
         dJointSetFeedback(motor_[j], reinterpret_cast<dJointFeedback *>(&feedback_[j]));
     }
+    if (options_.legs_kinematic) {
+        // The pelvis's limbs that hold no stick: every body whose branch off
+        // the pelvis carries neither hand. The pelvis is welded, so (up to
+        // the weld's softness and the iterative solve's residual) their
+        // joints' reactions end in the world: they move nothing that plays.
+        // Disabled, with their joints, they drop out of ODE's island and its
+        // solve; place_kinematic_bodies() puts them at their targets.
+        std::array<int, CharacterModel::kBodies> branch{};
+        for (int b = 1; b < CharacterModel::kBodies; ++b) {
+            const int parent = model_.bodies()[b].parent;
+            branch[b] = parent == 0 ? b : branch[parent]; // parents come first
+        }
+        std::array<bool, CharacterModel::kBodies> plays{};
+        for (int side = 0; side < 2; ++side)
+            plays[branch[model_.hand_body(static_cast<Side>(side))]] = true;
+        for (int b = 1; b < CharacterModel::kBodies; ++b) {
+            kinematic_body_[b] = !plays[branch[b]];
+            if (!kinematic_body_[b])
+                continue;
+            any_kinematic_ = true;
+            dJointDisable(ball_[b - 1]);
+            dJointDisable(motor_[b - 1]);
+            dBodyDisable(body_[b]);
+        }
+    }
 
     // Sticks: on a fulcrum, bodies of their own whose frame is the hand's at
     // the rest angle; rigid, geometry on the hand bodies (mass merged).
@@ -509,6 +534,8 @@ void Scene::apply_control()
     stops_active_ = 0;
     for (int j = 0; j < CharacterModel::kJoints; ++j) {
         const int child = j + 1;
+        if (kinematic_body_[child])
+            continue; // placed, not driven
         const int parent = model_.bodies()[child].parent;
         const Eigen::Quaterniond qp = to_eigen(dBodyGetQuaternion(body_[parent]));
         const Eigen::Quaterniond qc = to_eigen(dBodyGetQuaternion(body_[child]));
@@ -615,7 +642,7 @@ bool Scene::check() const
     for (int b = 0; b < CharacterModel::kBodies + 2; ++b) {
         dBodyID body =
             b < CharacterModel::kBodies ? body_[b] : stick_body_[b - CharacterModel::kBodies];
-        if (!body)
+        if (!body || (b < CharacterModel::kBodies && kinematic_body_[b]))
             continue;
         const Eigen::Vector3d p = to_eigen3(dBodyGetPosition(body));
         const Eigen::Vector3d v = to_eigen3(dBodyGetLinearVel(body));
@@ -627,6 +654,8 @@ bool Scene::check() const
             return false;
     }
     for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        if (kinematic_body_[j + 1])
+            continue;
         dVector3 a1, a2;
         dJointGetBallAnchor(ball_[j], a1);
         dJointGetBallAnchor2(ball_[j], a2);
@@ -678,6 +707,8 @@ StepResult Scene::step(StepTiming *timing)
     dJointGroupEmpty(contacts_);
     if (timing)
         t3 = clock::now();
+    if (any_kinematic_)
+        place_kinematic_bodies();
     const bool ok = check();
     if (timing) {
         t4 = clock::now();
@@ -696,6 +727,29 @@ StepResult Scene::step(StepTiming *timing)
     ++divergences_;
     reset(target_pose());
     return StepResult::diverged;
+}
+
+// The kinematic bodies at their joints' targets, from the pelvis as it is
+// (forward kinematics, CharacterModel::forward on those bodies only), at rest.
+void Scene::place_kinematic_bodies()
+{
+    std::array<Eigen::Quaterniond, CharacterModel::kBodies> rotation;
+    std::array<Eigen::Vector3d, CharacterModel::kBodies> origin;
+    rotation[0] = to_eigen(dBodyGetQuaternion(body_[0]));
+    origin[0] = to_eigen3(dBodyGetPosition(body_[0])) - rotation[0] * com_local_[0];
+    for (int b = 1; b < CharacterModel::kBodies; ++b) {
+        if (!kinematic_body_[b])
+            continue;
+        const BodySpec &spec = model_.bodies()[b];
+        const int p = spec.parent; // the pelvis or a kinematic body
+        origin[b] = origin[p] + rotation[p] * spec.offset_m;
+        rotation[b] = rotation[p] * target_[b - 1];
+        const Eigen::Vector3d c = origin[b] + rotation[b] * com_local_[b];
+        dBodySetPosition(body_[b], c.x(), c.y(), c.z());
+        dQuaternion q;
+        to_ode(rotation[b], q);
+        dBodySetQuaternion(body_[b], q);
+    }
 }
 
 CharacterPose Scene::target_pose() const

@@ -98,6 +98,13 @@ struct SceneOptions {
     // step when it is short of the margin, or takes it back to the margin
     // when past it (docs/perform.md, "Joint limits").
     bool stop_inelastic = false;
+    // The pelvis's limbs that hold no stick (the legs) out of the solve
+    // (score mode): with the pelvis welded to the world they move nothing
+    // that plays, so their bodies and joints are disabled in ODE and each
+    // step places them at their joint targets (forward kinematics from the
+    // pelvis; at rest). Their motors give no torque, the weld carries no leg
+    // weight. Off: every body simulated (docs/character.md, "Kinematic legs").
+    bool legs_kinematic = false;
     // The stick-head contact's damping is the head's own: the implicit
     // step's numerical damping (h k) is taken back out of it (Scene::set_drum
     // comments). Off: the plain ODE mapping.
@@ -177,6 +184,8 @@ class Scene
     StepResult step(StepTiming *timing = nullptr);
     // Places the character in `pose` (pelvis ignored: it is welded), at rest.
     void reset(const CharacterPose &pose);
+    // SceneOptions::legs_kinematic: whether body `b` is placed, not simulated.
+    bool body_kinematic(int b) const { return kinematic_body_.at(static_cast<size_t>(b)); }
 
     double time_s() const { return time_s_; }
     long steps() const { return steps_; }
@@ -271,6 +280,7 @@ class Scene
     void place_drum();
     void gather_contact_forces();
     CharacterPose target_pose() const;
+    void place_kinematic_bodies();
     Eigen::Vector3d bead_rel_com(Side side) const;
 
     CharacterModel model_;
@@ -281,6 +291,10 @@ class Scene
     std::vector<Eigen::Vector3d> target_rate_;
     std::array<Eigen::Vector3d, CharacterModel::kBodies> com_local_; // merged, body frame
     std::array<bool, CharacterModel::kJoints> motor_axes_world_;
+    // SceneOptions::legs_kinematic: the bodies placed at their targets
+    // (joint j moves body j + 1), none without it.
+    std::array<bool, CharacterModel::kBodies> kinematic_body_{};
+    bool any_kinematic_ = false;
     // The motor parameters last given to ODE, so that apply_control() sets only
     // what changed (NaN: never set).
     struct MotorParams {
