@@ -823,6 +823,7 @@ Performance::make_score_rig(const PerformanceOptions &options,
     // The legs hang off the welded pelvis and hold no stick: placed at their
     // targets, not simulated (SceneOptions::legs_kinematic, docs/perform.md).
     scene.legs_kinematic = true;
+    scene.pelvis_kinematic = true; // welded: fixed, without the weld's rows
     if (options.drum_auto)
         scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
                               options.score.drum_forward_m * forward -

@@ -257,9 +257,15 @@ void Scene::build(const CharacterPose &initial)
         dBodySetQuaternion(body, q);
         body_[b] = body;
     }
-    pelvis_weld_ = dJointCreateFixed(world_, nullptr);
-    dJointAttach(pelvis_weld_, body_[0], nullptr);
-    dJointSetFixed(pelvis_weld_);
+    if (options_.pelvis_kinematic) {
+        // Infinite mass at rest: nothing moves it, and no rows hold it.
+        pelvis_mass_kg_ = model_.bodies()[0].mass_kg;
+        dBodySetKinematic(body_[0]);
+    } else {
+        pelvis_weld_ = dJointCreateFixed(world_, nullptr);
+        dJointAttach(pelvis_weld_, body_[0], nullptr);
+        dJointSetFixed(pelvis_weld_);
+    }
 
     for (int j = 0; j < CharacterModel::kJoints; ++j) {
         const int child = j + 1;
@@ -268,6 +274,8 @@ void Scene::build(const CharacterPose &initial)
         ball_[j] = dJointCreateBall(world_, nullptr);
         dJointAttach(ball_[j], body_[child], body_[parent]);
         dJointSetBallAnchor(ball_[j], anchor.x(), anchor.y(), anchor.z());
+        if (options_.pelvis_kinematic && parent == 0)
+            dJointSetFeedback(ball_[j], reinterpret_cast<dJointFeedback *>(&ball_feedback_[j]));
         // Eq. 1 motor: body 1 = child so that the rows act on w_child - w_parent.
         motor_[j] = dJointCreateAMotor(world_, nullptr);
         dJointAttach(motor_[j], body_[child], body_[parent]);
@@ -354,7 +362,8 @@ void Scene::build(const CharacterPose &initial)
     place_drum();
 
     static_assert(sizeof(Feedback) == sizeof(dJointFeedback), "feedback layout");
-    dJointSetFeedback(pelvis_weld_, reinterpret_cast<dJointFeedback *>(&weld_feedback_));
+    if (pelvis_weld_)
+        dJointSetFeedback(pelvis_weld_, reinterpret_cast<dJointFeedback *>(&weld_feedback_));
 }
 
 void Scene::place_drum()
@@ -808,6 +817,7 @@ void Scene::reset(const CharacterPose &pose_in)
     dJointGroupEmpty(contacts_);
     drum_contact_ = {};
     weld_feedback_ = Feedback{};
+    ball_feedback_ = {};
     part_touching_.fill(false); // the next contact is judged afresh
     part_through_.fill(false);
 }
@@ -1034,7 +1044,14 @@ double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in) con
 
 Eigen::Vector3d Scene::support_force_n() const
 {
-    return to_eigen3(weld_feedback_.f1);
+    if (pelvis_weld_)
+        return to_eigen3(weld_feedback_.f1);
+    // The pelvis at rest: support + weight + its joints' forces on it = 0.
+    Eigen::Vector3d f(0.0, options_.gravity_mps2 * pelvis_mass_kg_, 0.0);
+    for (int j = 0; j < CharacterModel::kJoints; ++j)
+        if (model_.bodies()[j + 1].parent == 0 && !kinematic_body_[j + 1])
+            f -= to_eigen3(ball_feedback_[j].f2);
+    return f;
 }
 
 Eigen::Vector3d Scene::motor_torque(int joint) const

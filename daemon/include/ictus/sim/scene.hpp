@@ -105,6 +105,12 @@ struct SceneOptions {
     // pelvis; at rest). Their motors give no torque, the weld carries no leg
     // weight. Off: every body simulated (docs/character.md, "Kinematic legs").
     bool legs_kinematic = false;
+    // The pelvis as a kinematic body of ODE's (infinite mass, at rest)
+    // instead of a body welded to the world (score mode): the same fixed
+    // pelvis without the weld's six rows in the solve, and without its
+    // softness (ERP 0.2, CFM 1e-9). support_force_n() is then the pelvis's
+    // statics: its weight and its simulated joints' forces on it.
+    bool pelvis_kinematic = false;
     // The stick-head contact's damping is the head's own: the implicit
     // step's numerical damping (h k) is taken back out of it (Scene::set_drum
     // comments). Off: the plain ODE mapping.
@@ -254,7 +260,9 @@ class Scene
     }
     // The force the world exerts on the pelvis through its weld in the last
     // step, N, world frame (with the drum contacts, the only external forces
-    // besides gravity: at rest they sum to the character's weight).
+    // besides gravity: at rest they sum to the character's weight). A
+    // kinematic pelvis (SceneOptions::pelvis_kinematic): what a weld would
+    // carry, its weight less its simulated joints' forces on it.
     Eigen::Vector3d support_force_n() const;
 
     // The drum, changed on the live scene: the membrane moves and resizes at
@@ -327,6 +335,9 @@ class Scene
     int contact_slots_used_ = 0;
     std::array<StickDrumContact, 2> drum_contact_{};
     Feedback weld_feedback_{};
+    // SceneOptions::pelvis_kinematic: the ball joints' forces on the pelvis.
+    std::array<Feedback, CharacterModel::kJoints> ball_feedback_{};
+    double pelvis_mass_kg_ = 0.0;
     std::array<std::array<Eigen::Vector3d, 3>, CharacterModel::kJoints> motor_axes_{};
     dxJoint *pelvis_weld_ = nullptr;
     dxGeom *drum_ = nullptr;
