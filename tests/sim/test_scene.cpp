@@ -601,10 +601,17 @@ TEST_CASE("kinematic legs (score mode): the legs leave the solve and follow thei
         INFO("body " << m.bodies()[b].name);
         CHECK(exact_kin.body_kinematic(b) == leg[b]);
         CHECK(quick_kin.body_kinematic(b) == leg[b]);
+        CHECK(exact_fixed.body_kinematic(b) == (leg[b] || b == 0));
         CHECK_FALSE(exact.body_kinematic(b));
         legs += leg[b];
     }
     REQUIRE(legs == 6);
+    // A placed body takes no kick (it would keep the velocity forever).
+    CHECK_THROWS_AS(
+        exact_kin.kick(m.body_index("l_shank"), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d::Zero()),
+        CharacterError);
+    CHECK_THROWS_AS(exact_fixed.kick(0, Eigen::Vector3d(0, 1, 0), Eigen::Vector3d::Zero()),
+                    CharacterError);
 
     // Arms and legs swing together for 2 s: elbows and shoulders at 2 Hz,
     // hips and knees at 1.5 Hz (rates given in the parent frame).

@@ -261,6 +261,7 @@ void Scene::build(const CharacterPose &initial)
         // Infinite mass at rest: nothing moves it, and no rows hold it.
         pelvis_mass_kg_ = model_.bodies()[0].mass_kg;
         dBodySetKinematic(body_[0]);
+        kinematic_body_[0] = true;
     } else {
         pelvis_weld_ = dJointCreateFixed(world_, nullptr);
         dJointAttach(pelvis_weld_, body_[0], nullptr);
@@ -1092,6 +1093,9 @@ void Scene::kick(int body, const Eigen::Vector3d &dv, const Eigen::Vector3d &dw)
     // ODE aborts (dDebug) on a NaN quaternion inside a step: refuse non-finite input here.
     if (!dv.allFinite() || !dw.allFinite())
         throw CharacterError("kick: velocity change must be finite");
+    if (kinematic_body_[body])
+        throw CharacterError("kick: body " + std::to_string(body) +
+                             " is placed, not simulated (kinematic)");
     const Eigen::Vector3d v = to_eigen3(dBodyGetLinearVel(body_[body])) + dv;
     const Eigen::Vector3d w = to_eigen3(dBodyGetAngularVel(body_[body])) + dw;
     dBodySetLinearVel(body_[body], v.x(), v.y(), v.z());

@@ -190,7 +190,8 @@ class Scene
     StepResult step(StepTiming *timing = nullptr);
     // Places the character in `pose` (pelvis ignored: it is welded), at rest.
     void reset(const CharacterPose &pose);
-    // SceneOptions::legs_kinematic: whether body `b` is placed, not simulated.
+    // Whether body `b` is placed, not simulated (SceneOptions::legs_kinematic:
+    // the legs; pelvis_kinematic: the pelvis).
     bool body_kinematic(int b) const { return kinematic_body_.at(static_cast<size_t>(b)); }
 
     double time_s() const { return time_s_; }
@@ -276,7 +277,8 @@ class Scene
     double max_linear_speed_mps() const;
     double max_angular_speed_rad_s() const;
     // Adds a velocity change to a body's centre of mass (tests: injected
-    // kicks). Throws CharacterError for a bad body or a non-finite change.
+    // kicks). Throws CharacterError for a bad or kinematic body or a
+    // non-finite change.
     void kick(int body, const Eigen::Vector3d &delta_linear_mps,
               const Eigen::Vector3d &delta_angular_rad_s);
 
