@@ -567,8 +567,8 @@ TEST_CASE("the drum stops a stick on its head from above, a stick rising into it
     CHECK(lowest < head_y + 0.01);
 }
 
-TEST_CASE("kinematic legs (score mode): the legs leave the solve and follow their targets; the "
-          "arms and sticks move as they do beside simulated legs",
+TEST_CASE("kinematic legs and pelvis (score mode): the legs leave the solve and follow their "
+          "targets, the arms and sticks move as beside simulated legs and a welded pelvis",
           "[sim][scene]")
 {
     const CharacterModel m = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
