@@ -323,15 +323,17 @@ def _held_max(tips, hand, t0, t1):
     return _tip_max({"t": tips["t"], hand: tips["held"][hand]}, hand, t0, t1)
 
 
-def _held_down_speeds(tips, hand, t):
+def _held_down_speeds(tips, hand, t, above_m):
     """The held tip's speeds toward the membrane (m/s) over the tips.csv sample intervals
-    that overlap the drive window before t (tips.csv *_held_y_m), or None."""
+    that overlap the drive window before t (tips.csv *_held_y_m) and start with the held tip
+    higher than above_m over the membrane (the held bead above it: a stick pressed into the
+    head is not driven), or None when there is no held tip; 0 when no interval counts."""
     if not tips or "held" not in tips:
         return None
     ts, ys = tips["t"], tips["held"][hand]
     out = [-(ys[k] - ys[k - 1]) / (ts[k] - ts[k - 1]) for k in range(1, len(ts))
-           if ts[k] > t - DRIVE_WINDOW_S and ts[k - 1] <= t]
-    return out or None
+           if ts[k] > t - DRIVE_WINDOW_S and ts[k - 1] <= t and ys[k - 1] > above_m]
+    return out or [0.0]
 
 
 def _tip_max(tips, hand, t0, t1):
@@ -363,7 +365,8 @@ def check_bounce_tags(res, strikes, tips):
                     held = _held_max(tips, s["hand"], release, s["time_s"])
                     if held is not None and held <= limit:
                         high = None  # the hand kept the stick down: a bounce either way
-                    drive = _held_down_speeds(tips, s["hand"], s["time_s"])
+                    drive = _held_down_speeds(tips, s["hand"], s["time_s"],
+                                              TIP_OVER_BEAD_M + TIP_SLOP_M)
                     if drive is not None and max(drive) < DRIVEN_SPEED_MPS + DRIVEN_SLOP_MPS:
                         high = None  # the hand was not driving it down: the stick fell back
                     if high is not None and high > limit:
@@ -383,7 +386,8 @@ def check_bounce_tags(res, strikes, tips):
                     held = _held_max(tips, s["hand"], release, s["time_s"])
                     if held is not None and high is not None:
                         high = min(high, held)  # a primary: the tip and the hand both rose
-                    drive = _held_down_speeds(tips, s["hand"], s["time_s"])
+                    drive = _held_down_speeds(tips, s["hand"], s["time_s"],
+                                              TIP_OVER_BEAD_M - TIP_SLOP_M)
                     if drive is not None and max(drive) < DRIVEN_SPEED_MPS - DRIVEN_SLOP_MPS:
                         res.problems.append("primary seq %d: the hand was not driving the stick "
                                             "down (held tip %.2f m/s toward the head) %.1f ms "

@@ -196,7 +196,14 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.plan.strike_depth_m = parse_number(a, value(), -0.05, 0.05);
     else if (a == "--strike-aim")
         o.score.plan.strike_aim_s = parse_number(a, value(), 0.0, 0.01);
-    else if (a == "--strike-aim-from")
+    else if (a == "--move-margins") {
+        const std::string v = value();
+        const auto comma = v.find(',');
+        if (comma == std::string::npos)
+            throw UsageError("--move-margins: expected AFTER,BEFORE (fractions of the gap)");
+        o.score.plan.move_margin_after = parse_number(a, v.substr(0, comma), 0.0, 0.45);
+        o.score.plan.move_margin_before = parse_number(a, v.substr(comma + 1), 0.0, 0.45);
+    } else if (a == "--strike-aim-from")
         o.score.plan.strike_aim_from_mps = parse_number(a, value(), 0.0, 20.0);
     else if (a == "--advance")
         o.score.time_advance_s = parse_number(a, value(), 0, 0.1);

@@ -211,6 +211,10 @@ struct Item {
 // Cross-fade between items[j] and items[j + 1] over [begin, end].
 struct Window {
     double begin = 0.0, end = 0.0;
+    // The move across the head between the two units' spots (zero for a
+    // window to or from the rest tip), spread over [move_begin, move_end].
+    Eigen::Vector3d across = Eigen::Vector3d::Zero();
+    double move_begin = 0.0, move_end = 0.0;
 };
 
 // Quintic smoothstep: 0 -> 1 with zero slope and curvature at both ends.
@@ -259,6 +263,10 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("strike_aim_from_mps must be within 0..20 m/s", o.strike_aim_from_mps);
     if (!(o.blend_margin > 0.0 && o.blend_margin < 0.5))
         bad("blend_margin must be in (0, 0.5)", o.blend_margin);
+    if (!(o.move_margin_after >= 0.0 && o.move_margin_before >= 0.0 &&
+          o.move_margin_after + o.move_margin_before < 0.9))
+        bad("move margins must be >= 0 and leave > 10 % of the gap",
+            o.move_margin_after + o.move_margin_before);
     if (!(o.idle_return_s > 0.0) || !std::isfinite(o.idle_return_s))
         bad("idle_return_s must be > 0", o.idle_return_s);
     if (!(o.return_time_s > 0.0 && o.return_time_s <= 10.0))
@@ -457,8 +465,13 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
                 }
             } else {
                 const double gap = placed[k + 1].strike_t - it.strike_t;
-                windows[s].push_back(
-                    {it.strike_t + beta * gap, placed[k + 1].strike_t - beta * gap});
+                Window w{it.strike_t + beta * gap, placed[k + 1].strike_t - beta * gap};
+                // The move across the head (not the strike aim's depth).
+                const Eigen::Vector3d move = placed[k + 1].origin - it.origin;
+                w.across = move - move.dot(frame.up) * frame.up;
+                w.move_begin = it.strike_t + opt.move_margin_after * gap;
+                w.move_end = placed[k + 1].strike_t - opt.move_margin_before * gap;
+                windows[s].push_back(w);
             }
         }
     }
@@ -501,20 +514,37 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
         dir.resize(times.size());
         const std::vector<Item> &its = items[s];
         const std::vector<Window> &win = windows[s];
-        size_t j = 0;
+        size_t j = 0, m = 0;
         for (size_t i = 0; i < times.size(); ++i) {
             const double t = times[i];
             while (j < win.size() && t > win[j].end)
                 ++j;
+            while (m < win.size() && t > win[m].move_end)
+                ++m;
             Eigen::Vector3d p0, d0;
             its[j].eval(t, p0, d0);
             if (j < win.size() && t >= win[j].begin && win[j].end > win[j].begin) {
                 Eigen::Vector3d p1, d1;
                 its[j + 1].eval(t, p1, d1);
-                const double w = smoothstep5((t - win[j].begin) / (win[j].end - win[j].begin));
+                const double x = (t - win[j].begin) / (win[j].end - win[j].begin);
+                const double w = smoothstep5(x);
+                // Lifted on the way by a bump 16 x^2 (1 - x)^2: zero, with
+                // zero slope, at both ends (C1 with the units).
                 p0 = (1.0 - w) * p0 + w * p1;
                 const Eigen::Vector3d blended = (1.0 - w) * d0 + w * d1;
                 d0 = blended.norm() > 1e-9 ? blended.normalized() : (w < 0.5 ? d0 : d1);
+            }
+            // The move across the head: the units' blend makes it over
+            // [begin, end]; it is made over [move_begin, move_end] instead
+            // (smoothstep5 at both: C1 with the units).
+            if (m < win.size() && t >= win[m].move_begin && win[m].move_end > win[m].move_begin) {
+                const Window &mv = win[m];
+                const double made = t < mv.begin ? 0.0
+                                    : t > mv.end
+                                        ? 1.0
+                                        : smoothstep5((t - mv.begin) / (mv.end - mv.begin));
+                const double x = (t - mv.move_begin) / (mv.move_end - mv.move_begin);
+                p0 += (smoothstep5(x) - made) * mv.across;
             }
             tip[i] = p0;
             dir[i] = d0;

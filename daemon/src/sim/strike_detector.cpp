@@ -119,6 +119,7 @@ void StrikeDetector::to_membrane(const Eigen::Vector3d &world_m, double &x_m, do
 bool StrikeDetector::held_driving(const TipSample &a, const TipSample &b) const
 {
     return a.held_center_m.allFinite() && b.held_center_m.allFinite() && b.time_s > a.time_s &&
+           gap_m(a.held_center_m) > 0.0 &&
            -(b.held_center_m - a.held_center_m).dot(kNormal) / (b.time_s - a.time_s) >=
                options_.driven_speed_mps;
 }

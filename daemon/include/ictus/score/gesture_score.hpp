@@ -87,6 +87,13 @@ struct PlanOptions {
     // middle of the gap between their strikes, leaving this fraction of the
     // gap at each end to the units alone (0 < f < 0.5).
     double blend_margin = 0.25;
+    // The move across the head from one spot to the next takes the whole
+    // gap between their strikes but these fractions of it after the first
+    // strike and before the second (the units' shapes still blend over the
+    // middle, blend_margin): half as fast as a move over the blend alone,
+    // which the arm tracks closely (docs/score.md, "From score to motion").
+    double move_margin_after = 0.05;
+    double move_margin_before = 0.1;
     // A hand with no stroke for longer than this goes back to its rest tip.
     double idle_return_s = 4.0;
     double return_time_s = 0.6; // the move between the rest tip and a stroke

@@ -115,7 +115,9 @@ class StrikeDetector
     double gap_m(const Eigen::Vector3d &center_m) const;
     bool over_membrane(const Eigen::Vector3d &center_m) const;
     // Whether the held bead moved toward the membrane at driven_speed_mps or
-    // faster from a to b (false when either has none).
+    // faster from a to b, starting above the membrane plane (false when
+    // either has none): a hand pressing its stick into the head (a buzz) is
+    // not driving a stroke.
     bool held_driving(const TipSample &a, const TipSample &b) const;
     bool in_contact(int hand) const { return hands_[hand].in_contact; }
     long strikes() const { return next_seq_; }
