@@ -821,6 +821,10 @@ Performance::make_score_rig(const PerformanceOptions &options,
     scene.stop_margin_rad = std::min(scene.stop_margin_rad, 1.0 * M_PI / 180.0);
     scene.stop_erp = 1.0;
     scene.stop_inelastic = true;
+    // The legs hang off the welded pelvis and hold no stick: placed at their
+    // targets, not simulated (SceneOptions::legs_kinematic, docs/perform.md).
+    scene.legs_kinematic = true;
+    scene.pelvis_kinematic = true; // welded: fixed, without the weld's rows
     if (options.drum_auto)
         scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
                               options.score.drum_forward_m * forward -

@@ -257,9 +257,16 @@ void Scene::build(const CharacterPose &initial)
         dBodySetQuaternion(body, q);
         body_[b] = body;
     }
-    pelvis_weld_ = dJointCreateFixed(world_, nullptr);
-    dJointAttach(pelvis_weld_, body_[0], nullptr);
-    dJointSetFixed(pelvis_weld_);
+    if (options_.pelvis_kinematic) {
+        // Infinite mass at rest: nothing moves it, and no rows hold it.
+        pelvis_mass_kg_ = model_.bodies()[0].mass_kg;
+        dBodySetKinematic(body_[0]);
+        kinematic_body_[0] = true;
+    } else {
+        pelvis_weld_ = dJointCreateFixed(world_, nullptr);
+        dJointAttach(pelvis_weld_, body_[0], nullptr);
+        dJointSetFixed(pelvis_weld_);
+    }
 
     for (int j = 0; j < CharacterModel::kJoints; ++j) {
         const int child = j + 1;
@@ -268,12 +275,39 @@ void Scene::build(const CharacterPose &initial)
         ball_[j] = dJointCreateBall(world_, nullptr);
         dJointAttach(ball_[j], body_[child], body_[parent]);
         dJointSetBallAnchor(ball_[j], anchor.x(), anchor.y(), anchor.z());
+        if (options_.pelvis_kinematic && parent == 0)
+            dJointSetFeedback(ball_[j], reinterpret_cast<dJointFeedback *>(&ball_feedback_[j]));
         // Eq. 1 motor: body 1 = child so that the rows act on w_child - w_parent.
         motor_[j] = dJointCreateAMotor(world_, nullptr);
         dJointAttach(motor_[j], body_[child], body_[parent]);
         dJointSetAMotorMode(motor_[j], dAMotorUser);
         dJointSetAMotorNumAxes(motor_[j], 3);
         dJointSetFeedback(motor_[j], reinterpret_cast<dJointFeedback *>(&feedback_[j]));
+    }
+    if (options_.legs_kinematic) {
+        // The pelvis's limbs that hold no stick: every body whose branch off
+        // the pelvis carries neither hand. The pelvis is welded, so (up to
+        // the weld's softness and the iterative solve's residual) their
+        // joints' reactions end in the world: they move nothing that plays.
+        // Disabled, with their joints, they drop out of ODE's island and its
+        // solve; place_kinematic_bodies() puts them at their targets.
+        std::array<int, CharacterModel::kBodies> branch{};
+        for (int b = 1; b < CharacterModel::kBodies; ++b) {
+            const int parent = model_.bodies()[b].parent;
+            branch[b] = parent == 0 ? b : branch[parent]; // parents come first
+        }
+        std::array<bool, CharacterModel::kBodies> plays{};
+        for (int side = 0; side < 2; ++side)
+            plays[branch[model_.hand_body(static_cast<Side>(side))]] = true;
+        for (int b = 1; b < CharacterModel::kBodies; ++b) {
+            kinematic_body_[b] = !plays[branch[b]];
+            if (!kinematic_body_[b])
+                continue;
+            any_kinematic_ = true;
+            dJointDisable(ball_[b - 1]);
+            dJointDisable(motor_[b - 1]);
+            dBodyDisable(body_[b]);
+        }
     }
 
     // Sticks: on a fulcrum, bodies of their own whose frame is the hand's at
@@ -329,7 +363,8 @@ void Scene::build(const CharacterPose &initial)
     place_drum();
 
     static_assert(sizeof(Feedback) == sizeof(dJointFeedback), "feedback layout");
-    dJointSetFeedback(pelvis_weld_, reinterpret_cast<dJointFeedback *>(&weld_feedback_));
+    if (pelvis_weld_)
+        dJointSetFeedback(pelvis_weld_, reinterpret_cast<dJointFeedback *>(&weld_feedback_));
 }
 
 void Scene::place_drum()
@@ -509,6 +544,8 @@ void Scene::apply_control()
     stops_active_ = 0;
     for (int j = 0; j < CharacterModel::kJoints; ++j) {
         const int child = j + 1;
+        if (kinematic_body_[child])
+            continue; // placed, not driven
         const int parent = model_.bodies()[child].parent;
         const Eigen::Quaterniond qp = to_eigen(dBodyGetQuaternion(body_[parent]));
         const Eigen::Quaterniond qc = to_eigen(dBodyGetQuaternion(body_[child]));
@@ -615,7 +652,7 @@ bool Scene::check() const
     for (int b = 0; b < CharacterModel::kBodies + 2; ++b) {
         dBodyID body =
             b < CharacterModel::kBodies ? body_[b] : stick_body_[b - CharacterModel::kBodies];
-        if (!body)
+        if (!body || (b < CharacterModel::kBodies && kinematic_body_[b]))
             continue;
         const Eigen::Vector3d p = to_eigen3(dBodyGetPosition(body));
         const Eigen::Vector3d v = to_eigen3(dBodyGetLinearVel(body));
@@ -627,6 +664,8 @@ bool Scene::check() const
             return false;
     }
     for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        if (kinematic_body_[j + 1])
+            continue;
         dVector3 a1, a2;
         dJointGetBallAnchor(ball_[j], a1);
         dJointGetBallAnchor2(ball_[j], a2);
@@ -678,6 +717,8 @@ StepResult Scene::step(StepTiming *timing)
     dJointGroupEmpty(contacts_);
     if (timing)
         t3 = clock::now();
+    if (any_kinematic_)
+        place_kinematic_bodies();
     const bool ok = check();
     if (timing) {
         t4 = clock::now();
@@ -696,6 +737,29 @@ StepResult Scene::step(StepTiming *timing)
     ++divergences_;
     reset(target_pose());
     return StepResult::diverged;
+}
+
+// The kinematic bodies at their joints' targets, from the pelvis as it is
+// (forward kinematics, CharacterModel::forward on those bodies only), at rest.
+void Scene::place_kinematic_bodies()
+{
+    std::array<Eigen::Quaterniond, CharacterModel::kBodies> rotation;
+    std::array<Eigen::Vector3d, CharacterModel::kBodies> origin;
+    rotation[0] = to_eigen(dBodyGetQuaternion(body_[0]));
+    origin[0] = to_eigen3(dBodyGetPosition(body_[0])) - rotation[0] * com_local_[0];
+    for (int b = 1; b < CharacterModel::kBodies; ++b) {
+        if (!kinematic_body_[b])
+            continue;
+        const BodySpec &spec = model_.bodies()[b];
+        const int p = spec.parent; // the pelvis or a kinematic body
+        origin[b] = origin[p] + rotation[p] * spec.offset_m;
+        rotation[b] = rotation[p] * target_[b - 1];
+        const Eigen::Vector3d c = origin[b] + rotation[b] * com_local_[b];
+        dBodySetPosition(body_[b], c.x(), c.y(), c.z());
+        dQuaternion q;
+        to_ode(rotation[b], q);
+        dBodySetQuaternion(body_[b], q);
+    }
 }
 
 CharacterPose Scene::target_pose() const
@@ -754,6 +818,7 @@ void Scene::reset(const CharacterPose &pose_in)
     dJointGroupEmpty(contacts_);
     drum_contact_ = {};
     weld_feedback_ = Feedback{};
+    ball_feedback_ = {};
     part_touching_.fill(false); // the next contact is judged afresh
     part_through_.fill(false);
 }
@@ -980,7 +1045,14 @@ double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in) con
 
 Eigen::Vector3d Scene::support_force_n() const
 {
-    return to_eigen3(weld_feedback_.f1);
+    if (pelvis_weld_)
+        return to_eigen3(weld_feedback_.f1);
+    // The pelvis at rest: support + weight + its joints' forces on it = 0.
+    Eigen::Vector3d f(0.0, options_.gravity_mps2 * pelvis_mass_kg_, 0.0);
+    for (int j = 0; j < CharacterModel::kJoints; ++j)
+        if (model_.bodies()[j + 1].parent == 0 && !kinematic_body_[j + 1])
+            f -= to_eigen3(ball_feedback_[j].f2);
+    return f;
 }
 
 Eigen::Vector3d Scene::motor_torque(int joint) const
@@ -1021,6 +1093,9 @@ void Scene::kick(int body, const Eigen::Vector3d &dv, const Eigen::Vector3d &dw)
     // ODE aborts (dDebug) on a NaN quaternion inside a step: refuse non-finite input here.
     if (!dv.allFinite() || !dw.allFinite())
         throw CharacterError("kick: velocity change must be finite");
+    if (kinematic_body_[body])
+        throw CharacterError("kick: body " + std::to_string(body) +
+                             " is placed, not simulated (kinematic)");
     const Eigen::Vector3d v = to_eigen3(dBodyGetLinearVel(body_[body])) + dv;
     const Eigen::Vector3d w = to_eigen3(dBodyGetAngularVel(body_[body])) + dw;
     dBodySetLinearVel(body_[body], v.x(), v.y(), v.z());

@@ -98,6 +98,19 @@ struct SceneOptions {
     // step when it is short of the margin, or takes it back to the margin
     // when past it (docs/perform.md, "Joint limits").
     bool stop_inelastic = false;
+    // The pelvis's limbs that hold no stick (the legs) out of the solve
+    // (score mode): with the pelvis welded to the world they move nothing
+    // that plays, so their bodies and joints are disabled in ODE and each
+    // step places them at their joint targets (forward kinematics from the
+    // pelvis; at rest). Their motors give no torque, the weld carries no leg
+    // weight. Off: every body simulated (docs/character.md, "Kinematic legs").
+    bool legs_kinematic = false;
+    // The pelvis as a kinematic body of ODE's (infinite mass, at rest)
+    // instead of a body welded to the world (score mode): the same fixed
+    // pelvis without the weld's six rows in the solve, and without its
+    // softness (ERP 0.2, CFM 1e-9). support_force_n() is then the pelvis's
+    // statics: its weight and its simulated joints' forces on it.
+    bool pelvis_kinematic = false;
     // The stick-head contact's damping is the head's own: the implicit
     // step's numerical damping (h k) is taken back out of it (Scene::set_drum
     // comments). Off: the plain ODE mapping.
@@ -177,6 +190,9 @@ class Scene
     StepResult step(StepTiming *timing = nullptr);
     // Places the character in `pose` (pelvis ignored: it is welded), at rest.
     void reset(const CharacterPose &pose);
+    // Whether body `b` is placed, not simulated (SceneOptions::legs_kinematic:
+    // the legs; pelvis_kinematic: the pelvis).
+    bool body_kinematic(int b) const { return kinematic_body_.at(static_cast<size_t>(b)); }
 
     double time_s() const { return time_s_; }
     long steps() const { return steps_; }
@@ -245,7 +261,9 @@ class Scene
     }
     // The force the world exerts on the pelvis through its weld in the last
     // step, N, world frame (with the drum contacts, the only external forces
-    // besides gravity: at rest they sum to the character's weight).
+    // besides gravity: at rest they sum to the character's weight). A
+    // kinematic pelvis (SceneOptions::pelvis_kinematic): what a weld would
+    // carry, its weight less its simulated joints' forces on it.
     Eigen::Vector3d support_force_n() const;
 
     // The drum, changed on the live scene: the membrane moves and resizes at
@@ -259,7 +277,8 @@ class Scene
     double max_linear_speed_mps() const;
     double max_angular_speed_rad_s() const;
     // Adds a velocity change to a body's centre of mass (tests: injected
-    // kicks). Throws CharacterError for a bad body or a non-finite change.
+    // kicks). Throws CharacterError for a bad or kinematic body or a
+    // non-finite change.
     void kick(int body, const Eigen::Vector3d &delta_linear_mps,
               const Eigen::Vector3d &delta_angular_rad_s);
 
@@ -271,6 +290,7 @@ class Scene
     void place_drum();
     void gather_contact_forces();
     CharacterPose target_pose() const;
+    void place_kinematic_bodies();
     Eigen::Vector3d bead_rel_com(Side side) const;
 
     CharacterModel model_;
@@ -281,6 +301,10 @@ class Scene
     std::vector<Eigen::Vector3d> target_rate_;
     std::array<Eigen::Vector3d, CharacterModel::kBodies> com_local_; // merged, body frame
     std::array<bool, CharacterModel::kJoints> motor_axes_world_;
+    // SceneOptions::legs_kinematic: the bodies placed at their targets
+    // (joint j moves body j + 1), none without it.
+    std::array<bool, CharacterModel::kBodies> kinematic_body_{};
+    bool any_kinematic_ = false;
     // The motor parameters last given to ODE, so that apply_control() sets only
     // what changed (NaN: never set).
     struct MotorParams {
@@ -313,6 +337,9 @@ class Scene
     int contact_slots_used_ = 0;
     std::array<StickDrumContact, 2> drum_contact_{};
     Feedback weld_feedback_{};
+    // SceneOptions::pelvis_kinematic: the ball joints' forces on the pelvis.
+    std::array<Feedback, CharacterModel::kJoints> ball_feedback_{};
+    double pelvis_mass_kg_ = 0.0;
     std::array<std::array<Eigen::Vector3d, 3>, CharacterModel::kJoints> motor_axes_{};
     dxJoint *pelvis_weld_ = nullptr;
     dxGeom *drum_ = nullptr;
