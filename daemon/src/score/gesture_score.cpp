@@ -526,10 +526,7 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
             if (j < win.size() && t >= win[j].begin && win[j].end > win[j].begin) {
                 Eigen::Vector3d p1, d1;
                 its[j + 1].eval(t, p1, d1);
-                const double x = (t - win[j].begin) / (win[j].end - win[j].begin);
-                const double w = smoothstep5(x);
-                // Lifted on the way by a bump 16 x^2 (1 - x)^2: zero, with
-                // zero slope, at both ends (C1 with the units).
+                const double w = smoothstep5((t - win[j].begin) / (win[j].end - win[j].begin));
                 p0 = (1.0 - w) * p0 + w * p1;
                 const Eigen::Vector3d blended = (1.0 - w) * d0 + w * d1;
                 d0 = blended.norm() > 1e-9 ? blended.normalized() : (w < 0.5 ? d0 : d1);
