@@ -626,6 +626,11 @@ void Scene::apply_control()
                 }
             }
         }
+        // Score mode's stop (inelastic) also holds the joint's other two axes
+        // for the step: the range is not convex, so moving across the stop's
+        // axis took joints further out (an elbow held on its stop axis went
+        // from 0 to 2.4 and 4.4 deg out in two steps, random seed 2080).
+        const bool lock = stop && options_.stop_inelastic;
         Eigen::Vector3d axes[3];
         if (stop) {
             axes[0] = stop_axis;
@@ -660,7 +665,7 @@ void Scene::apply_control()
                 dJointSetAMotorParam(m, kCfm[i], cmd.cfm);
             // On a stopped axis only the stop acts: ODE would otherwise push
             // with the full motor force as an explicit torque.
-            const double fmax = (stop && i == 0) ? 0.0 : cmd.fmax;
+            const double fmax = (stop && (i == 0 || lock)) ? 0.0 : cmd.fmax;
             if (!(fmax == last.fmax[i]))
                 dJointSetAMotorParam(m, kFMax[i], fmax);
             last.fmax[i] = fmax;
@@ -670,10 +675,32 @@ void Scene::apply_control()
             dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
             dJointSetAMotorParam(m, dParamHiStop1, stop_at);
             dJointSetAMotorParam(m, dParamStopERP, options_.stop_erp);
+            if (lock) {
+                dJointSetAMotorAngle(m, 1, 0.0);
+                dJointSetAMotorAngle(m, 2, 0.0);
+                dJointSetAMotorParam(m, dParamLoStop2, 0.0);
+                dJointSetAMotorParam(m, dParamHiStop2, 0.0);
+                dJointSetAMotorParam(m, dParamLoStop3, 0.0);
+                dJointSetAMotorParam(m, dParamHiStop3, 0.0);
+                last.locked = true;
+            } else if (last.locked) {
+                dJointSetAMotorParam(m, dParamHiStop2, dInfinity);
+                dJointSetAMotorParam(m, dParamLoStop2, -dInfinity);
+                dJointSetAMotorParam(m, dParamHiStop3, dInfinity);
+                dJointSetAMotorParam(m, dParamLoStop3, -dInfinity);
+                last.locked = false;
+            }
             last.stops_open = false;
         } else if (!last.stops_open) {
             dJointSetAMotorParam(m, dParamHiStop1, dInfinity);
             dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
+            if (last.locked) {
+                dJointSetAMotorParam(m, dParamHiStop2, dInfinity);
+                dJointSetAMotorParam(m, dParamLoStop2, -dInfinity);
+                dJointSetAMotorParam(m, dParamHiStop3, dInfinity);
+                dJointSetAMotorParam(m, dParamLoStop3, -dInfinity);
+                last.locked = false;
+            }
             last.stops_open = true;
         }
     }

@@ -313,6 +313,7 @@ class Scene
                                       std::numeric_limits<double>::quiet_NaN(),
                                       std::numeric_limits<double>::quiet_NaN()};
         bool stops_open = false; // the stop rows set to +-infinity
+        bool locked = false;     // score mode: axes 2 and 3 held with the stop
     };
     std::array<MotorParams, CharacterModel::kJoints> motor_params_{};
 
