@@ -25,6 +25,24 @@ void blend_pose(const CharacterPose &from, const CharacterPose &to, double w, Ch
 {
     out.pelvis_position_m = to.pelvis_position_m;
     out.pelvis_rotation = to.pelvis_rotation;
+    if (w == 1.0) {
+        // Past the ramp (every step but its first ramp_s): Eigen's slerp at t = 1
+        // has scale0 = sin(0)/sin(theta) = +0 and scale1 = sin(theta)/sin(theta) = 1
+        // (or 1 - t and t on its linear branch), negated for a negative dot. The
+        // same expression with those scales, without its acos and three sines:
+        // the same bits.
+        for (size_t j = 0; j < out.local.size(); ++j) {
+            const double d = from.local[j].dot(to.local[j]);
+            if (!std::isfinite(d)) {
+                out.local[j] = from.local[j].slerp(w, to.local[j]);
+                continue;
+            }
+            const double scale0 = 0.0, scale1 = d < 0.0 ? -1.0 : 1.0;
+            out.local[j] =
+                Eigen::Quaterniond(scale0 * from.local[j].coeffs() + scale1 * to.local[j].coeffs());
+        }
+        return;
+    }
     for (size_t j = 0; j < out.local.size(); ++j)
         out.local[j] = from.local[j].slerp(w, to.local[j]);
 }
