@@ -4,6 +4,7 @@
 #include "ictus/base/rotation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -171,9 +172,20 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
     const CharacterModel &model = scene_->model();
     const int nj = CharacterModel::kJoints;
     const double h = scene_->options().step_s;
+    // The reference's rates, where something reads them: not an arm's when tips
+    // drive the arms (the kinematic IK below gives its rate), nor a joint whose
+    // body the scene places instead of driving it (SceneOptions::legs_kinematic).
+    std::array<bool, CharacterModel::kJoints> rate_read;
+    for (int j = 0; j < nj; ++j)
+        rate_read[j] = !scene_->body_kinematic(j + 1);
+    if (tips)
+        for (int s = 0; s < 2; ++s)
+            for (int k = 0; k < 4; ++k)
+                rate_read[arms_[s]->joint[k]] = false;
     for (int j = 0; j < nj; ++j) {
         target_[j] = reference.local[j];
-        rate_[j] = log_map(target_[j] * previous_reference_[j].conjugate()) / h;
+        if (rate_read[j])
+            rate_[j] = log_map(target_[j] * previous_reference_[j].conjugate()) / h;
     }
     previous_reference_ = reference.local; // same size: no allocation
     const bool cartesian = mode_ == TrackMode::cartesian;
