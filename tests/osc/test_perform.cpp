@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -38,7 +39,8 @@ constexpr bool kQuick = false;
 
 struct Performed {
     std::vector<PlannedNote> notes;
-    std::vector<StrikeEvent> strikes; // in onset order
+    std::vector<double> planned_speed_mps; // per note, the plan's impact speed (render.json's)
+    std::vector<StrikeEvent> strikes;      // in onset order
     double origin_s = 0.0;
     int divergences = 0;
 };
@@ -55,6 +57,8 @@ Performed perform(const std::string &score, TrackMode mode, Grip grip)
     perf.start_score();
     Performed r;
     r.notes = perf.plan()->notes;
+    for (size_t i = 0; i < r.notes.size(); ++i)
+        r.planned_speed_mps.push_back(perf.planned_impact_speed_mps(i));
     r.origin_s = perf.plan_origin_s();
     const long steps = std::lround(perf.plan()->duration_s / perf.step_s());
     StrikeEvent ev[2];
@@ -396,4 +400,72 @@ TEST_CASE("perform: grip firmness live, per note, and the buzz's loose press", "
     CHECK(left_k[0] == Approx(stiffness(0.9)));
     CHECK(right_k[0] == Approx(stiffness(kDefaultGripFirmness)));
     CHECK(right_k[1] == Approx(stiffness(Performance::kBuzzGripFirmness)));
+}
+
+// The rest pose is one the arms can take: at rest (before any plan) each hand
+// holds its stick forward, 15 degrees down and 40 degrees toward the midline
+// (gesture_score.hpp, rest_stick_direction), in both grips. Computed here from
+// the performer's frame (facing +Z, right = -X), not from the planner. Under
+// the old 20-degree rest the French grip asked the wrists for a rotation past
+// their range of motion (0.8 and 1.2 rad off), the IK stayed stuck at its
+// limits through the lead-in and a loud first stroke hit 1.6x too fast.
+TEST_CASE("perform: at rest each hand holds its stick in the rest direction, both grips",
+          "[perform]")
+{
+    const char *grip = GENERATE("french", "german");
+    PerformanceOptions o;
+    o.score.score_text = "R legato\n";
+    o.score.grip_given = true;
+    o.character.grip = grip_from_string(grip);
+    Performance perf(o);
+    StrikeEvent ev[2];
+    for (int n = 0; n < 500; ++n) // 0.5 s: the fulcrum settles
+        perf.step(ev);
+    const double down = 15.0 * M_PI / 180.0, yaw = 40.0 * M_PI / 180.0;
+    for (Side s : {Side::left, Side::right}) {
+        // The left hand is at +X, its midline side -X; the right hand's is +X.
+        const double inward_x = s == Side::left ? -1.0 : 1.0;
+        const Eigen::Vector3d expected(std::cos(down) * std::sin(yaw) * inward_x, -std::sin(down),
+                                       std::cos(down) * std::cos(yaw));
+        const Eigen::Vector3d axis = perf.scene().stick_axis(s);
+        const double off_deg = std::acos(std::clamp(axis.dot(expected), -1.0, 1.0)) * 180.0 / M_PI;
+        INFO(grip << ", " << (s == Side::left ? "left" : "right") << ": stick axis "
+                  << axis.transpose() << ", " << off_deg << " deg from the rest direction");
+        CHECK(off_deg < 3.0);
+    }
+}
+
+// A hand's first stroke starts from the rest pose, the next ones from the
+// stroke before: seeded random strokes (grip, hand, nuance, dynamics pp..ff,
+// slow tempi, where each stroke is whole) played three times in a row. The
+// first must be played as the plan asks, like the others: one strike per note
+// within 5 ms, and its impact speed as near the plan's as the third's.
+TEST_CASE("perform: a hand's first stroke from rest is played like the same stroke repeated",
+          "[perform]")
+{
+    std::mt19937 rng(20261125);
+    const char *grips[] = {"french", "german"};
+    const char *nuances[] = {"legato", "tenuto", "accent", "vertical_accent", "staccato"};
+    const int cases = kQuick ? 3 : 10;
+    for (int c = 0; c < cases; ++c) {
+        const char *grip = grips[std::uniform_int_distribution<int>(0, 1)(rng)];
+        const char *hand = std::uniform_int_distribution<int>(0, 1)(rng) ? "R" : "L";
+        const char *nuance = nuances[std::uniform_int_distribution<int>(0, 4)(rng)];
+        const double dynamics = std::uniform_real_distribution<double>(0.05, 1.0)(rng);
+        const int bpm = std::uniform_int_distribution<int>(40, 90)(rng);
+        std::ostringstream s;
+        s << "tempo " << bpm << "\ngrip " << grip << "\n";
+        for (int k = 0; k < 3; ++k)
+            s << hand << ' ' << nuance << ' ' << dynamics << "\n";
+        const std::string what = s.str();
+        const Performed p = perform(what, TrackMode::cartesian, grip_from_string(grip));
+        INFO(what);
+        REQUIRE(p.notes.size() == 3);
+        CHECK(p.divergences == 0);
+        const std::vector<double> speed = check_one_strike_per_note(p, what);
+        const double first = speed[0] / p.planned_speed_mps[0];
+        const double third = speed[2] / p.planned_speed_mps[2];
+        INFO("measured / planned impact speed: first " << first << ", third " << third);
+        CHECK(std::abs(first - third) < 0.1);
+    }
 }

@@ -468,6 +468,23 @@ TEST_CASE("plan: an idle hand waits at its rest tip", "[score][plan]")
     CHECK((plan.tips.tip_m[1].back() - f.rest_tip_m[1]).norm() < 1e-9);
     for (const auto &p : plan.tips.tip_m[0])
         CHECK((p - f.rest_tip_m[0]).norm() < 1e-12);
+    // At rest the stick points forward, 15 degrees down, 40 degrees toward the
+    // midline (the frame faces +Z; the left hand is at +X, its midline side -X):
+    // the idle hand all along, the playing hand at both ends and across its long rest.
+    const double down = 15.0 * M_PI / 180.0, yaw = 40.0 * M_PI / 180.0;
+    for (int side = 0; side < 2; ++side) {
+        const double inward_x = side == static_cast<int>(Side::left) ? -1.0 : 1.0;
+        const Eigen::Vector3d rest(std::cos(down) * std::sin(yaw) * inward_x, -std::sin(down),
+                                   std::cos(down) * std::cos(yaw));
+        const auto &dir = plan.stick_dir[side];
+        REQUIRE(!dir.empty());
+        CHECK((dir.front() - rest).norm() < 1e-9);
+        CHECK((dir.back() - rest).norm() < 1e-9);
+        CHECK((dir[index_at(plan, middle)] - rest).norm() < 1e-9);
+        if (side == static_cast<int>(Side::left))
+            for (const auto &d : dir)
+                CHECK((d - rest).norm() < 1e-9);
+    }
     // Rest tips of performer_frame_for_drum: 0.15 m above, 0.1 m to the side, 0.05 m nearer.
     CHECK((f.rest_tip_m[1] - (kCenter + Eigen::Vector3d(-0.1, 0.15, -0.05))).norm() < 1e-12);
     CHECK((f.rest_tip_m[0] - (kCenter + Eigen::Vector3d(0.1, 0.15, -0.05))).norm() < 1e-12);

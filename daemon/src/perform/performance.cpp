@@ -718,16 +718,6 @@ namespace
 // The plan's strike points are raised by it, so that the planned tip target
 // on the beat is the tip at first contact (strike_depth_m is then measured
 // from the contact, not from the plane).
-// Between plans: forward and 15 degrees down (kDefaultStickDirection), turned
-// 20 degrees toward the midline.
-Eigen::Vector3d rest_stick_direction(const PerformerFrame &f, int s)
-{
-    const double yaw = 20.0 * M_PI / 180.0;
-    const Eigen::Vector3d inward = s == static_cast<int>(Side::right) ? -f.right : f.right;
-    const Eigen::Vector3d level = std::cos(yaw) * f.forward + std::sin(yaw) * inward;
-    return (kDefaultStickDirection.y() * f.up + kDefaultStickDirection.z() * level).normalized();
-}
-
 double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_world)
 {
     return tip_radius_m * (1.0 + stick_dir_world.normalized().y());

@@ -293,6 +293,16 @@ PerformerFrame performer_frame_for_drum(const Eigen::Vector3d &membrane_center_m
     return f;
 }
 
+Eigen::Vector3d rest_stick_direction(const PerformerFrame &frame, int side)
+{
+    const double yaw = 40.0 * kPi / 180.0;
+    const Eigen::Vector3d inward =
+        side == static_cast<int>(Side::right) ? -frame.right : frame.right;
+    const Eigen::Vector3d level = std::cos(yaw) * frame.forward + std::sin(yaw) * inward;
+    return (kDefaultStickDirection.y() * frame.up + kDefaultStickDirection.z() * level)
+        .normalized();
+}
+
 Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg)
 {
     // docs/osc.md: x_m along world +X, y_m along world -Z.
@@ -380,11 +390,8 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
         Item rest;
         rest.rest_pos = frame.rest_tip_m[s];
         if (idx.empty()) {
-            // A hand with nothing to play holds its stick as at the top of a legato stroke.
-            const Grip g = score.notes.empty() ? Grip::french : score.notes.front().grip;
-            const UnitCurve &u = unit_for(g, Nuance::legato, static_cast<Side>(s), kDefaultDynamics,
-                                          kNominalPeriod_s, kNominalPeriod_s);
-            rest.rest_dir = (to_world * u.dir(0.0)).normalized();
+            // A hand with nothing to play holds its stick at rest.
+            rest.rest_dir = rest_stick_direction(frame, s);
             items[s].push_back(rest);
             continue;
         }
@@ -442,7 +449,7 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
             plan.notes[idx[k]].impact_velocity_mps = to_world * it.curve->impact_velocity();
         }
         // The timeline: rest, unit, [rest,] unit, ..., rest.
-        rest.rest_dir = placed.front().start_dir;
+        rest.rest_dir = rest_stick_direction(frame, s);
         items[s].push_back(rest);
         const double first_start = placed[0].strike_t - placed[0].prep_t;
         windows[s].push_back({std::max(0.0, first_start - tr), first_start});
@@ -452,7 +459,7 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
             if (k + 1 == n || via_rest[k]) {
                 Item back;
                 back.rest_pos = frame.rest_tip_m[s];
-                back.rest_dir = it.end_dir;
+                back.rest_dir = rest_stick_direction(frame, s);
                 const double lift_end = it.strike_t + it.lift_t;
                 windows[s].push_back({lift_end, lift_end + tr});
                 last_motion_end = std::max(last_motion_end, lift_end + tr);

@@ -45,6 +45,12 @@ struct PerformerFrame {
 PerformerFrame performer_frame_for_drum(const Eigen::Vector3d &membrane_center_m, double radius_m,
                                         double rest_height_m = 0.15);
 
+// How a hand holds its stick at its rest tip (butt -> tip, unit): forward and
+// 15 degrees down (kDefaultStickDirection), turned 40 degrees toward the
+// midline. The performer starts and ends every plan in it, and the plan's
+// rests (before the first note, between far-apart notes, after the last) ask for it.
+Eigen::Vector3d rest_stick_direction(const PerformerFrame &frame, int side);
+
 // A point of the head from the membrane frame of docs/osc.md (x_m = world
 // +X, y_m = world -Z, around the centre).
 Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg);
