@@ -295,8 +295,10 @@ static contact_step step_begin(const contact *c, double x0, double dt)
 }
 
 /* Force for the step x0 -> x1 and, when dforce is not NULL, dF/dx1 and
- * dforce_x0[0] = dF/dx0 (for the next sample's first guess only). */
-static double step_force(const contact_step *st, double x1, double *dforce, double *dforce_x0)
+ * dforce_x0[0] = dF/dx0 (for the next sample's first guess only). Inlined: the
+ * derivatives then stay in registers on the solve's dependency chain. */
+static inline __attribute__((always_inline)) double step_force(const contact_step *st, double x1,
+                                                               double *dforce, double *dforce_x0)
 {
     const double k = st->k, a = st->a, x0 = st->x0;
     double x1a_below = 0.0; /* x1^(a-1), for dh */
@@ -383,12 +385,11 @@ static double contact_solve(const contact *c, double x0, double x_free, double c
             u = u_guess;
         f = step_force(&st, u, &df, &df0);
         r = u - x_free + compliance * f;
-        if (r > 0.0) {
-            hi = u;
-        } else {
-            lo = u;
-            have_lo = 1;
-        }
+        /* The bracket's side, without a branch: the sign of r is a coin toss from
+         * sample to sample, and a mispredicted branch here lengthens the chain. */
+        hi = r > 0.0 ? u : hi;
+        lo = r > 0.0 ? lo : u;
+        have_lo = !(r > 0.0);
     } else {
         f = step_force(&st, x_free, &df, &df0);
         if (f == 0.0) {
@@ -428,12 +429,9 @@ static double contact_solve(const contact *c, double x0, double x_free, double c
         f = step_force(&st, u, &df, &df0);
         r = u - x_free + compliance * f;
         dr = 1.0 + compliance * df;
-        if (r > 0.0) {
-            hi = u;
-        } else {
-            lo = u;
-            have_lo = 1;
-        }
+        hi = r > 0.0 ? u : hi;
+        lo = r > 0.0 ? lo : u;
+        have_lo |= !(r > 0.0);
         tol = residual_tol(x0, x_free, compliance, f);
         if (have_lo && hi - lo <= 1e-3 * tol)
             break;

@@ -53,6 +53,10 @@ struct membrane {
      * scaled displacement r = q / (h w'), h = T / 2 (the energy coordinate q is
      * h w' r); cd = 2 / D is r's coefficient of p; ep the input gain of both. */
     float *q, *p, *c1, *cd, *c3, *ep;
+    /* The kernel's coordinates: q and p above hold r / sc and p / sc, sc = sqrt(cd)
+     * (0 for silent modes); ep_k = ep / sc, pick_k = psi_pick sc, and each point's
+     * psi_k = psi sc (membrane_kernel.inc). */
+    float *sc, *ep_k, *pick_k[MEMBRANE_PICKUPS];
     double coef_h; /* h of the coefficients (and of r) now in place */
     float *psi_strike, *psi_pick[MEMBRANE_PICKUPS];
     /* A moved pickup crossfades from its old shapes over a few ms (no click). */
@@ -147,6 +151,7 @@ static void update_coefficients(membrane *m, int rescale)
         if (k >= m->fading_modes || freq >= 0.95 * 0.5 * m->sample_rate || freq <= 0.0) {
             /* Silent: frozen at zero, no input, no output. */
             m->c1[k] = m->cd[k] = m->c3[k] = m->ep[k] = 0.0f;
+            m->sc[k] = m->ep_k[k] = 0.0f;
             m->q[k] = m->p[k] = 0.0f;
             m->omega_model[k] = 0.0;
             continue;
@@ -174,10 +179,14 @@ static void update_coefficients(membrane *m, int rescale)
         m->ep[k] = (float)(scale * T / D);
         if (fading) /* ringing out: no input (and zero input shapes, input_shapes) */
             m->ep[k] = 0.0f;
-        if (rescale && old_omega > 0.0) {
+        const double old_sc = m->sc[k];
+        m->sc[k] = (float)sqrt((double)m->cd[k]);
+        m->ep_k[k] = (float)(m->ep[k] / (double)m->sc[k]);
+        if (rescale && old_omega > 0.0 && old_sc > 0.0) {
             /* y = q / (sqrt(M) w'), y' = p / sqrt(M), sqrt(M) proportional to 1/scale;
-             * q = h w' r, so r scales by old_h / h (w' cancels). */
-            double r = old_scale / scale;
+             * q = h w' r, so r scales by old_h / h (w' cancels); the stored r / sc and
+             * p / sc by old_sc / sc besides. */
+            double r = old_scale / scale * (old_sc / m->sc[k]);
             m->q[k] = (float)(m->q[k] * r * old_h / h);
             m->p[k] = (float)(m->p[k] * r);
         } else if (rescale) {
@@ -200,9 +209,9 @@ static ictus_status build_modes(membrane *m, int modes)
         int cap = need;
         mode_table table = {0};
         double *om = calloc((size_t)cap, sizeof(double));
-        float *arrays[11];
+        float *arrays[15];
         int ok = om != NULL;
-        for (int i = 0; i < 11; i++) {
+        for (int i = 0; i < 15; i++) {
             arrays[i] = alloc_floats(cap);
             ok = ok && arrays[i];
         }
@@ -211,9 +220,9 @@ static ictus_status build_modes(membrane *m, int modes)
             impulse[i] = alloc_floats(cap);
             ok = ok && impulse[i];
         }
-        float *ppsi[MEMBRANE_MAX_POINTS][2];
+        float *ppsi[MEMBRANE_MAX_POINTS][3];
         for (int i = 0; i < MEMBRANE_MAX_POINTS; i++) {
-            for (int j = 0; j < 2; j++) {
+            for (int j = 0; j < 3; j++) {
                 ppsi[i][j] = NULL;
                 if (i < m->point_count) {
                     ppsi[i][j] = alloc_floats(cap);
@@ -228,12 +237,12 @@ static ictus_status build_modes(membrane *m, int modes)
         if (!ok) {
             mode_table_free(&table);
             free(om);
-            for (int i = 0; i < 11; i++)
+            for (int i = 0; i < 15; i++)
                 free(arrays[i]);
             for (int i = 0; i < IMPULSE_CACHE; i++)
                 free(impulse[i]);
             for (int i = 0; i < MEMBRANE_MAX_POINTS; i++)
-                for (int j = 0; j < 2; j++)
+                for (int j = 0; j < 3; j++)
                     free(ppsi[i][j]);
             return ICTUS_ENOMEM;
         }
@@ -243,15 +252,18 @@ static ictus_status build_modes(membrane *m, int modes)
         if (m->q) {
             memcpy(arrays[0], m->q, sizeof(float) * (size_t)keep);
             memcpy(arrays[1], m->p, sizeof(float) * (size_t)keep);
+            memcpy(arrays[11], m->sc, sizeof(float) * (size_t)keep); /* the state's scale */
             memcpy(om, m->omega_model, sizeof(double) * (size_t)keep);
         }
         mode_table_free(&m->table);
         free(m->omega_model);
         free(m->q), free(m->p), free(m->c1), free(m->cd), free(m->c3);
         free(m->ep), free(m->psi_strike);
+        free(m->sc), free(m->ep_k);
         for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
             free(m->psi_pick[i]);
             free(m->psi_pick_old[i]);
+            free(m->pick_k[i]);
             m->pick_fade_left[i] = 0;
         }
         m->table = table;
@@ -263,6 +275,9 @@ static ictus_status build_modes(membrane *m, int modes)
         m->psi_pick[1] = arrays[8];
         m->psi_pick_old[0] = arrays[9];
         m->psi_pick_old[1] = arrays[10];
+        m->sc = arrays[11], m->ep_k = arrays[12];
+        m->pick_k[0] = arrays[13];
+        m->pick_k[1] = arrays[14];
         for (int i = 0; i < IMPULSE_CACHE; i++) {
             free(m->impulse_cache[i].psi);
             m->impulse_cache[i].psi = impulse[i];
@@ -270,9 +285,10 @@ static ictus_status build_modes(membrane *m, int modes)
         }
         for (int i = 0; i < m->point_count; i++) {
             membrane_point *pt = m->points[i];
-            free(pt->psi), free(pt->psi_next);
+            free(pt->psi), free(pt->psi_next), free(pt->psi_k);
             pt->psi = ppsi[i][0];
             pt->psi_next = ppsi[i][1];
+            pt->psi_k = ppsi[i][2];
             pt->psi_cap = cap;
         }
         m->capacity = cap;
@@ -320,7 +336,7 @@ static void flush_points(membrane *m)
         membrane_point *pt = m->points[i];
         if (pt->force_pending != 0.0 && pt->psi) {
             for (int k = 0; k < m->count; k++) {
-                float du = m->ep[k] * ((float)pt->force_pending * pt->psi[k]);
+                float du = m->ep_k[k] * ((float)pt->force_pending * pt->psi[k]);
                 m->q[k] += du;
                 m->p[k] += du;
             }
@@ -353,10 +369,19 @@ static void point_couplings(membrane *m, membrane_point *pt)
     pt->self_compliance = K * displacement_scale(m);
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
         pt->pick_coupling[j] = dot_psi(m, m->psi_pick[j], pt->psi, m->ep);
+    for (int k = 0; k < m->capacity; k++)
+        pt->psi_k[k] = pt->psi[k] * m->sc[k];
 }
 
+/* The shapes and couplings in the kernel's coordinates, after the coefficients, the
+ * pickups or the shapes changed. */
 static void refresh_point_couplings(membrane *m)
 {
+    if (!m->sc)
+        return;
+    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+        for (int k = 0; k < m->capacity; k++)
+            m->pick_k[j][k] = m->psi_pick[j][k] * m->sc[k];
     for (int i = 0; i < m->point_count; i++)
         if (m->points[i]->psi)
             point_couplings(m, m->points[i]);
@@ -410,9 +435,11 @@ void membrane_free(membrane *m)
     free(m->omega_model);
     free(m->q), free(m->p), free(m->c1), free(m->cd), free(m->c3);
     free(m->ep), free(m->psi_strike);
+    free(m->sc), free(m->ep_k);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
         free(m->psi_pick[i]);
         free(m->psi_pick_old[i]);
+        free(m->pick_k[i]);
     }
     for (int i = 0; i < IMPULSE_CACHE; i++)
         free(m->impulse_cache[i].psi);
@@ -720,20 +747,21 @@ ictus_status membrane_point_attach_(membrane *m, membrane_point *pt)
         return ICTUS_ENOMEM;
     if (pt->owner)
         membrane_point_detach_(pt->owner, pt);
-    float *arr[2];
+    float *arr[3];
     int ok = 1;
-    for (int j = 0; j < 2; j++) {
+    for (int j = 0; j < 3; j++) {
         arr[j] = alloc_floats(m->capacity);
         ok = ok && arr[j];
     }
     if (!ok) {
-        for (int j = 0; j < 2; j++)
+        for (int j = 0; j < 3; j++)
             free(arr[j]);
         return ICTUS_ENOMEM;
     }
-    free(pt->psi), free(pt->psi_next);
+    free(pt->psi), free(pt->psi_next), free(pt->psi_k);
     pt->psi = arr[0];
     pt->psi_next = arr[1];
+    pt->psi_k = arr[2];
     pt->psi_cap = m->capacity;
     pt->owner = m;
     pt->slot = m->point_count;
@@ -772,8 +800,8 @@ void membrane_point_free_(membrane_point *pt)
         return;
     if (pt->owner)
         membrane_point_detach_(pt->owner, pt);
-    free(pt->psi), free(pt->psi_next);
-    pt->psi = pt->psi_next = NULL;
+    free(pt->psi), free(pt->psi_next), free(pt->psi_k);
+    pt->psi = pt->psi_next = pt->psi_k = NULL;
     pt->psi_cap = 0;
 }
 
@@ -799,13 +827,14 @@ void membrane_point_move_(membrane_point *pt, double r_over_a, double theta_deg,
 
 /* Adds an input impulse (force F over one sample along shape psi) after the
  * step: linear, so it equals passing it through the step's input. Updates the
- * pickup sums and coupling-point displacements of this sample too. */
+ * pickup sums and coupling-point displacements of this sample too (a's shapes are
+ * the kernel's, times sc, as the state). */
 static void add_input(membrane *m, const float *psi, double force, membrane_kernel_args *a)
 {
     double dpick[MEMBRANE_PICKUPS] = {0}, dw[MEMBRANE_MAX_POINTS] = {0};
     for (int k = 0; k < m->count; k++) {
         float u = (float)force * psi[k];
-        float dq = m->ep[k] * u, dp = dq; /* r and p take the same input */
+        float dq = m->ep_k[k] * u, dp = dq; /* r and p take the same input */
         m->q[k] += dq;
         m->p[k] += dp;
         for (int j = 0; j < MEMBRANE_PICKUPS; j++)
@@ -820,11 +849,12 @@ static void add_input(membrane *m, const float *psi, double force, membrane_kern
         a->point_w[c] += dw[c];
 }
 
-static double point_displacement(const membrane *m, const float *psi)
+/* psi_k: a point's shapes times sc (the stored state's coordinates). */
+static double point_displacement(const membrane *m, const float *psi_k)
 {
     double w = 0.0;
     for (int k = 0; k < m->count; k++)
-        w += (double)psi[k] * m->q[k];
+        w += (double)psi_k[k] * m->q[k];
     return w * displacement_scale(m);
 }
 
@@ -835,7 +865,7 @@ static void land_point(membrane *m, membrane_point *pt)
 {
     if (pt->force_pending != 0.0) {
         for (int k = 0; k < m->count; k++) {
-            float du = m->ep[k] * ((float)pt->force_pending * pt->psi[k]);
+            float du = m->ep_k[k] * ((float)pt->force_pending * pt->psi[k]);
             m->q[k] += du;
             m->p[k] += du;
         }
@@ -848,7 +878,7 @@ static void land_point(membrane *m, membrane_point *pt)
     pt->move_pending = 0;
     point_couplings(m, pt);
     pt->force_pending = 0.0;
-    pt->ops->landed(pt, point_displacement(m, pt->psi));
+    pt->ops->landed(pt, point_displacement(m, pt->psi_k));
 }
 
 /* The first sample after `after` on which a pending move lands in a block of n, or n. */
@@ -879,14 +909,14 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
     memset(&a, 0, sizeof(a));
     a.count = m->count;
     a.q = m->q, a.p = m->p, a.c1 = m->c1, a.cd = m->cd, a.c3 = m->c3;
-    a.ep = m->ep;
+    a.ep = m->ep_k;
     a.input_scale = (float)displacement_scale(m);
     const double wscale = displacement_scale(m);
     a.psi_strike = m->psi_strike;
     /* Pickups computed: both, or only the first when nothing takes the second. */
     const int picks = (out && !out[1]) ? 1 : MEMBRANE_PICKUPS;
     for (int j = 0; j < picks; j++)
-        a.psi_pick[j] = m->psi_pick[j];
+        a.psi_pick[j] = m->pick_k[j];
     for (int c = 0; c < m->point_count; c++)
         m->points[c]->ops->block_begin(m->points[c], n);
     int next_landing = next_move(m, -1, n);
@@ -912,7 +942,7 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             membrane_point *pt = m->points[c];
             if (pt->active || pt->force_pending != 0.0) {
                 act[na] = pt;
-                a.point_psi[na] = pt->psi;
+                a.point_psi[na] = pt->psi_k;
                 a.point_force_pending[na] = (float)pt->force_pending;
                 na++;
             }
@@ -975,7 +1005,7 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
                  * 5 ms (the points' direct term uses the new place throughout). */
                 double old = 0.0;
                 for (int k = 0; k < m->count; k++)
-                    old += (double)m->psi_pick_old[j][k] * m->p[k];
+                    old += (double)m->psi_pick_old[j][k] * m->sc[k] * m->p[k];
                 double w = (double)m->pick_fade_left[j] / m->pick_fade_len;
                 y[j] = (1.0 - w) * y[j] + w * out_scale * (old + extra[j]);
                 m->pick_fade_left[j]--;
@@ -1015,6 +1045,7 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             for (int k = m->modes; k < m->count; k++) {
                 m->q[k] = m->p[k] = 0.0f;
                 m->c1[k] = m->cd[k] = m->c3[k] = m->ep[k] = 0.0f;
+                m->sc[k] = m->ep_k[k] = 0.0f;
                 m->omega_model[k] = 0.0;
             }
             m->fading_modes = m->modes;
@@ -1101,9 +1132,9 @@ static void effective_state(const membrane *m, int k, double *q, double *p)
     for (int i = 0; i < m->point_count; i++)
         if (m->points[i]->force_pending != 0.0)
             u += m->points[i]->force_pending * m->points[i]->psi[k];
-    /* q = h w' r (membrane_kernel.inc) */
-    *q = (m->q[k] + (double)m->ep[k] * u) * m->coef_h * m->omega_model[k];
-    *p = m->p[k] + (double)m->ep[k] * u;
+    /* q = h w' r, r = sc (stored q) (membrane_kernel.inc) */
+    *q = ((double)m->sc[k] * m->q[k] + (double)m->ep[k] * u) * m->coef_h * m->omega_model[k];
+    *p = (double)m->sc[k] * m->p[k] + (double)m->ep[k] * u;
 }
 
 static double point_sum(const membrane *m, double r_over_a, double theta_deg, int velocity)

@@ -14,16 +14,22 @@
 
 /* Arguments of one sample of the modal update (see membrane_kernel.inc). */
 typedef struct membrane_kernel_args {
-    int count;    /* modes to update, a multiple of MEMBRANE_PAD */
-    float *q, *p; /* r = q / (h w') and p (membrane.c, update_coefficients) */
-    const float *c1, *cd, *c3, *ep;
+    int count; /* modes to update, a multiple of MEMBRANE_PAD */
+    /* r / sc and p / sc, sc = sqrt(cd) per mode (r = q / (h w'); membrane.c,
+     * update_coefficients): in these coordinates a point's force goes in, and its
+     * displacement comes out, through one array, psi sc (membrane_kernel.inc). */
+    float *q, *p;
+    const float *c1, *cd, *c3;
+    const float *ep;   /* strike input gain, ep / sc = input_scale sc */
     float input_scale; /* scale h: ep = input_scale cd, w = input_scale sum psi r */
     const float *psi_strike;
     const float *psi_pick[MEMBRANE_PICKUPS];
     float strike_force; /* N, at the strike point, during this sample */
     int points;         /* coupling points whose displacement is wanted */
-    /* Per point: its mode shapes, zero for fading modes. A force F goes in as
-     * F input_scale psi cd into r and p; the displacement is input_scale sum psi r. */
+    /* Per point: its mode shapes times sc (psi_k), zero for fading modes. A force F
+     * goes in as F input_scale psi cd into r and p, i.e. F input_scale psi_k into
+     * r / sc and p / sc; the displacement is input_scale sum psi r = input_scale
+     * sum psi_k (r / sc). The pickups' shapes come times sc too. */
     const float *point_psi[MEMBRANE_MAX_POINTS];
     float point_force_pending[MEMBRANE_MAX_POINTS]; /* last sample's forces, not yet in q, p */
     double pick_sum[MEMBRANE_PICKUPS];              /* out: sum psi_pick * p */
@@ -77,6 +83,8 @@ struct membrane_point {
      * at the place of a pending move. Allocated by the membrane at its capacity
      * (psi_cap floats each), freed by membrane_point_free_. */
     float *psi, *psi_next;
+    /* psi sc (membrane.c): the kernel's copy, in the coordinates of its stored state. */
+    float *psi_k;
     int psi_cap;
     double r_over_a, theta_deg;
     /* A move waiting to land move_offset samples into the next membrane_process(). */
