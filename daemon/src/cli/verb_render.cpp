@@ -90,7 +90,7 @@ void render_usage(std::ostream &out)
            "  --ik-gain G         Algorithm 2's gain on the tip error (default 4)\n"
            "  --ik-velocity-gain S  tip velocity error term, s (default 0.03)\n"
            "  --ik-rotation-weight W  weight of the hands' rotation task (1; 0: off)\n"
-           "  --iterations N      ODE QuickStep iterations (default 15)\n"
+           "  --iterations N      ODE QuickStep iterations (default 13)\n"
            "  --sor-w W           QuickStep's over-relaxation (default 1.3, ODE's)\n"
            "  --ik-max-joint-speed R  the kinematic IK turns no arm joint faster than R\n"
            "                      rad/s (default 35; 0: no cap)\n"

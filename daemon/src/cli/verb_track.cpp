@@ -65,7 +65,7 @@ void track_usage(std::ostream &out)
            "                         it forwards and backwards)\n"
            "  --step S               physics step, s (default 0.001)\n"
            "  --stepper quick|direct dWorldQuickStep (default) or dWorldStep\n"
-           "  --iterations N         QuickStep iterations (default 15)\n"
+           "  --iterations N         QuickStep iterations (default 13)\n"
            "  --sor-w W              QuickStep's over-relaxation (default 1.3, ODE's)\n"
            "  --body-mass KG         body mass for de Leva's table (default 70)\n"
            "  --grip french|german   hand-stick orientation (default french)\n"

@@ -233,7 +233,7 @@ IkResult ChainIkSolverPos_dls::solve(const KinematicChain &chain,
             jjt_.diagonal().array() += 1e-12;
             projector_llt_.compute(jjt_);
             projector_ready = true;
-            jacobian_solved_ = projector_llt_.solve(jacobian_);
+            projector_llt_.solve(jacobian_, jacobian_solved_);
             Eigen::Matrix3d jd_jt = Eigen::Matrix3d::Zero();
             Eigen::Vector3d stick_turn_from_tip_step = Eigen::Vector3d::Zero();
             for (int j = 0; j < n; ++j) {

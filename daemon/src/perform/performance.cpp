@@ -412,8 +412,11 @@ std::unique_ptr<Performance::Rig> Performance::make_clip_rig(PerformanceOptions 
     const CharacterPose initial = r.reference.frame(0);
     r.base_gains = default_gains(r.model, initial, options.gains);
     scale_gains(r.base_gains, gain_scale_, r.gains);
-    // Eq. 1 on every joint: the tracker's joint mode, as `ictusd track --mode joint`.
-    r.tracker = std::make_unique<Tracker>(r.model, options.scene, initial, r.gains, r.limits.refs(),
+    // Eq. 1 on every joint: the tracker's joint mode, as `ictusd track --mode joint`,
+    // in its scene (track_scene_defaults: the pelvis a kinematic body, not welded).
+    SceneOptions scene = options.scene;
+    scene.pelvis_kinematic = track_scene_defaults().pelvis_kinematic;
+    r.tracker = std::make_unique<Tracker>(r.model, scene, initial, r.gains, r.limits.refs(),
                                           TrackMode::joint);
     r.ref_pose = initial;
     r.step_pose = initial;

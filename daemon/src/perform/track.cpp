@@ -111,6 +111,13 @@ CartesianOptions track_cartesian_defaults()
     return c;
 }
 
+SceneOptions track_scene_defaults()
+{
+    SceneOptions s;
+    s.pelvis_kinematic = true;
+    return s;
+}
+
 void validate(const TrackOptions &o)
 {
     validate(o.scene);

@@ -4,6 +4,7 @@
 #include "ictus/base/rotation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -25,6 +26,24 @@ void blend_pose(const CharacterPose &from, const CharacterPose &to, double w, Ch
 {
     out.pelvis_position_m = to.pelvis_position_m;
     out.pelvis_rotation = to.pelvis_rotation;
+    if (w == 1.0) {
+        // Past the ramp (every step but its first ramp_s): Eigen's slerp at t = 1
+        // has scale0 = sin(0)/sin(theta) = +0 and scale1 = sin(theta)/sin(theta) = 1
+        // (or 1 - t and t on its linear branch), negated for a negative dot. The
+        // same expression with those scales, without its acos and three sines:
+        // the same bits.
+        for (size_t j = 0; j < out.local.size(); ++j) {
+            const double d = from.local[j].dot(to.local[j]);
+            if (!std::isfinite(d)) {
+                out.local[j] = from.local[j].slerp(w, to.local[j]);
+                continue;
+            }
+            const double scale0 = 0.0, scale1 = d < 0.0 ? -1.0 : 1.0;
+            out.local[j] =
+                Eigen::Quaterniond(scale0 * from.local[j].coeffs() + scale1 * to.local[j].coeffs());
+        }
+        return;
+    }
     for (size_t j = 0; j < out.local.size(); ++j)
         out.local[j] = from.local[j].slerp(w, to.local[j]);
 }
@@ -153,9 +172,20 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
     const CharacterModel &model = scene_->model();
     const int nj = CharacterModel::kJoints;
     const double h = scene_->options().step_s;
+    // The reference's rates, where something reads them: not an arm's when tips
+    // drive the arms (the kinematic IK below gives its rate), nor a joint whose
+    // body the scene places instead of driving it (SceneOptions::legs_kinematic).
+    std::array<bool, CharacterModel::kJoints> rate_read;
+    for (int j = 0; j < nj; ++j)
+        rate_read[j] = !scene_->body_kinematic(j + 1);
+    if (tips)
+        for (int s = 0; s < 2; ++s)
+            for (int k = 0; k < 4; ++k)
+                rate_read[arms_[s]->joint[k]] = false;
     for (int j = 0; j < nj; ++j) {
         target_[j] = reference.local[j];
-        rate_[j] = log_map(target_[j] * previous_reference_[j].conjugate()) / h;
+        if (rate_read[j])
+            rate_[j] = log_map(target_[j] * previous_reference_[j].conjugate()) / h;
     }
     previous_reference_ = reference.local; // same size: no allocation
     const bool cartesian = mode_ == TrackMode::cartesian;

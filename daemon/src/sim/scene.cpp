@@ -1129,20 +1129,22 @@ bool Scene::motor_saturated(int joint) const
     return false;
 }
 
+// One square root for the largest: sqrt is monotone and correctly rounded, so
+// sqrt(max |v|^2) is max sqrt(|v|^2) = max |v| (Eigen's norm()) bit for bit.
 double Scene::max_linear_speed_mps() const
 {
-    double m = 0.0;
+    double m2 = 0.0;
     for (dBodyID b : body_)
-        m = std::max(m, to_eigen3(dBodyGetLinearVel(b)).norm());
-    return m;
+        m2 = std::max(m2, to_eigen3(dBodyGetLinearVel(b)).squaredNorm());
+    return std::sqrt(m2);
 }
 
 double Scene::max_angular_speed_rad_s() const
 {
-    double m = 0.0;
+    double m2 = 0.0;
     for (dBodyID b : body_)
-        m = std::max(m, to_eigen3(dBodyGetAngularVel(b)).norm());
-    return m;
+        m2 = std::max(m2, to_eigen3(dBodyGetAngularVel(b)).squaredNorm());
+    return std::sqrt(m2);
 }
 
 void Scene::kick(int body, const Eigen::Vector3d &dv, const Eigen::Vector3d &dw)

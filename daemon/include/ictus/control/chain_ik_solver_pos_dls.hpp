@@ -4,6 +4,7 @@
 // See docs/ik.md for the maths, the choice of the damping and how the character uses it.
 #pragma once
 
+#include "ictus/base/cholesky3.hpp"
 #include "ictus/control/kinematic_chain.hpp"
 
 #include <Eigen/Cholesky>
@@ -126,15 +127,15 @@ class ChainIkSolverPos_dls
     std::array<ChainFrames, 2> frames_;
     Jacobian jacobian_;
     Eigen::Matrix3d jjt_, jjt_undamped_;
-    Eigen::LLT<Eigen::Matrix3d> llt_;
+    Cholesky3 llt_;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen_;
     JointVector step_, posture_step_;
     // Secondary (stick direction) task.
-    Eigen::LLT<Eigen::Matrix3d> projector_llt_;
+    Cholesky3 projector_llt_;
     Jacobian jacobian_solved_;
     Jacobian direction_jacobian_;
     Eigen::Matrix3d direction_jjt_;
-    Eigen::LLT<Eigen::Matrix3d> direction_llt_;
+    Cholesky3 direction_llt_;
 };
 
 } // namespace ictus

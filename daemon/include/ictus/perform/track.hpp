@@ -26,6 +26,11 @@ namespace ictus
 // CartesianOptions' own defaults.)
 CartesianOptions track_cartesian_defaults();
 
+// `ictusd track`'s scene: SceneOptions' own, with the pelvis a kinematic body
+// (SceneOptions::pelvis_kinematic) instead of welded: the same fixed pelvis
+// without the weld's six rows in QuickStep (docs/benchmarks.md, issue 16).
+SceneOptions track_scene_defaults();
+
 // The reference clean-up of `ictusd track` and `ictusd limits`: one-frame
 // spikes over 5 degrees replaced, then the zero-phase Butterworth low-pass at
 // 10 Hz (flat through a drummer's 4-8 Hz strokes; the Gaussian at the same
@@ -36,7 +41,7 @@ ReferenceFilter track_reference_filter();
 struct TrackOptions {
     TrackMode mode = TrackMode::joint;
     CartesianOptions cartesian = track_cartesian_defaults();
-    SceneOptions scene;
+    SceneOptions scene = track_scene_defaults();
     GainOptions gains;
     // Simulated time; 0 means the reference's length (longer runs play it
     // back and forth).

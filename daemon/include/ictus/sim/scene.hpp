@@ -70,7 +70,7 @@ constexpr double kDefaultGripDampingRatio = 0.7;
 struct SceneOptions {
     double step_s = 0.001;
     Stepper stepper = Stepper::quick;
-    int quickstep_iterations = 15;
+    int quickstep_iterations = 13;
     // QuickStep's successive over-relaxation factor (dWorldSetQuickStepW), 0..2
     // exclusive; ODE's default is 1.3.
     double quickstep_w = 1.3;
