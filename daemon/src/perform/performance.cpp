@@ -210,6 +210,7 @@ struct Performance::PlanState {
     std::array<std::vector<double>, 2> beats, lead_s, approach_mps;
     std::array<std::vector<double>, 2> firmness; // < 0: the performance's
     std::array<std::vector<bool>, 2> press;      // a buzz: loose from its beat on
+    std::array<std::vector<bool>, 2> down;       // a down stroke: firm until the next beat
     std::array<size_t, 2> grip_note = {0, 0};    // the note whose grip is applied
     std::vector<double> planned_speed_mps;       // [note of plan]
 };
@@ -968,6 +969,15 @@ std::unique_ptr<Performance::PlanState> Performance::make_plan(std::shared_ptr<c
             ps->press[s].push_back(press);
             ps->planned_speed_mps[i] = v;
         }
+        // Down strokes: a stroke followed soon by a much softer one of the
+        // same hand, neither with a grip of its own.
+        const size_t count = ps->beats[s].size();
+        ps->down[s].assign(count, false);
+        for (size_t k = 0; k + 1 < count; ++k)
+            ps->down[s][k] = ps->firmness[s][k] < 0.0 && ps->firmness[s][k + 1] < 0.0 &&
+                             !ps->press[s][k + 1] &&
+                             ps->beats[s][k + 1] - ps->beats[s][k] <= kDownStrokeGap_s &&
+                             ps->approach_mps[s][k + 1] < kDownStrokeRatio * ps->approach_mps[s][k];
     }
     return ps;
 }
@@ -1378,8 +1388,11 @@ void Performance::apply_note_grips(double t)
         while (k + 1 < beats.size() && t > 0.5 * (beats[k] + beats[k + 1]))
             ++k;
         const bool before_press = ps.press[s][k] && t < beats[k];
-        const double f =
-            ps.firmness[s][k] >= 0.0 && !before_press ? ps.firmness[s][k] : options_.grip_firmness;
+        // A down stroke holds the stick firm from its strike to the next beat.
+        const bool down = t >= beats[k] ? ps.down[s][k] : k > 0 && ps.down[s][k - 1];
+        const double f = down                                        ? kDownStrokeGripFirmness
+                         : ps.firmness[s][k] >= 0.0 && !before_press ? ps.firmness[s][k]
+                                                                     : options_.grip_firmness;
         if (f != applied_firmness_[s]) {
             score_rig_->tracker->scene().set_grip_firmness(static_cast<Side>(s), f);
             applied_firmness_[s] = f;

@@ -208,6 +208,14 @@ class Performance
     // /ictus/gains command.
     // The grip of a buzz note that gives none (docs/perform.md, "Buzz").
     static constexpr double kBuzzGripFirmness = 0.0;
+    // A down stroke (drumming pedagogy: a stroke that stops the stick low,
+    // for a soft note next): a stroke whose next note of the same hand comes
+    // within kDownStrokeGap_s and hits at under kDownStrokeRatio of its
+    // planned speed is held with this firmness from its strike to that next
+    // beat, unless either note gives its own grip (docs/perform.md).
+    static constexpr double kDownStrokeGripFirmness = 0.8;
+    static constexpr double kDownStrokeGap_s = 0.25;
+    static constexpr double kDownStrokeRatio = 0.5;
     static constexpr double kRunawayTipSpeed_mps = 40.0;
     static constexpr double kRunawayQuiet_s = 1.0;
     long runaways() const { return runaways_; }
