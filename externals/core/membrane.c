@@ -73,6 +73,7 @@ struct membrane {
     membrane_point *points[MEMBRANE_MAX_POINTS];
     int point_count;
     void (*kernel)(membrane_kernel_args *);
+    void (*kernel_pair)(membrane_kernel_args *); /* two samples per pass, same instruction set */
 };
 
 /* ---------------------------------------------------------------- helpers */
@@ -371,6 +372,20 @@ static void point_couplings(membrane *m, membrane_point *pt)
         pt->pick_coupling[j] = dot_psi(m, m->psi_pick[j], pt->psi, m->ep);
     for (int k = 0; k < m->capacity; k++)
         pt->psi_k[k] = pt->psi[k] * m->sc[k];
+    /* Two samples per pass: G g per unit force, g = psi_k in both rows, is
+     * psi_k (1 - c1 + cd) in r and psi_k (1 - c1 - c3) in p (membrane_kernel.inc). */
+    double sw = 0.0, sp[MEMBRANE_PICKUPS] = {0};
+    for (int k = 0; k < m->count; k++) {
+        double g = pt->psi_k[k];
+        double gr = g * (1.0 - (double)m->c1[k] + m->cd[k]);
+        double gp = g * (1.0 - (double)m->c1[k] - m->c3[k]);
+        sw += g * gr;
+        for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+            sp[j] += (double)m->psi_pick[j][k] * m->sc[k] * gp;
+    }
+    pt->pair_w = sw;
+    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+        pt->pair_pick[j] = sp[j];
 }
 
 /* The shapes and couplings in the kernel's coordinates, after the coefficients, the
@@ -408,16 +423,22 @@ membrane *membrane_new(double sample_rate_hz)
     m->pick_r[1] = 0.5;
     m->pick_theta[1] = 90.0;
     m->kernel = membrane_kernel_generic;
+    m->kernel_pair = membrane_kernel_pair_generic;
 #if defined(MEMBRANE_X86) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
     __builtin_cpu_init();
     if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    {
         m->kernel = membrane_kernel_avx2;
+        m->kernel_pair = membrane_kernel_pair_avx2;
+    }
 #endif
     /* ICTUS_MEMBRANE_KERNEL=generic picks the portable kernel on any machine, e.g.
      * to benchmark it inside Pd (bench/peers); read when the object is made. */
     const char *want = getenv("ICTUS_MEMBRANE_KERNEL");
-    if (want && strcmp(want, "generic") == 0)
+    if (want && strcmp(want, "generic") == 0) {
         m->kernel = membrane_kernel_generic;
+        m->kernel_pair = membrane_kernel_pair_generic;
+    }
     if (build_modes(m, MEMBRANE_DEFAULT_MODES) != ICTUS_OK) {
         membrane_free(m);
         return NULL;
@@ -449,6 +470,7 @@ void membrane_free(membrane *m)
 void membrane_use_generic_kernel_(membrane *m)
 {
     m->kernel = membrane_kernel_generic;
+    m->kernel_pair = membrane_kernel_pair_generic;
 }
 
 const char *membrane_kernel_name(const membrane *m)
@@ -893,6 +915,78 @@ static int next_move(const membrane *m, int after, int n)
     return next;
 }
 
+/* Sample i's output from the kernel's pickup sums and the points' direct terms
+ * (extra): the gain's smoothing, a moved pickup's crossfade, the overflow guard.
+ * 0 when the state overflowed and was cleared. */
+static int emit_sample(membrane *m, const double *pick_sum, const double *extra, int picks,
+                       float *const *out, int i, double gain_coef)
+{
+    double y[MEMBRANE_PICKUPS];
+    int finite = 1;
+    if (m->gain_smoothed != m->output_gain) {
+        m->gain_smoothed += (m->output_gain - m->gain_smoothed) * gain_coef;
+        if (fabs(m->gain_smoothed - m->output_gain) <= 1e-9 * fabs(m->output_gain))
+            m->gain_smoothed = m->output_gain;
+    }
+    const double out_scale = m->gain_smoothed * m->mass_scale;
+    y[1] = 0.0;
+    for (int j = 0; j < picks; j++) {
+        y[j] = out_scale * (pick_sum[j] + extra[j]);
+        if (m->pick_fade_left[j] > 0) {
+            /* Crossfade from a moved pickup: one more dot product per sample for
+             * 5 ms (the points' direct term uses the new place throughout). */
+            double old = 0.0;
+            for (int k = 0; k < m->count; k++)
+                old += (double)m->psi_pick_old[j][k] * m->sc[k] * m->p[k];
+            double w = (double)m->pick_fade_left[j] / m->pick_fade_len;
+            y[j] = (1.0 - w) * y[j] + w * out_scale * (old + extra[j]);
+            m->pick_fade_left[j]--;
+        }
+        finite = finite && fabs(y[j]) <= FLT_MAX;
+    }
+    if (picks < MEMBRANE_PICKUPS && m->pick_fade_left[1] > 0)
+        m->pick_fade_left[1]--; /* the skipped pickup's crossfade runs on */
+    if (!finite) {
+        /* Last line of defence (never reached with legal inputs in the tests):
+         * a state that overflowed float is silenced rather than sent out. */
+        membrane_clear(m);
+        y[0] = y[1] = 0.0;
+    }
+    for (int j = 0; j < MEMBRANE_PICKUPS; j++) {
+        if (out && out[j])
+            out[j][i] = (float)y[j];
+    }
+    return finite;
+}
+
+/* Two samples per pass leave the first one's force F as G g F not yet in the
+ * state (membrane_kernel.inc, the pair kernel): folded in here when the next
+ * sample is not a pair, in the kernel's arithmetic. */
+static void fold_pair_force(membrane *m, const membrane_point *pt, float force, float input_scale)
+{
+    const float f = force * input_scale;
+    for (int k = 0; k < m->count; k++) {
+        float ga = f * pt->psi_k[k];
+        float e = m->c1[k] * ga;
+        float base = ga - e;
+        m->q[k] += base + m->cd[k] * ga;
+        m->p[k] += base - m->c3[k] * ga;
+    }
+}
+
+/* Sample i and i + 1 can run as one pass: no strike force in either (checked by
+ * the caller), no landing at i + 1, no strike queued at either, no crossfade. */
+static int pair_ok(const membrane *m, int i, int n, int next_landing)
+{
+    if (i + 1 >= n || next_landing == i + 1 || m->pick_fade_left[0] > 0 ||
+        m->pick_fade_left[1] > 0)
+        return 0;
+    for (int s = 0; s < m->queued; s++)
+        if (m->queue[s].offset == i || m->queue[s].offset == i + 1)
+            return 0;
+    return 1;
+}
+
 void membrane_process(membrane *m, const float *force_in, float *const *out, int n)
 {
 #ifdef MEMBRANE_X86
@@ -920,6 +1014,10 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
     for (int c = 0; c < m->point_count; c++)
         m->points[c]->ops->block_begin(m->points[c], n);
     int next_landing = next_move(m, -1, n);
+    /* After a two-sample pass: pend_pt's force of two samples ago, whose input is
+     * not yet in the state (fold_pair_force), or NULL. */
+    const membrane_point *pend_pt = NULL;
+    float pend_a = 0.0f;
 
     for (int i = 0; i < n; i++) {
         float fin = force_in ? force_in[i] : 0.0f;
@@ -927,6 +1025,9 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             fin = 0.0f;
         /* Points landing now. */
         if (i == next_landing) {
+            if (pend_pt)
+                fold_pair_force(m, pend_pt, pend_a, a.input_scale);
+            pend_pt = NULL;
             for (int c = 0; c < m->point_count; c++) {
                 membrane_point *pt = m->points[c];
                 if (pt->move_pending && pt->move_offset == i)
@@ -948,6 +1049,62 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             }
         }
         a.points = na;
+        if (pend_pt && !(na == 1 && act[0] == pend_pt)) {
+            fold_pair_force(m, pend_pt, pend_a, a.input_scale);
+            pend_pt = NULL;
+        }
+        float fin1 = (force_in && i + 1 < n) ? force_in[i + 1] : 0.0f;
+        if (na <= 1 && fin == 0.0f && (fin1 == 0.0f || !isfinite(fin1)) &&
+            pair_ok(m, i, n, next_landing)) {
+            /* Samples i and i + 1 in one pass over the modes (membrane_kernel.inc). */
+            membrane_point *pt = na ? act[0] : NULL;
+            a.point_force_pending2 = pend_pt ? pend_a : 0.0f;
+            pend_pt = NULL;
+            a.strike_force = 0.0f;
+            m->kernel_pair(&a);
+            double extra[MEMBRANE_PICKUPS] = {0};
+            if (pt) {
+                pt->force_pending = 0.0;
+                if (pt->active) {
+                    double w = a.point_w[0] * wscale, K[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
+                    K[0][0] = pt->self_compliance;
+                    pt->ops->solve(act, 1, &w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
+                                   extra);
+                }
+            }
+            if (!emit_sample(m, a.pick_sum, extra, picks, out, i, gain_coef))
+                continue; /* cleared: sample i + 1 from the silent state, one at a time */
+            i++;
+            double ps[MEMBRANE_PICKUPS] = {a.pick_sum2[0], a.pick_sum2[1]};
+            double extra2[MEMBRANE_PICKUPS] = {0};
+            if (pt && pt->force_pending != 0.0) {
+                /* The first sample's force: its input G g F1 is not in the stored y. */
+                pend_a = (float)pt->force_pending;
+                pend_pt = pt;
+                pt->force_pending = 0.0;
+                const double f1 = (double)(pend_a * a.input_scale);
+                for (int j = 0; j < picks; j++)
+                    ps[j] += f1 * pt->pair_pick[j];
+                if (pt->active) {
+                    double w = (a.point_w2 + f1 * pt->pair_w) * wscale;
+                    double K[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
+                    K[0][0] = pt->self_compliance;
+                    pt->ops->solve(act, 1, &w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
+                                   extra2);
+                }
+            } else if (pt && pt->active) {
+                double w = a.point_w2 * wscale, K[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
+                K[0][0] = pt->self_compliance;
+                pt->ops->solve(act, 1, &w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i, extra2);
+            }
+            if (!emit_sample(m, ps, extra2, picks, out, i, gain_coef))
+                pend_pt = NULL;
+            continue;
+        }
+        if (pend_pt) {
+            fold_pair_force(m, pend_pt, pend_a, a.input_scale);
+            pend_pt = NULL;
+        }
         a.strike_force = fin;
         m->kernel(&a);
         for (int c = 0; c < na; c++)
@@ -989,42 +1146,10 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             act[0]->ops->solve(act, nact, a.point_w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
                                extra);
         }
-        double y[MEMBRANE_PICKUPS];
-        int finite = 1;
-        if (m->gain_smoothed != m->output_gain) {
-            m->gain_smoothed += (m->output_gain - m->gain_smoothed) * gain_coef;
-            if (fabs(m->gain_smoothed - m->output_gain) <= 1e-9 * fabs(m->output_gain))
-                m->gain_smoothed = m->output_gain;
-        }
-        const double out_scale = m->gain_smoothed * m->mass_scale;
-        y[1] = 0.0;
-        for (int j = 0; j < picks; j++) {
-            y[j] = out_scale * (a.pick_sum[j] + extra[j]);
-            if (m->pick_fade_left[j] > 0) {
-                /* Crossfade from a moved pickup: one more dot product per sample for
-                 * 5 ms (the points' direct term uses the new place throughout). */
-                double old = 0.0;
-                for (int k = 0; k < m->count; k++)
-                    old += (double)m->psi_pick_old[j][k] * m->sc[k] * m->p[k];
-                double w = (double)m->pick_fade_left[j] / m->pick_fade_len;
-                y[j] = (1.0 - w) * y[j] + w * out_scale * (old + extra[j]);
-                m->pick_fade_left[j]--;
-            }
-            finite = finite && fabs(y[j]) <= FLT_MAX;
-        }
-        if (picks < MEMBRANE_PICKUPS && m->pick_fade_left[1] > 0)
-            m->pick_fade_left[1]--; /* the skipped pickup's crossfade runs on */
-        if (!finite) {
-            /* Last line of defence (never reached with legal inputs in the tests):
-             * a state that overflowed float is silenced rather than sent out. */
-            membrane_clear(m);
-            y[0] = y[1] = 0.0;
-        }
-        for (int j = 0; j < MEMBRANE_PICKUPS; j++) {
-            if (out && out[j])
-                out[j][i] = (float)y[j];
-        }
+        emit_sample(m, a.pick_sum, extra, picks, out, i, gain_coef);
     }
+    if (pend_pt)
+        fold_pair_force(m, pend_pt, pend_a, a.input_scale);
     /* Carry pending strikes and moves past this block. */
     int kept = 0;
     for (int s = 0; s < m->queued; s++) {
