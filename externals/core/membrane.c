@@ -372,20 +372,6 @@ static void point_couplings(membrane *m, membrane_point *pt)
         pt->pick_coupling[j] = dot_psi(m, m->psi_pick[j], pt->psi, m->ep);
     for (int k = 0; k < m->capacity; k++)
         pt->psi_k[k] = pt->psi[k] * m->sc[k];
-    /* Two samples per pass: G g per unit force, g = psi_k in both rows, is
-     * psi_k (1 - c1 + cd) in r and psi_k (1 - c1 - c3) in p (membrane_kernel.inc). */
-    double sw = 0.0, sp[MEMBRANE_PICKUPS] = {0};
-    for (int k = 0; k < m->count; k++) {
-        double g = pt->psi_k[k];
-        double gr = g * (1.0 - (double)m->c1[k] + m->cd[k]);
-        double gp = g * (1.0 - (double)m->c1[k] - m->c3[k]);
-        sw += g * gr;
-        for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-            sp[j] += (double)m->psi_pick[j][k] * m->sc[k] * gp;
-    }
-    pt->pair_w = sw;
-    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-        pt->pair_pick[j] = sp[j];
 }
 
 /* The shapes and couplings in the kernel's coordinates, after the coefficients, the
@@ -426,8 +412,7 @@ membrane *membrane_new(double sample_rate_hz)
     m->kernel_pair = membrane_kernel_pair_generic;
 #if defined(MEMBRANE_X86) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
     __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-    {
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
         m->kernel = membrane_kernel_avx2;
         m->kernel_pair = membrane_kernel_pair_avx2;
     }
@@ -959,28 +944,17 @@ static int emit_sample(membrane *m, const double *pick_sum, const double *extra,
     return finite;
 }
 
-/* Two samples per pass leave the first one's force F as G g F not yet in the
- * state (membrane_kernel.inc, the pair kernel): folded in here when the next
- * sample is not a pair, in the kernel's arithmetic. */
-static void fold_pair_force(membrane *m, const membrane_point *pt, float force, float input_scale)
+/* Samples i and i + 1 of a block of n can run as one free pass (the pair kernel,
+ * membrane_kernel.inc): no point folded in at i (the caller checks), no strike
+ * force at either, no landing at i + 1 (a point could join), no strike queued at
+ * either (it goes into the state after sample i), no pickup crossfade (it reads
+ * the state after each sample). */
+static int pair_ok(const membrane *m, const float *force_in, int i, int n, int next_landing)
 {
-    const float f = force * input_scale;
-    for (int k = 0; k < m->count; k++) {
-        float ga = f * pt->psi_k[k];
-        float e = m->c1[k] * ga;
-        float base = ga - e;
-        m->q[k] += base + m->cd[k] * ga;
-        m->p[k] += base - m->c3[k] * ga;
-    }
-}
-
-/* Sample i and i + 1 can run as one pass: no strike force in either (checked by
- * the caller), no landing at i + 1, no strike queued at either, no crossfade. */
-static int pair_ok(const membrane *m, int i, int n, int next_landing)
-{
-    if (i + 1 >= n || next_landing == i + 1 || m->pick_fade_left[0] > 0 ||
-        m->pick_fade_left[1] > 0)
+    if (i + 1 >= n || next_landing == i + 1 || m->pick_fade_left[0] > 0 || m->pick_fade_left[1] > 0)
         return 0;
+    if (force_in && (force_in[i] != 0.0f || force_in[i + 1] != 0.0f))
+        return 0; /* NaN and inf (read as 0) take the one-sample path too */
     for (int s = 0; s < m->queued; s++)
         if (m->queue[s].offset == i || m->queue[s].offset == i + 1)
             return 0;
@@ -1014,10 +988,6 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
     for (int c = 0; c < m->point_count; c++)
         m->points[c]->ops->block_begin(m->points[c], n);
     int next_landing = next_move(m, -1, n);
-    /* After a two-sample pass: pend_pt's force of two samples ago, whose input is
-     * not yet in the state (fold_pair_force), or NULL. */
-    const membrane_point *pend_pt = NULL;
-    float pend_a = 0.0f;
 
     for (int i = 0; i < n; i++) {
         float fin = force_in ? force_in[i] : 0.0f;
@@ -1025,9 +995,6 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             fin = 0.0f;
         /* Points landing now. */
         if (i == next_landing) {
-            if (pend_pt)
-                fold_pair_force(m, pend_pt, pend_a, a.input_scale);
-            pend_pt = NULL;
             for (int c = 0; c < m->point_count; c++) {
                 membrane_point *pt = m->points[c];
                 if (pt->move_pending && pt->move_offset == i)
@@ -1049,63 +1016,18 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             }
         }
         a.points = na;
-        if (pend_pt && !(na == 1 && act[0] == pend_pt)) {
-            fold_pair_force(m, pend_pt, pend_a, a.input_scale);
-            pend_pt = NULL;
-        }
-        float fin1 = (force_in && i + 1 < n) ? force_in[i + 1] : 0.0f;
-        if (na <= 1 && fin == 0.0f && (fin1 == 0.0f || !isfinite(fin1)) &&
-            pair_ok(m, i, n, next_landing)) {
-            /* Samples i and i + 1 in one pass over the modes (membrane_kernel.inc). */
-            membrane_point *pt = na ? act[0] : NULL;
-            a.point_force_pending2 = pend_pt ? pend_a : 0.0f;
-            pend_pt = NULL;
-            a.strike_force = 0.0f;
+        a.strike_force = fin;
+        if (na == 0 && pair_ok(m, force_in, i, n, next_landing)) {
+            /* Ringing freely: samples i and i + 1 in one pass, bit-identical to two. */
             m->kernel_pair(&a);
-            double extra[MEMBRANE_PICKUPS] = {0};
-            if (pt) {
-                pt->force_pending = 0.0;
-                if (pt->active) {
-                    double w = a.point_w[0] * wscale, K[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
-                    K[0][0] = pt->self_compliance;
-                    pt->ops->solve(act, 1, &w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
-                                   extra);
-                }
+            const double none[MEMBRANE_PICKUPS] = {0};
+            if (emit_sample(m, a.pick_sum, none, picks, out, i, gain_coef)) {
+                i++;
+                emit_sample(m, a.pick_sum2, none, picks, out, i, gain_coef);
             }
-            if (!emit_sample(m, a.pick_sum, extra, picks, out, i, gain_coef))
-                continue; /* cleared: sample i + 1 from the silent state, one at a time */
-            i++;
-            double ps[MEMBRANE_PICKUPS] = {a.pick_sum2[0], a.pick_sum2[1]};
-            double extra2[MEMBRANE_PICKUPS] = {0};
-            if (pt && pt->force_pending != 0.0) {
-                /* The first sample's force: its input G g F1 is not in the stored y. */
-                pend_a = (float)pt->force_pending;
-                pend_pt = pt;
-                pt->force_pending = 0.0;
-                const double f1 = (double)(pend_a * a.input_scale);
-                for (int j = 0; j < picks; j++)
-                    ps[j] += f1 * pt->pair_pick[j];
-                if (pt->active) {
-                    double w = (a.point_w2 + f1 * pt->pair_w) * wscale;
-                    double K[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
-                    K[0][0] = pt->self_compliance;
-                    pt->ops->solve(act, 1, &w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
-                                   extra2);
-                }
-            } else if (pt && pt->active) {
-                double w = a.point_w2 * wscale, K[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
-                K[0][0] = pt->self_compliance;
-                pt->ops->solve(act, 1, &w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i, extra2);
-            }
-            if (!emit_sample(m, ps, extra2, picks, out, i, gain_coef))
-                pend_pt = NULL;
+            /* else the state was cleared after sample i: i + 1 runs from it alone */
             continue;
         }
-        if (pend_pt) {
-            fold_pair_force(m, pend_pt, pend_a, a.input_scale);
-            pend_pt = NULL;
-        }
-        a.strike_force = fin;
         m->kernel(&a);
         for (int c = 0; c < na; c++)
             act[c]->force_pending = 0.0;
@@ -1148,8 +1070,6 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
         }
         emit_sample(m, a.pick_sum, extra, picks, out, i, gain_coef);
     }
-    if (pend_pt)
-        fold_pair_force(m, pend_pt, pend_a, a.input_scale);
     /* Carry pending strikes and moves past this block. */
     int kept = 0;
     for (int s = 0; s < m->queued; s++) {

@@ -34,14 +34,8 @@ typedef struct membrane_kernel_args {
     float point_force_pending[MEMBRANE_MAX_POINTS]; /* last sample's forces, not yet in q, p */
     double pick_sum[MEMBRANE_PICKUPS];              /* out: sum psi_pick * p */
     double point_w[MEMBRANE_MAX_POINTS];            /* out: sum psi * r (unscaled) */
-    /* Two samples per pass (membrane_kernel_pair_*, no strike force, at most one
-     * point): the force of two samples ago, whose input G g F is not yet in q, p
-     * (the pass stores the free part of the second sample's state), and the second
-     * sample's free sums (without the first sample's force, which membrane.c adds as
-     * F times a precomputed scalar). */
-    float point_force_pending2;
+    /* out, membrane_kernel_pair_*: the second sample's sums (ringing freely). */
     double pick_sum2[MEMBRANE_PICKUPS];
-    double point_w2;
 } membrane_kernel_args;
 
 void membrane_kernel_generic(membrane_kernel_args *a);
@@ -104,10 +98,6 @@ struct membrane_point {
     double force_pending;   /* N, the last force, not yet added to the modal state */
     double self_compliance; /* K = d w / d F over one sample (m/N) */
     double pick_coupling[MEMBRANE_PICKUPS];
-    /* Two samples per pass (membrane.c): the second sample's displacement and pickup
-     * sums per unit of the first sample's force, sum psi_k (G g)_r and
-     * sum pick_k (G g)_p, g = psi_k (unscaled, as the kernel's sums). */
-    double pair_w, pair_pick[MEMBRANE_PICKUPS];
 };
 
 /* Attaches pt (ops set, arrays NULL or from an earlier attach) to m: computes its
