@@ -903,8 +903,10 @@ static int next_move(const membrane *m, int after, int n)
 /* Sample i's output from the kernel's pickup sums and the points' direct terms
  * (extra): the gain's smoothing, a moved pickup's crossfade, the overflow guard.
  * 0 when the state overflowed and was cleared. */
-static int emit_sample(membrane *m, const double *pick_sum, const double *extra, int picks,
-                       float *const *out, int i, double gain_coef)
+static inline __attribute__((always_inline)) int emit_sample(membrane *m, const double *pick_sum,
+                                                             const double *extra, int picks,
+                                                             float *const *out, int i,
+                                                             double gain_coef)
 {
     double y[MEMBRANE_PICKUPS];
     int finite = 1;
