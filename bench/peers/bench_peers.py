@@ -18,7 +18,7 @@ otherwise identical empty patch is subtracted):
   50 g     the same hits with contact~'s default 50 g stick (same tip): a drumstick,
            which bounces off (in contact ~9 % of the samples, solved ~20 %)
   before   the same patch with another build's Pd library (--before DIR), if given,
-           with the run-time selected kernel and with the generic one
+           with the run-time selected kernel and with the generic one, and its 50 g case
   bp~      N vanilla [bp~ f 10] fed by one [noise~]
   SDT      the Sound Design Toolkit's impact interactor + modal resonator
            (peer_sdt.py, pysdt from PyPI: SDT's Pd externals are not packaged);
@@ -165,6 +165,9 @@ def drum_round(r, results):
             cases.append(("before generic",
                           lambda: pd_run(ictus_patch(before, n, s_ictus), "before-generic-%d" % n,
                                          generic), s_ictus))
+            cases.append(("before 50 g",
+                          lambda: pd_run(ictus_patch(before, n, s_ictus, mass=0.05),
+                                         "before-stick-%d" % n), s_ictus))
         if "bp" not in skip:
             cases.append(("bp~", lambda: pd_run(bp_patch(n, s_bp), "bp-%d" % n), s_bp))
         for name, fn, s in cases:
@@ -275,7 +278,7 @@ def per_round_ratio(a, b):
 print("\nDrum in Pd, ns per mode per sample (best round), "
       "and peer / ictus avx2 (median of the per-round ratios)")
 cols = (["ictus avx2", "ictus generic", "ictus stereo", "ictus 50 g"]
-        + (["before avx2", "before generic"] if args.before else [])
+        + (["before avx2", "before generic", "before 50 g"] if args.before else [])
         + ([] if "bp" in skip else ["bp~"]) + ([] if "sdt" in skip else ["SDT"]))
 if "drum" not in skip:
     print("%6s " % "N" + " ".join("%14s" % c for c in cols) + "   peer / ictus avx2")

@@ -73,6 +73,7 @@ struct membrane {
     membrane_point *points[MEMBRANE_MAX_POINTS];
     int point_count;
     void (*kernel)(membrane_kernel_args *);
+    void (*kernel_pair)(membrane_kernel_args *); /* two samples per pass, same instruction set */
 };
 
 /* ---------------------------------------------------------------- helpers */
@@ -408,16 +409,21 @@ membrane *membrane_new(double sample_rate_hz)
     m->pick_r[1] = 0.5;
     m->pick_theta[1] = 90.0;
     m->kernel = membrane_kernel_generic;
+    m->kernel_pair = membrane_kernel_pair_generic;
 #if defined(MEMBRANE_X86) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
     __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
         m->kernel = membrane_kernel_avx2;
+        m->kernel_pair = membrane_kernel_pair_avx2;
+    }
 #endif
     /* ICTUS_MEMBRANE_KERNEL=generic picks the portable kernel on any machine, e.g.
      * to benchmark it inside Pd (bench/peers); read when the object is made. */
     const char *want = getenv("ICTUS_MEMBRANE_KERNEL");
-    if (want && strcmp(want, "generic") == 0)
+    if (want && strcmp(want, "generic") == 0) {
         m->kernel = membrane_kernel_generic;
+        m->kernel_pair = membrane_kernel_pair_generic;
+    }
     if (build_modes(m, MEMBRANE_DEFAULT_MODES) != ICTUS_OK) {
         membrane_free(m);
         return NULL;
@@ -449,6 +455,7 @@ void membrane_free(membrane *m)
 void membrane_use_generic_kernel_(membrane *m)
 {
     m->kernel = membrane_kernel_generic;
+    m->kernel_pair = membrane_kernel_pair_generic;
 }
 
 const char *membrane_kernel_name(const membrane *m)
@@ -893,6 +900,69 @@ static int next_move(const membrane *m, int after, int n)
     return next;
 }
 
+/* Sample i's output from the kernel's pickup sums and the points' direct terms
+ * (extra): the gain's smoothing, a moved pickup's crossfade, the overflow guard.
+ * 0 when the state overflowed and was cleared. */
+static inline __attribute__((always_inline)) int emit_sample(membrane *m, const double *pick_sum,
+                                                             const double *extra, int picks,
+                                                             float *const *out, int i,
+                                                             double gain_coef)
+{
+    double y[MEMBRANE_PICKUPS];
+    int finite = 1;
+    if (m->gain_smoothed != m->output_gain) {
+        m->gain_smoothed += (m->output_gain - m->gain_smoothed) * gain_coef;
+        if (fabs(m->gain_smoothed - m->output_gain) <= 1e-9 * fabs(m->output_gain))
+            m->gain_smoothed = m->output_gain;
+    }
+    const double out_scale = m->gain_smoothed * m->mass_scale;
+    y[1] = 0.0;
+    for (int j = 0; j < picks; j++) {
+        y[j] = out_scale * (pick_sum[j] + extra[j]);
+        if (m->pick_fade_left[j] > 0) {
+            /* Crossfade from a moved pickup: one more dot product per sample for
+             * 5 ms (the points' direct term uses the new place throughout). */
+            double old = 0.0;
+            for (int k = 0; k < m->count; k++)
+                old += (double)m->psi_pick_old[j][k] * m->sc[k] * m->p[k];
+            double w = (double)m->pick_fade_left[j] / m->pick_fade_len;
+            y[j] = (1.0 - w) * y[j] + w * out_scale * (old + extra[j]);
+            m->pick_fade_left[j]--;
+        }
+        finite = finite && fabs(y[j]) <= FLT_MAX;
+    }
+    if (picks < MEMBRANE_PICKUPS && m->pick_fade_left[1] > 0)
+        m->pick_fade_left[1]--; /* the skipped pickup's crossfade runs on */
+    if (!finite) {
+        /* Last line of defence (never reached with legal inputs in the tests):
+         * a state that overflowed float is silenced rather than sent out. */
+        membrane_clear(m);
+        y[0] = y[1] = 0.0;
+    }
+    for (int j = 0; j < MEMBRANE_PICKUPS; j++) {
+        if (out && out[j])
+            out[j][i] = (float)y[j];
+    }
+    return finite;
+}
+
+/* Samples i and i + 1 of a block of n can run as one free pass (the pair kernel,
+ * membrane_kernel.inc): no point folded in at i (the caller checks), no strike
+ * force at either, no landing at i + 1 (a point could join), no strike queued at
+ * either (it goes into the state after sample i), no pickup crossfade (it reads
+ * the state after each sample). */
+static int pair_ok(const membrane *m, const float *force_in, int i, int n, int next_landing)
+{
+    if (i + 1 >= n || next_landing == i + 1 || m->pick_fade_left[0] > 0 || m->pick_fade_left[1] > 0)
+        return 0;
+    if (force_in && (force_in[i] != 0.0f || force_in[i + 1] != 0.0f))
+        return 0; /* NaN and inf (read as 0) take the one-sample path too */
+    for (int s = 0; s < m->queued; s++)
+        if (m->queue[s].offset == i || m->queue[s].offset == i + 1)
+            return 0;
+    return 1;
+}
+
 void membrane_process(membrane *m, const float *force_in, float *const *out, int n)
 {
 #ifdef MEMBRANE_X86
@@ -949,6 +1019,17 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
         }
         a.points = na;
         a.strike_force = fin;
+        if (na == 0 && pair_ok(m, force_in, i, n, next_landing)) {
+            /* Ringing freely: samples i and i + 1 in one pass, bit-identical to two. */
+            m->kernel_pair(&a);
+            const double none[MEMBRANE_PICKUPS] = {0};
+            if (emit_sample(m, a.pick_sum, none, picks, out, i, gain_coef)) {
+                i++;
+                emit_sample(m, a.pick_sum2, none, picks, out, i, gain_coef);
+            }
+            /* else the state was cleared after sample i: i + 1 runs from it alone */
+            continue;
+        }
         m->kernel(&a);
         for (int c = 0; c < na; c++)
             act[c]->force_pending = 0.0;
@@ -989,41 +1070,7 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             act[0]->ops->solve(act, nact, a.point_w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
                                extra);
         }
-        double y[MEMBRANE_PICKUPS];
-        int finite = 1;
-        if (m->gain_smoothed != m->output_gain) {
-            m->gain_smoothed += (m->output_gain - m->gain_smoothed) * gain_coef;
-            if (fabs(m->gain_smoothed - m->output_gain) <= 1e-9 * fabs(m->output_gain))
-                m->gain_smoothed = m->output_gain;
-        }
-        const double out_scale = m->gain_smoothed * m->mass_scale;
-        y[1] = 0.0;
-        for (int j = 0; j < picks; j++) {
-            y[j] = out_scale * (a.pick_sum[j] + extra[j]);
-            if (m->pick_fade_left[j] > 0) {
-                /* Crossfade from a moved pickup: one more dot product per sample for
-                 * 5 ms (the points' direct term uses the new place throughout). */
-                double old = 0.0;
-                for (int k = 0; k < m->count; k++)
-                    old += (double)m->psi_pick_old[j][k] * m->sc[k] * m->p[k];
-                double w = (double)m->pick_fade_left[j] / m->pick_fade_len;
-                y[j] = (1.0 - w) * y[j] + w * out_scale * (old + extra[j]);
-                m->pick_fade_left[j]--;
-            }
-            finite = finite && fabs(y[j]) <= FLT_MAX;
-        }
-        if (picks < MEMBRANE_PICKUPS && m->pick_fade_left[1] > 0)
-            m->pick_fade_left[1]--; /* the skipped pickup's crossfade runs on */
-        if (!finite) {
-            /* Last line of defence (never reached with legal inputs in the tests):
-             * a state that overflowed float is silenced rather than sent out. */
-            membrane_clear(m);
-            y[0] = y[1] = 0.0;
-        }
-        for (int j = 0; j < MEMBRANE_PICKUPS; j++) {
-            if (out && out[j])
-                out[j][i] = (float)y[j];
-        }
+        emit_sample(m, a.pick_sum, extra, picks, out, i, gain_coef);
     }
     /* Carry pending strikes and moves past this block. */
     int kept = 0;

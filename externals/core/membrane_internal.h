@@ -34,10 +34,14 @@ typedef struct membrane_kernel_args {
     float point_force_pending[MEMBRANE_MAX_POINTS]; /* last sample's forces, not yet in q, p */
     double pick_sum[MEMBRANE_PICKUPS];              /* out: sum psi_pick * p */
     double point_w[MEMBRANE_MAX_POINTS];            /* out: sum psi * r (unscaled) */
+    /* out, membrane_kernel_pair_*: the second sample's sums (ringing freely). */
+    double pick_sum2[MEMBRANE_PICKUPS];
 } membrane_kernel_args;
 
 void membrane_kernel_generic(membrane_kernel_args *a);
 void membrane_kernel_avx2(membrane_kernel_args *a);
+void membrane_kernel_pair_generic(membrane_kernel_args *a);
+void membrane_kernel_pair_avx2(membrane_kernel_args *a);
 
 /* Benchmarks only: run the portable kernel even on an AVX2 machine. */
 void membrane_use_generic_kernel_(membrane *m);
