@@ -560,6 +560,11 @@ void Scene::apply_control()
         Eigen::Vector3d stop_axis = Eigen::Vector3d::UnitX();
         if (options_.limit_stops && !limits_.empty() && limits_[j].active()) {
             const Eigen::Quaterniond current = qp.conjugate() * qc;
+            // The joint's present rate (child relative to parent, world).
+            auto relative_rate = [&] {
+                return Eigen::Vector3d(to_eigen3(dBodyGetAngularVel(body_[child])) -
+                                       to_eigen3(dBodyGetAngularVel(body_[parent])));
+            };
             const Eigen::Quaterniond inside = limits_[j].clamp(current);
             // A joint the clamp leaves where it is (every limit returns
             // q.normalized() inside) has no violation: the rotation between
@@ -580,8 +585,7 @@ void Scene::apply_control()
                 // this step (the stop set at the present angle). Else the
                 // row sees the predicted angle.
                 const Eigen::Vector3d axis = (qp * v) / violation;
-                const Eigen::Vector3d w_rel = to_eigen3(dBodyGetAngularVel(body_[child])) -
-                                              to_eigen3(dBodyGetAngularVel(body_[parent]));
+                const Eigen::Vector3d w_rel = relative_rate();
                 const double rate = options_.stop_inelastic
                                         ? std::max(w_rel.dot(axis), cmd.velocity_world.dot(axis))
                                         : w_rel.dot(axis);
@@ -602,8 +606,7 @@ void Scene::apply_control()
                 // the step at the present rate is tested instead; past the
                 // margin, the row holds it where it is along the predicted
                 // violation for this step (as a joint short of the margin).
-                const Eigen::Vector3d w_now = to_eigen3(dBodyGetAngularVel(body_[child])) -
-                                              to_eigen3(dBodyGetAngularVel(body_[parent]));
+                const Eigen::Vector3d w_now = relative_rate();
                 const Eigen::Vector3d &w_rel =
                     cmd.velocity_world.squaredNorm() > w_now.squaredNorm() ? cmd.velocity_world
                                                                            : w_now;
@@ -675,33 +678,25 @@ void Scene::apply_control()
             dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
             dJointSetAMotorParam(m, dParamHiStop1, stop_at);
             dJointSetAMotorParam(m, dParamStopERP, options_.stop_erp);
-            if (lock) {
-                dJointSetAMotorAngle(m, 1, 0.0);
-                dJointSetAMotorAngle(m, 2, 0.0);
-                dJointSetAMotorParam(m, dParamLoStop2, 0.0);
-                dJointSetAMotorParam(m, dParamHiStop2, 0.0);
-                dJointSetAMotorParam(m, dParamLoStop3, 0.0);
-                dJointSetAMotorParam(m, dParamHiStop3, 0.0);
-                last.locked = true;
-            } else if (last.locked) {
-                dJointSetAMotorParam(m, dParamHiStop2, dInfinity);
-                dJointSetAMotorParam(m, dParamLoStop2, -dInfinity);
-                dJointSetAMotorParam(m, dParamHiStop3, dInfinity);
-                dJointSetAMotorParam(m, dParamLoStop3, -dInfinity);
-                last.locked = false;
-            }
             last.stops_open = false;
         } else if (!last.stops_open) {
             dJointSetAMotorParam(m, dParamHiStop1, dInfinity);
             dJointSetAMotorParam(m, dParamLoStop1, -dInfinity);
-            if (last.locked) {
-                dJointSetAMotorParam(m, dParamHiStop2, dInfinity);
-                dJointSetAMotorParam(m, dParamLoStop2, -dInfinity);
-                dJointSetAMotorParam(m, dParamHiStop3, dInfinity);
-                dJointSetAMotorParam(m, dParamLoStop3, -dInfinity);
-                last.locked = false;
-            }
             last.stops_open = true;
+        }
+        // Axes 2 and 3: held at their present angle (a two-sided stop at 0)
+        // while locked, open otherwise; only what changed goes to ODE.
+        if (lock) {
+            dJointSetAMotorAngle(m, 1, 0.0);
+            dJointSetAMotorAngle(m, 2, 0.0);
+        }
+        if (lock != last.locked) {
+            const double lo = lock ? 0.0 : -dInfinity, hi = lock ? 0.0 : dInfinity;
+            dJointSetAMotorParam(m, dParamHiStop2, hi);
+            dJointSetAMotorParam(m, dParamLoStop2, lo);
+            dJointSetAMotorParam(m, dParamHiStop3, hi);
+            dJointSetAMotorParam(m, dParamLoStop3, lo);
+            last.locked = lock;
         }
     }
 }
