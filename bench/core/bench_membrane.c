@@ -5,14 +5,26 @@
  * (10 kg on a soft tip, a fresh stroke before each timed run, which is shorter
  * than the stroke; the "touching" column shows the share of blocks with force > 0), with the
  * run-time selected kernel and with the generic one. Best of several repeats (clock_gettime,
- * CLOCK_MONOTONIC). Usage: bench_membrane_core [seconds] */
-#define _POSIX_C_SOURCE 199309L
+ * CLOCK_MONOTONIC).
+ *
+ * Then the machine's memory floor for the kernel (docs/benchmarks.md): a loop that moves
+ * what the kernel moves per mode and sample with a stick pressed -- 7 floats loaded (state
+ * q, p; coefficients c1, cd, c3; the point's and the pickup's shapes), 2 stored -- with
+ * only vector adds in between, over arrays allocated as the membrane allocates them. No
+ * kernel that streams those arrays once per sample can beat it on this machine: it says
+ * how much of the kernel's time is the cache's and how much the arithmetic's (on a Zen 1
+ * core, where a 256-bit load is two 128-bit ones, it is ~0.45 ns at 2 GHz; on Zen 4 ~0.11).
+ * Usage: bench_membrane_core [seconds]
+ *        bench_membrane_core --floor MODES [seconds]   (the floor alone: one number, for
+ *                                                       bench/peers/bench_peers.py) */
+#define _POSIX_C_SOURCE 200112L
 #include "contact.h"
 #include "membrane.h"
 #include "membrane_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #define BLOCK 64
@@ -74,8 +86,90 @@ static double run(int modes, int with_contact, int generic, int blocks, int repe
     return best;
 }
 
+/* ---------------------------------------------------------------- the memory floor */
+
+enum { FLOOR_LOADS = 7, FLOOR_STORES = 2 };
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define FLOOR_TARGET __attribute__((target("avx2"), noinline))
+#define FLOOR_WIDTH  8
+#else
+#define FLOOR_TARGET __attribute__((noinline))
+#define FLOOR_WIDTH  4
+#endif
+typedef float floor_vec __attribute__((vector_size(4 * FLOOR_WIDTH)));
+
+/* One pass over n modes: the kernel's loads and stores, adds only (no FMA-pipe work). */
+static FLOOR_TARGET float floor_pass(float *const *a, int n)
+{
+    floor_vec acc = {0};
+    for (int i = 0; i < n; i += FLOOR_WIDTH) {
+        floor_vec q = *(floor_vec *)(a[0] + i), p = *(floor_vec *)(a[1] + i);
+        floor_vec c1 = *(const floor_vec *)(a[2] + i), cd = *(const floor_vec *)(a[3] + i);
+        floor_vec c3 = *(const floor_vec *)(a[4] + i), psi = *(const floor_vec *)(a[5] + i);
+        floor_vec pick = *(const floor_vec *)(a[6] + i);
+        *(floor_vec *)(a[0] + i) = q + c1 + cd;
+        *(floor_vec *)(a[1] + i) = p + c3 + psi;
+        acc += pick;
+    }
+    float s = 0.0f;
+    for (int j = 0; j < FLOOR_WIDTH; j++)
+        s += acc[j];
+    return s;
+}
+
+static double cpu_now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* Best ns per mode-sample of floor_pass over `modes` modes, `samples` passes a run, in
+ * CPU time (as bench/peers/bench_peers.py measures Pd: a busy machine's scheduler out). */
+static double memory_floor(int modes, long samples, int repeats)
+{
+    float *a[FLOOR_LOADS];
+    for (int j = 0; j < FLOOR_LOADS; j++) {
+        void *ptr = NULL;
+        if (posix_memalign(&ptr, 64, sizeof(float) * (size_t)modes) != 0) {
+            fprintf(stderr, "bench_membrane_core: out of memory\n");
+            exit(1);
+        }
+        memset(ptr, 0, sizeof(float) * (size_t)modes); /* zeros: no denormals, no overflow */
+        a[j] = ptr;
+    }
+    double best = 1e30;
+    volatile float sink = 0.0f;
+    for (int r = 0; r < repeats; r++) {
+        double t0 = cpu_now_s();
+        for (long s = 0; s < samples; s++)
+            sink += floor_pass(a, modes);
+        double ns = (cpu_now_s() - t0) * 1e9 / ((double)samples * modes);
+        if (ns < best)
+            best = ns;
+    }
+    (void)sink;
+    for (int j = 0; j < FLOOR_LOADS; j++)
+        free(a[j]);
+    return best;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 2 && strcmp(argv[1], "--floor") == 0) {
+        int modes = atoi(argv[2]);
+        double sec = argc > 3 ? atof(argv[3]) : 0.2;
+        if (modes < MEMBRANE_PAD || modes % MEMBRANE_PAD != 0 || !(sec > 0.0)) {
+            fprintf(stderr,
+                    "bench_membrane_core: --floor takes a mode count that is a positive "
+                    "multiple of %d and a positive time, got %s\n",
+                    MEMBRANE_PAD, argv[2]);
+            return 2;
+        }
+        printf("%.4f\n", memory_floor(modes, (long)(sec * 48000.0) + 64, 7));
+        return 0;
+    }
     double seconds = argc > 1 ? atof(argv[1]) : 0.04;
     if (!(seconds > 0.0))
         seconds = 0.05;
@@ -94,6 +188,15 @@ int main(int argc, char **argv)
             double held = run(modes, 1, generic, blocks, 7, &frac, &kernel);
             printf("%-6d %-9s %12.3f %12.3f %9.0f%%\n", modes, kernel, ring, held, frac * 100.0);
         }
+    }
+    printf("\nmemory floor: %d floats loaded and %d stored per mode and sample (a stick pressed),\n"
+           "%d-float vectors, adds only: ns per mode per sample\n",
+           FLOOR_LOADS, FLOOR_STORES, FLOOR_WIDTH);
+    for (int i = 1; i < 4; i++) {
+        long samples = (long)(seconds * 48000.0);
+        if (samples < 64)
+            samples = 64;
+        printf("%-6d %12.3f\n", sizes[i], memory_floor(sizes[i], samples, 7));
     }
     return 0;
 }

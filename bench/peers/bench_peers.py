@@ -17,6 +17,8 @@ otherwise identical empty patch is subtracted):
   stereo   the same with both outlets listened to (the second pickup computed)
   50 g     the same hits with contact~'s default 50 g stick (same tip): a drumstick,
            which bounces off (in contact ~9 % of the samples, solved ~20 %)
+  floor    the machine's memory floor for that kernel (bench_membrane_core --floor N,
+           when built): the loads and stores of a pressed-stick pass, adds only
   before   the same patch with another build's Pd library (--before DIR), if given,
            with the run-time selected kernel and with the generic one, and its 50 g case
   bp~      N vanilla [bp~ f 10] fed by one [noise~]
@@ -67,6 +69,7 @@ args = ap.parse_args()
 build = os.path.abspath(args.build)
 lib = os.path.join(build, "ictus")
 ictusd = os.path.join(build, "ictusd")
+floor_bin = os.path.join(build, "bench", "core", "bench_membrane_core")
 skip = set(s for s in args.skip.split(",") if s)
 sizes = [int(s) for s in args.sizes.split(",")]
 work = tempfile.mkdtemp(prefix="ictus-peers-")
@@ -176,6 +179,14 @@ def drum_round(r, results):
             results.setdefault((name, n), []).append(ns)
             raw.append({"round": r, "case": name, "modes": n, "audio_s": s, "cpu_s": cpu,
                         "empty_cpu_s": empties[s], "ns_per_mode_sample": ns})
+        if os.access(floor_bin, os.X_OK):
+            # The machine's memory floor for the kernel with a stick pressed (what it
+            # loads and stores, adds only; bench/core/bench_membrane.c), in the same round.
+            _, out = run_cpu([floor_bin, "--floor", str(n), "0.5"])
+            floor_ns = float(out.strip().splitlines()[-1])
+            results.setdefault(("floor", n), []).append(floor_ns)
+            raw.append({"round": r, "case": "memory floor", "modes": n,
+                        "ns_per_mode_sample": floor_ns})
         if "sdt" not in skip:
             sec = max(0.2, min(2.0, 2.5e7 / (n * SR)))
             _, out = run_cpu([args.python, os.path.join(ROOT, "bench", "peers", "peer_sdt.py"),
@@ -245,11 +256,31 @@ def loadavg():
 
 
 def cpu_model():
+    """The model name and what tells two machines of one name apart: "AMD EPYC" has
+    been a Zen 1 (family 23, 256-bit vectors run as two 128-bit halves) and a Zen 4
+    (family 25) here, with ~2x between them; the family, model, the widest vectors
+    and the L1d size say which (docs/benchmarks.md)."""
+    info = {}
     with open("/proc/cpuinfo") as f:
         for line in f:
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    return platform.processor()
+            if ":" in line:
+                key, value = (t.strip() for t in line.split(":", 1))
+                info.setdefault(key, value)
+            elif not line.strip() and info:
+                break  # the first processor is enough
+    name = info.get("model name", platform.processor())
+    flags = info.get("flags", "").split()
+    vec = "avx512" if "avx512f" in flags else "avx2" if "avx2" in flags else "sse2"
+    extra = ["family %s model %s stepping %s" % (info.get("cpu family", "?"), info.get("model", "?"),
+                                                  info.get("stepping", "?")), vec]
+    if "cpu MHz" in info:
+        extra.append("%.0f MHz" % float(info["cpu MHz"]))
+    try:
+        with open("/sys/devices/system/cpu/cpu0/cache/index0/size") as f:
+            extra.append("L1d " + f.read().strip())
+    except OSError:
+        pass
+    return "%s (%s)" % (name, ", ".join(extra))
 
 
 pd_version = subprocess.run(["pd", "-version"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
@@ -289,6 +320,19 @@ if "drum" not in skip:
             ratio = per_round_ratio(results[(c, n)], results[("ictus avx2", n)])
             ratios.append("%s %.1fx" % (c, ratio))
         print("%6d " % n + " ".join(row) + "   " + ", ".join(ratios))
+    if ("floor", sizes[0]) in results:
+        print("\nThe machine's memory floor for the kernel with a stick pressed (7 floats loaded, "
+              "2 stored\nper mode and sample, adds only; bench_membrane_core --floor), best round, "
+              "and ictus / floor\n(median of the per-round ratios)")
+        for n in sizes:
+            f = results[("floor", n)]
+            print("%6d %14.3f   avx2 %.2fx, generic %.2fx" % (
+                n, min(f), per_round_ratio(results[("ictus avx2", n)], f),
+                per_round_ratio(results[("ictus generic", n)], f)))
+    if 1024 in sizes:
+        print("Targets (issue 16) at 1024 modes, the 10 kg pressed stick: avx2 %.3f (target <= 0.20), "
+              "generic %.3f (target <= 0.5), best rounds" % (
+                  min(results[("ictus avx2", 1024)]), min(results[("ictus generic", 1024)])))
 if "performer" not in skip:
     t, mj, rd = results["track"], results["mujoco"], results["render"]
     print("\nPerformer, real-time factor on CPU time (best round; all rounds)")
