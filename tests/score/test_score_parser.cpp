@@ -299,6 +299,44 @@ TEST_CASE("score: separators and comments", "[score][parser]")
     CHECK(a.notes[3].column == 8);
 }
 
+TEST_CASE("score: lines end in LF, CRLF or a lone CR, and a byte order mark is no statement",
+          "[score][parser]")
+{
+    // The default score and a faulty one, each line ended at random (seeded)
+    // by one of the three, with and without a UTF-8 BOM: the same notes at the
+    // same lines and columns, the same error at the same place.
+    const std::string text = default_score_text();
+    const Score lf = parse_score(text, "lf");
+    const char *const ends[] = {"\n", "\r\n", "\r"};
+    std::mt19937 rng(20261127);
+    for (int trial = 0; trial < 40; ++trial) {
+        std::string mixed = trial % 2 ? "\xEF\xBB\xBF" : "";
+        for (char c : text)
+            mixed += c == '\n' ? ends[rng() % 3] : std::string(1, c);
+        INFO("trial " << trial);
+        const Score m = parse_score(mixed, "mixed");
+        REQUIRE(m.notes.size() == lf.notes.size());
+        CHECK(same_notes(m, lf));
+        for (size_t i = 0; i < lf.notes.size(); ++i) {
+            CHECK(m.notes[i].line == lf.notes[i].line);
+            CHECK(m.notes[i].column == lf.notes[i].column);
+        }
+    }
+    require_error("tempo 100\rR\rL acent\r", 3, 3, "acent");
+    require_error("\xEF\xBB\xBFR, L acent\r\n", 1, 6, "acent");
+    require_error("\xEF\xBB\xBF\xEF\xBB\xBFR\n", 1, 1, "unknown statement"); // one mark only
+}
+
+TEST_CASE("score: an error quotes control bytes as \\xNN, a NUL included",
+          "[score][parser][errors]")
+{
+    // A NUL in a statement cut the message at it (the list of statements lost).
+    const std::string nul = std::string("R, X") + '\0' + "Y\n";
+    require_error(nul, 1, 4, "unknown statement 'X\\x00Y'");
+    require_error(nul, 1, 4, "tempo"); // the rest of the message is there
+    require_error("R, Z\x1b[2J\n", 1, 4, "'Z\\x1b[2J'");
+}
+
 TEST_CASE("score: a Pd message box - statements one by one - equals the file", "[score][parser]")
 {
     const std::string file = default_score_text();

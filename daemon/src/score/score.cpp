@@ -16,10 +16,32 @@
 namespace ictus
 {
 
+namespace
+{
+// A message quotes the score's words as typed: control bytes in them (a NUL
+// cut the message short on a terminal, and in C strings) are shown as \xNN.
+std::string printable(const std::string &message)
+{
+    std::string out;
+    for (const char c : message) {
+        const auto u = static_cast<unsigned char>(c);
+        if ((u < 0x20 && c != '\t') || u == 0x7f) {
+            static const char hex[] = "0123456789abcdef";
+            out += "\\x";
+            out += hex[u >> 4];
+            out += hex[u & 15];
+        } else {
+            out += c;
+        }
+    }
+    return out;
+}
+} // namespace
+
 ScoreError::ScoreError(const std::string &source, int line, int column, const std::string &message)
     : std::runtime_error(source + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
-                         message),
-      source_(source), line_(line), column_(column), message_(message)
+                         printable(message)),
+      source_(source), line_(line), column_(column), message_(printable(message))
 {
 }
 
@@ -745,11 +767,21 @@ Score ScoreBuilder::finish() const
 Score parse_score(const std::string &text, const std::string &source_name)
 {
     ScoreBuilder builder(source_name);
-    std::istringstream in(text);
-    std::string line;
+    // Lines end in LF, CRLF or a lone CR (old Mac editors): a score saved
+    // with CRs alone would otherwise be one line, and its first statement's
+    // error would name the second's word. A UTF-8 byte order mark, which
+    // Windows editors write, is not part of the first statement.
+    std::size_t start = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
     int number = 0;
-    while (std::getline(in, line))
-        builder.add_line(line, ++number);
+    while (start < text.size()) {
+        const std::size_t end = text.find_first_of("\r\n", start);
+        if (end == std::string::npos) {
+            builder.add_line(text.substr(start), ++number);
+            break;
+        }
+        builder.add_line(text.substr(start, end - start), ++number);
+        start = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
+    }
     return builder.finish();
 }
 
