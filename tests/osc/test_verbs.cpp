@@ -632,6 +632,7 @@ TEST_CASE("render: --out refuses a used folder, --force replaces render's own fi
          {"strikes.csv", "events.txt", "render.json", "tips.csv", "notes.csv", "performance.bvh"})
         REQUIRE(fs::exists(out / f));
     std::ofstream(out / "mine.txt") << "kept\n";
+    std::ofstream(out / "performance.wav") << "an earlier render's sound (--wav)\n";
     std::ofstream(dir / "elsewhere.csv") << "the target of a link, kept\n";
     fs::remove(out / "notes.csv");
     fs::create_symlink(dir / "elsewhere.csv", out / "notes.csv");
@@ -650,6 +651,8 @@ TEST_CASE("render: --out refuses a used folder, --force replaces render's own fi
                    out.string(), "--force"});
     CHECK(forced.wait() == 0);
     CHECK_FALSE(fs::exists(out / "performance.bvh")); // the earlier render's, not this one's
+    CHECK_FALSE(fs::exists(out / "performance.wav")); // this one has no --wav
+    CHECK(forced.err.find("not struck") == std::string::npos); // all four notes played
     CHECK(slurp((out / "mine.txt").string()) == "kept\n");
     CHECK(slurp((dir / "elsewhere.csv").string()) == "the target of a link, kept\n");
     CHECK_FALSE(fs::is_symlink(out / "notes.csv"));
@@ -661,6 +664,62 @@ TEST_CASE("render: --out refuses a used folder, --force replaces render's own fi
     fs::create_directories(dir / "empty");
     CHECK(osctest::run({ICTUSD_OSC_PATH, "render", "--score", score, "--bvh-rate", "0", "--out",
                         (dir / "empty").string()}) == 0);
+    fs::remove_all(dir);
+}
+
+// A drum out of the sticks' reach played nothing, and render said only "0
+// strikes" on stdout (the count of missed notes was in render.json alone).
+TEST_CASE("render: missed notes and a score without notes are said on stderr, exit 0",
+          "[osc][verbs]")
+{
+    const fs::path dir = scratch("render-missed");
+    const std::string score = four_notes(dir).string();
+    // 5 m behind the performer: no stick reaches it.
+    Daemon far({"render", "--score", score, "--bvh-rate", "0", "--tips-rate", "0", "--drum-pos",
+                "0,-5,0", "--out", (dir / "far").string()});
+    CHECK(far.wait() == 0);
+    INFO(far.err);
+    CHECK(far.err.find("4 of 4 notes of the score were not struck") != std::string::npos);
+    CHECK(far.err.find("--drum-pos") != std::string::npos);
+    CHECK(lines(slurp((dir / "far" / "strikes.csv").string())).size() == 1); // the header only
+    CHECK(slurp((dir / "far" / "render.json").string()).find("\"missed_notes\": 4") !=
+          std::string::npos);
+
+    std::ofstream(dir / "none.score") << "tempo 100 # no notes\n";
+    Daemon none({"render", "--score", (dir / "none.score").string(), "--bvh-rate", "0",
+                 "--tips-rate", "0", "--out", (dir / "none").string()});
+    CHECK(none.wait() == 0);
+    CHECK(none.err.find("the score has no notes") != std::string::npos);
+    fs::remove_all(dir);
+}
+
+// --wav-bits 8 was refused as "got '8.000000'", --wav-rate 44100.5 was cut to
+// 44100 without a word, and --score given a folder said it was empty.
+TEST_CASE("render: a bad value is quoted as typed, a fractional rate refused, a folder is no score",
+          "[osc][verbs]")
+{
+    const fs::path dir = scratch("render-values");
+    fs::create_directories(dir);
+    const struct {
+        std::vector<std::string> args;
+        int status;
+        std::string said;
+    } cases[] = {
+        {{"--wav-bits", "8"}, 2, "--wav-bits: expected 16, 24 or 32, got '8'"},
+        {{"--wav-rate", "44100.5"}, 2, "--wav-rate: expected a whole number of Hz, got '44100.5'"},
+        {{"--midi-channel", "2.5"}, 2, "--midi-channel: expected a whole number 1..16, got '2.5'"},
+        {{"--score", dir.string()}, 1, "--score: '" + dir.string() + "' is a folder"},
+    };
+    int k = 0;
+    for (const auto &c : cases) {
+        std::vector<std::string> argv = {"render", "--bvh-rate", "0", "--out",
+                                         (dir / ("out" + std::to_string(k++))).string()};
+        argv.insert(argv.end(), c.args.begin(), c.args.end());
+        Daemon d(argv);
+        INFO(c.said << "\n" << d.err);
+        CHECK(d.wait() == c.status);
+        CHECK(d.err.find(c.said) != std::string::npos);
+    }
     fs::remove_all(dir);
 }
 

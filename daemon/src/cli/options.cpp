@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -185,6 +186,9 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
     } else if (a == "--score") {
         // A score that cannot be read is a file error (exit 1), not a usage error.
         const std::string path = value();
+        std::error_code ec;
+        if (std::filesystem::is_directory(path, ec)) // opens, and reads as empty
+            throw std::runtime_error("--score: '" + path + "' is a folder, not a score file");
         std::ifstream in(path, std::ios::binary);
         if (!in)
             throw std::runtime_error("--score: cannot read '" + path + "'");

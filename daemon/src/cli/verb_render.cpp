@@ -53,7 +53,8 @@ void render_usage(std::ostream &out)
            "                      that no earlier render's file passes for this one's)\n"
            "  --force             write into a used folder: render's own files there\n"
            "                      (strikes.csv, events.txt, render.json, tips.csv, notes.csv,\n"
-           "                      performance.bvh, performance.mid, pd.log) are removed\n"
+           "                      performance.bvh, performance.mid, pd.log,\n"
+           "                      performance.wav) are removed\n"
            "                      first, no other file\n"
            "  --tips-rate HZ      tips.csv rows per second (default 250; 0: none)\n"
            "  --bvh-rate HZ       performance.bvh frames per second (default 250; 0: none)\n"
@@ -124,10 +125,11 @@ void render_usage(std::ostream &out)
            "out/r2\n";
 }
 
-// The files render writes into --out, all it may remove (--force).
+// The files render writes into --out, all it may remove (--force);
+// performance.wav is --wav's name in README and scripts/main.sh.
 const char *const kRenderOutputs[] = {"strikes.csv",     "events.txt", "render.json",
                                       "tips.csv",        "notes.csv",  "performance.bvh",
-                                      "performance.mid", "pd.log"};
+                                      "performance.mid", "pd.log",     "performance.wav"};
 
 // --out: created, or else empty, so that no file of an earlier render (a
 // score's notes.csv beside a clip's strikes) passes for this one's. With
@@ -380,10 +382,11 @@ int cmd_render(Args &args)
         } else if (a == "--bvh-rate") {
             bvh_rate = parse_number(a, args.value(a), 0, 1000);
         } else if (a == "--midi-channel") {
-            midi_channel = parse_number(a, args.value(a), 1, 16);
+            const std::string text = args.value(a);
+            midi_channel = parse_number(a, text, 1, 16);
             if (midi_channel != std::floor(midi_channel))
-                throw UsageError("--midi-channel: expected a whole number 1..16, got '" +
-                                 std::to_string(midi_channel) + "'");
+                throw UsageError("--midi-channel: expected a whole number 1..16, got '" + text +
+                                 "'");
         } else if (a == "--progress-every") {
             progress_every = parse_number(a, args.value(a), 0, 3600);
         } else if (a == "--wav") {
@@ -393,15 +396,19 @@ int cmd_render(Args &args)
             if (pd.mix != "stereo" && pd.mix != "pickups")
                 throw UsageError("--wav-mix: expected stereo or pickups, got '" + pd.mix + "'");
         } else if (a == "--wav-bits") {
-            const double bits = parse_number(a, args.value(a));
+            const std::string text = args.value(a);
+            const double bits = parse_number(a, text);
             if (bits != 16 && bits != 24 && bits != 32)
-                throw UsageError("--wav-bits: expected 16, 24 or 32, got '" + std::to_string(bits) +
-                                 "'");
+                throw UsageError("--wav-bits: expected 16, 24 or 32, got '" + text + "'");
             pd.bits = static_cast<int>(bits);
         } else if (a == "--wav-gain") {
             pd.gain_db = parse_number(a, args.value(a), -120, 40);
         } else if (a == "--wav-rate") {
-            pd.sample_rate = static_cast<int>(parse_number(a, args.value(a), 8000, 192000));
+            const std::string text = args.value(a);
+            const double rate = parse_number(a, text, 8000, 192000);
+            if (rate != std::floor(rate))
+                throw UsageError("--wav-rate: expected a whole number of Hz, got '" + text + "'");
+            pd.sample_rate = static_cast<int>(rate);
         } else if (a == "--pd") {
             pd.pd = args.value(a);
         } else if (a == "--pd-lib") {
@@ -534,9 +541,12 @@ int cmd_render(Args &args)
                  {"channel", static_cast<int>(midi_channel)},
                  {"notes", strikes},
                  {"ticks_per_quarter", kMidiTicksPerQuarter}};
+    long score_notes = 0, missed_notes = 0;
     if (score_mode) {
         const GesturePlan &plan = *perf.plan();
         const MatchSummary m = match_strikes(plan.notes, log.strikes(), perf.plan_origin_s());
+        score_notes = static_cast<long>(plan.notes.size());
+        missed_notes = score_notes - m.matched_notes;
         text.str("");
         write_notes_csv(text, plan, m, perf.plan_origin_s());
         notes_csv->write_and_close(text.str());
@@ -551,6 +561,17 @@ int cmd_render(Args &args)
                                "notes.csv"
                              : "/{strikes.csv,events.txt,render.json,performance.mid")
               << (bvh ? ",performance.bvh}\n" : "}\n");
+    // What render.json says in missed_notes, said where it is seen: a drum out
+    // of the sticks' reach (--drum-pos) plays nothing and still exits 0.
+    if (score_mode && score_notes == 0)
+        std::cerr << "ictusd render: warning: the score has no notes: nothing was played\n";
+    else if (missed_notes > 0)
+        std::cerr << "ictusd render: warning: " << missed_notes << " of " << score_notes
+                  << " notes of the score were not struck (strike_seq -1 in notes.csv"
+                  << (missed_notes == score_notes
+                          ? "; is the drum within the sticks' reach? --drum-pos"
+                          : "")
+                  << ")\n";
     if (interrupted)
         return 130;
     if (!wav.empty()) {
