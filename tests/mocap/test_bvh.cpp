@@ -321,7 +321,10 @@ TEST_CASE("BVH: malformed files give FILE:LINE errors", "[mocap][bvh][errors]")
     {
         BvhOptions skip;
         skip.skip_frames = 2;
-        require_error(minimal_bvh(), 17, "expected BvhOptions::skip_frames in [0, 1], got 2", skip);
+        require_error(minimal_bvh(), 17,
+                      "expected the frames skipped at the start (--skip-frames, "
+                      "BvhOptions::skip_frames) in [0, 1], got 2 (the file has 2 frames)",
+                      skip);
     }
     SECTION("extra motion lines are ignored with a warning")
     {

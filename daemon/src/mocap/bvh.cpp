@@ -390,9 +390,12 @@ class BvhParser
         const auto channel_count = static_cast<std::size_t>(bvh_.channel_count);
         if (options_.skip_frames < 0 || options_.skip_frames >= declared)
             throw MocapError(source_, frame_time_line_ - 1,
-                             "expected BvhOptions::skip_frames in [0, " +
+                             "expected the frames skipped at the start (--skip-frames, "
+                             "BvhOptions::skip_frames) in [0, " +
                                  std::to_string(declared - 1) + "], got " +
-                                 std::to_string(options_.skip_frames));
+                                 std::to_string(options_.skip_frames) + " (the file has " +
+                                 std::to_string(declared) +
+                                 (declared == 1 ? " frame)" : " frames)"));
         // Columns holding a position (compared with kMaxCoordinate_m).
         std::vector<bool> position_column;
         for (const auto &list : bvh_.channels)
