@@ -327,7 +327,7 @@ TEST_CASE("score: lines end in LF, CRLF or a lone CR, and a byte order mark is n
     require_error("\xEF\xBB\xBF\xEF\xBB\xBFR\n", 1, 1, "unknown statement"); // one mark only
 }
 
-TEST_CASE("score: an error quotes control bytes as \\xNN, a NUL included",
+TEST_CASE("score: an error shows control bytes as hex escapes, a NUL included",
           "[score][parser][errors]")
 {
     // A NUL in a statement cut the message at it (the list of statements lost).
