@@ -39,16 +39,17 @@ Outcome whole_file(const std::string &text)
     return o;
 }
 
-// One add_statement() per line, as parse_score splits them (std::getline:
-// a last line without '\n' counts, an empty one after the last '\n' does not).
+// One add_statement() per line, as parse_score splits them: a line ends in
+// LF, CRLF or a lone CR, a last line without an end counts, an empty one after
+// the last end does not; a UTF-8 byte order mark at the start is skipped.
 Outcome statement_by_statement(const std::string &text)
 {
     Outcome o;
     ScoreBuilder builder("fuzz");
     bool threw = false;
-    std::size_t start = 0;
+    std::size_t start = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
     while (start < text.size()) {
-        std::size_t end = text.find('\n', start);
+        std::size_t end = text.find_first_of("\r\n", start);
         if (end == std::string::npos)
             end = text.size();
         try {
@@ -56,7 +57,7 @@ Outcome statement_by_statement(const std::string &text)
         } catch (const ScoreError &) {
             threw = true;
         }
-        start = end + 1;
+        start = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
     }
     ICTUS_FUZZ_CHECK(builder.failed() == threw, "failed() does not say a statement threw");
     try {
