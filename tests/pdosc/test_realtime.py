@@ -177,13 +177,18 @@ check(abs(late_fire - t_late_sent) < 0.010,
       "the late bundle fired on arrival (%.2f ms after sending)" % ((late_fire - t_late_sent) * 1e3))
 # lateness is counted against the logical time at which pd handled the packet,
 # i.e. (in this test's own mapping) the fire time minus (timetag - latency); the
-# count is the running total, the strikes handled late above included
+# count is the running total, the strikes handled late above included. The
+# expectation goes through the mapping (wall_of_logical), which is late by the
+# tick reports' transit, in [0, rtt]: so the report may fall short of it by
+# that much more than 1 ms, as the late strikes above are judged (a run under
+# ASan on a slow core fell short by 1.02 ms with rtt 0.24 ms).
 expected_late_ms = (late_fire - t_late) * 1000.0 + LATENCY_MS
 last = lates[-1] if lates else None
 check(last is not None and len(lates) == len(late_strikes) + 1
-      and abs(last[2] - expected_late_ms) < 1.0 and last[3] == len(lates),
-      "the late bundle's report, %.2f ms late (expected %.2f), counted %s: %s"
-      % (last[2] if last else -1, expected_late_ms, last[3] if last else -1, lates))
+      and -1.0 - rtt_ms <= last[2] - expected_late_ms <= 1.0 and last[3] == len(lates),
+      "the late bundle's report, %.2f ms late (expected %.2f, from 1 ms + the mapping's %.3f "
+      "below to 1 ms above), counted %s: %s"
+      % (last[2] if last else -1, expected_late_ms, rtt_ms, last[3] if last else -1, lates))
 
 poses = [a[1:] for _, a in records if a[0] == "pose"]
 check(["frame", 42.0, 1.5] in poses and ["body", 3.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]
