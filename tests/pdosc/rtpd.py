@@ -8,7 +8,10 @@ back over UDP (FUDI text, [netsend -u]):
     plain <logical_ms> <seq>;     (optional) a strike parsed by a bare [oscparse]
     pose ... / reply ... / info ...;   the other outlets
 
-Python stamps each report with CLOCK_REALTIME on arrival. The smallest
+Each report is stamped with CLOCK_REALTIME on arrival by the kernel
+(SO_TIMESTAMPNS: when the datagram reached the socket, not when this Python
+thread woke up to read it, which on a loaded machine was milliseconds later
+and moved the mapping below by as much). The smallest
 (arrival - logical_ms) over the ticks maps logical time to wall time,
 independently of [ictus_timetag] (another process, another clock read, another
 path): Pd runs a logical time no earlier than its wall time, so the smallest
@@ -16,6 +19,7 @@ observed difference is the mapping (plus the loopback's few tens of us)."""
 import os
 import re
 import socket
+import struct
 import subprocess
 import sys
 import threading
@@ -26,11 +30,21 @@ from pdrun import PD, PD_ENV, Patch, free_udp_port, make_workdir  # noqa: E402,F
 from oscpacket import now  # noqa: E402
 
 
+# Linux's SO_TIMESTAMPNS (= SCM_TIMESTAMPNS): the kernel's CLOCK_REALTIME arrival
+# stamp of each datagram, as a struct timespec in the ancillary data.
+SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
+
+
 class Listener:
-    """UDP socket that stamps every datagram with the wall clock on arrival."""
+    """UDP socket that stamps every datagram with the wall clock on arrival
+    (the kernel's stamp where it gives one, else the clock when read)."""
 
     def __init__(self):
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            self.sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+        except OSError:
+            pass  # no kernel stamps: read-time stamps, as before
         self.sock.bind(("127.0.0.1", 0))
         self.sock.settimeout(0.2)
         self.port = self.sock.getsockname()[1]
@@ -43,12 +57,16 @@ class Listener:
     def _run(self):
         while self.running:
             try:
-                data = self.sock.recv(65536)
+                data, ancillary, _, _ = self.sock.recvmsg(65536, 64)
             except socket.timeout:
                 continue
             except OSError:
                 return
             t = now()
+            for level, kind, payload in ancillary:
+                if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(payload) >= 16:
+                    sec, nsec = struct.unpack("qq", payload[:16])
+                    t = sec + nsec * 1e-9
             with self.lock:
                 self.items.append((t, data))
 

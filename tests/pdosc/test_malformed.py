@@ -1,7 +1,9 @@
 """Malformed and fuzzed packets sent to [ictus-receive]'s port are dropped whole, counted
 (info outlet `malformed <count> <reason>`), reported with an error naming
 ictus_timetag (the first 5 only), and break nothing: strikes sent afterwards
-still start at their timetag within 1 ms. A well-formed /ictus/strike with
+still start at their timetag within 1 ms (or, handled after it by a stalled
+machine, fire at once and are reported late with their lateness, as in
+test_realtime.py). A well-formed /ictus/strike with
 other type tags than docs/osc.md fixes (wrong count, floats for ints, a string)
 is refused too: ictus-receive tells ictus_timetag `expect /ictus/strike ...`."""
 import argparse
@@ -108,6 +110,24 @@ check(not others, "nothing else in pd's log: %s" % others)
 offset = wall_of_logical(records)
 fires = {int(a[10]): a for _, a in records if a[0] == "fire" and int(a[10]) != 999}
 check(sorted(fires) == sorted(sent), "exactly the 10 good strikes came out: %s" % sorted(fires))
-worst = max(abs(offset + fires[s][1] / 1000.0 - sent[s]) * 1000.0 for s in sent)
-check(worst <= 1.0, "after the malformed packets, strikes start at their timetag within 1 ms "
-      "(worst %.3f ms)" % worst)
+# As in test_realtime.py: a strike pd handled after its time (the sender or pd
+# stalled past the 50 ms lookahead: once 26 ms late under a loaded CI run) fires
+# at once by design and is reported late with its lateness (docs/pd-osc.md).
+# Each strike more than 1 ms off must be one of those, its report's lateness its
+# own error within 1 ms, and most must be on time, or the run judged nothing.
+errors = {s: (offset + fires[s][1] / 1000.0 - sent[s]) * 1000.0 for s in sent}
+reported = [a[2] for _, a in records if a[0] == "info" and len(a) > 2 and a[1] == "late"]
+unexplained = []
+for s, e in sorted(errors.items()):
+    if abs(e) <= 1.0:
+        continue
+    match = [r for r in reported if abs(r - e) <= 1.0]
+    if match:
+        reported.remove(match[0])
+    else:
+        unexplained.append((s, round(e, 3)))
+on_time = [abs(e) for e in errors.values() if abs(e) <= 1.0]
+check(not unexplained and len(on_time) >= len(sent) - 2,
+      "after the malformed packets, strikes start at their timetag within 1 ms (worst %.3f ms, "
+      "%d of %d), or were handled late and reported so (unexplained: %s)"
+      % (max(on_time) if on_time else float("inf"), len(on_time), len(sent), unexplained))
