@@ -9,6 +9,7 @@ is refused too: ictus-receive tells ictus_timetag `expect /ictus/strike ...`."""
 import argparse
 import os
 import random
+import re
 import socket
 import struct
 import sys
@@ -105,7 +106,11 @@ check(len(timetag_errors) == 5, "the first 5 malformed packets are reported by n
 # the four new ones, and the ,q / ,iiii / ,i strikes above (caught by their tags first)
 check(sum(1 for m in malformed[:len(bad)] if m[3] == "unexpected-type-tags") == 7,
       "strikes with other type tags than ,iiiiffffffffffffff are refused (unexpected-type-tags)")
-others = [l for l in lines if l not in timetag_errors]
+# Pd's own note that a send of the report path ([netsend] to this test) took
+# long ("verbose(3): netsend/netreceive: blocked 8 msec": the process was off the
+# CPU, once under a loaded ASan run) says nothing about the packets: not counted.
+others = [l for l in lines if l not in timetag_errors
+          and not re.match(r"verbose\(\d\): netsend/netreceive: blocked \d+ msec$", l.strip())]
 check(not others, "nothing else in pd's log: %s" % others)
 offset = wall_of_logical(records)
 fires = {int(a[10]): a for _, a in records if a[0] == "fire" and int(a[10]) != 999}
