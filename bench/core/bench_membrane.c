@@ -12,8 +12,9 @@
  * q, p; coefficients c1, cd, c3; the point's and the pickup's shapes), 2 stored -- with
  * only vector adds in between, over arrays allocated as the membrane allocates them. No
  * kernel that streams those arrays once per sample can beat it on this machine: it says
- * how much of the kernel's time is the cache's and how much the arithmetic's (on a Zen 1
- * core, where a 256-bit load is two 128-bit ones, it is ~0.45 ns at 2 GHz; on Zen 4 ~0.11).
+ * how much of the kernel's time is the cache's and how much the arithmetic's (measured
+ * 0.39-0.50 ns at 1024 modes on a Zen 1 core, where a 256-bit load is two 128-bit ones;
+ * docs/benchmarks.md).
  * Usage: bench_membrane_core [seconds]
  *        bench_membrane_core --floor MODES [seconds]   (the floor alone: one number, for
  *                                                       bench/peers/bench_peers.py) */
