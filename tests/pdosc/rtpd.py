@@ -207,6 +207,22 @@ def wait_for_ticks(listener, timeout=20.0, count=20):
     return False
 
 
+def unexplained_late(late_strikes, reported_ms, tolerance_ms):
+    """The (seq, error_ms) of late_strikes that no `late` report explains: a strike
+    pd handled after its time fires at once and is reported late with its lateness
+    (docs/pd-osc.md), so each late strike must match one report (each report used
+    once) within tolerance_ms."""
+    left = list(reported_ms)
+    unexplained = []
+    for seq, e in late_strikes:
+        match = [r for r in left if abs(r - e) <= tolerance_ms]
+        if match:
+            left.remove(match[0])
+        else:
+            unexplained.append((seq, round(e, 3)))
+    return unexplained
+
+
 def wall_of_logical(records):
     """Offset (s) such that wall = offset + logical_ms / 1000: the minimum of
     arrival - logical over the tick reports."""

@@ -17,7 +17,7 @@ import time
 
 from oscpacket import bundle, message, now, osc_string, strike, timetag
 from rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd, wait_for_ticks,
-                  wall_of_logical)
+                  unexplained_late, wall_of_logical)
 from pdrun import check
 
 ap = argparse.ArgumentParser()
@@ -122,15 +122,8 @@ check(sorted(fires) == sorted(sent), "exactly the 10 good strikes came out: %s" 
 # own error within 1 ms, and most must be on time, or the run judged nothing.
 errors = {s: (offset + fires[s][1] / 1000.0 - sent[s]) * 1000.0 for s in sent}
 reported = [a[2] for _, a in records if a[0] == "info" and len(a) > 2 and a[1] == "late"]
-unexplained = []
-for s, e in sorted(errors.items()):
-    if abs(e) <= 1.0:
-        continue
-    match = [r for r in reported if abs(r - e) <= 1.0]
-    if match:
-        reported.remove(match[0])
-    else:
-        unexplained.append((s, round(e, 3)))
+unexplained = unexplained_late([(s, e) for s, e in sorted(errors.items()) if abs(e) > 1.0],
+                               reported, 1.0)
 on_time = [abs(e) for e in errors.values() if abs(e) <= 1.0]
 check(not unexplained and len(on_time) >= len(sent) - 2,
       "after the malformed packets, strikes start at their timetag within 1 ms (worst %.3f ms, "

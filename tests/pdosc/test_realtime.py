@@ -19,7 +19,7 @@ import time
 
 from oscpacket import bundle, message, now, strike, timetag, IMMEDIATE
 from rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd, wait_for_ticks,
-                  wall_of_logical)
+                  unexplained_late, wall_of_logical)
 from pdrun import check, error_lines
 
 ap = argparse.ArgumentParser()
@@ -153,14 +153,7 @@ lates = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "lat
 # 1 ms; and most strikes must be on time, or the run judged nothing.
 judged = [max(e - rtt_ms, 0.0) if e > 0 else -e for e in errors_ms]
 late_strikes = [(seq, e) for seq, e, j in zip(sorted(sent), errors_ms, judged) if j > 1.0]
-unexplained = []
-reported = [a[2] for a in lates]
-for seq, e in late_strikes:
-    match = [r for r in reported if abs(r - e) <= 1.0 + rtt_ms]
-    if match:
-        reported.remove(match[0])
-    else:
-        unexplained.append((seq, round(e, 3)))
+unexplained = unexplained_late(late_strikes, [a[2] for a in lates], 1.0 + rtt_ms)
 on_time = [j for j in judged if j <= 1.0]
 worst = max(on_time) if on_time else float("inf")
 if late_strikes:
