@@ -33,7 +33,7 @@ means this model of the rule is wrong, and is reported as a failure.
 Nuances: the list is read from the parser -- `ictusd render` on a one-line score with an unknown
 nuance prints "unknown nuance '...' (valid: legato, tenuto, ...)" -- when an ictusd is given,
 else from kNuanceNames in daemon/src/gesture/gesture_unit.cpp (the names the parser accepts),
-else FALLBACK_NUANCES. A new nuance (the `buzz`/press stroke of issue 12) is thus drawn without
+else FALLBACK_NUANCES. A new nuance (such as the `buzz`/press stroke) is thus drawn without
 touching this file. Other note options: NOTE_OPTIONS below is the one place to add one (e.g. a
 grip firmness) -- a name, a drawing function, and whether `R+L` may carry it.
 """

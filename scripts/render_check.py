@@ -2,7 +2,7 @@
 the generator (scripts/random_score.py) says the score holds -- times from its own tempo map,
 not from the daemon. Shared by tests/perform/test_random_scores.py and bench/random_scores.py.
 
-The acceptance (issue 12, "Any valid score plays right"):
+The acceptance ("Any valid score plays right", docs/perform.md):
 - the render is accepted (exit 0): the generator only writes valid scores;
 - notes.csv lists exactly the generator's notes (hand, nuance, grip; time within 10 us);
 - every note gets exactly one primary (bounce = 0) strike of its hand within +-TOLERANCE_MS of its
@@ -478,7 +478,7 @@ def planted_faults(score, out):
         check(res, d)
         found.append((name, any(sign in p for p in res.problems), res.problems))
         shutil.rmtree(d, ignore_errors=True)
-    # A joint beyond its limit, as the render.json of issue 12 reports it.
+    # A joint beyond its limit, as render.json reports it.
     d = out + "-planted-limits"
     shutil.rmtree(d, ignore_errors=True)
     shutil.copytree(out, d)

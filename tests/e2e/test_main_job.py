@@ -76,7 +76,7 @@ x, sr = read_wav_float(os.path.join(out, "performance.wav"))
 check(sr == 48000 and x.shape[1] == 2 and np.all(np.isfinite(x)), "performance.wav: 2 ch, 48 kHz, finite")
 check(x.shape[0] / sr > strikes[-1]["time_s"], "performance.wav lasts past the last strike")
 check(float(np.abs(x).max()) > 1e-3, "performance.wav sounds")
-# Listenable (issue 14): no sample within 0.3 dB of full scale, and a stereo
+# Listenable: no sample within 0.3 dB of full scale, and a stereo
 # mix whose two channels are within 3 dB of each other in RMS.
 peak_dbfs = 20 * np.log10(float(np.abs(x).max()))
 rms_db = [20 * np.log10(float(np.sqrt(np.mean(x[:, c].astype(np.float64) ** 2)))) for c in (0, 1)]

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Any valid score plays right (issue 12): seeded random scores in the whole score language
+"""Any valid score plays right: seeded random scores in the whole score language
 (scripts/random_score.py: tempi 40..220 bpm and ramps, every fraction with triplets and dotted
 values, rests, R+L, both grips, every nuance the parser knows, pp..ff and numbers, `at`,
 repeats), each rendered by the real `ictusd render`, in parallel over the cores. For every

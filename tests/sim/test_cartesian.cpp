@@ -59,7 +59,7 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
     for (int s = 0; s < 2; ++s) {
         CHECK(cart.tip_rms_mm[s] <= 5.0);
         CHECK(cart.tip_rms_mm[s] < joint.tip_rms_mm[s]);
-        // ... and against the raw capture as well (issue 15): with the
+        // ... and against the raw capture as well: with the
         // Gaussian clean-up the right tip was 25.7 mm from the raw capture,
         // joint space 24.0 (docs/ik.md).
         CHECK(cart.tip_rms_raw_mm[s] < joint.tip_rms_raw_mm[s]);

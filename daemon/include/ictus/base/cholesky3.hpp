@@ -16,7 +16,7 @@ namespace ictus
 // (a product with the diagonal's reciprocal). Written out, without Eigen's
 // runtime-sized blocks, L1 norm and packed triangular solve, which took ~5 % of
 // `ictusd render` in the IK's three 3x3 solves per iteration (docs/benchmarks.md,
-// issue 16). A matrix Eigen would find not positive definite (a diagonal pivot
+// "Performer"). A matrix Eigen would find not positive definite (a diagonal pivot
 // <= 0 or NaN) goes to Eigen's own LLT, so the results are Eigen's in every case
 // (checked against it on random matrices: tests/kinematics/test_cholesky3.cpp).
 class Cholesky3

@@ -28,7 +28,7 @@ CartesianOptions track_cartesian_defaults();
 
 // `ictusd track`'s scene: SceneOptions' own, with the pelvis a kinematic body
 // (SceneOptions::pelvis_kinematic) instead of welded: the same fixed pelvis
-// without the weld's six rows in QuickStep (docs/benchmarks.md, issue 16).
+// without the weld's six rows in QuickStep (docs/benchmarks.md).
 SceneOptions track_scene_defaults();
 
 // The reference clean-up of `ictusd track` and `ictusd limits`: one-frame
