@@ -135,6 +135,7 @@ void membrane_clear(membrane *m)
 
 /* ---------------------------------------------------------------- process */
 
+/* The first sample after `after` on which a pending move lands in a block of n, or n. */
 static int next_move(const membrane *m, int after, int n)
 {
     int next = n;

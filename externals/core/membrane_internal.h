@@ -167,10 +167,6 @@ void membrane_add_input_(membrane *m, const float *psi, double force, membrane_k
 /* A point's pending move lands now (from the processing loop). */
 void membrane_land_point_(membrane *m, membrane_point *pt);
 
-/* membrane_params.c. After a physical parameter changed: the points' pending forces
- * go in, then the coefficients and the couplings follow; returns s. */
-ictus_status membrane_physics_changed_(membrane *m, ictus_status s);
-
 /* ---------------------------------------------------------------- coupling points
  *
  * A coupling point is where an object attached to the membrane (a stick: contact.c)

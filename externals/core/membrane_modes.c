@@ -1,7 +1,6 @@
 /* membrane_modes.c -- the membrane's modes: the arrays of the modal state and its
  * coefficients, built for a mode count (the table of modes itself is mode_table.c),
  * and the coefficients computed from the physics (docs/membrane.md). */
-#define _POSIX_C_SOURCE 200112L
 #include "membrane_internal.h"
 
 #include <stdlib.h>
@@ -247,6 +246,8 @@ static void refresh_shapes(membrane *m)
     }
 }
 
+/* Keeps the state of the modes in both the old and the new table: a mode keeps its
+ * index (the order is a prefix property of the sort, mode_table.h). */
 ictus_status membrane_build_modes_(membrane *m, int modes)
 {
     int need = membrane_padded_(modes);

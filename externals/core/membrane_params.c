@@ -6,7 +6,9 @@
 #include <math.h>
 #include <stddef.h>
 
-ictus_status membrane_physics_changed_(membrane *m, ictus_status s)
+/* After a physical parameter changed: the points' pending forces go in, then the
+ * coefficients and the couplings follow (the state is rescaled: no click); returns s. */
+static ictus_status physics_changed(void *m, ictus_status s)
 {
     membrane_flush_points_(m);
     membrane_update_coefficients_(m, 1);
@@ -14,16 +16,11 @@ ictus_status membrane_physics_changed_(membrane *m, ictus_status s)
     return s;
 }
 
-static ictus_status physics_changed(void *m, ictus_status s)
-{
-    return membrane_physics_changed_(m, s);
-}
-
 ictus_status membrane_set_sample_rate(membrane *m, double sr)
 {
     ictus_status s = ictus_clamp(&sr, MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, 48000.0);
     m->sample_rate = sr;
-    return membrane_physics_changed_(m, s);
+    return physics_changed(m, s);
 }
 
 ictus_status membrane_set_modes(membrane *m, int count)
