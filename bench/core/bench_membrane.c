@@ -51,10 +51,11 @@ static double run(int modes, int with_contact, int generic, int blocks, int repe
         membrane_use_generic_kernel_(m);
     *kernel = membrane_kernel_name(m);
     membrane_set_modes(m, modes);
-    membrane_set_t60(m, 60.0); /* keep ringing: no denormal shortcut */
+    /* keep ringing: no denormal shortcut */
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_T60, 60.0);
     membrane_attach_contact(m, c);
-    contact_set_mass(c, 10.0);
-    contact_set_stiffness(c, 1.0e6);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS, 10.0);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_STIFFNESS, 1.0e6);
     float o0[BLOCK], o1[BLOCK];
     float *out[2] = {o0, o1};
     membrane_strike(m, 0.3, 10.0, 0.01, 0);

@@ -1,4 +1,4 @@
-/* bessel_internal.h -- helpers shared by membrane.c and contact.c (not public API). */
+/* bessel_internal.h -- helpers shared by bessel.c and mode_table.c (not public API). */
 #ifndef ICTUS_BESSEL_INTERNAL_H
 #define ICTUS_BESSEL_INTERNAL_H
 

@@ -21,6 +21,7 @@
 #include "membrane_internal.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -74,115 +75,29 @@ void contact_free(contact *c)
     free(c);
 }
 
-ictus_status contact_set_mass(contact *c, double v)
-{
-    ictus_status s = ictus_clamp(&v, CONTACT_MASS_MIN, CONTACT_MASS_MAX, CONTACT_DEFAULT_MASS);
-    c->mass_kg = v;
-    return s;
-}
+/* Indexed by contact_param: name (as the Pd message), unit, range, and the double it
+ * is kept in. */
+/* clang-format off */
+#define RANGE(P) {CONTACT_##P##_MIN, CONTACT_##P##_MAX, CONTACT_DEFAULT_##P}
+/* clang-format on */
+static const ictus_param_def contact_param_def[CONTACT_PARAM_COUNT] = {
+    [CONTACT_PARAM_MASS] = {"mass", "kg", RANGE(MASS), offsetof(contact, mass_kg), NULL},
+    [CONTACT_PARAM_STIFFNESS] = {"stiffness", "N/m^alpha", RANGE(STIFFNESS),
+                                 offsetof(contact, stiffness), NULL},
+    [CONTACT_PARAM_ALPHA] = {"alpha", "", RANGE(ALPHA), offsetof(contact, alpha), NULL},
+    [CONTACT_PARAM_DAMPING] = {"damping", "N s/m^(alpha+1)", RANGE(DAMPING),
+                               offsetof(contact, damping), NULL},
+};
+#undef RANGE
 
-ictus_status contact_set_stiffness(contact *c, double v)
-{
-    ictus_status s =
-        ictus_clamp(&v, CONTACT_STIFFNESS_MIN, CONTACT_STIFFNESS_MAX, CONTACT_DEFAULT_STIFFNESS);
-    c->stiffness = v;
-    return s;
-}
-
-ictus_status contact_set_alpha(contact *c, double v)
-{
-    ictus_status s = ictus_clamp(&v, CONTACT_ALPHA_MIN, CONTACT_ALPHA_MAX, CONTACT_DEFAULT_ALPHA);
-    c->alpha = v;
-    return s;
-}
-
-ictus_status contact_set_damping(contact *c, double v)
-{
-    ictus_status s =
-        ictus_clamp(&v, CONTACT_DAMPING_MIN, CONTACT_DAMPING_MAX, CONTACT_DEFAULT_DAMPING);
-    c->damping = v;
-    return s;
-}
-
-double contact_get_mass(const contact *c)
-{
-    return c->mass_kg;
-}
-double contact_get_stiffness(const contact *c)
-{
-    return c->stiffness;
-}
-double contact_get_alpha(const contact *c)
-{
-    return c->alpha;
-}
-double contact_get_damping(const contact *c)
-{
-    return c->damping;
-}
-
-ictus_status contact_set_param(contact *c, contact_param p, double value)
-{
-    switch (p) {
-    case CONTACT_PARAM_MASS:
-        return contact_set_mass(c, value);
-    case CONTACT_PARAM_STIFFNESS:
-        return contact_set_stiffness(c, value);
-    case CONTACT_PARAM_ALPHA:
-        return contact_set_alpha(c, value);
-    case CONTACT_PARAM_DAMPING:
-        return contact_set_damping(c, value);
-    default:
-        return ICTUS_CLAMPED;
-    }
-}
-
-double contact_get_param(const contact *c, contact_param p)
-{
-    switch (p) {
-    case CONTACT_PARAM_MASS:
-        return contact_get_mass(c);
-    case CONTACT_PARAM_STIFFNESS:
-        return contact_get_stiffness(c);
-    case CONTACT_PARAM_ALPHA:
-        return contact_get_alpha(c);
-    case CONTACT_PARAM_DAMPING:
-        return contact_get_damping(c);
-    default:
-        return 0.0;
-    }
-}
-
-ictus_range contact_param_range(contact_param p)
-{
-    static const ictus_range ranges[CONTACT_PARAM_COUNT] = {
-        [CONTACT_PARAM_MASS] = {CONTACT_MASS_MIN, CONTACT_MASS_MAX, CONTACT_DEFAULT_MASS},
-        [CONTACT_PARAM_STIFFNESS] = {CONTACT_STIFFNESS_MIN, CONTACT_STIFFNESS_MAX,
-                                     CONTACT_DEFAULT_STIFFNESS},
-        [CONTACT_PARAM_ALPHA] = {CONTACT_ALPHA_MIN, CONTACT_ALPHA_MAX, CONTACT_DEFAULT_ALPHA},
-        [CONTACT_PARAM_DAMPING] = {CONTACT_DAMPING_MIN, CONTACT_DAMPING_MAX,
-                                   CONTACT_DEFAULT_DAMPING},
-    };
-    const ictus_range none = {0.0, 0.0, 0.0};
-    if ((int)p < 0 || p >= CONTACT_PARAM_COUNT)
-        return none;
-    return ranges[p];
-}
+const ictus_param_table contact_params = {contact_param_def, CONTACT_PARAM_COUNT};
 
 ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, double theta_deg,
                          int sample_offset)
 {
     ictus_status s = ictus_clamp(&velocity_mps, 0.0, CONTACT_VELOCITY_MAX, 1.0);
-    if (ictus_clamp(&r_over_a, MEMBRANE_R_OVER_A_MIN, MEMBRANE_R_OVER_A_MAX,
-                    MEMBRANE_R_OVER_A_MIN) != ICTUS_OK)
+    if (membrane_clamp_point_(&r_over_a, &theta_deg) != ICTUS_OK)
         s = ICTUS_CLAMPED;
-    if (!isfinite(theta_deg)) {
-        theta_deg = 0.0;
-        s = ICTUS_CLAMPED;
-    }
-    theta_deg = fmod(theta_deg, 360.0);
-    if (theta_deg < 0.0)
-        theta_deg += 360.0;
     if (sample_offset < 0) {
         sample_offset = 0;
         s = ICTUS_CLAMPED;

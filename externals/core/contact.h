@@ -46,14 +46,18 @@ extern "C" {
 #define CONTACT_DEFAULT_ALPHA     1.5
 #define CONTACT_DEFAULT_DAMPING   5.0e6 /* mu = lambda / k = 0.5 s/m */
 
-/* The one-number parameters, for the table-driven access below. */
+/* The one-number parameters, set, read and ranged through contact_params
+ * (ictus_param.h): ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS, 0.05). */
 typedef enum contact_param {
-    CONTACT_PARAM_MASS,      /* contact_set_mass */
-    CONTACT_PARAM_STIFFNESS, /* contact_set_stiffness */
-    CONTACT_PARAM_ALPHA,     /* contact_set_alpha */
-    CONTACT_PARAM_DAMPING,   /* contact_set_damping */
+    CONTACT_PARAM_MASS,      /* kg */
+    CONTACT_PARAM_STIFFNESS, /* k, N/m^alpha */
+    CONTACT_PARAM_ALPHA,     /* the exponent alpha */
+    CONTACT_PARAM_DAMPING,   /* lambda, N s/m^(alpha+1) */
     CONTACT_PARAM_COUNT
 } contact_param;
+
+/* Indexed by contact_param; names as the Pd messages. */
+extern const ictus_param_table contact_params;
 
 typedef struct contact contact;
 
@@ -68,20 +72,6 @@ typedef struct contact_report {
 /* Allocates. Returns NULL when memory cannot be had. */
 contact *contact_new(void);
 void contact_free(contact *c);
-
-ictus_status contact_set_mass(contact *c, double mass_kg);
-ictus_status contact_set_stiffness(contact *c, double k);
-ictus_status contact_set_alpha(contact *c, double alpha);
-ictus_status contact_set_damping(contact *c, double lambda);
-double contact_get_mass(const contact *c);
-double contact_get_stiffness(const contact *c);
-double contact_get_alpha(const contact *c);
-double contact_get_damping(const contact *c);
-
-/* Table-driven access, as membrane_set_param() and its kin (membrane.h). */
-ictus_status contact_set_param(contact *c, contact_param p, double value);
-double contact_get_param(const contact *c, contact_param p);
-ictus_range contact_param_range(contact_param p);
 
 /* Attach / detach a contact (at most MEMBRANE_MAX_CONTACTS per membrane). A contact
  * is solved jointly with the modes, sample by sample. Attaching an attached contact

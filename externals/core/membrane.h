@@ -24,22 +24,14 @@
 #ifndef ICTUS_MEMBRANE_H
 #define ICTUS_MEMBRANE_H
 
+#include "ictus_param.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* Result of a setter: the value was taken as given, clamped into range (the
- * clamped value can be read back with the matching getter), or refused
- * because memory could not be had (state unchanged). NaN counts as out of
- * range and is replaced by the parameter's default. */
-typedef enum {
-    ICTUS_OK = 0,      /* taken as given */
-    ICTUS_CLAMPED = 1, /* clamped or NaN replaced (also: no such pickup, strike queue full) */
-    ICTUS_ENOMEM = 2   /* refused: memory could not be had, state unchanged */
-} ictus_status;
-
 /* Legal ranges (SI units). Setters clamp into them and say so (ICTUS_CLAMPED);
- * membrane_param_range() gives the same numbers at run time. */
+ * ictus_param_range() gives the same numbers at run time. */
 #define MEMBRANE_RADIUS_MIN     0.01  /* m */
 #define MEMBRANE_RADIUS_MAX     2.0   /* m */
 #define MEMBRANE_TENSION_MIN    1.0   /* N/m */
@@ -73,24 +65,28 @@ typedef enum {
  * scale with this gain (measured by tests/core, docs/membrane.md#output-scale). */
 #define MEMBRANE_DEFAULT_GAIN 0.16
 
-/* A parameter's legal range and its default, in the units of its setter. */
-typedef struct ictus_range {
-    double min, max, def;
-} ictus_range;
-
-/* The one-number parameters, for the table-driven access below (the wrappers'
- * parameter tables, externals/pd/ictus_pd_common.h). */
+/* The one-number parameters, set, read and ranged through membrane_params
+ * (ictus_param.h): ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_T60, 2.0).
+ * Setting one that shapes the modes recomputes the coefficients and rescales the
+ * state so that the sound goes on without a click. */
 typedef enum membrane_param {
-    MEMBRANE_PARAM_RADIUS,     /* membrane_set_radius */
-    MEMBRANE_PARAM_TENSION,    /* membrane_set_tension */
-    MEMBRANE_PARAM_DENSITY,    /* membrane_set_density */
-    MEMBRANE_PARAM_MASS,       /* membrane_set_mass */
-    MEMBRANE_PARAM_MODES,      /* membrane_set_modes; a fraction rounds to the nearest count */
-    MEMBRANE_PARAM_T60,        /* membrane_set_t60 */
-    MEMBRANE_PARAM_HF_DAMPING, /* membrane_set_hf_damping */
-    MEMBRANE_PARAM_GAIN,       /* membrane_set_output_gain */
+    MEMBRANE_PARAM_RADIUS,  /* m */
+    MEMBRANE_PARAM_TENSION, /* N/m */
+    MEMBRANE_PARAM_DENSITY, /* kg/m^2 */
+    /* kg: sets the density as mass / (pi a^2), clamped into the density range times
+     * pi a^2 (its range follows the radius); density wins if set later. */
+    MEMBRANE_PARAM_MASS,
+    MEMBRANE_PARAM_MODES, /* a count, as membrane_set_modes(); a fraction rounds to the nearest */
+    /* Damping: T60 of the fundamental (s), and the high-frequency damping control
+     * (documented in docs/membrane.md; 0 = every mode decays like the fundamental). */
+    MEMBRANE_PARAM_T60,
+    MEMBRANE_PARAM_HF_DAMPING,
+    MEMBRANE_PARAM_GAIN, /* output gain applied to the pickups (docs/membrane.md) */
     MEMBRANE_PARAM_COUNT
 } membrane_param;
+
+/* Indexed by membrane_param; names as the Pd messages (hfdamp, gain). */
+extern const ictus_param_table membrane_params;
 
 typedef struct membrane membrane;
 
@@ -102,22 +98,10 @@ void membrane_free(membrane *m);
 /* Sample rate of this instance (Hz); recomputes the coefficients, keeps the state. */
 ictus_status membrane_set_sample_rate(membrane *m, double sample_rate_hz);
 
-/* Physics. Mass sets the density as mass / (pi a^2), clamped into the density range
- * times pi a^2; density wins if set later. */
-ictus_status membrane_set_radius(membrane *m, double radius_m);
-ictus_status membrane_set_tension(membrane *m, double tension_n_per_m);
-ictus_status membrane_set_density(membrane *m, double density_kg_per_m2);
-ictus_status membrane_set_mass(membrane *m, double mass_kg);
-
 /* Number of modes (sorted by frequency). Allocates when growing beyond the
  * capacity reached so far; call from a message handler, never from audio.
  * Modes above Nyquist*0.95 are kept silent (counted, not ringing). */
 ictus_status membrane_set_modes(membrane *m, int count);
-
-/* Damping: T60 of the fundamental (s), and the high-frequency damping control
- * (documented in docs/membrane.md; 0 = every mode decays like the fundamental). */
-ictus_status membrane_set_t60(membrane *m, double t60_s);
-ictus_status membrane_set_hf_damping(membrane *m, double control);
 
 /* Pickup `index` (0 .. MEMBRANE_PICKUPS-1) at r/a in [0, 1], angle in degrees. */
 ictus_status membrane_set_pickup(membrane *m, int index, double r_over_a, double theta_deg);
@@ -134,9 +118,6 @@ ictus_status membrane_strike(membrane *m, double r_over_a, double theta_deg, dou
 /* Silences every mode at once, and ends the stroke of every attached contact. */
 void membrane_clear(membrane *m);
 
-/* Output gain applied to the pickups (see docs/membrane.md for the scale). */
-ictus_status membrane_set_output_gain(membrane *m, double gain);
-
 /* Advances n samples. force_in (may be NULL) is a force (N) applied at the
  * strike point; out[0..MEMBRANE_PICKUPS-1] receive the pickup signals
  * (membrane velocity, see docs/membrane.md). force_in may alias an output.
@@ -144,26 +125,13 @@ ictus_status membrane_set_output_gain(membrane *m, double gain);
  * (one dot product per mode and sample less); pickup 0 is the same either way. */
 void membrane_process(membrane *m, const float *force_in, float *const *out, int n);
 
-/* Table-driven access to the one-number parameters: the setter and getter named in
- * the membrane_param list, and the range that setter clamps into (the mass's follows
- * the radius). An unknown p does nothing (ICTUS_CLAMPED, 0, an empty range). */
-ictus_status membrane_set_param(membrane *m, membrane_param p, double value);
-double membrane_get_param(const membrane *m, membrane_param p);
-ictus_range membrane_param_range(const membrane *m, membrane_param p);
-
-/* Read-back, for tests, help patches and the wrappers' error messages. */
+/* Read-back, for tests, help patches and the wrappers' error messages (the
+ * one-number parameters: ictus_param_get(&membrane_params, m, id)). */
 double membrane_get_sample_rate(const membrane *m);
-double membrane_get_radius(const membrane *m);
-double membrane_get_tension(const membrane *m);
-double membrane_get_density(const membrane *m);
-double membrane_get_mass(const membrane *m);
 int membrane_get_modes(const membrane *m);
 /* Of those modes, how many ring: the others lie above 0.95 x Nyquist and are kept
  * silent. 0 means the membrane makes no sound at this sample rate. */
 int membrane_get_sounding_modes(const membrane *m);
-double membrane_get_t60(const membrane *m);
-double membrane_get_hf_damping(const membrane *m);
-double membrane_get_output_gain(const membrane *m);
 /* Mode k (0-based, sorted by frequency): frequency (Hz), T60 (s), indices (m, n)
  * and which of the degenerate pair (0 = cos, 1 = sin). Return 0 on a bad k. */
 int membrane_get_mode(const membrane *m, int k, double *freq_hz, double *t60_s, int *bessel_m,

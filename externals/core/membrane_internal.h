@@ -7,6 +7,11 @@
 
 #include <math.h>
 #include "membrane.h"
+#include "mode_table.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 /* Arrays are padded to this many floats and aligned to 64 bytes so that the
  * kernels can run whole 8-wide vectors with no remainder loop. */
@@ -15,8 +20,8 @@
 /* Arguments of one sample of the modal update (see membrane_kernel.inc). */
 typedef struct membrane_kernel_args {
     int count; /* modes to update, a multiple of MEMBRANE_PAD */
-    /* r / sc and p / sc, sc = sqrt(cd) per mode (r = q / (h w'); membrane.c,
-     * update_coefficients): in these coordinates a point's force goes in, and its
+    /* r / sc and p / sc, sc = sqrt(cd) per mode (r = q / (h w'); membrane_modes.c,
+     * membrane_update_coefficients_): in these coordinates a point's force goes in, and its
      * displacement comes out, through one array, psi sc (membrane_kernel.inc). */
     float *q, *p;
     const float *c1, *cd, *c3;
@@ -46,6 +51,122 @@ void membrane_kernel_pair_avx2(membrane_kernel_args *a);
 /* Benchmarks only: run the portable kernel even on an AVX2 machine. */
 void membrane_use_generic_kernel_(membrane *m);
 
+/* ---------------------------------------------------------------- the membrane
+ *
+ * Its rooms: membrane.c (life cycle, pickups, the processing loop, read-back),
+ * membrane_modes.c (mode arrays and coefficients), membrane_points.c (strikes and
+ * coupling points), membrane_params.c (the one-number parameters). */
+
+#define STRIKE_QUEUE  64
+#define FADE_S        0.03 /* s: ring-out of modes dropped by membrane_set_modes() */
+#define IMPULSE_CACHE 4
+
+typedef struct pending_strike {
+    double r_over_a, theta_deg, impulse_ns;
+    int offset;
+} pending_strike;
+
+typedef struct impulse_shape {
+    double r_over_a, theta_deg;
+    int valid;
+    float *psi;
+} impulse_shape;
+
+typedef struct membrane_point membrane_point;
+
+struct membrane {
+    double sample_rate, radius, tension, density, t60, hf_damping, output_gain;
+    double gain_smoothed; /* output gain as applied, follows output_gain in ~5 ms */
+    int modes;            /* requested mode count */
+    /* After the count shrinks, the dropped modes ring out over FADE_S (no input,
+     * T60 of FADE_S) before they go: modes .. fading_modes-1, fade_left samples. */
+    int fading_modes;
+    long fade_left;
+    int count;    /* modes rounded up to MEMBRANE_PAD: the kernel's loop length */
+    int capacity; /* floats allocated per array */
+    /* Mode table, capacity entries; entries >= modes are padding. */
+    mode_table table;
+    double *omega_model; /* model stiffness w' per mode (0: silent) */
+    /* SoA float state and coefficients (see membrane_kernel.inc): q holds the
+     * scaled displacement r = q / (h w'), h = T / 2 (the energy coordinate q is
+     * h w' r); cd = 2 / D is r's coefficient of p; ep the input gain of both. */
+    float *q, *p, *c1, *cd, *c3, *ep;
+    /* The kernel's coordinates: q and p above hold r / sc and p / sc, sc = sqrt(cd)
+     * (0 for silent modes); ep_k = ep / sc, pick_k = psi_pick sc, and each point's
+     * psi_k = psi sc (membrane_kernel.inc). */
+    float *sc, *ep_k, *pick_k[MEMBRANE_PICKUPS];
+    double coef_h; /* h of the coefficients (and of r) now in place */
+    float *psi_strike, *psi_pick[MEMBRANE_PICKUPS];
+    /* A moved pickup crossfades from its old shapes over a few ms (no click). */
+    float *psi_pick_old[MEMBRANE_PICKUPS];
+    int pick_fade_left[MEMBRANE_PICKUPS], pick_fade_len;
+    double mass_scale; /* 1 / sqrt(density * radius^2) */
+    double strike_r, strike_theta;
+    double pick_r[MEMBRANE_PICKUPS], pick_theta[MEMBRANE_PICKUPS];
+    pending_strike queue[STRIKE_QUEUE];
+    int queued;
+    long dropped;
+    impulse_shape impulse_cache[IMPULSE_CACHE];
+    int impulse_next;
+    membrane_point *points[MEMBRANE_MAX_POINTS];
+    int point_count;
+    void (*kernel)(membrane_kernel_args *);
+    void (*kernel_pair)(membrane_kernel_args *); /* two samples per pass, same instruction set */
+};
+
+/* Aligned, zeroed floats for the kernels (NULL when memory cannot be had). Allocates. */
+float *membrane_alloc_floats_(int n);
+
+static inline int membrane_padded_(int n)
+{
+    return (n + MEMBRANE_PAD - 1) / MEMBRANE_PAD * MEMBRANE_PAD;
+}
+
+/* The displacement per unit of sum psi r: w = sum dm psi q = scale h sum psi r. */
+static inline double membrane_displacement_scale_(const membrane *m)
+{
+    return m->mass_scale * m->coef_h;
+}
+
+/* Shapes of the sounding modes (the fading ones included) at a point; see mode_table.h.
+ * For the pickups, which hear the fading modes ring out. */
+static inline void membrane_mode_shapes_(const membrane *m, double r_over_a, double theta_deg,
+                                         float *psi)
+{
+    mode_table_shapes(&m->table, m->fading_modes, r_over_a, theta_deg, psi);
+}
+
+/* Shapes at an input point (strikes, coupling points): zero for the fading modes,
+ * which take no input and are invisible to the points (the kernel folds a point's
+ * force in through cd, which the fading modes keep for their ring-out). */
+static inline void membrane_input_shapes_(const membrane *m, double r_over_a, double theta_deg,
+                                          float *psi)
+{
+    mode_table_shapes(&m->table, m->modes, r_over_a, theta_deg, psi);
+}
+
+/* membrane_modes.c. Recomputes every coefficient from the physics; with rescale, the
+ * modal state follows so that each mode's displacement and velocity stay continuous. */
+void membrane_update_coefficients_(membrane *m, int rescale);
+/* Builds the mode arrays for `modes` modes, keeping the state of the modes in both
+ * the old and the new table. Allocates when growing. */
+ictus_status membrane_build_modes_(membrane *m, int modes);
+/* Frees the arrays built for the capacity (not the points'). */
+void membrane_free_mode_arrays_(membrane *m);
+
+/* membrane_points.c. The points' pending forces into the state (message time only:
+ * before coefficients or shapes change). */
+void membrane_flush_points_(membrane *m);
+/* The shapes and couplings in the kernel's coordinates, after the coefficients, the
+ * pickups or the shapes changed. */
+void membrane_refresh_couplings_(membrane *m);
+/* The cached input shapes at (r, theta), computed into the cache when missing. */
+impulse_shape *membrane_impulse_shape_(membrane *m, double r, double theta);
+/* An impulse of `force` N over one sample along psi, after the kernel's step. */
+void membrane_add_input_(membrane *m, const float *psi, double force, membrane_kernel_args *a);
+/* A point's pending move lands now (from the processing loop). */
+void membrane_land_point_(membrane *m, membrane_point *pt);
+
 /* ---------------------------------------------------------------- coupling points
  *
  * A coupling point is where an object attached to the membrane (a stick: contact.c)
@@ -55,8 +176,6 @@ void membrane_use_generic_kernel_(membrane *m);
  * the modal state one sample late (the kernel does it). The object owns the force:
  * the membrane calls it through membrane_point_ops at fixed places of
  * membrane_process(), and never sees its type. */
-typedef struct membrane_point membrane_point;
-
 typedef struct membrane_point_ops {
     /* A pending move has just landed (membrane_point_move_): the point is at its
      * new place, displacement_m is the membrane's displacement there. */
@@ -87,7 +206,7 @@ struct membrane_point {
      * at the place of a pending move. Allocated by the membrane at its capacity
      * (psi_cap floats each), freed by membrane_point_free_. */
     float *psi, *psi_next;
-    /* psi sc (membrane.c): the kernel's copy, in the coordinates of its stored state. */
+    /* psi sc (membrane_points.c): the kernel's copy, in the coordinates of its stored state. */
     float *psi_k;
     int psi_cap;
     double r_over_a, theta_deg;
@@ -131,6 +250,23 @@ static inline ictus_status ictus_clamp(double *v, double lo, double hi, double f
         return ICTUS_CLAMPED;
     }
     return ICTUS_OK;
+}
+
+/* Clamps a point on the head: r/a into [0, 1] (NaN: 0), theta (deg) wrapped into
+ * [0, 360) so that cos/sin stay accurate (not finite: 0). ICTUS_CLAMPED when either
+ * changed (a wrapped angle is no change). */
+static inline ictus_status membrane_clamp_point_(double *r_over_a, double *theta_deg)
+{
+    ictus_status s =
+        ictus_clamp(r_over_a, MEMBRANE_R_OVER_A_MIN, MEMBRANE_R_OVER_A_MAX, MEMBRANE_R_OVER_A_MIN);
+    if (!isfinite(*theta_deg)) {
+        *theta_deg = 0.0;
+        return ICTUS_CLAMPED;
+    }
+    *theta_deg = fmod(*theta_deg, 360.0);
+    if (*theta_deg < 0.0)
+        *theta_deg += 360.0;
+    return s;
 }
 
 #endif

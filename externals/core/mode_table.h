@@ -1,7 +1,7 @@
 /* mode_table.h -- the modes of an ideal circular membrane fixed at its rim, in
  * order of frequency: the Bessel zero each mode rings at, its (m, n) indices, which
  * partner of a degenerate cos/sin pair it is, and its mass-normalised shape
- * (docs/membrane.md, "The membrane"). Internal to the core (membrane.c). */
+ * (docs/membrane.md, "The membrane"). Internal to the core (the membrane's rooms). */
 #ifndef ICTUS_MODE_TABLE_H
 #define ICTUS_MODE_TABLE_H
 

@@ -33,37 +33,7 @@ t_class *ictus_contact_tilde_class;
 
 /* ---------------- parameters ---------------- */
 
-static ictus_status contact_tilde_core_set(void *core, int id, double value)
-{
-    return contact_set_param((contact *)core, (contact_param)id, value);
-}
-
-static double contact_tilde_core_get(const void *core, int id)
-{
-    return contact_get_param((const contact *)core, (contact_param)id);
-}
-
-static ictus_range contact_tilde_core_range(const void *core, int id)
-{
-    (void)core;
-    return contact_param_range((contact_param)id);
-}
-
-static const t_ictus_param contact_tilde_param[] = {
-    {"mass", "kg", CONTACT_PARAM_MASS},
-    {"stiffness", "N/m^alpha", CONTACT_PARAM_STIFFNESS},
-    {"alpha", "", CONTACT_PARAM_ALPHA},
-    {"damping", "N s/m^(alpha+1)", CONTACT_PARAM_DAMPING},
-};
-
-static const t_ictus_params contact_tilde_params = {
-    "contact~",
-    contact_tilde_param,
-    (int)(sizeof(contact_tilde_param) / sizeof(contact_tilde_param[0])),
-    contact_tilde_core_set,
-    contact_tilde_core_get,
-    contact_tilde_core_range,
-};
+static const t_ictus_params contact_tilde_params = {"contact~", &contact_params};
 
 /* mass, stiffness, alpha, damping: one number each. */
 static void contact_tilde_setparam(t_contact_tilde *x, t_symbol *s, int argc, t_atom *argv)
@@ -150,6 +120,7 @@ static void contact_tilde_membrane_gone(void *owner)
 {
     t_contact_tilde *x = (t_contact_tilde *)owner;
     contact *fresh;
+    int id;
     x->x_membrane = 0;
     if (!contact_is_active(x->x_core))
         return;
@@ -158,10 +129,9 @@ static void contact_tilde_membrane_gone(void *owner)
         pd_error(x, "contact~: out of memory; the interrupted stroke is kept");
         return;
     }
-    contact_set_mass(fresh, contact_get_mass(x->x_core));
-    contact_set_stiffness(fresh, contact_get_stiffness(x->x_core));
-    contact_set_alpha(fresh, contact_get_alpha(x->x_core));
-    contact_set_damping(fresh, contact_get_damping(x->x_core));
+    for (id = 0; id < CONTACT_PARAM_COUNT; id++)
+        ictus_param_set(&contact_params, fresh, id,
+                        ictus_param_get(&contact_params, x->x_core, id));
     contact_set_force_output(fresh, x->x_force, x->x_force_size);
     contact_free(x->x_core);
     x->x_core = fresh;
@@ -239,14 +209,11 @@ static void contact_tilde_dsp(t_contact_tilde *x, t_signal **sp)
 
 static void *contact_tilde_new(t_symbol *s, int argc, t_atom *argv)
 {
-    t_contact_tilde *x;
     contact *core = contact_new();
+    t_contact_tilde *x = ictus_core_object_new(ictus_contact_tilde_class, "contact~", core);
     (void)s;
-    if (!core) {
-        pd_error(0, "contact~: out of memory");
+    if (!x)
         return 0;
-    }
-    x = (t_contact_tilde *)pd_new(ictus_contact_tilde_class);
     x->x_core = core;
     x->x_f = 0;
     x->x_membrane = 0;

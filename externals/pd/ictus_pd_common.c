@@ -76,6 +76,17 @@ void ictus_clock_block_end(t_ictus_clock *c, int n)
     c->c_samples_done += n;
 }
 
+/* ---------------- objects built on a core ---------------- */
+
+void *ictus_core_object_new(t_class *c, const char *name, const void *core)
+{
+    if (!core) {
+        pd_error(0, "%s: out of memory", name);
+        return 0;
+    }
+    return pd_new(c);
+}
+
 /* ---------------- message arguments ---------------- */
 
 int ictus_getnumber(void *x, const char *obj, const char *msg, const char *arg, int argc,
@@ -122,15 +133,6 @@ int ictus_getpoint(void *x, const char *obj, const char *msg, int argc, const t_
 
 /* ---------------- parameter tables ---------------- */
 
-const t_ictus_param *ictus_params_find(const t_ictus_params *ps, const t_symbol *s)
-{
-    int i;
-    for (i = 0; i < ps->ps_count; i++)
-        if (!strcmp(s->s_name, ps->ps_param[i].p_name))
-            return &ps->ps_param[i];
-    return 0;
-}
-
 /* Whether `value`, just outside a range, is its `limit` as the user wrote it. A Pd
  * message carries a t_float: a limit typed in a message (0.01, 1e-4) arrives as the
  * float nearest to it, up to half a float's step away from the double the core
@@ -147,42 +149,43 @@ static int ictus_is_limit(double value, double limit)
     return !strcmp(typed, quoted);
 }
 
-void ictus_params_set(void *x, const t_ictus_params *ps, void *core, const t_ictus_param *p,
-                      double value)
+void ictus_params_set(void *x, const t_ictus_params *ps, void *core, int id, double value)
 {
+    const ictus_param_def *p = &ps->ps_table->def[id];
     /* The range before setting: the mass's follows the radius, not the mass. */
-    ictus_range range = ps->ps_range(core, p->p_id);
-    const char *space = *p->p_unit ? " " : "";
+    ictus_range range = ictus_param_range(ps->ps_table, core, id);
+    const char *space = *p->unit ? " " : "";
     ictus_status status;
     if (value < range.min && ictus_is_limit(value, range.min))
         value = range.min;
     else if (value > range.max && ictus_is_limit(value, range.max))
         value = range.max;
-    status = ps->ps_set(core, p->p_id, value);
+    status = ictus_param_set(ps->ps_table, core, id, value);
     if (status == ICTUS_ENOMEM)
-        pd_error(x, "%s: %s %g: out of memory; keeping %g", ps->ps_class, p->p_name, value,
-                 ps->ps_get(core, p->p_id));
+        pd_error(x, "%s: %s %g: out of memory; keeping %g", ps->ps_class, p->name, value,
+                 ictus_param_get(ps->ps_table, core, id));
     else if (status == ICTUS_CLAMPED)
-        pd_error(x, "%s: %s must be in [%g, %g]%s%s, got %g; using %g", ps->ps_class, p->p_name,
-                 range.min, range.max, space, p->p_unit, value, ps->ps_get(core, p->p_id));
+        pd_error(x, "%s: %s must be in [%g, %g]%s%s, got %g; using %g", ps->ps_class, p->name,
+                 range.min, range.max, space, p->unit, value,
+                 ictus_param_get(ps->ps_table, core, id));
 }
 
 void ictus_params_message(void *x, const t_ictus_params *ps, void *core, const t_symbol *s,
                           int argc, const t_atom *argv)
 {
-    const t_ictus_param *p = ictus_params_find(ps, s);
+    int id = ictus_param_find(ps->ps_table, s->s_name);
     double value;
-    if (!p)
+    if (id < 0)
         return;
     if (argc > 1)
-        pd_error(x, "%s: %s takes one number; extra arguments ignored", ps->ps_class, p->p_name);
-    if (ictus_getnumber(x, ps->ps_class, p->p_name, "value", argc, argv, 0, &value))
-        ictus_params_set(x, ps, core, p, value);
+        pd_error(x, "%s: %s takes one number; extra arguments ignored", ps->ps_class, s->s_name);
+    if (ictus_getnumber(x, ps->ps_class, s->s_name, "value", argc, argv, 0, &value))
+        ictus_params_set(x, ps, core, id, value);
 }
 
 void ictus_params_addmethods(t_class *c, const t_ictus_params *ps, t_method method)
 {
     int i;
-    for (i = 0; i < ps->ps_count; i++)
-        class_addmethod(c, method, gensym(ps->ps_param[i].p_name), A_GIMME, 0);
+    for (i = 0; i < ps->ps_table->count; i++)
+        class_addmethod(c, method, gensym(ps->ps_table->def[i].name), A_GIMME, 0);
 }

@@ -31,6 +31,12 @@ void ictus_clock_block_end(t_ictus_clock *c, int n);
  * compute, of the current logical time. 0 before DSP runs. */
 int ictus_clock_offset_now(const t_ictus_clock *c);
 
+/* ---------------- objects built on a core ---------------- */
+
+/* pd_new(c) for an object of class `name` whose core is `core`; NULL, with the error
+ * said, when the core could not be made (core NULL: out of memory). */
+void *ictus_core_object_new(t_class *c, const char *name, const void *core);
+
 /* ---------------- message arguments ---------------- */
 
 /* Reads argv[i] as a finite number into *value, or reports (object, message,
@@ -46,32 +52,20 @@ int ictus_getpoint(void *x, const char *obj, const char *msg, int argc, const t_
 
 /* ---------------- parameter tables ----------------
  *
- * One table per class lists its one-number messages. Setting goes through the core,
+ * The core's table of a class lists its one-number messages (ictus_param.h), one
+ * message per entry, named as the entry. Setting goes through the core,
  * which clamps into its own range and says so (ICTUS_CLAMPED); the error line then
  * quotes the core's range (ictus_range) and the value it kept. */
-typedef struct _ictus_param {
-    const char *p_name; /* the message that sets it, and its name in errors */
-    const char *p_unit; /* shown after the range; "" for none */
-    int p_id;           /* the core's parameter (membrane_param, contact_param) */
-} t_ictus_param;
-
 typedef struct _ictus_params {
-    const char *ps_class; /* "membrane~": errors start with it */
-    const t_ictus_param *ps_param;
-    int ps_count;
-    /* The core's table-driven access, on the object's core (membrane *, contact *). */
-    ictus_status (*ps_set)(void *core, int id, double value);
-    double (*ps_get)(const void *core, int id);
-    ictus_range (*ps_range)(const void *core, int id);
+    const char *ps_class;              /* "membrane~": errors start with it */
+    const ictus_param_table *ps_table; /* the core's (membrane_params, contact_params) */
 } t_ictus_params;
 
-/* The entry named s, or NULL. */
-const t_ictus_param *ictus_params_find(const t_ictus_params *ps, const t_symbol *s);
-/* Sets one parameter on core and reports, on x, what the core clamped or refused. A
- * value just outside the range that is its limit as a Pd float, or as the error line
- * prints it (%g), is taken as that limit, without a word. */
-void ictus_params_set(void *x, const t_ictus_params *ps, void *core, const t_ictus_param *p,
-                      double value);
+/* Sets parameter id (an entry of the core's table) on core and reports, on x, what
+ * the core clamped or refused. A value just outside the range that is its limit as a
+ * Pd float, or as the error line prints it (%g), is taken as that limit, without a
+ * word. */
+void ictus_params_set(void *x, const t_ictus_params *ps, void *core, int id, double value);
 /* The A_GIMME method body for every entry's message: one number, checked and set. */
 void ictus_params_message(void *x, const t_ictus_params *ps, void *core, const t_symbol *s,
                           int argc, const t_atom *argv);

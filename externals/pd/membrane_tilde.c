@@ -46,40 +46,12 @@ t_class *ictus_membrane_tilde_class;
 
 /* ---------------- parameters ---------------- */
 
-static ictus_status membrane_tilde_core_set(void *core, int id, double value)
-{
-    return membrane_set_param((membrane *)core, (membrane_param)id, value);
-}
-
-static double membrane_tilde_core_get(const void *core, int id)
-{
-    return membrane_get_param((const membrane *)core, (membrane_param)id);
-}
-
-static ictus_range membrane_tilde_core_range(const void *core, int id)
-{
-    return membrane_param_range((const membrane *)core, (membrane_param)id);
-}
-
 /* gain is dimensionless to the user: output = membrane velocity x gain (docs/membrane.md). */
-static const t_ictus_param membrane_tilde_param[] = {
-    {"radius", "m", MEMBRANE_PARAM_RADIUS},        {"tension", "N/m", MEMBRANE_PARAM_TENSION},
-    {"density", "kg/m^2", MEMBRANE_PARAM_DENSITY}, {"mass", "kg", MEMBRANE_PARAM_MASS},
-    {"modes", "", MEMBRANE_PARAM_MODES},           {"t60", "s", MEMBRANE_PARAM_T60},
-    {"hfdamp", "", MEMBRANE_PARAM_HF_DAMPING},     {"gain", "", MEMBRANE_PARAM_GAIN},
-};
-
-static const t_ictus_params membrane_tilde_params = {
-    "membrane~",
-    membrane_tilde_param,
-    (int)(sizeof(membrane_tilde_param) / sizeof(membrane_tilde_param[0])),
-    membrane_tilde_core_set,
-    membrane_tilde_core_get,
-    membrane_tilde_core_range,
-};
+static const t_ictus_params membrane_tilde_params = {"membrane~", &membrane_params};
 
 /* The creation arguments after NAME, in order. */
-static const char *const membrane_tilde_args[] = {"radius", "tension", "density", "modes"};
+static const membrane_param membrane_tilde_args[] = {MEMBRANE_PARAM_RADIUS, MEMBRANE_PARAM_TENSION,
+                                                     MEMBRANE_PARAM_DENSITY, MEMBRANE_PARAM_MODES};
 #define NARGS (int)(sizeof(membrane_tilde_args) / sizeof(membrane_tilde_args[0]))
 
 /* A head whose lowest mode lies above the core's cutoff (0.95 x Nyquist) makes no
@@ -158,14 +130,19 @@ static void membrane_tilde_clear(t_membrane_tilde *x)
 /* print: the physics and the first modes, in the Pd window. */
 static void membrane_tilde_print(t_membrane_tilde *x)
 {
-    int k, count = membrane_get_modes(x->x_core);
+    const membrane *core = x->x_core;
+    int k, count = membrane_get_modes(core);
     post("membrane~ %s: radius %g m, tension %g N/m, density %g kg/m^2 (mass %g kg), "
          "%d modes, t60 %g s, hfdamp %g, gain %g, sr %g Hz",
-         x->x_name != &s_ ? x->x_name->s_name : "(no name)", membrane_get_radius(x->x_core),
-         membrane_get_tension(x->x_core), membrane_get_density(x->x_core),
-         membrane_get_mass(x->x_core), count, membrane_get_t60(x->x_core),
-         membrane_get_hf_damping(x->x_core), membrane_get_output_gain(x->x_core),
-         membrane_get_sample_rate(x->x_core));
+         x->x_name != &s_ ? x->x_name->s_name : "(no name)",
+         ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_RADIUS),
+         ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_TENSION),
+         ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_DENSITY),
+         ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_MASS), count,
+         ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_T60),
+         ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_HF_DAMPING),
+         ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_GAIN),
+         membrane_get_sample_rate(core));
     for (k = 0; k < count && k < 12; k++) {
         double f, t60;
         int bm, bn, sinp;
@@ -247,15 +224,12 @@ static void membrane_tilde_dsp(t_membrane_tilde *x, t_signal **sp)
 
 static void *membrane_tilde_new(t_symbol *s, int argc, t_atom *argv)
 {
-    t_membrane_tilde *x;
     membrane *core = membrane_new(sys_getsr() > 0 ? sys_getsr() : 44100);
+    t_membrane_tilde *x = ictus_core_object_new(ictus_membrane_tilde_class, "membrane~", core);
     int first = 0, i;
     (void)s;
-    if (!core) {
-        pd_error(0, "membrane~: out of memory");
+    if (!x)
         return 0;
-    }
-    x = (t_membrane_tilde *)pd_new(ictus_membrane_tilde_class);
     x->x_core = core;
     x->x_f = 0;
     x->x_name = &s_;
@@ -269,10 +243,10 @@ static void *membrane_tilde_new(t_symbol *s, int argc, t_atom *argv)
     /* optional: radius tension density modes */
     for (i = first; i < argc && i - first < NARGS; i++) {
         double value;
-        const t_ictus_param *p =
-            ictus_params_find(&membrane_tilde_params, gensym(membrane_tilde_args[i - first]));
-        if (ictus_getnumber(x, "membrane~", "creation argument", p->p_name, argc, argv, i, &value))
-            ictus_params_set(x, &membrane_tilde_params, x->x_core, p, value);
+        int id = membrane_tilde_args[i - first];
+        if (ictus_getnumber(x, "membrane~", "creation argument", membrane_params.def[id].name, argc,
+                            argv, i, &value))
+            ictus_params_set(x, &membrane_tilde_params, x->x_core, id, value);
     }
     if (argc - first > NARGS)
         pd_error(x, "membrane~: arguments are NAME radius tension density modes; "

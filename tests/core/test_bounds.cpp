@@ -141,19 +141,19 @@ result play(const stroke &s, const stroke &ask, double seconds)
     contact *c = contact_new();
     REQUIRE((m && c));
     membrane_set_modes(m, ask.h.modes);
-    membrane_set_radius(m, ask.h.radius);
-    membrane_set_tension(m, ask.h.tension);
-    membrane_set_density(m, ask.h.density);
-    membrane_set_t60(m, ask.t60);
-    membrane_set_hf_damping(m, ask.hf);
-    membrane_set_output_gain(m, ask.gain);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_RADIUS, ask.h.radius);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION, ask.h.tension);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_DENSITY, ask.h.density);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_T60, ask.t60);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_HF_DAMPING, ask.hf);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_GAIN, ask.gain);
     for (int j = 0; j < 2; j++)
         membrane_set_pickup(m, j, s.pick_r[j], s.pick_theta[j]);
     REQUIRE(membrane_attach_contact(m, c) == ICTUS_OK);
-    contact_set_mass(c, ask.stick_mass);
-    contact_set_stiffness(c, ask.stiffness);
-    contact_set_alpha(c, ask.alpha);
-    contact_set_damping(c, ask.damping);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS, ask.stick_mass);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_STIFFNESS, ask.stiffness);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_ALPHA, ask.alpha);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_DAMPING, ask.damping);
     contact_hit(c, ask.velocity, s.hit_r, s.hit_theta, s.hit_offset);
     if (s.impulse > 0.0)
         membrane_strike(m, s.strike_r, s.strike_theta, s.impulse, s.strike_offset);

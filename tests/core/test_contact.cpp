@@ -64,7 +64,7 @@ hit_result hit_membrane(membrane *m, contact *c, double v, double r, double thet
 TEST_CASE("Rigid target: contact time approaches Hertz within 5 %", "[core][contact]")
 {
     contact *c = contact_new();
-    contact_set_damping(c, 0.0);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_DAMPING, 0.0);
     struct {
         double mass, k, alpha, v0;
     } cases[] = {{0.05, 1e7, 1.5, 5.0},
@@ -73,9 +73,9 @@ TEST_CASE("Rigid target: contact time approaches Hertz within 5 %", "[core][cont
                  {0.01, 1e9, 2.5, 10.0},
                  {1.0, 1e6, 4.0, 1.0}};
     for (auto &cs : cases) {
-        contact_set_mass(c, cs.mass);
-        contact_set_stiffness(c, cs.k);
-        contact_set_alpha(c, cs.alpha);
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS, cs.mass);
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_STIFFNESS, cs.k);
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_ALPHA, cs.alpha);
         double tau = hertz_time(cs.mass, cs.k, cs.alpha, cs.v0);
         // Sample rate giving >= 100 samples in contact.
         double fs = std::max(48000.0, 100.0 / tau);
@@ -97,14 +97,14 @@ TEST_CASE("Stiff heavy membrane: contact time approaches Hertz within 5 %", "[co
 {
     membrane *m = membrane_new(96000.0);
     membrane_set_modes(m, 64);
-    membrane_set_radius(m, 0.05);
-    membrane_set_tension(m, 1e5);
-    membrane_set_density(m, 20.0);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_RADIUS, 0.05);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION, 1e5);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_DENSITY, 20.0);
     contact *c = contact_new();
-    contact_set_damping(c, 0.0);
-    contact_set_stiffness(c, 1e5);
-    contact_set_alpha(c, 1.5);
-    contact_set_mass(c, 0.05);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_DAMPING, 0.0);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_STIFFNESS, 1e5);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_ALPHA, 1.5);
+    ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS, 0.05);
     membrane_attach_contact(m, c);
     double tau = hertz_time(0.05, 1e5, 1.5, 1.0);
     hit_result h = hit_membrane(m, c, 1.0, 0.0, 0.0, 96000 / 5);
@@ -124,26 +124,35 @@ TEST_CASE("Passivity over 10^4 random legal contacts", "[core][contact]")
     contact *c = contact_new();
     int checked = 0;
     for (int i = 0; i < 10000; i++) {
-        contact_set_mass(c, logu(CONTACT_MASS_MIN, CONTACT_MASS_MAX));
-        contact_set_stiffness(c, logu(1e3, CONTACT_STIFFNESS_MAX));
-        contact_set_alpha(c,
-                          CONTACT_ALPHA_MIN + (CONTACT_ALPHA_MAX - CONTACT_ALPHA_MIN) * u01(rng));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS,
+                        logu(CONTACT_MASS_MIN, CONTACT_MASS_MAX));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_STIFFNESS,
+                        logu(1e3, CONTACT_STIFFNESS_MAX));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_ALPHA,
+                        CONTACT_ALPHA_MIN + (CONTACT_ALPHA_MAX - CONTACT_ALPHA_MIN) * u01(rng));
         // lambda spans mu = lambda / k from 1e-3 to 1e3 s/m.
-        contact_set_damping(c, u01(rng) < 0.2 ? 0.0 : logu(1e-3, 1e3) * contact_get_stiffness(c));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_DAMPING,
+                        u01(rng) < 0.2
+                            ? 0.0
+                            : logu(1e-3, 1e3) *
+                                  ictus_param_get(&contact_params, c, CONTACT_PARAM_STIFFNESS));
         double v = logu(0.01, CONTACT_VELOCITY_MAX);
         contact_report r{};
         // At least 20 samples across the Hertz time of the undamped contact.
         // Only a time scale here: a coarse integral is plenty.
-        double tau =
-            hertz_time(contact_get_mass(c), contact_get_stiffness(c), contact_get_alpha(c), v, 200);
+        double tau = hertz_time(ictus_param_get(&contact_params, c, CONTACT_PARAM_MASS),
+                                ictus_param_get(&contact_params, c, CONTACT_PARAM_STIFFNESS),
+                                ictus_param_get(&contact_params, c, CONTACT_PARAM_ALPHA), v, 200);
         double fs = std::min(std::max(20.0 / tau, 1000.0), 1e8);
         if (!contact_simulate_rigid(c, v, fs, 50.0 * tau, &r))
             continue; // heavy damping can stop the stick (it then never leaves)
         // Everything runs in double; the energy error per step of the bracketed
         // solve is a few ulp of the stick's energy, so over < 10^4 steps the rebound
         // may exceed v by at most ~1e4 * 4 * DBL_EPSILON relative.
-        INFO("case " << i << " m " << contact_get_mass(c) << " k " << contact_get_stiffness(c)
-                     << " a " << contact_get_alpha(c) << " lambda " << contact_get_damping(c)
+        INFO("case " << i << " m " << ictus_param_get(&contact_params, c, CONTACT_PARAM_MASS)
+                     << " k " << ictus_param_get(&contact_params, c, CONTACT_PARAM_STIFFNESS)
+                     << " a " << ictus_param_get(&contact_params, c, CONTACT_PARAM_ALPHA)
+                     << " lambda " << ictus_param_get(&contact_params, c, CONTACT_PARAM_DAMPING)
                      << " v " << v);
         REQUIRE(r.rebound_velocity_mps <= v * (1.0 + 1e4 * 4.0 * DBL_EPSILON));
         checked++;
@@ -161,21 +170,26 @@ TEST_CASE("Passivity with the membrane: total discrete energy never grows", "[co
     for (int trial = 0; trial < 150; trial++) {
         membrane *m = membrane_new(logu(22050.0, 192000.0));
         membrane_set_modes(m, modes);
-        membrane_set_radius(m, logu(0.05, 0.5));
-        membrane_set_tension(m, logu(100.0, 1e5));
-        membrane_set_density(m, logu(0.05, 5.0));
-        membrane_set_t60(m, logu(0.05, 10.0));
-        membrane_set_hf_damping(m, u01(rng) * 5.0);
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_RADIUS, logu(0.05, 0.5));
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION, logu(100.0, 1e5));
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_DENSITY, logu(0.05, 5.0));
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_T60, logu(0.05, 10.0));
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_HF_DAMPING, u01(rng) * 5.0);
         contact *c = contact_new();
-        contact_set_mass(c, logu(0.005, 1.0));
-        contact_set_stiffness(c, logu(1e4, 1e9));
-        contact_set_alpha(c, 1.0 + 2.0 * u01(rng));
-        contact_set_damping(c, u01(rng) < 0.3 ? 0.0 : logu(0.01, 10.0) * contact_get_stiffness(c));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS, logu(0.005, 1.0));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_STIFFNESS, logu(1e4, 1e9));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_ALPHA, 1.0 + 2.0 * u01(rng));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_DAMPING,
+                        u01(rng) < 0.3
+                            ? 0.0
+                            : logu(0.01, 10.0) *
+                                  ictus_param_get(&contact_params, c, CONTACT_PARAM_STIFFNESS));
         membrane_attach_contact(m, c);
         double v = logu(0.1, 20.0), r = 0.9 * u01(rng), th = 360.0 * u01(rng);
         contact_hit(c, v, r, th, 0);
-        const double mass = contact_get_mass(c), k = contact_get_stiffness(c),
-                     a = contact_get_alpha(c);
+        const double mass = ictus_param_get(&contact_params, c, CONTACT_PARAM_MASS),
+                     k = ictus_param_get(&contact_params, c, CONTACT_PARAM_STIFFNESS),
+                     a = ictus_param_get(&contact_params, c, CONTACT_PARAM_ALPHA);
         const double e0 = 0.5 * mass * v * v;
         // The membrane state is float: each step rounds q and p of every mode
         // (2 * FLT_EPSILON of its energy) and the displacement read back here differs
@@ -214,10 +228,10 @@ TEST_CASE("Harder hits are shorter and brighter", "[core][contact]")
     const double tension = GENERATE(MEMBRANE_DEFAULT_TENSION, 20000.0);
     membrane *m = membrane_new(48000.0);
     membrane_set_modes(m, 128);
-    membrane_set_tension(m, tension);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION, tension);
     contact *c = contact_new();
     if (tension != MEMBRANE_DEFAULT_TENSION)
-        contact_set_damping(c, 0.0);
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_DAMPING, 0.0);
     membrane_attach_contact(m, c);
     double prev_dur = 1e9, prev_centroid = 0.0;
     for (double v : {0.25, 0.5, 1.0, 2.0, 4.0, 8.0}) {
@@ -260,7 +274,7 @@ TEST_CASE("Two sticks at once: joint solve stays passive and both report", "[cor
     for (int i = 0; i < 2; i++) {
         REQUIRE(membrane_attach_contact(m, c[i]) == ICTUS_OK);
         contact_hit(c[i], v[i], r[i], th[i], 0);
-        e0 += 0.5 * contact_get_mass(c[i]) * v[i] * v[i];
+        e0 += 0.5 * ictus_param_get(&contact_params, c[i], CONTACT_PARAM_MASS) * v[i] * v[i];
     }
     // Same per-sample rounding slack as the single-stick test, for two sticks.
     const double slack = 2.0 * (2.0 + 2.5 * 24) * FLT_EPSILON * e0;
@@ -273,8 +287,10 @@ TEST_CASE("Two sticks at once: joint solve stays passive and both report", "[cor
         for (int i = 0; i < 2; i++) {
             double x = contact_stick_position(c[i]) - membrane_displacement_at(m, r[i], th[i]);
             double sv = contact_stick_velocity(c[i]);
-            e += 0.5 * contact_get_mass(c[i]) * sv * sv +
-                 (x > 0 ? contact_get_stiffness(c[i]) * std::pow(x, 2.5) / 2.5 : 0.0);
+            e += 0.5 * ictus_param_get(&contact_params, c[i], CONTACT_PARAM_MASS) * sv * sv +
+                 (x > 0 ? ictus_param_get(&contact_params, c[i], CONTACT_PARAM_STIFFNESS) *
+                              std::pow(x, 2.5) / 2.5
+                        : 0.0);
         }
         INFO("sample " << s);
         REQUIRE(e <= prev + slack);
@@ -288,7 +304,8 @@ TEST_CASE("Two sticks at once: joint solve stays passive and both report", "[cor
         contact_report rep{};
         CHECK(contact_take_report(c[i], &rep) == 1);
         CHECK(rep.duration_ms > 0.0);
-        e_out += 0.5 * contact_get_mass(c[i]) * rep.rebound_velocity_mps * rep.rebound_velocity_mps;
+        e_out += 0.5 * ictus_param_get(&contact_params, c[i], CONTACT_PARAM_MASS) *
+                 rep.rebound_velocity_mps * rep.rebound_velocity_mps;
         contact_free(c[i]);
     }
     CHECK(e_out < e0);
@@ -323,8 +340,9 @@ TEST_CASE("Force buffer carries the stroke and the report is made once", "[core]
     CHECK(integral == Approx(rep.impulse_ns).epsilon(1e-5));
     CHECK(peak == Approx(rep.peak_force_n).epsilon(1e-6));
     // Momentum: the stick's change of momentum is the impulse.
-    CHECK(rep.impulse_ns ==
-          Approx(contact_get_mass(c) * (2.0 + rep.rebound_velocity_mps)).epsilon(1e-9));
+    CHECK(rep.impulse_ns == Approx(ictus_param_get(&contact_params, c, CONTACT_PARAM_MASS) *
+                                   (2.0 + rep.rebound_velocity_mps))
+                                .epsilon(1e-9));
     membrane_free(m);
     contact_free(c);
 }

@@ -31,8 +31,9 @@ using membrane_ptr = std::unique_ptr<membrane, membrane_deleter>;
 
 double theory_hz(const membrane *m, double j)
 {
-    double c = std::sqrt(membrane_get_tension(m) / membrane_get_density(m));
-    return j * c / (2.0 * M_PI * membrane_get_radius(m));
+    double c = std::sqrt(ictus_param_get(&membrane_params, m, MEMBRANE_PARAM_TENSION) /
+                         ictus_param_get(&membrane_params, m, MEMBRANE_PARAM_DENSITY));
+    return j * c / (2.0 * M_PI * ictus_param_get(&membrane_params, m, MEMBRANE_PARAM_RADIUS));
 }
 } // namespace
 
@@ -42,8 +43,8 @@ TEST_CASE("First 20 partials within 0.1 cent of j_mn c / (2 pi a)", "[core][memb
     membrane_ptr m(membrane_new(fs));
     REQUIRE(m);
     membrane_set_modes(m.get(), 20);
-    membrane_set_t60(m.get(), 60.0);
-    membrane_set_hf_damping(m.get(), 0.0);
+    ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 60.0);
+    ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_HF_DAMPING, 0.0);
     membrane_set_pickup(m.get(), 0, 0.61, 71.0);
     // Strike and pickup off every nodal line of the first 20 modes.
     membrane_strike(m.get(), 0.37, 23.0, 0.01, 0);
@@ -78,10 +79,12 @@ TEST_CASE("Low modes at 96 kHz: pitch within 0.1 cent, T60 and hf law within 2 %
         membrane_ptr m(membrane_new(fs));
         membrane_set_modes(m.get(), 3); // (0,1) and the (1,1) pair
         // c = 2 pi a f / j01 for f = 50 Hz.
-        double c = 2.0 * M_PI * membrane_get_radius(m.get()) * 50.0 / 2.4048255576957729;
-        membrane_set_tension(m.get(), c * c * membrane_get_density(m.get()));
-        membrane_set_t60(m.get(), 4.0);
-        membrane_set_hf_damping(m.get(), 0.0);
+        double c = 2.0 * M_PI * ictus_param_get(&membrane_params, m.get(), MEMBRANE_PARAM_RADIUS) *
+                   50.0 / 2.4048255576957729;
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_TENSION,
+                        c * c * ictus_param_get(&membrane_params, m.get(), MEMBRANE_PARAM_DENSITY));
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 4.0);
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_HF_DAMPING, 0.0);
         membrane_set_pickup(m.get(), 0, 0.5, 0.0);
         membrane_strike(m.get(), 0.5, 0.0, 0.01, 0); // theta 0: sin partner silent
         std::vector<float> x = tools::render(m.get(), (size_t)(fs * 2.0));
@@ -102,10 +105,12 @@ TEST_CASE("Low modes at 96 kHz: pitch within 0.1 cent, T60 and hf law within 2 %
     {
         membrane_ptr m(membrane_new(fs));
         membrane_set_modes(m.get(), 1);
-        double c = 2.0 * M_PI * membrane_get_radius(m.get()) * 50.0 / 2.4048255576957729;
-        membrane_set_tension(m.get(), c * c * membrane_get_density(m.get()));
+        double c = 2.0 * M_PI * ictus_param_get(&membrane_params, m.get(), MEMBRANE_PARAM_RADIUS) *
+                   50.0 / 2.4048255576957729;
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_TENSION,
+                        c * c * ictus_param_get(&membrane_params, m.get(), MEMBRANE_PARAM_DENSITY));
         const double t60 = 0.7;
-        membrane_set_t60(m.get(), t60);
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, t60);
         membrane_strike(m.get(), 0.2, 0.0, 0.01, 0);
         std::vector<float> x = tools::render(m.get(), (size_t)(fs * 1.0));
         // Peak of |x| in each period (1920 samples at 50 Hz), regress log(peak) on time.
@@ -131,11 +136,13 @@ TEST_CASE("Low modes at 96 kHz: pitch within 0.1 cent, T60 and hf law within 2 %
         membrane_ptr m(membrane_new(fs));
         membrane_set_modes(m.get(), 3);
         // Fundamental at 1 kHz so that the air-like term matters.
-        double c = 2.0 * M_PI * membrane_get_radius(m.get()) * 1000.0 / 2.4048255576957729;
-        membrane_set_tension(m.get(), c * c * membrane_get_density(m.get()));
+        double c = 2.0 * M_PI * ictus_param_get(&membrane_params, m.get(), MEMBRANE_PARAM_RADIUS) *
+                   1000.0 / 2.4048255576957729;
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_TENSION,
+                        c * c * ictus_param_get(&membrane_params, m.get(), MEMBRANE_PARAM_DENSITY));
         const double t60 = 1.5, hf = 2.0;
-        membrane_set_t60(m.get(), t60);
-        membrane_set_hf_damping(m.get(), hf);
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, t60);
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_HF_DAMPING, hf);
         membrane_set_pickup(m.get(), 0, 0.5, 0.0);
         membrane_strike(m.get(), 0.5, 0.0, 0.01, 0);
         std::vector<float> x = tools::render(m.get(), (size_t)(fs * 0.5));
@@ -165,8 +172,8 @@ TEST_CASE("Centre strike excites no m >= 1 mode", "[core][membrane]")
     const double fs = 48000.0;
     membrane_ptr m(membrane_new(fs));
     membrane_set_modes(m.get(), 20);
-    membrane_set_t60(m.get(), 30.0);
-    membrane_set_hf_damping(m.get(), 0.0);
+    ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 30.0);
+    ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_HF_DAMPING, 0.0);
     membrane_set_pickup(m.get(), 0, 0.55, 33.0);
     membrane_strike(m.get(), 0.0, 0.0, 0.01, 0);
     tools::render(m.get(), 100);
@@ -202,8 +209,8 @@ TEST_CASE("A pickup on a nodal line does not hear that mode", "[core][membrane]"
     auto level_at = [&](double pr, double pt, double sr, double st, double j) {
         membrane_ptr m(membrane_new(fs));
         membrane_set_modes(m.get(), 8);
-        membrane_set_t60(m.get(), 30.0);
-        membrane_set_hf_damping(m.get(), 0.0);
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 30.0);
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_HF_DAMPING, 0.0);
         membrane_set_pickup(m.get(), 0, pr, pt);
         membrane_strike(m.get(), sr, st, 0.01, 0);
         std::vector<double> mag = tools::spectrum(tools::render(m.get(), n), n * 4);
@@ -308,9 +315,9 @@ TEST_CASE("Tension change keeps physical velocity continuous", "[core][membrane]
     tools::render(m.get(), 777);
     double v = membrane_velocity_at(m.get(), 0.45, 70.0);
     double w = membrane_displacement_at(m.get(), 0.45, 70.0);
-    membrane_set_tension(m.get(), 5000.0);
-    membrane_set_radius(m.get(), 0.2);
-    membrane_set_density(m.get(), 0.3);
+    ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_TENSION, 5000.0);
+    ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_RADIUS, 0.2);
+    ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_DENSITY, 0.3);
     CHECK(membrane_velocity_at(m.get(), 0.45, 70.0) == Approx(v).epsilon(1e-5));
     CHECK(membrane_displacement_at(m.get(), 0.45, 70.0) == Approx(w).epsilon(1e-5));
 }
@@ -325,7 +332,7 @@ TEST_CASE("Setters while sounding do not click", "[core][membrane]")
     for (int which = 0; which < 11; which++) {
         membrane_ptr m(membrane_new(48000.0));
         membrane_set_modes(m.get(), 40);
-        membrane_set_t60(m.get(), 3.0);
+        ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 3.0);
         membrane_strike(m.get(), 0.3, 10.0, 0.01, 0);
         std::vector<float> before = tools::render(m.get(), 4800);
         double max_step = 0.0;
@@ -333,19 +340,19 @@ TEST_CASE("Setters while sounding do not click", "[core][membrane]")
             max_step = std::max(max_step, (double)std::fabs(before[i + 1] - before[i]));
         switch (which) {
         case 0:
-            membrane_set_tension(m.get(), 4000.0);
+            ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_TENSION, 4000.0);
             break;
         case 1:
-            membrane_set_radius(m.get(), 0.16);
+            ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_RADIUS, 0.16);
             break;
         case 2:
-            membrane_set_density(m.get(), 0.3);
+            ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_DENSITY, 0.3);
             break;
         case 3:
-            membrane_set_t60(m.get(), 0.2);
+            ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 0.2);
             break;
         case 4:
-            membrane_set_hf_damping(m.get(), 20.0);
+            ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_HF_DAMPING, 20.0);
             break;
         case 5:
             membrane_set_pickup(m.get(), 0, 0.8, 200.0);
@@ -354,7 +361,7 @@ TEST_CASE("Setters while sounding do not click", "[core][membrane]")
             membrane_set_modes(m.get(), 200);
             break;
         case 7:
-            membrane_set_output_gain(m.get(), 0.5);
+            ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_GAIN, 0.5);
             break;
         case 8:
             membrane_set_strike_point(m.get(), 0.9, 90.0);
@@ -387,7 +394,7 @@ TEST_CASE("Modes above 0.95 Nyquist are silent", "[core][membrane]")
     const double fs = 1000.0;
     membrane_ptr m(membrane_new(fs));
     membrane_set_modes(m.get(), 10);
-    membrane_set_t60(m.get(), 20.0);
+    ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 20.0);
     membrane_set_pickup(m.get(), 0, 0.4, 20.0);
     membrane_strike(m.get(), 0.37, 23.0, 0.01, 0);
     const size_t n = 1u << 14;
@@ -444,7 +451,7 @@ TEST_CASE("Without the second output the first pickup is the same, bit for bit",
         membrane_ptr m(membrane_new(48000.0));
         membrane_set_modes(m.get(), 300);
         contact *c = contact_new();
-        contact_set_mass(c, 2.0);
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS, 2.0);
         membrane_attach_contact(m.get(), c);
         membrane_strike(m.get(), 0.4, 10.0, 0.002, 5);
         std::vector<float> o0(64), o1(64), out, force;

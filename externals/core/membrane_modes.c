@@ -1,0 +1,296 @@
+/* membrane_modes.c -- the membrane's modes: the arrays of the modal state and its
+ * coefficients, built for a mode count (the table of modes itself is mode_table.c),
+ * and the coefficients computed from the physics (docs/membrane.md). */
+#include "membrane_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Damping law sigma_k = s0 + s1 w_k^2 with s0 + s1 w_1^2 = ln(1000)/t60 and
+ * s1 w_ref^2 = hf * s0 at w_ref = 2 pi 1 kHz. */
+static double mode_decay_rate(const membrane *m, double omega)
+{
+    double omega1 = m->table.j[0] * sqrt(m->tension / m->density) / m->radius;
+    double w_ref = 2.0 * M_PI * 1000.0;
+    double rate1 = log(1000.0) / m->t60;
+    double s0 = rate1 / (1.0 + m->hf_damping * (omega1 / w_ref) * (omega1 / w_ref));
+    double s1 = m->hf_damping * s0 / (w_ref * w_ref);
+    return s0 + s1 * omega * omega;
+}
+
+/* Recomputes every coefficient from the physics. When rescale is set, the modal
+ * state is rescaled so that each mode's physical displacement and velocity are
+ * continuous across the change (no click from a parameter move). */
+void membrane_update_coefficients_(membrane *m, int rescale)
+{
+    const double T = 1.0 / m->sample_rate, h = 0.5 * T;
+    const double c = sqrt(m->tension / m->density);
+    const double old_scale = m->mass_scale, old_h = m->coef_h;
+    m->mass_scale = 1.0 / sqrt(m->density * m->radius * m->radius);
+    m->coef_h = h;
+    const double scale = m->mass_scale;
+    for (int k = 0; k < m->capacity; k++) {
+        double old_omega = m->omega_model[k];
+        int fading = k >= m->modes;
+        double freq = (k < m->fading_modes) ? m->table.j[k] * c / (2.0 * M_PI * m->radius) : 0.0;
+        if (k >= m->fading_modes || freq >= 0.95 * 0.5 * m->sample_rate || freq <= 0.0) {
+            /* Silent: frozen at zero, no input, no output. */
+            m->c1[k] = m->cd[k] = m->c3[k] = m->ep[k] = 0.0f;
+            m->sc[k] = m->ep_k[k] = 0.0f;
+            m->q[k] = m->p[k] = 0.0f;
+            m->omega_model[k] = 0.0;
+            continue;
+        }
+        double omega = 2.0 * M_PI * freq;
+        double sigma = fading ? log(1000.0) / FADE_S : mode_decay_rate(m, omega);
+        /* Inverse bilinear map of the wanted discrete poles z = exp((-sigma +- i w) T):
+         * s = (2/T) tanh((-sigma +- i w) T / 2) = a +- i b, so the midpoint rule's poles
+         * land exactly on the target pitch and decay. */
+        double u2 = sigma * T, v2 = omega * T;
+        double den = cosh(u2) + cos(v2);
+        double a = -(2.0 / T) * sinh(u2) / den;
+        double b = (2.0 / T) * sin(v2) / den;
+        double wm = sqrt(a * a + b * b); /* model stiffness w' */
+        double sm = -a;                  /* model damping s' */
+        double D = 1.0 + 2.0 * h * sm + h * h * wm * wm;
+        /* In q, p: q+ = q - c1 q + c2 p + eq u, p+ = p - c2 q - c3 p + ep u with
+         * c2 = 2 h w' / D and eq = h w' ep. With r = q / (h w') (c2 h w' = c1,
+         * c2 / (h w') = 2 / D): r+ = r - c1 r + cd p + ep u, p+ = p - c1 r - c3 p + ep u,
+         * one input gain for both, and the displacement weights dm psi q =
+         * scale h psi r need no per-mode array (docs/membrane.md). */
+        m->c1[k] = (float)(2.0 * h * h * wm * wm / D);
+        m->cd[k] = (float)(2.0 / D);
+        m->c3[k] = (float)((2.0 * h * h * wm * wm + 4.0 * h * sm) / D);
+        m->ep[k] = (float)(scale * T / D);
+        if (fading) /* ringing out: no input (and zero input shapes, membrane_input_shapes_) */
+            m->ep[k] = 0.0f;
+        const double old_sc = m->sc[k];
+        m->sc[k] = (float)sqrt((double)m->cd[k]);
+        m->ep_k[k] = (float)(m->ep[k] / (double)m->sc[k]);
+        if (rescale && old_omega > 0.0 && old_sc > 0.0) {
+            /* y = q / (sqrt(M) w'), y' = p / sqrt(M), sqrt(M) proportional to 1/scale;
+             * q = h w' r, so r scales by old_h / h (w' cancels); the stored r / sc and
+             * p / sc by old_sc / sc besides. */
+            double r = old_scale / scale * (old_sc / m->sc[k]);
+            m->q[k] = (float)(m->q[k] * r * old_h / h);
+            m->p[k] = (float)(m->p[k] * r);
+        } else if (rescale) {
+            m->q[k] = m->p[k] = 0.0f;
+        }
+        m->omega_model[k] = wm;
+    }
+}
+
+/* The float arrays of the modal state and coefficients, in their order in memory. */
+enum {
+    ARR_Q,
+    ARR_P,
+    ARR_C1,
+    ARR_CD,
+    ARR_C3,
+    ARR_EP,
+    ARR_PSI_STRIKE,
+    ARR_PICK0,
+    ARR_PICK1,
+    ARR_PICK_OLD0,
+    ARR_PICK_OLD1,
+    ARR_SC,
+    ARR_EP_K,
+    ARR_PICK_K0,
+    ARR_PICK_K1,
+    ARR_COUNT
+};
+
+/* A new set of the arrays that depend on the capacity, before it replaces the old. */
+typedef struct mode_arrays {
+    mode_table table;
+    double *omega_model;
+    float *f[ARR_COUNT];
+    float *impulse[IMPULSE_CACHE];
+    float *point_psi[MEMBRANE_MAX_POINTS][3]; /* psi, psi_next, psi_k of each point */
+} mode_arrays;
+
+static void mode_arrays_free(mode_arrays *a)
+{
+    mode_table_free(&a->table);
+    free(a->omega_model);
+    for (int i = 0; i < ARR_COUNT; i++)
+        free(a->f[i]);
+    for (int i = 0; i < IMPULSE_CACHE; i++)
+        free(a->impulse[i]);
+    for (int i = 0; i < MEMBRANE_MAX_POINTS; i++)
+        for (int j = 0; j < 3; j++)
+            free(a->point_psi[i][j]);
+}
+
+/* Allocates every array at capacity cap (the points' for `points` points); 0, with
+ * nothing left allocated, when memory cannot be had. */
+static int mode_arrays_alloc(mode_arrays *a, int cap, int points)
+{
+    memset(a, 0, sizeof(*a));
+    a->omega_model = calloc((size_t)cap, sizeof(double));
+    int ok = a->omega_model != NULL;
+    for (int i = 0; i < ARR_COUNT; i++) {
+        a->f[i] = membrane_alloc_floats_(cap);
+        ok = ok && a->f[i];
+    }
+    for (int i = 0; i < IMPULSE_CACHE; i++) {
+        a->impulse[i] = membrane_alloc_floats_(cap);
+        ok = ok && a->impulse[i];
+    }
+    for (int i = 0; i < points; i++) {
+        for (int j = 0; j < 3; j++) {
+            a->point_psi[i][j] = membrane_alloc_floats_(cap);
+            ok = ok && a->point_psi[i][j];
+        }
+    }
+    /* The table last: it computes the Bessel zeros in scratch memory that it
+     * frees, and state arrays allocated after that landed at heap offsets
+     * that cost ~5 % in bench_membrane_core (contact, 1024 modes). */
+    ok = ok && mode_table_build(&a->table, cap) == ICTUS_OK;
+    if (!ok)
+        mode_arrays_free(a);
+    return ok;
+}
+
+/* Frees the arrays that depend on the capacity (not the points'). */
+void membrane_free_mode_arrays_(membrane *m)
+{
+    mode_table_free(&m->table);
+    free(m->omega_model);
+    free(m->q), free(m->p), free(m->c1), free(m->cd), free(m->c3);
+    free(m->ep), free(m->psi_strike);
+    free(m->sc), free(m->ep_k);
+    for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
+        free(m->psi_pick[i]);
+        free(m->psi_pick_old[i]);
+        free(m->pick_k[i]);
+    }
+    for (int i = 0; i < IMPULSE_CACHE; i++)
+        free(m->impulse_cache[i].psi);
+}
+
+/* The new arrays replace the old; the state of the modes we had is kept (same
+ * index = same mode). */
+static void mode_arrays_install(membrane *m, mode_arrays *a, int cap)
+{
+    float **f = a->f;
+    membrane_flush_points_(m);
+    int keep = m->capacity < cap ? m->capacity : cap;
+    if (m->q) {
+        memcpy(f[ARR_Q], m->q, sizeof(float) * (size_t)keep);
+        memcpy(f[ARR_P], m->p, sizeof(float) * (size_t)keep);
+        memcpy(f[ARR_SC], m->sc, sizeof(float) * (size_t)keep); /* the state's scale */
+        memcpy(a->omega_model, m->omega_model, sizeof(double) * (size_t)keep);
+    }
+    membrane_free_mode_arrays_(m);
+    m->table = a->table;
+    m->omega_model = a->omega_model;
+    m->q = f[ARR_Q], m->p = f[ARR_P], m->c1 = f[ARR_C1], m->cd = f[ARR_CD];
+    m->c3 = f[ARR_C3], m->ep = f[ARR_EP];
+    m->psi_strike = f[ARR_PSI_STRIKE];
+    m->psi_pick[0] = f[ARR_PICK0];
+    m->psi_pick[1] = f[ARR_PICK1];
+    m->psi_pick_old[0] = f[ARR_PICK_OLD0];
+    m->psi_pick_old[1] = f[ARR_PICK_OLD1];
+    m->sc = f[ARR_SC], m->ep_k = f[ARR_EP_K];
+    m->pick_k[0] = f[ARR_PICK_K0];
+    m->pick_k[1] = f[ARR_PICK_K1];
+    for (int i = 0; i < MEMBRANE_PICKUPS; i++)
+        m->pick_fade_left[i] = 0;
+    for (int i = 0; i < IMPULSE_CACHE; i++) {
+        m->impulse_cache[i].psi = a->impulse[i];
+        m->impulse_cache[i].valid = 0;
+    }
+    for (int i = 0; i < m->point_count; i++) {
+        membrane_point *pt = m->points[i];
+        free(pt->psi), free(pt->psi_next), free(pt->psi_k);
+        pt->psi = a->point_psi[i][0];
+        pt->psi_next = a->point_psi[i][1];
+        pt->psi_k = a->point_psi[i][2];
+        pt->psi_cap = cap;
+    }
+    m->capacity = cap;
+}
+
+/* The count becomes `modes`. Shrinking while sounding, the dropped modes ring out
+ * over FADE_S instead of vanishing with a click. */
+static void set_mode_count(membrane *m, int modes)
+{
+    int old_limit = m->fading_modes > m->modes ? m->fading_modes : m->modes;
+    if (modes < old_limit && membrane_energy(m) > 0.0) {
+        m->fading_modes = old_limit;
+        m->fade_left = (long)(FADE_S * m->sample_rate) + 1;
+    } else {
+        m->fading_modes = modes;
+        m->fade_left = 0;
+    }
+    m->modes = modes;
+    m->count = membrane_padded_(m->fading_modes);
+    /* Modes dropped now start from rest if they come back later. */
+    for (int k = m->fading_modes; k < m->capacity; k++)
+        m->q[k] = m->p[k] = 0.0f;
+}
+
+/* The shapes at the strike point, the pickups and the points, for the modes now in place. */
+static void refresh_shapes(membrane *m)
+{
+    membrane_input_shapes_(m, m->strike_r, m->strike_theta, m->psi_strike);
+    for (int i = 0; i < MEMBRANE_PICKUPS; i++)
+        membrane_mode_shapes_(m, m->pick_r[i], m->pick_theta[i], m->psi_pick[i]);
+    for (int i = 0; i < m->point_count; i++) {
+        membrane_point *pt = m->points[i];
+        membrane_input_shapes_(m, pt->r_over_a, pt->theta_deg, pt->psi);
+        if (pt->move_pending)
+            membrane_input_shapes_(m, pt->move_r, pt->move_theta, pt->psi_next);
+    }
+}
+
+/* Keeps the state of the modes in both the old and the new table: a mode keeps its
+ * index (the order is a prefix property of the sort, mode_table.h). */
+ictus_status membrane_build_modes_(membrane *m, int modes)
+{
+    int need = membrane_padded_(modes);
+    if (need > m->capacity || !m->table.j) {
+        mode_arrays a;
+        if (!mode_arrays_alloc(&a, need, m->point_count))
+            return ICTUS_ENOMEM;
+        mode_arrays_install(m, &a, need);
+    } else {
+        membrane_flush_points_(m);
+        for (int i = 0; i < IMPULSE_CACHE; i++)
+            m->impulse_cache[i].valid = 0;
+    }
+    set_mode_count(m, modes);
+    membrane_update_coefficients_(m, 1);
+    refresh_shapes(m);
+    membrane_refresh_couplings_(m);
+    return ICTUS_OK;
+}
+
+int membrane_get_sounding_modes(const membrane *m)
+{
+    int sounding = 0;
+    for (int k = 0; k < m->modes; k++)
+        sounding += m->omega_model[k] > 0.0;
+    return sounding;
+}
+
+int membrane_get_mode(const membrane *m, int k, double *freq_hz, double *t60_s, int *bessel_m,
+                      int *bessel_n, int *sin_partner)
+{
+    if (k < 0 || k >= m->modes)
+        return 0;
+    double omega = m->table.j[k] * sqrt(m->tension / m->density) / m->radius;
+    if (freq_hz)
+        *freq_hz = omega / (2.0 * M_PI);
+    if (t60_s)
+        *t60_s = log(1000.0) / mode_decay_rate(m, omega);
+    if (bessel_m)
+        *bessel_m = m->table.m[k];
+    if (bessel_n)
+        *bessel_n = m->table.n[k];
+    if (sin_partner)
+        *sin_partner = m->table.sin[k];
+    return 1;
+}
