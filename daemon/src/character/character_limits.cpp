@@ -1,5 +1,6 @@
 // Joint limits as the simulation enforces them (see character_limits.hpp).
 #include "ictus/character/character_limits.hpp"
+#include "ictus/base/enum_names.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,27 +8,21 @@
 namespace ictus
 {
 
+namespace
+{
+const EnumNames<3> kLimitKindNames = {"none", "euler", "quaternion"};
+} // namespace
+
 const char *to_string(LimitKind kind)
 {
-    switch (kind) {
-    case LimitKind::none:
-        return "none";
-    case LimitKind::euler:
-        return "euler";
-    case LimitKind::quaternion:
-        return "quaternion";
-    }
-    return "?";
+    return enum_name(kLimitKindNames, kind, "?");
 }
 
 LimitKind limit_kind_from_string(const std::string &text)
 {
-    if (text == "none")
-        return LimitKind::none;
-    if (text == "euler")
-        return LimitKind::euler;
-    if (text == "quaternion")
-        return LimitKind::quaternion;
+    LimitKind kind;
+    if (enum_from_name(kLimitKindNames, text, kind))
+        return kind;
     throw CharacterError("limits: expected none, euler or quaternion, got '" + text + "'");
 }
 

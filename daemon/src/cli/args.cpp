@@ -119,6 +119,40 @@ std::string Args::value(const std::string &option)
     return next();
 }
 
+bool dispatch_option(const OptionTable &table, const std::string &option, Args &args)
+{
+    for (const Option &entry : table)
+        if (option == entry.name) {
+            entry.handle(option, args);
+            return true;
+        }
+    return false;
+}
+
+OptionHandler store_text(std::string &target)
+{
+    return [&target](const std::string &option, Args &args) { target = args.value(option); };
+}
+
+OptionHandler store_flag(bool &target)
+{
+    return [&target](const std::string &, Args &) { target = true; };
+}
+
+bool walk_args(Args &args, void (*usage)(std::ostream &),
+               const std::function<void(const std::string &item)> &handle)
+{
+    while (!args.done()) {
+        const std::string item = args.next();
+        if (item == "--help" || item == "-h") {
+            usage(std::cout);
+            return false;
+        }
+        handle(item);
+    }
+    return true;
+}
+
 int run_verb(const char *verb, const std::function<int()> &body)
 {
     try {

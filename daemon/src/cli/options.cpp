@@ -132,10 +132,19 @@ MocapBoundError with_force_hint(const MocapBoundError &e)
     return MocapBoundError(e.file(), e.line(), e.message() + " (--force reads it anyway)");
 }
 
-void print_warnings(const MocapWarnings &warnings)
+// What `read(&warnings)` reads, its warnings printed to stderr; an
+// out-of-bounds error says that --force would read it.
+template <typename Read> auto read_capture(const Read &read)
 {
-    for (const std::string &w : warnings)
-        std::cerr << "ictusd: warning: " << w << "\n";
+    MocapWarnings warnings;
+    try {
+        auto capture = read(&warnings);
+        for (const std::string &w : warnings)
+            std::cerr << "ictusd: warning: " << w << "\n";
+        return capture;
+    } catch (const MocapBoundError &e) {
+        throw with_force_hint(e);
+    }
 }
 } // namespace
 
@@ -145,26 +154,13 @@ BvhFile load_bvh(const std::string &path, double scale, int skip, bool force)
     o.scale = scale;
     o.skip_frames = skip;
     o.accept_out_of_bounds = force;
-    MocapWarnings warnings;
-    try {
-        BvhFile bvh = read_bvh(path, o, &warnings);
-        print_warnings(warnings);
-        return bvh;
-    } catch (const MocapBoundError &e) {
-        throw with_force_hint(e);
-    }
+    return read_capture([&](MocapWarnings *warnings) { return read_bvh(path, o, warnings); });
 }
 
 MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o)
 {
-    MocapWarnings warnings;
-    try {
-        MarkerCapture capture = read_marker_csv(path, o, &warnings);
-        print_warnings(warnings);
-        return capture;
-    } catch (const MocapBoundError &e) {
-        throw with_force_hint(e);
-    }
+    return read_capture(
+        [&](MocapWarnings *warnings) { return read_marker_csv(path, o, warnings); });
 }
 
 // Options shared by run and render. Returns false when `a` is not one of them.

@@ -109,13 +109,14 @@ std::string find_pd_binary(const std::string &pd)
                              "or bash scripts/deps.sh) or give --pd /path/to/pd");
 }
 
-PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(double)> &progress)
+namespace
 {
-    const std::string pd = find_pd_binary(o.pd);
-    const std::string lib = find_pd_library(o.library);
-    check_pd_path("--wav", o.wav);
-    check_pd_path("--out", o.events);
-    check_pd_path("--pd-lib", lib);
+
+// Pd's command line: batch mode, the render patch, and the drum, the mix
+// and the files as -send messages to it.
+std::vector<std::string> pd_command_line(const PdRenderOptions &o, const std::string &pd,
+                                         const std::string &lib)
+{
     std::vector<std::string> argv = {pd,       "-nogui",  "-nosound", "-nomidi",
                                      "-batch", "-stderr", "-r",       std::to_string(o.sample_rate),
                                      "-path",  lib,       "-open",    lib + "/ictus-render.pd"};
@@ -133,10 +134,18 @@ PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(
         argv.push_back("-send");
         argv.push_back(s);
     }
-    std::error_code ec;
-    fs::remove(o.wav, ec); // so that an earlier file never passes for this one
-    if (ec)
-        throw std::runtime_error("--wav: cannot replace '" + o.wav + "': " + ec.message());
+    return argv;
+}
+
+// A running Pd: its process and the read end of the pipe that carries its
+// stdout and stderr.
+struct PdProcess {
+    pid_t pid = -1;
+    int output_fd = -1;
+};
+
+PdProcess spawn_pd(const std::string &pd, std::vector<std::string> &argv)
+{
     std::vector<char *> cargv;
     for (std::string &a : argv)
         cargv.push_back(a.data());
@@ -150,75 +159,72 @@ PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(
     posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
     posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    pid_t pid = -1;
-    const int spawned = ::posix_spawn(&pid, pd.c_str(), &actions, nullptr, cargv.data(), environ);
+    PdProcess p;
+    const int spawned = ::posix_spawn(&p.pid, pd.c_str(), &actions, nullptr, cargv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
     ::close(fds[1]);
     if (spawned != 0) {
         ::close(fds[0]);
         throw std::runtime_error("--wav: cannot start '" + pd + "': " + std::strerror(spawned));
     }
+    p.output_fd = fds[0];
+    return p;
+}
 
-    // Pd in batch mode renders many times faster than real time; a patch that
-    // never quits (the library half loaded) must not hang render.
-    const double timeout_s = 120.0 + 10.0 * o.seconds;
-    const auto t0 = std::chrono::steady_clock::now();
-    auto elapsed = [&] {
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    };
+// How Pd ended: its output, its wait status, and why it was stopped ("" when
+// it ended by itself).
+struct PdEnd {
     std::string output;
-    double next_progress = 2.0;
-    std::string stop_reason;
     int status = 0;
+    std::string stop_reason;
+};
+
+// Collects Pd's output until it ends. Pd in batch mode renders many times
+// faster than real time; a patch that never quits (the library half loaded)
+// must not hang render: it is killed after `timeout_s`, and stopped on SIGINT.
+PdEnd wait_for_pd(const PdProcess &p, double timeout_s, const std::function<double()> &elapsed,
+                  const std::function<void(double)> &progress)
+{
+    PdEnd end;
+    double next_progress = 2.0;
     bool reaped = false;
     for (;;) {
-        pollfd p{fds[0], POLLIN, 0};
-        const int r = ::poll(&p, 1, 250);
-        if (r == 0 && ::waitpid(pid, &status, WNOHANG) == pid) {
+        pollfd poll_fd{p.output_fd, POLLIN, 0};
+        const int r = ::poll(&poll_fd, 1, 250);
+        if (r == 0 && ::waitpid(p.pid, &end.status, WNOHANG) == p.pid) {
             reaped = true; // gone, though something it started may hold the pipe
             break;
         }
         if (r > 0) {
             char buf[4096];
-            const ssize_t n = ::read(fds[0], buf, sizeof buf);
+            const ssize_t n = ::read(p.output_fd, buf, sizeof buf);
             if (n > 0)
-                output.append(buf, static_cast<size_t>(n));
+                end.output.append(buf, static_cast<size_t>(n));
             else if (n == 0 || errno != EINTR)
                 break; // Pd closed its output: it is ending
         }
-        if (g_interrupted && stop_reason.empty()) {
-            stop_reason = "interrupted";
-            ::kill(pid, SIGTERM);
-        } else if (elapsed() > timeout_s && stop_reason.empty()) {
-            stop_reason = "timed out after " + format("%.0f", timeout_s) + " s";
-            ::kill(pid, SIGKILL);
+        if (g_interrupted && end.stop_reason.empty()) {
+            end.stop_reason = "interrupted";
+            ::kill(p.pid, SIGTERM);
+        } else if (elapsed() > timeout_s && end.stop_reason.empty()) {
+            end.stop_reason = "timed out after " + format("%.0f", timeout_s) + " s";
+            ::kill(p.pid, SIGKILL);
         }
         if (elapsed() >= next_progress) {
             progress(elapsed());
             next_progress += 2.0;
         }
     }
-    ::close(fds[0]);
-    while (!reaped && ::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    ::close(p.output_fd);
+    while (!reaped && ::waitpid(p.pid, &end.status, 0) < 0 && errno == EINTR) {
     }
+    return end;
+}
 
-    PdRenderResult result;
-    result.wall_s = elapsed();
-    if (!o.log.empty()) {
-        std::ofstream log(o.log, std::ios::binary);
-        log << output;
-        if (!log.flush())
-            throw std::runtime_error("--wav: cannot write '" + o.log + "'");
-    }
-    const std::string log_note = o.log.empty() ? "" : " (log: " + o.log + ")";
-    if (!stop_reason.empty())
-        throw std::runtime_error("--wav: pd " + stop_reason + log_note);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-        throw std::runtime_error("--wav: pd failed (" +
-                                 (WIFEXITED(status)
-                                      ? "exit status " + std::to_string(WEXITSTATUS(status))
-                                      : "signal " + std::to_string(WTERMSIG(status))) +
-                                 ")" + log_note);
+// Pd's error lines and its report line (ictus-render's peaks) into `result`;
+// false when there was no report.
+bool read_pd_report(const std::string &output, PdRenderResult &result)
+{
     std::istringstream lines(output);
     std::string line;
     bool reported = false;
@@ -233,8 +239,54 @@ PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(
             reported = true;
         }
     }
+    return reported;
+}
+
+} // namespace
+
+PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(double)> &progress)
+{
+    const std::string pd = find_pd_binary(o.pd);
+    const std::string lib = find_pd_library(o.library);
+    check_pd_path("--wav", o.wav);
+    check_pd_path("--out", o.events);
+    check_pd_path("--pd-lib", lib);
+    std::vector<std::string> argv = pd_command_line(o, pd, lib);
+    std::error_code ec;
+    fs::remove(o.wav, ec); // so that an earlier file never passes for this one
+    if (ec)
+        throw std::runtime_error("--wav: cannot replace '" + o.wav + "': " + ec.message());
+    const PdProcess process = spawn_pd(pd, argv);
+
+    const double timeout_s = 120.0 + 10.0 * o.seconds;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto elapsed = [&] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+    const PdEnd end = wait_for_pd(process, timeout_s, elapsed, progress);
+
+    PdRenderResult result;
+    result.wall_s = elapsed();
+    if (!o.log.empty()) {
+        std::ofstream log(o.log, std::ios::binary);
+        log << end.output;
+        if (!log.flush())
+            throw std::runtime_error("--wav: cannot write '" + o.log + "'");
+    }
+    const std::string log_note = o.log.empty() ? "" : " (log: " + o.log + ")";
+    if (!end.stop_reason.empty())
+        throw std::runtime_error("--wav: pd " + end.stop_reason + log_note);
+    const int status = end.status;
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        throw std::runtime_error("--wav: pd failed (" +
+                                 (WIFEXITED(status)
+                                      ? "exit status " + std::to_string(WEXITSTATUS(status))
+                                      : "signal " + std::to_string(WTERMSIG(status))) +
+                                 ")" + log_note);
+    const bool reported = read_pd_report(end.output, result);
     if (!reported || !fs::is_regular_file(o.wav, ec))
-        throw std::runtime_error("--wav: pd wrote no '" + o.wav + "'" + log_note + ":\n" + output);
+        throw std::runtime_error("--wav: pd wrote no '" + o.wav + "'" + log_note + ":\n" +
+                                 end.output);
     return result;
 }
 

@@ -72,38 +72,24 @@ int cmd_gestures(Args &args)
     double dynamics = 0.6;
     ImportOptions io;
     StickCsvOptions sticks;
-    while (!args.done()) {
-        const std::string a = args.next();
-        auto value = [&]() { return args.value(a); };
-        if (a == "--help" || a == "-h") {
-            gestures_usage(std::cout);
-            return 0;
-        } else if (a == "--list") {
-            list = true;
-        } else if (a == "--export") {
-            export_path = value();
-        } else if (a == "--import") {
-            import_path = value();
-        } else if (a == "--db") {
-            db_path = value();
-        } else if (a == "--out") {
-            out_path = value();
-        } else if (a == "--grip") {
-            grip = value();
-        } else if (a == "--nuance") {
-            nuance = value();
-        } else if (a == "--hand") {
-            hand = value();
-        } else if (a == "--stroke") {
-            stroke = parse_int(a, value(), 0, 1000000);
-        } else if (a == "--dynamics") {
-            dynamics = parse_number(a, value(), 0.0, 1.0);
-        } else if (parse_bvh_option(a, args, io.bvh_scale, io.bvh_skip_frames)) {
-        } else if (parse_stick_csv_option(a, args, sticks)) {
-        } else {
+    const OptionTable options = {{"--list", store_flag(list)},
+                                 {"--export", store_text(export_path)},
+                                 {"--import", store_text(import_path)},
+                                 {"--db", store_text(db_path)},
+                                 {"--out", store_text(out_path)},
+                                 {"--grip", store_text(grip)},
+                                 {"--nuance", store_text(nuance)},
+                                 {"--hand", store_text(hand)},
+                                 {"--stroke", store(stroke, parse_int, 0, 1000000)},
+                                 {"--dynamics", store(dynamics, parse_number, 0.0, 1.0)}};
+    const bool go_on = walk_args(args, gestures_usage, [&](const std::string &a) {
+        if (!dispatch_option(options, a, args) &&
+            !parse_bvh_option(a, args, io.bvh_scale, io.bvh_skip_frames) &&
+            !parse_stick_csv_option(a, args, sticks))
             throw UsageError("unknown option '" + a + "' (see ictusd gestures --help)");
-        }
-    }
+    });
+    if (!go_on)
+        return 0;
     const int actions = list + !export_path.empty() + !import_path.empty();
     if (actions != 1)
         throw UsageError("give exactly one of --list, --export FILE, --import CAPTURE");

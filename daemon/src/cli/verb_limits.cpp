@@ -49,26 +49,23 @@ int cmd_limits(Args &args)
     std::string file, out = "limits.json";
     ClipOptions clip;
     CharacterLimitOptions lo;
-    while (!args.done()) {
-        const std::string a = args.next();
-        if (a == "--help" || a == "-h") {
-            limits_usage(std::cout);
-            return 0;
-        } else if (a == "--out") {
-            out = args.value(a);
-        } else if (parse_clip_option(a, args, clip)) {
-        } else if (a == "--k") {
-            lo.k = parse_positive(a, args.value(a));
-        } else if (a == "--min-deg") {
-            lo.min_half_width_rad = parse_min_half_width_deg(a, args.value(a)) * M_PI / 180.0;
-        } else if (!a.empty() && a[0] == '-' && a != "-") {
+    const OptionTable options = {{"--out", store_text(out)},
+                                 {"--k", store(lo.k, parse_positive)},
+                                 {"--min-deg", [&](const std::string &a, Args &args) {
+                                      lo.min_half_width_rad =
+                                          parse_min_half_width_deg(a, args.value(a)) * M_PI / 180.0;
+                                  }}};
+    const bool go_on = walk_args(args, limits_usage, [&](const std::string &a) {
+        if (dispatch_option(options, a, args) || parse_clip_option(a, args, clip))
+            return;
+        if (!a.empty() && a[0] == '-' && a != "-")
             throw UsageError("unknown option '" + a + "' (see ictusd limits --help)");
-        } else if (file.empty()) {
-            file = a;
-        } else {
+        if (!file.empty())
             throw UsageError("one FILE expected, got also '" + a + "'");
-        }
-    }
+        file = a;
+    });
+    if (!go_on)
+        return 0;
     if (file.empty())
         throw UsageError("FILE is required (ictusd limits FILE)");
     const BvhFile bvh = load_bvh(file, clip.scale, clip.skip, clip.force);

@@ -359,10 +359,8 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
     return j;
 }
 
-} // namespace
-
-int cmd_render(Args &args)
-{
+// The command line of a render.
+struct RenderArgs {
     PerformanceOptions o;
     double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0, midi_channel = 1.0;
     std::string out_dir;
@@ -370,238 +368,333 @@ int cmd_render(Args &args)
     double progress_every = 2.0;
     std::string wav;
     PdRenderOptions pd;
-    while (!args.done()) {
-        const std::string a = args.next();
-        if (a == "--help" || a == "-h") {
-            render_usage(std::cout);
-            return 0;
-        } else if (a == "--out") {
-            out_dir = args.value(a);
-        } else if (a == "--force") {
-            force = true;
-        } else if (a == "--bvh-rate") {
-            bvh_rate = parse_number(a, args.value(a), 0, 1000);
-        } else if (a == "--midi-channel") {
-            const std::string text = args.value(a);
-            midi_channel = parse_number(a, text, 1, 16);
-            if (midi_channel != std::floor(midi_channel))
-                throw UsageError("--midi-channel: expected a whole number 1..16, got '" + text +
-                                 "'");
-        } else if (a == "--progress-every") {
-            progress_every = parse_number(a, args.value(a), 0, 3600);
-        } else if (a == "--wav") {
-            wav = args.value(a);
-        } else if (a == "--wav-mix") {
-            pd.mix = args.value(a);
-            if (pd.mix != "stereo" && pd.mix != "pickups")
-                throw UsageError("--wav-mix: expected stereo or pickups, got '" + pd.mix + "'");
-        } else if (a == "--wav-bits") {
-            const std::string text = args.value(a);
-            const double bits = parse_number(a, text);
-            if (bits != 16 && bits != 24 && bits != 32)
-                throw UsageError("--wav-bits: expected 16, 24 or 32, got '" + text + "'");
-            pd.bits = static_cast<int>(bits);
-        } else if (a == "--wav-gain") {
-            pd.gain_db = parse_number(a, args.value(a), -120, 40);
-        } else if (a == "--wav-rate") {
-            const std::string text = args.value(a);
-            const double rate = parse_number(a, text, 8000, 192000);
-            if (rate != std::floor(rate))
-                throw UsageError("--wav-rate: expected a whole number of Hz, got '" + text + "'");
-            pd.sample_rate = static_cast<int>(rate);
-        } else if (a == "--pd") {
-            pd.pd = args.value(a);
-        } else if (a == "--pd-lib") {
-            pd.library = args.value(a);
-        } else if (a == "--tips-rate") {
-            tips_rate = parse_number(a, args.value(a), 0, 1000);
-        } else if (!parse_performance_option(a, args, o, duration)) {
+};
+
+// render's own options (parse_performance_option has the shared ones).
+OptionTable render_options(RenderArgs &r)
+{
+    PdRenderOptions &pd = r.pd;
+    return {
+        {"--out", store_text(r.out_dir)},
+        {"--force", store_flag(r.force)},
+        {"--bvh-rate", store(r.bvh_rate, parse_number, 0.0, 1000.0)},
+        {"--midi-channel",
+         [&r](const std::string &a, Args &args) {
+             const std::string text = args.value(a);
+             r.midi_channel = parse_number(a, text, 1, 16);
+             if (r.midi_channel != std::floor(r.midi_channel))
+                 throw UsageError("--midi-channel: expected a whole number 1..16, got '" + text +
+                                  "'");
+         }},
+        {"--progress-every", store(r.progress_every, parse_number, 0.0, 3600.0)},
+        {"--wav", store_text(r.wav)},
+        {"--wav-mix",
+         [&pd](const std::string &a, Args &args) {
+             pd.mix = args.value(a);
+             if (pd.mix != "stereo" && pd.mix != "pickups")
+                 throw UsageError("--wav-mix: expected stereo or pickups, got '" + pd.mix + "'");
+         }},
+        {"--wav-bits",
+         [&pd](const std::string &a, Args &args) {
+             const std::string text = args.value(a);
+             const double bits = parse_number(a, text);
+             if (bits != 16 && bits != 24 && bits != 32)
+                 throw UsageError("--wav-bits: expected 16, 24 or 32, got '" + text + "'");
+             pd.bits = static_cast<int>(bits);
+         }},
+        {"--wav-gain", store(pd.gain_db, parse_number, -120.0, 40.0)},
+        {"--wav-rate",
+         [&pd](const std::string &a, Args &args) {
+             const std::string text = args.value(a);
+             const double rate = parse_number(a, text, 8000, 192000);
+             if (rate != std::floor(rate))
+                 throw UsageError("--wav-rate: expected a whole number of Hz, got '" + text + "'");
+             pd.sample_rate = static_cast<int>(rate);
+         }},
+        {"--pd", store_text(pd.pd)},
+        {"--pd-lib", store_text(pd.library)},
+        {"--tips-rate", store(r.tips_rate, parse_number, 0.0, 1000.0)},
+    };
+}
+
+// The command line; false when --help was printed (exit 0). What the options
+// mean together is checked here, and Pd and its library are looked for now,
+// not after the physics.
+bool parse_render_args(Args &args, RenderArgs &r)
+{
+    const OptionTable options = render_options(r);
+    const bool go_on = walk_args(args, render_usage, [&](const std::string &a) {
+        if (!dispatch_option(options, a, args) &&
+            !parse_performance_option(a, args, r.o, r.duration))
             throw UsageError("unknown option '" + a + "' (see ictusd render --help)");
+    });
+    if (!go_on)
+        return false;
+    if (!r.o.mocap.empty() && !r.o.score.score_text.empty())
+        throw UsageError("--score and --mocap are two motion sources: give one");
+    if (r.out_dir.empty())
+        throw UsageError("--out DIR is required");
+    if (!r.wav.empty()) {
+        find_pd_binary(r.pd.pd);
+        r.pd.library = find_pd_library(r.pd.library);
+        r.wav = std::filesystem::absolute(r.wav).lexically_normal().string();
+        check_pd_path("--wav", r.wav);
+        check_pd_path("--out", std::filesystem::absolute(r.out_dir).lexically_normal().string());
+        check_pd_path("--pd-lib", r.pd.library);
+    }
+    return true;
+}
+
+// Every output but the sound, opened before the run (an unwritable folder is
+// found at once) and written at the end.
+struct RenderFiles {
+    RenderFiles(const std::string &dir, bool score_mode)
+        : strikes_csv(dir + "/strikes.csv"), events_txt(dir + "/events.txt"),
+          render_json(dir + "/render.json"), performance_mid(dir + "/performance.mid")
+    {
+        if (score_mode) {
+            tips_csv = std::make_unique<RenderOutput>(dir + "/tips.csv");
+            notes_csv = std::make_unique<RenderOutput>(dir + "/notes.csv");
         }
     }
-    const bool score_mode = o.mocap.empty();
-    if (!score_mode && !o.score.score_text.empty())
-        throw UsageError("--score and --mocap are two motion sources: give one");
-    if (out_dir.empty())
-        throw UsageError("--out DIR is required");
-    if (!wav.empty()) {
-        // Pd and its library are looked for now, not after the physics.
-        find_pd_binary(pd.pd);
-        pd.library = find_pd_library(pd.library);
-        wav = std::filesystem::absolute(wav).lexically_normal().string();
-        check_pd_path("--wav", wav);
-        check_pd_path("--out", std::filesystem::absolute(out_dir).lexically_normal().string());
-        check_pd_path("--pd-lib", pd.library);
-    }
-    prepare_out_dir(out_dir, force);
+    RenderOutput strikes_csv, events_txt, render_json, performance_mid;
+    std::unique_ptr<RenderOutput> tips_csv, notes_csv; // score mode
+};
 
-    Performance perf(o);
+// What the physics of a render leaves, kept in memory.
+struct RenderRecording {
+    StrikeLog log;
+    std::ostringstream tips; // tips.csv, about 100 bytes a row
+    std::unique_ptr<BvhRecorder> bvh;
+    bool interrupted = false;
+    double wall_s = 0.0;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Every how many steps a row of a file `rate_hz` rows a second (0: none) is taken.
+long every_steps(double rate_hz, double step_s)
+{
+    return rate_hz > 0.0 ? std::max(1L, std::lround(1.0 / (rate_hz * step_s))) : 0;
+}
+
+// One frame of performance.bvh: the simulated bodies and the sticks.
+void record_bvh_frame(Performance &perf, BodyFrames &frames, BvhRecorder &bvh)
+{
+    perf.scene().body_frames(frames);
+    bvh.record(frames,
+               {perf.scene().stick_in_hand(Side::left), perf.scene().stick_in_hand(Side::right)});
+}
+
+// The physics, `duration_s` of it as fast as it goes: the strikes, tips.csv's
+// rows (score mode) and performance.bvh's frames, f at f / bvh_rate s from t = 0.
+void simulate(Performance &perf, const RenderArgs &r, bool score_mode, RenderRecording &rec)
+{
     if (score_mode)
-        perf.start_score();
-    if (duration <= 0.0)
-        duration = perf.clip_duration_s();
-    // Every output is opened now (an unwritable folder is found before the
-    // run), kept in memory while the physics runs and written at the end.
-    RenderOutput strikes_csv(out_dir + "/strikes.csv"), events_txt(out_dir + "/events.txt"),
-        render_json(out_dir + "/render.json"), performance_mid(out_dir + "/performance.mid");
-    std::unique_ptr<RenderOutput> tips_csv, notes_csv;
-    if (score_mode) {
-        tips_csv = std::make_unique<RenderOutput>(out_dir + "/tips.csv");
-        notes_csv = std::make_unique<RenderOutput>(out_dir + "/notes.csv");
-    }
-    std::ostringstream tips; // about 100 bytes a row
-    if (score_mode)
-        write_tips_header(tips);
+        write_tips_header(rec.tips);
     const auto wall0 = std::chrono::steady_clock::now();
     const double h = perf.step_s();
-    const long steps = std::max(1L, std::lround(duration / h));
-    const long tips_every =
-        score_mode && tips_rate > 0.0 ? std::max(1L, std::lround(1.0 / (tips_rate * h))) : 0;
-    // performance.bvh: the simulated bodies on the source skeleton (plus
-    // the sticks), frame f at f / bvh_rate s, from t = 0.
-    const long bvh_every = bvh_rate > 0.0 ? std::max(1L, std::lround(1.0 / (bvh_rate * h))) : 0;
-    std::unique_ptr<BvhRecorder> bvh;
+    const long steps = std::max(1L, std::lround(r.duration / h));
+    const long tips_every = score_mode ? every_steps(r.tips_rate, h) : 0;
+    const long bvh_every = every_steps(r.bvh_rate, h);
     BodyFrames frames;
     if (bvh_every) {
-        bvh = std::make_unique<BvhRecorder>(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h));
-        perf.scene().body_frames(frames);
-        bvh->record(frames, {perf.scene().stick_in_hand(Side::left),
-                             perf.scene().stick_in_hand(Side::right)});
+        rec.bvh =
+            std::make_unique<BvhRecorder>(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h));
+        record_bvh_frame(perf, frames, *rec.bvh);
     }
-    StrikeLog log;
     StrikeEvent ev[2];
-    bool interrupted = false;
-    double next_progress = progress_every;
+    double next_progress = r.progress_every;
     for (long n = 0; n < steps; ++n) {
         if (g_interrupted) {
-            interrupted = true;
+            rec.interrupted = true;
             break;
         }
-        if (progress_every > 0.0 && (n & 63) == 0) {
-            const double w =
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+        if (r.progress_every > 0.0 && (n & 63) == 0) {
+            const double w = seconds_since(wall0);
             if (w >= next_progress) {
                 std::fprintf(stderr, "render: %.1f of %.1f s simulated (%.0f s)\n", perf.time_s(),
                              steps * h, w);
-                next_progress = w + progress_every;
+                next_progress = w + r.progress_every;
             }
         }
         const int k = perf.step(ev);
-        log.add(ev, k);
+        rec.log.add(ev, k);
         if (tips_every && (n + 1) % tips_every == 0)
-            write_tips_row(tips, perf);
-        if (bvh && (n + 1) % bvh_every == 0) {
-            perf.scene().body_frames(frames);
-            bvh->record(frames, {perf.scene().stick_in_hand(Side::left),
-                                 perf.scene().stick_in_hand(Side::right)});
-        }
+            write_tips_row(rec.tips, perf);
+        if (rec.bvh && (n + 1) % bvh_every == 0)
+            record_bvh_frame(perf, frames, *rec.bvh);
     }
     StrikeEvent last;
     while (perf.flush(last))
-        log.add(&last, 1);
-    log.finish();
-    const double wall =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+        rec.log.add(&last, 1);
+    rec.log.finish();
+    rec.wall_s = seconds_since(wall0);
+}
 
-    const long strikes = static_cast<long>(log.strikes().size()), bounces = log.bounces();
-    std::ostringstream text;
-    log.write_csv(text);
-    strikes_csv.write_and_close(text.str());
-    text.str("");
-    log.write_events(text);
-    events_txt.write_and_close(text.str());
-    if (bvh)
-        bvh->write(out_dir + "/performance.bvh");
-    // performance.mid: the score's tempo at each note (a clip: --tempo).
+// performance.mid: the strikes as notes at the score's tempo at each note (a
+// clip: --tempo).
+std::string render_midi(const Performance &perf, const RenderArgs &r, bool score_mode,
+                        const StrikeLog &log)
+{
     std::vector<MidiTempo> tempo;
     if (score_mode) {
         for (const PlannedNote &n : perf.plan()->notes)
             tempo.push_back({perf.plan_origin_s() + n.time_s, n.tempo_bpm});
     }
     if (tempo.empty())
-        tempo.push_back({0.0, score_mode ? 120.0 : o.tempo_bpm});
-    performance_mid.write_and_close(
-        standard_midi_file(log.strikes(), tempo, static_cast<int>(midi_channel) - 1));
+        tempo.push_back({0.0, score_mode ? 120.0 : r.o.tempo_bpm});
+    return standard_midi_file(log.strikes(), tempo, static_cast<int>(r.midi_channel) - 1);
+}
+
+// render.json but its "performance" (score mode).
+nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool score_mode,
+                              const StrikeLog &log)
+{
+    const long strikes = static_cast<long>(log.strikes().size());
     nlohmann::json j;
     if (score_mode)
-        j["score"] = o.score.score_text.empty() ? "default" : o.score.score_name;
+        j["score"] = r.o.score.score_text.empty() ? "default" : r.o.score.score_name;
     else
-        j["mocap"] = o.mocap;
+        j["mocap"] = r.o.mocap;
     j["duration_s"] = perf.time_s();
-    j["step_s"] = h;
+    j["step_s"] = perf.step_s();
     j["strikes"] = strikes;
-    j["bounces"] = bounces;
+    j["bounces"] = log.bounces();
     j["divergences"] = perf.divergences();
     j["side_entries"] = perf.detector().side_entries();
     j["grip"] = to_string(perf.options().character.grip);
     if (!score_mode)
-        j["tempo_bpm"] = o.tempo_bpm;
+        j["tempo_bpm"] = r.o.tempo_bpm;
     j["drum"] = drum_json(perf);
     j["midi"] = {{"file", "performance.mid"},
-                 {"channel", static_cast<int>(midi_channel)},
+                 {"channel", static_cast<int>(r.midi_channel)},
                  {"notes", strikes},
                  {"ticks_per_quarter", kMidiTicksPerQuarter}};
-    long score_notes = 0, missed_notes = 0;
+    return j;
+}
+
+// The notes of the score and how many of them were not struck.
+struct NoteCount {
+    long notes = 0, missed = 0;
+};
+
+// Every output but the sound, from memory; in score mode the notes matched
+// with the strikes (notes.csv, render.json's "performance").
+NoteCount write_render_files(RenderFiles &files, const Performance &perf, const RenderArgs &r,
+                             bool score_mode, const RenderRecording &rec)
+{
+    std::ostringstream text;
+    rec.log.write_csv(text);
+    files.strikes_csv.write_and_close(text.str());
+    text.str("");
+    rec.log.write_events(text);
+    files.events_txt.write_and_close(text.str());
+    if (rec.bvh)
+        rec.bvh->write(r.out_dir + "/performance.bvh");
+    files.performance_mid.write_and_close(render_midi(perf, r, score_mode, rec.log));
+    nlohmann::json j = render_summary(perf, r, score_mode, rec.log);
+    NoteCount count;
     if (score_mode) {
         const GesturePlan &plan = *perf.plan();
-        const MatchSummary m = match_strikes(plan.notes, log.strikes(), perf.plan_origin_s());
-        score_notes = static_cast<long>(plan.notes.size());
-        missed_notes = score_notes - m.matched_notes;
+        const MatchSummary m = match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s());
+        count.notes = static_cast<long>(plan.notes.size());
+        count.missed = count.notes - m.matched_notes;
         text.str("");
         write_notes_csv(text, plan, m, perf.plan_origin_s());
-        notes_csv->write_and_close(text.str());
-        tips_csv->write_and_close(tips.str());
-        j["performance"] = performance_json(o, perf, m);
+        files.notes_csv->write_and_close(text.str());
+        files.tips_csv->write_and_close(rec.tips.str());
+        j["performance"] = performance_json(r.o, perf, m);
     }
-    render_json.write_and_close(j.dump(2) + "\n");
+    files.render_json.write_and_close(j.dump(2) + "\n");
+    return count;
+}
+
+// The summary line on stdout, and on stderr what render.json says in
+// missed_notes, said where it is seen: a drum out of the sticks' reach
+// (--drum-pos) plays nothing and still exits 0.
+void print_render_summary(const Performance &perf, const RenderArgs &r, bool score_mode,
+                          const RenderRecording &rec, const NoteCount &count)
+{
+    const double wall = rec.wall_s;
     std::cout << "render: " << perf.time_s() << " s simulated in " << wall << " s ("
-              << perf.time_s() / std::max(wall, 1e-9) << "x real time), " << strikes << " strikes ("
-              << bounces << " bounces), wrote " << out_dir
+              << perf.time_s() / std::max(wall, 1e-9) << "x real time), "
+              << static_cast<long>(rec.log.strikes().size()) << " strikes (" << rec.log.bounces()
+              << " bounces), wrote " << r.out_dir
               << (score_mode ? "/{strikes.csv,events.txt,render.json,performance.mid,tips.csv,"
                                "notes.csv"
                              : "/{strikes.csv,events.txt,render.json,performance.mid")
-              << (bvh ? ",performance.bvh}\n" : "}\n");
-    // What render.json says in missed_notes, said where it is seen: a drum out
-    // of the sticks' reach (--drum-pos) plays nothing and still exits 0.
-    if (score_mode && score_notes == 0)
+              << (rec.bvh ? ",performance.bvh}\n" : "}\n");
+    if (score_mode && count.notes == 0)
         std::cerr << "ictusd render: warning: the score has no notes: nothing was played\n";
-    else if (missed_notes > 0)
-        std::cerr << "ictusd render: warning: " << missed_notes << " of " << score_notes
+    else if (count.missed > 0)
+        std::cerr << "ictusd render: warning: " << count.missed << " of " << count.notes
                   << " notes of the score were not struck (strike_seq -1 in notes.csv"
-                  << (missed_notes == score_notes
+                  << (count.missed == count.notes
                           ? "; is the drum within the sticks' reach? --drum-pos"
                           : "")
                   << ")\n";
-    if (interrupted)
-        return 130;
-    if (!wav.empty()) {
-        const DrumParams &d = perf.scene().options().drum;
-        pd.events = std::filesystem::absolute(out_dir + "/events.txt").lexically_normal().string();
-        pd.log = out_dir + "/pd.log";
-        pd.wav = wav;
-        pd.seconds = perf.time_s() + 1.5; // the last strike rings out (as scripts/main.sh)
-        pd.radius_m = d.radius_m;
-        pd.tension_n_per_m = d.tension_n_per_m;
-        pd.density_kg_per_m2 = perf.options().drum_density_kg_per_m2;
-        std::cout << "render: pd: " << pd.seconds << " s of sound into " << wav << " ..."
-                  << std::endl;
-        const PdRenderResult r = run_pd_render(pd, [&](double s) {
-            if (progress_every > 0.0)
-                std::fprintf(stderr, "render: pd still rendering (%.0f s)\n", s);
-        });
-        if (!r.errors.empty()) {
-            std::cerr << "ictusd render: pd reported errors (log: " << pd.log << "):\n" << r.errors;
-            return 1;
-        }
-        char line[512];
-        std::snprintf(line, sizeof line,
-                      "render: wrote %s in %.1f s (%s, %d-bit%s, %d Hz): peak %.2f dBFS, %.2f "
-                      "dBFS before the limiter\n",
-                      wav.c_str(), r.wall_s, pd.mix.c_str(), pd.bits, pd.bits == 32 ? " float" : "",
-                      pd.sample_rate, r.peak_out_dbfs, r.peak_in_dbfs);
-        std::cout << line;
+}
+
+// --wav: events.txt played by Pd on the same drum. Returns the exit status.
+int render_wav(RenderArgs &r, const Performance &perf)
+{
+    PdRenderOptions &pd = r.pd;
+    const DrumParams &d = perf.scene().options().drum;
+    pd.events = std::filesystem::absolute(r.out_dir + "/events.txt").lexically_normal().string();
+    pd.log = r.out_dir + "/pd.log";
+    pd.wav = r.wav;
+    pd.seconds = perf.time_s() + 1.5; // the last strike rings out (as scripts/main.sh)
+    pd.radius_m = d.radius_m;
+    pd.tension_n_per_m = d.tension_n_per_m;
+    pd.density_kg_per_m2 = perf.options().drum_density_kg_per_m2;
+    std::cout << "render: pd: " << pd.seconds << " s of sound into " << r.wav << " ..."
+              << std::endl;
+    const PdRenderResult result = run_pd_render(pd, [&](double s) {
+        if (r.progress_every > 0.0)
+            std::fprintf(stderr, "render: pd still rendering (%.0f s)\n", s);
+    });
+    if (!result.errors.empty()) {
+        std::cerr << "ictusd render: pd reported errors (log: " << pd.log << "):\n"
+                  << result.errors;
+        return 1;
     }
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "render: wrote %s in %.1f s (%s, %d-bit%s, %d Hz): peak %.2f dBFS, %.2f "
+                  "dBFS before the limiter\n",
+                  r.wav.c_str(), result.wall_s, pd.mix.c_str(), pd.bits,
+                  pd.bits == 32 ? " float" : "", pd.sample_rate, result.peak_out_dbfs,
+                  result.peak_in_dbfs);
+    std::cout << line;
     return 0;
+}
+
+} // namespace
+
+int cmd_render(Args &args)
+{
+    RenderArgs r;
+    if (!parse_render_args(args, r))
+        return 0;
+    const bool score_mode = r.o.mocap.empty();
+    prepare_out_dir(r.out_dir, r.force);
+    Performance perf(r.o);
+    if (score_mode)
+        perf.start_score();
+    if (r.duration <= 0.0)
+        r.duration = perf.clip_duration_s();
+    RenderFiles files(r.out_dir, score_mode);
+    RenderRecording rec;
+    simulate(perf, r, score_mode, rec);
+    const NoteCount count = write_render_files(files, perf, r, score_mode, rec);
+    print_render_summary(perf, r, score_mode, rec, count);
+    if (rec.interrupted)
+        return 130;
+    return r.wav.empty() ? 0 : render_wav(r, perf);
 }
 
 } // namespace cli

@@ -132,125 +132,134 @@ bool is_csv(const std::string &path)
     return ext == ".csv";
 }
 
-TrackArgs parse_track_args(Args &args)
+// The inverse kinematics of Cartesian mode (docs/ik.md).
+OptionTable ik_options(TrackArgs &t)
 {
-    TrackArgs t;
-    while (!args.done()) {
-        const std::string a = args.next();
-        if (a == "--help" || a == "-h") {
-            track_usage(std::cout);
-            t.help = true;
-            return t;
-        } else if (a == "--mode") {
-            t.mode = args.value(a);
-            t.options.mode = parse_track_mode(a, t.mode);
-        } else if (a == "--ik-gain") {
-            t.options.cartesian.gain = parse_positive(a, args.value(a));
-        } else if (parse_stick_csv_option(a, args, t.sticks)) {
-        } else if (a == "--drum") {
-            const std::string v = args.value(a);
-            if (v != "auto") {
-                try {
-                    t.options.scene.drum.center_m =
-                        parse_vec3(a, v, -kMaxDrumDistance_m, kMaxDrumDistance_m);
-                } catch (const UsageError &) {
-                    throw UsageError("--drum: expected auto or X,Y,Z (m), got '" + v + "'");
-                }
-                t.drum_pos_given = true;
-            }
-        } else if (a == "--ik-velocity-gain") {
-            t.options.cartesian.velocity_gain_s = parse_number(a, args.value(a));
-        } else if (a == "--ik-accel-ff") {
-            t.options.cartesian.acceleration_feedforward_s2 = parse_number(a, args.value(a));
-        } else if (a == "--ik-correction-limit") {
-            t.options.cartesian.correction_limit_m = parse_number(a, args.value(a));
-        } else if (a == "--ik-start") {
-            const std::string v = args.value(a);
-            if (v != "simulated" && v != "kinematic")
-                throw UsageError("--ik-start: expected simulated or kinematic, got '" + v + "'");
-            t.options.cartesian.start_from_simulated = v == "simulated";
-        } else if (a == "--tip-smooth-hz") {
-            t.tip_smooth_hz = parse_number(a, args.value(a));
-            if (!(t.tip_smooth_hz >= 0.0 && t.tip_smooth_hz <= 1000.0))
-                throw UsageError("--tip-smooth-hz: expected 0 <= HZ <= 1000, got " + args.value(a));
-        } else if (a == "--ik-iterations") {
-            t.options.cartesian.feedback_iterations = parse_int(a, args.value(a), 0, 10000);
-        } else if (a == "--ik-kinematic-iterations") {
-            t.options.cartesian.kinematic_iterations = parse_int(a, args.value(a), 0, 10000);
-        } else if (a == "--ik-posture-weight") {
-            t.options.cartesian.posture_weight = parse_number(a, args.value(a));
-        } else if (a == "--ik-integral") {
-            t.options.cartesian.integral_per_s = parse_number(a, args.value(a));
-        } else if (a == "--mocap") {
-            t.mocap = args.value(a);
-        } else if (a == "--out") {
-            t.out_dir = args.value(a);
-        } else if (parse_clip_option(a, args, t.clip)) {
-        } else if (a == "--duration") {
-            t.options.duration_s = parse_positive(a, args.value(a));
-        } else if (a == "--step") {
-            t.options.scene.step_s = parse_positive(a, args.value(a));
-        } else if (a == "--stepper") {
-            const std::string s = args.value(a);
-            if (s == "quick")
-                t.options.scene.stepper = Stepper::quick;
-            else if (s == "direct")
-                t.options.scene.stepper = Stepper::direct;
-            else
-                throw UsageError("--stepper: expected quick or direct, got '" + s + "'");
-        } else if (a == "--iterations") {
-            t.options.scene.quickstep_iterations = parse_int(a, args.value(a), 1, 1000);
-        } else if (a == "--sor-w") {
-            t.options.scene.quickstep_w = parse_number(a, args.value(a), 0.01, 1.99);
-        } else if (a == "--body-mass") {
-            t.character.body_mass_kg = parse_positive(a, args.value(a));
-        } else if (a == "--grip") {
-            t.character.grip = parse_grip(a, args.value(a));
-        } else if (a == "--stick-length") {
-            t.character.stick.length_m = parse_positive(a, args.value(a));
-        } else if (a == "--stick-mass") {
-            t.character.stick.mass_kg = parse_positive(a, args.value(a));
-        } else if (a == "--stick-tip-radius") {
-            t.character.stick.tip_radius_m = parse_positive(a, args.value(a));
-        } else if (a == "--drum-pos") {
-            t.options.scene.drum.center_m =
-                parse_vec3(a, args.value(a), -kMaxDrumDistance_m, kMaxDrumDistance_m);
-            t.drum_pos_given = true;
-        } else if (a == "--drum-radius") {
-            t.options.scene.drum.radius_m = parse_positive(a, args.value(a));
-        } else if (a == "--drum-tension") {
-            t.options.scene.drum.tension_n_per_m = parse_positive(a, args.value(a));
-        } else if (a == "--gain-hz") {
-            t.options.gains.natural_frequency_hz = parse_positive(a, args.value(a));
-        } else if (a == "--damping-ratio") {
-            t.options.gains.damping_ratio = parse_positive(a, args.value(a));
-        } else if (a == "--torque-scale") {
-            t.options.gains.torque_scale = parse_positive(a, args.value(a));
-        } else if (a == "--gains") {
-            t.gains_file = args.value(a);
-        } else if (a == "--limits") {
-            t.limits_mode = args.value(a);
-            if (t.limits_mode != "none" && t.limits_mode != "euler" &&
-                t.limits_mode != "quaternion")
-                throw UsageError("--limits: expected none, euler or quaternion, got '" +
-                                 t.limits_mode + "'");
-        } else if (a == "--limit-k") {
-            t.limit_k = parse_positive(a, args.value(a));
-        } else if (a == "--limit-min-deg") {
-            t.limit_width_deg = parse_min_half_width_deg(a, args.value(a));
-        } else if (a == "--no-stops") {
-            t.options.scene.limit_stops = false;
-        } else if (a == "--ramp") {
-            t.options.ramp_s = parse_number(a, args.value(a));
-            if (t.options.ramp_s < 0.0)
-                throw UsageError("--ramp: expected a number >= 0, got " +
-                                 std::to_string(t.options.ramp_s));
-        } else if (a == "--quiet" || a == "-q") {
-            t.quiet = true;
-        } else {
-            throw UsageError("unknown option '" + a + "' (see ictusd track --help)");
-        }
-    }
+    CartesianOptions &ik = t.options.cartesian;
+    return {
+        {"--mode",
+         [&t](const std::string &a, Args &args) {
+             t.mode = args.value(a);
+             t.options.mode = parse_track_mode(a, t.mode);
+         }},
+        {"--ik-gain", store(ik.gain, parse_positive)},
+        {"--ik-velocity-gain", store(ik.velocity_gain_s, parse_number)},
+        {"--ik-accel-ff", store(ik.acceleration_feedforward_s2, parse_number)},
+        {"--ik-correction-limit", store(ik.correction_limit_m, parse_number)},
+        {"--ik-start",
+         [&ik](const std::string &a, Args &args) {
+             const std::string v = args.value(a);
+             if (v != "simulated" && v != "kinematic")
+                 throw UsageError("--ik-start: expected simulated or kinematic, got '" + v + "'");
+             ik.start_from_simulated = v == "simulated";
+         }},
+        {"--tip-smooth-hz",
+         [&t](const std::string &a, Args &args) {
+             t.tip_smooth_hz = parse_number(a, args.value(a));
+             if (!(t.tip_smooth_hz >= 0.0 && t.tip_smooth_hz <= 1000.0))
+                 throw UsageError("--tip-smooth-hz: expected 0 <= HZ <= 1000, got " +
+                                  args.value(a));
+         }},
+        {"--ik-iterations", store(ik.feedback_iterations, parse_int, 0, 10000)},
+        {"--ik-kinematic-iterations", store(ik.kinematic_iterations, parse_int, 0, 10000)},
+        {"--ik-posture-weight", store(ik.posture_weight, parse_number)},
+        {"--ik-integral", store(ik.integral_per_s, parse_number)},
+    };
+}
+
+// The simulation: the step, the solver, the drum, the stops, the ramp.
+OptionTable scene_options(TrackArgs &t)
+{
+    SceneOptions &scene = t.options.scene;
+    return {
+        {"--drum",
+         [&t](const std::string &a, Args &args) {
+             const std::string v = args.value(a);
+             if (v == "auto")
+                 return;
+             try {
+                 t.options.scene.drum.center_m =
+                     parse_vec3(a, v, -kMaxDrumDistance_m, kMaxDrumDistance_m);
+             } catch (const UsageError &) {
+                 throw UsageError("--drum: expected auto or X,Y,Z (m), got '" + v + "'");
+             }
+             t.drum_pos_given = true;
+         }},
+        {"--drum-pos",
+         [&t](const std::string &a, Args &args) {
+             t.options.scene.drum.center_m =
+                 parse_vec3(a, args.value(a), -kMaxDrumDistance_m, kMaxDrumDistance_m);
+             t.drum_pos_given = true;
+         }},
+        {"--drum-radius", store(scene.drum.radius_m, parse_positive)},
+        {"--drum-tension", store(scene.drum.tension_n_per_m, parse_positive)},
+        {"--duration", store(t.options.duration_s, parse_positive)},
+        {"--step", store(scene.step_s, parse_positive)},
+        {"--stepper",
+         [&scene](const std::string &a, Args &args) {
+             const std::string s = args.value(a);
+             if (s == "quick")
+                 scene.stepper = Stepper::quick;
+             else if (s == "direct")
+                 scene.stepper = Stepper::direct;
+             else
+                 throw UsageError("--stepper: expected quick or direct, got '" + s + "'");
+         }},
+        {"--iterations", store(scene.quickstep_iterations, parse_int, 1, 1000)},
+        {"--sor-w", store(scene.quickstep_w, parse_number, 0.01, 1.99)},
+        {"--no-stops", [&scene](const std::string &, Args &) { scene.limit_stops = false; }},
+        {"--ramp",
+         [&t](const std::string &a, Args &args) {
+             t.options.ramp_s = parse_number(a, args.value(a));
+             if (t.options.ramp_s < 0.0)
+                 throw UsageError("--ramp: expected a number >= 0, got " +
+                                  std::to_string(t.options.ramp_s));
+         }},
+    };
+}
+
+// The body: mass, grip, sticks, joint gains and limits.
+OptionTable body_options(TrackArgs &t)
+{
+    CharacterOptions &body = t.character;
+    GainOptions &gains = t.options.gains;
+    return {
+        {"--body-mass", store(body.body_mass_kg, parse_positive)},
+        {"--grip", store(body.grip, parse_grip)},
+        {"--stick-length", store(body.stick.length_m, parse_positive)},
+        {"--stick-mass", store(body.stick.mass_kg, parse_positive)},
+        {"--stick-tip-radius", store(body.stick.tip_radius_m, parse_positive)},
+        {"--gain-hz", store(gains.natural_frequency_hz, parse_positive)},
+        {"--damping-ratio", store(gains.damping_ratio, parse_positive)},
+        {"--torque-scale", store(gains.torque_scale, parse_positive)},
+        {"--gains", store_text(t.gains_file)},
+        {"--limits",
+         [&t](const std::string &a, Args &args) {
+             t.limits_mode = args.value(a);
+             if (t.limits_mode != "none" && t.limits_mode != "euler" &&
+                 t.limits_mode != "quaternion")
+                 throw UsageError("--limits: expected none, euler or quaternion, got '" +
+                                  t.limits_mode + "'");
+         }},
+        {"--limit-k", store(t.limit_k, parse_positive)},
+        {"--limit-min-deg", store(t.limit_width_deg, parse_min_half_width_deg)},
+    };
+}
+
+// The capture, the output folder, the chatter.
+OptionTable io_options(TrackArgs &t)
+{
+    return {
+        {"--mocap", store_text(t.mocap)},
+        {"--out", store_text(t.out_dir)},
+        {"--quiet", store_flag(t.quiet)},
+        {"-q", store_flag(t.quiet)},
+    };
+}
+
+// What the options mean together, checked before any file is read.
+void check_track_args(TrackArgs &t)
+{
     if (t.mode.empty())
         throw UsageError("--mode is required (--mode joint or --mode cartesian)");
     if (t.mocap.empty())
@@ -282,6 +291,24 @@ TrackArgs parse_track_args(Args &args)
                          "none)\n";
         t.limits_mode = "range_of_motion";
     }
+}
+
+TrackArgs parse_track_args(Args &args)
+{
+    TrackArgs t;
+    const OptionTable tables[] = {ik_options(t), scene_options(t), body_options(t), io_options(t)};
+    const bool go_on = walk_args(args, track_usage, [&](const std::string &a) {
+        for (const OptionTable &table : tables)
+            if (dispatch_option(table, a, args))
+                return;
+        if (!parse_stick_csv_option(a, args, t.sticks) && !parse_clip_option(a, args, t.clip))
+            throw UsageError("unknown option '" + a + "' (see ictusd track --help)");
+    });
+    if (!go_on) {
+        t.help = true;
+        return t;
+    }
+    check_track_args(t);
     return t;
 }
 

@@ -1,5 +1,6 @@
 // chain_ik_solver_pos_dls.cpp -- damped-least-squares IK (paper eq. 2, Wampler 1986).
 #include "ictus/control/chain_ik_solver_pos_dls.hpp"
+#include "ictus/base/enum_names.hpp"
 #include "ictus/base/rotation.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -10,23 +11,15 @@
 namespace ictus
 {
 
+namespace
+{
+const EnumNames<6> kIkStatusNames = {"converged",     "max_iterations", "unreachable",
+                                     "joint_limited", "singular",       "invalid_input"};
+} // namespace
+
 const char *to_string(IkStatus status)
 {
-    switch (status) {
-    case IkStatus::converged:
-        return "converged";
-    case IkStatus::max_iterations:
-        return "max_iterations";
-    case IkStatus::unreachable:
-        return "unreachable";
-    case IkStatus::joint_limited:
-        return "joint_limited";
-    case IkStatus::singular:
-        return "singular";
-    case IkStatus::invalid_input:
-        return "invalid_input";
-    }
-    return "unknown";
+    return enum_name(kIkStatusNames, status, "unknown");
 }
 
 // The secondary task's weight is cut to no less than this before the damping grows.

@@ -47,11 +47,14 @@ std::vector<GestureUnit> segment_strokes(const std::vector<double> &time_s,
                            nullptr);
 }
 
-std::vector<GestureUnit> segment_strokes(const std::vector<double> &time_s,
-                                         const std::vector<Eigen::Vector3d> &tip_world_m,
-                                         const Eigen::Vector3d &performer_right_world, Grip g,
-                                         Nuance n, Side h, const SegmentOptions &opts,
-                                         const std::vector<Eigen::Vector3d> *stick_dir_world)
+namespace
+{
+
+// The input of segment_strokes: as many times as samples (and directions),
+// at least 3, finite, times strictly increasing; a positive output rate.
+void check_samples(const std::vector<double> &time_s,
+                   const std::vector<Eigen::Vector3d> &tip_world_m, const SegmentOptions &opts,
+                   const std::vector<Eigen::Vector3d> *stick_dir_world)
 {
     if (time_s.size() != tip_world_m.size())
         throw GestureError("segment_strokes: " + std::to_string(time_s.size()) + " times but " +
@@ -70,31 +73,33 @@ std::vector<GestureUnit> segment_strokes(const std::vector<double> &time_s,
             throw GestureError("segment_strokes: time not strictly increasing at sample " +
                                std::to_string(i));
     }
+}
+
+// The performer frame's axes in the world (a reflection of it).
+struct PerformerAxes {
+    Eigen::Vector3d right, up, forward;
+};
+
+PerformerAxes performer_axes(const Eigen::Vector3d &performer_right_world)
+{
     Eigen::Vector3d right(performer_right_world.x(), 0.0, performer_right_world.z());
     if (!right.allFinite() || right.norm() < 1e-9)
         throw GestureError("segment_strokes: the performer's right has no horizontal direction");
     right.normalize();
     const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
-    const Eigen::Vector3d forward = up.cross(right); // performer frame: a reflection of the world
+    return {right, up, up.cross(right)};
+}
 
-    const double rate = opts.rate_hz;
-    if ((time_s.back() - time_s.front()) * rate > 1e8)
-        throw GestureError("segment_strokes: more than 1e8 samples at the output rate");
-    const int count =
-        1 + static_cast<int>(std::floor((time_s.back() - time_s.front()) * rate + 1e-9));
-    if (count < 3)
-        throw GestureError("segment_strokes: trajectory shorter than 3 samples at the output rate");
-    const std::vector<Eigen::Vector3d> tip = resample_linear(time_s, tip_world_m, rate, count);
-    std::vector<Eigen::Vector3d> dir;
-    if (stick_dir_world)
-        dir = resample_linear(time_s, *stick_dir_world, rate, count);
-
-    // The strike rule (docs/gestures.md): a local minimum of height, deep
-    // enough (within the lowest depth_fraction of the height range, or
-    // min_depth_window_m of the lowest point), approached fast enough (mean
-    // downward speed over approach_window_s), and separated from the previous
-    // strike by a rise of at least min_rise_m (else the lower one is kept:
-    // bounces and jitter).
+// The strike rule (docs/gestures.md): a local minimum of height, deep
+// enough (within the lowest depth_fraction of the height range, or
+// min_depth_window_m of the lowest point), approached fast enough (mean
+// downward speed over approach_window_s), and separated from the previous
+// strike by a rise of at least min_rise_m (else the lower one is kept:
+// bounces and jitter). The strikes' sample indices; a GestureError when none.
+std::vector<int> find_strikes(const std::vector<Eigen::Vector3d> &tip, double rate,
+                              const SegmentOptions &opts)
+{
+    const int count = static_cast<int>(tip.size());
     double lo = tip[0].y(), hi = tip[0].y();
     for (const auto &p : tip) {
         lo = std::min(lo, p.y());
@@ -130,6 +135,31 @@ std::vector<GestureUnit> segment_strokes(const std::vector<double> &time_s,
                            "within " +
                            std::to_string(depth) + " m of the lowest point approached at >= " +
                            std::to_string(opts.min_approach_mps) + " m/s)");
+    return strikes;
+}
+
+} // namespace
+
+std::vector<GestureUnit> segment_strokes(const std::vector<double> &time_s,
+                                         const std::vector<Eigen::Vector3d> &tip_world_m,
+                                         const Eigen::Vector3d &performer_right_world, Grip g,
+                                         Nuance n, Side h, const SegmentOptions &opts,
+                                         const std::vector<Eigen::Vector3d> *stick_dir_world)
+{
+    check_samples(time_s, tip_world_m, opts, stick_dir_world);
+    const PerformerAxes axes = performer_axes(performer_right_world);
+    const double rate = opts.rate_hz;
+    if ((time_s.back() - time_s.front()) * rate > 1e8)
+        throw GestureError("segment_strokes: more than 1e8 samples at the output rate");
+    const int count =
+        1 + static_cast<int>(std::floor((time_s.back() - time_s.front()) * rate + 1e-9));
+    if (count < 3)
+        throw GestureError("segment_strokes: trajectory shorter than 3 samples at the output rate");
+    const std::vector<Eigen::Vector3d> tip = resample_linear(time_s, tip_world_m, rate, count);
+    std::vector<Eigen::Vector3d> dir;
+    if (stick_dir_world)
+        dir = resample_linear(time_s, *stick_dir_world, rate, count);
+    const std::vector<int> strikes = find_strikes(tip, rate, opts);
 
     // Cuts at the highest sample between strikes (and before the first, after the last).
     auto argmax = [&](int a, int b) {
@@ -158,10 +188,10 @@ std::vector<GestureUnit> segment_strokes(const std::vector<double> &time_s,
         const Eigen::Vector3d origin = tip[s];
         for (int j = a; j <= b; ++j) {
             const Eigen::Vector3d d = tip[j] - origin;
-            u.tip_m.emplace_back(d.dot(right), d.dot(up), d.dot(forward));
+            u.tip_m.emplace_back(d.dot(axes.right), d.dot(axes.up), d.dot(axes.forward));
             if (!dir.empty()) {
                 const Eigen::Vector3d sd = dir[j].normalized();
-                u.stick_dir.emplace_back(sd.dot(right), sd.dot(up), sd.dot(forward));
+                u.stick_dir.emplace_back(sd.dot(axes.right), sd.dot(axes.up), sd.dot(axes.forward));
             }
         }
         units.push_back(std::move(u));

@@ -4,6 +4,7 @@
 // motion section line by line, so a wrong value count is reported on its line.
 #include "ictus/mocap/bvh.hpp"
 
+#include "ictus/base/enum_names.hpp"
 #include "ictus/mocap/capture_bounds.hpp"
 #include "text_lines.hpp"
 
@@ -125,20 +126,12 @@ std::string number_text(double value)
     return text.str();
 }
 
+const EnumNames<6> kChannelNames = {"Xposition", "Yposition", "Zposition",
+                                    "Xrotation", "Yrotation", "Zrotation"};
+
 bool channel_from_name(const std::string &name, BvhChannel &channel)
 {
-    static const struct {
-        const char *name;
-        BvhChannel channel;
-    } table[] = {{"Xposition", BvhChannel::Xposition}, {"Yposition", BvhChannel::Yposition},
-                 {"Zposition", BvhChannel::Zposition}, {"Xrotation", BvhChannel::Xrotation},
-                 {"Yrotation", BvhChannel::Yrotation}, {"Zrotation", BvhChannel::Zrotation}};
-    for (const auto &entry : table)
-        if (name == entry.name) {
-            channel = entry.channel;
-            return true;
-        }
-    return false;
+    return enum_from_name(kChannelNames, name, channel);
 }
 
 bool is_position(BvhChannel c)
@@ -319,17 +312,22 @@ class BvhParser
         bvh_.channels.emplace_back();
     }
 
+    // The value after `label` ("Frames:"), a token of its own or joined to
+    // the label ("Frames:N"); `what` names the value when it is missing.
+    std::string labelled_value(const std::string &label, const char *what)
+    {
+        const std::string token = cursor_.next(label);
+        if (token == label)
+            return cursor_.next(what);
+        if (token.rfind(label, 0) != 0)
+            cursor_.fail(label, token);
+        return token.substr(label.size());
+    }
+
     // "Frames: N" (also "Frames:N").
     long parse_frames()
     {
-        std::string token = cursor_.next("Frames:");
-        std::string value_token;
-        if (token == "Frames:")
-            value_token = cursor_.next("a frame count");
-        else if (token.rfind("Frames:", 0) == 0)
-            value_token = token.substr(7);
-        else
-            cursor_.fail("Frames:", token);
+        const std::string value_token = labelled_value("Frames:", "a frame count");
         frames_line_ = cursor_.token_line();
         double frames = 0.0;
         const std::string range = "[1, " + std::to_string(options_.max_frames) + "]";
@@ -347,14 +345,7 @@ class BvhParser
         const std::string frame = cursor_.next("Frame Time:");
         if (frame != "Frame")
             cursor_.fail("Frame Time:", frame);
-        std::string token = cursor_.next("Time:");
-        std::string value_token;
-        if (token == "Time:")
-            value_token = cursor_.next("a frame time");
-        else if (token.rfind("Time:", 0) == 0)
-            value_token = token.substr(5);
-        else
-            cursor_.fail("Time:", token);
+        const std::string value_token = labelled_value("Time:", "a frame time");
         double frame_time = 0.0;
         if (!detail::parse_double(value_token, frame_time) || !std::isfinite(frame_time) ||
             frame_time < kMinFrameTimeS || frame_time > kMaxFrameTimeS)
@@ -530,21 +521,7 @@ int BvhFile::channelled_joints() const
 
 const char *to_string(BvhChannel channel)
 {
-    switch (channel) {
-    case BvhChannel::Xposition:
-        return "Xposition";
-    case BvhChannel::Yposition:
-        return "Yposition";
-    case BvhChannel::Zposition:
-        return "Zposition";
-    case BvhChannel::Xrotation:
-        return "Xrotation";
-    case BvhChannel::Yrotation:
-        return "Yrotation";
-    case BvhChannel::Zrotation:
-        return "Zrotation";
-    }
-    return "?";
+    return enum_name(kChannelNames, channel, "?");
 }
 
 BvhFile parse_bvh(std::istream &in, const std::string &source_name, const BvhOptions &options,

@@ -1,6 +1,7 @@
 // rotation_stats.cpp -- the sign-robust mean rotation and the named Tait-Bryan orders
 // (rotation_stats.hpp) over base/rotation.hpp.
 #include "ictus/mocap/rotation_stats.hpp"
+#include "ictus/base/enum_names.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -37,23 +38,14 @@ Eigen::Quaterniond mean_rotation(const std::vector<Eigen::Quaterniond> &series)
     return mean;
 }
 
+namespace
+{
+const EnumNames<6> kEulerOrderNames = {"XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"};
+} // namespace
+
 const char *to_string(EulerOrder order)
 {
-    switch (order) {
-    case EulerOrder::XYZ:
-        return "XYZ";
-    case EulerOrder::XZY:
-        return "XZY";
-    case EulerOrder::YXZ:
-        return "YXZ";
-    case EulerOrder::YZX:
-        return "YZX";
-    case EulerOrder::ZXY:
-        return "ZXY";
-    case EulerOrder::ZYX:
-        return "ZYX";
-    }
-    return "?";
+    return enum_name(kEulerOrderNames, order, "?");
 }
 
 EulerOrder euler_order_from_string(const std::string &text)
@@ -61,10 +53,9 @@ EulerOrder euler_order_from_string(const std::string &text)
     std::string upper;
     for (char c : text)
         upper.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
-    for (EulerOrder order : {EulerOrder::XYZ, EulerOrder::XZY, EulerOrder::YXZ, EulerOrder::YZX,
-                             EulerOrder::ZXY, EulerOrder::ZYX})
-        if (upper == to_string(order))
-            return order;
+    EulerOrder order;
+    if (enum_from_name(kEulerOrderNames, upper, order))
+        return order;
     throw MocapError("euler order", 0,
                      "expected one of XYZ XZY YXZ YZX ZXY ZYX, got '" + text + "'");
 }

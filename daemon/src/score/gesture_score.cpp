@@ -310,44 +310,51 @@ Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, dou
     return frame.membrane_center_m + Eigen::Vector3d(r * std::cos(th), 0.0, -r * std::sin(th));
 }
 
-GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
-                             const PerformerFrame &frame, const PlanOptions &opt)
+namespace
 {
-    validate(frame, opt);
-    Eigen::Matrix3d to_world;
-    to_world.col(0) = frame.right;
-    to_world.col(1) = frame.up;
-    to_world.col(2) = frame.forward;
 
-    GesturePlan plan;
-    plan.score_start_s = opt.lead_in_s;
+// Units are shared by notes with the same grip, nuance, hand, dynamics
+// and periods. The parametric model's units are made at the hand's own
+// periods (the downswing for the time since its previous strike, the lift
+// for the time to its next one: gesture.hpp's stroke_model), so the warp
+// has little to do; imported units come from instantiate() and are warped.
+class UnitCache
+{
+  public:
+    explicit UnitCache(const GestureDatabase &db) : db_(db) {}
 
-    // Units are shared by notes with the same grip, nuance, hand, dynamics
-    // and periods. The parametric model's units are made at the hand's own
-    // periods (the downswing for the time since its previous strike, the lift
-    // for the time to its next one: gesture.hpp's stroke_model), so the warp
-    // has little to do; imported units come from instantiate() and are warped.
-    std::map<std::tuple<int, int, int, double, long, long>, std::unique_ptr<UnitCurve>> units;
-    auto unit_for = [&](Grip g, Nuance n, Side s, double dynamics, double prep_period_s,
-                        double lift_period_s) -> const UnitCurve & {
+    const UnitCurve &unit_for(Grip g, Nuance n, Side s, double dynamics, double prep_period_s,
+                              double lift_period_s)
+    {
         const long prep_us = std::lround(prep_period_s * 1e6);
         const long lift_us = std::lround(lift_period_s * 1e6);
         const auto key = std::make_tuple(static_cast<int>(g), static_cast<int>(n),
                                          static_cast<int>(s), dynamics, prep_us, lift_us);
-        auto it = units.find(key);
-        if (it == units.end()) {
-            const GestureUnit *stored = db.find(g, n, s);
+        auto it = units_.find(key);
+        if (it == units_.end()) {
+            const GestureUnit *stored = db_.find(g, n, s);
             const GestureUnit unit =
                 !stored || stored->source == "model"
                     ? stroke_model(g, n, s, dynamics, prep_us * 1e-6, lift_us * 1e-6)
-                    : db.instantiate(g, n, s, dynamics);
-            it = units.emplace(key, std::make_unique<UnitCurve>(unit)).first;
+                    : db_.instantiate(g, n, s, dynamics);
+            it = units_.emplace(key, std::make_unique<UnitCurve>(unit)).first;
         }
         return *it->second;
-    };
+    }
 
-    // The notes, timed by the tempo map.
-    std::array<std::vector<size_t>, 2> by_hand;
+  private:
+    const GestureDatabase &db_;
+    std::map<std::tuple<int, int, int, double, long, long>, std::unique_ptr<UnitCurve>> units_;
+};
+
+using HandNotes = std::array<std::vector<size_t>, 2>; // each hand's notes, indices into plan.notes
+
+// The notes, timed by the tempo map, into plan.notes (score order); a hand
+// asked to play faster than one hand plays is a ScoreError.
+HandNotes time_notes(const Score &score, const PerformerFrame &frame, const PlanOptions &opt,
+                     GesturePlan &plan)
+{
+    HandNotes by_hand;
     for (const ScoreNote &n : score.notes) {
         PlannedNote p;
         p.time_s = opt.lead_in_s + score.note_time_s(n);
@@ -380,121 +387,162 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
         by_hand[static_cast<int>(n.hand)].push_back(plan.notes.size());
         plan.notes.push_back(p);
     }
+    return by_hand;
+}
 
+// One hand's strokes on their way to the timeline: the units placed on
+// their notes, and which gaps go through the rest tip (note k -> k+1).
+struct HandStrokes {
+    std::vector<Item> placed;
+    std::vector<bool> via_rest;
+};
+
+// The units at their notes' targets and strikes. A long gap goes through the
+// rest tip: when it is longer than idle_return_s and leaves room for a
+// nominal lift, two moves and a nominal preparation.
+HandStrokes place_strokes(const std::vector<size_t> &idx, const GesturePlan &plan,
+                          const PlanOptions &opt, const Eigen::Matrix3d &to_world)
+{
+    const size_t n = idx.size();
+    HandStrokes h{std::vector<Item>(n), std::vector<bool>(n, false)};
+    for (size_t k = 0; k < n; ++k) {
+        const PlannedNote &p = plan.notes[idx[k]];
+        Item &it = h.placed[k];
+        it.rest = false;
+        it.to_world = to_world;
+        it.origin = p.tip_target_m;
+        it.strike_t = p.time_s;
+    }
+    const double tr = opt.return_time_s;
+    for (size_t k = 0; k + 1 < n; ++k) {
+        const double gap = h.placed[k + 1].strike_t - h.placed[k].strike_t;
+        h.via_rest[k] = gap > opt.idle_return_s && gap > 2.0 * kNominalPeriod_s + 2.0 * tr + 0.2;
+    }
+    return h;
+}
+
+// The unit of each stroke, made at its periods: the downswing's from the
+// hand's previous strike, else nominal (the first stroke, or one after a
+// rest, is a whole stroke); the lift's to its next strike, else from the
+// previous one, else nominal (a lone stroke).
+void choose_units(HandStrokes &h, const std::vector<size_t> &idx, const GesturePlan &plan,
+                  UnitCache &units)
+{
+    std::vector<Item> &placed = h.placed;
+    const size_t n = placed.size();
+    for (size_t k = 0; k < n; ++k) {
+        const bool has_prev = k > 0 && !h.via_rest[k - 1];
+        const bool has_next = k + 1 < n && !h.via_rest[k];
+        const double before =
+            has_prev ? placed[k].strike_t - placed[k - 1].strike_t : kNominalPeriod_s;
+        const double after = has_next ? placed[k + 1].strike_t - placed[k].strike_t
+                                      : (has_prev ? before : kNominalPeriod_s);
+        const PlannedNote &p = plan.notes[idx[k]];
+        placed[k].curve = &units.unit_for(p.grip, p.nuance, p.hand, p.dynamics, before, after);
+    }
+}
+
+// Each unit's warp: its preparation and lift fit the time to the
+// neighbouring strikes; the target aimed below the head by the impact speed.
+void warp_units(HandStrokes &h, const std::vector<size_t> &idx, const PerformerFrame &frame,
+                const PlanOptions &opt, const Eigen::Matrix3d &to_world, GesturePlan &plan)
+{
+    std::vector<Item> &placed = h.placed;
+    const size_t n = placed.size();
+    const double beta = opt.blend_margin;
+    for (size_t k = 0; k < n; ++k) {
+        Item &it = placed[k];
+        // Time before the strike: back to the previous strike (direct
+        // link) or to the plan's start (first note); unlimited after a rest.
+        double before = std::numeric_limits<double>::infinity();
+        if (k == 0)
+            before = it.strike_t;
+        else if (!h.via_rest[k - 1])
+            before = it.strike_t - placed[k - 1].strike_t;
+        double after = std::numeric_limits<double>::infinity();
+        if (k + 1 < n && !h.via_rest[k])
+            after = placed[k + 1].strike_t - it.strike_t;
+        it.prep_t = std::min(it.curve->prep_s, (1.0 - beta) * before);
+        it.lift_t = std::min(it.curve->lift_s, (1.0 - beta) * after);
+        const Eigen::Vector3d impact = to_world * it.curve->impact_velocity();
+        it.origin -= opt.strike_aim_s *
+                     std::max(0.0, -impact.dot(frame.up) - opt.strike_aim_from_mps) * frame.up;
+        plan.notes[idx[k]].tip_target_m = it.origin;
+        it.prepare();
+        plan.notes[idx[k]].impact_velocity_mps = to_world * it.curve->impact_velocity();
+    }
+}
+
+// A hand's timeline: rest, unit, [rest,] unit, ..., rest, and the
+// cross-fade windows between consecutive items.
+struct HandTimeline {
+    std::vector<Item> items;
+    std::vector<Window> windows;
+};
+
+// The timeline of a hand with strokes; returns the end of its last motion.
+double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
+                      const PlanOptions &opt, HandTimeline &line)
+{
+    const std::vector<Item> &placed = h.placed;
+    const size_t n = placed.size();
     const double beta = opt.blend_margin, tr = opt.return_time_s;
-    std::array<std::vector<Item>, 2> items;
-    std::array<std::vector<Window>, 2> windows;
     double last_motion_end = 0.0;
-    for (int s = 0; s < 2; ++s) {
-        const std::vector<size_t> &idx = by_hand[s];
-        Item rest;
-        rest.rest_pos = frame.rest_tip_m[s];
-        if (idx.empty()) {
-            // A hand with nothing to play holds its stick at rest.
-            rest.rest_dir = rest_stick_direction(frame, s);
-            items[s].push_back(rest);
-            continue;
-        }
-        const size_t n = idx.size();
-        std::vector<Item> placed(n);
-        std::vector<bool> via_rest(n, false); // note k -> k+1 through the rest tip
-        for (size_t k = 0; k < n; ++k) {
-            const PlannedNote &p = plan.notes[idx[k]];
-            Item &it = placed[k];
-            it.rest = false;
-            it.to_world = to_world;
-            it.origin = p.tip_target_m;
-            it.strike_t = p.time_s;
-        }
-        // A long gap goes through the rest tip: when it is longer than
-        // idle_return_s and leaves room for a nominal lift, two moves and a
-        // nominal preparation.
-        for (size_t k = 0; k + 1 < n; ++k) {
-            const double gap = placed[k + 1].strike_t - placed[k].strike_t;
-            via_rest[k] = gap > opt.idle_return_s && gap > 2.0 * kNominalPeriod_s + 2.0 * tr + 0.2;
-        }
-        for (size_t k = 0; k < n; ++k) {
-            // The unit's periods: the downswing's from the hand's previous
-            // strike, else nominal (the first stroke, or one after a rest, is
-            // a whole stroke); the lift's to its next strike, else from the
-            // previous one, else nominal (a lone stroke).
-            const bool has_prev = k > 0 && !via_rest[k - 1];
-            const bool has_next = k + 1 < n && !via_rest[k];
-            const double before =
-                has_prev ? placed[k].strike_t - placed[k - 1].strike_t : kNominalPeriod_s;
-            const double after = has_next ? placed[k + 1].strike_t - placed[k].strike_t
-                                          : (has_prev ? before : kNominalPeriod_s);
-            const PlannedNote &p = plan.notes[idx[k]];
-            placed[k].curve = &unit_for(p.grip, p.nuance, p.hand, p.dynamics, before, after);
-        }
-        for (size_t k = 0; k < n; ++k) {
-            Item &it = placed[k];
-            // Time before the strike: back to the previous strike (direct
-            // link) or to the plan's start (first note); unlimited after a rest.
-            double before = std::numeric_limits<double>::infinity();
-            if (k == 0)
-                before = it.strike_t;
-            else if (!via_rest[k - 1])
-                before = it.strike_t - placed[k - 1].strike_t;
-            double after = std::numeric_limits<double>::infinity();
-            if (k + 1 < n && !via_rest[k])
-                after = placed[k + 1].strike_t - it.strike_t;
-            it.prep_t = std::min(it.curve->prep_s, (1.0 - beta) * before);
-            it.lift_t = std::min(it.curve->lift_s, (1.0 - beta) * after);
-            const Eigen::Vector3d impact = to_world * it.curve->impact_velocity();
-            it.origin -= opt.strike_aim_s *
-                         std::max(0.0, -impact.dot(frame.up) - opt.strike_aim_from_mps) * frame.up;
-            plan.notes[idx[k]].tip_target_m = it.origin;
-            it.prepare();
-            plan.notes[idx[k]].impact_velocity_mps = to_world * it.curve->impact_velocity();
-        }
-        // The timeline: rest, unit, [rest,] unit, ..., rest.
-        rest.rest_dir = rest_stick_direction(frame, s);
-        items[s].push_back(rest);
-        const double first_start = placed[0].strike_t - placed[0].prep_t;
-        windows[s].push_back({std::max(0.0, first_start - tr), first_start});
-        for (size_t k = 0; k < n; ++k) {
-            items[s].push_back(placed[k]);
-            const Item &it = placed[k];
-            if (k + 1 == n || via_rest[k]) {
-                Item back;
-                back.rest_pos = frame.rest_tip_m[s];
-                back.rest_dir = rest_stick_direction(frame, s);
-                const double lift_end = it.strike_t + it.lift_t;
-                windows[s].push_back({lift_end, lift_end + tr});
-                last_motion_end = std::max(last_motion_end, lift_end + tr);
-                if (k + 1 < n) {
-                    items[s].push_back(back);
-                    const double next_start = placed[k + 1].strike_t - placed[k + 1].prep_t;
-                    windows[s].push_back({next_start - tr, next_start});
-                } else {
-                    items[s].push_back(back);
-                }
-            } else {
-                const double gap = placed[k + 1].strike_t - it.strike_t;
-                Window w{it.strike_t + beta * gap, placed[k + 1].strike_t - beta * gap};
-                // The move across the head (not the strike aim's depth).
-                const Eigen::Vector3d move = placed[k + 1].origin - it.origin;
-                w.across = move - move.dot(frame.up) * frame.up;
-                w.move_begin = it.strike_t + opt.move_margin_after * gap;
-                w.move_end = placed[k + 1].strike_t - opt.move_margin_before * gap;
-                windows[s].push_back(w);
+    Item rest;
+    rest.rest_pos = frame.rest_tip_m[s];
+    rest.rest_dir = rest_stick_direction(frame, s);
+    line.items.push_back(rest);
+    const double first_start = placed[0].strike_t - placed[0].prep_t;
+    line.windows.push_back({std::max(0.0, first_start - tr), first_start});
+    for (size_t k = 0; k < n; ++k) {
+        line.items.push_back(placed[k]);
+        const Item &it = placed[k];
+        if (k + 1 == n || h.via_rest[k]) {
+            Item back;
+            back.rest_pos = frame.rest_tip_m[s];
+            back.rest_dir = rest_stick_direction(frame, s);
+            const double lift_end = it.strike_t + it.lift_t;
+            line.windows.push_back({lift_end, lift_end + tr});
+            last_motion_end = std::max(last_motion_end, lift_end + tr);
+            line.items.push_back(back);
+            if (k + 1 < n) {
+                const double next_start = placed[k + 1].strike_t - placed[k + 1].prep_t;
+                line.windows.push_back({next_start - tr, next_start});
             }
+        } else {
+            const double gap = placed[k + 1].strike_t - it.strike_t;
+            Window w{it.strike_t + beta * gap, placed[k + 1].strike_t - beta * gap};
+            // The move across the head (not the strike aim's depth).
+            const Eigen::Vector3d move = placed[k + 1].origin - it.origin;
+            w.across = move - move.dot(frame.up) * frame.up;
+            w.move_begin = it.strike_t + opt.move_margin_after * gap;
+            w.move_end = placed[k + 1].strike_t - opt.move_margin_before * gap;
+            line.windows.push_back(w);
         }
     }
+    return last_motion_end;
+}
 
-    plan.duration_s =
+// The plan's length: the score's and the tail, or the last motion's end; a
+// ScoreError beyond the planner's limit.
+double plan_duration(const Score &score, const PlanOptions &opt, double last_motion_end)
+{
+    const double duration_s =
         std::max(opt.lead_in_s + score.duration_s() + opt.tail_s, last_motion_end + 0.1);
-    if (plan.duration_s > opt.max_duration_s) {
+    if (duration_s > opt.max_duration_s) {
         const int line = score.notes.empty() ? 0 : score.notes.back().line;
         const int column = score.notes.empty() ? 0 : score.notes.back().column;
         std::ostringstream m;
-        m << "the performance lasts " << plan.duration_s << " s, longer than the planner's limit ("
+        m << "the performance lasts " << duration_s << " s, longer than the planner's limit ("
           << opt.max_duration_s << " s)";
         throw ScoreError(score.source, line, column, m.str());
     }
+    return duration_s;
+}
 
-    // Sample times: the grid plus each strike exactly.
+// Sample times: the grid plus each strike exactly.
+void sample_times(const PlanOptions &opt, GesturePlan &plan)
+{
     std::vector<double> strikes;
     for (const PlannedNote &p : plan.notes)
         strikes.push_back(p.time_s);
@@ -513,47 +561,89 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
         if (times.empty() || t > times.back() + 1e-6)
             times.push_back(t);
     }
+}
 
-    for (int s = 0; s < 2; ++s) {
-        auto &tip = plan.tips.tip_m[s];
-        auto &dir = plan.stick_dir[s];
-        tip.resize(times.size());
-        dir.resize(times.size());
-        const std::vector<Item> &its = items[s];
-        const std::vector<Window> &win = windows[s];
-        size_t j = 0, m = 0;
-        for (size_t i = 0; i < times.size(); ++i) {
-            const double t = times[i];
-            while (j < win.size() && t > win[j].end)
-                ++j;
-            while (m < win.size() && t > win[m].move_end)
-                ++m;
-            Eigen::Vector3d p0, d0;
-            its[j].eval(t, p0, d0);
-            if (j < win.size() && t >= win[j].begin && win[j].end > win[j].begin) {
-                Eigen::Vector3d p1, d1;
-                its[j + 1].eval(t, p1, d1);
-                const double w = smoothstep5((t - win[j].begin) / (win[j].end - win[j].begin));
-                p0 = (1.0 - w) * p0 + w * p1;
-                const Eigen::Vector3d blended = (1.0 - w) * d0 + w * d1;
-                d0 = blended.norm() > 1e-9 ? blended.normalized() : (w < 0.5 ? d0 : d1);
-            }
-            // The move across the head: the units' blend makes it over
-            // [begin, end]; it is made over [move_begin, move_end] instead
-            // (smoothstep5 at both: C1 with the units).
-            if (m < win.size() && t >= win[m].move_begin && win[m].move_end > win[m].move_begin) {
-                const Window &mv = win[m];
-                const double made = t < mv.begin ? 0.0
-                                    : t > mv.end
-                                        ? 1.0
-                                        : smoothstep5((t - mv.begin) / (mv.end - mv.begin));
-                const double x = (t - mv.move_begin) / (mv.move_end - mv.move_begin);
-                p0 += (smoothstep5(x) - made) * mv.across;
-            }
-            tip[i] = p0;
-            dir[i] = d0;
+// A hand's tip and stick direction at every sample time: the ruling item,
+// cross-faded with the next one inside a window, and the move across the head.
+void sample_hand(const std::vector<double> &times, const HandTimeline &line,
+                 std::vector<Eigen::Vector3d> &tip, std::vector<Eigen::Vector3d> &dir)
+{
+    tip.resize(times.size());
+    dir.resize(times.size());
+    const std::vector<Item> &its = line.items;
+    const std::vector<Window> &win = line.windows;
+    size_t j = 0, m = 0;
+    for (size_t i = 0; i < times.size(); ++i) {
+        const double t = times[i];
+        while (j < win.size() && t > win[j].end)
+            ++j;
+        while (m < win.size() && t > win[m].move_end)
+            ++m;
+        Eigen::Vector3d p0, d0;
+        its[j].eval(t, p0, d0);
+        if (j < win.size() && t >= win[j].begin && win[j].end > win[j].begin) {
+            Eigen::Vector3d p1, d1;
+            its[j + 1].eval(t, p1, d1);
+            const double w = smoothstep5((t - win[j].begin) / (win[j].end - win[j].begin));
+            p0 = (1.0 - w) * p0 + w * p1;
+            const Eigen::Vector3d blended = (1.0 - w) * d0 + w * d1;
+            d0 = blended.norm() > 1e-9 ? blended.normalized() : (w < 0.5 ? d0 : d1);
         }
+        // The move across the head: the units' blend makes it over
+        // [begin, end]; it is made over [move_begin, move_end] instead
+        // (smoothstep5 at both: C1 with the units).
+        if (m < win.size() && t >= win[m].move_begin && win[m].move_end > win[m].move_begin) {
+            const Window &mv = win[m];
+            const double made = t < mv.begin ? 0.0
+                                : t > mv.end ? 1.0
+                                             : smoothstep5((t - mv.begin) / (mv.end - mv.begin));
+            const double x = (t - mv.move_begin) / (mv.move_end - mv.move_begin);
+            p0 += (smoothstep5(x) - made) * mv.across;
+        }
+        tip[i] = p0;
+        dir[i] = d0;
     }
+}
+
+} // namespace
+
+GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
+                             const PerformerFrame &frame, const PlanOptions &opt)
+{
+    validate(frame, opt);
+    Eigen::Matrix3d to_world;
+    to_world.col(0) = frame.right;
+    to_world.col(1) = frame.up;
+    to_world.col(2) = frame.forward;
+
+    GesturePlan plan;
+    plan.score_start_s = opt.lead_in_s;
+    UnitCache units(db); // the timelines' items point into it
+    const HandNotes by_hand = time_notes(score, frame, opt, plan);
+
+    std::array<HandTimeline, 2> timelines;
+    double last_motion_end = 0.0;
+    for (int s = 0; s < 2; ++s) {
+        const std::vector<size_t> &idx = by_hand[s];
+        if (idx.empty()) {
+            // A hand with nothing to play holds its stick at rest.
+            Item rest;
+            rest.rest_pos = frame.rest_tip_m[s];
+            rest.rest_dir = rest_stick_direction(frame, s);
+            timelines[s].items.push_back(rest);
+            continue;
+        }
+        HandStrokes strokes = place_strokes(idx, plan, opt, to_world);
+        choose_units(strokes, idx, plan, units);
+        warp_units(strokes, idx, frame, opt, to_world, plan);
+        last_motion_end =
+            std::max(last_motion_end, build_timeline(strokes, frame, s, opt, timelines[s]));
+    }
+
+    plan.duration_s = plan_duration(score, opt, last_motion_end);
+    sample_times(opt, plan);
+    for (int s = 0; s < 2; ++s)
+        sample_hand(plan.tips.time_s, timelines[s], plan.tips.tip_m[s], plan.stick_dir[s]);
     std::stable_sort(
         plan.notes.begin(), plan.notes.end(),
         [](const PlannedNote &a, const PlannedNote &b) { return a.time_s < b.time_s; });

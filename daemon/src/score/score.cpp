@@ -404,6 +404,19 @@ class LineParser
         return tk[i];
     }
 
+    // A statement of one value, `KEY VALUE`, of kind `kind`: the value as
+    // `parse` reads it (`needed` when it is missing), then nothing after it
+    // (`what` names it).
+    template <typename Parse>
+    auto one_value(const std::vector<Token> &tk, Statement &st, Kind kind, const char *needed,
+                   const char *what, const Parse &parse) const
+    {
+        st.kind = kind;
+        const auto value = parse(need(tk, 1, needed));
+        no_more(tk, 2, what);
+        return value;
+    }
+
     Statement statement(const std::vector<Token> &tk) const
     {
         Statement st;
@@ -468,24 +481,21 @@ class LineParser
                 st.beats = duration(tk[i++], "rest");
             no_more(tk, i, "the rest");
         } else if (key == "beats") {
-            st.kind = Kind::default_beats;
-            st.beats = duration(need(tk, 1, "'beats' needs a duration, e.g. 'beats 1/2'"), "beats");
-            no_more(tk, 2, "the duration");
+            st.beats =
+                one_value(tk, st, Kind::default_beats, "'beats' needs a duration, e.g. 'beats 1/2'",
+                          "the duration", [&](const Token &t) { return duration(t, "beats"); });
         } else if (key == "dynamics") {
-            st.kind = Kind::default_dynamics;
-            st.dynamics = dynamics_value(need(tk, 1, "'dynamics' needs a value 0..1 or pp..ff"));
-            no_more(tk, 2, "the dynamics");
+            st.dynamics =
+                one_value(tk, st, Kind::default_dynamics, "'dynamics' needs a value 0..1 or pp..ff",
+                          "the dynamics", [&](const Token &t) { return dynamics_value(t); });
         } else if (key == "nuance") {
-            st.kind = Kind::default_nuance;
-            const Token &t = need(tk, 1, "'nuance' needs a nuance, e.g. 'nuance accent'");
-            st.nuance = nuance_word(t.lower);
-            if (!st.nuance)
-                fail(t.column, "unknown nuance '" + t.text + "' (valid: " + nuance_list() + ")");
-            no_more(tk, 2, "the nuance");
+            st.nuance = one_value(tk, st, Kind::default_nuance,
+                                  "'nuance' needs a nuance, e.g. 'nuance accent'", "the nuance",
+                                  [&](const Token &t) { return nuance_value(t); });
         } else if (key == "firmness") {
-            st.kind = Kind::default_firmness;
-            st.firmness = firmness_value(need(tk, 1, "'firmness' needs a value 0..1"));
-            no_more(tk, 2, "the firmness");
+            st.firmness =
+                one_value(tk, st, Kind::default_firmness, "'firmness' needs a value 0..1",
+                          "the firmness", [&](const Token &t) { return firmness_value(t); });
         } else if (key == "repeat") {
             st.kind = Kind::repeat;
             const Token &n = need(tk, 1, "repeat needs a count, e.g. 'repeat 4'");
@@ -504,6 +514,14 @@ class LineParser
                      "beats, dynamics, firmness, nuance, repeat, end)");
         }
         return st;
+    }
+
+    Nuance nuance_value(const Token &t) const
+    {
+        const std::optional<Nuance> nuance = nuance_word(t.lower);
+        if (!nuance)
+            fail(t.column, "unknown nuance '" + t.text + "' (valid: " + nuance_list() + ")");
+        return *nuance;
     }
 
     double firmness_value(const Token &t) const
@@ -736,16 +754,14 @@ Score ScoreBuilder::finish() const
             grip = st.grip;
             break;
         case Kind::default_beats:
-            default_beats = *st.beats;
-            break;
         case Kind::default_dynamics:
-            default_dynamics = *st.dynamics;
-            break;
         case Kind::default_firmness:
-            default_firmness = *st.firmness;
-            break;
         case Kind::default_nuance:
-            default_nuance = *st.nuance;
+            // A default statement carries its one value; the others stay.
+            default_beats = st.beats.value_or(default_beats);
+            default_dynamics = st.dynamics.value_or(default_dynamics);
+            default_firmness = st.firmness.value_or(default_firmness);
+            default_nuance = st.nuance.value_or(default_nuance);
             break;
         case Kind::repeat:
             loops.push_back({pc + 1, st.count - 1});

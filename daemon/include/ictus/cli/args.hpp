@@ -8,6 +8,7 @@
 
 #include <csignal>
 #include <functional>
+#include <iosfwd>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -47,6 +48,48 @@ class Args
     std::vector<std::string> items_;
     size_t at_ = 0;
 };
+
+// What a verb does with one of its options: `option` is its name, its value
+// (when it has one) is the next item of `args`.
+using OptionHandler = std::function<void(const std::string &option, Args &args)>;
+
+// A verb's options as a table of {name, handler}, in the manner of liblo's
+// lo_server_add_method registry.
+struct Option {
+    const char *name;
+    OptionHandler handle;
+};
+using OptionTable = std::vector<Option>;
+
+// Runs the handler of `option` from `table`; false when the table has none.
+bool dispatch_option(const OptionTable &table, const std::string &option, Args &args);
+
+// Handlers that store an option's value in `target` (which must outlive
+// the table): as it is, or read by one of the parsers above, e.g.
+// store(k, parse_positive), store(channel, parse_int, 1, 16).
+OptionHandler store_text(std::string &target);
+template <typename T>
+OptionHandler store(T &target, T (*parse)(const std::string &, const std::string &))
+{
+    return [&target, parse](const std::string &option, Args &args) {
+        target = parse(option, args.value(option));
+    };
+}
+template <typename T>
+OptionHandler store(T &target, T (*parse)(const std::string &, const std::string &, T, T), T lo,
+                    T hi)
+{
+    return [&target, parse, lo, hi](const std::string &option, Args &args) {
+        target = parse(option, args.value(option), lo, hi);
+    };
+}
+// A flag: no value; sets `target` to true.
+OptionHandler store_flag(bool &target);
+
+// Walks a verb's command line: --help or -h prints `usage` and returns false
+// at once (the verb exits 0); every other item goes to `handle`.
+bool walk_args(Args &args, void (*usage)(std::ostream &),
+               const std::function<void(const std::string &item)> &handle);
 
 // Set by SIGINT (and SIGTERM once install_interrupt_handler(true) ran); the
 // loops of track, run and render check it every step.
