@@ -261,7 +261,9 @@ TrackArgs parse_track_args(Args &args)
     // usage errors too: check them before reading the file.
     try {
         validate(t.options);
-    } catch (const CharacterError &e) {
+    } catch (const PerformError &e) {
+        throw UsageError(e.what());
+    } catch (const CharacterError &e) { // the scene's options
         throw UsageError(e.what());
     }
     // A .csv capture is stick-only (Cartesian mode): the default body holds a
