@@ -260,8 +260,10 @@ void check_mass(const std::string &body, double mass_kg, const Eigen::Vector3d &
 
 } // namespace
 
-CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
-                                             const CharacterOptions &options)
+namespace
+{
+
+void check_options(const CharacterOptions &options)
 {
     const StickParams &s = options.stick;
     if (!finite_positive(options.body_mass_kg) || options.body_mass_kg > 500.0)
@@ -282,26 +284,19 @@ CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
     if (!std::isfinite(s.grip_angle_rad) || std::fabs(s.grip_angle_rad) > 1.5708)
         throw CharacterError("stick grip angle: expected |rad| <= pi/2, got " +
                              fmt(s.grip_angle_rad));
+}
 
-    CharacterModel model;
-    model.options_ = options;
-    model.bodies_.resize(kBodies);
-    std::vector<int> source(kBodies), distal(kBodies);
-    for (int b = 0; b < kBodies; ++b) {
-        source[b] = find_joint(skeleton, kMap[b].source);
-        distal[b] = find_joint(skeleton, kMap[b].distal);
-    }
-    check_segment_lengths(skeleton, source, distal);
-
-    // Inertia lengths: limbs use their mocap lengths; segments whose mocap
-    // length does not span the anatomical segment (trunk, head, hand, foot)
-    // use de Leva's mean length scaled by the subject's limb proportions.
+// Inertia lengths: limbs use their mocap lengths; segments whose mocap
+// length does not span the anatomical segment (trunk, head, hand, foot)
+// use de Leva's mean length scaled by the subject's limb proportions: this ratio.
+double limb_size_ratio(const Skeleton &skeleton, const std::vector<int> &source,
+                       const std::vector<int> &distal)
+{
     double ratio_sum = 0.0;
     int ratio_n = 0;
-    for (int b = 0; b < kBodies; ++b) {
+    for (int b = 0; b < CharacterModel::kBodies; ++b) {
         const DeLevaSegment seg = kMap[b].segment;
-        if (seg == DeLevaSegment::upper_arm || seg == DeLevaSegment::forearm ||
-            seg == DeLevaSegment::thigh || seg == DeLevaSegment::shank) {
+        if (is_limb(seg)) {
             const double l =
                 rest_offset(skeleton, path_between(skeleton, source[b], distal[b])).norm();
             ratio_sum += l / de_leva_male(seg).length_m;
@@ -311,97 +306,129 @@ CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
     const double size_ratio = ratio_n > 0 ? ratio_sum / ratio_n : 1.0;
     if (!finite_positive(size_ratio))
         throw CharacterError("skeleton: limb lengths are zero (check --scale)");
+    return size_ratio;
+}
 
-    for (int b = 0; b < kBodies; ++b) {
-        const MapRow &row = kMap[b];
-        BodySpec &body = model.bodies_[b];
-        body.name = row.body;
-        body.joint_name = row.joint;
-        body.source = row.source;
-        body.parent = row.parent;
-        if (b > 0) {
-            body.source_path = path_between(skeleton, source[row.parent], source[b]);
-            body.offset_m = rest_offset(skeleton, body.source_path);
-        } else {
-            body.source_path = {source[0]};
-        }
-        body.distal_m = rest_offset(skeleton, path_between(skeleton, source[b], distal[b]));
-        body.length_m = body.distal_m.norm();
-
-        const SegmentParameters &table = de_leva_male(row.segment);
-        const bool limb =
-            row.segment == DeLevaSegment::upper_arm || row.segment == DeLevaSegment::forearm ||
-            row.segment == DeLevaSegment::thigh || row.segment == DeLevaSegment::shank;
-        const double inertia_length = limb ? body.length_m : table.length_m * size_ratio;
-        double fraction = table.mass_fraction;
-        if (row.mass_fraction > 0.0)
-            fraction = row.mass_fraction;
-        body.mass_kg = fraction * options.body_mass_kg;
-        switch (row.rule) {
-        case MassRule::table:
-            body.com_m = table.com_fraction * body.distal_m;
-            break;
-        case MassRule::table_reversed:
-            body.com_m = (1.0 - table.com_fraction) * body.distal_m;
-            break;
-        case MassRule::share:
-            body.com_m = 0.5 * body.distal_m;
-            break;
-        }
-        // Shares carved out of a table segment keep that segment's radii of
-        // gyration relative to their own (mocap) length.
-        const double len =
-            row.rule == MassRule::share ? std::max(body.length_m, 0.02) : inertia_length;
-        body.inertia_kg_m2 = segment_inertia(body.mass_kg, len, body.distal_m, table);
+// Body b of kMap: its place in the skeleton, its mass, centre of mass and inertia.
+void build_body(const Skeleton &skeleton, const std::vector<int> &source,
+                const std::vector<int> &distal, int b, double size_ratio, double body_mass_kg,
+                BodySpec &body)
+{
+    const MapRow &row = kMap[b];
+    body.name = row.body;
+    body.joint_name = row.joint;
+    body.source = row.source;
+    body.parent = row.parent;
+    if (b > 0) {
+        body.source_path = path_between(skeleton, source[row.parent], source[b]);
+        body.offset_m = rest_offset(skeleton, body.source_path);
+    } else {
+        body.source_path = {source[0]};
     }
+    body.distal_m = rest_offset(skeleton, path_between(skeleton, source[b], distal[b]));
+    body.length_m = body.distal_m.norm();
 
-    // Sticks. Hand frame at rest: fingers along distal_m, thumb towards the
-    // thumb's end site, palm normal facing down (the CMU T-pose).
+    const SegmentParameters &table = de_leva_male(row.segment);
+    const double inertia_length =
+        is_limb(row.segment) ? body.length_m : table.length_m * size_ratio;
+    double fraction = table.mass_fraction;
+    if (row.mass_fraction > 0.0)
+        fraction = row.mass_fraction;
+    body.mass_kg = fraction * body_mass_kg;
+    switch (row.rule) {
+    case MassRule::table:
+        body.com_m = table.com_fraction * body.distal_m;
+        break;
+    case MassRule::table_reversed:
+        body.com_m = (1.0 - table.com_fraction) * body.distal_m;
+        break;
+    case MassRule::share:
+        body.com_m = 0.5 * body.distal_m;
+        break;
+    }
+    // Shares carved out of a table segment keep that segment's radii of
+    // gyration relative to their own (mocap) length.
+    const double len = row.rule == MassRule::share ? std::max(body.length_m, 0.02) : inertia_length;
+    body.inertia_kg_m2 = segment_inertia(body.mass_kg, len, body.distal_m, table);
+}
+
+// The direction of the hand's thumb at rest, across the fingers `f`: towards the
+// thumb's end site when the skeleton has one, else what is left of +z.
+Eigen::Vector3d thumb_direction(const Skeleton &skeleton, int side, int hand_joint,
+                                const Eigen::Vector3d &f)
+{
+    Eigen::Vector3d t = Eigen::Vector3d::UnitZ();
+    const int thumb = skeleton.find(side == 0 ? "LThumb" : "RThumb");
+    if (thumb >= 0) {
+        try {
+            const int thumb_end =
+                find_joint(skeleton, std::string(side == 0 ? "LThumb" : "RThumb") + "/end");
+            const Eigen::Vector3d d =
+                rest_offset(skeleton, path_between(skeleton, hand_joint, thumb_end));
+            if (d.norm() > 1e-9)
+                t = d;
+        } catch (const CharacterError &) {
+        }
+    }
+    t = (t - t.dot(f) * f);
+    if (t.norm() < 1e-6)
+        t = Eigen::Vector3d::UnitZ() - f.z() * f;
+    t.normalize();
+    return t;
+}
+
+// A stick in `hand`. Hand frame at rest: fingers along distal_m, thumb towards the
+// thumb's end site, palm normal facing down (the CMU T-pose).
+void build_stick(const Skeleton &skeleton, const CharacterOptions &options, int side,
+                 int hand_joint, const BodySpec &hand, StickInHand &st)
+{
+    const StickParams &s = options.stick;
+    const Eigen::Vector3d f =
+        hand.distal_m.norm() > 1e-9 ? hand.distal_m.normalized() : Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d t = thumb_direction(skeleton, side, hand_joint, f);
+    Eigen::Vector3d n = f.cross(t);
+    if (n.y() > 0.0)
+        n = -n;
+    const double a = s.grip_angle_rad;
+    st.axis = (std::cos(a) * f + std::sin(a) * (options.grip == Grip::german ? t : n)).normalized();
+    // The fulcrum sits in the fist: at the hand's CoM along the fingers,
+    // 2.5 cm towards the palm.
+    st.grip_m = de_leva_male(DeLevaSegment::hand).com_fraction * hand.distal_m + 0.025 * n;
+    // The stroke plane holds the stick and the hand's direction that is
+    // vertical in the grip (German: the palm normal; French: the thumb);
+    // the fulcrum turns about its normal.
+    st.fulcrum_axis = st.axis.cross(options.grip == Grip::german ? n : t).normalized();
+    st.butt_m = st.grip_m - s.grip_from_butt_m * st.axis;
+    st.tip_m = st.grip_m + (s.length_m - s.grip_from_butt_m) * st.axis;
+    st.com_m = 0.5 * (st.butt_m + st.tip_m);
+    const Eigen::Matrix3d aa = st.axis * st.axis.transpose();
+    st.inertia_kg_m2 =
+        s.mass_kg * s.length_m * s.length_m / 12.0 * (Eigen::Matrix3d::Identity() - aa) +
+        0.5 * s.mass_kg * s.shaft_radius_m * s.shaft_radius_m * aa;
+}
+
+} // namespace
+
+CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
+                                             const CharacterOptions &options)
+{
+    check_options(options);
+    CharacterModel model;
+    model.options_ = options;
+    model.bodies_.resize(kBodies);
+    std::vector<int> source(kBodies), distal(kBodies);
+    for (int b = 0; b < kBodies; ++b) {
+        source[b] = find_joint(skeleton, kMap[b].source);
+        distal[b] = find_joint(skeleton, kMap[b].distal);
+    }
+    check_segment_lengths(skeleton, source, distal);
+    const double size_ratio = limb_size_ratio(skeleton, source, distal);
+    for (int b = 0; b < kBodies; ++b)
+        build_body(skeleton, source, distal, b, size_ratio, options.body_mass_kg, model.bodies_[b]);
     for (int side = 0; side < 2; ++side) {
         const int hb = side == 0 ? 9 : 13;
         model.hand_body_[side] = hb;
-        const BodySpec &hand = model.bodies_[hb];
-        const Eigen::Vector3d f =
-            hand.distal_m.norm() > 1e-9 ? hand.distal_m.normalized() : Eigen::Vector3d::UnitX();
-        Eigen::Vector3d t = Eigen::Vector3d::UnitZ();
-        const int thumb = skeleton.find(side == 0 ? "LThumb" : "RThumb");
-        if (thumb >= 0) {
-            const int hand_joint = source[hb];
-            try {
-                const int thumb_end =
-                    find_joint(skeleton, std::string(side == 0 ? "LThumb" : "RThumb") + "/end");
-                const Eigen::Vector3d d =
-                    rest_offset(skeleton, path_between(skeleton, hand_joint, thumb_end));
-                if (d.norm() > 1e-9)
-                    t = d;
-            } catch (const CharacterError &) {
-            }
-        }
-        t = (t - t.dot(f) * f);
-        if (t.norm() < 1e-6)
-            t = Eigen::Vector3d::UnitZ() - f.z() * f;
-        t.normalize();
-        Eigen::Vector3d n = f.cross(t);
-        if (n.y() > 0.0)
-            n = -n;
-        const double a = s.grip_angle_rad;
-        StickInHand &st = model.stick_[side];
-        st.axis =
-            (std::cos(a) * f + std::sin(a) * (options.grip == Grip::german ? t : n)).normalized();
-        // The fulcrum sits in the fist: at the hand's CoM along the fingers,
-        // 2.5 cm towards the palm.
-        st.grip_m = de_leva_male(DeLevaSegment::hand).com_fraction * hand.distal_m + 0.025 * n;
-        // The stroke plane holds the stick and the hand's direction that is
-        // vertical in the grip (German: the palm normal; French: the thumb);
-        // the fulcrum turns about its normal.
-        st.fulcrum_axis = st.axis.cross(options.grip == Grip::german ? n : t).normalized();
-        st.butt_m = st.grip_m - s.grip_from_butt_m * st.axis;
-        st.tip_m = st.grip_m + (s.length_m - s.grip_from_butt_m) * st.axis;
-        st.com_m = 0.5 * (st.butt_m + st.tip_m);
-        const Eigen::Matrix3d aa = st.axis * st.axis.transpose();
-        st.inertia_kg_m2 =
-            s.mass_kg * s.length_m * s.length_m / 12.0 * (Eigen::Matrix3d::Identity() - aa) +
-            0.5 * s.mass_kg * s.shaft_radius_m * s.shaft_radius_m * aa;
+        build_stick(skeleton, options, side, source[hb], model.bodies_[hb], model.stick_[side]);
     }
     for (int b = 0; b < kBodies; ++b) {
         double mass_kg;

@@ -74,7 +74,7 @@ TrackMode parse_track_mode(const std::string &option, const std::string &text)
 {
     try {
         return track_mode_from_string(text);
-    } catch (const CharacterError &e) {
+    } catch (const PerformError &e) {
         throw UsageError(option + after_name(e.what()));
     }
 }

@@ -270,7 +270,9 @@ void check_track_args(TrackArgs &t)
     // usage errors too: check them before reading the file.
     try {
         validate(t.options);
-    } catch (const CharacterError &e) {
+    } catch (const PerformError &e) {
+        throw UsageError(e.what());
+    } catch (const CharacterError &e) { // the scene's options
         throw UsageError(e.what());
     }
     // A .csv capture is stick-only (Cartesian mode): the default body holds a

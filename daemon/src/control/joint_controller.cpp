@@ -36,7 +36,7 @@ double default_torque_limit_nm(const std::string &joint_name, double body_mass_k
     for (const TorqueRow &row : kTorque)
         if (base == row.suffix)
             return row.nm * body_mass_kg / 70.0;
-    throw CharacterError("torque limit: unknown joint '" + joint_name + "'");
+    throw ControlError("torque limit: unknown joint '" + joint_name + "'");
 }
 
 std::vector<JointGains> default_gains(const CharacterModel &model, const CharacterPose &pose,
@@ -45,7 +45,7 @@ std::vector<JointGains> default_gains(const CharacterModel &model, const Charact
     auto bad = [](const char *what, double v) {
         std::ostringstream s;
         s << what << ": expected a finite value > 0, got " << v;
-        return CharacterError(s.str());
+        return ControlError(s.str());
     };
     if (!(std::isfinite(options.natural_frequency_hz) && options.natural_frequency_hz > 0.0))
         throw bad("gain natural frequency (Hz)", options.natural_frequency_hz);
@@ -70,15 +70,15 @@ void apply_gain_overrides(const CharacterModel &model, const nlohmann::json &ove
                           const std::string &source, std::vector<JointGains> &gains)
 {
     if (!overrides.is_object())
-        throw CharacterError(source + ": expected a JSON object {joint: {field: value}}");
+        throw ControlError(source + ": expected a JSON object {joint: {field: value}}");
     if (gains.size() != static_cast<size_t>(CharacterModel::kJoints))
-        throw CharacterError(source + ": gains must cover the 19 joints");
+        throw ControlError(source + ": gains must cover the 19 joints");
     for (auto it = overrides.begin(); it != overrides.end(); ++it) {
         const int j = model.joint_index(it.key());
         if (j < 0)
-            throw CharacterError(source + ": unknown joint '" + it.key() + "'");
+            throw ControlError(source + ": unknown joint '" + it.key() + "'");
         if (!it.value().is_object())
-            throw CharacterError(source + ": joint '" + it.key() + "': expected an object");
+            throw ControlError(source + ": joint '" + it.key() + "': expected an object");
         for (auto f = it.value().begin(); f != it.value().end(); ++f) {
             double *field = nullptr;
             if (f.key() == "kp_nm_per_rad")
@@ -88,13 +88,12 @@ void apply_gain_overrides(const CharacterModel &model, const nlohmann::json &ove
             else if (f.key() == "torque_limit_nm")
                 field = &gains[j].torque_limit_nm;
             else
-                throw CharacterError(source + ": joint '" + it.key() + "': unknown field '" +
-                                     f.key() +
-                                     "' (kp_nm_per_rad, kd_nm_s_per_rad, torque_limit_nm)");
+                throw ControlError(source + ": joint '" + it.key() + "': unknown field '" +
+                                   f.key() + "' (kp_nm_per_rad, kd_nm_s_per_rad, torque_limit_nm)");
             if (!f.value().is_number() || !std::isfinite(f.value().get<double>()) ||
                 f.value().get<double>() <= 0.0)
-                throw CharacterError(source + ": joint '" + it.key() + "': " + f.key() +
-                                     " must be a finite number > 0, got " + f.value().dump());
+                throw ControlError(source + ": joint '" + it.key() + "': " + f.key() +
+                                   " must be a finite number > 0, got " + f.value().dump());
             *field = f.value().get<double>();
         }
     }

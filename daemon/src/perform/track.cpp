@@ -122,56 +122,73 @@ void validate(const TrackOptions &o)
 {
     validate(o.scene);
     if (!(std::isfinite(o.duration_s) && o.duration_s >= 0.0 && o.duration_s <= 86400.0))
-        throw CharacterError("duration: expected 0 <= s <= 86400, got " +
-                             std::to_string(o.duration_s));
+        throw PerformError("duration: expected 0 <= s <= 86400, got " +
+                           std::to_string(o.duration_s));
     if (!(std::isfinite(o.ramp_s) && o.ramp_s >= 0.0))
-        throw CharacterError("ramp: expected a finite value >= 0 s");
+        throw PerformError("ramp: expected a finite value >= 0 s");
     if (!(std::isfinite(o.sample_rate_hz) && o.sample_rate_hz >= 0.0))
-        throw CharacterError("sample rate: expected a finite value >= 0 Hz");
+        throw PerformError("sample rate: expected a finite value >= 0 Hz");
     const CartesianOptions &c = o.cartesian;
     if (!(std::isfinite(c.gain) && c.gain > 0.0 && c.gain <= 100.0))
-        throw CharacterError("ik gain: expected 0 < gain <= 100, got " + std::to_string(c.gain));
+        throw PerformError("ik gain: expected 0 < gain <= 100, got " + std::to_string(c.gain));
     if (!std::isfinite(c.velocity_gain_s) || c.velocity_gain_s > 1.0)
-        throw CharacterError("ik velocity gain: expected a value <= 1 s (< 0: automatic)");
+        throw PerformError("ik velocity gain: expected a value <= 1 s (< 0: automatic)");
     if (!(std::isfinite(c.acceleration_feedforward_s2) && c.acceleration_feedforward_s2 >= 0.0 &&
           c.acceleration_feedforward_s2 <= 1.0))
-        throw CharacterError("ik acceleration feedforward: expected 0 <= s^2 <= 1");
+        throw PerformError("ik acceleration feedforward: expected 0 <= s^2 <= 1");
     if (!(std::isfinite(c.correction_limit_m) && c.correction_limit_m >= 0.0))
-        throw CharacterError("ik correction limit: expected a finite value >= 0 m");
+        throw PerformError("ik correction limit: expected a finite value >= 0 m");
     if (!(std::isfinite(c.integral_per_s) && c.integral_per_s >= 0.0))
-        throw CharacterError("ik integral: expected a finite value >= 0 /s");
+        throw PerformError("ik integral: expected a finite value >= 0 /s");
     if (!(std::isfinite(c.integral_limit_m) && c.integral_limit_m >= 0.0))
-        throw CharacterError("ik integral limit: expected a finite value >= 0 m");
+        throw PerformError("ik integral limit: expected a finite value >= 0 m");
     if (!(std::isfinite(c.posture_weight) && c.posture_weight >= 0.0 && c.posture_weight <= 1.0))
-        throw CharacterError("ik posture weight: expected 0 <= w <= 1, got " +
-                             std::to_string(c.posture_weight));
+        throw PerformError("ik posture weight: expected 0 <= w <= 1, got " +
+                           std::to_string(c.posture_weight));
     ChainIkSolverPos_dls probe(4);
     if (!probe.set_params(c.ik))
-        throw CharacterError("ik parameters: expected finite positive values");
+        throw PerformError("ik parameters: expected finite positive values");
 }
+
+namespace
+{
+// {"left": v[0], "right": v[1]}.
+template <typename T> nlohmann::json sides(const T (&v)[2])
+{
+    return {{"left", v[0]}, {"right", v[1]}};
+}
+} // namespace
 
 nlohmann::json TrackSummary::to_json() const
 {
-    nlohmann::json j;
-    j["mode"] = mode;
-    j["frames"] = frames;
-    j["samples"] = samples;
-    j["steps"] = steps;
-    j["duration_s"] = duration_s;
-    j["wall_time_s"] = wall_time_s;
-    j["realtime_factor"] = realtime_factor;
-    j["us_per_step"] = steps > 0 ? 1e6 * wall_time_s / steps : 0.0;
-    j["tip_rms_mm"] = {{"left", tip_rms_mm[0]}, {"right", tip_rms_mm[1]}};
-    j["tip_rms_raw_mm"] = {{"left", tip_rms_raw_mm[0]}, {"right", tip_rms_raw_mm[1]}};
-    j["joint_rms_raw_deg_all"] = joint_rms_raw_deg_all;
-    j["tip_max_mm"] = {{"left", tip_max_mm[0]}, {"right", tip_max_mm[1]}};
-    j["tip_rms_free_mm"] = {{"left", tip_rms_free_mm[0]}, {"right", tip_rms_free_mm[1]}};
-    j["tip_rms_contact_mm"] = {{"left", tip_rms_contact_mm[0]}, {"right", tip_rms_contact_mm[1]}};
-    j["tip_rms_raw_free_mm"] = {{"left", tip_rms_raw_free_mm[0]},
-                                {"right", tip_rms_raw_free_mm[1]}};
-    j["tip_rms_raw_contact_mm"] = {{"left", tip_rms_raw_contact_mm[0]},
-                                   {"right", tip_rms_raw_contact_mm[1]}};
-    j["captured_impacts"] = {{"left", captured_impacts[0]}, {"right", captured_impacts[1]}};
+    nlohmann::json j = {
+        {"mode", mode},
+        {"frames", frames},
+        {"samples", samples},
+        {"steps", steps},
+        {"duration_s", duration_s},
+        {"wall_time_s", wall_time_s},
+        {"realtime_factor", realtime_factor},
+        {"us_per_step", steps > 0 ? 1e6 * wall_time_s / steps : 0.0},
+        {"tip_rms_mm", sides(tip_rms_mm)},
+        {"tip_rms_raw_mm", sides(tip_rms_raw_mm)},
+        {"joint_rms_raw_deg_all", joint_rms_raw_deg_all},
+        {"tip_max_mm", sides(tip_max_mm)},
+        {"tip_rms_free_mm", sides(tip_rms_free_mm)},
+        {"tip_rms_contact_mm", sides(tip_rms_contact_mm)},
+        {"tip_rms_raw_free_mm", sides(tip_rms_raw_free_mm)},
+        {"tip_rms_raw_contact_mm", sides(tip_rms_raw_contact_mm)},
+        {"captured_impacts", sides(captured_impacts)},
+        {"diverged", diverged},
+        {"interrupted", interrupted},
+        {"divergences", divergences},
+        {"max_linear_speed_mps", max_linear_speed_mps},
+        {"max_angular_speed_rad_s", max_angular_speed_rad_s},
+        {"contact_steps", contact_steps},
+        {"stop_steps", stop_steps},
+        {"drum_center_m", {drum_center_m.x(), drum_center_m.y(), drum_center_m.z()}},
+        {"drum_rule", drum_rule},
+        {"drum_through_fraction", drum_through_fraction}};
     nlohmann::json rms = nlohmann::json::object(), mx = nlohmann::json::object();
     nlohmann::json peak = nlohmann::json::object(), sat = nlohmann::json::object();
     double sum2 = 0.0;
@@ -189,25 +206,13 @@ nlohmann::json TrackSummary::to_json() const
     j["joint_peak_torque_nm"] = peak;
     j["joint_saturated_fraction"] = sat;
     j["joint_rms_deg_all"] = joint_names.empty() ? 0.0 : std::sqrt(sum2 / joint_names.size());
-    j["diverged"] = diverged;
-    j["interrupted"] = interrupted;
-    j["divergences"] = divergences;
-    j["max_linear_speed_mps"] = max_linear_speed_mps;
-    j["max_angular_speed_rad_s"] = max_angular_speed_rad_s;
-    j["contact_steps"] = contact_steps;
-    j["stop_steps"] = stop_steps;
-    j["drum_center_m"] = {drum_center_m.x(), drum_center_m.y(), drum_center_m.z()};
-    j["drum_rule"] = drum_rule;
-    j["drum_through_fraction"] = drum_through_fraction;
     if (mode == "cartesian") {
-        j["ik"] = {{"mean_iterations", ik_mean_iterations},
-                   {"max_iterations", ik_max_iterations},
-                   {"us_per_step", ik_us_per_step},
-                   {"not_converged", ik_not_converged},
-                   {"elbow_flexion_rms_deg", elbow_measured
-                                                 ? nlohmann::json{{"left", elbow_ik_rms_deg[0]},
-                                                                  {"right", elbow_ik_rms_deg[1]}}
-                                                 : nlohmann::json()}};
+        j["ik"] = {
+            {"mean_iterations", ik_mean_iterations},
+            {"max_iterations", ik_max_iterations},
+            {"us_per_step", ik_us_per_step},
+            {"not_converged", ik_not_converged},
+            {"elbow_flexion_rms_deg", elbow_measured ? sides(elbow_ik_rms_deg) : nlohmann::json()}};
     }
     return j;
 }
@@ -241,402 +246,561 @@ Eigen::Vector3d auto_drum_center(const CharacterModel &model, const ReferenceMot
     return c;
 }
 
-TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotion &reference,
-                               const TrackOptions &options_in,
-                               const std::vector<JointLimitRef> &limits, std::ostream *csv,
-                               const ProgressFn &progress, const std::vector<JointGains> *gains_in,
-                               const ReferenceMotion *raw_reference)
+namespace
+{
+
+// The elbow flexion (elbow_flexion_deg) of either arm from its elbow's local rotation.
+class ElbowFlexion
+{
+  public:
+    explicit ElbowFlexion(const CharacterModel &model)
+    {
+        for (int s = 0; s < 2; ++s) {
+            joint[s] = model.joint_index(Tracker::kArmJoints[s][2]);
+            upper_arm_axis_[s] = model.joint_body(joint[s]).offset_m;
+            forearm_axis_[s] =
+                model.joint_body(model.joint_index(Tracker::kArmJoints[s][3])).offset_m;
+        }
+    }
+    double operator()(int s, const Eigen::Quaterniond &q) const
+    {
+        return elbow_flexion_deg(upper_arm_axis_[s], forearm_axis_[s], q);
+    }
+    int joint[2]; // the elbows' joint indices [side]
+
+  private:
+    Eigen::Vector3d upper_arm_axis_[2], forearm_axis_[2];
+};
+
+// The sums behind the summary's errors, over the counted samples.
+struct ErrorSums {
+    explicit ErrorSums(int joints) : joint_sum2(joints, 0.0), joint_max(joints, 0.0) {}
+    std::vector<double> joint_sum2, joint_max;
+    double tip_sum2[2] = {0, 0}, tip_max[2] = {0, 0}, raw_tip_sum2[2] = {0, 0};
+    double raw_joint_sum2 = 0.0;
+    double elbow_sum2[2] = {0.0, 0.0};
+    double split_sum2[2][2][2] = {}; // [side][raw?][contact?]
+    long split_n[2][2] = {};         // [side][contact?]
+};
+
+// The CSV's header line (one column group per joint, per tip, per elbow).
+void write_csv_header(const CharacterModel &model, std::ostream &csv)
+{
+    csv << "time_s";
+    for (int j = 0; j < CharacterModel::kJoints; ++j) {
+        const std::string &n = model.joint_name(j);
+        for (const char *what : {"ref", "sim"})
+            for (const char *axis : {"x", "y", "z"})
+                csv << ',' << n << '_' << what << '_' << axis << "_deg";
+        csv << ',' << n << "_err_deg";
+    }
+    for (const char *side : {"left", "right"})
+        for (const char *what : {"ref", "sim"})
+            for (const char *axis : {"x", "y", "z"})
+                csv << ",tip_" << side << '_' << what << '_' << axis << "_m";
+    // Elbow flexion (the angle between upper arm and forearm, deg): cleaned
+    // capture, PD target (joint mode: the capture; Cartesian mode: Theta^T from
+    // IK), simulation. Then the raw capture's tips and elbow flexion.
+    for (const char *side : {"l", "r"})
+        for (const char *what : {"ref", "target", "sim"})
+            csv << ',' << side << "_elbow_flexion_" << what << "_deg";
+    for (const char *side : {"left", "right"}) {
+        for (const char *axis : {"x", "y", "z"})
+            csv << ",tip_" << side << "_raw_" << axis << "_m";
+        csv << ',' << side[0] << "_elbow_flexion_raw_deg";
+    }
+    csv << ",contacts\n";
+}
+
+// `options` checked (validate()) and completed for the run: a stick-only capture
+// checked, the IK's reference arms off where nothing gives them.
+TrackOptions run_options(const TrackOptions &options_in)
 {
     validate(options_in);
     TrackOptions options = options_in;
     const TipTrajectory *tips_in = options.tip_reference;
     if (tips_in) {
         if (options.mode != TrackMode::cartesian)
-            throw CharacterError("a stick-only capture needs the Cartesian mode");
+            throw PerformError("a stick-only capture needs the Cartesian mode");
         if (tips_in->time_s.size() < 2 || tips_in->tip_m[0].size() != tips_in->time_s.size() ||
             tips_in->tip_m[1].size() != tips_in->time_s.size())
-            throw CharacterError("stick capture: expected at least two frames of both tips");
+            throw PerformError("stick capture: expected at least two frames of both tips");
         options.cartesian.reference_has_arms = false;
     }
     // Algorithm 2 literally: the arms are driven by the stick tips alone; the
     // capture's arm rotations seed no IK (its clip-wide mean is the posture).
     if (options.cartesian.start_from_simulated)
         options.cartesian.reference_has_arms = false;
+    return options;
+}
+
+// One run of track_joint_space: set up in the constructor (drum, tips, initial
+// pose, tracker), then run() steps it, measures and writes the CSV.
+class TrackRun
+{
+  public:
+    TrackRun(const CharacterModel &model, const ReferenceMotion &reference,
+             const TrackOptions &options_in, const std::vector<JointLimitRef> &limits,
+             std::ostream *csv, const ProgressFn &progress, const std::vector<JointGains> *gains_in,
+             const ReferenceMotion *raw_reference);
+    TrackRun(const TrackRun &) = delete;
+    TrackRun &operator=(const TrackRun &) = delete;
+    TrackSummary run();
+
+  private:
+    void place_the_drum();
+    void press_impacts();
+    void start_tracker(const std::vector<JointGains> *gains_in);
+    void set_capture_posture();
+    void start_summary();
+    void update_tip_rates(double t_next);
+    void update_tip_positions(double t_next);
+    void record_step();
+    void sample(double t_next);
+    void count_errors(double t_next, const std::array<Eigen::Vector3d, 2> &ref_tips,
+                      const std::array<Eigen::Vector3d, 2> &sim_tips);
+    void write_csv_row(double t_next, const std::array<Eigen::Vector3d, 2> &ref_tips,
+                       const std::array<Eigen::Vector3d, 2> &sim_tips);
+    void report_progress(long n, long &last_progress) const;
+    void finish_summary(long n);
+    Scene &scene() { return tracker_->scene(); }
+
+    static constexpr int nj = CharacterModel::kJoints;
+    const CharacterModel &model_;
+    const ReferenceMotion &reference_;
+    TrackOptions options_;
+    const std::vector<JointLimitRef> &limits_;
+    std::ostream *csv_;
+    const ProgressFn &progress_;
+    const ReferenceMotion *raw_reference_;
+    const bool cartesian_;
     // The tips the errors are measured against (and the Cartesian mode's X^T):
     // the stick-only capture, else the cleaned tip motion, else the reference.
-    const ReferenceMotion &tip_src = options.tip_motion ? *options.tip_motion : reference;
-    // The strokes' turnarounds: the drum (--drum auto) and the contact windows.
-    // The drum at the turnarounds, for stick-only and full-body captures alike,
-    // unless the captured tips pass through it there (a drum kit: strokes for the
-    // other drums cross its place); then under the lowest tips (place_drum,
-    // docs/mocap.md, "Drum placement").
-    DrumFit drum_fit;
-    bool have_impacts = true;
-    DrumPlacement placement;
-    try {
-        placement = place_drum(tips_in ? *tips_in : reference_tip_trajectory(model, tip_src),
-                               model.options().stick.tip_radius_m, options.scene.drum.radius_m);
-        drum_fit = placement.fit;
-    } catch (const CharacterError &) {
-        if (options.drum_auto && tips_in)
-            throw;
-        have_impacts = false;
-    }
-    if (options.drum_auto)
-        options.scene.drum.center_m =
-            have_impacts ? placement.center_m : auto_drum_center(model, reference);
+    const ReferenceMotion &tip_src_;
+    // The stick-only capture (tips_in_: with its impacts restored when the drum
+    // fit found them) and the tips its X^T follows (targets_in_); null for a
+    // full-body capture.
+    const TipTrajectory *tips_in_, *targets_in_;
     // A stick-only capture's impacts restored between its samples (X^T and the errors).
-    TipTrajectory restored;
+    TipTrajectory restored_;
     // X^T asks for more at an impact: the stick's end down to the membrane plane at the
     // vertex (the fitted membrane: kImpactPitchFactor tip radii below it), so that the
     // simulated stick's bead reaches the head whatever its pitch, as the captured one did
     // (docs/ik.md, "Stick-only captures"). The errors stay against the capture.
-    TipTrajectory pressed;
-    const TipTrajectory *targets_in = tips_in;
-    if (tips_in && have_impacts) {
-        restored = with_impact_vertices(*tips_in, drum_fit.impacts);
-        // ... and a little deeper, by the dent a strike at the captured speed makes
-        // in the simulated membrane (impact_press_depth_m): the tracked end rounds
-        // the V off by millimetres, and with the end asked to the contact height
-        // alone a third to all of the impacts at 120 Hz went unstruck.
-        std::array<std::vector<StrokeTurnaround>, 2> at_membrane = drum_fit.impacts;
-        const double r_tip = model.options().stick.tip_radius_m;
-        for (auto &side : at_membrane)
-            for (StrokeTurnaround &ta : side)
-                ta.position_m.y() -=
-                    kImpactPitchFactor * r_tip +
-                    impact_press_depth_m(ta.speed_in_mps, model.options().stick.mass_kg,
-                                         options.scene.drum.stiffness_n_per_m(r_tip));
-        pressed = with_impact_vertices(*tips_in, at_membrane);
-        tips_in = &restored;
-        targets_in = &pressed;
-    }
-    const double h = options.scene.step_s;
-    const double duration = options.duration_s > 0.0 ? options.duration_s
-                            : tips_in                ? tips_in->duration_s()
-                                                     : reference.duration_s();
-    const long steps = std::max(1L, std::lround(duration / h));
-    const double sample_rate =
-        options.sample_rate_hz > 0.0 ? options.sample_rate_hz : reference.frame_rate_hz();
-    long last_sample_index = 0;
+    TipTrajectory pressed_;
+    DrumPlacement placement_;
+    bool have_impacts_ = true;
+    double h_ = 0.0, sample_rate_ = 0.0;
+    long steps_ = 0, last_sample_index_ = 0;
+    CharacterPose initial_;
+    std::unique_ptr<Tracker> tracker_;
+    ElbowFlexion flexion_;
+    ErrorSums sums_;
+    TrackSummary summary_;
+    // Per-step scratch.
+    CharacterPose ref_pose_, step_pose_, around_pose_, tip_pose_, raw_pose_;
+    std::vector<Eigen::Quaterniond> sim_local_;
+    TipTargets tip_targets_;
+};
 
-    CharacterPose initial = reference.frame(0);
-    if (tips_in) {
+TrackRun::TrackRun(const CharacterModel &model, const ReferenceMotion &reference,
+                   const TrackOptions &options_in, const std::vector<JointLimitRef> &limits,
+                   std::ostream *csv, const ProgressFn &progress,
+                   const std::vector<JointGains> *gains_in, const ReferenceMotion *raw_reference)
+    : model_(model), reference_(reference), options_(run_options(options_in)), limits_(limits),
+      csv_(csv), progress_(progress), raw_reference_(raw_reference),
+      cartesian_(options_.mode == TrackMode::cartesian),
+      tip_src_(options_.tip_motion ? *options_.tip_motion : reference),
+      tips_in_(options_.tip_reference), targets_in_(options_.tip_reference), flexion_(model),
+      sums_(nj)
+{
+    place_the_drum();
+    press_impacts();
+    h_ = options_.scene.step_s;
+    const double duration = options_.duration_s > 0.0 ? options_.duration_s
+                            : tips_in_                ? tips_in_->duration_s()
+                                                      : reference_.duration_s();
+    steps_ = std::max(1L, std::lround(duration / h_));
+    sample_rate_ =
+        options_.sample_rate_hz > 0.0 ? options_.sample_rate_hz : reference_.frame_rate_hz();
+    start_tracker(gains_in);
+    set_capture_posture();
+    start_summary();
+}
+
+// The strokes' turnarounds: the drum (--drum auto) and the contact windows.
+// The drum at the turnarounds, for stick-only and full-body captures alike,
+// unless the captured tips pass through it there (a drum kit: strokes for the
+// other drums cross its place); then under the lowest tips (place_drum,
+// docs/mocap.md, "Drum placement").
+void TrackRun::place_the_drum()
+{
+    try {
+        placement_ = place_drum(tips_in_ ? *tips_in_ : reference_tip_trajectory(model_, tip_src_),
+                                model_.options().stick.tip_radius_m, options_.scene.drum.radius_m);
+    } catch (const CharacterError &) {
+        if (options_.drum_auto && tips_in_)
+            throw;
+        have_impacts_ = false;
+    }
+    if (options_.drum_auto)
+        options_.scene.drum.center_m =
+            have_impacts_ ? placement_.center_m : auto_drum_center(model_, reference_);
+}
+
+void TrackRun::press_impacts()
+{
+    if (!(tips_in_ && have_impacts_))
+        return;
+    restored_ = with_impact_vertices(*tips_in_, placement_.fit.impacts);
+    // ... and a little deeper, by the dent a strike at the captured speed makes
+    // in the simulated membrane (impact_press_depth_m): the tracked end rounds
+    // the V off by millimetres, and with the end asked to the contact height
+    // alone a third to all of the impacts at 120 Hz went unstruck.
+    std::array<std::vector<StrokeTurnaround>, 2> at_membrane = placement_.fit.impacts;
+    const double r_tip = model_.options().stick.tip_radius_m;
+    for (auto &side : at_membrane)
+        for (StrokeTurnaround &ta : side)
+            ta.position_m.y() -=
+                kImpactPitchFactor * r_tip +
+                impact_press_depth_m(ta.speed_in_mps, model_.options().stick.mass_kg,
+                                     options_.scene.drum.stiffness_n_per_m(r_tip));
+    pressed_ = with_impact_vertices(*tips_in_, at_membrane);
+    tips_in_ = &restored_;
+    targets_in_ = &pressed_;
+}
+
+void TrackRun::start_tracker(const std::vector<JointGains> *gains_in)
+{
+    initial_ = reference_.frame(0);
+    if (tips_in_) {
         // The arms' first pose: a cold IK solve to the first tips from a drummer's
         // arms (drummer_arms), not from the reference's (the default body's T-pose):
         // from the T-pose the solve ended in a pose whose first impacts threw the
         // sticks sideways (6.7 m/s strokes: 21 and 20 mm in the first two strokes'
         // free flight, 2.5 after; docs/ik.md, "Stick-only captures").
-        drummer_arms(model, initial);
-        Tracker::solve_arms(model, limits, options.cartesian.ik,
-                            {tips_in->tip_m[0][0], tips_in->tip_m[1][0]}, initial);
+        drummer_arms(model_, initial_);
+        Tracker::solve_arms(model_, limits_, options_.cartesian.ik,
+                            {tips_in_->tip_m[0][0], tips_in_->tip_m[1][0]}, initial_);
     }
     const std::vector<JointGains> gains =
-        gains_in ? *gains_in : default_gains(model, initial, options.gains);
-    Tracker tracker(model, options.scene, initial, gains, limits, options.mode, options.cartesian,
-                    options.gains);
-    Scene &scene = tracker.scene();
-    // The posture of the IK's null-space task: a full-body capture's mean arm
-    // pose over the clip (the centre of the learned limits, Algorithm 1's
-    // mean), a stick-only capture's first (cold-solved) arms.
-    if (!tips_in && reference.frames() > 0)
-        for (int s = 0; s < 2; ++s) {
-            Eigen::Quaterniond posture[4];
-            std::vector<Eigen::Quaterniond> series(reference.frames());
-            for (int k = 0; k < 4; ++k) {
-                const int j = model.joint_index(Tracker::kArmJoints[s][k]);
-                for (int f = 0; f < reference.frames(); ++f)
-                    series[f] = reference.frame(f).local[j];
-                posture[k] = mean_rotation(series);
-            }
-            tracker.set_posture(s, posture);
-        }
+        gains_in ? *gains_in : default_gains(model_, initial_, options_.gains);
+    tracker_ = std::make_unique<Tracker>(model_, options_.scene, initial_, gains, limits_,
+                                         options_.mode, options_.cartesian, options_.gains);
+    step_pose_ = initial_;
+}
 
-    const int nj = CharacterModel::kJoints;
-    const bool cartesian = options.mode == TrackMode::cartesian;
-    double elbow_sum2[2] = {0.0, 0.0};
-    CharacterPose around_pose, tip_pose;
-    Eigen::Vector3d upper_arm_axis[2], forearm_axis[2];
-    int elbow_joint[2];
+// The posture of the IK's null-space task: a full-body capture's mean arm
+// pose over the clip (the centre of the learned limits, Algorithm 1's
+// mean), a stick-only capture's first (cold-solved) arms.
+void TrackRun::set_capture_posture()
+{
+    if (tips_in_ || reference_.frames() <= 0)
+        return;
     for (int s = 0; s < 2; ++s) {
-        elbow_joint[s] = model.joint_index(Tracker::kArmJoints[s][2]);
-        upper_arm_axis[s] = model.joint_body(elbow_joint[s]).offset_m;
-        forearm_axis[s] = model.joint_body(model.joint_index(Tracker::kArmJoints[s][3])).offset_m;
+        Eigen::Quaterniond posture[4];
+        std::vector<Eigen::Quaterniond> series(reference_.frames());
+        for (int k = 0; k < 4; ++k) {
+            const int j = model_.joint_index(Tracker::kArmJoints[s][k]);
+            for (int f = 0; f < reference_.frames(); ++f)
+                series[f] = reference_.frame(f).local[j];
+            posture[k] = mean_rotation(series);
+        }
+        tracker_->set_posture(s, posture);
     }
-    const auto flexion = [&](int s, const Eigen::Quaterniond &q) {
-        return elbow_flexion_deg(upper_arm_axis[s], forearm_axis[s], q);
-    };
-    double split_sum2[2][2][2] = {}; // [side][raw?][contact?]
-    long split_n[2][2] = {};         // [side][contact?]
+}
 
-    TrackSummary summary;
-    summary.mode = to_string(options.mode);
-    summary.frames = reference.frames();
-    summary.drum_center_m = options.scene.drum.center_m;
-    summary.drum_rule = !options.drum_auto         ? "given"
-                        : !have_impacts            ? "lowest_tips"
-                        : placement.at_turnarounds ? "turnarounds"
-                                                   : "lowest_tips";
-    summary.drum_through_fraction = have_impacts ? placement.through_fraction : 0.0;
+void TrackRun::start_summary()
+{
+    summary_.mode = to_string(options_.mode);
+    summary_.frames = reference_.frames();
+    summary_.drum_center_m = options_.scene.drum.center_m;
+    summary_.drum_rule = !options_.drum_auto         ? "given"
+                         : !have_impacts_            ? "lowest_tips"
+                         : placement_.at_turnarounds ? "turnarounds"
+                                                     : "lowest_tips";
+    summary_.drum_through_fraction = have_impacts_ ? placement_.through_fraction : 0.0;
     for (int j = 0; j < nj; ++j)
-        summary.joint_names.push_back(model.joint_name(j));
-    std::vector<double> joint_sum2(nj, 0.0), joint_max(nj, 0.0);
-    summary.joint_peak_torque_nm.assign(nj, 0.0);
-    summary.joint_saturated_fraction.assign(nj, 0.0);
-    double tip_sum2[2] = {0, 0}, tip_max[2] = {0, 0}, raw_tip_sum2[2] = {0, 0};
-    double raw_joint_sum2 = 0.0;
-    CharacterPose raw_pose;
+        summary_.joint_names.push_back(model_.joint_name(j));
+    summary_.joint_peak_torque_nm.assign(nj, 0.0);
+    summary_.joint_saturated_fraction.assign(nj, 0.0);
+}
 
-    if (csv) {
-        *csv << "time_s";
-        for (int j = 0; j < nj; ++j) {
-            const std::string &n = model.joint_name(j);
-            for (const char *what : {"ref", "sim"})
-                for (const char *axis : {"x", "y", "z"})
-                    *csv << ',' << n << '_' << what << '_' << axis << "_deg";
-            *csv << ',' << n << "_err_deg";
-        }
-        for (const char *side : {"left", "right"})
-            for (const char *what : {"ref", "sim"})
-                for (const char *axis : {"x", "y", "z"})
-                    *csv << ",tip_" << side << '_' << what << '_' << axis << "_m";
-        // Elbow flexion (the angle between upper arm and forearm, deg): cleaned
-        // capture, PD target (joint mode: the capture; Cartesian mode: Theta^T from
-        // IK), simulation. Then the raw capture's tips and elbow flexion.
-        for (const char *side : {"l", "r"})
-            for (const char *what : {"ref", "target", "sim"})
-                *csv << ',' << side << "_elbow_flexion_" << what << "_deg";
-        for (const char *side : {"left", "right"}) {
-            for (const char *axis : {"x", "y", "z"})
-                *csv << ",tip_" << side << "_raw_" << axis << "_m";
-            *csv << ',' << side[0] << "_elbow_flexion_raw_deg";
-        }
-        *csv << ",contacts\n";
-    }
-
-    CharacterPose ref_pose, step_pose = initial;
-    std::vector<Eigen::Quaterniond> sim_local;
-    TipTargets tip_targets;
+TrackSummary TrackRun::run()
+{
+    if (csv_)
+        write_csv_header(model_, *csv_);
     long last_progress = -1;
     const auto wall_start = std::chrono::steady_clock::now();
-
     long n = 0;
-    for (; n < steps; ++n) {
-        if (options.interrupt && *options.interrupt) {
-            summary.interrupted = true;
+    for (; n < steps_; ++n) {
+        if (options_.interrupt && *options_.interrupt) {
+            summary_.interrupted = true;
             break;
         }
-        const double t_next = (n + 1) * h;
+        const double t_next = (n + 1) * h_;
         // Targets for the end of this step, blended in from the initial pose.
-        reference.sample(t_next, ref_pose);
-        blend_pose(initial, ref_pose, ramp_weight(t_next, options.ramp_s), step_pose);
-        if (cartesian) {
-            // Algorithm 2. X^T: the stick tips of the (blended) reference pose,
-            // or of the stick-only capture.
-            // Reference tip velocity and acceleration by central differences over
-            // one reference frame (the sampled reference is piecewise linear
-            // between frames, so per-step differences would be steps and spikes).
-            const double frame_s =
-                tips_in ? tips_in->duration_s() / static_cast<double>(tips_in->time_s.size() - 1)
-                        : 1.0 / reference.frame_rate_hz();
-            if (t_next - frame_s >= options.ramp_s) {
-                std::array<Eigen::Vector3d, 2> before, after, now;
-                if (tips_in) {
-                    for (int s = 0; s < 2; ++s) {
-                        before[s] = targets_in->sample(s, t_next - frame_s);
-                        after[s] = targets_in->sample(s, t_next + frame_s);
-                        now[s] = targets_in->sample(s, t_next);
-                    }
-                } else {
-                    tip_src.sample(t_next - frame_s, around_pose);
-                    before = reference_tips(model, around_pose);
-                    tip_src.sample(t_next + frame_s, around_pose);
-                    after = reference_tips(model, around_pose);
-                    if (options.tip_motion) {
-                        tip_src.sample(t_next, around_pose);
-                        now = reference_tips(model, around_pose);
-                    } else {
-                        now = reference_tips(model, ref_pose);
-                    }
-                }
-                for (int s = 0; s < 2; ++s) {
-                    tip_targets.velocity_mps[s] = (after[s] - before[s]) / (2.0 * frame_s);
-                    tip_targets.acceleration_mps2[s] =
-                        (after[s] - 2.0 * now[s] + before[s]) / (frame_s * frame_s);
-                }
-            } else {
-                tip_targets.velocity_mps.fill(Eigen::Vector3d::Zero());
-                tip_targets.acceleration_mps2.fill(Eigen::Vector3d::Zero());
-            }
-            tip_targets.has_position = tips_in != nullptr || options.tip_motion != nullptr;
-            if (tips_in) {
-                for (int s = 0; s < 2; ++s)
-                    tip_targets.position_m[s] = targets_in->sample(s, t_next);
-            } else if (options.tip_motion) {
-                // The cleaned tips, blended in from the (ramped) reference's tips
-                // like the joint targets: X^T = tips(step pose) + w (tips(tip motion)
-                // - tips(reference)).
-                const double w = ramp_weight(t_next, options.ramp_s);
-                options.tip_motion->sample(t_next, tip_pose);
-                const auto cleaned = reference_tips(model, tip_pose);
-                const auto body = reference_tips(model, ref_pose);
-                const auto blended = reference_tips(model, step_pose);
-                for (int s = 0; s < 2; ++s)
-                    tip_targets.position_m[s] = blended[s] + w * (cleaned[s] - body[s]);
-            }
+        reference_.sample(t_next, ref_pose_);
+        blend_pose(initial_, ref_pose_, ramp_weight(t_next, options_.ramp_s), step_pose_);
+        if (cartesian_) {
+            update_tip_rates(t_next);
+            update_tip_positions(t_next);
         }
-        tracker.step(step_pose, cartesian ? &tip_targets : nullptr, t_next >= options.ramp_s);
-        if (options.on_step)
-            options.on_step(scene);
-        const std::vector<Eigen::Quaterniond> &target = tracker.targets();
-        summary.max_linear_speed_mps =
-            std::max(summary.max_linear_speed_mps, scene.max_linear_speed_mps());
-        summary.max_angular_speed_rad_s =
-            std::max(summary.max_angular_speed_rad_s, scene.max_angular_speed_rad_s());
-        summary.stop_steps += scene.stops_active_last_step();
-        for (int j = 0; j < nj; ++j) {
-            summary.joint_peak_torque_nm[j] =
-                std::max(summary.joint_peak_torque_nm[j], scene.motor_torque(j).norm());
-            if (scene.motor_saturated(j))
-                summary.joint_saturated_fraction[j] += 1.0;
-        }
-
+        tracker_->step(step_pose_, cartesian_ ? &tip_targets_ : nullptr, t_next >= options_.ramp_s);
+        if (options_.on_step)
+            options_.on_step(scene());
+        record_step();
         // Sample on the rate's grid (nearest following step), so that a 120 Hz
         // CSV has 120 rows per second at any physics step.
-        const long sample_index = static_cast<long>(std::floor(t_next * sample_rate + 1e-9));
-        if (sample_index > last_sample_index) {
-            last_sample_index = sample_index;
-            // Errors against the reference itself (not the ramped or clamped target).
-            scene.local_rotations(sim_local);
-            std::array<Eigen::Vector3d, 2> ref_tips;
-            if (tips_in) {
-                ref_tips = {tips_in->sample(0, t_next), tips_in->sample(1, t_next)};
-            } else {
-                tip_src.sample(t_next, tip_pose);
-                ref_tips = reference_tips(model, tip_pose);
-            }
-            std::array<Eigen::Vector3d, 2> sim_tips = {scene.tip_position(Side::left),
-                                                       scene.tip_position(Side::right)};
-            const bool counted = t_next >= options.ramp_s;
-            if (counted) {
-                ++summary.samples;
-                for (int j = 0; j < nj; ++j) {
-                    const double e =
-                        log_map(ref_pose.local[j] * sim_local[j].conjugate()).norm() * kRadToDeg;
-                    joint_sum2[j] += e * e;
-                    joint_max[j] = std::max(joint_max[j], e);
-                }
-                bool contact[2] = {false, false};
-                for (int s = 0; s < 2; ++s) {
-                    const double e = (ref_tips[s] - sim_tips[s]).norm() * 1e3;
-                    tip_sum2[s] += e * e;
-                    tip_max[s] = std::max(tip_max[s], e);
-                    const double de = flexion(s, ref_pose.local[elbow_joint[s]]) -
-                                      flexion(s, target[elbow_joint[s]]);
-                    elbow_sum2[s] += de * de;
-                    contact[s] = have_impacts && to_nearest_impact_s(drum_fit.impacts[s], t_next) <=
-                                                     kContactWindow_s;
-                    split_sum2[s][0][contact[s]] += e * e;
-                    ++split_n[s][contact[s]];
-                }
-                if (raw_reference && !tips_in) {
-                    raw_reference->sample(t_next, raw_pose);
-                    const auto raw_tips = reference_tips(model, raw_pose);
-                    for (int s = 0; s < 2; ++s) {
-                        const double e2 = 1e6 * (raw_tips[s] - sim_tips[s]).squaredNorm();
-                        raw_tip_sum2[s] += e2;
-                        split_sum2[s][1][contact[s]] += e2;
-                    }
-                    for (int j = 0; j < nj; ++j) {
-                        const double e =
-                            log_map(raw_pose.local[j] * sim_local[j].conjugate()).norm() *
-                            kRadToDeg;
-                        raw_joint_sum2 += e * e;
-                    }
-                }
-            }
-            if (csv) {
-                *csv << t_next;
-                for (int j = 0; j < nj; ++j) {
-                    const Eigen::Vector3d r = log_map(ref_pose.local[j]) * kRadToDeg;
-                    const Eigen::Vector3d q = log_map(sim_local[j]) * kRadToDeg;
-                    const double e =
-                        log_map(ref_pose.local[j] * sim_local[j].conjugate()).norm() * kRadToDeg;
-                    *csv << ',' << r.x() << ',' << r.y() << ',' << r.z() << ',' << q.x() << ','
-                         << q.y() << ',' << q.z() << ',' << e;
-                }
-                for (int s = 0; s < 2; ++s)
-                    for (const Eigen::Vector3d &p : {ref_tips[s], sim_tips[s]})
-                        *csv << ',' << p.x() << ',' << p.y() << ',' << p.z();
-                for (int s = 0; s < 2; ++s) {
-                    const int elbow = elbow_joint[s];
-                    *csv << ',' << flexion(s, ref_pose.local[elbow]) << ','
-                         << flexion(s, target[elbow]) << ',' << flexion(s, sim_local[elbow]);
-                }
-                if (raw_reference && !tips_in) {
-                    raw_reference->sample(t_next, raw_pose);
-                    const auto raw_tips = reference_tips(model, raw_pose);
-                    for (int s = 0; s < 2; ++s)
-                        *csv << ',' << raw_tips[s].x() << ',' << raw_tips[s].y() << ','
-                             << raw_tips[s].z() << ','
-                             << flexion(s, raw_pose.local[elbow_joint[s]]);
-                } else {
-                    *csv << ",,,,,,,,";
-                }
-                *csv << ',' << scene.contacts_last_step() << '\n';
-            }
+        const long sample_index = static_cast<long>(std::floor(t_next * sample_rate_ + 1e-9));
+        if (sample_index > last_sample_index_) {
+            last_sample_index_ = sample_index;
+            sample(t_next);
         }
-        if (progress) {
-            const long pct = (n + 1) * 100 / steps;
-            if (pct != last_progress) {
-                last_progress = pct;
-                progress(static_cast<double>(n + 1) / steps);
-            }
-        }
+        report_progress(n, last_progress);
     }
-    summary.wall_time_s =
+    summary_.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-    summary.steps = n;
-    for (double &f : summary.joint_saturated_fraction)
-        f /= std::max(1L, n);
-    summary.duration_s = n * h;
-    summary.realtime_factor =
-        summary.wall_time_s > 0.0 ? summary.duration_s / summary.wall_time_s : 0.0;
-    const double ns = std::max(1, summary.samples);
-    for (int j = 0; j < nj; ++j) {
-        summary.joint_rms_deg.push_back(std::sqrt(joint_sum2[j] / ns));
-        summary.joint_max_deg.push_back(joint_max[j]);
+    finish_summary(n);
+    return summary_;
+}
+
+// Algorithm 2. X^T's velocity and acceleration: the stick tips of the (blended)
+// reference pose, or of the stick-only capture, by central differences over one
+// reference frame (the sampled reference is piecewise linear between frames, so
+// per-step differences would be steps and spikes).
+void TrackRun::update_tip_rates(double t_next)
+{
+    const double frame_s =
+        tips_in_ ? tips_in_->duration_s() / static_cast<double>(tips_in_->time_s.size() - 1)
+                 : 1.0 / reference_.frame_rate_hz();
+    if (!(t_next - frame_s >= options_.ramp_s)) {
+        tip_targets_.velocity_mps.fill(Eigen::Vector3d::Zero());
+        tip_targets_.acceleration_mps2.fill(Eigen::Vector3d::Zero());
+        return;
+    }
+    std::array<Eigen::Vector3d, 2> before, after, now;
+    if (tips_in_) {
+        for (int s = 0; s < 2; ++s) {
+            before[s] = targets_in_->sample(s, t_next - frame_s);
+            after[s] = targets_in_->sample(s, t_next + frame_s);
+            now[s] = targets_in_->sample(s, t_next);
+        }
+    } else {
+        tip_src_.sample(t_next - frame_s, around_pose_);
+        before = reference_tips(model_, around_pose_);
+        tip_src_.sample(t_next + frame_s, around_pose_);
+        after = reference_tips(model_, around_pose_);
+        if (options_.tip_motion) {
+            tip_src_.sample(t_next, around_pose_);
+            now = reference_tips(model_, around_pose_);
+        } else {
+            now = reference_tips(model_, ref_pose_);
+        }
     }
     for (int s = 0; s < 2; ++s) {
-        summary.tip_rms_mm[s] = std::sqrt(tip_sum2[s] / ns);
-        summary.tip_max_mm[s] = tip_max[s];
-        summary.tip_rms_raw_mm[s] = std::sqrt(raw_tip_sum2[s] / ns);
-        for (int c = 0; c < 2; ++c) {
-            const double m = std::max(1L, split_n[s][c]);
-            (c ? summary.tip_rms_contact_mm : summary.tip_rms_free_mm)[s] =
-                std::sqrt(split_sum2[s][0][c] / m);
-            (c ? summary.tip_rms_raw_contact_mm : summary.tip_rms_raw_free_mm)[s] =
-                std::sqrt(split_sum2[s][1][c] / m);
-        }
-        summary.captured_impacts[s] =
-            have_impacts ? static_cast<int>(drum_fit.impacts[s].size()) : 0;
+        tip_targets_.velocity_mps[s] = (after[s] - before[s]) / (2.0 * frame_s);
+        tip_targets_.acceleration_mps2[s] =
+            (after[s] - 2.0 * now[s] + before[s]) / (frame_s * frame_s);
     }
-    summary.joint_rms_raw_deg_all = std::sqrt(raw_joint_sum2 / (ns * nj));
-    if (cartesian) {
-        const TrackerIkStats &ik = tracker.ik_stats();
-        summary.ik_mean_iterations =
-            ik.solves > 0 ? static_cast<double>(ik.iterations) / ik.solves : 0.0;
-        summary.ik_max_iterations = ik.max_iterations;
-        summary.ik_not_converged = ik.not_converged;
-        summary.ik_us_per_step = n > 0 ? 1e6 * ik.wall_s / n : 0.0;
+}
+
+// X^T itself: the stick-only capture's, the cleaned tips' or (has_position
+// false) the tracker's own forward kinematics of the step's reference pose.
+void TrackRun::update_tip_positions(double t_next)
+{
+    tip_targets_.has_position = tips_in_ != nullptr || options_.tip_motion != nullptr;
+    if (tips_in_) {
         for (int s = 0; s < 2; ++s)
-            summary.elbow_ik_rms_deg[s] = std::sqrt(elbow_sum2[s] / ns);
-        summary.elbow_measured = tips_in == nullptr;
+            tip_targets_.position_m[s] = targets_in_->sample(s, t_next);
+    } else if (options_.tip_motion) {
+        // The cleaned tips, blended in from the (ramped) reference's tips
+        // like the joint targets: X^T = tips(step pose) + w (tips(tip motion)
+        // - tips(reference)).
+        const double w = ramp_weight(t_next, options_.ramp_s);
+        options_.tip_motion->sample(t_next, tip_pose_);
+        const auto cleaned = reference_tips(model_, tip_pose_);
+        const auto body = reference_tips(model_, ref_pose_);
+        const auto blended = reference_tips(model_, step_pose_);
+        for (int s = 0; s < 2; ++s)
+            tip_targets_.position_m[s] = blended[s] + w * (cleaned[s] - body[s]);
     }
-    summary.divergences = scene.divergences();
-    summary.diverged = summary.divergences > 0;
-    summary.contact_steps = scene.contact_steps();
-    return summary;
+}
+
+// Every step's statistics: the body's speeds, the stops, the motors' torques.
+void TrackRun::record_step()
+{
+    Scene &sc = scene();
+    summary_.max_linear_speed_mps =
+        std::max(summary_.max_linear_speed_mps, sc.max_linear_speed_mps());
+    summary_.max_angular_speed_rad_s =
+        std::max(summary_.max_angular_speed_rad_s, sc.max_angular_speed_rad_s());
+    summary_.stop_steps += sc.stops_active_last_step();
+    for (int j = 0; j < nj; ++j) {
+        summary_.joint_peak_torque_nm[j] =
+            std::max(summary_.joint_peak_torque_nm[j], sc.motor_torque(j).norm());
+        if (sc.motor_saturated(j))
+            summary_.joint_saturated_fraction[j] += 1.0;
+    }
+}
+
+// One sample: errors against the reference itself (not the ramped or clamped
+// target), counted after the ramp, and the CSV row.
+void TrackRun::sample(double t_next)
+{
+    scene().local_rotations(sim_local_);
+    std::array<Eigen::Vector3d, 2> ref_tips;
+    if (tips_in_) {
+        ref_tips = {tips_in_->sample(0, t_next), tips_in_->sample(1, t_next)};
+    } else {
+        tip_src_.sample(t_next, tip_pose_);
+        ref_tips = reference_tips(model_, tip_pose_);
+    }
+    std::array<Eigen::Vector3d, 2> sim_tips = {scene().tip_position(Side::left),
+                                               scene().tip_position(Side::right)};
+    if (t_next >= options_.ramp_s)
+        count_errors(t_next, ref_tips, sim_tips);
+    if (csv_)
+        write_csv_row(t_next, ref_tips, sim_tips);
+}
+
+void TrackRun::count_errors(double t_next, const std::array<Eigen::Vector3d, 2> &ref_tips,
+                            const std::array<Eigen::Vector3d, 2> &sim_tips)
+{
+    const std::vector<Eigen::Quaterniond> &target = tracker_->targets();
+    ++summary_.samples;
+    for (int j = 0; j < nj; ++j) {
+        const double e = log_map(ref_pose_.local[j] * sim_local_[j].conjugate()).norm() * kRadToDeg;
+        sums_.joint_sum2[j] += e * e;
+        sums_.joint_max[j] = std::max(sums_.joint_max[j], e);
+    }
+    bool contact[2] = {false, false};
+    for (int s = 0; s < 2; ++s) {
+        const double e = (ref_tips[s] - sim_tips[s]).norm() * 1e3;
+        sums_.tip_sum2[s] += e * e;
+        sums_.tip_max[s] = std::max(sums_.tip_max[s], e);
+        const double de = flexion_(s, ref_pose_.local[flexion_.joint[s]]) -
+                          flexion_(s, target[flexion_.joint[s]]);
+        sums_.elbow_sum2[s] += de * de;
+        contact[s] = have_impacts_ &&
+                     to_nearest_impact_s(placement_.fit.impacts[s], t_next) <= kContactWindow_s;
+        sums_.split_sum2[s][0][contact[s]] += e * e;
+        ++sums_.split_n[s][contact[s]];
+    }
+    if (!(raw_reference_ && !tips_in_))
+        return;
+    raw_reference_->sample(t_next, raw_pose_);
+    const auto raw_tips = reference_tips(model_, raw_pose_);
+    for (int s = 0; s < 2; ++s) {
+        const double e2 = 1e6 * (raw_tips[s] - sim_tips[s]).squaredNorm();
+        sums_.raw_tip_sum2[s] += e2;
+        sums_.split_sum2[s][1][contact[s]] += e2;
+    }
+    for (int j = 0; j < nj; ++j) {
+        const double e = log_map(raw_pose_.local[j] * sim_local_[j].conjugate()).norm() * kRadToDeg;
+        sums_.raw_joint_sum2 += e * e;
+    }
+}
+
+void TrackRun::write_csv_row(double t_next, const std::array<Eigen::Vector3d, 2> &ref_tips,
+                             const std::array<Eigen::Vector3d, 2> &sim_tips)
+{
+    const std::vector<Eigen::Quaterniond> &target = tracker_->targets();
+    std::ostream &csv = *csv_;
+    csv << t_next;
+    for (int j = 0; j < nj; ++j) {
+        const Eigen::Vector3d r = log_map(ref_pose_.local[j]) * kRadToDeg;
+        const Eigen::Vector3d q = log_map(sim_local_[j]) * kRadToDeg;
+        const double e = log_map(ref_pose_.local[j] * sim_local_[j].conjugate()).norm() * kRadToDeg;
+        csv << ',' << r.x() << ',' << r.y() << ',' << r.z() << ',' << q.x() << ',' << q.y() << ','
+            << q.z() << ',' << e;
+    }
+    for (int s = 0; s < 2; ++s)
+        for (const Eigen::Vector3d &p : {ref_tips[s], sim_tips[s]})
+            csv << ',' << p.x() << ',' << p.y() << ',' << p.z();
+    for (int s = 0; s < 2; ++s) {
+        const int elbow = flexion_.joint[s];
+        csv << ',' << flexion_(s, ref_pose_.local[elbow]) << ',' << flexion_(s, target[elbow])
+            << ',' << flexion_(s, sim_local_[elbow]);
+    }
+    if (raw_reference_ && !tips_in_) {
+        raw_reference_->sample(t_next, raw_pose_);
+        const auto raw_tips = reference_tips(model_, raw_pose_);
+        for (int s = 0; s < 2; ++s)
+            csv << ',' << raw_tips[s].x() << ',' << raw_tips[s].y() << ',' << raw_tips[s].z() << ','
+                << flexion_(s, raw_pose_.local[flexion_.joint[s]]);
+    } else {
+        csv << ",,,,,,,,";
+    }
+    csv << ',' << scene().contacts_last_step() << '\n';
+}
+
+void TrackRun::report_progress(long n, long &last_progress) const
+{
+    if (!progress_)
+        return;
+    const long pct = (n + 1) * 100 / steps_;
+    if (pct != last_progress) {
+        last_progress = pct;
+        progress_(static_cast<double>(n + 1) / steps_);
+    }
+}
+
+// The summary's figures from the sums, after `n` steps.
+void TrackRun::finish_summary(long n)
+{
+    summary_.steps = n;
+    for (double &f : summary_.joint_saturated_fraction)
+        f /= std::max(1L, n);
+    summary_.duration_s = n * h_;
+    summary_.realtime_factor =
+        summary_.wall_time_s > 0.0 ? summary_.duration_s / summary_.wall_time_s : 0.0;
+    const double ns = std::max(1, summary_.samples);
+    for (int j = 0; j < nj; ++j) {
+        summary_.joint_rms_deg.push_back(std::sqrt(sums_.joint_sum2[j] / ns));
+        summary_.joint_max_deg.push_back(sums_.joint_max[j]);
+    }
+    for (int s = 0; s < 2; ++s) {
+        summary_.tip_rms_mm[s] = std::sqrt(sums_.tip_sum2[s] / ns);
+        summary_.tip_max_mm[s] = sums_.tip_max[s];
+        summary_.tip_rms_raw_mm[s] = std::sqrt(sums_.raw_tip_sum2[s] / ns);
+        for (int c = 0; c < 2; ++c) {
+            const double m = std::max(1L, sums_.split_n[s][c]);
+            (c ? summary_.tip_rms_contact_mm : summary_.tip_rms_free_mm)[s] =
+                std::sqrt(sums_.split_sum2[s][0][c] / m);
+            (c ? summary_.tip_rms_raw_contact_mm : summary_.tip_rms_raw_free_mm)[s] =
+                std::sqrt(sums_.split_sum2[s][1][c] / m);
+        }
+        summary_.captured_impacts[s] =
+            have_impacts_ ? static_cast<int>(placement_.fit.impacts[s].size()) : 0;
+    }
+    summary_.joint_rms_raw_deg_all = std::sqrt(sums_.raw_joint_sum2 / (ns * nj));
+    if (cartesian_) {
+        const TrackerIkStats &ik = tracker_->ik_stats();
+        summary_.ik_mean_iterations =
+            ik.solves > 0 ? static_cast<double>(ik.iterations) / ik.solves : 0.0;
+        summary_.ik_max_iterations = ik.max_iterations;
+        summary_.ik_not_converged = ik.not_converged;
+        summary_.ik_us_per_step = n > 0 ? 1e6 * ik.wall_s / n : 0.0;
+        for (int s = 0; s < 2; ++s)
+            summary_.elbow_ik_rms_deg[s] = std::sqrt(sums_.elbow_sum2[s] / ns);
+        summary_.elbow_measured = tips_in_ == nullptr;
+    }
+    summary_.divergences = scene().divergences();
+    summary_.diverged = summary_.divergences > 0;
+    summary_.contact_steps = scene().contact_steps();
+}
+
+} // namespace
+
+TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotion &reference,
+                               const TrackOptions &options,
+                               const std::vector<JointLimitRef> &limits, std::ostream *csv,
+                               const ProgressFn &progress, const std::vector<JointGains> *gains,
+                               const ReferenceMotion *raw_reference)
+{
+    TrackRun run(model, reference, options, limits, csv, progress, gains, raw_reference);
+    return run.run();
 }
 
 } // namespace ictus

@@ -59,7 +59,7 @@ TrackMode track_mode_from_string(const std::string &text)
         return TrackMode::joint;
     if (text == "cartesian")
         return TrackMode::cartesian;
-    throw CharacterError("mode: expected joint or cartesian, got '" + text + "'");
+    throw PerformError("mode: expected joint or cartesian, got '" + text + "'");
 }
 
 // One arm of Algorithm 2: the chain thorax -> clavicle -> shoulder -> elbow ->
@@ -84,8 +84,8 @@ void build_arm(const CharacterModel &model, int side, const CharacterPose &initi
     for (int k = 0; k < 4; ++k) {
         joint[k] = model.joint_index(Tracker::kArmJoints[side][k]);
         if (joint[k] < 0)
-            throw CharacterError(std::string("cartesian mode: the character has no joint '") +
-                                 Tracker::kArmJoints[side][k] + "'");
+            throw PerformError(std::string("cartesian mode: the character has no joint '") +
+                               Tracker::kArmJoints[side][k] + "'");
     }
     base_body = model.joint_body(joint[0]).parent;
     for (int c = 0; c < 2; ++c) {
@@ -112,10 +112,10 @@ Tracker::Tracker(const CharacterModel &model, const SceneOptions &scene_options,
 {
     const int nj = CharacterModel::kJoints;
     if (static_cast<int>(initial.local.size()) != nj)
-        throw CharacterError("tracker: the initial pose needs one rotation per joint");
+        throw PerformError("tracker: the initial pose needs one rotation per joint");
     ChainIkSolverPos_dls probe(4);
     if (!probe.set_params(cartesian.ik))
-        throw CharacterError("ik parameters: expected finite positive values");
+        throw PerformError("ik parameters: expected finite positive values");
     velocity_gain_s_ = cartesian.velocity_gain_s >= 0.0
                            ? cartesian.velocity_gain_s
                            : (std::sqrt(cartesian.gain) - 1.0) * 2.0 * gain_options.damping_ratio /
@@ -169,16 +169,28 @@ const Eigen::Quaterniond &Tracker::kinematic_target(int side, int k) const
 
 StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips, bool integrate)
 {
-    const CharacterModel &model = scene_->model();
+    follow_reference(reference, tips != nullptr);
+    const bool cartesian = mode_ == TrackMode::cartesian;
+    if (cartesian && !tips)
+        throw PerformError("cartesian mode: a step needs tip targets");
+    if (tips)
+        drive_arms(reference, *tips, integrate);
+    scene_->set_joint_targets(target_, rate_);
+    ++steps_;
+    return scene_->step();
+}
+
+void Tracker::follow_reference(const CharacterPose &reference, bool tips_drive_arms)
+{
     const int nj = CharacterModel::kJoints;
     const double h = scene_->options().step_s;
     // The reference's rates, where something reads them: not an arm's when tips
-    // drive the arms (the kinematic IK below gives its rate), nor a joint whose
+    // drive the arms (the kinematic IK gives its rate), nor a joint whose
     // body the scene places instead of driving it (SceneOptions::legs_kinematic).
     std::array<bool, CharacterModel::kJoints> rate_read;
     for (int j = 0; j < nj; ++j)
         rate_read[j] = !scene_->body_kinematic(j + 1);
-    if (tips)
+    if (tips_drive_arms)
         for (int s = 0; s < 2; ++s)
             for (int k = 0; k < 4; ++k)
                 rate_read[arms_[s]->joint[k]] = false;
@@ -188,131 +200,148 @@ StepResult Tracker::step(const CharacterPose &reference, const TipTargets *tips,
             rate_[j] = log_map(target_[j] * previous_reference_[j].conjugate()) / h;
     }
     previous_reference_ = reference.local; // same size: no allocation
+}
+
+// Algorithm 2 (Cartesian), or the kinematic IK alone (joint mode with tips).
+void Tracker::drive_arms(const CharacterPose &reference, const TipTargets &tips, bool integrate)
+{
+    const CharacterModel &model = scene_->model();
     const bool cartesian = mode_ == TrackMode::cartesian;
-    if (cartesian && !tips)
-        throw CharacterError("cartesian mode: a step needs tip targets");
-    if (tips) {
-        // Algorithm 2 (Cartesian), or the kinematic IK alone (joint mode with tips).
-        const CartesianOptions &co = cartesian_;
-        const auto ik_start = std::chrono::steady_clock::now();
-        target_pose_.pelvis_position_m = reference.pelvis_position_m;
-        target_pose_.pelvis_rotation = reference.pelvis_rotation;
-        target_pose_.local = target_;
-        model.forward(target_pose_, target_frames_);
-        if (cartesian) {
-            scene_->body_frames(sim_frames_);
-            scene_->local_rotations(sim_local_);
-        }
-        for (int s = 0; s < 2; ++s) {
-            Arm &arm = *arms_[s];
-            const Side side = static_cast<Side>(s);
-            const int hb = model.hand_body(side);
-            const Eigen::Vector3d tip_target =
-                tips->has_position ? tips->position_m[s]
-                                   : model.tip_position(side, target_frames_.origin_m[hb],
-                                                        target_frames_.rotation[hb]);
-            // Kinematic IK: the arm's target trajectory without the body,
-            // for the target rates (feedforward of eq. 1).
-            arm.kinematic.set_base(target_frames_.origin_m[arm.base_body],
-                                   target_frames_.rotation[arm.base_body]);
-            if (co.reference_has_arms)
-                for (int k = 0; k < 4; ++k)
-                    arm.kinematic_target[k] = target_[arm.joint[k]];
-            arm.kinematic.set_rotations(arm.kinematic_target);
-            Eigen::Quaterniond hand_target;
-            double plane = 0.0;
-            const bool orient =
-                tips->has_direction && co.rotation_weight > 0.0 &&
-                held_rotation(model, side, tips->stick_direction[s], hand_target, &plane);
-            IkResult r = orient ? solver_->solve(arm.kinematic, tip_target, hand_target,
-                                                 co.rotation_weight * plane, arm.kinematic_target)
-                         : co.posture_weight > 0.0
-                             ? solver_->solve_with_posture(arm.kinematic, tip_target, arm.posture,
-                                                           co.posture_weight, arm.kinematic_target)
-                             : solver_->solve(arm.kinematic, tip_target, arm.kinematic_target);
-            ik_stats_.iterations += r.iterations;
-            ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
-            ik_stats_.not_converged += r.status != IkStatus::converged;
-            ++ik_stats_.solves;
-            if (co.max_joint_speed_rad_s > 0.0 && steps_ > 0) {
-                const double cap = co.max_joint_speed_rad_s * h;
-                for (int k = 0; k < 4; ++k) {
-                    const double a =
-                        rotation_angle_between(arm.previous_kinematic[k], arm.kinematic_target[k]);
-                    if (a > cap) {
-                        arm.kinematic_target[k] =
-                            arm.previous_kinematic[k].slerp(cap / a, arm.kinematic_target[k]);
-                        ++ik_stats_.rate_capped;
-                    }
-                }
-            }
-            if (cartesian) {
-                // Eq. 2 with its gain: the IK target is X^S + gain (X^T - X^S) (+ the
-                // velocity, acceleration and integral terms, capped), X^S from the
-                // simulated thorax and Theta^S. The solve starts from Theta^S (eq. 2
-                // literally) or from the kinematic solution, which holds the arm's
-                // null space (CartesianOptions::start_from_simulated, docs/ik.md).
-                arm.feedback.set_base(sim_frames_.origin_m[arm.base_body],
-                                      sim_frames_.rotation[arm.base_body]);
-                for (int k = 0; k < 4; ++k)
-                    arm.feedback.set_rotation(k, sim_local_[arm.joint[k]]);
-                const Eigen::Vector3d sim_tip_chain = arm.feedback.tip_position();
-                if (!co.start_from_simulated)
-                    arm.feedback.set_rotations(arm.kinematic_target);
-                // X^S where the hand holds the stick: on a fulcrum the stick's
-                // own swing (its rebound) is physics, not an error for the arm.
-                const Eigen::Vector3d error = tip_target - scene_->held_tip_position(side);
-                const Eigen::Vector3d velocity_error =
-                    tips->velocity_mps[s] - scene_->held_tip_velocity(side);
-                if (co.integral_per_s > 0.0 && integrate) {
-                    arm.integral_m += co.integral_per_s * h * error;
-                    const double norm = arm.integral_m.norm();
-                    if (norm > co.integral_limit_m)
-                        arm.integral_m *= co.integral_limit_m / norm;
-                }
-                Eigen::Vector3d correction =
-                    (co.gain - 1.0) * error + velocity_gain_s_ * velocity_error +
-                    co.acceleration_feedforward_s2 * tips->acceleration_mps2[s];
-                const double correction_norm = correction.norm();
-                if (correction_norm > co.correction_limit_m)
-                    correction *= co.correction_limit_m / correction_norm;
-                const Eigen::Vector3d ik_target =
-                    sim_tip_chain + error + correction + arm.integral_m;
-                // The hands' rotation task stays in the kinematic IK: from its
-                // solution the feedback solve moves the arm only as the tip
-                // error asks (with the hand's rotation held, the gain's
-                // correction would have to come from the upper arm alone, and
-                // the loop chattered: docs/perform.md, "Holding the stick").
-                // From Theta^S the posture task holds the arm's null space (docs/ik.md).
-                r = co.start_from_simulated && co.posture_weight > 0.0
-                        ? feedback_solver_->solve_with_posture(arm.feedback, ik_target, arm.posture,
-                                                               co.posture_weight, arm.theta_target)
-                        : feedback_solver_->solve(arm.feedback, ik_target, arm.theta_target);
-                ik_stats_.iterations += r.iterations;
-                ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
-                ik_stats_.not_converged += r.status != IkStatus::converged;
-                ++ik_stats_.solves;
-            } else {
-                for (int k = 0; k < 4; ++k)
-                    arm.theta_target[k] = arm.kinematic_target[k];
-            }
-            for (int k = 0; k < 4; ++k) {
-                const int j = arm.joint[k];
-                target_[j] = arm.theta_target[k];
-                rate_[j] = steps_ == 0
-                               ? Eigen::Vector3d::Zero()
-                               : Eigen::Vector3d(log_map(arm.kinematic_target[k] *
-                                                         arm.previous_kinematic[k].conjugate()) /
-                                                 h);
-                arm.previous_kinematic[k] = arm.kinematic_target[k];
-            }
-        }
-        ik_stats_.wall_s +=
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - ik_start).count();
+    const auto ik_start = std::chrono::steady_clock::now();
+    target_pose_.pelvis_position_m = reference.pelvis_position_m;
+    target_pose_.pelvis_rotation = reference.pelvis_rotation;
+    target_pose_.local = target_;
+    model.forward(target_pose_, target_frames_);
+    if (cartesian) {
+        scene_->body_frames(sim_frames_);
+        scene_->local_rotations(sim_local_);
     }
-    scene_->set_joint_targets(target_, rate_);
-    ++steps_;
-    return scene_->step();
+    for (int s = 0; s < 2; ++s) {
+        Arm &arm = *arms_[s];
+        const Side side = static_cast<Side>(s);
+        const int hb = model.hand_body(side);
+        const Eigen::Vector3d tip_target =
+            tips.has_position ? tips.position_m[s]
+                              : model.tip_position(side, target_frames_.origin_m[hb],
+                                                   target_frames_.rotation[hb]);
+        solve_kinematic(arm, side, tip_target, tips);
+        if (cartesian) {
+            solve_feedback(arm, side, tip_target, tips, integrate);
+        } else {
+            for (int k = 0; k < 4; ++k)
+                arm.theta_target[k] = arm.kinematic_target[k];
+        }
+        set_arm_targets(arm);
+    }
+    ik_stats_.wall_s +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - ik_start).count();
+}
+
+void Tracker::count_solve(const IkResult &r)
+{
+    ik_stats_.iterations += r.iterations;
+    ik_stats_.max_iterations = std::max(ik_stats_.max_iterations, r.iterations);
+    ik_stats_.not_converged += r.status != IkStatus::converged;
+    ++ik_stats_.solves;
+}
+
+// Kinematic IK: the arm's target trajectory without the body, for the target
+// rates (feedforward of eq. 1), capped at CartesianOptions::max_joint_speed_rad_s.
+void Tracker::solve_kinematic(Arm &arm, Side side, const Eigen::Vector3d &tip_target,
+                              const TipTargets &tips)
+{
+    const CartesianOptions &co = cartesian_;
+    const int s = static_cast<int>(side);
+    arm.kinematic.set_base(target_frames_.origin_m[arm.base_body],
+                           target_frames_.rotation[arm.base_body]);
+    if (co.reference_has_arms)
+        for (int k = 0; k < 4; ++k)
+            arm.kinematic_target[k] = target_[arm.joint[k]];
+    arm.kinematic.set_rotations(arm.kinematic_target);
+    Eigen::Quaterniond hand_target;
+    double plane = 0.0;
+    const bool orient =
+        tips.has_direction && co.rotation_weight > 0.0 &&
+        held_rotation(scene_->model(), side, tips.stick_direction[s], hand_target, &plane);
+    const IkResult r = orient ? solver_->solve(arm.kinematic, tip_target, hand_target,
+                                               co.rotation_weight * plane, arm.kinematic_target)
+                       : co.posture_weight > 0.0
+                           ? solver_->solve_with_posture(arm.kinematic, tip_target, arm.posture,
+                                                         co.posture_weight, arm.kinematic_target)
+                           : solver_->solve(arm.kinematic, tip_target, arm.kinematic_target);
+    count_solve(r);
+    if (!(co.max_joint_speed_rad_s > 0.0 && steps_ > 0))
+        return;
+    const double cap = co.max_joint_speed_rad_s * scene_->options().step_s;
+    for (int k = 0; k < 4; ++k) {
+        const double a = rotation_angle_between(arm.previous_kinematic[k], arm.kinematic_target[k]);
+        if (a > cap) {
+            arm.kinematic_target[k] =
+                arm.previous_kinematic[k].slerp(cap / a, arm.kinematic_target[k]);
+            ++ik_stats_.rate_capped;
+        }
+    }
+}
+
+// Eq. 2 with its gain: the IK target is X^S + gain (X^T - X^S) (+ the
+// velocity, acceleration and integral terms, capped), X^S from the
+// simulated thorax and Theta^S. The solve starts from Theta^S (eq. 2
+// literally) or from the kinematic solution, which holds the arm's
+// null space (CartesianOptions::start_from_simulated, docs/ik.md).
+void Tracker::solve_feedback(Arm &arm, Side side, const Eigen::Vector3d &tip_target,
+                             const TipTargets &tips, bool integrate)
+{
+    const CartesianOptions &co = cartesian_;
+    const int s = static_cast<int>(side);
+    const double h = scene_->options().step_s;
+    arm.feedback.set_base(sim_frames_.origin_m[arm.base_body], sim_frames_.rotation[arm.base_body]);
+    for (int k = 0; k < 4; ++k)
+        arm.feedback.set_rotation(k, sim_local_[arm.joint[k]]);
+    const Eigen::Vector3d sim_tip_chain = arm.feedback.tip_position();
+    if (!co.start_from_simulated)
+        arm.feedback.set_rotations(arm.kinematic_target);
+    // X^S where the hand holds the stick: on a fulcrum the stick's
+    // own swing (its rebound) is physics, not an error for the arm.
+    const Eigen::Vector3d error = tip_target - scene_->held_tip_position(side);
+    const Eigen::Vector3d velocity_error = tips.velocity_mps[s] - scene_->held_tip_velocity(side);
+    if (co.integral_per_s > 0.0 && integrate) {
+        arm.integral_m += co.integral_per_s * h * error;
+        const double norm = arm.integral_m.norm();
+        if (norm > co.integral_limit_m)
+            arm.integral_m *= co.integral_limit_m / norm;
+    }
+    Eigen::Vector3d correction = (co.gain - 1.0) * error + velocity_gain_s_ * velocity_error +
+                                 co.acceleration_feedforward_s2 * tips.acceleration_mps2[s];
+    const double correction_norm = correction.norm();
+    if (correction_norm > co.correction_limit_m)
+        correction *= co.correction_limit_m / correction_norm;
+    const Eigen::Vector3d ik_target = sim_tip_chain + error + correction + arm.integral_m;
+    // The hands' rotation task stays in the kinematic IK: from its
+    // solution the feedback solve moves the arm only as the tip
+    // error asks (with the hand's rotation held, the gain's
+    // correction would have to come from the upper arm alone, and
+    // the loop chattered: docs/perform.md, "Holding the stick").
+    // From Theta^S the posture task holds the arm's null space (docs/ik.md).
+    count_solve(co.start_from_simulated && co.posture_weight > 0.0
+                    ? feedback_solver_->solve_with_posture(arm.feedback, ik_target, arm.posture,
+                                                           co.posture_weight, arm.theta_target)
+                    : feedback_solver_->solve(arm.feedback, ik_target, arm.theta_target));
+}
+
+// The arm's PD targets Theta^T and, for the feedforward, the kinematic IK's rates.
+void Tracker::set_arm_targets(Arm &arm)
+{
+    const double h = scene_->options().step_s;
+    for (int k = 0; k < 4; ++k) {
+        const int j = arm.joint[k];
+        target_[j] = arm.theta_target[k];
+        rate_[j] =
+            steps_ == 0
+                ? Eigen::Vector3d::Zero()
+                : Eigen::Vector3d(
+                      log_map(arm.kinematic_target[k] * arm.previous_kinematic[k].conjugate()) / h);
+        arm.previous_kinematic[k] = arm.kinematic_target[k];
+    }
 }
 
 bool held_rotation(const CharacterModel &model, Side side, const Eigen::Vector3d &direction,

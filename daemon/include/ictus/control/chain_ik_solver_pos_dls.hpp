@@ -112,6 +112,57 @@ class ChainIkSolverPos_dls
 
     double direction_error(const ChainFrames &frames, const Eigen::Vector3d &target_direction,
                            Eigen::Vector3d *rotation_vector) const;
+    // The tip's and the secondary task's errors at one configuration.
+    struct TaskError {
+        Eigen::Vector3d tip_m = Eigen::Vector3d::Zero(); // target - tip
+        double tip_norm_m = 0.0;
+        // The world rotation vector turning the stick (or hand) onto its target, and its angle.
+        Eigen::Vector3d direction_step = Eigen::Vector3d::Zero();
+        double direction_rad = 0.0;
+    };
+    // Where one solve() stands: the accepted configuration rotation_[current] and its errors,
+    // the Levenberg-Marquardt damping and the secondary task's weight for the next step.
+    struct Iterate {
+        int current = 0;
+        TaskError error;
+        double damping_m = 0.0, secondary_weight = 0.0;
+        bool limits_active = false; // a limit clamped a joint in the last step tried
+    };
+    // The errors at `frames` (the direction's only with a direction target).
+    void measure(const ChainFrames &frames, const Eigen::Vector3d &target_tip_m,
+                 const Eigen::Vector3d *direction_target, TaskError &at) const;
+    // One step tried from `it`, accepted or refused (Levenberg-Marquardt); false when the
+    // step is too small to move (stalled).
+    bool iterate(const KinematicChain &chain, const Eigen::Vector3d &target_tip_m,
+                 const Eigen::Vector3d *direction_target, double direction_weight,
+                 bool with_posture, Iterate &it);
+    // The steps of solve(), in its order. The inputs' finiteness and sizes; the warm start
+    // into rotation_[0] (false, with rotations_out the warm start, when anything is invalid).
+    bool inputs_valid(const KinematicChain &chain, const Eigen::Vector3d &target_tip_m,
+                      const Eigen::Vector3d &target_direction, double direction_weight,
+                      const Eigen::Quaterniond *rotations_out) const;
+    bool load_warm_start(const KinematicChain &chain, bool valid,
+                         Eigen::Quaterniond *rotations_out);
+    // step_ = the damped tip step (eq. 2) at `frames`; jacobian_, jjt_undamped_ its J, J J^T.
+    void tip_step(const ChainFrames &frames, const Eigen::Vector3d &error, double error_m,
+                  double damping_m);
+    // projector_llt_ = the (barely regularised) J J^T of the null-space projector.
+    void factor_projector();
+    // step_ += the direction (or rotation) task's step in the tip task's null space.
+    void add_direction_step(double secondary_weight, const Eigen::Vector3d &direction_step);
+    // step_ += the posture task's step in the tip task's null space; returns the bound on
+    // how far it moves the tip (m).
+    double add_posture_step(const KinematicChain &chain, const ChainFrames &frames, int current,
+                            bool projector_ready);
+    // Scales step_ to the joint-step bound; false when it is too small to move (stalled).
+    bool bound_step();
+    // rotation_[candidate] = rotation_[current] turned by step_, clamped into the chain's
+    // limits; true when a limit clamped a joint.
+    bool apply_step(const KinematicChain &chain, const ChainFrames &frames, int current,
+                    int candidate);
+    // Why the solve ended short of the target (sets result.min_singular_value_m).
+    IkStatus failure_status(const KinematicChain &chain, const Eigen::Vector3d &target_tip_m,
+                            int current, IkResult &result);
     // The secondary task is the last frame's whole rotation (solve with a target rotation).
     bool full_rotation_ = false;
     Eigen::Quaterniond target_rotation_ = Eigen::Quaterniond::Identity();

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "ictus/character/character.hpp"
+#include "ictus/control/control_error.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -48,18 +49,18 @@ void scale_gains(const std::vector<JointGains> &base, const double scale[2],
 
 // A human-sized torque limit for a joint of the character, N m per axis, for
 // a body of the given mass (limits scale linearly with body mass from 70 kg).
-// Throws CharacterError for an unknown joint name.
+// Throws ControlError for an unknown joint name.
 double default_torque_limit_nm(const std::string &joint_name, double body_mass_kg);
 
 // Per-joint gains: k_s, k_d from the subtree inertia at `pose` (sticks
 // included) and the options; torque limits from default_torque_limit_nm.
-// Throws CharacterError on non-finite or non-positive options.
+// Throws ControlError on non-finite or non-positive options.
 std::vector<JointGains> default_gains(const CharacterModel &model, const CharacterPose &pose,
                                       const GainOptions &options = {});
 
 // Per-joint overrides, e.g. {"l_wrist": {"kp_nm_per_rad": 40, "torque_limit_nm": 20}}:
 // any subset of kp_nm_per_rad, kd_nm_s_per_rad, torque_limit_nm per joint name.
-// Throws CharacterError naming `source`, the joint and the field on anything
+// Throws ControlError naming `source`, the joint and the field on anything
 // unknown, non-numeric, non-finite or not > 0.
 void apply_gain_overrides(const CharacterModel &model, const nlohmann::json &overrides,
                           const std::string &source, std::vector<JointGains> &gains);

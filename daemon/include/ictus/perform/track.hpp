@@ -73,7 +73,8 @@ struct TrackOptions {
     // included (e.g. the strike detector behind `ictusd track`'s strikes.csv).
     std::function<void(const Scene &)> on_step;
 };
-// Throws CharacterError naming the first bad option.
+// Throws PerformError naming the first bad option (the scene's options: the
+// scene's own error).
 void validate(const TrackOptions &options);
 
 struct TrackSummary {
@@ -161,7 +162,8 @@ using ProgressFn = std::function<void(double fraction)>;
 
 // Runs the tracking of `reference` in options.mode (errors are measured against it, and also
 // against `raw_reference` when given). `limits` as Scene::set_joint_limits (empty: none). When
-// csv is given, writes a header and one row per sample. Throws CharacterError.
+// csv is given, writes a header and one row per sample. Throws PerformError (bad options or
+// input), and what the areas below throw (the drum fit, the scene, the gains).
 TrackSummary track_joint_space(const CharacterModel &model, const ReferenceMotion &reference,
                                const TrackOptions &options,
                                const std::vector<JointLimitRef> &limits = {},

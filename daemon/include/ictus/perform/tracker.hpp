@@ -11,6 +11,7 @@
 #include "ictus/character/character.hpp"
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/control/kinematic_chain.hpp"
+#include "ictus/perform/perform_error.hpp"
 #include "ictus/sim/scene.hpp"
 
 #include <Eigen/Core>
@@ -27,7 +28,7 @@ enum class TrackMode {
     cartesian // Algorithm 2: the arms' targets from IK (eq. 2) toward the stick tips
 };
 const char *to_string(TrackMode mode);
-TrackMode track_mode_from_string(const std::string &text); // throws CharacterError
+TrackMode track_mode_from_string(const std::string &text); // throws PerformError
 
 // The Cartesian (hybrid) mode's IK settings.
 struct CartesianOptions {
@@ -149,7 +150,7 @@ class Tracker
     // `gain_options` only for the automatic velocity gain (cartesian.velocity_gain_s < 0).
     // `limits` as Scene::set_joint_limits (empty: none; they must outlive the tracker);
     // `ik_limits` (nullptr: `limits`) those the arms' IK clamps into.
-    // Throws CharacterError (a joint missing from the model, bad options).
+    // Throws PerformError (a joint missing from the model, bad options).
     Tracker(const CharacterModel &model, const SceneOptions &scene_options,
             const CharacterPose &initial, const std::vector<JointGains> &gains,
             const std::vector<JointLimitRef> &limits, TrackMode mode,
@@ -204,6 +205,15 @@ class Tracker
 
   private:
     struct Arm;
+    // The steps of step(): the reference's targets and rates, then the arms' IK.
+    void follow_reference(const CharacterPose &reference, bool tips_drive_arms);
+    void drive_arms(const CharacterPose &reference, const TipTargets &tips, bool integrate);
+    void solve_kinematic(Arm &arm, Side side, const Eigen::Vector3d &tip_target,
+                         const TipTargets &tips);
+    void solve_feedback(Arm &arm, Side side, const Eigen::Vector3d &tip_target,
+                        const TipTargets &tips, bool integrate);
+    void set_arm_targets(Arm &arm);
+    void count_solve(const IkResult &r);
     TrackMode mode_;
     CartesianOptions cartesian_;
     double velocity_gain_s_ = 0.0;
