@@ -1,4 +1,4 @@
-"""ictus against its peers, side by side in one run (issue 16). Run through
+"""ictus against its peers, side by side in one run. Run through
 bench/peers/run_peers.sh, which sets up the peers' virtual environment.
 
 Every round runs each case once, ictus and peers alternating, so that the load
@@ -48,7 +48,6 @@ import resource
 import shutil
 import statistics
 import subprocess
-import sys
 import tempfile
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
@@ -330,7 +329,7 @@ if "drum" not in skip:
                 n, min(f), per_round_ratio(results[("ictus avx2", n)], f),
                 per_round_ratio(results[("ictus generic", n)], f)))
     if 1024 in sizes:
-        print("Targets (issue 16) at 1024 modes, the 10 kg pressed stick: avx2 %.3f (target <= 0.20), "
+        print("Targets at 1024 modes, the 10 kg pressed stick: avx2 %.3f (target <= 0.20), "
               "generic %.3f (target <= 0.5), best rounds" % (
                   min(results[("ictus avx2", 1024)]), min(results[("ictus generic", 1024)])))
 if "performer" not in skip:

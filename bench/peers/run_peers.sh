@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# ictus against its peers, side by side in one run (issue 16; docs/benchmarks.md):
+# ictus against its peers, side by side in one run (docs/benchmarks.md):
 # the drum in Pd against vanilla [bp~] banks and the Sound Design Toolkit, and
 # `ictusd track --mode joint` against MuJoCo's CMU humanoid, plus `ictusd render`.
 # Installs the peers it needs into BUILD_DIR/peers/venv (PyPI: mujoco and

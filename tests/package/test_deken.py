@@ -17,12 +17,11 @@ import re
 import shutil
 import stat
 import subprocess
-import sys
 import zipfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "pd"))
-from pdrun import PD, PD_ENV, check, error_lines, make_workdir, read_wav_float  # noqa: E402
+from ictus_tools.checks import check
+from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float
 
 REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
 ap = argparse.ArgumentParser()

@@ -7,7 +7,8 @@ import argparse
 import os
 import subprocess
 
-from pdrun import PD, PD_ENV, check, error_lines
+from ictus_tools.checks import check
+from ictus_tools.pdrun import PD, PD_ENV, error_lines
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

@@ -22,9 +22,8 @@ import subprocess
 
 import numpy as np
 
-import sys
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "pd"))
-from pdrun import PD, PD_ENV, check, error_lines, make_workdir, read_wav_float
+from ictus_tools.checks import check
+from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

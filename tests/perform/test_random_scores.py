@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Any valid score plays right (issue 12): seeded random scores in the whole score language
-(scripts/random_score.py: tempi 40..220 bpm and ramps, every fraction with triplets and dotted
+"""Any valid score plays right: seeded random scores in the whole score language
+(ictus_tools.random_score: tempi 40..220 bpm and ramps, every fraction with triplets and dotted
 values, rests, R+L, both grips, every nuance the parser knows, pp..ff and numbers, `at`,
 repeats), each rendered by the real `ictusd render`, in parallel over the cores. For every
-score (scripts/render_check.py):
+score (ictus_tools.render_check):
 
 - ictusd accepts it (the generator keeps the planner's rule: strokes of one hand >= 0.1 s apart);
 - notes.csv holds exactly the generator's notes, at the times of the generator's own tempo map
@@ -32,9 +32,8 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import random_score  # noqa: E402
-import render_check  # noqa: E402
+from ictus_tools import random_score
+from ictus_tools import render_check
 
 
 def main():

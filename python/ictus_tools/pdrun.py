@@ -3,17 +3,17 @@
 A test builds a patch from a list of boxes and connections, runs
 `pd -nogui -nosound -batch -stderr`, and reads back what the patch wrote into a
 table (32-bit float WAV via soundfiler, see docs/externals.md)."""
-import os
 import atexit
+import os
 import re
 import shutil
 import socket
 import subprocess
-import sys
 import tempfile
-import wave
 
 import numpy as np
+
+from ictus_tools import checks
 
 PD = os.environ.get("ICTUS_PD", "pd")
 # Under the ASan build, the sanitizer runtime to preload into pd (which is not
@@ -172,11 +172,10 @@ def read_wav_any(path):
 
 
 _workdirs = []
-_failed = [False]
 
 
 def _cleanup():
-    if _failed[0] or os.environ.get("ICTUS_KEEP_TMP"):
+    if checks.failed() or os.environ.get("ICTUS_KEEP_TMP"):
         for d in _workdirs:
             print("kept for inspection:", d)
         return
@@ -197,11 +196,3 @@ def make_workdir(prefix):
 
 def error_lines(log):
     return [l for l in log.splitlines() if ERROR_RE.search(l)]
-
-
-def check(cond, message):
-    if not cond:
-        print("FAIL:", message)
-        _failed[0] = True
-        sys.exit(1)
-    print("ok:", message)

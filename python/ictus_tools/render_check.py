@@ -1,8 +1,8 @@
 """Render a random score with the real `ictusd render` and check what came out against the notes
-the generator (scripts/random_score.py) says the score holds -- times from its own tempo map,
+the generator (ictus_tools.random_score) says the score holds -- times from its own tempo map,
 not from the daemon. Shared by tests/perform/test_random_scores.py and bench/random_scores.py.
 
-The acceptance (issue 12, "Any valid score plays right"):
+The acceptance ("Any valid score plays right", docs/perform.md):
 - the render is accepted (exit 0): the generator only writes valid scores;
 - notes.csv lists exactly the generator's notes (hand, nuance, grip; time within 10 us);
 - every note gets exactly one primary (bounce = 0) strike of its hand within +-TOLERANCE_MS of its
@@ -27,7 +27,7 @@ import shutil
 import subprocess
 import tempfile
 
-from random_score import LEAD_IN_S, RandomScore
+from ictus_tools.random_score import LEAD_IN_S, RandomScore
 
 TOLERANCE_MS = 5.0            # the acceptance bound, never loosened
 ASSIGN_MS = 50.0              # a strike further than this from a note is not its strike
@@ -116,7 +116,8 @@ class Result:
         """Everything needed to reproduce and see a failure."""
         out = ["seed %d: %s" % (self.seed, "; ".join(self.problems[:6]) +
                                 (" ..." if len(self.problems) > 6 else ""))]
-        out.append("  reproduce: python3 scripts/random_score.py --seed %d --ictusd %s > s.txt && "
+        out.append("  reproduce: PYTHONPATH=python python3 -m ictus_tools.random_score --seed %d --ictusd %s "
+                   "> s.txt && "
                    "%s render --score s.txt --out out-%d" % (self.seed, ictusd, ictusd, self.seed))
         out.append("  score:")
         out.extend("    | " + line for line in self.score.text.rstrip("\n").split("\n"))
@@ -478,7 +479,7 @@ def planted_faults(score, out):
         check(res, d)
         found.append((name, any(sign in p for p in res.problems), res.problems))
         shutil.rmtree(d, ignore_errors=True)
-    # A joint beyond its limit, as the render.json of issue 12 reports it.
+    # A joint beyond its limit, as render.json reports it.
     d = out + "-planted-limits"
     shutil.rmtree(d, ignore_errors=True)
     shutil.copytree(out, d)
