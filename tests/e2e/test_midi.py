@@ -18,15 +18,14 @@ import subprocess
 import sys
 
 from ictus_tools import e2e_util as u
-from ictus_tools.checks import check
+from ictus_tools.checks import check, fail
 from ictus_tools.pdrun import make_workdir
 
 try:
     import mido
 except ImportError:
     if os.environ.get("CI") == "true":
-        print("FAIL: python3-mido is missing (scripts/deps.sh installs it)")
-        sys.exit(1)
+        fail("python3-mido is missing (scripts/deps.sh installs it)")
     print("SKIPPED: python3-mido is missing (scripts/deps.sh installs it)")
     sys.exit(77)
 

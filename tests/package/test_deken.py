@@ -19,11 +19,10 @@ import stat
 import subprocess
 import zipfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+from ictus_tools import ROOT as REPO
 from ictus_tools.checks import check
 from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float
 
-REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 ap.add_argument("--cmake", default="cmake", help="the cmake that configured the build")

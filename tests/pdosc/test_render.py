@@ -22,6 +22,7 @@ import subprocess
 
 import numpy as np
 
+from ictus_tools import ROOT
 from ictus_tools.checks import check
 from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float
 
@@ -29,8 +30,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 args = ap.parse_args()
 build = os.path.abspath(args.build)
-root = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-render = os.path.join(root, "patches", "ictus-render.pd")
+render = os.path.join(ROOT, "patches", "ictus-render.pd")
 work = make_workdir("ictus-render-")
 rng = np.random.default_rng(5)
 

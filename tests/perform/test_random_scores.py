@@ -30,10 +30,8 @@ import sys
 import tempfile
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
-from ictus_tools import random_score
-from ictus_tools import render_check
+from ictus_tools import checks, random_score, render_check
+from ictus_tools.checks import check, fail
 
 
 def main():
@@ -50,8 +48,7 @@ def main():
     args = ap.parse_args()
 
     if not os.access(args.ictusd, os.X_OK):
-        print("FAIL: no ictusd at %s" % args.ictusd)
-        return 1
+        fail("no ictusd at %s" % args.ictusd)
     nuances = random_score.nuance_list(args.ictusd)
     print("nuances from the parser: %s" % ", ".join(nuances))
 
@@ -133,12 +130,13 @@ def main():
             shutil.rmtree(os.path.join(workdir, "planted"), ignore_errors=True)
     if not failed and not args.keep:
         shutil.rmtree(workdir, ignore_errors=True)
+    checks.keep_going()  # every problem is reported
     for p in problems:
-        print("FAIL: " + p)
-    if not problems:
-        print("PASS: every note of %d random scores got one primary strike within +-%g ms, no "
-              "extra primary strike" % (len(results), render_check.TOLERANCE_MS))
-    return 1 if problems else 0
+        check(False, p)
+    checks.finish()
+    print("PASS: every note of %d random scores got one primary strike within +-%g ms, no "
+          "extra primary strike" % (len(results), render_check.TOLERANCE_MS))
+    return 0
 
 
 if __name__ == "__main__":
