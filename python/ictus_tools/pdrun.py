@@ -196,3 +196,18 @@ def make_workdir(prefix):
 
 def error_lines(log):
     return [l for l in log.splitlines() if ERROR_RE.search(l)]
+
+
+# Gem's start-up chatter (no config file, an optional capture plugin's missing
+# library) is not an error of the patch.
+GEM_NOISE = ("gem.conf", "libDeckLinkAPI")
+
+
+def open_patch(path, extra_args=(), timeout=60):
+    """Opens a patch in pd batch mode, switches DSP on and quits: (exit status, the error
+    lines of pd's output but Gem's start-up chatter)."""
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr"] + list(extra_args) + [
+        "-open", path, "-send", "pd dsp 1", "-send", "pd quit"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=PD_ENV)
+    log = proc.stdout + proc.stderr
+    return proc.returncode, [l for l in error_lines(log) if not any(n in l for n in GEM_NOISE)]

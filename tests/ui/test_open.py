@@ -6,9 +6,8 @@ this area (ui) have the parts of a vanilla help patch."""
 import argparse
 import glob
 import os
-import subprocess
 
-from ictus_tools import uitest
+from ictus_tools import pdrun, uitest
 from ictus_tools.checks import check
 
 ap = argparse.ArgumentParser()
@@ -16,18 +15,11 @@ ap.add_argument("--build", required=True)
 args = ap.parse_args()
 build = os.path.abspath(args.build)
 libdir = os.path.join(build, "ictus")
-# Gem's start-up chatter (no config file, an optional capture plugin's missing
-# library) is not an error of the patch.
-GEM_NOISE = ("gem.conf", "libDeckLinkAPI")
 
 
 def open_patch(path, name):
-    cmd = [uitest.PD, "-nogui", "-nosound", "-batch", "-stderr", "-open", path,
-           "-send", "pd dsp 1", "-send", "pd quit"]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
-    log = proc.stdout + proc.stderr
-    bad = [l for l in uitest.error_lines(log) if not any(n in l for n in GEM_NOISE)]
-    check(proc.returncode == 0 and not bad,
+    status, bad = pdrun.open_patch(path)
+    check(status == 0 and not bad,
           "%s opens without error lines%s" % (name, "" if not bad else ":\n" + "\n".join(bad)))
 
 
