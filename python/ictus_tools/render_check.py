@@ -167,11 +167,13 @@ def render(ictusd, score, workdir, timeout_s=600, extra_args=()):
             res.crashed = "exit %d: %s" % (proc.returncode, "\n".join(msg[-20:]))
             res.problems.append("ictusd render failed, " + res.crashed)
         return res
-    check(res, out)
+    judge(res, out)
     return res
 
 
-def check(res, out):
+def judge(res, out):
+    """Judges the render in `out` against res.score (the acceptance above): fills res.notes,
+    res.extra and res.problems."""
     score = res.score
     with open(os.path.join(out, "render.json")) as f:
         text = f.read()
@@ -476,7 +478,7 @@ def planted_faults(score, out):
         with open(os.path.join(d, "strikes.csv"), "w") as f:
             f.write("\n".join([lines[0]] + [",".join(r) for r in mutated]) + "\n")
         res = Result(score)
-        check(res, d)
+        judge(res, d)
         found.append((name, any(sign in p for p in res.problems), res.problems))
         shutil.rmtree(d, ignore_errors=True)
     # A joint beyond its limit, as render.json reports it.
@@ -489,7 +491,7 @@ def planted_faults(score, out):
     with open(os.path.join(d, "render.json"), "w") as f:
         json.dump(j, f)
     res = Result(score)
-    check(res, d)
+    judge(res, d)
     found.append(("a joint 2.5 deg beyond its limit", any("joint limit" in p for p in res.problems),
                   res.problems))
     shutil.rmtree(d, ignore_errors=True)
