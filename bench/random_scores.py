@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Random scores through the real `ictusd render`: how well any valid score is played.
 
-Renders N seeded random scores (scripts/random_score.py; seeds FIRST .. FIRST+N-1) with the
+Renders N seeded random scores (ictus_tools.random_score; seeds FIRST .. FIRST+N-1) with the
 given ictusd, in parallel, checks each as tests/perform/test_random_scores.py does
-(scripts/render_check.py), and prints the distribution as markdown, ready for docs/perform.md:
+(ictus_tools.render_check), and prints the distribution as markdown, ready for docs/perform.md:
 notes, missed notes, extra primary strikes, bounces, timing error (mean, p50, p99, worst and its
 seed), contact duration (median, p5/p95), measured / planned impact speed, and the notes not
 played right by score feature (tempo band, fraction, grip, nuance, dynamics, ...) so that weak
@@ -24,11 +24,9 @@ import os
 import sys
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.abspath(os.path.join(HERE, ".."))
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import random_score  # noqa: E402
-import render_check  # noqa: E402
+# Run by hand: the one bootstrap that finds the helpers' package (python/ in this repository).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from ictus_tools import random_score, render_check  # noqa: E402
 
 
 def pct(values, p):

@@ -12,7 +12,6 @@ with stress-ng beside it (--load). Prints the distribution; docs/benchmarks.md
 usage: bench/strike_lateness.py ICTUSD [--seconds 600] [--lookahead 0.02] [--load] [--realtime]
 """
 import argparse
-import os
 import socket
 import struct
 import subprocess

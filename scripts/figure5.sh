@@ -29,5 +29,6 @@ if ! "$ictusd" render --help 2>&1 | grep -q -- "--score"; then
 fi
 mkdir -p "$out"
 "$ictusd" render --score "$score" --out "$out" --force
-/usr/bin/python3 "$root/scripts/figure5.py" "$out" --out "$out/figure5" \
+PYTHONPATH="$root/python${PYTHONPATH:+:$PYTHONPATH}" /usr/bin/python3 -m ictus_tools.figure5 \
+    "$out" --out "$out/figure5" \
     --title "Stick-tip heights, $(basename "$score") (paper, Figure 5)"

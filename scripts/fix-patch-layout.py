@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Moves the boxes of Pd patches apart until none overlaps another, with box
-extents as Pd 0.53 draws them in Debian's default font (tests/ui/pdlayout.py,
-the same model test_help_layout.py checks with).
+extents as Pd 0.53 draws them in Debian's default font (ictus_tools.pdlayout,
+the same model tests/ui/test_help_layout.py checks with).
 
     python3 scripts/fix-patch-layout.py FILE.pd ...
 
@@ -15,11 +15,11 @@ import os
 import re
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "ui"))
-import pdlayout  # noqa: E402
+# Run by hand: the one bootstrap that finds the helpers' package (python/ in this repository).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from ictus_tools import ROOT, pdlayout  # noqa: E402
 
 GAP = 4
-ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 ABSTRACTIONS = [os.path.join(ROOT, d) for d in ("patches", "patches/ui", "patches/sound")]
 
 

@@ -10,7 +10,7 @@
 #   4. Pd in batch mode plays the events on the drum of render.json
 #      (ictusd render --wav, patches/ictus-render.pd): OUT/performance.wav
 #      (stereo, 48 kHz, 32-bit float, peaks below -0.5 dBFS: docs/main-job.md)
-#   5. the tip-trajectory plot (scripts/figure5.py): OUT/tips.png and .svg
+#   5. the tip-trajectory plot (ictus_tools.figure5): OUT/tips.png and .svg
 # and prints where each output is and a short summary.
 #
 # usage: scripts/main.sh [--build DIR] [--out DIR] [--score FILE] [--no-deps] [--no-build]
@@ -60,6 +60,8 @@ mkdir -p "$out"
 build=$(cd "$(dirname "$build")" && pwd)/$(basename "$build")
 out=$(cd "$out" && pwd)
 cd "$root"
+# the Python helpers' package (docs/python.md)
+export PYTHONPATH="$root/python${PYTHONPATH:+:$PYTHONPATH}"
 
 if [[ $deps == 1 ]]; then
     bash scripts/deps.sh
@@ -101,14 +103,13 @@ for f in strikes.csv events.txt render.json performance.wav; do
 done
 
 # 5. the figure
-/usr/bin/python3 "$root/scripts/figure5.py" "$out" --out "$out/tips"
+/usr/bin/python3 -m ictus_tools.figure5 "$out" --out "$out/tips"
 
 # where everything is, and a summary
 ICTUS_MIX=$mix /usr/bin/python3 - "$out" <<'PY'
 import json, os, sys
-sys.path.insert(0, "tests/pd")
 import numpy as np
-from pdrun import read_wav_any
+from ictus_tools.pdrun import read_wav_any
 
 out = sys.argv[1]
 wav = os.path.join(out, "performance.wav")

@@ -8,7 +8,7 @@ pd runs without -batch (its clock follows the system clock, -nosound) with
 Each strike bundle (timetag = send time + lookahead) goes to both ports. The
 onset is the logical time at which each path outputs the strike (the sample
 contact~ would start on), mapped to wall-clock time through pd's own tick
-reports (tests/pdosc/rtpd.py). Figures, in ms:
+reports (ictus_tools.rtpd). Figures, in ms:
   scheduled: onset - timetag   (what matters: 0 = on time)
   plain:     onset - send time (no lookahead; its spread is the jitter)
 plus how late pd actually handled the scheduled strikes on the wall clock
@@ -17,16 +17,13 @@ Usage: bench_latency.py BUILD_DIR [--strikes 200] [--spacing-ms 20] [--lookahead
 import argparse
 import os
 import socket
-import sys
 import time
 
 import numpy as np
 
-here = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(here, "..", "..", "tests", "pdosc"))
-from oscpacket import bundle, now, strike, timetag  # noqa: E402
-from rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd,  # noqa: E402
-                  wait_for_ticks, wall_of_logical)
+from ictus_tools.oscpacket import bundle, now, strike, timetag
+from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd,
+                              wait_for_ticks, wall_of_logical)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("build")

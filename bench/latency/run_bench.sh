@@ -13,5 +13,6 @@ if [ ! -f "$build/ictus/ictus_timetag.pd_linux" ]; then
 fi
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cpu; $(pd -version 2>&1 | head -1 | cut -d' ' -f1)"
 echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'); load before: $(cut -d' ' -f1-3 /proc/loadavg)"
-ICTUS_PD=${ICTUS_PD:-pd} /usr/bin/python3 "$root/bench/latency/bench_latency.py" "$build" "$@"
+ICTUS_PD=${ICTUS_PD:-pd} PYTHONPATH="$root/python${PYTHONPATH:+:$PYTHONPATH}" \
+    /usr/bin/python3 "$root/bench/latency/bench_latency.py" "$build" "$@"
 echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)"

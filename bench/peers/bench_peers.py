@@ -48,7 +48,6 @@ import resource
 import shutil
 import statistics
 import subprocess
-import sys
 import tempfile
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))

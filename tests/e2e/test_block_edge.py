@@ -12,13 +12,12 @@ onset (first sample above 1e-7 after silence, e2e_util.detect_onsets) must be
 sample round(t * sr), and there must be exactly one onset per strike."""
 import argparse
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import e2e_util as u  # noqa: E402
-from pdrun import check, error_lines, make_workdir  # noqa: E402
+from ictus_tools import e2e_util as u
+from ictus_tools.checks import check
+from ictus_tools.pdrun import error_lines, make_workdir
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

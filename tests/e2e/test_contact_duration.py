@@ -47,9 +47,9 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import e2e_util as u  # noqa: E402
-from pdrun import check, error_lines, make_workdir  # noqa: E402
+from ictus_tools import e2e_util as u
+from ictus_tools.checks import check
+from ictus_tools.pdrun import error_lines, make_workdir
 
 BOUND = 0.25           # |d_pd - d_physics| / d_physics: per strike (law), median (score)
 TIP_RADIUS_M = 0.007   # the bead (daemon: StrikeDetectorOptions::tip_radius_m, docs/osc.md)

@@ -1,6 +1,6 @@
 """The README main job (docs/main-job.md)'s core steps on the default score, in this
 build (scripts/main.sh --no-deps --no-build: ictusd render --out, pd batch
-render, figure5.py), and what it leaves in its output folder:
+render, ictus_tools.figure5), and what it leaves in its output folder:
 - performance.wav: the events rendered to the sample, peaking at or below
   -0.3 dBFS, its two channels within 3 dB of each other in RMS. The onsets found in the
   signal alone match strikes.csv within 1 ms with no extra onsets (the strikes
@@ -21,9 +21,9 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import e2e_util as u  # noqa: E402
-from pdrun import check, error_lines, make_workdir, read_wav_float  # noqa: E402
+from ictus_tools import e2e_util as u
+from ictus_tools.checks import check
+from ictus_tools.pdrun import error_lines, make_workdir, read_wav_float
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -218,8 +218,7 @@ if "LeftHandStick_End" in names and "RightHandStick_End" in names and os.path.is
     # exported pose (rotations on fixed offsets) cannot show: measured over
     # the default score every 4 ms (FK of pose_from_frames vs the physics'
     # hand frames), median 0.05 mm, p99 0.4 mm, max 0.80 mm (at an impact).
-    sys.path.insert(0, os.path.join(u.ROOT, "scripts"))
-    import figure5  # noqa: E402  (its column matcher)
+    from ictus_tools import figure5  # (its column matcher)
     with open(tips_csv) as f:
         lines = [l.strip() for l in f if l.strip() and not l.startswith("#")]
     header = lines[0].split(",")

@@ -17,16 +17,15 @@ import os
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import e2e_util as u  # noqa: E402
-from pdrun import check, make_workdir  # noqa: E402
+from ictus_tools import e2e_util as u
+from ictus_tools.checks import check, fail
+from ictus_tools.pdrun import make_workdir
 
 try:
     import mido
 except ImportError:
     if os.environ.get("CI") == "true":
-        print("FAIL: python3-mido is missing (scripts/deps.sh installs it)")
-        sys.exit(1)
+        fail("python3-mido is missing (scripts/deps.sh installs it)")
     print("SKIPPED: python3-mido is missing (scripts/deps.sh installs it)")
     sys.exit(77)
 

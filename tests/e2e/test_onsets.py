@@ -23,9 +23,9 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import e2e_util as u  # noqa: E402
-from pdrun import check, error_lines, make_workdir  # noqa: E402
+from ictus_tools import e2e_util as u
+from ictus_tools.checks import check
+from ictus_tools.pdrun import error_lines, make_workdir
 
 SKIP = 77  # CTest SKIP_RETURN_CODE
 

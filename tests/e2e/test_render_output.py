@@ -20,13 +20,12 @@ import argparse
 import os
 import re
 import subprocess
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import e2e_util as u  # noqa: E402
-from pdrun import PD, PD_ENV, check, error_lines, make_workdir, read_wav_any  # noqa: E402
+from ictus_tools import e2e_util as u
+from ictus_tools.checks import check
+from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_any
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

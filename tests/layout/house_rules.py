@@ -10,7 +10,7 @@ usage: house_rules.py ROOT           check the tree at ROOT; exit 1, naming file
 Rules:
   * no C or C++ source in daemon/ or externals/ over 900 lines;
   * no Markdown file in docs/ (nor README.md) over 500 lines;
-  * no issue-tracker number ("issue 12", "issues 3 and 4", "issue #7") in any text file:
+  * no issue-tracker number (the word followed by a number, with or without "#") in any text file:
     history stays in git, docs and comments say what is;
   * at most 2 edits of Python's module search path in the tree (the helpers are one package,
     imported by name; docs/python.md).

@@ -17,22 +17,18 @@ import re
 import shutil
 import stat
 import subprocess
-import sys
 import zipfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "pd"))
-from pdrun import PD, PD_ENV, check, error_lines, make_workdir, read_wav_float  # noqa: E402
+from ictus_tools import ROOT as REPO
+from ictus_tools import pdrun
+from ictus_tools.checks import check
+from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float
 
-REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 ap.add_argument("--cmake", default="cmake", help="the cmake that configured the build")
 args = ap.parse_args()
 build = os.path.abspath(args.build)
-# Gem's start-up chatter (no config file, an optional capture plugin's missing
-# library) is not an error of the patch (as tests/ui/test_open.py).
-GEM_NOISE = ("gem.conf", "libDeckLinkAPI")
 
 # The name deken expects, computed here from the sources and the machine.
 top_cmake = open(os.path.join(REPO, "CMakeLists.txt")).read()
@@ -116,12 +112,8 @@ if os.path.isdir(gem):
 
 
 def open_patch(path, name):
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr"] + pd_path + [
-        "-open", path, "-send", "pd dsp 1", "-send", "pd quit"]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
-    log = proc.stdout + proc.stderr
-    bad = [l for l in error_lines(log) if not any(n in l for n in GEM_NOISE)]
-    check(proc.returncode == 0 and not bad,
+    status, bad = pdrun.open_patch(path, pd_path)
+    check(status == 0 and not bad,
           "%s opens from the package without error lines%s"
           % (name, "" if not bad else ":\n" + "\n".join(bad)))
 

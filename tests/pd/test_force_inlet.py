@@ -11,7 +11,8 @@ import os
 
 import numpy as np
 
-from pdrun import make_workdir, Patch, check, error_lines, read_wav_float, recorder, run_pd
+from ictus_tools.checks import check
+from ictus_tools.pdrun import make_workdir, Patch, error_lines, read_wav_float, recorder, run_pd
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

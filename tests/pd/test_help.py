@@ -7,7 +7,9 @@ import argparse
 import os
 import subprocess
 
-from pdrun import PD, PD_ENV, check, error_lines
+from ictus_tools import ROOT
+from ictus_tools.checks import check
+from ictus_tools.pdrun import PD, PD_ENV, error_lines
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -17,7 +19,7 @@ build = os.path.abspath(args.build)
 for name in ("membrane~-help.pd", "contact~-help.pd", "ictus-meta.pd"):
     path = os.path.join(build, "ictus", name)
     check(os.path.isfile(path), "%s is in the library folder" % name)
-    source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "help", name)
+    source = os.path.join(ROOT, "help", name)
     # the copy beside the binaries with no search path (as Pd's help browser
     # opens it), and the source file with -path <build>
     for where, extra in ((path, []), (source, ["-path", build])):

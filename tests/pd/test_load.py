@@ -8,7 +8,8 @@ line."""
 import argparse
 import os
 
-from pdrun import make_workdir, Patch, check, error_lines, run_pd
+from ictus_tools.checks import check
+from ictus_tools.pdrun import make_workdir, Patch, error_lines, run_pd
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

@@ -5,10 +5,9 @@ loads (with a file that does not exist it must only complain about that file).""
 import argparse
 import os
 import subprocess
-import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "pd"))
-from pdrun import PD, PD_ENV, check, error_lines  # noqa: E402
+from ictus_tools.checks import check
+from ictus_tools.pdrun import PD, PD_ENV, error_lines
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

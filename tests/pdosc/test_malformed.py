@@ -12,13 +12,12 @@ import random
 import re
 import socket
 import struct
-import sys
 import time
 
-from oscpacket import bundle, message, now, osc_string, strike, timetag
-from rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd, wait_for_ticks,
-                  unexplained_late, wall_of_logical)
-from pdrun import check
+from ictus_tools.oscpacket import bundle, message, now, osc_string, strike, timetag
+from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd,
+                              wait_for_ticks, unexplained_late, wall_of_logical)
+from ictus_tools.checks import check
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

@@ -2,7 +2,7 @@
 [ictus-receive]; this script sends hand-built OSC bundles over loopback with
 timetag = now + lookahead and checks that each strike comes out at the logical
 time that corresponds to its timetag, within 1 ms. The logical-to-wall mapping
-is measured here, from pd's own tick reports (rtpd.py), not taken from the
+is measured here, from pd's own tick reports (ictus_tools.rtpd), not taken from the
 code under test. The reports reach this script some transit time after pd
 sent them, so that mapping is late by the transit; round trips (`probe`,
 echoed by the patch) bound it: the transit is at most the shortest round trip,
@@ -17,10 +17,11 @@ import socket
 import struct
 import time
 
-from oscpacket import bundle, message, now, strike, timetag, IMMEDIATE
-from rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd, wait_for_ticks,
-                  unexplained_late, wall_of_logical)
-from pdrun import check, error_lines
+from ictus_tools.oscpacket import bundle, message, now, strike, timetag, IMMEDIATE
+from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd,
+                              wait_for_ticks, unexplained_late, wall_of_logical)
+from ictus_tools.checks import check
+from ictus_tools.pdrun import error_lines
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

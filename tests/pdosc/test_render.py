@@ -22,16 +22,15 @@ import subprocess
 
 import numpy as np
 
-import sys
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "pd"))
-from pdrun import PD, PD_ENV, check, error_lines, make_workdir, read_wav_float
+from ictus_tools import ROOT
+from ictus_tools.checks import check
+from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 args = ap.parse_args()
 build = os.path.abspath(args.build)
-root = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-render = os.path.join(root, "patches", "ictus-render.pd")
+render = os.path.join(ROOT, "patches", "ictus-render.pd")
 work = make_workdir("ictus-render-")
 rng = np.random.default_rng(5)
 

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Any valid score plays right: seeded random scores in the whole score language
-(scripts/random_score.py: tempi 40..220 bpm and ramps, every fraction with triplets and dotted
+(ictus_tools.random_score: tempi 40..220 bpm and ramps, every fraction with triplets and dotted
 values, rests, R+L, both grips, every nuance the parser knows, pp..ff and numbers, `at`,
 repeats), each rendered by the real `ictusd render`, in parallel over the cores. For every
-score (scripts/render_check.py):
+score (ictus_tools.render_check):
 
 - ictusd accepts it (the generator keeps the planner's rule: strokes of one hand >= 0.1 s apart);
 - notes.csv holds exactly the generator's notes, at the times of the generator's own tempo map
@@ -30,11 +30,8 @@ import sys
 import tempfile
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import random_score  # noqa: E402
-import render_check  # noqa: E402
+from ictus_tools import checks, random_score, render_check
+from ictus_tools.checks import check, fail
 
 
 def main():
@@ -51,8 +48,7 @@ def main():
     args = ap.parse_args()
 
     if not os.access(args.ictusd, os.X_OK):
-        print("FAIL: no ictusd at %s" % args.ictusd)
-        return 1
+        fail("no ictusd at %s" % args.ictusd)
     nuances = random_score.nuance_list(args.ictusd)
     print("nuances from the parser: %s" % ", ".join(nuances))
 
@@ -134,12 +130,13 @@ def main():
             shutil.rmtree(os.path.join(workdir, "planted"), ignore_errors=True)
     if not failed and not args.keep:
         shutil.rmtree(workdir, ignore_errors=True)
+    checks.keep_going()  # every problem is reported
     for p in problems:
-        print("FAIL: " + p)
-    if not problems:
-        print("PASS: every note of %d random scores got one primary strike within +-%g ms, no "
-              "extra primary strike" % (len(results), render_check.TOLERANCE_MS))
-    return 1 if problems else 0
+        check(False, p)
+    checks.finish()
+    print("PASS: every note of %d random scores got one primary strike within +-%g ms, no "
+          "extra primary strike" % (len(results), render_check.TOLERANCE_MS))
+    return 0
 
 
 if __name__ == "__main__":

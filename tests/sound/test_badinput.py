@@ -8,13 +8,11 @@ import argparse
 import os
 import shutil
 import subprocess
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from soundrun import (PD, PD_ENV, RENDER, check, make_workdir, read_wav_float,  # noqa: E402
-                      write_events)
+from ictus_tools.checks import check
+from ictus_tools.soundrun import PD, PD_ENV, RENDER, make_workdir, read_wav_float, write_events
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

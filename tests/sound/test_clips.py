@@ -16,13 +16,12 @@ Velocities straddle every layer boundary (1.06, 2.12, 4.24 m/s) and go beyond
 both ends; the level still rises with velocity across each boundary."""
 import argparse
 import os
-import sys
 import wave
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from soundrun import check, make_workdir, render, write_events  # noqa: E402
+from ictus_tools.checks import check
+from ictus_tools.soundrun import make_workdir, render, write_events
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

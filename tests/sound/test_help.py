@@ -6,10 +6,9 @@ vanilla help patch: the object on top, a working example with dac~, a
 import argparse
 import os
 import subprocess
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from soundrun import PD, PD_ENV, check, error_lines, make_workdir  # noqa: E402
+from ictus_tools.checks import check
+from ictus_tools.soundrun import PD, PD_ENV, error_lines, make_workdir
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

@@ -18,12 +18,11 @@ in real pd batch mode, and each one:
 The clips model also runs at 44.1 kHz (clips are 48 kHz files): same onsets."""
 import argparse
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from soundrun import MODELS, check, make_workdir, onsets, render, rms, write_events  # noqa: E402
+from ictus_tools.checks import check
+from ictus_tools.soundrun import MODELS, make_workdir, onsets, render, rms, write_events
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

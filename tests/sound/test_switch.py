@@ -14,12 +14,11 @@ sample-to-sample step is no larger than the ringing's own just before it (no
 click)."""
 import argparse
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from soundrun import check, make_workdir, render, write_events  # noqa: E402
+from ictus_tools.checks import check
+from ictus_tools.soundrun import make_workdir, render, write_events
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

@@ -11,13 +11,12 @@ cosine), and all move by sqrt(4500/3000). The fundamental's decay follows t60
 0.5 s +- 5 %."""
 import argparse
 import os
-import sys
 
 import numpy as np
 from scipy import signal, special
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from soundrun import check, make_workdir, render, write_events  # noqa: E402
+from ictus_tools.checks import check
+from ictus_tools.soundrun import make_workdir, render, write_events
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

@@ -1,6 +1,6 @@
 """[ictus-view] in Gem under Xvfb (Mesa's software GL): a synthetic pose stream sent
 as OSC bundles over UDP to [ictus-receive] -> [ictus-view], two screenshots kept in
-<build>/artifacts/. Checked against the figure's geometry (tests/ui/uitest.py):
+<build>/artifacts/. Checked against the figure's geometry (ictus_tools.uitest):
  - the picture is not blank: the character's colours are there, on a background;
  - the front camera looks at the character's face, so its left side (blue, world +X)
    is right of its right side (red) on the screen;
@@ -18,8 +18,8 @@ import subprocess
 import tempfile
 import time
 
-import uitest
-from uitest import ok, fail
+from ictus_tools import uitest
+from ictus_tools.checks import check, fail
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -86,7 +86,7 @@ text = open(log_path).read()
 print("artefacts: %s, %s" % (shot_a, shot_b))
 bad = [l for l in uitest.error_lines(text)
        if "gem.conf" not in l and "DeckLink" not in l]
-ok(not bad, "pd log has no error lines" + ("" if not bad else ":\n" + "\n".join(bad)))
+check(not bad, "pd log has no error lines" + ("" if not bad else ":\n" + "\n".join(bad)))
 
 
 def classes(img):
@@ -115,25 +115,25 @@ def gem_window(img):
 
 a = gem_window(uitest.load_image(shot_a))
 b = gem_window(uitest.load_image(shot_b))
-ok(a.shape[:2] == (H, W), "the Gem window is %dx%d" % (W, H))
+check(a.shape[:2] == (H, W), "the Gem window is %dx%d" % (W, H))
 ca, cb = classes(a), classes(b)
 n_px = W * H
 print("front: " + ", ".join("%s %d px" % (k, v.sum()) for k, v in ca.items()))
-ok(len(set(map(tuple, a.reshape(-1, 3)))) > 50, "the Gem view is not blank (many colours)")
-ok(0.3 * n_px < ca["background"].sum() < 0.97 * n_px, "the background fills most but not all of it")
+check(len(set(map(tuple, a.reshape(-1, 3)))) > 50, "the Gem view is not blank (many colours)")
+check(0.3 * n_px < ca["background"].sum() < 0.97 * n_px, "the background fills most but not all of it")
 for k in ("blue", "red", "yellow"):
-    ok(ca[k].sum() > 100, "the character's %s pixels are drawn" % k)
+    check(ca[k].sum() > 100, "the character's %s pixels are drawn" % k)
 bx = centroid(ca["blue"])[0]
 rx = centroid(ca["red"])[0]
-ok(bx > W / 2 + 10 and rx < W / 2 - 10,
-   "front view: the left side (blue, x %.0f) is right of the right side (red, x %.0f)" % (bx, rx))
+check(bx > W / 2 + 10 and rx < W / 2 - 10,
+      "front view: the left side (blue, x %.0f) is right of the right side (red, x %.0f)" % (bx, rx))
 hx_a, hy_a, hw_a, hh_a = centroid(ca["yellow"])
 hx_b, hy_b, hw_b, hh_b = centroid(cb["yellow"])
 print("head: identity at x %.0f (%dx%d px), turned at x %.0f (%dx%d px)" % (hx_a, hw_a, hh_a, hx_b, hw_b, hh_b))
-ok(hh_a > 1.2 * hw_a, "identity quaternion: the head stands up (taller than wide)")
-ok(hw_b > 1.2 * hh_b, "head turned 90 deg about +Z: it lies sideways (wider than tall)")
-ok(hx_b < hx_a - 8, "head turned toward world -X: its centre moves to the screen's left")
+check(hh_a > 1.2 * hw_a, "identity quaternion: the head stands up (taller than wide)")
+check(hw_b > 1.2 * hh_b, "head turned 90 deg about +Z: it lies sideways (wider than tall)")
+check(hx_b < hx_a - 8, "head turned toward world -X: its centre moves to the screen's left")
 rates = [float(v) for v in re.findall(r"view: poserate (\S+)", text)]
 print("rate meter: %s" % rates)
-ok(any(abs(r - RATE_HZ) <= 2 for r in rates[1:]), "the rate meter reports ~%g pose frames/s" % RATE_HZ)
+check(any(abs(r - RATE_HZ) <= 2 for r in rates[1:]), "the rate meter reports ~%g pose frames/s" % RATE_HZ)
 shutil.rmtree(work, ignore_errors=True)

@@ -9,8 +9,8 @@ import shutil
 import subprocess
 import time
 
-import uitest
-from uitest import ok, fail
+from ictus_tools import uitest
+from ictus_tools.checks import check, fail
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -67,16 +67,16 @@ finally:
 print("artefact: " + shot)
 os.remove(log_path)
 bad = [l for l in uitest.error_lines(log) if "gem.conf" not in l and "DeckLink" not in l]
-ok(not bad, "pd with its GUI logs no error lines (Tcl errors included)" + ("" if not bad else ":\n" + "\n".join(bad)))
+check(not bad, "pd with its GUI logs no error lines (Tcl errors included)" + ("" if not bad else ":\n" + "\n".join(bad)))
 img = uitest.load_image(shot)
 colours = len(set(map(tuple, img.reshape(-1, 3))))
-ok(colours > 20 and img.std() > 20, "the screenshot is not blank (%d colours, std %.0f)" % (colours, img.std()))
+check(colours > 20 and img.std() > 20, "the screenshot is not blank (%d colours, std %.0f)" % (colours, img.std()))
 xs = {}
 for k, m in counts.items():
     n = int(m.sum())
     area = PANELS[k][1]
-    ok(0.5 * area < n <= area, "the %s panel is drawn: %d px of its colour (area %d)" % (k, n, area))
+    check(0.5 * area < n <= area, "the %s panel is drawn: %d px of its colour (area %d)" % (k, n, area))
     xs[k] = m.nonzero()[1].mean()
-ok(xs["physics"] < xs["graphics"] < xs["sound"],
-   "panels left to right: physics (x %.0f), graphics (x %.0f), sound (x %.0f)"
-   % (xs["physics"], xs["graphics"], xs["sound"]))
+check(xs["physics"] < xs["graphics"] < xs["sound"],
+      "panels left to right: physics (x %.0f), graphics (x %.0f), sound (x %.0f)"
+      % (xs["physics"], xs["graphics"], xs["sound"]))

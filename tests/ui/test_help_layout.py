@@ -1,5 +1,5 @@
 """No two boxes overlap in any shipped patch (help/, patches/), with box
-extents as Pd 0.53 draws them in Debian's default font (pdlayout.py: DejaVu
+extents as Pd 0.53 draws them in Debian's default font (ictus_tools.pdlayout: DejaVu
 Sans Mono bold, 7 x 15 px per character at Pd's size 12, measured in the real
 GUI; docs/ui.md). The model itself is checked first against extents measured
 in the real pd-gui under Xvfb, and on a patch with a known overlap. Every help
@@ -8,25 +8,17 @@ help patch that makes sound (has a [dac~]) a volume slider that reaches it."""
 import argparse
 import glob
 import os
-import sys
 import tempfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-import pdlayout  # noqa: E402
+from ictus_tools import ROOT as REPO
+from ictus_tools import checks, pdlayout
+from ictus_tools.checks import check
 
-REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
 ABSTRACTIONS = [os.path.join(REPO, d) for d in ("patches", "patches/ui", "patches/sound")]
 ap = argparse.ArgumentParser()
 ap.add_argument("--build")  # unused: the patches are read from the sources
 ap.parse_args()
-failed = []
-
-
-def ok(cond, msg):
-    print(("ok: " if cond else "FAIL: ") + msg)
-    if not cond:
-        failed.append(msg)
+checks.keep_going()  # every patch is reported before the test ends
 
 
 def patch(text):
@@ -48,34 +40,34 @@ known = patch("#N canvas 0 0 600 400 12;\n"
               "#X text 660 180 <- replies are shown, f 30;\n"  # box 30 columns, glyphs 20
               "#X text 20 500 " + " ".join(["word"] * 30) + ";\n")  # 149 chars: 3 lines of <= 60
 boxes = pdlayout.parse(known)[""]
-ok([(b.w, b.h) for b in boxes[:4]] == [(186, 20), (86, 20), (68, 35), (32, 20)],
-   "object and message boxes measure as in pd-gui: %s" % [(b.w, b.h) for b in boxes[:4]])
-ok(boxes[4].visible[2:] == (343, 15),
-   "a comment's glyphs measure as in pd-gui: %s" % (boxes[4].visible[2:],))
-ok(boxes[5].w == 30 * 7 + 4 and boxes[5].visible[2] == 20 * 7,
-   "', f 30' sets a comment's box, not its glyphs: %d, %d" % (boxes[5].w, boxes[5].visible[2]))
-ok(boxes[6].h == 3 * 15 + 5 and boxes[6].visible[2] == 59 * 7,
-   "a long comment wraps at 60 characters on a space: %d lines, %d px"
-   % ((boxes[6].h - 5) // 15, boxes[6].visible[2]))
+check([(b.w, b.h) for b in boxes[:4]] == [(186, 20), (86, 20), (68, 35), (32, 20)],
+      "object and message boxes measure as in pd-gui: %s" % [(b.w, b.h) for b in boxes[:4]])
+check(boxes[4].visible[2:] == (343, 15),
+      "a comment's glyphs measure as in pd-gui: %s" % (boxes[4].visible[2:],))
+check(boxes[5].w == 30 * 7 + 4 and boxes[5].visible[2] == 20 * 7,
+      "', f 30' sets a comment's box, not its glyphs: %d, %d" % (boxes[5].w, boxes[5].visible[2]))
+check(boxes[6].h == 3 * 15 + 5 and boxes[6].visible[2] == 59 * 7,
+      "a long comment wraps at 60 characters on a space: %d lines, %d px"
+      % ((boxes[6].h - 5) // 15, boxes[6].visible[2]))
 os.remove(known)
 
 # 2. The check finds an overlap: two comments 15 px apart whose first wraps.
 bad = patch("#N canvas 0 0 600 400 12;\n#X text 20 20 " + " ".join(["word"] * 20) + ";\n"
             "#X text 20 35 next;\n#X obj 100 200 f;\n#X obj 110 205 f;\n")
 found = pdlayout.overlaps(bad)
-ok(len(found) == 2,
-   "the check finds a wrapped comment over the next and two stacked boxes: %d" % len(found))
+check(len(found) == 2,
+      "the check finds a wrapped comment over the next and two stacked boxes: %d" % len(found))
 os.remove(bad)
 
 # 3. Every shipped patch.
 patches = sorted(glob.glob(os.path.join(REPO, "help", "*.pd")) +
                  glob.glob(os.path.join(REPO, "patches", "**", "*.pd"), recursive=True))
-ok(len(patches) >= 25, "%d patches to check" % len(patches))
+check(len(patches) >= 25, "%d patches to check" % len(patches))
 for path in patches:
     name = os.path.relpath(path, REPO)
     found = pdlayout.overlaps(path, ABSTRACTIONS)
-    ok(not found, "%s: no overlapping boxes%s" % (
-        name, "".join("\n    in canvas '%s': %r / %r" % (c, a, b) for c, a, b in found)))
+    check(not found, "%s: no overlapping boxes%s" % (
+           name, "".join("\n    in canvas '%s': %r / %r" % (c, a, b) for c, a, b in found)))
 
 # 4. Help patches: "see also" as object boxes; a volume slider before [dac~].
 LIBRARY = {"membrane~", "contact~", "ictus_timetag", "ictus-receive", "ictus-drum", "ictus-sound",
@@ -92,7 +84,7 @@ for path in sorted(glob.glob(os.path.join(REPO, "help", "*-help.pd"))):
             see_also += [b.text.split()[0] for b in boxes if b.kind == "obj"
                          and s.y < b.y <= s.y + s.h + 30 and b.x >= s.x - 10]
     linked = [o for o in see_also if o in LIBRARY and o != subject]
-    ok(len(linked) >= 1, "%s: 'see also' names other objects as object boxes: %s" % (name, see_also))
+    check(len(linked) >= 1, "%s: 'see also' names other objects as object boxes: %s" % (name, see_also))
 
     text = open(path).read()
     records = [pdlayout.atoms(r) for r in pdlayout.split_records(text)]
@@ -130,10 +122,8 @@ for path in sorted(glob.glob(os.path.join(REPO, "help", "*-help.pd"))):
                     todo.append((b, passed))
         return False
 
-    ok(any(reaches(s, dacs, "*~") for s in sliders),
-       "%s: a volume slider reaches [dac~] through a [*~]" % name)
+    check(any(reaches(s, dacs, "*~") for s in sliders),
+          "%s: a volume slider reaches [dac~] through a [*~]" % name)
 
-if failed:
-    print("%d check(s) failed" % len(failed))
-    sys.exit(1)
+checks.finish()
 print("ok: all")

@@ -17,8 +17,8 @@ import tempfile
 import threading
 import time
 
-import uitest
-from uitest import ok, fail
+from ictus_tools import uitest
+from ictus_tools.checks import check, fail
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -121,30 +121,30 @@ finally:
 text = open(pd_log_path).read()
 print("artefact: " + shot)
 bad = [l for l in uitest.error_lines(text) if "gem.conf" not in l and "DeckLink" not in l]
-ok(not bad, "pd log has no error lines" + ("" if not bad else ":\n" + "\n".join(bad)))
+check(not bad, "pd log has no error lines" + ("" if not bad else ":\n" + "\n".join(bad)))
 if "Direct Rendering" not in text and re.search(r"gemglxwindow|could not open display", text, re.I):
     uitest.skip_or_fail("Gem could not open a GL window under Xvfb here:\n" + text[-2000:])
 for s in STATEMENTS:
     want = "daemon: reply /ictus/score " + s.replace(" ", "\\ ")
-    ok(want in text, "the daemon accepted the panel's statement %r (%s)" % (s, want))
-ok("daemon: error" not in text, "no error replies")
-ok("daemon: pong" in text, "ping -> pong")
+    check(want in text, "the daemon accepted the panel's statement %r (%s)" % (s, want))
+check("daemon: error" not in text, "no error replies")
+check("daemon: pong" in text, "ping -> pong")
 # each of the meter's reports against the frames relayed in its second
-ok(t0 is not None and len(rates) >= 3, "the rate meter reported (%s)" % rates)
+check(t0 is not None and len(rates) >= 3, "the rate meter reported (%s)" % rates)
 relayed = [sum(1 for t in pose_times if t0 + k - 1 < t <= t0 + k) for k in range(1, len(rates))]
 print("rate meter: %s, relayed in the same seconds: %s" % (rates[1:], relayed))
-ok(sum(relayed) > 10, "poses were streamed (%d relayed)" % sum(relayed))
+check(sum(relayed) > 10, "poses were streamed (%d relayed)" % sum(relayed))
 # The meter bins by Pd's logical seconds, the relay by wall-clock ones: when
 # Pd stalls and catches up (a loaded machine, a sanitizer), frames move
 # between neighbouring bins (seen: meter 33 2 15 for relayed 20 15 15), but
 # none is lost or counted twice: the totals agree within 2, and each second
 # agrees within 2 whenever Pd kept up (no bin above the relay's rate).
-ok(abs(sum(rates[1:]) - sum(relayed)) <= 2,
-   "the view's rate meter counts the frames that arrived (%d, relayed %d, within 2)"
-   % (sum(rates[1:]), sum(relayed)))
+check(abs(sum(rates[1:]) - sum(relayed)) <= 2,
+      "the view's rate meter counts the frames that arrived (%d, relayed %d, within 2)"
+      % (sum(rates[1:]), sum(relayed)))
 if max(rates[1:]) <= max(relayed) + 2:
-    ok(all(abs(m - r) <= 2 for m, r in zip(rates[1:], relayed)),
-       "each second, the view's rate meter reports the frames that arrived (within 2)")
+    check(all(abs(m - r) <= 2 for m, r in zip(rates[1:], relayed)),
+          "each second, the view's rate meter reports the frames that arrived (within 2)")
 img = uitest.load_image(shot)
 lit = img.sum(axis=2) > 0
 ys, xs = lit.nonzero()
@@ -155,4 +155,4 @@ counts = {"left (blue)": ((b > r + 50) & (b > g + 20)).sum(),
           "head (yellow)": ((r > 120) & (g > 90) & (b < 0.6 * g) & (r > b + 60)).sum(),
           "drum head (off-white)": ((r > 200) & (g > 200) & (b > 180)).sum()}
 for k, n in counts.items():
-    ok(n > 40, "the live view shows the %s: %d px" % (k, n))
+    check(n > 40, "the live view shows the %s: %d px" % (k, n))

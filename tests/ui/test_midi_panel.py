@@ -11,14 +11,12 @@ import argparse
 import math
 import os
 import subprocess
-import sys
 import tempfile
 
-import uitest
-from uitest import ok
+from ictus_tools import uitest
+from ictus_tools.checks import check
 
-sys.path.insert(0, os.path.join(uitest.REPO, "tests", "e2e"))
-import e2e_util as u  # noqa: E402
+from ictus_tools import e2e_util as u
 
 try:
     import mido
@@ -50,7 +48,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-midi-") as work:
                                                                            "short.score"),
                            "--out", out, "--midi-channel", "3", "--bvh-rate", "0", "--tips-rate", "0"],
                           capture_output=True, text=True, timeout=600, env=env)
-    ok(proc.returncode == 0, "ictusd render ran: %s" % proc.stderr[-1000:])
+    check(proc.returncode == 0, "ictusd render ran: %s" % proc.stderr[-1000:])
     strikes = u.read_strikes(os.path.join(out, "strikes.csv"))
     file_notes = [(m.note, m.velocity, m.channel + 1) for m in mido.MidiFile(os.path.join(out, "performance.mid"))
                   if m.type == "note_on" and m.velocity > 0]
@@ -71,31 +69,31 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-midi-") as work:
                            os.path.join(build, "ictus"), "-open", patch, "-send", "pd quit"],
                           capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
 log = proc.stdout + proc.stderr
-ok(not uitest.error_lines(log), "no error lines: %s" % uitest.error_lines(log))
+check(not uitest.error_lines(log), "no error lines: %s" % uitest.error_lines(log))
 got = [tuple(int(float(w)) for w in l.split()[1:]) for l in log.splitlines() if l.startswith("midi: ")]
 n = len(strikes)
-ok(len(file_notes) == n and len(got) == n + 2,
-   "a note per strike (%d strikes, %d in performance.mid, %d from the panel, +2 expected after)"
-   % (n, len(file_notes), len(got)))
+check(len(file_notes) == n and len(got) == n + 2,
+      "a note per strike (%d strikes, %d in performance.mid, %d from the panel, +2 expected after)"
+      % (n, len(file_notes), len(got)))
 live = [(g[0], g[1], g[2]) for g in got[:n]]
-ok(live == file_notes, "the panel's notes are performance.mid's, in order (note, velocity, channel)")
-ok(live == [mapping(s["hand"], s["normal_velocity_mps"], s["r_over_a"]) + (3,) for s in strikes],
-   "... and the mapping computed here from strikes.csv")
-ok([g[3] for g in got[:n]] == [s["bounce"] for s in strikes], "the outlet flags the bounces")
-ok(got[n] == (54, 83, 3, 1), "a bounce plays while 'bounces' is ticked: %s" % (got[n],))
-ok(got[n + 1] == (48 + 1, mapping(0, 5, 0.5)[1], 16, 0),
-   "nothing while off; then on channel 16: %s (the bounce with 'bounces' off left out)" % (got[n + 1],))
+check(live == file_notes, "the panel's notes are performance.mid's, in order (note, velocity, channel)")
+check(live == [mapping(s["hand"], s["normal_velocity_mps"], s["r_over_a"]) + (3,) for s in strikes],
+      "... and the mapping computed here from strikes.csv")
+check([g[3] for g in got[:n]] == [s["bounce"] for s in strikes], "the outlet flags the bounces")
+check(got[n] == (54, 83, 3, 1), "a bounce plays while 'bounces' is ticked: %s" % (got[n],))
+check(got[n + 1] == (48 + 1, mapping(0, 5, 0.5)[1], 16, 0),
+      "nothing while off; then on channel 16: %s (the bounce with 'bounces' off left out)" % (got[n + 1],))
 # MIDI in: each note-on of the mapping gives a strike list whose hand, zone and speed map
 # back (with the mapping above) to that note and velocity; the others, and any note while
 # 'in' is off, give nothing.
 heard = [[float(w) for w in l.split()[1:]] for l in log.splitlines() if l.startswith("midiin: ")]
 want = [nv for nv in MIDI_IN if nv[0] in (48, 49, 50, 52, 53, 54) and nv[1] > 0]
-ok(len(heard) == len(want), "MIDI in: one strike per note-on of the mapping while 'in' is on "
-   "(%d, want %d)" % (len(heard), len(want)))
+check(len(heard) == len(want), "MIDI in: one strike per note-on of the mapping while 'in' is on "
+      "(%d, want %d)" % (len(heard), len(want)))
 for (note, vel), (hand, speed, r, theta) in zip(want, heard):
     speed_want = 0.1 * 100 ** ((vel - 1) / 126)
-    ok(mapping(hand, speed, r) == (note, vel) and abs(speed - speed_want) <= 1e-4 * speed_want and
-       theta == (180 if hand else 0),
-       "MIDI in note %d velocity %d -> hand %d, %.4f m/s, r/a %g, theta %g: maps back" %
-       (note, vel, hand, speed, r, theta))
+    check(mapping(hand, speed, r) == (note, vel) and abs(speed - speed_want) <= 1e-4 * speed_want and
+          theta == (180 if hand else 0),
+          "MIDI in note %d velocity %d -> hand %d, %.4f m/s, r/a %g, theta %g: maps back" %
+          (note, vel, hand, speed, r, theta))
 print("PASS")

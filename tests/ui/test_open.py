@@ -6,36 +6,28 @@ this area (ui) have the parts of a vanilla help patch."""
 import argparse
 import glob
 import os
-import subprocess
 
-import uitest
-from uitest import ok
+from ictus_tools import pdrun, uitest
+from ictus_tools.checks import check
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 args = ap.parse_args()
 build = os.path.abspath(args.build)
 libdir = os.path.join(build, "ictus")
-# Gem's start-up chatter (no config file, an optional capture plugin's missing
-# library) is not an error of the patch.
-GEM_NOISE = ("gem.conf", "libDeckLinkAPI")
 
 
 def open_patch(path, name):
-    cmd = [uitest.PD, "-nogui", "-nosound", "-batch", "-stderr", "-open", path,
-           "-send", "pd dsp 1", "-send", "pd quit"]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
-    log = proc.stdout + proc.stderr
-    bad = [l for l in uitest.error_lines(log) if not any(n in l for n in GEM_NOISE)]
-    ok(proc.returncode == 0 and not bad,
-       "%s opens without error lines%s" % (name, "" if not bad else ":\n" + "\n".join(bad)))
+    status, bad = pdrun.open_patch(path)
+    check(status == 0 and not bad,
+          "%s opens without error lines%s" % (name, "" if not bad else ":\n" + "\n".join(bad)))
 
 
 main = os.path.join(build, "patches", "ictus.pd")
-ok(os.path.isfile(main), "the main patch is in the build: %s" % main)
+check(os.path.isfile(main), "the main patch is in the build: %s" % main)
 # A copy beside it on a free port: the test must not depend on UDP 9000 being free.
 text = open(main).read()
-ok("ictus-receive 9000" in text, "the main patch listens on UDP 9000 (ictusd's default --target)")
+check("ictus-receive 9000" in text, "the main patch listens on UDP 9000 (ictusd's default --target)")
 copy = os.path.join(build, "patches", "ictus-test-open-%d.pd" % os.getpid())
 with open(copy, "w") as f:
     f.write(text.replace("ictus-receive 9000", "ictus-receive 0"))
@@ -44,30 +36,30 @@ try:
 finally:
     os.remove(copy)
 for name in ("ictus-physics", "ictus-graphics", "ictus-sound-panel", "ictus-view", "ictus-sound"):
-    ok(("#X obj" in text) and (" %s" % name) in text, "the main patch uses [%s]" % name)
+    check(("#X obj" in text) and (" %s" % name) in text, "the main patch uses [%s]" % name)
 
 helps = sorted(glob.glob(os.path.join(uitest.REPO, "help", "*.pd")))
-ok(len(helps) >= 10, "help/ has the help patches (%d files)" % len(helps))
+check(len(helps) >= 10, "help/ has the help patches (%d files)" % len(helps))
 for src in helps:
     name = os.path.basename(src)
     path = os.path.join(libdir, name)
-    ok(os.path.isfile(path), "%s is copied into the library folder" % name)
+    check(os.path.isfile(path), "%s is copied into the library folder" % name)
     open_patch(path, name)
 
 for obj in ("ictus-physics", "ictus-graphics", "ictus-sound-panel", "ictus-view"):
     help_text = open(os.path.join(libdir, obj + "-help.pd")).read()
-    ok("#X obj 20 14 %s;" % obj in help_text and "pd reference" in help_text
-       and "See also" in help_text and "ictus 0.1.0" in help_text,
-       "%s-help.pd: the object on top, [pd reference], see also, the version" % obj)
+    check("#X obj 20 14 %s;" % obj in help_text and "pd reference" in help_text
+          and "See also" in help_text and "ictus 0.1.0" in help_text,
+          "%s-help.pd: the object on top, [pd reference], see also, the version" % obj)
 
 meta = open(os.path.join(libdir, "ictus-meta.pd")).read()
 objects = [l for l in meta.splitlines() if "OBJECTS" in l]
-ok(len(objects) == 1, "ictus-meta.pd has an OBJECTS line")
+check(len(objects) == 1, "ictus-meta.pd has an OBJECTS line")
 for obj in ("membrane~", "contact~", "ictus_timetag", "ictus-receive", "ictus-drum", "ictus-sound",
             "ictus-sound-clips", "ictus-sound-synth", "ictus-sound-modal", "ictus-physics",
             "ictus-graphics", "ictus-sound-panel", "ictus-view"):
-    ok((" %s " % obj) in objects[0].replace(";", " "), "ictus-meta.pd lists %s" % obj)
-    ok(os.path.isfile(os.path.join(libdir, obj + "-help.pd")), "%s has a help patch" % obj)
+    check((" %s " % obj) in objects[0].replace(";", " "), "ictus-meta.pd lists %s" % obj)
+    check(os.path.isfile(os.path.join(libdir, obj + "-help.pd")), "%s has a help patch" % obj)
 # every abstraction, external and patch in the library folder is in the meta file
 # (top-level patches such as ictus-render.pd are listed on the PATCHES line, with .pd)
 listed = " ".join(l for l in meta.splitlines()
@@ -79,4 +71,4 @@ for f in sorted(os.listdir(libdir)):
         continue
     if ext == ".pd_linux":
         stem = stem.replace("_tilde", "~")
-    ok((" %s " % stem) in listed, "ictus-meta.pd lists %s (in the library folder)" % stem)
+    check((" %s " % stem) in listed, "ictus-meta.pd lists %s (in the library folder)" % stem)

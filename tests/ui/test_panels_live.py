@@ -15,18 +15,14 @@ a handshake on pd's printed lines, with a deadline."""
 import argparse
 import math
 import os
-import queue
 import re
-import shutil
 import signal
 import socket
 import subprocess
 import tempfile
-import threading
-import time
 
-import uitest
-from uitest import ok
+from ictus_tools import uitest
+from ictus_tools.checks import check
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -37,26 +33,9 @@ build = os.path.abspath(args.build)
 
 
 pd_port, daemon_port, ctl_port = uitest.free_udp_port(), uitest.free_udp_port(), uitest.free_udp_port()
-lines = queue.Queue()
-printed = []
-
-
-def reader(stream):
-    for line in stream:
-        lines.put(line.rstrip("\n"))
-
-
-def wait_for(pred, what, timeout=60):
-    deadline = time.time() + timeout
-    while time.time() < deadline:
-        try:
-            line = lines.get(timeout=0.2)
-        except queue.Empty:
-            continue
-        printed.append(line)
-        if pred(line):
-            return line
-    ok(False, "%s within %g s (pd printed, last lines: %s)" % (what, timeout, printed[-25:]))
+pd_lines = uitest.PdLines()
+printed = pd_lines.printed
+wait_for = pd_lines.wait_for
 
 
 def unescape(line):
@@ -101,7 +80,7 @@ def nothing_sent_before_pong(what):
     seen = []
     wait_for(lambda l: seen.append(l) or l == "ictusd: pong", "pong after %s" % what)
     sent = [l for l in seen if l.startswith("ictusd: reply") or l.startswith("ictusd: error")]
-    ok(not sent, "%s: nothing reached the daemon (before the pong: %s)" % (what, sent))
+    check(not sent, "%s: nothing reached the daemon (before the pong: %s)" % (what, sent))
 
 
 def drum_controls(radius, tension, mass):
@@ -115,7 +94,7 @@ def drum_controls(radius, tension, mass):
     line = wait_for(lambda l: l.startswith("ictusd: reply /ictus/drum/density "), "the density")
     density = float(line.split()[-1])
     want = mass / (math.pi * radius * radius)
-    ok(abs(density - want) <= 1e-5 * want, "drum density %g = mass / (pi a^2) = %g" % (density, want))
+    check(abs(density - want) <= 1e-5 * want, "drum density %g = mass / (pi a^2) = %g" % (density, want))
 
 
 def start_daemon(extra, log):
@@ -140,8 +119,8 @@ def stop_daemon(daemon):
 # remote hand (FUDI on ctl_port: '<receive name> <value>;' to that name), and
 # prints of what the physics panel shows and of the daemon panel's state.
 main = open(os.path.join(build, "patches", "ictus.pd")).read()
-ok("ictus-receive 9000;" in main and "connect 127.0.0.1 9001;" in main,
-   "the main patch listens on 9000 and sends to 9001")
+check("ictus-receive 9000;" in main and "connect 127.0.0.1 9001;" in main,
+      "the main patch listens on 9000 and sends to 9001")
 main = main.replace("ictus-receive 9000;", "ictus-receive %d;" % pd_port)
 main = main.replace("connect 127.0.0.1 9001;", "connect 127.0.0.1 %d;" % daemon_port)
 records = [r for r in re.split(r"(?<!\\);\n", main) if r.strip()]
@@ -163,15 +142,15 @@ for r in records:
             index.setdefault("boxes", []).append(
                 (n, re.sub(r", f \d+$", "", " ".join(words[4:]))))
         n += 1
-ok("ictus-physics" in index and "ictus-status" in index and "ictus-sound-panel" in index
-   and len(index["boxes"]) >= 4,
-   "the main patch has the physics and daemon panels and score boxes")
+check("ictus-physics" in index and "ictus-status" in index and "ictus-sound-panel" in index
+      and len(index["boxes"]) >= 4,
+      "the main patch has the physics and daemon panels and score boxes")
 score_boxes = [(i, t) for i, t in index["boxes"] if "R" in t.split()]
 replace_boxes = [(i, t) for i, t in score_boxes if t.startswith("clear") and "play" in t]
 append_boxes = [(i, t) for i, t in score_boxes if not t.startswith("clear")]
-ok(len(replace_boxes) >= 3 and len(append_boxes) >= 1,
-   "score boxes that replace and play (%d) and one that appends (%d)"
-   % (len(replace_boxes), len(append_boxes)))
+check(len(replace_boxes) >= 3 and len(append_boxes) >= 1,
+      "score boxes that replace and play (%d) and one that appends (%d)"
+      % (len(replace_boxes), len(append_boxes)))
 extra = ["#X obj 20 1000 netreceive -u %d" % ctl_port, "#X obj 20 1030 list",
          "#X obj 20 1060 t a a", "#X obj 200 1090 list split 1", "#X obj 200 1120 symbol",
          "#X obj 20 1090 list split 1", "#X obj 20 1150 s", "#X obj 400 1000 print shown",
@@ -197,7 +176,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-panels-") as work:
                            os.path.join(build, "ictus"), "-open", patch],
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                           env=uitest.PD_ENV)
-    threading.Thread(target=reader, args=(pd.stdout,), daemon=True).start()
+    pd_lines.follow(pd.stdout)
     daemon = None
     try:
         # ---- nobody there: the panel says so
@@ -206,15 +185,15 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-panels-") as work:
         daemon = start_daemon([], log)
         shown("source score")
         s = state_where(lambda s: True, "a status")
-        ok(s["source"] == "score" and s["mode"] == "cartesian" and s["grip"] == "french",
-           "the daemon plays scores, Cartesian, French grip: %s" % s)
+        check(s["source"] == "score" and s["mode"] == "cartesian" and s["grip"] == "french",
+              "the daemon plays scores, Cartesian, French grip: %s" % s)
         shown("daemon score stopped")
         # The built-in score begins at 90 bpm (docs/score.md): the tempo box follows.
         shown("tempo 90")
         for _ in range(3):
             s = state_where(lambda s: True, "a status while waiting for play")
-            ok(s["playing"] == 0 and s["strikes"] == 0,
-               "ictusd run waits for play: not playing, no strike (%s)" % s)
+            check(s["playing"] == 0 and s["strikes"] == 0,
+                  "ictusd run waits for play: not playing, no strike (%s)" % s)
 
         # tempo, stopped: the next play starts there
         move("ictus-physics-tempo", 120)
@@ -279,12 +258,12 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-panels-") as work:
         state_where(lambda s: s["playing"] == 1, "playing again")
         move("ictus-physics-tempo", 400)
         err = wait_for(lambda l: l.startswith("ictusd: error /ictus/tempo"), "the refusal of 400 bpm")
-        ok("400" in err, "the error names the range: %s" % unescape(err))
+        check("400" in err, "the error names the range: %s" % unescape(err))
         # (the panel may have shown it before the patch printed it)
         shown_error = lambda l: unescape(l).startswith("shown: reply error /ictus/tempo tempo:")
         if not any(shown_error(l) for l in printed[-20:]):
             wait_for(shown_error, "the refusal shown in the panel")
-        ok(True, "the refusal is shown in the physics panel's last reply")
+        check(True, "the refusal is shown in the physics panel's last reply")
         move("ictus-physics-stop")
         reply("/ictus/stop")
 
@@ -295,7 +274,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-panels-") as work:
         for statement in [w.strip() for w in app[1].split("\\,")]:
             reply("/ictus/score", statement)
         s = state_where(lambda s: True, "a status after the append box")
-        ok(s["playing"] == 0, "appending does not play")
+        check(s["playing"] == 0, "appending does not play")
         move("ictus-physics-play")
         reply("/ictus/play")
         state_where(lambda s: s["playing"] == 1, "play plays the statements received")
@@ -313,8 +292,8 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-panels-") as work:
             daemon = start_daemon(["--mocap", args.clip], log)
             shown("source clip", 120)
             s = state_where(lambda s: True, "a clip status")
-            ok(s["source"] == "clip" and s["mode"] == "joint" and s["playing"] == 0,
-               "the clip waits for play, in joint space: %s" % s)
+            check(s["source"] == "clip" and s["mode"] == "joint" and s["playing"] == 0,
+                  "the clip waits for play, in joint space: %s" % s)
             shown("daemon clip stopped")
             # covered: nuance, control mode, clear score, score statements
             move("ictus-physics-nuance", 3)
@@ -359,5 +338,5 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-panels-") as work:
 bad = uitest.error_lines("\n".join(l for l in printed
                                    if not l.startswith("ictusd: error")
                                    and not l.startswith("shown: reply error")))
-ok(not bad, "no error lines from pd: %s" % bad)
+check(not bad, "no error lines from pd: %s" % bad)
 print("PASS")

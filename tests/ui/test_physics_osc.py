@@ -10,8 +10,8 @@ import struct
 import subprocess
 import tempfile
 
-import uitest
-from uitest import ok
+from ictus_tools import uitest
+from ictus_tools.checks import check
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -69,7 +69,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-osc-") as work:
                            os.path.join(build, "ictus"), "-open", patch],
                           capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
 log = proc.stdout + proc.stderr
-ok(proc.returncode == 0 and not uitest.error_lines(log), "pd ran without error lines" + ("" if not log else ": " + log))
+check(proc.returncode == 0 and not uitest.error_lines(log), "pd ran without error lines" + ("" if not log else ": " + log))
 got = []
 sock.settimeout(2)
 try:
@@ -77,7 +77,7 @@ try:
         got.append(parse(sock.recv(4096)))
 except socket.timeout:
     pass
-ok(len(got) == len(STATEMENTS), "one packet per statement (%d of %d)" % (len(got), len(STATEMENTS)))
+check(len(got) == len(STATEMENTS), "one packet per statement (%d of %d)" % (len(got), len(STATEMENTS)))
 for want, (address, tags, values) in zip(STATEMENTS, got):
-    ok(address == "/ictus/score" and tags == ",s" and values == [want],
-       "%r -> /ictus/score ,s %r (got %s %s %r)" % (want, want, address, tags, values))
+    check(address == "/ictus/score" and tags == ",s" and values == [want],
+          "%r -> /ictus/score ,s %r (got %s %s %r)" % (want, want, address, tags, values))

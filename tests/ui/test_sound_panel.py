@@ -11,8 +11,8 @@ import os
 import subprocess
 import tempfile
 
-import uitest
-from uitest import ok
+from ictus_tools import uitest
+from ictus_tools.checks import check
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -36,28 +36,28 @@ print("\n".join(lines))
 snd = [l[5:].split() for l in lines if l.startswith("snd: ")]
 dmn = [l[5:].split() for l in lines if l.startswith("dmn: ")]
 sound = [(w[0], float(w[1])) for w in snd]
-ok(sound == [("mass", 0.0261), ("radius", 0.2), ("mass", 0.05), ("tension", 4500), ("modes", 4096),
-             ("t60", 0.005), ("hfdamp", 3), ("volume", 0.5)],
-   "to ictus-sound: each value in order, modes and t60 clamped to 4096 and 0.005")
+check(sound == [("mass", 0.0261), ("radius", 0.2), ("mass", 0.05), ("tension", 4500), ("modes", 4096),
+                ("t60", 0.005), ("hfdamp", 3), ("volume", 0.5)],
+      "to ictus-sound: each value in order, modes and t60 clamped to 4096 and 0.005")
 daemon = [(w[0], float(w[1])) for w in dmn]
 names = [d[0] for d in daemon]
-ok(names == ["drum/density", "drum/radius", "drum/density", "drum/tension"],
-   "to ictusd: density, radius, density, tension (%s)" % names)
+check(names == ["drum/density", "drum/radius", "drum/density", "drum/tension"],
+      "to ictusd: density, radius, density, tension (%s)" % names)
 # defaults: a = 0.178 m (membrane~'s) until the preset's radius 0.2
 for got, (mass, a) in zip([d[1] for d in daemon if d[0] == "drum/density"], ((0.0261, 0.178), (0.05, 0.2))):
     want = mass / (math.pi * a * a)
-    ok(abs(got - want) <= 1e-5 * want, "drum/density %.6g = %g kg / (pi %g^2 m^2) = %.6g" % (got, mass, a, want))
-ok(("drum/radius", 0.2) in daemon and ("drum/tension", 4500) in daemon, "radius and tension mirrored to ictusd")
-ok(not any(l.startswith("snd: model") for l in lines), "the model report is not sent back to ictus-sound")
+    check(abs(got - want) <= 1e-5 * want, "drum/density %.6g = %g kg / (pi %g^2 m^2) = %.6g" % (got, mass, a, want))
+check(("drum/radius", 0.2) in daemon and ("drum/tension", 4500) in daemon, "radius and tension mirrored to ictusd")
+check(not any(l.startswith("snd: model") for l in lines), "the model report is not sent back to ictus-sound")
 errs = uitest.error_lines("\n".join(lines))
-ok(len(errs) == 0, "no error-class lines besides the named one")
-ok(any(l.startswith("ictus-sound-panel: unknown message: bogus") for l in lines),
-   "an unknown message is named")
+check(len(errs) == 0, "no error-class lines besides the named one")
+check(any(l.startswith("ictus-sound-panel: unknown message: bogus") for l in lines),
+      "an unknown message is named")
 for want in ("ictus-sound-panel: modes: expected 1 to 4096 but got 5000 (clamped)",
              "ictus-sound-panel: t60: expected 0.005 to 60 but got 0.001 (clamped)"):
-    ok(want in lines, "out of range: %r" % want)
+    check(want in lines, "out of range: %r" % want)
 named = [l for l in lines if l.startswith("ictus-sound-panel:")]
-ok(len(named) == 3, "exactly those three lines name a problem (%d)" % len(named))
+check(len(named) == 3, "exactly those three lines name a problem (%d)" % len(named))
 
 # The panel's messages against the real [ictus-sound] (docs/sound.md's interface):
 # every one is accepted without an error line, DSP on, and a model switch is
@@ -78,8 +78,8 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-sound-") as work:
                           capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
 log = proc.stdout + proc.stderr
 print(log)
-ok(proc.returncode == 0 and not uitest.error_lines(log) and "ictus-sound-panel:" not in log,
-   "[ictus-sound] takes every message of the panel without an error line")
+check(proc.returncode == 0 and not uitest.error_lines(log) and "ictus-sound-panel:" not in log,
+      "[ictus-sound] takes every message of the panel without an error line")
 reports = [l.split()[1:] for l in log.splitlines() if l.startswith("report: model")]
-ok(reports[-2:] == [["model", "synth", "1"], ["model", "clips", "0"]],
-   "the model switches are reported back into the panel (%s)" % reports)
+check(reports[-2:] == [["model", "synth", "1"], ["model", "clips", "0"]],
+      "the model switches are reported back into the panel (%s)" % reports)

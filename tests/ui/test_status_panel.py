@@ -9,17 +9,13 @@ is stopped it must say so within its 2.5 s watchdog. Waits are handshakes on
 pd's printed lines, with deadlines."""
 import argparse
 import os
-import queue
 import signal
 import socket
-import struct
 import subprocess
 import tempfile
-import threading
-import time
 
-import uitest
-from uitest import ok
+from ictus_tools import oscpacket, uitest
+from ictus_tools.checks import check
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -29,36 +25,9 @@ build = os.path.abspath(args.build)
 
 
 pd_port, daemon_port = uitest.free_udp_port(), uitest.free_udp_port()
-lines = queue.Queue()
-printed = []
-
-
-def reader(stream):
-    for line in stream:
-        lines.put(line.rstrip("\n"))
-
-
-def wait_for(pred, what, timeout):
-    deadline = time.time() + timeout
-    while time.time() < deadline:
-        try:
-            line = lines.get(timeout=0.2)
-        except queue.Empty:
-            continue
-        printed.append(line)
-        if pred(line):
-            return line
-    ok(False, "%s within %g s (pd printed: %s)" % (what, timeout, printed[-20:]))
-
-
-def osc(address, types, *vals):
-    """A plain OSC message (the test sends commands as Pd would)."""
-    def pad(b):
-        return b + b"\0" * (4 - len(b) % 4)
-    data = pad(address.encode()) + pad(("," + types).encode())
-    for t, v in zip(types, vals):
-        data += struct.pack(">f", v) if t == "f" else pad(v.encode())
-    return data
+pd_lines = uitest.PdLines()
+printed = pd_lines.printed
+wait_for = pd_lines.wait_for
 
 
 with tempfile.TemporaryDirectory(prefix="ictus-ui-status-") as work:
@@ -76,7 +45,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-status-") as work:
                            os.path.join(build, "ictus"), "-open", patch],
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                           env=uitest.PD_ENV)
-    threading.Thread(target=reader, args=(pd.stdout,), daemon=True).start()
+    pd_lines.follow(pd.stdout)
     env = dict(os.environ)
     env.pop("LD_PRELOAD", None)
     daemon = None
@@ -88,15 +57,15 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-status-") as work:
                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
         wait_for(lambda l: l == "panel: answering 1", "answering once the daemon runs", 60)
         state = wait_for(lambda l: l.startswith("panel: state "), "a state line", 30).split()
-        ok(state[2:5] == ["score", "cartesian", "french"],
-           "the panel shows the daemon's source, mode and grip: %s" % state[2:])
-        ok(float(state[6]) > 0, "... and its tempo (%s bpm)" % state[6])
+        check(state[2:5] == ["score", "cartesian", "french"],
+              "the panel shows the daemon's source, mode and grip: %s" % state[2:])
+        check(float(state[6]) > 0, "... and its tempo (%s bpm)" % state[6])
         # ictusd replies to --reply (Pd's port) whoever sends: the test sends as Pd would.
         ctl = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        ctl.sendto(osc("/ictus/tempo", "f", 1000.0), ("127.0.0.1", daemon_port))
+        ctl.sendto(oscpacket.message("/ictus/tempo", "f", 1000.0), ("127.0.0.1", daemon_port))
         err = wait_for(lambda l: l.startswith("other: error"), "the daemon's refusal passed on", 30)
-        ok("/ictus/tempo" in err and "1000" in err, "the error names the address and value: %s" % err)
-        ctl.sendto(osc("/ictus/ping", ""), ("127.0.0.1", daemon_port))
+        check("/ictus/tempo" in err and "1000" in err, "the error names the address and value: %s" % err)
+        ctl.sendto(oscpacket.message("/ictus/ping", ""), ("127.0.0.1", daemon_port))
         wait_for(lambda l: l.startswith("other: pong"), "pong passed on", 30)
         daemon.send_signal(signal.SIGTERM)
         daemon.wait(30)
@@ -106,9 +75,9 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-status-") as work:
             daemon.kill()
             daemon.wait()
         uitest.stop(pd)
-ok(sum(l == "poll: poll" for l in printed) >= 2, "the panel polls (poll: /ictus/status through ictus-receive)")
-ok(not [l for l in printed if "/ictus/status" in l and l.startswith("other:")],
-   "status replies stay in the panel")
-ok(not uitest.error_lines("\n".join(l for l in printed if not l.startswith("other: error"))),
-   "no error lines from pd")
+check(sum(l == "poll: poll" for l in printed) >= 2, "the panel polls (poll: /ictus/status through ictus-receive)")
+check(not [l for l in printed if "/ictus/status" in l and l.startswith("other:")],
+      "status replies stay in the panel")
+check(not uitest.error_lines("\n".join(l for l in printed if not l.startswith("other: error"))),
+      "no error lines from pd")
 print("PASS")

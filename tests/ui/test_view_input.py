@@ -6,8 +6,8 @@ import os
 import subprocess
 import tempfile
 
-import uitest
-from uitest import ok
+from ictus_tools import uitest
+from ictus_tools.checks import check
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -54,10 +54,10 @@ for l in lines:
         groups[current] = []
     elif current is not None:
         groups[current].append(l)
-ok(sorted(groups) == list(range(len(CASES))), "every case ran (%d)" % len(groups))
+check(sorted(groups) == list(range(len(CASES))), "every case ran (%d)" % len(groups))
 for n, (msg, want) in enumerate(CASES):
     got = groups.get(n, [])
     if want is None:
-        ok(got == [], "%r prints nothing" % msg)
+        check(got == [], "%r prints nothing" % msg)
     else:
-        ok(got == [want], "%r -> %r (got %r)" % (msg, want, got))
+        check(got == [want], "%r -> %r (got %r)" % (msg, want, got))

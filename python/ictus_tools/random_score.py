@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """Seeded random scores in the whole score language (docs/score.md), valid ones only.
 
-    python3 scripts/random_score.py --seed N          # print score N
-    python3 scripts/random_score.py --seed N --notes  # and the notes it must give
-    python3 scripts/random_score.py --seed N --ictusd build/ictusd   # nuances from that parser
-    python3 scripts/random_score.py --coverage 100    # how many of seeds 1..100 hold each form
+    python3 -m ictus_tools.random_score --seed N          # print score N
+    python3 -m ictus_tools.random_score --seed N --notes  # and the notes it must give
+    python3 -m ictus_tools.random_score --seed N --ictusd build/ictusd   # nuances from that parser
+    python3 -m ictus_tools.random_score --coverage 100    # how many of seeds 1..100 hold each form
+
+(with python/ on PYTHONPATH, as everywhere for this package: docs/python.md).
 
 Used by tests/perform/test_random_scores.py (CTest) and bench/random_scores.py. The same seed
 and the same nuance list give the same bytes (Python's own `random.Random(seed)`, no hashing
@@ -46,8 +48,7 @@ import subprocess
 import sys
 import tempfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.abspath(os.path.join(HERE, ".."))
+from ictus_tools import ROOT
 
 MIN_STROKE_INTERVAL_S = 0.1   # PlanOptions::min_stroke_interval_s (docs/score.md, "Errors")
 INTERVAL_MARGIN_S = 1e-6      # our tempo map and the daemon's differ by ~1e-15 s
@@ -566,7 +567,7 @@ class Generator:
 
     def render_text(self, statements):
         rng = self.rng
-        lines = ["# random score, seed %d (scripts/random_score.py)" % self.seed]
+        lines = ["# random score, seed %d (ictus_tools.random_score)" % self.seed]
         pending = []
 
         def flush():

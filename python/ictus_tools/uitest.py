@@ -2,20 +2,20 @@
 display of its own, a screenshot, and a synthetic pose stream (docs/osc.md) built
 here from a standing figure, independently of the daemon."""
 import os
+import queue
 import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "pd"))
-sys.path.insert(0, os.path.join(HERE, "..", "pdosc"))
-from pdrun import PD, PD_ENV, error_lines, free_udp_port  # noqa: E402,F401
-import oscpacket  # noqa: E402
+from ictus_tools import ROOT as REPO  # noqa: F401 (uitest.REPO in the tests)
+from ictus_tools import oscpacket
+from ictus_tools.checks import fail
+from ictus_tools.pdrun import PD, PD_ENV, error_lines, free_udp_port  # noqa: F401
 
 SKIP = 77
-REPO = os.path.abspath(os.path.join(HERE, "..", ".."))
 
 
 def stop(process, timeout_s=10):
@@ -30,15 +30,33 @@ def stop(process, timeout_s=10):
         process.wait()
 
 
-def fail(msg):
-    print("FAIL: " + msg)
-    sys.exit(1)
+class PdLines:
+    """What a pd process prints, line by line, read by a thread (follow): wait_for(pred,
+    what, timeout) is a test's handshake, the next line that pred accepts within a deadline
+    (the test fails naming the last lines otherwise); `printed` holds every line waited over."""
 
+    def __init__(self):
+        self.queue = queue.Queue()
+        self.printed = []
 
-def ok(cond, msg):
-    if not cond:
-        fail(msg)
-    print("ok: " + msg)
+    def follow(self, stream):
+        threading.Thread(target=self._read, args=(stream,), daemon=True).start()
+
+    def _read(self, stream):
+        for line in stream:
+            self.queue.put(line.rstrip("\n"))
+
+    def wait_for(self, pred, what, timeout=60):
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            try:
+                line = self.queue.get(timeout=0.2)
+            except queue.Empty:
+                continue
+            self.printed.append(line)
+            if pred(line):
+                return line
+        fail("%s within %g s (pd printed, last lines: %s)" % (what, timeout, self.printed[-25:]))
 
 
 def skip_or_fail(reason, missing_package=False):

@@ -29,14 +29,11 @@ How onsets are measured (docs/main-job.md, "Checking the onsets"):
 import json
 import os
 import subprocess
-import sys
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(ROOT, "tests", "pd"))
-from pdrun import PD, PD_ENV, error_lines, read_wav_float  # noqa: E402
+from ictus_tools import ROOT
+from ictus_tools.pdrun import PD, PD_ENV, read_wav_float
 
 RENDER_PATCH = os.path.join(ROOT, "patches", "ictus-render.pd")
 MIN_GAP_S = 0.060   # strikes closer than this go to different passes

@@ -3,14 +3,12 @@ format of ictus-render.pd) through patches/sound/ictus-sound-render.pd with a
 chosen model in real pd batch mode, and simple analysis (onsets, RMS)."""
 import os
 import subprocess
-import sys
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(ROOT, "tests", "pd"))
-from pdrun import PD, PD_ENV, check, error_lines, make_workdir, read_wav_float  # noqa: E402,F401
+from ictus_tools import ROOT
+from ictus_tools.checks import check
+from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float  # noqa: F401
 
 RENDER = os.path.join(ROOT, "patches", "sound", "ictus-sound-render.pd")
 MODELS = ("clips", "synth", "modal")

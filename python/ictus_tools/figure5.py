@@ -1,8 +1,9 @@
-#!/usr/bin/python3
 """The paper's Figure 5 from a render folder: the heights of the right and left
 stick tips against time, the score above them, the strike list marked.
 
-  usage: /usr/bin/python3 scripts/figure5.py DIR [--out STEM] [--title TEXT]
+  usage: python3 -m ictus_tools.figure5 DIR [--out STEM] [--title TEXT]
+
+(run by scripts/main.sh and scripts/figure5.sh, which put python/ on PYTHONPATH)
 
 Reads what `ictusd render --score FILE --out DIR` writes (docs/osc.md,
 docs/main-job.md):
@@ -36,17 +37,17 @@ SHORT = {"legato": "leg", "tenuto": "ten", "accent": "acc", "vertical_accent": "
          "staccato": "stac"}
 
 
-def fail(message):
-    sys.exit("figure5.py: " + message)
+def die(message):
+    sys.exit("figure5: " + message)
 
 
 def read_table(path):
     if not os.path.isfile(path):
-        fail("%s is missing" % path)
+        die("%s is missing" % path)
     with open(path, newline="") as f:
         rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
     if not rows:
-        fail("%s is empty" % path)
+        die("%s is empty" % path)
     header = [h.strip() for h in rows[0]]
     return header, [r for r in rows[1:] if r]
 
@@ -85,7 +86,7 @@ def column(header, rows, names, path, convert=float, required=True):
             i = header.index(name)
             return [convert(r[i]) for r in rows]
     if required:
-        fail("%s: no column %s (columns: %s)" % (path, " or ".join(names), ", ".join(header)))
+        die("%s: no column %s (columns: %s)" % (path, " or ".join(names), ", ".join(header)))
     return None
 
 
@@ -95,7 +96,7 @@ def hand_value(text):
         return "left"
     if t in ("1", "r", "right"):
         return "right"
-    fail("hand '%s' is neither left nor right" % text)
+    die("hand '%s' is neither left nor right" % text)
 
 
 def main():
@@ -113,7 +114,7 @@ def main():
     cols = tip_columns(header)
     for hand in HANDS:
         if (hand, "sim") not in cols:
-            fail("%s: no simulated height (y) column for the %s hand (columns: %s)"
+            die("%s: no simulated height (y) column for the %s hand (columns: %s)"
                  % (tips_path, hand, ", ".join(header)))
     print("figure5: %s columns used: %s" % (tips_path, ", ".join(
         "%s %s = %s" % (h, k, header[i]) for (h, k), i in sorted(cols.items()))))

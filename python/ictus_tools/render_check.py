@@ -1,5 +1,5 @@
 """Render a random score with the real `ictusd render` and check what came out against the notes
-the generator (scripts/random_score.py) says the score holds -- times from its own tempo map,
+the generator (ictus_tools.random_score) says the score holds -- times from its own tempo map,
 not from the daemon. Shared by tests/perform/test_random_scores.py and bench/random_scores.py.
 
 The acceptance ("Any valid score plays right", docs/perform.md):
@@ -27,7 +27,7 @@ import shutil
 import subprocess
 import tempfile
 
-from random_score import LEAD_IN_S, RandomScore
+from ictus_tools.random_score import LEAD_IN_S, RandomScore
 
 TOLERANCE_MS = 5.0            # the acceptance bound, never loosened
 ASSIGN_MS = 50.0              # a strike further than this from a note is not its strike
@@ -116,7 +116,8 @@ class Result:
         """Everything needed to reproduce and see a failure."""
         out = ["seed %d: %s" % (self.seed, "; ".join(self.problems[:6]) +
                                 (" ..." if len(self.problems) > 6 else ""))]
-        out.append("  reproduce: python3 scripts/random_score.py --seed %d --ictusd %s > s.txt && "
+        out.append("  reproduce: PYTHONPATH=python python3 -m ictus_tools.random_score --seed %d --ictusd %s "
+                   "> s.txt && "
                    "%s render --score s.txt --out out-%d" % (self.seed, ictusd, ictusd, self.seed))
         out.append("  score:")
         out.extend("    | " + line for line in self.score.text.rstrip("\n").split("\n"))
@@ -166,11 +167,13 @@ def render(ictusd, score, workdir, timeout_s=600, extra_args=()):
             res.crashed = "exit %d: %s" % (proc.returncode, "\n".join(msg[-20:]))
             res.problems.append("ictusd render failed, " + res.crashed)
         return res
-    check(res, out)
+    judge(res, out)
     return res
 
 
-def check(res, out):
+def judge(res, out):
+    """Judges the render in `out` against res.score (the acceptance above): fills res.notes,
+    res.extra and res.problems."""
     score = res.score
     with open(os.path.join(out, "render.json")) as f:
         text = f.read()
@@ -475,7 +478,7 @@ def planted_faults(score, out):
         with open(os.path.join(d, "strikes.csv"), "w") as f:
             f.write("\n".join([lines[0]] + [",".join(r) for r in mutated]) + "\n")
         res = Result(score)
-        check(res, d)
+        judge(res, d)
         found.append((name, any(sign in p for p in res.problems), res.problems))
         shutil.rmtree(d, ignore_errors=True)
     # A joint beyond its limit, as render.json reports it.
@@ -488,7 +491,7 @@ def planted_faults(score, out):
     with open(os.path.join(d, "render.json"), "w") as f:
         json.dump(j, f)
     res = Result(score)
-    check(res, d)
+    judge(res, d)
     found.append(("a joint 2.5 deg beyond its limit", any("joint limit" in p for p in res.problems),
                   res.problems))
     shutil.rmtree(d, ignore_errors=True)

@@ -21,13 +21,11 @@ import re
 import socket
 import struct
 import subprocess
-import sys
 import threading
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "pd"))
-from pdrun import PD, PD_ENV, Patch, free_udp_port, make_workdir  # noqa: E402,F401
-from oscpacket import now  # noqa: E402
+from ictus_tools.oscpacket import now
+from ictus_tools.pdrun import PD, PD_ENV, Patch, free_udp_port, make_workdir  # noqa: F401
 
 
 # Linux's SO_TIMESTAMPNS (= SCM_TIMESTAMPNS): the kernel's CLOCK_REALTIME arrival
