@@ -263,6 +263,8 @@ TrackArgs parse_track_args(Args &args)
         validate(t.options);
     } catch (const CharacterError &e) {
         throw UsageError(e.what());
+    } catch (const SimError &e) {
+        throw UsageError(e.what());
     }
     // A .csv capture is stick-only (Cartesian mode): the default body holds a
     // neutral pose and its arms follow the two stick tips.
