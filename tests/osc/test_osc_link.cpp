@@ -192,6 +192,49 @@ TEST_CASE("osc out: strike bundles reach oscdump with the fixed layout and timet
     CHECK(c.send_errors == 0);
 }
 
+TEST_CASE("osc out: /ictus/strike/end carries the field table's end fields, at the release",
+          "[osc][link]")
+{
+    int port = 0;
+    auto dump = start_oscdump(port);
+    ictus::OscSenderOptions o;
+    o.target_url = "osc.udp://127.0.0.1:" + std::to_string(port);
+    o.lookahead_s = 0.02;
+    ictus::OscSender sender(o);
+    const ictus::NtpTime epoch = ictus::ntp_add_seconds(ictus::ntp_now(), -1000.0);
+    sender.set_epoch(epoch);
+    const ictus::StrikeEvent e = sample_strike(3, 1.25);
+    REQUIRE(sender.post_strike_end(e));
+    DumpLine d;
+    REQUIRE(next_dump(*dump, "/ictus/strike/end", d));
+    // The message is the table's in_osc_end fields in the table's order ...
+    std::string types;
+    std::vector<ictus::StrikeField> fields;
+    for (int i = 0; i < ictus::kStrikeFieldCount; ++i) {
+        const auto f = static_cast<ictus::StrikeField>(i);
+        if (!ictus::strike_field_info(f).in_osc_end)
+            continue;
+        fields.push_back(f);
+        types += ictus::strike_field_info(f).integer ? 'i' : 'f';
+    }
+    // ... which docs/osc.md names: seq, hand, peak_force_n, impulse_n_s,
+    // duration_ms, force_dir_x, _y, _z.
+    CHECK(types == "iiffffff");
+    CHECK(d.types == types);
+    REQUIRE(d.args.size() == fields.size());
+    for (std::size_t k = 0; k < fields.size(); ++k) {
+        INFO(ictus::strike_field_info(fields[k]).name);
+        const double expected = ictus::strike_field(e, fields[k]);
+        CHECK(std::stod(d.args[k]) == Approx(expected).margin(2e-6 * (1 + std::fabs(expected))));
+    }
+    // Due at the release: onset + duration + lookahead.
+    CHECK(d.timetag ==
+          hex_timetag(ictus::ntp_add_seconds(epoch, e.time_s + 1e-3 * e.duration_ms + 0.02)));
+    sender.stop();
+    CHECK(sender.counters().strike_ends_sent == 1);
+    CHECK(sender.counters().strikes_sent == 0);
+}
+
 TEST_CASE("osc out: a receiver holds a strike bundle until its timetag", "[osc][link]")
 {
     // liblo's server (oscdump) dispatches a bundle at its timetag: the

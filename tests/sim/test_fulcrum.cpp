@@ -74,10 +74,10 @@ TEST_CASE("grip firmness: k = 2 * 2^(7 f) N m/rad, c at the damping ratio asked"
         CHECK(g.damping_nm_s_per_rad ==
               Approx(2.0 * 0.7 * std::sqrt(g.stiffness_nm_per_rad * inertia)));
     }
-    CHECK_THROWS_AS(grip_spring(-0.1, inertia, 0.7), CharacterError);
-    CHECK_THROWS_AS(grip_spring(1.1, inertia, 0.7), CharacterError);
-    CHECK_THROWS_AS(grip_spring(std::nan(""), inertia, 0.7), CharacterError);
-    CHECK_THROWS_AS(grip_spring(0.5, inertia, -1.0), CharacterError);
+    CHECK_THROWS_AS(grip_spring(-0.1, inertia, 0.7), SimError);
+    CHECK_THROWS_AS(grip_spring(1.1, inertia, 0.7), SimError);
+    CHECK_THROWS_AS(grip_spring(std::nan(""), inertia, 0.7), SimError);
+    CHECK_THROWS_AS(grip_spring(0.5, inertia, -1.0), SimError);
 }
 
 TEST_CASE("the grip holds the stick against gravity as a spring: k theta = torque",

@@ -274,6 +274,8 @@ void check_track_args(TrackArgs &t)
         throw UsageError(e.what());
     } catch (const CharacterError &e) { // the scene's options
         throw UsageError(e.what());
+    } catch (const SimError &e) {
+        throw UsageError(e.what());
     }
     // A .csv capture is stick-only (Cartesian mode): the default body holds a
     // neutral pose and its arms follow the two stick tips.

@@ -217,6 +217,41 @@ OscSenderCounters OscSender::counters() const
     return c;
 }
 
+namespace
+{
+// A strike's fields as the arguments of an OSC message, in the field table's
+// order: those whose `in_message` column (StrikeFieldInfo::in_osc or
+// in_osc_end) is set, integers as int32, reals as float32.
+void add_strike_fields(lo_message m, const StrikeEvent &e, bool StrikeFieldInfo::*in_message)
+{
+    for (int i = 0; i < kStrikeFieldCount; ++i) {
+        const StrikeField f = static_cast<StrikeField>(i);
+        const StrikeFieldInfo &info = strike_field_info(f);
+        if (!(info.*in_message))
+            continue;
+        if (info.integer)
+            lo_message_add_int32(m, static_cast<std::int32_t>(strike_field_integer(e, f)));
+        else
+            lo_message_add_float(m, static_cast<float>(strike_field(e, f)));
+    }
+}
+
+template <std::size_t N> void add_floats(lo_message m, const float (&values)[N])
+{
+    for (float v : values)
+        lo_message_add_float(m, v);
+}
+
+// What a send did: the message counted as sent, or the send error.
+void count_send(int result, std::atomic<unsigned long> &sent, std::atomic<unsigned long> &errors)
+{
+    if (result < 0)
+        errors.fetch_add(1);
+    else
+        sent.fetch_add(1);
+}
+} // namespace
+
 void OscSender::strike_loop()
 {
     if (options_.realtime)
@@ -235,35 +270,11 @@ void OscSender::strike_loop()
                 tt = to_lo(ntp_add_seconds(epoch(), due_s + options_.lookahead_s));
             lo_bundle b = lo_bundle_new(tt);
             lo_message m = lo_message_new();
-            if (sm.end) {
-                lo_message_add_int32(m, static_cast<std::int32_t>(e.seq));
-                lo_message_add_int32(m, e.hand);
-                for (const double v : {e.peak_force_n, e.impulse_n_s, e.duration_ms,
-                                       e.force_dir.x(), e.force_dir.y(), e.force_dir.z()})
-                    lo_message_add_float(m, static_cast<float>(v));
-                lo_bundle_add_message(b, "/ictus/strike/end", m);
-                if (lo_send_bundle(impl_->strike_target, b) < 0)
-                    send_errors_.fetch_add(1);
-                else
-                    strike_ends_sent_.fetch_add(1);
-                lo_bundle_free_recursive(b);
-                continue;
-            }
-            for (int i = 0; i < kStrikeFieldCount; ++i) {
-                const StrikeField f = static_cast<StrikeField>(i);
-                const StrikeFieldInfo &info = strike_field_info(f);
-                if (!info.in_osc)
-                    continue;
-                if (info.integer)
-                    lo_message_add_int32(m, static_cast<std::int32_t>(strike_field_integer(e, f)));
-                else
-                    lo_message_add_float(m, static_cast<float>(strike_field(e, f)));
-            }
-            lo_bundle_add_message(b, "/ictus/strike", m);
-            if (lo_send_bundle(impl_->strike_target, b) < 0)
-                send_errors_.fetch_add(1);
-            else
-                strikes_sent_.fetch_add(1);
+            add_strike_fields(m, e,
+                              sm.end ? &StrikeFieldInfo::in_osc_end : &StrikeFieldInfo::in_osc);
+            lo_bundle_add_message(b, sm.end ? "/ictus/strike/end" : "/ictus/strike", m);
+            count_send(lo_send_bundle(impl_->strike_target, b),
+                       sm.end ? strike_ends_sent_ : strikes_sent_, send_errors_);
             lo_bundle_free_recursive(b);
         }
         if (!running)
@@ -287,45 +298,33 @@ void OscSender::pose_loop()
             for (int i = 0; i < p.bodies && i < PoseSnapshot::kMaxBodies; ++i) {
                 lo_message m = lo_message_new();
                 lo_message_add_int32(m, i);
-                for (float v : p.position_m[i])
-                    lo_message_add_float(m, v);
-                for (float v : p.rotation_wxyz[i])
-                    lo_message_add_float(m, v);
+                add_floats(m, p.position_m[i]);
+                add_floats(m, p.rotation_wxyz[i]);
                 lo_bundle_add_message(b, "/ictus/pose/body", m);
             }
             for (int hand = 0; hand < 2; ++hand) {
                 lo_message m = lo_message_new();
                 lo_message_add_int32(m, hand);
-                for (float v : p.stick_tip_m[hand])
-                    lo_message_add_float(m, v);
-                for (float v : p.stick_butt_m[hand])
-                    lo_message_add_float(m, v);
+                add_floats(m, p.stick_tip_m[hand]);
+                add_floats(m, p.stick_butt_m[hand]);
                 lo_bundle_add_message(b, "/ictus/pose/stick", m);
             }
             lo_message d = lo_message_new();
             lo_message_add_int32(d, 0);
-            for (float v : p.drum_center_m)
-                lo_message_add_float(d, v);
+            add_floats(d, p.drum_center_m);
             lo_message_add_float(d, p.drum_radius_m);
             lo_bundle_add_message(b, "/ictus/pose/drum", d);
-            if (lo_send_bundle(impl_->pose_target, b) < 0)
-                send_errors_.fetch_add(1);
-            else
-                poses_sent_.fetch_add(1);
+            count_send(lo_send_bundle(impl_->pose_target, b), poses_sent_, send_errors_);
             lo_bundle_free_recursive(b);
         }
         while (tips_.pop(t)) {
             lo_message m = lo_message_new();
             lo_message_add_int32(m, t.hand);
-            for (float v : t.position_m)
-                lo_message_add_float(m, v);
-            for (float v : t.velocity_mps)
-                lo_message_add_float(m, v);
+            add_floats(m, t.position_m);
+            add_floats(m, t.velocity_mps);
             lo_message_add_float(m, static_cast<float>(t.time_s));
-            if (lo_send_message(impl_->pose_target, "/ictus/tip", m) < 0)
-                send_errors_.fetch_add(1);
-            else
-                tips_sent_.fetch_add(1);
+            count_send(lo_send_message(impl_->pose_target, "/ictus/tip", m), tips_sent_,
+                       send_errors_);
             lo_message_free(m);
         }
         if (!running)

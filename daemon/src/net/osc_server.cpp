@@ -1,8 +1,9 @@
 // OSC in: Pd (or anything that speaks OSC) controls the daemon (osc_server.hpp,
 // docs/osc.md). A plain UDP socket of our own, so that the bind address, the
 // peer allow-list and the packet size are checked before any parsing; liblo
-// deserialises and validates each message; handlers check the type tags and
-// the values, queue a Command for the physics thread and reply over OSC.
+// deserialises and validates each message; a table of methods (address, type
+// tags, handler: kMethods) dispatches it, and the handlers check the values,
+// queue a Command for the physics thread and reply over OSC.
 #include "ictus/net/osc_server.hpp"
 #include "ictus/character/character.hpp"
 #include "ictus/perform/tracker.hpp"
@@ -111,6 +112,50 @@ bool parse_ipv4(const std::string &text, in_addr &out)
     return inet_pton(AF_INET, text.c_str(), &out) == 1;
 }
 
+OscServerCounters snapshot(const Counters &c)
+{
+    OscServerCounters o;
+    o.packets = c.packets;
+    o.accepted = c.accepted;
+    o.unknown_address = c.unknown_address;
+    o.bad_type_tags = c.bad_type_tags;
+    o.bad_values = c.bad_values;
+    o.malformed = c.malformed;
+    o.oversized = c.oversized;
+    o.refused_peers = c.refused_peers;
+    o.bundles = c.bundles;
+    o.queue_full = c.queue_full;
+    o.replies = c.replies;
+    o.errors_sent = c.errors_sent;
+    o.errors_unanswered = c.errors_unanswered;
+    o.score_lines = c.score_lines;
+    return o;
+}
+
+// A rate-limited log: at most one line per second, with the count of the
+// lines suppressed since.
+class RateLimitedLog
+{
+  public:
+    void operator()(const char *what, const std::string &detail)
+    {
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_ < std::chrono::seconds(1)) {
+            ++suppressed_;
+            return;
+        }
+        if (suppressed_)
+            std::fprintf(stderr, "ictusd: osc: (%lu similar lines suppressed)\n", suppressed_);
+        suppressed_ = 0;
+        last_ = now;
+        std::fprintf(stderr, "ictusd: osc: %s: %s\n", what, detail.c_str());
+    }
+
+  private:
+    std::chrono::steady_clock::time_point last_{};
+    unsigned long suppressed_ = 0;
+};
+
 } // namespace
 
 struct OscServer::Impl {
@@ -121,28 +166,12 @@ struct OscServer::Impl {
     Counters counters;
     ErrorReplyBudget error_budget;
     sockaddr_in last_peer{}; // the last allowed peer heard from (sin_port 0: none yet)
-    // Rate-limited log: at most one line per second, with the count of the
-    // lines suppressed since.
-    std::chrono::steady_clock::time_point last_log{};
-    unsigned long suppressed = 0;
+    RateLimitedLog log;
     unsigned char buffer[65536 + 1];
     ~Impl()
     {
         if (fd >= 0)
             close(fd);
-    }
-    void log(const char *what, const std::string &detail)
-    {
-        const auto now = std::chrono::steady_clock::now();
-        if (now - last_log < std::chrono::seconds(1)) {
-            ++suppressed;
-            return;
-        }
-        if (suppressed)
-            std::fprintf(stderr, "ictusd: osc: (%lu similar lines suppressed)\n", suppressed);
-        suppressed = 0;
-        last_log = now;
-        std::fprintf(stderr, "ictusd: osc: %s: %s\n", what, detail.c_str());
     }
 };
 
@@ -216,23 +245,7 @@ void OscServer::stop()
 
 OscServerCounters OscServer::counters() const
 {
-    const Counters &c = impl_->counters;
-    OscServerCounters o;
-    o.packets = c.packets;
-    o.accepted = c.accepted;
-    o.unknown_address = c.unknown_address;
-    o.bad_type_tags = c.bad_type_tags;
-    o.bad_values = c.bad_values;
-    o.malformed = c.malformed;
-    o.oversized = c.oversized;
-    o.refused_peers = c.refused_peers;
-    o.bundles = c.bundles;
-    o.queue_full = c.queue_full;
-    o.replies = c.replies;
-    o.errors_sent = c.errors_sent;
-    o.errors_unanswered = c.errors_unanswered;
-    o.score_lines = c.score_lines;
-    return o;
+    return snapshot(impl_->counters);
 }
 
 void OscServer::loop()
@@ -324,38 +337,20 @@ struct Reply {
     }
 };
 
-// The commands: address, type tags, and what a value must be.
-struct Spec {
-    const char *address;
-    const char *types;
-    CommandKind kind;
-    double lo, hi; // range of the first float
-    const char *what;
+// What a command's value must be: a float's range, a word's list, or (no
+// words, a string) a score statement.
+struct CommandSpec {
+    CommandKind kind = CommandKind::play;
+    double lo = 0, hi = 0; // range of the floats
+    const char *what = "";
+    const char *const *words = nullptr; // the words a string may be (null-terminated)
+    const char *expected = "";          // the words, as an error names them
 };
 
-const Spec kSpecs[] = {
-    {"/ictus/play", "", CommandKind::play, 0, 0, ""},
-    {"/ictus/stop", "", CommandKind::stop, 0, 0, ""},
-    {"/ictus/tempo", "f", CommandKind::tempo, 20.0, 400.0, "tempo (bpm)"},
-    {"/ictus/grip", "s", CommandKind::grip, 0, 0, "grip"},
-    {"/ictus/nuance", "s", CommandKind::nuance, 0, 0, "nuance"},
-    {"/ictus/mode", "s", CommandKind::mode, 0, 0, "mode"},
-    {"/ictus/gains", "ff", CommandKind::gains, 0.05, 4.0, "gain scale"},
-    {"/ictus/drum/radius", "f", CommandKind::drum_radius, 0.05, 1.0, "drum radius (m)"},
-    {"/ictus/drum/tension", "f", CommandKind::drum_tension, 10.0, 1e5, "drum tension (N/m)"},
-    {"/ictus/drum/density", "f", CommandKind::drum_density, 0.01, 10.0, "drum density (kg/m^2)"},
-    {"/ictus/score", "s", CommandKind::score, 0, 0, "score statement"},
-    {"/ictus/score/clear", "", CommandKind::score_clear, 0, 0, ""},
-    {"/ictus/grip/firmness", "f", CommandKind::grip_firmness, 0.0, 1.0, "grip firmness (0..1)"},
-};
-
-bool one_of(const char *text, std::initializer_list<const char *> words)
-{
-    for (const char *w : words)
-        if (std::strcmp(text, w) == 0)
-            return true;
-    return false;
-}
+constexpr const char *kGrips[] = {"french", "german", nullptr};
+constexpr const char *kNuances[] = {"legato",   "tenuto", "accent", "vertical_accent",
+                                    "staccato", "buzz",   nullptr};
+constexpr const char *kModes[] = {"joint", "cartesian", nullptr};
 
 // Why a score statement cannot be queued, or "" when it can. The score's own
 // syntax is the physics thread's business (its parser names the fault's
@@ -377,11 +372,193 @@ std::string score_statement_problem(const char *text, std::size_t length)
     return "";
 }
 
-std::string format_range(const Spec &s, double v)
+std::string format_range(const CommandSpec &s, double v)
 {
     char buf[160];
     std::snprintf(buf, sizeof buf, "%s: expected %g to %g, got %g", s.what, s.lo, s.hi, v);
     return buf;
+}
+
+// Why a string argument cannot be queued, or "" when it can.
+std::string text_problem(const CommandSpec &s, const char *text, std::size_t length)
+{
+    if (!s.words)
+        return score_statement_problem(text, length);
+    for (const char *const *w = s.words; *w; ++w)
+        if (std::strcmp(text, *w) == 0)
+            return "";
+    return std::string(s.what) + ": expected " + s.expected + ", got '" +
+           std::string(text, std::min<std::size_t>(length, 40)) + "'";
+}
+
+// One message as the methods see it: what arrived, from whom, and what the
+// server lends them (the replies, the counters, the log, the status, the
+// command queue).
+struct Request {
+    const char *path;
+    const char *types;
+    lo_arg **argv;
+    const sockaddr_in &peer;
+    Reply &reply;
+    Counters &counters;
+    RateLimitedLog &log;
+    LiveStatus *status;
+    SpscQueue<Command, 256> &commands;
+};
+
+// The OSC namespace (docs/osc.md) as a table of methods, in the manner of
+// liblo's lo_server_add_method(server, path, types, handler, user_data): a
+// message whose address and type tags match exactly goes to the handler,
+// with the method's user data (here a command's kind and checks).
+struct Method {
+    const char *address;
+    const char *types;
+    void (*handler)(const Request &request, const CommandSpec &command);
+    CommandSpec command; // the user data: a command's kind and checks (none for queries)
+};
+
+void handle_ping(const Request &r, const CommandSpec &)
+{
+    r.counters.accepted++;
+    lo_message pong = lo_message_new();
+    r.counters.replies++;
+    r.reply.send("/ictus/pong", pong);
+}
+
+void handle_status(const Request &r, const CommandSpec &)
+{
+    Counters &c = r.counters;
+    const LiveStatus *status = r.status;
+    c.accepted++;
+    lo_message s = lo_message_new();
+    lo_message_add_float(s, status ? static_cast<float>(status->time_s.load()) : 0.0f);
+    lo_message_add_int32(s, status ? status->playing.load() : 0);
+    lo_message_add_float(s, status ? static_cast<float>(status->tempo_bpm.load()) : 0.0f);
+    lo_message_add_int32(s, status ? static_cast<int>(status->strikes.load()) : 0);
+    lo_message_add_int32(s, static_cast<int>(c.packets.load()));
+    lo_message_add_int32(s, static_cast<int>(c.accepted.load()));
+    const OscServerCounters snap = snapshot(c);
+    lo_message_add_int32(s, static_cast<int>(snap.errors()));
+    lo_message_add_int32(s, static_cast<int>(c.refused_peers.load()));
+    lo_message_add_int32(s, status ? static_cast<int>(status->overruns.load()) : 0);
+    // The performance's state, by name: source, control mode, grip.
+    lo_message_add_string(s, status && status->score.load() ? "score" : "clip");
+    // (the mode by its name here: TrackMode's to_string lives with the tracker,
+    // which the OSC fuzz harness does not link)
+    const bool cartesian = status && status->mode.load() == static_cast<int>(TrackMode::cartesian);
+    lo_message_add_string(s, cartesian ? "cartesian" : "joint");
+    lo_message_add_string(s, to_string(static_cast<Grip>(status ? status->grip.load() : 0)));
+    r.reply.ok(r.path, s);
+}
+
+// The command's arguments into `cmd` (floats in the spec's range, a string
+// that passes text_problem()), or the reason it is refused.
+std::string read_arguments(const Request &r, const CommandSpec &s, Command &cmd)
+{
+    double *const floats[2] = {&cmd.value, &cmd.value2};
+    for (int i = 0; i < 2 && r.types[i] == 'f'; ++i) {
+        *floats[i] = lo_arg_float(r.argv[i]);
+        if (!(std::isfinite(*floats[i]) && *floats[i] >= s.lo && *floats[i] <= s.hi))
+            return format_range(s, *floats[i]);
+    }
+    if (r.types[0] == 's') {
+        const char *text = lo_arg_string(r.argv[0]);
+        // liblo checked the string's terminator inside the packet; the
+        // packet limit bounds its length.
+        const std::size_t length = std::strlen(text);
+        const std::string problem = text_problem(s, text, length);
+        if (!problem.empty())
+            return problem;
+        std::memcpy(cmd.text, text, length + 1); // fits: checked above
+    }
+    return "";
+}
+
+// A command: checked, queued for the physics thread, echoed in /ictus/reply.
+void handle_command(const Request &r, const CommandSpec &s)
+{
+    Counters &c = r.counters;
+    Command cmd;
+    cmd.kind = s.kind;
+    cmd.peer_ipv4 = r.peer.sin_addr.s_addr;
+    cmd.peer_port = r.peer.sin_port;
+    std::snprintf(cmd.address, sizeof cmd.address, "%s", r.path);
+    const std::string problem = read_arguments(r, s, cmd);
+    if (!problem.empty()) {
+        c.bad_values++;
+        r.reply.error(r.path, problem);
+        return;
+    }
+    if (!r.commands.push(cmd)) {
+        c.queue_full++;
+        r.reply.error(r.path, "command queue full (the physics thread is not reading)");
+        return;
+    }
+    c.accepted++;
+    if (s.kind == CommandKind::score)
+        c.score_lines++;
+    lo_message echo = lo_message_new();
+    for (int i = 0; r.types[i]; ++i) {
+        if (r.types[i] == 'f')
+            lo_message_add_float(echo, lo_arg_float(r.argv[i]));
+        else if (r.types[i] == 's')
+            lo_message_add_string(echo, lo_arg_string(r.argv[i]));
+    }
+    r.reply.ok(r.path, echo);
+}
+
+// One method a line (clang-format would break the rows).
+// clang-format off
+const Method kMethods[] = {
+    {"/ictus/ping",          "",   handle_ping,    {}},
+    {"/ictus/status",        "",   handle_status,  {}},
+    {"/ictus/play",          "",   handle_command, {CommandKind::play}},
+    {"/ictus/stop",          "",   handle_command, {CommandKind::stop}},
+    {"/ictus/tempo",         "f",  handle_command, {CommandKind::tempo, 20.0, 400.0, "tempo (bpm)"}},
+    {"/ictus/grip",          "s",  handle_command, {CommandKind::grip, 0, 0, "grip", kGrips, "french or german"}},
+    {"/ictus/nuance",        "s",  handle_command, {CommandKind::nuance, 0, 0, "nuance", kNuances,
+                                                    "legato, tenuto, accent, vertical_accent, staccato or buzz"}},
+    {"/ictus/mode",          "s",  handle_command, {CommandKind::mode, 0, 0, "mode", kModes, "joint or cartesian"}},
+    {"/ictus/gains",         "ff", handle_command, {CommandKind::gains, 0.05, 4.0, "gain scale"}},
+    {"/ictus/drum/radius",   "f",  handle_command, {CommandKind::drum_radius, 0.05, 1.0, "drum radius (m)"}},
+    {"/ictus/drum/tension",  "f",  handle_command, {CommandKind::drum_tension, 10.0, 1e5, "drum tension (N/m)"}},
+    {"/ictus/drum/density",  "f",  handle_command, {CommandKind::drum_density, 0.01, 10.0, "drum density (kg/m^2)"}},
+    {"/ictus/score",         "s",  handle_command, {CommandKind::score, 0, 0, "score statement"}},
+    {"/ictus/score/clear",   "",   handle_command, {CommandKind::score_clear}},
+    {"/ictus/grip/firmness", "f",  handle_command, {CommandKind::grip_firmness, 0.0, 1.0, "grip firmness (0..1)"}},
+};
+// clang-format on
+
+// The method for the request's address, its type tags checked: called, or the
+// request refused (unknown address, wrong type tags) and counted.
+void dispatch(const Request &r)
+{
+    const Method *method = nullptr;
+    for (const Method &m : kMethods) {
+        if (std::strcmp(r.path, m.address) == 0) {
+            method = &m;
+            break;
+        }
+    }
+    if (!method) {
+        r.counters.unknown_address++;
+        std::string shown(r.path, strnlen(r.path, 80));
+        r.log("unknown address", shown);
+        r.reply.error(r.path, "unknown address (see docs/osc.md)");
+        return;
+    }
+    if (std::strcmp(r.types, method->types) != 0) {
+        r.counters.bad_type_tags++;
+        if (method->handler != handle_command) { // a query: it takes no arguments
+            r.reply.error(r.path, std::string("type tags: expected none, got ,") + r.types);
+            return;
+        }
+        r.log("wrong type tags", std::string(r.path) + " ," + r.types);
+        r.reply.error(r.path,
+                      std::string("type tags: expected ,") + method->types + ", got ," + r.types);
+        return;
+    }
+    method->handler(r, method->command);
 }
 
 } // namespace
@@ -407,6 +584,8 @@ void OscServer::send_refusals()
     }
 }
 
+// A datagram: from an allowed peer, not oversized, not a bundle, a message
+// liblo accepts; then its method (dispatch()).
 void OscServer::handle(const unsigned char *data, std::size_t size, const void *peer_ptr)
 {
     const sockaddr_in &peer = *static_cast<const sockaddr_in *>(peer_ptr);
@@ -453,138 +632,12 @@ void OscServer::handle(const unsigned char *data, std::size_t size, const void *
     }
     // The path is the packet's first string; deserialise validated it.
     const char *path = reinterpret_cast<const char *>(copy.data());
-    const char *types = lo_message_get_types(m);
-    lo_arg **argv = lo_message_get_argv(m);
     struct Free {
         lo_message m;
         ~Free() { lo_message_free(m); }
     } free_m{m};
-
-    if (std::strcmp(path, "/ictus/ping") == 0) {
-        if (types[0] != '\0') {
-            c.bad_type_tags++;
-            reply.error(path, std::string("type tags: expected none, got ,") + types);
-            return;
-        }
-        c.accepted++;
-        lo_message pong = lo_message_new();
-        c.replies++;
-        reply.send("/ictus/pong", pong);
-        return;
-    }
-    if (std::strcmp(path, "/ictus/status") == 0) {
-        if (types[0] != '\0') {
-            c.bad_type_tags++;
-            reply.error(path, std::string("type tags: expected none, got ,") + types);
-            return;
-        }
-        c.accepted++;
-        lo_message s = lo_message_new();
-        lo_message_add_float(s, status_ ? static_cast<float>(status_->time_s.load()) : 0.0f);
-        lo_message_add_int32(s, status_ ? status_->playing.load() : 0);
-        lo_message_add_float(s, status_ ? static_cast<float>(status_->tempo_bpm.load()) : 0.0f);
-        lo_message_add_int32(s, status_ ? static_cast<int>(status_->strikes.load()) : 0);
-        lo_message_add_int32(s, static_cast<int>(c.packets.load()));
-        lo_message_add_int32(s, static_cast<int>(c.accepted.load()));
-        const OscServerCounters snap = counters();
-        lo_message_add_int32(s, static_cast<int>(snap.errors()));
-        lo_message_add_int32(s, static_cast<int>(c.refused_peers.load()));
-        lo_message_add_int32(s, status_ ? static_cast<int>(status_->overruns.load()) : 0);
-        // The performance's state, by name: source, control mode, grip.
-        lo_message_add_string(s, status_ && status_->score.load() ? "score" : "clip");
-        // (the mode by its name here: TrackMode's to_string lives with the tracker,
-        // which the OSC fuzz harness does not link)
-        const bool cartesian =
-            status_ && status_->mode.load() == static_cast<int>(TrackMode::cartesian);
-        lo_message_add_string(s, cartesian ? "cartesian" : "joint");
-        lo_message_add_string(s, to_string(static_cast<Grip>(status_ ? status_->grip.load() : 0)));
-        reply.ok(path, s);
-        return;
-    }
-    for (const Spec &s : kSpecs) {
-        if (std::strcmp(path, s.address) != 0)
-            continue;
-        if (std::strcmp(types, s.types) != 0) {
-            c.bad_type_tags++;
-            im.log("wrong type tags", std::string(path) + " ," + types);
-            reply.error(path, std::string("type tags: expected ,") + s.types + ", got ," + types);
-            return;
-        }
-        Command cmd;
-        cmd.kind = s.kind;
-        cmd.peer_ipv4 = peer.sin_addr.s_addr;
-        cmd.peer_port = peer.sin_port;
-        std::snprintf(cmd.address, sizeof cmd.address, "%s", s.address);
-        if (s.types[0] == 'f') {
-            cmd.value = lo_arg_float(argv[0]);
-            if (!(std::isfinite(cmd.value) && cmd.value >= s.lo && cmd.value <= s.hi)) {
-                c.bad_values++;
-                reply.error(path, format_range(s, cmd.value));
-                return;
-            }
-            if (s.types[1] == 'f') {
-                cmd.value2 = lo_arg_float(argv[1]);
-                if (!(std::isfinite(cmd.value2) && cmd.value2 >= s.lo && cmd.value2 <= s.hi)) {
-                    c.bad_values++;
-                    reply.error(path, format_range(s, cmd.value2));
-                    return;
-                }
-            }
-        } else if (s.types[0] == 's') {
-            const char *text = lo_arg_string(argv[0]);
-            // liblo checked the string's terminator inside the packet; the
-            // packet limit bounds its length.
-            const std::size_t length = std::strlen(text);
-            std::string problem;
-            if (s.kind == CommandKind::score) {
-                problem = score_statement_problem(text, length);
-            } else {
-                bool ok = false;
-                std::string expected;
-                if (s.kind == CommandKind::grip) {
-                    ok = one_of(text, {"french", "german"});
-                    expected = "french or german";
-                } else if (s.kind == CommandKind::nuance) {
-                    ok = one_of(text, {"legato", "tenuto", "accent", "vertical_accent", "staccato",
-                                       "buzz"});
-                    expected = "legato, tenuto, accent, vertical_accent, staccato or buzz";
-                } else if (s.kind == CommandKind::mode) {
-                    ok = one_of(text, {"joint", "cartesian"});
-                    expected = "joint or cartesian";
-                }
-                if (!ok)
-                    problem = std::string(s.what) + ": expected " + expected + ", got '" +
-                              std::string(text, std::min<std::size_t>(length, 40)) + "'";
-            }
-            if (!problem.empty()) {
-                c.bad_values++;
-                reply.error(path, problem);
-                return;
-            }
-            std::memcpy(cmd.text, text, length + 1); // fits: checked above
-        }
-        if (!commands_.push(cmd)) {
-            c.queue_full++;
-            reply.error(path, "command queue full (the physics thread is not reading)");
-            return;
-        }
-        c.accepted++;
-        if (s.kind == CommandKind::score)
-            c.score_lines++;
-        lo_message echo = lo_message_new();
-        for (int i = 0; types[i]; ++i) {
-            if (types[i] == 'f')
-                lo_message_add_float(echo, lo_arg_float(argv[i]));
-            else if (types[i] == 's')
-                lo_message_add_string(echo, lo_arg_string(argv[i]));
-        }
-        reply.ok(path, echo);
-        return;
-    }
-    c.unknown_address++;
-    std::string shown(path, strnlen(path, 80));
-    im.log("unknown address", shown);
-    reply.error(path, "unknown address (see docs/osc.md)");
+    dispatch(Request{path, lo_message_get_types(m), lo_message_get_argv(m), peer, reply, c, im.log,
+                     status_, commands_});
 }
 
 bool OscServer::dispatch_packet(const void *data, std::size_t size)

@@ -131,11 +131,32 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
     const bool touching = gap < 0.0 && over_membrane(s.center_m);
     const double depth_rate = -s.velocity_mps.dot(kNormal);
     bool ended = false;
+    if (entered_from_side(h, s, gap, touching))
+        return false;
+    if (!h.in_contact && touching)
+        begin_contact(h, hand, s, gap);
+    if (h.in_contact && touching) {
+        continue_contact(h, s, gap, depth_rate);
+    } else if (h.in_contact && !touching) {
+        end_contact(h, s, gap, depth_rate, out);
+        ended = true;
+    }
+    if (!h.in_contact)
+        track_release(h, s, gap, ended);
+    if (h.has_previous && held_driving(h.previous, s))
+        h.last_driven_s = s.time_s;
+    h.previous = s;
+    h.previous_gap = gap;
+    h.has_previous = true;
+    return ended;
+}
 
-    // A tip that comes in over the disk already below the membrane plane
-    // entered from the side: that is the shell (or rim), not a strike on the
-    // membrane. It is ignored until the tip is above the plane again. So is a
-    // tip first seen below the plane (no approach was observed), uncounted.
+// A tip that comes in over the disk already below the membrane plane entered
+// from the side: that is the shell (or rim), not a strike on the membrane. It
+// is ignored until the tip is above the plane again. So is a tip first seen
+// below the plane (no approach was observed), uncounted. True while ignored.
+bool StrikeDetector::entered_from_side(Hand &h, const TipSample &s, double gap, bool touching)
+{
     if (!h.in_contact && touching && !h.side_entry) {
         if (!h.has_previous) {
             h.side_entry = true;
@@ -144,121 +165,125 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
             ++side_entries_;
         }
     }
-    if (h.side_entry) {
-        if (gap >= 0.0)
-            h.side_entry = false;
-        h.previous = s;
-        h.previous_gap = gap;
+    if (!h.side_entry)
         return false;
-    }
-
-    if (!h.in_contact && touching) {
-        // Onset: where the gap crosses zero between the last free sample and
-        // this one (here previous_gap >= 0 > gap: the cases above left).
-        const TipSample &before = h.previous;
-        const double g0 = h.previous_gap;
-        const double frac = g0 > 0.0 ? g0 / (g0 - gap) : 0.0;
-        const double t_on = before.time_s + frac * (s.time_s - before.time_s);
-        const Eigen::Vector3d p_on = before.center_m + frac * (s.center_m - before.center_m) -
-                                     membrane_.tip_radius_m * kNormal;
-        StrikeEvent &e = h.event;
-        e = StrikeEvent();
-        e.hand = hand & 1;
-        e.drum = membrane_.drum_id;
-        e.time_s = t_on;
-        to_membrane(p_on, e.x_m, e.y_m);
-        e.r_over_a = std::hypot(e.x_m, e.y_m) / membrane_.radius_m;
-        e.theta_deg = std::atan2(e.y_m, e.x_m) * 180.0 / M_PI;
-        if (e.theta_deg <= -180.0)
-            e.theta_deg += 360.0;
-        const Eigen::Vector3d v = approach_velocity(before, g0, s, options_.semi_implicit_samples);
-        e.normal_velocity_mps = -v.dot(kNormal);
-        e.tangential_velocity_mps = (v - v.dot(kNormal) * kNormal).norm();
-        // Driven: the hand moved the stick toward the membrane within the
-        // drive window, the onset's own step included (the held bead; a
-        // rigid stick or a trajectory has none: always driven).
-        const bool driven = !s.held_center_m.allFinite() || held_driving(h.previous, s) ||
-                            s.time_s - h.last_driven_s <= options_.drive_window_s + 1e-9;
-        e.bounce = h.released_once && (t_on - h.release_time_s) <= options_.bounce_window_s &&
-                   (h.max_gap_since_release < options_.bounce_height_m ||
-                    h.max_held_gap_since_release < options_.bounce_height_m || !driven);
-        e.stick_mass_kg = s.effective_mass_kg;
-        if (!e.bounce)
-            ++h.stroke;
-        e.stroke = std::max(h.stroke, 0L);
-        e.seq = next_seq_++;
-        // The force law at the onset (the damper acts at once).
-        const double f_on = normal_force_n(0.0, -v.dot(kNormal));
-        h.last_force_n = f_on;
-        h.last_time_s = t_on;
-        h.friction_sum.setZero();
-        h.peak_t[1] = t_on;
-        h.peak_f[1] = f_on;
-        h.peak_has_before = false;
-        h.peak_has_after = false;
-        h.in_contact = true;
-        h.onset_new = true;
-    }
-
-    if (h.in_contact && touching) {
-        const double f = normal_force_n(-gap, depth_rate);
-        const double dt = s.time_s - h.last_time_s;
-        h.event.impulse_n_s += 0.5 * (h.last_force_n + f) * dt;
-        // Kinetic friction on the membrane along the tip's sliding direction.
-        const Eigen::Vector3d vt = s.velocity_mps - s.velocity_mps.dot(kNormal) * kNormal;
-        if (vt.norm() > 1e-6)
-            h.friction_sum +=
-                membrane_.friction * 0.5 * (h.last_force_n + f) * dt * vt.normalized();
-        if (f > h.peak_f[1]) {
-            h.peak_t[0] = h.last_time_s;
-            h.peak_f[0] = h.last_force_n;
-            h.peak_has_before = true;
-            h.peak_t[1] = s.time_s;
-            h.peak_f[1] = f;
-            h.peak_has_after = false;
-        } else if (!h.peak_has_after && h.peak_t[1] == h.last_time_s) {
-            h.peak_t[2] = s.time_s;
-            h.peak_f[2] = f;
-            h.peak_has_after = true;
-        }
-        h.last_force_n = f;
-        h.last_time_s = s.time_s;
-    } else if (h.in_contact && !touching) {
-        // Release where the gap crosses zero again (at once when the tip left
-        // the disk sideways).
-        double frac = 1.0;
-        const double g0 = std::min(h.previous_gap, 0.0);
-        if (gap >= 0.0 && g0 < 0.0)
-            frac = -g0 / (gap - g0);
-        const double t_rel = h.previous.time_s + frac * (s.time_s - h.previous.time_s);
-        const double f_rel = normal_force_n(0.0, depth_rate);
-        const double dt = t_rel - h.last_time_s;
-        h.event.impulse_n_s += 0.5 * (h.last_force_n + f_rel) * dt;
-        if (!h.peak_has_after && h.peak_t[1] == h.last_time_s) {
-            h.peak_t[2] = t_rel;
-            h.peak_f[2] = f_rel;
-            h.peak_has_after = true;
-        }
-        finish(h, t_rel, out);
-        ended = true;
-    }
-
-    if (!h.in_contact) {
-        const double held_gap = s.held_center_m.allFinite() ? gap_m(s.held_center_m) : gap;
-        if (ended) {
-            h.max_gap_since_release = std::max(gap, 0.0);
-            h.max_held_gap_since_release = std::max(held_gap, 0.0);
-        } else {
-            h.max_gap_since_release = std::max(h.max_gap_since_release, gap);
-            h.max_held_gap_since_release = std::max(h.max_held_gap_since_release, held_gap);
-        }
-    }
-    if (h.has_previous && held_driving(h.previous, s))
-        h.last_driven_s = s.time_s;
+    if (gap >= 0.0)
+        h.side_entry = false;
     h.previous = s;
     h.previous_gap = gap;
-    h.has_previous = true;
-    return ended;
+    return true;
+}
+
+// Onset: where the gap crosses zero between the last free sample and this one
+// (here previous_gap >= 0 > gap: entered_from_side() left the other cases).
+void StrikeDetector::begin_contact(Hand &h, int hand, const TipSample &s, double gap)
+{
+    const TipSample &before = h.previous;
+    const double g0 = h.previous_gap;
+    const double frac = g0 > 0.0 ? g0 / (g0 - gap) : 0.0;
+    const double t_on = before.time_s + frac * (s.time_s - before.time_s);
+    const Eigen::Vector3d p_on =
+        before.center_m + frac * (s.center_m - before.center_m) - membrane_.tip_radius_m * kNormal;
+    StrikeEvent &e = h.event;
+    e = StrikeEvent();
+    e.hand = hand & 1;
+    e.drum = membrane_.drum_id;
+    e.time_s = t_on;
+    to_membrane(p_on, e.x_m, e.y_m);
+    e.r_over_a = std::hypot(e.x_m, e.y_m) / membrane_.radius_m;
+    e.theta_deg = std::atan2(e.y_m, e.x_m) * 180.0 / M_PI;
+    if (e.theta_deg <= -180.0)
+        e.theta_deg += 360.0;
+    const Eigen::Vector3d v = approach_velocity(before, g0, s, options_.semi_implicit_samples);
+    e.normal_velocity_mps = -v.dot(kNormal);
+    e.tangential_velocity_mps = (v - v.dot(kNormal) * kNormal).norm();
+    // Driven: the hand moved the stick toward the membrane within the
+    // drive window, the onset's own step included (the held bead; a
+    // rigid stick or a trajectory has none: always driven).
+    const bool driven = !s.held_center_m.allFinite() || held_driving(h.previous, s) ||
+                        s.time_s - h.last_driven_s <= options_.drive_window_s + 1e-9;
+    e.bounce = h.released_once && (t_on - h.release_time_s) <= options_.bounce_window_s &&
+               (h.max_gap_since_release < options_.bounce_height_m ||
+                h.max_held_gap_since_release < options_.bounce_height_m || !driven);
+    e.stick_mass_kg = s.effective_mass_kg;
+    if (!e.bounce)
+        ++h.stroke;
+    e.stroke = std::max(h.stroke, 0L);
+    e.seq = next_seq_++;
+    // The force law at the onset (the damper acts at once).
+    const double f_on = normal_force_n(0.0, -v.dot(kNormal));
+    h.last_force_n = f_on;
+    h.last_time_s = t_on;
+    h.friction_sum.setZero();
+    h.peak_t[1] = t_on;
+    h.peak_f[1] = f_on;
+    h.peak_has_before = false;
+    h.peak_has_after = false;
+    h.in_contact = true;
+    h.onset_new = true;
+}
+
+// A sample inside the contact: the force law's impulse (trapezoids), the
+// friction along the sliding direction, and the largest force sample with its
+// neighbours (for the sub-step peak).
+void StrikeDetector::continue_contact(Hand &h, const TipSample &s, double gap, double depth_rate)
+{
+    const double f = normal_force_n(-gap, depth_rate);
+    const double dt = s.time_s - h.last_time_s;
+    h.event.impulse_n_s += 0.5 * (h.last_force_n + f) * dt;
+    // Kinetic friction on the membrane along the tip's sliding direction.
+    const Eigen::Vector3d vt = s.velocity_mps - s.velocity_mps.dot(kNormal) * kNormal;
+    if (vt.norm() > 1e-6)
+        h.friction_sum += membrane_.friction * 0.5 * (h.last_force_n + f) * dt * vt.normalized();
+    if (f > h.peak_f[1]) {
+        h.peak_t[0] = h.last_time_s;
+        h.peak_f[0] = h.last_force_n;
+        h.peak_has_before = true;
+        h.peak_t[1] = s.time_s;
+        h.peak_f[1] = f;
+        h.peak_has_after = false;
+    } else if (!h.peak_has_after && h.peak_t[1] == h.last_time_s) {
+        h.peak_t[2] = s.time_s;
+        h.peak_f[2] = f;
+        h.peak_has_after = true;
+    }
+    h.last_force_n = f;
+    h.last_time_s = s.time_s;
+}
+
+// Release where the gap crosses zero again (at once when the tip left the disk
+// sideways): the last trapezoid and the event finished into `out`.
+void StrikeDetector::end_contact(Hand &h, const TipSample &s, double gap, double depth_rate,
+                                 StrikeEvent &out)
+{
+    double frac = 1.0;
+    const double g0 = std::min(h.previous_gap, 0.0);
+    if (gap >= 0.0 && g0 < 0.0)
+        frac = -g0 / (gap - g0);
+    const double t_rel = h.previous.time_s + frac * (s.time_s - h.previous.time_s);
+    const double f_rel = normal_force_n(0.0, depth_rate);
+    const double dt = t_rel - h.last_time_s;
+    h.event.impulse_n_s += 0.5 * (h.last_force_n + f_rel) * dt;
+    if (!h.peak_has_after && h.peak_t[1] == h.last_time_s) {
+        h.peak_t[2] = t_rel;
+        h.peak_f[2] = f_rel;
+        h.peak_has_after = true;
+    }
+    finish(h, t_rel, out);
+}
+
+// Out of contact: how high the bead and the held bead rose since the release
+// (from this sample on when the contact ended just now).
+void StrikeDetector::track_release(Hand &h, const TipSample &s, double gap, bool ended)
+{
+    const double held_gap = s.held_center_m.allFinite() ? gap_m(s.held_center_m) : gap;
+    if (ended) {
+        h.max_gap_since_release = std::max(gap, 0.0);
+        h.max_held_gap_since_release = std::max(held_gap, 0.0);
+    } else {
+        h.max_gap_since_release = std::max(h.max_gap_since_release, gap);
+        h.max_held_gap_since_release = std::max(h.max_held_gap_since_release, held_gap);
+    }
 }
 
 bool StrikeDetector::take_onset(int hand, StrikeEvent &out)

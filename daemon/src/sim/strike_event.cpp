@@ -11,26 +11,27 @@ namespace ictus
 
 namespace
 {
+// name, integer, decimals, in /ictus/strike, in /ictus/strike/end
 constexpr StrikeFieldInfo kInfo[kStrikeFieldCount] = {
-    {"seq", true, 0, true},
-    {"hand", true, 0, true},
-    {"drum", true, 0, true},
-    {"bounce", true, 0, true},
-    {"stroke", true, 0, false}, // per hand; the OSC message has none (docs/osc.md)
-    {"time_s", false, 6, true},
-    {"x_m", false, 5, true},
-    {"y_m", false, 5, true},
-    {"r_over_a", false, 5, true},
-    {"theta_deg", false, 2, true},
-    {"normal_velocity_mps", false, 4, true},
-    {"tangential_velocity_mps", false, 4, true},
-    {"peak_force_n", false, 3, true},
-    {"impulse_n_s", false, 6, true},
-    {"duration_ms", false, 3, true},
-    {"force_dir_x", false, 4, true},
-    {"force_dir_y", false, 4, true},
-    {"force_dir_z", false, 4, true},
-    {"stick_mass_kg", false, 5, true},
+    {"seq", true, 0, true, true},
+    {"hand", true, 0, true, true},
+    {"drum", true, 0, true, false},
+    {"bounce", true, 0, true, false},
+    {"stroke", true, 0, false, false}, // per hand; the OSC messages have none (docs/osc.md)
+    {"time_s", false, 6, true, false},
+    {"x_m", false, 5, true, false},
+    {"y_m", false, 5, true, false},
+    {"r_over_a", false, 5, true, false},
+    {"theta_deg", false, 2, true, false},
+    {"normal_velocity_mps", false, 4, true, false},
+    {"tangential_velocity_mps", false, 4, true, false},
+    {"peak_force_n", false, 3, true, true},
+    {"impulse_n_s", false, 6, true, true},
+    {"duration_ms", false, 3, true, true},
+    {"force_dir_x", false, 4, true, true},
+    {"force_dir_y", false, 4, true, true},
+    {"force_dir_z", false, 4, true, true},
+    {"stick_mass_kg", false, 5, true, false},
 };
 
 // Fixed notation with a given number of decimals; -0 printed as 0 so that

@@ -8,6 +8,7 @@
 #include "ictus/character/character.hpp"
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/character/joint_limit_ref.hpp"
+#include "ictus/sim/sim_error.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -62,7 +63,7 @@ struct GripSpring {
 // spring: k = 2 * 2^(7 f) N m/rad (2 at 0, a loose hold, 256 at 1, the hand
 // clamped on the stick: a welded stick's press), c = 2 zeta sqrt(k I) for the
 // stick's inertia I about its fulcrum (docs/character.md, "The fulcrum").
-// Throws CharacterError outside [0, 1] or for a bad inertia or ratio.
+// Throws SimError outside [0, 1] or for a bad inertia or ratio.
 GripSpring grip_spring(double firmness, double stick_inertia_kg_m2, double damping_ratio);
 constexpr double kDefaultGripFirmness = 0.35;
 constexpr double kDefaultGripDampingRatio = 0.7;
@@ -120,7 +121,7 @@ struct SceneOptions {
     std::array<GripSpring, 2> grip{};                     // [side], fulcrum mount only
     double grip_damping_ratio = kDefaultGripDampingRatio; // set_grip_firmness()'s
 };
-// Throws CharacterError naming the first bad option.
+// Throws SimError naming the first bad option.
 void validate(const SceneOptions &options);
 
 enum class StepResult { ok, diverged };
@@ -236,7 +237,7 @@ class Scene
     // The fulcrum's axis and the stick's axis (butt to tip), unit, world.
     Eigen::Vector3d fulcrum_axis(Side side) const;
     Eigen::Vector3d stick_axis(Side side) const;
-    // The grip's spring (fulcrum mount), changed at once. Throws CharacterError
+    // The grip's spring (fulcrum mount), changed at once. Throws SimError
     // for a non-finite or non-positive stiffness, or a negative damping.
     void set_grip(Side side, const GripSpring &grip);
     const GripSpring &grip(Side side) const { return options_.grip[static_cast<int>(side)]; }
@@ -268,7 +269,7 @@ class Scene
 
     // The drum, changed on the live scene: the membrane moves and resizes at
     // once and the contact law (k = 2 pi T / ln(R / r_tip), c) is recomputed
-    // for the next step; the character is untouched. Throws CharacterError
+    // for the next step; the character is untouched. Throws SimError
     // naming the bad value (the scene keeps its drum).
     void set_drum(const DrumParams &drum);
     const DrumParams &drum() const { return options_.drum; }
@@ -277,14 +278,35 @@ class Scene
     double max_linear_speed_mps() const;
     double max_angular_speed_rad_s() const;
     // Adds a velocity change to a body's centre of mass (tests: injected
-    // kicks). Throws CharacterError for a bad or kinematic body or a
+    // kicks). Throws SimError for a bad or kinematic body or a
     // non-finite change.
     void kick(int body, const Eigen::Vector3d &delta_linear_mps,
               const Eigen::Vector3d &delta_angular_rad_s);
 
   private:
+    // Building (scene_build.cpp), in the order ODE gets it.
     void build(const CharacterPose &initial);
+    void create_world();
+    void create_bodies(const BodyFrames &frames);
+    void create_joints(const BodyFrames &frames);
+    void make_legs_kinematic();
+    void create_stick(int side, const BodyFrames &frames);
+    void create_drum();
+    // Stepping (scene_step.cpp): eq. 1's motor rows and the limit stops.
+    struct LimitStop {
+        bool engaged = false;
+        Eigen::Vector3d axis = Eigen::Vector3d::UnitX(); // world, unit
+        double violation = 0.0; // the angle past the limit the stop row sees, rad
+        double stop_at = 0.0;   // the stop row's high stop, rad
+    };
     void apply_control();
+    Eigen::Vector3d relative_rate(int joint) const;
+    LimitStop limit_stop(int joint, const Eigen::Quaterniond &parent,
+                         const Eigen::Quaterniond &child, const MotorCommand &command) const;
+    void look_ahead_stop(int joint, const Eigen::Quaterniond &parent,
+                         const Eigen::Quaterniond &current, const MotorCommand &command,
+                         LimitStop &stop) const;
+    void drive_motor(int joint, const MotorCommand &command, const LimitStop &stop);
     bool check() const;
     static void near_callback(void *data, dxGeom *a, dxGeom *b);
     void place_drum();

@@ -154,6 +154,14 @@ class StrikeDetector
         long stroke = -1;
         bool onset_new = false; // take_onset() has not seen this contact yet
     };
+    // update()'s parts: a tip below the plane that came in from the side, a
+    // contact's onset, a sample inside it, its release, and the heights
+    // since the release (the bounce rule's).
+    bool entered_from_side(Hand &h, const TipSample &s, double gap, bool touching);
+    void begin_contact(Hand &h, int hand, const TipSample &s, double gap);
+    void continue_contact(Hand &h, const TipSample &s, double gap, double depth_rate);
+    void end_contact(Hand &h, const TipSample &s, double gap, double depth_rate, StrikeEvent &out);
+    void track_release(Hand &h, const TipSample &s, double gap, bool ended);
     void finish(Hand &h, double release_time_s, StrikeEvent &out);
     void to_membrane(const Eigen::Vector3d &world_m, double &x_m, double &y_m) const;
 

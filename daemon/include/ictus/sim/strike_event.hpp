@@ -1,8 +1,8 @@
 // strike_event.hpp -- a strike as the rest of the chain sees it: one contact
 // episode of a stick tip with the membrane, and its fields declared once
 // (name, integer or real, decimals in files). strikes.csv, the events file
-// for Pd and the /ictus/strike OSC message are each a list of these fields
-// (docs/osc.md gives the three layouts).
+// for Pd and the /ictus/strike and /ictus/strike/end OSC messages are each a
+// list of these fields (docs/osc.md gives the layouts).
 #pragma once
 
 #include <Eigen/Core>
@@ -63,16 +63,17 @@ struct StrikeFieldInfo {
     const char *name; // column name, with its unit
     bool integer;     // an integer (seq, hand, ...) or a real
     int decimals;     // fixed decimals of a real in the files
-    bool in_osc;      // part of the /ictus/strike message
+    bool in_osc;      // part of the /ictus/strike message (at the onset)
+    bool in_osc_end;  // part of the /ictus/strike/end message (at the release)
 };
 const StrikeFieldInfo &strike_field_info(StrikeField field);
 // A field's value (integers exactly, as doubles).
 double strike_field(const StrikeEvent &event, StrikeField field);
 long strike_field_integer(const StrikeEvent &event, StrikeField field);
 
-// The three layouts: strikes.csv has every field in StrikeField's order; the
-// /ictus/strike OSC message those with in_osc, in the same order; the events
-// file's `hit` line these, after "hit":
+// The layouts: strikes.csv has every field in StrikeField's order; the
+// /ictus/strike OSC message those with in_osc and /ictus/strike/end those with
+// in_osc_end, in the same order; the events file's `hit` line these, after "hit":
 extern const StrikeField kEventsStrikeFields[12];
 
 // strikes.csv: a header line and one line per event, fixed precision (so that
