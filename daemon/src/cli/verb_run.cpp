@@ -1,13 +1,13 @@
-// `ictusd run`: the performance in real time: physics paced by the wall
-// clock, strikes and poses out over OSC (each strike time-tagged for exact
-// scheduling), commands in. The physics loop never waits on the network and
-// never touches the disk: strikes.csv is written by a thread of its own, a
-// whole line at a time. docs/osc.md, docs/perform.md.
-#include "ictus/base/realtime.hpp"
+// `ictusd run`: the performance in real time (perform/realtime_loop.hpp),
+// wired to the network: strikes and poses out over OSC (each strike
+// time-tagged for exact scheduling), commands in. The physics loop never
+// waits on the network and never touches the disk: strikes.csv is written by
+// a thread of its own, a whole line at a time. docs/osc.md, docs/perform.md.
 #include "ictus/base/spsc_queue.hpp"
 #include "ictus/cli/verbs.hpp"
 #include "ictus/net/osc_sender.hpp"
 #include "ictus/net/osc_server.hpp"
+#include "ictus/perform/realtime_loop.hpp"
 #include "ictus/perform/strike_log.hpp"
 #include "ictus/sim/strike_event.hpp"
 
@@ -198,211 +198,115 @@ class CsvWriter
     std::thread thread_;
 };
 
-} // namespace
-
-int cmd_run(Args &args)
+// What `ictusd run` gives the real-time loop: commands from the OSC server,
+// refusals back to it, strikes, poses and tip states to the OSC sender,
+// strikes.csv rows to the writer. Each call only posts to a queue.
+class OscIo : public RealtimeIo
 {
-    PerformanceOptions o;
-    OscSenderOptions so;
-    so.lookahead_s = 0.02;
-    OscServerOptions io;
-    double duration = 0.0, pose_rate = 30.0, tip_rate = 0.0;
-    bool autoplay = false, realtime = false;
+  public:
+    OscIo(OscSender &sender, OscServer &server, CsvWriter &writer)
+        : sender_(sender), server_(server), writer_(writer)
+    {
+    }
+    bool next_command(Command &out) override { return server_.pop_command(out); }
+    void refused(const Refusal &refusal) override { server_.post_refusal(refusal); }
+    void strike_onset(const StrikeEvent &strike) override { sender_.post_strike(strike); }
+    void strike_end(const StrikeEvent &strike) override { sender_.post_strike_end(strike); }
+    void strike_logged(const StrikeEvent &strike) override { writer_.post(strike); }
+    void pose(const PoseSnapshot &pose) override { sender_.post_pose(pose); }
+    void tip(const TipState &tip) override { sender_.post_tip(tip); }
+    void clock_started() override { sender_.set_epoch(ntp_now()); }
+    void clock_slipped(double lag_s) override
+    {
+        sender_.set_epoch(ntp_add_seconds(sender_.epoch(), lag_s));
+    }
+    bool stop_requested() override { return g_interrupted || writer_.failed(); }
+
+  private:
+    OscSender &sender_;
+    OscServer &server_;
+    CsvWriter &writer_;
+};
+
+struct RunOptions {
+    PerformanceOptions performance;
+    OscSenderOptions sender;
+    OscServerOptions server;
+    RealtimeLoopOptions loop;
+    bool autoplay = false;
     std::string out_dir;
+    RunOptions() { sender.lookahead_s = 0.02; }
+};
+
+// --allow A,B,...: an empty list (or item) must not mean "every peer": that is 'any'.
+void parse_allow(const std::string &v, OscServerOptions &io)
+{
+    if (v.empty() || v.front() == ',' || v.back() == ',' || v.find(",,") != std::string::npos)
+        throw UsageError("--allow: expected numeric IPv4 addresses A,B,... or 'any', got '" + v +
+                         "' (an empty list or item)");
+    io.allow_any = v == "any";
+    io.allow = io.allow_any ? std::vector<std::string>{} : split(v, ',');
+}
+
+// False: --help was given (the usage is printed).
+bool parse_run_args(Args &args, RunOptions &r)
+{
     while (!args.done()) {
         const std::string a = args.next();
         auto value = [&]() { return args.value(a); };
         if (a == "--help" || a == "-h") {
             run_usage(std::cout);
-            return 0;
+            return false;
         } else if (a == "--target") {
-            so.target_url = value();
+            r.sender.target_url = value();
         } else if (a == "--port") {
-            io.port = parse_int(a, value(), 0, 65535);
+            r.server.port = parse_int(a, value(), 0, 65535);
         } else if (a == "--bind") {
-            io.bind_address = value();
+            r.server.bind_address = value();
         } else if (a == "--allow") {
-            const std::string v = value();
-            // An empty list (or item) must not mean "every peer": that is 'any'.
-            if (v.empty() || v.front() == ',' || v.back() == ',' ||
-                v.find(",,") != std::string::npos)
-                throw UsageError("--allow: expected numeric IPv4 addresses A,B,... or 'any', "
-                                 "got '" +
-                                 v + "' (an empty list or item)");
-            io.allow_any = v == "any";
-            io.allow = io.allow_any ? std::vector<std::string>{} : split(v, ',');
+            parse_allow(value(), r.server);
         } else if (a == "--reply") {
-            io.reply_url = value();
+            r.server.reply_url = value();
         } else if (a == "--lookahead") {
-            so.lookahead_s = parse_number(a, value(), 0, 10);
+            r.sender.lookahead_s = parse_number(a, value(), 0, 10);
         } else if (a == "--pose-rate") {
-            pose_rate = parse_number(a, value(), 0, 1000);
+            r.loop.pose_rate_hz = parse_number(a, value(), 0, 1000);
         } else if (a == "--tip-rate") {
-            tip_rate = parse_number(a, value(), 0, 1000);
+            r.loop.tip_rate_hz = parse_number(a, value(), 0, 1000);
         } else if (a == "--realtime") {
-            realtime = true;
+            r.loop.realtime = true;
         } else if (a == "--paused") {
-            autoplay = false;
+            r.autoplay = false;
         } else if (a == "--autoplay") {
-            autoplay = true;
+            r.autoplay = true;
         } else if (a == "--out") {
-            out_dir = value();
-        } else if (!parse_performance_option(a, args, o, duration)) {
+            r.out_dir = value();
+        } else if (!parse_performance_option(a, args, r.performance, r.loop.duration_s)) {
             throw UsageError("unknown option '" + a + "' (see ictusd run --help)");
         }
     }
+    const PerformanceOptions &o = r.performance;
     if (!o.mocap.empty() && !o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
-    // A numeric IPv4 address (the server checks it) in 127.0.0.0/8.
-    if (io.allow_any && io.bind_address.compare(0, 4, "127.") != 0)
-        std::cerr << "ictusd run: warning: --allow any with --bind " << io.bind_address
-                  << ": every host that reaches this address may play, stop and change the "
-                     "performance; list the peers with --allow A,B\n";
-    // The target is checked before the clip loads: a bad URL is a usage error
-    // at once (exit 2), not a run whose every send fails.
-    so.realtime = realtime; // the strike thread asks for itself
-    OscSender sender(so);
-    std::string csv_path;
-    if (!out_dir.empty()) {
-        std::error_code ec;
-        std::filesystem::create_directories(out_dir, ec);
-        if (ec)
-            throw std::runtime_error("--out: cannot create '" + out_dir + "': " + ec.message());
-        csv_path = out_dir + "/strikes.csv";
-    }
-    // Opened (and its header written) before the clip loads: an unwritable
-    // folder or a full disk shows at once.
-    CsvWriter writer(csv_path);
+    return true;
+}
 
-    Performance perf(o);
-    // Every refusal goes to stderr and, as /ictus/error, to the client.
-    OscServer *server_ptr = nullptr;
-    auto refuse = [&](std::uint32_t ipv4, std::uint16_t port, const char *address,
-                      const char *why) {
-        std::fprintf(stderr, "ictusd run: %s%s%s\n", address, address[0] ? ": " : "", why);
-        Refusal f;
-        f.peer_ipv4 = ipv4;
-        f.peer_port = port;
-        std::snprintf(f.address, sizeof f.address, "%s", address);
-        std::snprintf(f.why, sizeof f.why, "%s", why);
-        if (server_ptr)
-            server_ptr->post_refusal(f);
-    };
-    // Waits for /ictus/play unless --autoplay (docs/osc.md, "Starting").
-    if (!autoplay) {
-        Command stop;
-        stop.kind = CommandKind::stop;
-        perf.apply(stop);
-    } else if (perf.score_mode()) {
-        perf.start_score(); // a score that cannot be played ends here, exit 1
-    }
-    LiveStatus status;
-    status.tempo_bpm = o.tempo_bpm;
-    status.score = perf.score_mode() ? 1 : 0;
-    status.mode = static_cast<int>(perf.mode());
-    status.grip = static_cast<int>(perf.options().character.grip);
-    OscServer server(io, &status);
-    server_ptr = &server;
-    // Planning and rebuilds from now on run beside the physics loop.
-    perf.set_background_work(true);
-    std::cerr << "ictusd run: commands on " << io.bind_address << ":" << server.port()
-              << ", strikes and poses to " << so.target_url << "\n";
-    g_interrupted = 0;
-    install_interrupt_handler(true);
+// DIR/strikes.csv, DIR created; empty without --out.
+std::string strikes_csv_path(const std::string &out_dir)
+{
+    if (out_dir.empty())
+        return "";
+    std::error_code ec;
+    std::filesystem::create_directories(out_dir, ec);
+    if (ec)
+        throw std::runtime_error("--out: cannot create '" + out_dir + "': " + ec.message());
+    return out_dir + "/strikes.csv";
+}
 
-    // The physics loop and the strike sender keep time: real-time
-    // scheduling when the system grants it (docs/osc.md, "Real time"). Asked
-    // for after the other threads exist, which keep ordinary scheduling.
-    if (realtime) {
-        std::string why;
-        if (!set_realtime_priority(kPhysicsPriority, &why))
-            std::fprintf(stderr,
-                         "ictusd run: note: no real-time scheduling (%s); on a busy machine "
-                         "strikes may arrive late (raise --lookahead, or allow rtprio)\n",
-                         why.c_str());
-    }
-    using clock = std::chrono::steady_clock;
-    const double h = perf.step_s();
-    const auto period =
-        std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(h));
-    const long pose_every = pose_rate > 0.0 ? std::max(1L, std::lround(1.0 / (pose_rate * h))) : 0;
-    const long tip_every = tip_rate > 0.0 ? std::max(1L, std::lround(1.0 / (tip_rate * h))) : 0;
-    const long steps = duration > 0.0 ? std::lround(duration / h) : -1;
-    // Simulation time 0 is now, on the wall clock and in NTP.
-    auto wall0 = clock::now();
-    sender.set_epoch(ntp_now());
-    // strikes.csv in onset order, as track and render write it.
-    StrikeOrder order;
-    auto to_file = [&](const StrikeEvent &e) { writer.post(e); };
-    StrikeEvent ev[2];
-    long n = 0;
-    for (; steps < 0 || n < steps; ++n) {
-        if (g_interrupted || writer.failed())
-            break;
-        // Pace: step n starts at wall0 + n h. Far behind (a stall), move
-        // the anchor, so that timetags stay ahead of the wall clock.
-        const auto due = wall0 + n * period;
-        const auto now = clock::now();
-        if (now < due) {
-            std::this_thread::sleep_until(due);
-        } else if (now - due > 50 * period) {
-            const auto lag = now - due;
-            wall0 += lag;
-            sender.set_epoch(
-                ntp_add_seconds(sender.epoch(), std::chrono::duration<double>(lag).count()));
-            status.overruns++;
-        }
-        Command c;
-        while (server.pop_command(c)) {
-            std::string why;
-            if (!perf.apply(c, &why))
-                refuse(c.peer_ipv4, c.peer_port, c.address, why.c_str());
-        }
-        const int k = perf.step(ev);
-        // Refusals found later (a score the worker could not plan, the
-        // runaway guard) reach the client too.
-        for (Refusal f; perf.pop_refusal(f);)
-            refuse(f.peer_ipv4, f.peer_port, f.address, f.why);
-        // A strike leaves at its onset with what the sound needs, so that
-        // the lookahead covers only transport and jitter; its force and
-        // duration follow at the release.
-        StrikeEvent onset[2];
-        const int ons = perf.take_onsets(onset);
-        for (int i = 0; i < ons; ++i)
-            sender.post_strike(onset[i]);
-        for (int i = 0; i < k; ++i) {
-            sender.post_strike_end(ev[i]);
-            order.push(ev[i], to_file);
-        }
-        order.release(perf.detector().first_open_seq(), to_file);
-        if (pose_every && n % pose_every == 0) {
-            PoseSnapshot p;
-            perf.pose(p);
-            sender.post_pose(p);
-        }
-        if (tip_every && n % tip_every == 0)
-            for (int hand = 0; hand < 2; ++hand) {
-                TipState t;
-                perf.tip(hand, t);
-                sender.post_tip(t);
-            }
-        status.time_s = perf.time_s();
-        status.playing = perf.playing() ? 1 : 0;
-        status.tempo_bpm = perf.tempo_bpm();
-        status.strikes += k;
-        status.runaways = perf.runaways();
-        status.mode = static_cast<int>(perf.mode());
-        status.grip = static_cast<int>(perf.options().character.grip);
-    }
-    StrikeEvent last;
-    while (perf.flush(last)) {
-        sender.post_strike_end(last);
-        order.push(last, to_file);
-    }
-    order.flush(to_file);
-    sender.stop();
-    server.stop();
-    writer.stop();
+void print_summary(const Performance &perf, const OscSender &sender, const OscServer &server,
+                   const LiveStatus &status, const CsvWriter &writer, bool csv,
+                   const RealtimeLoopResult &loop)
+{
     const OscSenderCounters sc = sender.counters();
     const OscServerCounters rc = server.counters();
     std::cout << "run: " << perf.time_s() << " s simulated, " << sc.strikes_sent
@@ -411,10 +315,59 @@ int cmd_run(Args &args)
               << rc.accepted << " accepted, " << rc.errors() << " errors (" << rc.errors_unanswered
               << " unanswered: error-reply budget), " << rc.refused_peers << " refused; "
               << status.overruns.load() << " overruns, " << perf.runaways() << " runaways";
-    if (!csv_path.empty())
+    if (csv)
         std::cout << "; strikes.csv: " << writer.written() << " rows, " << writer.dropped()
-                  << " dropped (queue full), " << order.early() << " out of order";
+                  << " dropped (queue full), " << loop.out_of_order << " out of order";
     std::cout << "\n";
+}
+
+} // namespace
+
+int cmd_run(Args &args)
+{
+    RunOptions r;
+    if (!parse_run_args(args, r))
+        return 0;
+    const OscServerOptions &io = r.server;
+    // A numeric IPv4 address (the server checks it) in 127.0.0.0/8.
+    if (io.allow_any && io.bind_address.compare(0, 4, "127.") != 0)
+        std::cerr << "ictusd run: warning: --allow any with --bind " << io.bind_address
+                  << ": every host that reaches this address may play, stop and change the "
+                     "performance; list the peers with --allow A,B\n";
+    // The target is checked before the clip loads: a bad URL is a usage error
+    // at once (exit 2), not a run whose every send fails.
+    r.sender.realtime = r.loop.realtime; // the strike thread asks for itself
+    OscSender sender(r.sender);
+    const std::string csv_path = strikes_csv_path(r.out_dir);
+    // Opened (and its header written) before the clip loads: an unwritable
+    // folder or a full disk shows at once.
+    CsvWriter writer(csv_path);
+
+    Performance perf(r.performance);
+    // Waits for /ictus/play unless --autoplay (docs/osc.md, "Starting").
+    if (!r.autoplay) {
+        Command stop;
+        stop.kind = CommandKind::stop;
+        perf.apply(stop);
+    } else if (perf.score_mode()) {
+        perf.start_score(); // a score that cannot be played ends here, exit 1
+    }
+    LiveStatus status;
+    begin_status(perf, status);
+    OscServer server(io, &status);
+    // Planning and rebuilds from now on run beside the physics loop.
+    perf.set_background_work(true);
+    std::cerr << "ictusd run: commands on " << io.bind_address << ":" << server.port()
+              << ", strikes and poses to " << r.sender.target_url << "\n";
+    g_interrupted = 0;
+    install_interrupt_handler(true);
+
+    OscIo osc(sender, server, writer);
+    const RealtimeLoopResult loop = run_realtime(perf, osc, status, r.loop);
+    sender.stop();
+    server.stop();
+    writer.stop();
+    print_summary(perf, sender, server, status, writer, !csv_path.empty(), loop);
     if (writer.failed())
         throw std::runtime_error(writer.error()); // exit 1
     return g_interrupted ? 130 : 0;

@@ -8,10 +8,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 namespace ictus
 {
@@ -149,6 +151,53 @@ double TempoMap::beat_at_time(double time_s) const
     if (std::abs(k) * c.ramp_beats < 1e-9 * c.start_bpm)
         return c.beat + dt * c.start_bpm / 60.0;
     return c.beat + c.start_bpm * std::expm1(k * dt / 60.0) / k;
+}
+
+TempoMap scale_tempo_from(const TempoMap &map, double from_beat, double factor)
+{
+    const std::vector<TempoMap::Change> &changes = map.changes();
+    auto check = [&](double bpm, double beat, double scaled) {
+        if (!(scaled >= kMinTempoBpm && scaled <= kMaxTempoBpm)) {
+            char buf[200];
+            std::snprintf(buf, sizeof buf,
+                          "tempo: the score's %g bpm at beat %g would become %.4g bpm (beyond "
+                          "%g..%g)",
+                          bpm, beat, scaled, kMinTempoBpm, kMaxTempoBpm);
+            throw std::invalid_argument(buf);
+        }
+    };
+    TempoMap out(changes.front().start_bpm);
+    const TempoMap::Change *running = &changes.front();
+    for (const TempoMap::Change &c : changes) {
+        if (c.beat >= from_beat)
+            break;
+        out.add(c.beat, c.start_bpm, c.end_bpm, c.ramp_beats);
+        running = &c;
+    }
+    for (const TempoMap::Change &c : changes)
+        if (c.beat <= from_beat)
+            running = &c;
+    const double here = map.tempo_at_beat(from_beat);
+    const double ramp_left = std::max(0.0, running->beat + running->ramp_beats - from_beat);
+    check(here, from_beat, factor * here);
+    check(running->end_bpm, running->beat + running->ramp_beats, factor * running->end_bpm);
+    out.add(from_beat, factor * here, factor * (ramp_left > 0.0 ? running->end_bpm : here),
+            ramp_left);
+    for (const TempoMap::Change &c : changes) {
+        if (c.beat <= from_beat)
+            continue;
+        check(c.start_bpm, c.beat, factor * c.start_bpm);
+        check(c.end_bpm, c.beat + c.ramp_beats, factor * c.end_bpm);
+        out.add(c.beat, factor * c.start_bpm, factor * c.end_bpm, c.ramp_beats);
+    }
+    return out;
+}
+
+Score scale_score_from(const Score &score, double from_beat, double factor)
+{
+    Score out = score;
+    out.tempo = scale_tempo_from(score.tempo, from_beat, factor);
+    return out;
 }
 
 // ---------------------------------------------------------------- statements

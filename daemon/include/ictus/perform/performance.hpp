@@ -13,11 +13,13 @@
 #include "ictus/gesture/gesture.hpp"
 #include "ictus/score/gesture_score.hpp"
 #include "ictus/control/joint_controller.hpp"
+#include "ictus/perform/body_stats.hpp"
 #include "ictus/perform/commands.hpp"
 #include "ictus/sim/scene.hpp"
 #include "ictus/score/score.hpp"
 #include "ictus/sim/strike_detector.hpp"
 #include "ictus/perform/track.hpp"
+#include "ictus/perform/strike_match.hpp"
 #include "ictus/perform/tracker.hpp"
 
 #include <memory>
@@ -78,33 +80,23 @@ struct PerformanceOptions {
     PerformanceOptions(); // the sticks on their fulcrum (SceneOptions::sticks)
 };
 
-// How the strikes of a performance met its planned notes: per hand, each
-// primary (non-bounce) strike is given to the nearest note of that hand; a
-// note keeps the nearest of the strikes given to it (the others are extra).
-struct NoteMatch {
-    long strike_seq = -1; // -1: no strike for this note
-    double strike_time_s = 0.0;
-    double error_ms = 0.0; // strike - beat
-    double normal_velocity_mps = 0.0;
-    double duration_ms = 0.0;
-};
-struct MatchSummary {
-    std::vector<NoteMatch> notes; // [note], as the plan's notes
-    long primary_strikes = 0, bounces = 0;
-    long matched_notes = 0;
-    long extra_strikes = 0; // primary strikes not matched to a note
-    double mean_abs_error_ms = 0.0, max_abs_error_ms = 0.0;
-};
-// `origin_s`: simulation time of the plan's time 0.
-MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
-                           const std::vector<StrikeEvent> &strikes, double origin_s);
+class PerformMode;
+class ClipMode;
+class ScoreMode;
+class Work;
+class PlanningWorker;
 
 // The physics side of run and render: the character tracking the clip or
-// performing a score, the drum, the strike detector, and the commands Pd may send.
+// performing a score, the drum, the strike detector, and the commands Pd may
+// send. The motion source is a mode (clip_mode.cpp, score_mode.cpp) behind one
+// interface: apply() handles each command once and asks the mode for what
+// differs.
 class Performance
 {
   public:
-    explicit Performance(const PerformanceOptions &options); // throws on bad file/options
+    // Throws PerformError on bad options, the readers' errors on a bad file
+    // (clip, score, gesture database).
+    explicit Performance(const PerformanceOptions &options);
     ~Performance();
 
     // One physics step; returns the number of strikes ended in it (<= 2),
@@ -118,7 +110,8 @@ class Performance
     // Ends contacts still open (end of a run).
     bool flush(StrikeEvent &out) { return detector_.flush(out); }
     // Applies a command from the OSC thread. Returns false with a reason when
-    // it cannot be applied (the OSC thread has already validated the values).
+    // it cannot be applied (the OSC thread has already validated the values;
+    // what a command throws is refused with its what()).
     bool apply(const Command &command, std::string *why = nullptr);
 
     void pose(PoseSnapshot &out) const;
@@ -134,7 +127,7 @@ class Performance
     double tempo_bpm() const;
     // Score mode: the live tempo scale (/ictus/tempo), 1 until one is sent;
     // a new score (/ictus/score/clear) plays at its own tempi again.
-    double tempo_scale() const { return tempo_scale_; }
+    double tempo_scale() const;
     // A live tempo change under way leaves alone the strokes the hands have
     // begun, and those they begin within this time (the planner's latency).
     static constexpr double kTempoLatency_s = 0.25;
@@ -147,28 +140,19 @@ class Performance
     const StrikeDetector &detector() const { return detector_; }
     int divergences() const;
 
-    // How the body moved (score mode, since the last rig was installed): how
-    // far any joint went outside its range of motion (the simulated pose:
-    // range_of_motion.hpp), and how far the trunk (thorax) turned from its
-    // rest, degrees.
-    struct BodyStats {
-        double max_limit_excursion_deg = 0.0;
-        std::string max_limit_joint;
-        long steps = 0;
-        double trunk_max_deg = 0.0;
-        double trunk_sum_sq_deg2 = 0.0;
-        double trunk_rms_deg() const;
-    };
-    const BodyStats &body_stats() const { return body_stats_; }
+    // How the body moved (score mode, since the performance began:
+    // body_stats.hpp); all zero for a clip.
+    using BodyStats = ::ictus::BodyStats;
+    const BodyStats &body_stats() const;
 
     // Score mode.
     bool score_mode() const { return options_.mocap.empty(); }
     // The plan being performed (or last performed); nullptr before the first.
-    const GesturePlan *plan() const { return plan_; }
-    bool plan_active() const { return plan_active_; }
+    const GesturePlan *plan() const;
+    bool plan_active() const;
     // Simulation time of the plan's time 0, and the plan's clock.
-    double plan_origin_s() const { return plan_origin_s_; }
-    double plan_time_s() const { return plan_time_s_; }
+    double plan_origin_s() const;
+    double plan_time_s() const;
     // The tip target X^T the controller was given in the last step [hand].
     Eigen::Vector3d tip_target(int hand) const;
     Eigen::Vector3d tip_position(int hand) const;
@@ -178,7 +162,8 @@ class Performance
     // per note of plan() (m/s).
     double planned_impact_speed_mps(size_t note) const;
     // Plans the current score and starts it now (what /ictus/play does in
-    // score mode). Throws ScoreError / GestureError; on error nothing changes.
+    // score mode). Throws PerformError (not in score mode, background work
+    // under way), ScoreError / GestureError; on error nothing changes.
     void start_score();
 
     // Background work. Finishing and planning a score and rebuilding the
@@ -232,91 +217,44 @@ class Performance
     static constexpr double kMinDampingRatio = 0.70710678118654752;
 
   private:
-    struct Rig;
-    struct ScoreRig;
-    struct PlanState;
-    struct Job;
-    struct Result;
-    class Worker;
-    // Built off the live state, from copies (the worker thread may run them).
-    std::unique_ptr<Rig> make_clip_rig(PerformanceOptions &options) const;
-    std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
-                                             const std::vector<Eigen::Quaterniond> *pose) const;
-    std::unique_ptr<PlanState> make_plan(std::shared_ptr<const Score> score,
-                                         const PerformerFrame &frame,
-                                         const PlanOptions &plan) const;
-    std::unique_ptr<Result> execute(Job &job); // the worker, or inline
+    friend class ClipMode;
+    friend class ScoreMode;
+    // What both modes share. The rig's gains at the live scale, on its scene.
+    void apply_gains();
+    void set_grips(double firmness); // both hands, now
+    // A new rig took over (clip_mode.cpp, score_mode.cpp): the live drum,
+    // gains and grip on its scene; the simulation clock goes on from
+    // `previous_time_s` (strike times and timetags stay monotonic).
+    void took_over(double previous_time_s);
     // Runs or queues a job; false with why when it was refused inline.
-    bool submit(std::unique_ptr<Job> job, std::string *why);
-    bool install(std::unique_ptr<Result> result, std::string *why);
-    void install_clip_rig(std::unique_ptr<Rig> rig);
-    void install_score_rig(std::unique_ptr<ScoreRig> rig, bool keep_pose);
-    void install_plan(std::unique_ptr<PlanState> plan, bool start_now);
+    bool submit(std::unique_ptr<Work> job, std::string *why);
+    bool install(std::unique_ptr<Work> work, std::string *why);
+    // Frees what the physics thread replaced on the worker thread (here without one).
+    void discard(std::unique_ptr<Work> old);
     void take_results();
     void refuse_later(const Command &origin, const std::string &why);
     bool check_gains(const double scale[2], std::string *why) const;
+    bool apply_gains_command(const Command &c, std::string *why);
+    bool apply_drum_command(const Command &c, std::string *why);
     int guard_runaway(int k); // the strikes that may leave (0 while quiet)
-    PerformerFrame frame_for_drum(const ScoreRig &rig) const;
-    std::unique_ptr<Job> plan_job(const Command &origin, bool start_now) const;
-    int step_clip(StrikeEvent out[2]);
-    int step_score(StrikeEvent out[2]);
-    bool apply_score(const Command &command, std::string *why);
-    void start_rest_move();
-    Eigen::Vector3d target_at(int side, double plan_time_s) const;
-    Eigen::Vector3d direction_at(int side, double plan_time_s) const;
-    Eigen::Vector3d rest_direction(int side) const;
-    double plan_time_of(int side, double plan_time_s) const;
-    void apply_note_grips(double plan_time_s);
-    void trunk_synergy(ScoreRig &rig) const;
-    // The trunk (docs/perform.md, "The trunk"): eq. 1's natural frequency of
-    // the lumbar and thorax joints, and how they follow the sticks.
-    static constexpr double kTrunkHz = 8.0;
-    static constexpr double kTrunkLean_rad_per_m = 0.15;
-    static constexpr double kTrunkTwist_rad_per_m = 0.2;
-    void set_grips(double firmness); // both hands, now
-    double applied_firmness_[2] = {-1.0, -1.0};
-    BodyStats body_stats_;
-    void measure_body();
-    void apply_drum_now();
+
     PerformanceOptions options_;
     Skeleton skeleton_;
-    std::unique_ptr<BvhFile> clip_; // clip mode: the capture, read once
-    mutable BodyFrames frames_;     // scratch of pose()
-    std::unique_ptr<Rig> rig_;
-    std::unique_ptr<ScoreRig> score_rig_;
+    mutable BodyFrames frames_; // scratch of pose()
     StrikeDetector detector_;
-    // Score mode: the database (read only after construction), the
-    // statements received (physics thread), the current score (only
-    // execute() touches it: the worker's, or inline) and the plan performed.
-    std::unique_ptr<GestureDatabase> db_;
-    std::unique_ptr<ScoreBuilder> builder_;
-    std::shared_ptr<const Score> score_;
-    std::shared_ptr<const Score> played_;    // score_ at its tempo scale (execute() only)
-    double tempo_scale_ = 1.0;               // the physics thread's (Result::tempo_scale)
-    double start_bpm_ = 0.0;                 // > 0: the next play starts at this tempo
-    bool play_pending_ = false;              // a play handed to the worker, not back yet
-    double score_first_bpm_ = 120.0;         // the current score's own first tempo
-    Nuance default_nuance_ = Nuance::legato; // /ictus/nuance: of the statements that follow
-    std::unique_ptr<PlanState> plan_state_;
-    const GesturePlan *plan_ = nullptr; // &plan_state_->plan
-    bool plan_active_ = false;
-    double plan_origin_s_ = 0.0, plan_time_s_ = 0.0;
-    // Between plans the tips move to (and hold) the rest tips.
-    std::array<Eigen::Vector3d, 2> rest_from_m_;
-    double rest_move_start_s_ = -1e9;
-    std::vector<double> no_speeds_;
+    std::unique_ptr<PerformMode> mode_;
+    ClipMode *clip_ = nullptr;   // mode_, in clip mode
+    ScoreMode *score_ = nullptr; // mode_, in score mode
     bool playing_ = true;
-    bool rebuild_pending_ = false;
-    std::unique_ptr<Worker> worker_;
+    std::unique_ptr<PlanningWorker> worker_;
     std::vector<Refusal> refusals_; // oldest first
-    std::vector<Eigen::Quaterniond> pose_scratch_;
-    Command last_gains_; // the origin a runaway is reported to
+    Command last_gains_;            // the origin a runaway is reported to
     long runaways_ = 0;
     double quiet_until_s_ = -1.0; // no strike leaves before this time (runaway)
-    double clip_time_s_ = 0.0;
-    double time_offset_s_ = 0.0; // simulation time at the last (re)build
+    double time_offset_s_ = 0.0;  // simulation time at the last (re)build
     double gain_scale_[2] = {1.0, 1.0};
     int divergences_before_ = 0;
+    double applied_firmness_[2] = {-1.0, -1.0};
 };
 
 } // namespace ictus

@@ -116,6 +116,15 @@ struct Score {
     double note_time_s(const ScoreNote &note) const { return tempo.time_at_beat(note.beat); }
 };
 
+// The live tempo scale (docs/osc.md, /ictus/tempo in score mode): the tempo
+// map with every tempo from `from_beat` on multiplied by `factor`, the beats
+// before it (and so every time up to it) as they were. A ramp running at
+// `from_beat` goes on, scaled, to its end. Throws std::invalid_argument when a
+// scaled tempo leaves the score's range (kMinTempoBpm..kMaxTempoBpm).
+TempoMap scale_tempo_from(const TempoMap &map, double from_beat, double factor);
+// The score with its tempo map scaled so (scale_tempo_from).
+Score scale_score_from(const Score &score, double from_beat, double factor);
+
 // Builds a score one statement at a time, as statements arrive from Pd
 // (`/ictus/score ,s "L accent 0.8"`). Each add_statement() counts as one line
 // for error positions. A statement that throws changes nothing; once one has

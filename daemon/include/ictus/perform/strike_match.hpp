@@ -1,0 +1,34 @@
+// strike_match.hpp -- how the strikes of a performance met its planned notes
+// (what `ictusd render` reports for a score: notes.csv, performance.json).
+#pragma once
+
+#include "ictus/score/gesture_score.hpp"
+#include "ictus/sim/strike_event.hpp"
+
+#include <vector>
+
+namespace ictus
+{
+
+// Per hand, each primary (non-bounce) strike is given to the nearest note of
+// that hand; a note keeps the nearest of the strikes given to it (the others
+// are extra).
+struct NoteMatch {
+    long strike_seq = -1; // -1: no strike for this note
+    double strike_time_s = 0.0;
+    double error_ms = 0.0; // strike - beat
+    double normal_velocity_mps = 0.0;
+    double duration_ms = 0.0;
+};
+struct MatchSummary {
+    std::vector<NoteMatch> notes; // [note], as the plan's notes
+    long primary_strikes = 0, bounces = 0;
+    long matched_notes = 0;
+    long extra_strikes = 0; // primary strikes not matched to a note
+    double mean_abs_error_ms = 0.0, max_abs_error_ms = 0.0;
+};
+// `origin_s`: simulation time of the plan's time 0.
+MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
+                           const std::vector<StrikeEvent> &strikes, double origin_s);
+
+} // namespace ictus

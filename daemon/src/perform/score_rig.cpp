@@ -1,0 +1,140 @@
+// The body that performs a score (score_rig.hpp).
+#include "score_rig.hpp"
+
+#include "ictus/character/stick_capture.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace ictus
+{
+
+namespace
+{
+// The stick-tip sits this far above the membrane plane when its bead touches
+// it: the bead's centre is one tip radius above, the end point a further
+// r * (stick axis . up) (the stick points down at the head, so less than 2 r).
+// The plan's strike points are raised by it, so that the planned tip target
+// on the beat is the tip at first contact (strike_depth_m is then measured
+// from the contact, not from the plane).
+double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_world)
+{
+    return tip_radius_m * (1.0 + stick_dir_world.normalized().y());
+}
+} // namespace
+
+PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
+                         const Eigen::Vector3d &forward)
+{
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+    PerformerFrame f = performer_frame_for_drum(
+        drum.center_m + contact_height_m(tip_radius_m, kDefaultStickDirection) * up, drum.radius_m);
+    f.right = right;
+    f.forward = forward;
+    return f;
+}
+
+std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
+                                         const std::vector<Eigen::Quaterniond> *pose)
+{
+    const Skeleton skeleton = default_skeleton();
+    Motion motion;
+    motion.frame_rate_hz = 100.0;
+    motion.root_position_m.push_back(Eigen::Vector3d(0.0, 0.9, 0.0));
+    motion.local_rotation.emplace_back(skeleton.joints.size(), Eigen::Quaterniond::Identity());
+    const CharacterModel model = CharacterModel::from_skeleton(skeleton, options.character);
+    auto rig = std::make_unique<ScoreRig>(model, options.score.ik_limit_margin_deg * M_PI / 180.0);
+    ScoreRig &r = *rig;
+    r.body = model.pose_from_motion(motion, 0);
+
+    // The drum in front of the performer: from the midpoint of the shoulders,
+    // drum_forward_m along the facing direction and drum_below_m down, unless
+    // a centre was given.
+    BodyFrames frames;
+    model.forward(r.body, frames);
+    const Eigen::Vector3d shoulder[2] = {frames.origin_m[model.body_index("l_upper_arm")],
+                                         frames.origin_m[model.body_index("r_upper_arm")]};
+    Eigen::Vector3d left = shoulder[0] - shoulder[1];
+    left.y() = 0.0;
+    left.normalize();
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d forward = left.cross(up);
+    SceneOptions scene = options.scene;
+    // A joint pushed outside its range of motion (the stick's reactions on the
+    // wrist) meets its stop 1 degree out, which takes the whole overshoot
+    // back in one step (docs/perform.md, "Joint limits").
+    scene.stop_margin_rad = std::min(scene.stop_margin_rad, 1.0 * M_PI / 180.0);
+    scene.stop_erp = 1.0;
+    scene.stop_inelastic = true;
+    // The legs hang off the welded pelvis and hold no stick: placed at their
+    // targets, not simulated (SceneOptions::legs_kinematic, docs/perform.md).
+    scene.legs_kinematic = true;
+    scene.pelvis_kinematic = true; // welded: fixed, without the weld's rows
+    if (options.drum_auto)
+        scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
+                              options.score.drum_forward_m * forward -
+                              options.score.drum_below_m * up;
+    r.drum_center_m = scene.drum.center_m;
+    r.frame = frame_for(scene.drum, options.character.stick.tip_radius_m, -left, forward);
+
+    // Start: the arms solved to hold the sticks at the rest tips (or the
+    // pose the old rig was in, when a grip change rebuilds it).
+    CharacterPose initial = r.body;
+    if (pose && pose->size() == initial.local.size())
+        initial.local = *pose;
+    else {
+        const std::array<Eigen::Vector3d, 2> directions = {rest_stick_direction(r.frame, 0),
+                                                           rest_stick_direction(r.frame, 1)};
+        Tracker::solve_arms(model, r.ik_limits, options.score.cartesian.ik, r.frame.rest_tip_m,
+                            initial, &directions);
+    }
+    r.base_gains = default_gains(model, initial, options.gains);
+    // The trunk is compliant: lumbar and thorax under eq. 1 at kTrunkHz (the
+    // arms' natural frequency is options.gains'), so they sway under the arms'
+    // reactions (docs/perform.md, "The trunk").
+    const double trunk_ratio = ScoreRig::kTrunkHz / options.gains.natural_frequency_hz;
+    if (trunk_ratio < 1.0)
+        for (int j : {r.lumbar, r.thorax}) {
+            r.base_gains[j].kp_nm_per_rad *= trunk_ratio * trunk_ratio;
+            r.base_gains[j].kd_nm_s_per_rad *= trunk_ratio;
+        }
+    r.step_body = r.body;
+    r.gains = r.base_gains; // scaled when installed
+    CartesianOptions co = options.score.cartesian;
+    co.reference_has_arms = false; // the body's reference has no arm motion
+    r.tracker =
+        std::make_unique<Tracker>(r.model, scene, initial, r.gains, r.range_of_motion.refs(),
+                                  options.score.mode, co, options.gains, &r.ik_limits);
+    r.tips.has_position = true;
+    for (int s = 0; s < 2; ++s)
+        r.tips.position_m[s] = r.tracker->scene().tip_position(static_cast<Side>(s));
+    return rig;
+}
+
+// The trunk leans forward as the sticks go
+// down (kTrunkLean_rad_per_m of the mean tip target's drop below the rest
+// tips) and turns the shoulder of the higher stick back (kTrunkTwist_rad_per_m
+// of the difference of the tips' heights), 40 % at the lumbar joint and 60 %
+// at the thorax; eq. 1 then follows it with the trunk's compliant gains.
+void ScoreRig::trunk_synergy()
+{
+    ScoreRig &r = *this;
+    const PerformerFrame &f = r.frame;
+    const TipTargets &tips = r.tips;
+    auto height = [&](int s) { return (tips.position_m[s] - f.membrane_center_m).dot(f.up); };
+    const double rest = 0.5 * ((f.rest_tip_m[0] - f.membrane_center_m).dot(f.up) +
+                               (f.rest_tip_m[1] - f.membrane_center_m).dot(f.up));
+    const int right = static_cast<int>(Side::right), left = static_cast<int>(Side::left);
+    const double lean = kTrunkLean_rad_per_m * (rest - 0.5 * (height(left) + height(right)));
+    const double twist = -kTrunkTwist_rad_per_m * (height(right) - height(left));
+    // Lean about the performer's left axis (forward flexion), twist about up.
+    const Eigen::Vector3d left_axis = -f.right;
+    const Eigen::Quaterniond q = Eigen::Quaterniond(Eigen::AngleAxisd(twist, f.up)) *
+                                 Eigen::Quaterniond(Eigen::AngleAxisd(lean, left_axis));
+    const Eigen::Quaterniond part = Eigen::Quaterniond::Identity().slerp(0.4, q);
+    r.step_body.local[r.lumbar] = r.body.local[r.lumbar] * part;
+    r.step_body.local[r.thorax] = r.body.local[r.thorax] * part.conjugate() * q;
+}
+
+} // namespace ictus

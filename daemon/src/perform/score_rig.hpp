@@ -1,0 +1,56 @@
+// score_rig.hpp -- the body that performs a score (private to src/perform):
+// the default character standing before the drum, its controller, and the
+// trunk's part in the strokes (docs/perform.md, "The trunk").
+#pragma once
+
+#include "ictus/perform/performance.hpp"
+
+#include <memory>
+#include <vector>
+
+namespace ictus
+{
+
+// The character, its controller and the drum of score mode, rebuilt together
+// when the grip or the drum changes (a Scene has no setters for them).
+struct ScoreRig {
+    CharacterModel model;
+    RangeOfMotion range_of_motion;    // the joint limits (declared before the tracker)
+    RangeOfMotion ik_range_of_motion; // the same, narrowed: the arms' IK's
+    std::vector<JointLimitRef> ik_limits = ik_range_of_motion.refs();
+    int lumbar = model.joint_index("lumbar"), thorax = model.joint_index("thorax");
+    std::vector<JointGains> base_gains, gains;
+    std::unique_ptr<Tracker> tracker;
+    CharacterPose body;      // the reference held by the trunk and legs (arms: IK)
+    CharacterPose step_body; // body with the trunk's synergy of this step
+    PerformerFrame frame;
+    Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero(); // where the drum goes
+    TipTargets tips;
+    ScoreRig(const CharacterModel &m, double ik_limit_margin_rad)
+        : model(m), range_of_motion(model), ik_range_of_motion(model, ik_limit_margin_rad)
+    {
+    }
+    // The trunk takes part in the strokes: step_body is body with the lean
+    // and twist that the tip targets of this step call for.
+    void trunk_synergy();
+
+    // The trunk: eq. 1's natural frequency of the lumbar and thorax joints,
+    // and how they follow the sticks.
+    static constexpr double kTrunkHz = 8.0;
+    static constexpr double kTrunkLean_rad_per_m = 0.15;
+    static constexpr double kTrunkTwist_rad_per_m = 0.2;
+};
+
+// The default body (stick_capture.hpp), standing with the hips 0.9 m up,
+// pelvis welded, facing +Z, in `pose` (joint rotations) or with the arms
+// solved to hold the sticks at the rest tips. Reads only `options`.
+std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
+                                         const std::vector<Eigen::Quaterniond> *pose);
+
+// The plan's frame for a drum: the shared frames of docs/perform.md, facing
+// `forward` with `right` to the performer's right, the membrane raised by the
+// tip's contact height.
+PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
+                         const Eigen::Vector3d &forward);
+
+} // namespace ictus
