@@ -1,15 +1,11 @@
 // The error type of the control area (docs/architecture.md, "Errors").
 #pragma once
 
-#include <stdexcept>
+#include "ictus/base/area_error.hpp"
 
 namespace ictus {
 
 /// What the control area throws: a chain, gain or limit that the controllers refuse.
-class ControlError : public std::runtime_error
-{
-  public:
-    using std::runtime_error::runtime_error;
-};
+using ControlError = AreaError<struct ControlArea>;
 
 } // namespace ictus

@@ -1,15 +1,11 @@
 // The error type of the perform area (docs/architecture.md, "Errors").
 #pragma once
 
-#include <stdexcept>
+#include "ictus/base/area_error.hpp"
 
 namespace ictus {
 
 /// What the perform area throws: a score, clip or command that the performance refuses.
-class PerformError : public std::runtime_error
-{
-  public:
-    using std::runtime_error::runtime_error;
-};
+using PerformError = AreaError<struct PerformArea>;
 
 } // namespace ictus

@@ -1,15 +1,11 @@
 // The error type of the sim area (docs/architecture.md, "Errors").
 #pragma once
 
-#include <stdexcept>
+#include "ictus/base/area_error.hpp"
 
 namespace ictus {
 
 /// What the sim area throws: a scene, drum or control input that the simulation refuses.
-class SimError : public std::runtime_error
-{
-  public:
-    using std::runtime_error::runtime_error;
-};
+using SimError = AreaError<struct SimArea>;
 
 } // namespace ictus
