@@ -155,10 +155,10 @@ OptionTable ik_options(TrackArgs &t)
          }},
         {"--tip-smooth-hz",
          [&t](const std::string &a, Args &args) {
-             t.tip_smooth_hz = parse_number(a, args.value(a));
+             const std::string text = args.value(a);
+             t.tip_smooth_hz = parse_number(a, text);
              if (!(t.tip_smooth_hz >= 0.0 && t.tip_smooth_hz <= 1000.0))
-                 throw UsageError("--tip-smooth-hz: expected 0 <= HZ <= 1000, got " +
-                                  args.value(a));
+                 throw UsageError("--tip-smooth-hz: expected 0 <= HZ <= 1000, got " + text);
          }},
         {"--ik-iterations", store(ik.feedback_iterations, parse_int, 0, 10000)},
         {"--ik-kinematic-iterations", store(ik.kinematic_iterations, parse_int, 0, 10000)},
