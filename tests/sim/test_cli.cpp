@@ -129,6 +129,7 @@ TEST_CASE("ictusd track: every option refuses a bad value, naming it", "[sim][cl
         {"--ik-correction-limit", "-1", "correction limit"},
         {"--ik-integral", "-1", "ik integral"},
         {"--ik-start", "nowhere", "--ik-start"},
+        {"--tip-smooth-hz", "2000", "got 2000"},
     };
     for (const auto &c : cases) {
         const Run r = ictusd(base + c[0] + " " + c[1]);
