@@ -1,6 +1,6 @@
 // fuzz_score_plan.cpp -- libFuzzer harness of the planner (score/gesture_score.hpp):
 // a score that parses is planned on the built-in gesture database, for the
-// default body's drum (character/stick_capture.hpp: default_skeleton(), the
+// default body's drum (character/default_skeleton.hpp: default_skeleton(), the
 // drum where a score performance puts it), as run and render do.
 //
 // A refusal (ScoreError: a hand too fast, a performance too long) is a pass.
@@ -11,7 +11,7 @@
 #include "fuzz_check.hpp"
 
 #include "ictus/character/character.hpp"
-#include "ictus/character/stick_capture.hpp"
+#include "ictus/character/default_skeleton.hpp"
 #include "ictus/gesture/gesture.hpp"
 #include "ictus/score/gesture_score.hpp"
 #include "ictus/score/score.hpp"

@@ -4,7 +4,7 @@
 #include "ictus/character/character_limits.hpp"
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/sim/scene.hpp"
-#include "sim_test_util.hpp"
+#include "support/sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -99,7 +99,7 @@ TEST_CASE("limits: the ellipsoid clamp keeps what is inside and only that, at th
 TEST_CASE("limits: a target outside the learned region is clamped and the joint stays inside",
           "[sim][limits]")
 {
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     const ReferenceMotion ref(m, swinging_elbows(skel));
     for (LimitKind kind : {LimitKind::quaternion, LimitKind::euler}) {
@@ -155,7 +155,7 @@ TEST_CASE("limits: a target outside the learned region is clamped and the joint 
 
 TEST_CASE("limits: a kicked joint meets the safety-net stop", "[sim][limits]")
 {
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     const ReferenceMotion ref(m, swinging_elbows(skel));
     const CharacterLimits limits(m, ref);
@@ -201,7 +201,7 @@ TEST_CASE("limits: a kicked joint meets the safety-net stop", "[sim][limits]")
 TEST_CASE("limits: no stop engages on a joint inside its region, however fast it turns",
           "[sim][limits]")
 {
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     const ReferenceMotion ref(m, swinging_elbows(skel));
     const CharacterLimits limits(m, ref);
@@ -247,7 +247,7 @@ TEST_CASE("limits: no stop engages on a joint inside its region, however fast it
 // row existed. Seeded kicks of both forearms about random axes at 20-60 rad/s.
 TEST_CASE("limits: score mode's stop catches a fast joint from inside its region", "[sim][limits]")
 {
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     const ReferenceMotion ref(m, swinging_elbows(skel));
     const CharacterLimits limits(m, ref);

@@ -3,7 +3,7 @@
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/sim/scene.hpp"
 #include "ictus/sim/strike_detector.hpp"
-#include "sim_test_util.hpp"
+#include "support/sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -66,7 +66,7 @@ double gravity_torque(const CharacterModel &m, const CharacterPose &pose, int jo
 
 TEST_CASE("still pose: each joint sags by its gravity torque over k_s, and no more", "[sim][scene]")
 {
-    const CharacterModel m = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
+    const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
     const CharacterPose pose = still_pose(m);
     const std::vector<JointGains> gains = default_gains(m, pose);
     SceneOptions so;
@@ -110,7 +110,7 @@ TEST_CASE("still pose: each joint sags by its gravity torque over k_s, and no mo
 
 TEST_CASE("divergence is detected, counted and the character reset to its targets", "[sim][scene]")
 {
-    const CharacterModel m = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
+    const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
     const CharacterPose pose = still_pose(m);
     Scene scene(m, SceneOptions{}, pose, default_gains(m, pose));
     const std::vector<Eigen::Vector3d> zero(CharacterModel::kJoints, Eigen::Vector3d::Zero());
@@ -141,7 +141,7 @@ TEST_CASE("divergence is detected, counted and the character reset to its target
 
 TEST_CASE("a NaN never enters ODE (which would abort)", "[sim][scene]")
 {
-    const CharacterModel m = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
+    const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
     const CharacterPose pose = still_pose(m);
     Scene scene(m, SceneOptions{}, pose, default_gains(m, pose));
     CHECK_THROWS_WITH(
@@ -154,7 +154,7 @@ TEST_CASE("a NaN never enters ODE (which would abort)", "[sim][scene]")
 
 TEST_CASE("scene options are checked", "[sim][scene]")
 {
-    const CharacterModel m = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
+    const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
     const CharacterPose pose = still_pose(m);
     const auto gains = default_gains(m, pose);
     SceneOptions so;
@@ -183,7 +183,7 @@ TEST_CASE("scene options are checked", "[sim][scene]")
 
 TEST_CASE("the drum: a stick pressed onto the membrane is held by contact", "[sim][scene]")
 {
-    const CharacterModel m = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
+    const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
     const CharacterPose pose = still_pose(m);
     SceneOptions so;
     // Membrane 2 cm above the right stick's tip in the target pose: the motor
@@ -215,7 +215,7 @@ namespace
 // The still pose with the right bead pressed `press_m` into a drum placed
 // under it: the membrane `press_m` above the bead's lowest point.
 struct PressedStick {
-    CharacterModel model = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
+    CharacterModel model = CharacterModel::from_skeleton(default_skeleton());
     CharacterPose pose = still_pose(model);
     SceneOptions options;
     Eigen::Vector3d bead_lowest_m; // in the target pose
@@ -341,7 +341,7 @@ TEST_CASE("set_drum moves, resizes and re-tensions the drum of a live scene at o
 TEST_CASE("bead centre: one tip radius back along the stick, moving as a point of the hand",
           "[sim][scene]")
 {
-    const CharacterModel m = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
+    const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
     const CharacterPose pose = still_pose(m);
     SceneOptions so;
     so.drum.center_m = Eigen::Vector3d(0, -5, 0); // out of reach
@@ -517,7 +517,7 @@ TEST_CASE("the drum stops a stick on its head from above, a stick rising into it
           "passes through",
           "[sim][scene]")
 {
-    const CharacterModel m = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
+    const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
     SceneOptions far;
     far.drum.center_m = Eigen::Vector3d(5.0, 0.5, 5.0); // out of reach
     // Which way is up for this shoulder turn: the tip must rise > 10 cm.
@@ -571,7 +571,7 @@ TEST_CASE("kinematic legs and pelvis (score mode): the legs leave the solve and 
           "targets, the arms and sticks move as beside simulated legs and a welded pelvis",
           "[sim][scene]")
 {
-    const CharacterModel m = CharacterModel::from_skeleton(simtest::cmu_like_skeleton());
+    const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
     const CharacterPose pose = still_pose(m);
     const std::vector<JointGains> gains = default_gains(m, pose);
     // Direct solver, then QuickStep: legs simulated, legs kinematic, legs and

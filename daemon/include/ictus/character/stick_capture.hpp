@@ -1,10 +1,11 @@
 // stick_capture.hpp -- stick-only captures for the Cartesian mode: the two
 // stick tips' trajectories (e.g. two rigid bodies or tip markers from an
-// optical system), a default body to drive with them, the placement of the
-// body behind the sticks and the drum under the strokes.
+// optical system), the placement of the default body (default_skeleton.hpp)
+// behind the sticks and the drum under the strokes.
 #pragma once
 
 #include "ictus/character/character.hpp"
+#include "ictus/character/default_skeleton.hpp" // the body a stick-only capture drives
 #include "ictus/mocap/motion.hpp"
 
 #include <Eigen/Core>
@@ -30,10 +31,6 @@ struct TipTrajectory {
 // Throws CharacterError naming the missing object and listing the names.
 std::array<int, 2> find_stick_tracks(const MarkerCapture &capture, const std::string &left,
                                      const std::string &right);
-
-// A body with the CMU joint names and round-number dimensions (1.75 m), for
-// captures that have only the sticks.
-Skeleton default_skeleton();
 
 // Moves the capture's tips into the character's frame (a rotation about the
 // vertical and a translation; the motion itself is untouched): the capture's

@@ -4,7 +4,7 @@
 #include "ictus/net/osc_sender.hpp"
 #include "ictus/net/osc_server.hpp"
 #include "ictus/perform/tracker.hpp"
-#include "osc_test_util.hpp"
+#include "support/osc_test_util.hpp"
 
 #include <catch2/catch.hpp>
 

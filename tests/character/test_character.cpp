@@ -3,7 +3,7 @@
 #include "ictus/character/character.hpp"
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/sim/scene.hpp"
-#include "sim_test_util.hpp"
+#include "support/sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -32,7 +32,7 @@ TEST_CASE("de Leva's male mass fractions of the whole body add up to 1", "[sim][
 
 TEST_CASE("the character has 19 three-DoF joints with CMU segment lengths", "[sim][character]")
 {
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     CharacterOptions opt;
     opt.body_mass_kg = 80.0;
     const CharacterModel m = CharacterModel::from_skeleton(skel, opt);
@@ -68,10 +68,10 @@ TEST_CASE("the character has 19 three-DoF joints with CMU segment lengths", "[si
 
 TEST_CASE("a missing CMU joint or a bad option is refused with its name", "[sim][character]")
 {
-    Skeleton skel = simtest::cmu_like_skeleton();
+    Skeleton skel = default_skeleton();
     skel.joints[skel.find("LeftForeArm")].name = "LeftLowerArm";
     CHECK_THROWS_WITH(CharacterModel::from_skeleton(skel), Catch::Contains("LeftForeArm"));
-    const Skeleton good = simtest::cmu_like_skeleton();
+    const Skeleton good = default_skeleton();
     CharacterOptions opt;
     opt.body_mass_kg = -3;
     CHECK_THROWS_WITH(CharacterModel::from_skeleton(good, opt), Catch::Contains("body mass"));
@@ -88,7 +88,7 @@ TEST_CASE("a missing CMU joint or a bad option is refused with its name", "[sim]
 TEST_CASE("grips: German sticks lie in the palm plane, French ones in the finger-palm plane",
           "[sim][character]")
 {
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     for (Grip grip : {Grip::german, Grip::french}) {
         CharacterOptions opt;
         opt.grip = grip;
@@ -122,7 +122,7 @@ TEST_CASE("grips: German sticks lie in the palm plane, French ones in the finger
 TEST_CASE("reference motion: composed rotations, slerp in time, ping-pong past the end",
           "[sim][character]")
 {
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     // Elbow (LeftForeArm) turns about z by 10 degrees per frame, Spine1 by 1 per frame.
     const Motion motion = simtest::make_motion(skel, 5, 10.0, [](int f, const std::string &j) {
@@ -183,7 +183,7 @@ TEST_CASE("reference clean-up: the Butterworth kernel has the zero-phase 2nd-ord
     // smoothing is linear, so mid-clip the swing keeps G(4 Hz) of its
     // amplitude: 0.9750 with the Butterworth at 10 Hz, exp(-0.08) = 0.9231
     // with the Gaussian.
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     const double amp = 30.0 * M_PI / 180.0;
     const Motion motion = simtest::make_motion(skel, 361, 120.0, [&](int f, const std::string &j) {
@@ -248,7 +248,7 @@ TEST_CASE("a limb of zero length is refused at its OFFSET, naming the joint", "[
                  {"RightLeg", "r_thigh"},         {"RightFoot", "r_shank"}};
     for (const auto &limb : limbs) {
         INFO(limb.joint);
-        Skeleton skel = simtest::cmu_like_skeleton();
+        Skeleton skel = default_skeleton();
         const int j = skel.find(limb.joint);
         skel.joints[j].offset_m.setZero();
         CHECK_THROWS_WITH(CharacterModel::from_skeleton(skel),
@@ -262,18 +262,18 @@ TEST_CASE("a limb of zero length is refused at its OFFSET, naming the joint", "[
                           Catch::StartsWith(std::string("clip.bvh:42: joint '") + limb.joint));
     }
     // Too long: a segment of more than 1 m, the joint with the longest OFFSET named.
-    Skeleton skel = simtest::cmu_like_skeleton();
+    Skeleton skel = default_skeleton();
     skel.joints[skel.find("Head_end")].offset_m *= 20.0; // 1.9 m of head
     CHECK_THROWS_WITH(CharacterModel::from_skeleton(skel),
                       Catch::StartsWith("skeleton: joint 'Head_end': expected the head segment to "
                                         "be at most 1 m (a human body), got 1.9"));
-    skel = simtest::cmu_like_skeleton();
+    skel = default_skeleton();
     skel.joints[skel.find("LHipJoint")].offset_m = Eigen::Vector3d(0, -1.5, 0);
     CHECK_THROWS_WITH(CharacterModel::from_skeleton(skel),
                       Catch::Contains("joint 'LHipJoint': expected the l_hip joint's distance "
                                       "from its parent to be at most 1 m"));
     // Not a number: refused, not built.
-    skel = simtest::cmu_like_skeleton();
+    skel = default_skeleton();
     skel.joints[skel.find("LeftShoulder")].offset_m.x() = std::nan("");
     CHECK_THROWS_AS(CharacterModel::from_skeleton(skel), CharacterError);
 }
@@ -286,7 +286,7 @@ TEST_CASE("a limb of zero length is refused at its OFFSET, naming the joint", "[
 TEST_CASE("zeroing any one OFFSET either names the joint or builds a physical body",
           "[sim][character]")
 {
-    const Skeleton good = simtest::cmu_like_skeleton();
+    const Skeleton good = default_skeleton();
     int refused = 0;
     for (std::size_t j = 1; j < good.joints.size(); ++j) {
         Skeleton skel = good;
@@ -312,7 +312,7 @@ TEST_CASE("zeroing any one OFFSET either names the joint or builds a physical bo
     CHECK(refused == 8); // the eight limbs, nothing else
 }
 
-// Property: the hand-made skeleton at a random scale is built exactly when its
+// Property: the default skeleton at a random scale is built exactly when its
 // shortest limb (forearm, 3.6 units) is >= 0.05 m and its longest segment
 // (shank, |(2.6, -7, 0)| units) <= 1 m; every body built is physical.
 TEST_CASE("a skeleton at any scale is built exactly within the bounds of a human body",
@@ -331,10 +331,10 @@ TEST_CASE("a skeleton at any scale is built exactly within the bounds of a human
             continue; // on an edge: either answer is rounding
         if (human) {
             const CharacterModel m =
-                CharacterModel::from_skeleton(simtest::cmu_like_skeleton(scale));
+                CharacterModel::from_skeleton(simtest::default_skeleton_at_scale(scale));
             require_physical_bodies(m);
         } else {
-            CHECK_THROWS_WITH(CharacterModel::from_skeleton(simtest::cmu_like_skeleton(scale)),
+            CHECK_THROWS_WITH(CharacterModel::from_skeleton(simtest::default_skeleton_at_scale(scale)),
                               Catch::Contains(scale * shortest_limb < kMinLimbLength_m
                                                   ? "a human limb"
                                                   : "check the scale, --scale"));

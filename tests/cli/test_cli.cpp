@@ -1,6 +1,6 @@
 // The real ictusd binary: help, version, usage errors, bad values for every
 // option, missing and malformed files (exit 1), and the files `track --out` writes.
-#include "sim_test_util.hpp"
+#include "support/sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -47,7 +47,7 @@ Run ictusd(const std::string &args)
 std::string tiny_bvh()
 {
     static const std::string path = simtest::write_temp(
-        "tiny.bvh", simtest::cmu_like_bvh(121, 1.0 / 120, [](int f, const std::string &j) {
+        "tiny.bvh", simtest::default_skeleton_bvh(121, 1.0 / 120, [](int f, const std::string &j) {
             if (j == "RightForeArm")
                 return Eigen::Vector3d(0, 20.0 * std::sin(2 * M_PI * f / 120.0), 0);
             return Eigen::Vector3d(0, 0, 0);
@@ -546,7 +546,7 @@ namespace
 // the 1-based line of that OFFSET.
 std::string with_offset(const std::string &joint, const std::string &offset, int &line)
 {
-    std::istringstream in(simtest::cmu_like_bvh(
+    std::istringstream in(simtest::default_skeleton_bvh(
         121, 1.0 / 120, [](int, const std::string &) { return Eigen::Vector3d::Zero(); }));
     const bool end_site = joint.size() > 4 && joint.substr(joint.size() - 4) == "_end";
     const std::string owner = end_site ? joint.substr(0, joint.size() - 4) : joint;
@@ -577,7 +577,7 @@ std::string with_offset(const std::string &joint, const std::string &offset, int
 // The tiny clip with the text of line `prefix...` replaced; `line` gets its number.
 std::string tiny_with_line(const std::string &prefix, const std::string &replacement, int &line)
 {
-    std::istringstream in(simtest::cmu_like_bvh(
+    std::istringstream in(simtest::default_skeleton_bvh(
         121, 1.0 / 120, [](int, const std::string &) { return Eigen::Vector3d::Zero(); }));
     std::string text, l;
     int n = 0;
@@ -629,11 +629,11 @@ TEST_CASE("ictusd track: a zero OFFSET on any joint runs or names that joint, ne
           "[sim][cli][bounds]")
 {
     int refused = 0;
-    for (const auto &row : simtest::cmu_like_rows()) {
-        if (!row.parent[0])
+    for (const ictus::SkeletonJoint &joint : ictus::default_skeleton().joints) {
+        if (joint.parent < 0)
             continue; // the root's OFFSET is a position, not a segment
         int line = 0;
-        const std::string name = row.name;
+        const std::string name = joint.name;
         const std::string bvh =
             simtest::write_temp("zero_one.bvh", with_offset(name, "0 0 0", line));
         const Run r = ictusd("track --mode joint --quiet --duration 0.02 --mocap " + bvh);

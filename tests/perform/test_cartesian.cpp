@@ -8,7 +8,7 @@
 #include "ictus/character/range_of_motion.hpp"
 #include "ictus/perform/track.hpp"
 #include "ictus/sim/strike_detector.hpp"
-#include "sim_test_util.hpp"
+#include "support/sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -25,7 +25,7 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
     if (path.empty())
         return;
     BvhOptions bo;
-    bo.scale = simtest::kCmuScale;
+    bo.scale = kCmuBvhScale_m;
     bo.skip_frames = 1;
     const BvhFile bvh = read_bvh(path, bo);
     const CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton);
@@ -125,7 +125,7 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
 TEST_CASE("Cartesian tracking of a synthetic swing: tips within millimetres",
           "[sim][track][cartesian]")
 {
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     // Right elbow and shoulder swing 20 degrees at 1 Hz for 2 s.
     const Motion motion = simtest::make_motion(skel, 241, 120.0, [](int f, const std::string &j) {
@@ -459,7 +459,7 @@ TEST_CASE("drum auto on a full-body capture: the turnaround rule, as for stick-o
     // a stroke train with its impacts (h = 0) every 0.3 s at 4 m/s, rebound 0.6,
     // captured at 120 Hz. The tips' height falls monotonically with the bend, so
     // the strokes turn where the bend is deepest, 0.6 rad.
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     const auto bend = [](double phi) {
         return Eigen::Quaterniond(Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitX()));

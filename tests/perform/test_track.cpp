@@ -3,7 +3,7 @@
 #include "ictus/mocap/bvh.hpp"
 #include "ictus/character/character_limits.hpp"
 #include "ictus/perform/track.hpp"
-#include "sim_test_util.hpp"
+#include "support/sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -24,7 +24,7 @@ struct Clip {
 Clip load_cmu(const std::string &path)
 {
     BvhOptions o;
-    o.scale = simtest::kCmuScale;
+    o.scale = kCmuBvhScale_m;
     o.skip_frames = 1; // the converter's reference pose
     BvhFile bvh = read_bvh(path, o);
     CharacterModel model = CharacterModel::from_skeleton(bvh.skeleton);
@@ -91,7 +91,7 @@ TEST_CASE("CMU 80_13 played back and forth for ten simulated minutes never diver
 TEST_CASE("track: a slow synthetic swing is followed closely, the CSV has one row per sample",
           "[sim][track]")
 {
-    const Skeleton skel = simtest::cmu_like_skeleton();
+    const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     // Right elbow and shoulder swing 20 degrees at 1 Hz for 2 s.
     const Motion motion = simtest::make_motion(skel, 241, 120.0, [](int f, const std::string &j) {

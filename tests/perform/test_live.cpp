@@ -3,7 +3,7 @@
 // controller's stability bound (docs/perform.md, "Live changes"). The daemon
 // is the real ictusd; the client is a raw UDP peer; waits are handshakes with
 // deadlines.
-#include "osc_test_util.hpp"
+#include "support/osc_test_util.hpp"
 
 #include "ictus/perform/performance.hpp"
 #include "ictus/score/score.hpp"
@@ -62,7 +62,7 @@ struct LiveDaemon {
     explicit LiveDaemon(std::vector<std::string> extra = {})
     {
         std::vector<std::string> args = {
-            ICTUSD_OSC_PATH,      "run",      "--port",
+            ICTUSD_PATH,      "run",      "--port",
             std::to_string(port), "--target", "osc.udp://127.0.0.1:" + std::to_string(dump_port),
             "--pose-rate",        "0"};
         args.insert(args.end(), extra.begin(), extra.end());
@@ -134,7 +134,7 @@ TEST_CASE("run: repeats nested around no note are refused to the client, the dae
         const int devnull = open("/dev/null", O_WRONLY);
         dup2(devnull, STDOUT_FILENO);
         dup2(devnull, STDERR_FILENO);
-        execl(ICTUSD_OSC_PATH, ICTUSD_OSC_PATH, "run", "--paused", "--port",
+        execl(ICTUSD_PATH, ICTUSD_PATH, "run", "--paused", "--port",
               std::to_string(port).c_str(), "--pose-rate", "0", "--target", "osc.udp://127.0.0.1:9",
               static_cast<char *>(nullptr));
         _exit(127);
@@ -267,7 +267,7 @@ TEST_CASE("run: a drum slider at 20 messages a second loses no strike", "[osc][l
     REQUIRE(osctest::wait_until_bound(dump_port));
     const int port = osctest::free_udp_port();
     Peer client;
-    Child daemon({ICTUSD_OSC_PATH, "run", "--score", score, "--paused", "--port",
+    Child daemon({ICTUSD_PATH, "run", "--score", score, "--paused", "--port",
                   std::to_string(port), "--target",
                   "osc.udp://127.0.0.1:" + std::to_string(dump_port), "--pose-rate", "0"});
     REQUIRE(ping_until_pong(client, port, 60.0));

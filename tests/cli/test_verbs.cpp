@@ -5,7 +5,7 @@
 // --allow, --target and --port checked up front, error replies within their
 // budget, strikes.csv whole line by line on a full disk and after SIGKILL,
 // render's --out folder and write errors.
-#include "osc_test_util.hpp"
+#include "support/osc_test_util.hpp"
 
 #include "ictus/perform/performance.hpp"
 
@@ -103,7 +103,7 @@ class Daemon
                 setrlimit(RLIMIT_FSIZE, &limit);
                 signal(SIGXFSZ, SIG_IGN); // kept across exec
             }
-            std::vector<std::string> all = {ICTUSD_OSC_PATH};
+            std::vector<std::string> all = {ICTUSD_PATH};
             all.insert(all.end(), args.begin(), args.end());
             std::vector<char *> argv;
             for (std::string &a : all)
@@ -205,7 +205,7 @@ TEST_CASE("render: two renders give identical bytes, the events add up to the st
         return;
     const fs::path dir = scratch("render");
     for (const char *sub : {"a", "b"})
-        REQUIRE(osctest::run({ICTUSD_OSC_PATH, "render", "--mocap", clip, "--duration", "4",
+        REQUIRE(osctest::run({ICTUSD_PATH, "render", "--mocap", clip, "--duration", "4",
                               "--out", (dir / sub).string()}) == 0);
     for (const char *f : {"strikes.csv", "events.txt", "render.json"})
         CHECK(slurp((dir / "a" / f).string()) == slurp((dir / "b" / f).string()));
@@ -280,7 +280,7 @@ TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked r
     const double seconds = 4.0;
     std::atomic<bool> done{false};
     std::thread daemon([&]() {
-        osctest::run({ICTUSD_OSC_PATH, "run", "--mocap", clip, "--autoplay", "--duration",
+        osctest::run({ICTUSD_PATH, "run", "--mocap", clip, "--autoplay", "--duration",
                       std::to_string(seconds), "--target",
                       "osc.udp://127.0.0.1:" + std::to_string(dump_port), "--port",
                       std::to_string(port), "--reply",
@@ -626,7 +626,7 @@ TEST_CASE("render: --out refuses a used folder, --force replaces render's own fi
     const fs::path dir = scratch("render-out");
     const std::string score = four_notes(dir).string();
     const fs::path out = dir / "out";
-    REQUIRE(osctest::run({ICTUSD_OSC_PATH, "render", "--score", score, "--bvh-rate", "10", "--out",
+    REQUIRE(osctest::run({ICTUSD_PATH, "render", "--score", score, "--bvh-rate", "10", "--out",
                           out.string()}) == 0);
     for (const char *f :
          {"strikes.csv", "events.txt", "render.json", "tips.csv", "notes.csv", "performance.bvh"})
@@ -662,7 +662,7 @@ TEST_CASE("render: --out refuses a used folder, --force replaces render's own fi
 
     // An empty folder is as good as a new one.
     fs::create_directories(dir / "empty");
-    CHECK(osctest::run({ICTUSD_OSC_PATH, "render", "--score", score, "--bvh-rate", "0", "--out",
+    CHECK(osctest::run({ICTUSD_PATH, "render", "--score", score, "--bvh-rate", "0", "--out",
                         (dir / "empty").string()}) == 0);
     fs::remove_all(dir);
 }

@@ -6,7 +6,7 @@
 #include "ictus/character/range_of_motion.hpp"
 #include "ictus/character/stick_capture.hpp"
 #include "ictus/mocap/bvh.hpp"
-#include "sim_test_util.hpp"
+#include "support/sim_test_util.hpp"
 
 #include <catch2/catch.hpp>
 

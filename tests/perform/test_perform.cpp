@@ -6,7 +6,7 @@
 // nuances (gesture.hpp's documented kLoudnessOrder) hit the head faster.
 // The strikes are matched to the notes here, independently of the daemon's
 // own match_strikes (which render.json uses).
-#include "osc_test_util.hpp"
+#include "support/osc_test_util.hpp"
 
 #include "ictus/perform/performance.hpp"
 
@@ -314,7 +314,7 @@ TEST_CASE("render --score: the files, the summary, deterministic bytes", "[perfo
         score << "tempo 144\ngrip german\nR accent f, L legato, R tenuto p, L staccato\n";
     }
     for (const char *sub : {"a", "b"})
-        REQUIRE(osctest::run({ICTUSD_OSC_PATH, "render", "--score", (dir / "s.score").string(),
+        REQUIRE(osctest::run({ICTUSD_PATH, "render", "--score", (dir / "s.score").string(),
                               "--out", (dir / sub).string()}) == 0);
     for (const char *f : {"strikes.csv", "events.txt", "render.json", "tips.csv", "notes.csv"}) {
         INFO(f);
@@ -348,10 +348,10 @@ TEST_CASE("render --score: the files, the summary, deterministic bytes", "[perfo
         std::ofstream bad(dir / "bad.score");
         bad << "tempo 120\nR legato\nL acent\n";
     }
-    CHECK(osctest::run({ICTUSD_OSC_PATH, "render", "--score", (dir / "bad.score").string(), "--out",
+    CHECK(osctest::run({ICTUSD_PATH, "render", "--score", (dir / "bad.score").string(), "--out",
                         (dir / "c").string()}) == 1);
     // A score that cannot be read is a file error (exit 1, the help's "1 error in a file").
-    CHECK(osctest::run({ICTUSD_OSC_PATH, "render", "--score", (dir / "none.score").string(),
+    CHECK(osctest::run({ICTUSD_PATH, "render", "--score", (dir / "none.score").string(),
                         "--out", (dir / "c").string()}) == 1);
     fs::remove_all(dir);
 }
