@@ -116,7 +116,7 @@ for channel in (1, 10):
           "a text event 'bounce' with each of the %d bounces" % len(bounce_times))
     if not bounce_times:
         print("NOTE: this render has no bounces; the bounce flag is checked byte by byte in "
-              "tests/osc/test_midi_file.cpp")
+              "tests/cli/test_midi_file.cpp")
 
 bad = subprocess.run([ictusd, "render", "--score", args.score, "--out", os.path.join(work, "bad"),
                       "--midi-channel", "17"], capture_output=True, text=True, timeout=60, env=env)

@@ -18,7 +18,7 @@ namespace ictus
 // `ictusd render` in the IK's three 3x3 solves per iteration (docs/benchmarks.md,
 // "Performer"). A matrix Eigen would find not positive definite (a diagonal pivot
 // <= 0 or NaN) goes to Eigen's own LLT, so the results are Eigen's in every case
-// (checked against it on random matrices: tests/kinematics/test_cholesky3.cpp).
+// (checked against it on random matrices: tests/base/test_cholesky3.cpp).
 class Cholesky3
 {
   public:
