@@ -80,7 +80,9 @@ struct LiveStatus {
     std::atomic<int> playing{0};
     std::atomic<double> tempo_bpm{120.0};
     std::atomic<long> strikes{0};
-    std::atomic<long> overruns{0}; // physics steps that started late by > 1 step
+    // Stalls: steps that started more than 50 steps late, after which the
+    // loop moved its anchor on the wall clock (docs/osc.md).
+    std::atomic<long> overruns{0};
     std::atomic<long> runaways{0}; // times the runaway guard stopped the strikes
     std::atomic<int> mode{0};      // TrackMode, as an int (/ictus/status: its name)
     std::atomic<int> grip{0};      // Grip, as an int
