@@ -13,7 +13,9 @@ Rules:
   * no issue-tracker number (the word followed by a number, with or without "#") in any text file:
     history stays in git, docs and comments say what is;
   * at most 2 edits of Python's module search path in the tree (the helpers are one package,
-    imported by name; docs/python.md).
+    imported by name; docs/python.md);
+  * tests/ mirrors daemon/src/: a tests/<area>/ for every area, and no other folder in tests/
+    but those kept apart (TESTS_APART).
 The files are those git tracks when ROOT is a git checkout, else every file below ROOT.
 """
 
@@ -34,6 +36,8 @@ ISSUE_RE = re.compile(r"\b" + "iss" + r"ues?\s*#?\s*[0-9]+", re.IGNORECASE)
 PATH_EDIT_RE = re.compile(r"\b" + "sys" + r"\.path\s*(\.\s*(insert|append|extend)\s*\(|\[[^\]]*\]\s*=[^=]|\+=|=[^=])")
 SYS_PATH = "sys" + ".path"
 SKIP_DIRS = {".git", "__pycache__"}
+# The folders of tests/ that test no daemon area (docs/architecture.md, "Tests").
+TESTS_APART = {"core", "pd", "pdosc", "sound", "ui", "e2e", "layout", "package", "support"}
 
 
 def tree_files(root):
@@ -80,9 +84,21 @@ def check(root):
                 problems.append(f"{rel}:{i}: names an issue number ('{m.group(0)}'): say the fact instead")
             if rel.endswith((".py", ".sh")) and PATH_EDIT_RE.search(line):
                 path_edits.append(f"{rel}:{i}")
+    problems += check_test_folders(tree_files(root))
     if len(path_edits) > MAX_PATH_EDITS:
         problems.append(f"{len(path_edits)} edits of Python's module path, more than {MAX_PATH_EDITS} "
                         f"(import the helpers' package by name): {', '.join(path_edits)}")
+    return problems
+
+
+def check_test_folders(files):
+    """tests/<area>/ for every daemon/src/<area>/, and nothing else but TESTS_APART."""
+    areas = {f.split("/")[2] for f in files if f.startswith("daemon/src/") and f.count("/") >= 3}
+    folders = {f.split("/")[1] for f in files if f.startswith("tests/") and f.count("/") >= 2}
+    problems = [f"tests/{a}/: missing: the tests of daemon/src/{a}/ belong there"
+                for a in sorted(areas - folders)]
+    problems += [f"tests/{t}/: neither a daemon area nor a folder kept apart ({', '.join(sorted(TESTS_APART))})"
+                 for t in sorted(folders - areas - TESTS_APART)]
     return problems
 
 
@@ -98,6 +114,7 @@ def self_test(scratch):
         return d
 
     clean = {"daemon/src/a/a.cpp": "int a;\n" * MAX_SOURCE_LINES,
+             "tests/a/test_a.cpp": "int t;\n",
              "docs/a.md": "# A\n" + "text\n" * (MAX_DOC_LINES - 1),
              "tests/t.py": f"import sys\n{SYS_PATH}.insert(0, 'x')\n",
              "scripts/s.py": f"import sys\n{SYS_PATH}.append('y')\nprint({SYS_PATH}[0])\n"}
@@ -106,6 +123,8 @@ def self_test(scratch):
         "long doc": ({"docs/b.md": "x\n" * (MAX_DOC_LINES + 1)}, "more than 500"),
         "issue number": ({"daemon/src/a/b.cpp": "// as " + "Issue" + " #12 asked\n"}, "issue number"),
         "issue numbers": ({"docs/c.md": "see " + "issues" + " 3 and 4\n"}, "issue number"),
+        "area without tests": ({"daemon/src/b/b.cpp": "int b;\n"}, "tests/b/: missing"),
+        "stray test folder": ({"tests/kinematics/t.cpp": "int k;\n"}, "neither a daemon area"),
         "path edits": ({"bench/b.py": f"import sys\n{SYS_PATH}[0:0] = ['z']\n"}, "edits of Python"),
     }
     passed = failures = 0
