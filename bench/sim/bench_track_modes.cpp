@@ -43,7 +43,7 @@ int main(int argc, char **argv)
     std::printf("mode        us/step  ik us/step  ik it/solve  real time  tip rms L/R mm\n");
     // joint; cartesian at the defaults (Algorithm 2 from the simulated state,
     // posture task, 2 iterations per solve); the capture-seeded variant
-    // (--ik-start kinematic, solved to convergence: the default until 2026-11-24).
+    // (--ik-start kinematic, solved to convergence).
     for (int variant = 0; variant < 3; ++variant) {
         const TrackMode mode = variant == 0 ? TrackMode::joint : TrackMode::cartesian;
         TrackOptions o;

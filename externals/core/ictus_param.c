@@ -1,7 +1,7 @@
 /* ictus_param.c -- table-driven access to the core's one-number parameters
  * (ictus_param.h). */
 #include "ictus_param.h"
-#include "membrane_internal.h"
+#include "ictus_clamp.h"
 
 #include <string.h>
 

@@ -6,6 +6,7 @@
 #define ICTUS_MEMBRANE_INTERNAL_H
 
 #include <math.h>
+#include "ictus_clamp.h"
 #include "membrane.h"
 #include "mode_table.h"
 
@@ -232,25 +233,6 @@ void membrane_point_free_(membrane_point *pt);
  * membrane_process() call (later blocks when past it); the shapes of the new place
  * are computed here, in the message handler, when pt is attached. */
 void membrane_point_move_(membrane_point *pt, double r_over_a, double theta_deg, int sample_offset);
-
-/* Clamps *v into [lo, hi]; NaN becomes `fallback`. ICTUS_CLAMPED when *v changed.
- * Every setter of the core validates through this one rule. */
-static inline ictus_status ictus_clamp(double *v, double lo, double hi, double fallback)
-{
-    if (isnan(*v)) {
-        *v = fallback;
-        return ICTUS_CLAMPED;
-    }
-    if (*v < lo) {
-        *v = lo;
-        return ICTUS_CLAMPED;
-    }
-    if (*v > hi) {
-        *v = hi;
-        return ICTUS_CLAMPED;
-    }
-    return ICTUS_OK;
-}
 
 /* Clamps a point on the head: r/a into [0, 1] (NaN: 0), theta (deg) wrapped into
  * [0, 360) so that cos/sin stay accurate (not finite: 0). ICTUS_CLAMPED when either

@@ -34,8 +34,7 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
     const ReferenceMotion raw(model, bvh.motion);
     // The default options throughout (limits at k = 3, Algorithm 2 from the
     // simulated state with the posture task, docs/ik.md). Both modes get the
-    // same limits and the same gains. (Until 2026-11-24 this test used k = 4
-    // and the capture-seeded IK start, which the defaults no longer are.)
+    // same limits and the same gains.
     const CharacterLimits limits(model, reference, CharacterLimitOptions{});
     TrackOptions joint_options;
     const std::vector<JointGains> gains =
@@ -152,8 +151,8 @@ TEST_CASE("Cartesian tracking of a synthetic swing: tips within millimetres",
     // Driven by the tips alone from the simulated arm (the default), Theta^T's
     // elbow is not the motion's: the tips do not determine how the swing is
     // shared between shoulder and elbow (measured 11 deg RMS off a 14 deg RMS
-    // flexion signal). Until 2026-11-24 this test checked < 2 deg with the
-    // capture-seeded start; that variant is checked in the CMU test above.
+    // flexion signal). The capture-seeded start's tighter bound is checked in
+    // the CMU test above.
     INFO("elbow flexion rms " << cart.elbow_ik_rms_deg[1] << " deg");
     const nlohmann::json j = cart.to_json();
     CHECK(j["mode"] == "cartesian");

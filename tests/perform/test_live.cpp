@@ -253,9 +253,8 @@ TEST_CASE("run: refusals of the physics thread and of the planner reach the clie
 TEST_CASE("run: a drum slider at 20 messages a second loses no strike", "[osc][live]")
 {
     // Eight notes, one primary strike each, while /ictus/drum/radius sweeps
-    // 0.15 -> 0.30 -> 0.15 m at 20 messages per second (before, each message
-    // rebuilt the scene at rest and replanned on the physics thread: 9
-    // strikes of 32 notes were left).
+    // 0.15 -> 0.30 -> 0.15 m at 20 messages per second: each message is
+    // applied to the live scene and replanned on the worker, so every note is struck.
     const fs::path dir = fs::temp_directory_path() / ("ictus_live_" + std::to_string(getpid()));
     fs::create_directories(dir);
     const std::string score = (dir / "eight.score").string();
