@@ -581,52 +581,6 @@ TEST_CASE("osc in: 10^5 random and malformed packets are counted, each answered 
     CHECK(pong);
 }
 
-namespace
-{
-// A bare UDP socket on a loopback address, for what Peer hides: the size of
-// each datagram received.
-class RawPeer
-{
-  public:
-    explicit RawPeer(const char *address)
-    {
-        fd_ = socket(AF_INET, SOCK_DGRAM, 0);
-        sockaddr_in sa{};
-        sa.sin_family = AF_INET;
-        inet_pton(AF_INET, address, &sa.sin_addr);
-        bind(fd_, reinterpret_cast<sockaddr *>(&sa), sizeof sa);
-        int big = 1 << 20;
-        setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &big, sizeof big);
-    }
-    ~RawPeer() { close(fd_); }
-    void send(int port, const void *data, size_t size)
-    {
-        sockaddr_in to{};
-        to.sin_family = AF_INET;
-        to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        to.sin_port = htons(static_cast<uint16_t>(port));
-        sendto(fd_, data, size, 0, reinterpret_cast<sockaddr *>(&to), sizeof to);
-    }
-    // The next datagram: its size (its OSC path in `path`), or -1 after timeout_ms.
-    long receive(std::string &path, int timeout_ms)
-    {
-        pollfd p{fd_, POLLIN, 0};
-        if (poll(&p, 1, timeout_ms) <= 0)
-            return -1;
-        char buf[65536];
-        const ssize_t n = recv(fd_, buf, sizeof buf - 1, 0);
-        if (n < 0)
-            return -1;
-        buf[n] = '\0';
-        path = buf;
-        return static_cast<long>(n);
-    }
-
-  private:
-    int fd_ = -1;
-};
-} // namespace
-
 // A 1-byte packet earned a 64-byte /ictus/error, and with --allow any every
 // packet was answered: the port was a 64x amplifier. Now each address has a
 // budget (kErrorReplyBurst, refilled at kErrorRepliesPerSecond): past it an
@@ -640,12 +594,12 @@ TEST_CASE("osc in: error replies are limited per peer address, the rest counted,
     so.port = 0;
     so.allow_any = true;
     ictus::OscServer server(so, nullptr);
-    RawPeer flooder("127.0.0.1"), other("127.0.0.2");
+    Peer flooder("127.0.0.1"), other("127.0.0.2");
     const int total = 2000;
     const unsigned char junk = 'x';
     const auto t0 = std::chrono::steady_clock::now();
     for (int i = 0; i < total; ++i) {
-        flooder.send(server.port(), &junk, 1);
+        flooder.send_raw(server.port(), &junk, 1);
         // Paced so that the kernel drops none: every packet must be counted.
         if (i % 32 == 31 || i == total - 1)
             for (int w = 0;
@@ -657,7 +611,7 @@ TEST_CASE("osc in: error replies are limited per peer address, the rest counted,
     long replies = 0, largest = 0;
     std::string path;
     for (long n;
-         replies < static_cast<long>(k.errors_sent) && (n = flooder.receive(path, 2000)) >= 0;
+         replies < static_cast<long>(k.errors_sent) && (n = flooder.receive_size(path, 2000)) >= 0;
          ++replies) {
         CHECK(path == "/ictus/error");
         largest = std::max(largest, n);
@@ -675,11 +629,11 @@ TEST_CASE("osc in: error replies are limited per peer address, the rest counted,
           ictus::kErrorReplyBurst + ictus::kErrorRepliesPerSecond * elapsed_s + 1.0);
     CHECK(replies == static_cast<long>(k.errors_sent));
     CHECK(largest <= 64);
-    CHECK_FALSE(flooder.receive(path, 0) >= 0); // nothing beyond the counted replies
+    CHECK_FALSE(flooder.receive_size(path, 0) >= 0); // nothing beyond the counted replies
 
     // Another address has its own budget: answered at once.
-    other.send(server.port(), &junk, 1);
-    REQUIRE(other.receive(path, 2000) > 0);
+    other.send_raw(server.port(), &junk, 1);
+    REQUIRE(other.receive_size(path, 2000) > 0);
     CHECK(path == "/ictus/error");
     // An unknown address of 3000 characters: the reply names it in 64 (it
     // was over 3 kB, too long for the reply buffer, and never sent).
@@ -689,9 +643,9 @@ TEST_CASE("osc in: error replies are limited per peer address, the rest counted,
         const std::string long_path = "/" + std::string(2999, 'v');
         void *data = lo_message_serialise(m, long_path.c_str(), nullptr, &size);
         lo_message_free(m);
-        other.send(server.port(), data, size);
+        other.send_raw(server.port(), data, size);
         std::free(data);
-        const long n = other.receive(path, 2000);
+        const long n = other.receive_size(path, 2000);
         REQUIRE(n > 0);
         CHECK(path == "/ictus/error");
         CHECK(n <= 128);
@@ -702,17 +656,17 @@ TEST_CASE("osc in: error replies are limited per peer address, the rest counted,
         size_t size = 0;
         void *data = lo_message_serialise(m, "/ictus/ping", nullptr, &size);
         lo_message_free(m);
-        flooder.send(server.port(), data, size);
+        flooder.send_raw(server.port(), data, size);
         std::free(data);
-        REQUIRE(flooder.receive(path, 2000) > 0);
+        REQUIRE(flooder.receive_size(path, 2000) > 0);
         CHECK(path == "/ictus/pong");
     }
     // The budget refills: junk resent until it is answered again (a token
     // every 1 / kErrorRepliesPerSecond s), within a deadline.
     bool answered = false;
     for (int i = 0; i < 100 && !answered; ++i) {
-        flooder.send(server.port(), &junk, 1);
-        answered = flooder.receive(path, 50) > 0 && path == "/ictus/error";
+        flooder.send_raw(server.port(), &junk, 1);
+        answered = flooder.receive_size(path, 50) > 0 && path == "/ictus/error";
     }
     CHECK(answered);
     k = server.counters();

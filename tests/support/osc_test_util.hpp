@@ -233,6 +233,21 @@ class Peer
         lo_message_free(m);
         return true;
     }
+    // The next datagram as it came, for what receive() hides: its size (its
+    // OSC path in `path`), or -1 after timeout_ms.
+    long receive_size(std::string &path, int timeout_ms)
+    {
+        pollfd p{fd_, POLLIN, 0};
+        if (poll(&p, 1, timeout_ms) <= 0)
+            return -1;
+        char buf[65536];
+        const ssize_t n = recv(fd_, buf, sizeof buf - 1, 0);
+        if (n < 0)
+            return -1;
+        buf[n] = '\0';
+        path = buf;
+        return static_cast<long>(n);
+    }
     void drain()
     {
         Message m;
