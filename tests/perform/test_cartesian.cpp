@@ -127,14 +127,7 @@ TEST_CASE("Cartesian tracking of a synthetic swing: tips within millimetres",
     const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     // Right elbow and shoulder swing 20 degrees at 1 Hz for 2 s.
-    const Motion motion = simtest::make_motion(skel, 241, 120.0, [](int f, const std::string &j) {
-        const double a = 20.0 * M_PI / 180 * std::sin(2 * M_PI * f / 120.0);
-        if (j == "RightForeArm")
-            return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()));
-        if (j == "RightArm")
-            return Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * a, Eigen::Vector3d::UnitZ()));
-        return Eigen::Quaterniond::Identity();
-    });
+    const Motion motion = simtest::right_arm_swing(skel);
     const ReferenceMotion ref(m, motion);
     TrackOptions o;
     o.sample_rate_hz = 50.0;

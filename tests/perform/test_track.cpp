@@ -94,14 +94,7 @@ TEST_CASE("track: a slow synthetic swing is followed closely, the CSV has one ro
     const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
     // Right elbow and shoulder swing 20 degrees at 1 Hz for 2 s.
-    const Motion motion = simtest::make_motion(skel, 241, 120.0, [](int f, const std::string &j) {
-        const double a = 20.0 * M_PI / 180 * std::sin(2 * M_PI * f / 120.0);
-        if (j == "RightForeArm")
-            return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()));
-        if (j == "RightArm")
-            return Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * a, Eigen::Vector3d::UnitZ()));
-        return Eigen::Quaterniond::Identity();
-    });
+    const Motion motion = simtest::right_arm_swing(skel);
     const ReferenceMotion ref(m, motion);
     std::ostringstream csv;
     TrackOptions o;

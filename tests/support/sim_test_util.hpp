@@ -10,6 +10,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -46,6 +47,20 @@ make_motion(const ictus::Skeleton &s, int frames, double rate_hz,
         m.local_rotation.push_back(q);
     }
     return m;
+}
+
+// A slow swing of the right arm: elbow and shoulder 20 degrees at 1 Hz, 2 s
+// at 120 Hz (241 frames), every other joint at rest.
+inline ictus::Motion right_arm_swing(const ictus::Skeleton &s)
+{
+    return make_motion(s, 241, 120.0, [](int f, const std::string &j) {
+        const double a = 20.0 * M_PI / 180 * std::sin(2 * M_PI * f / 120.0);
+        if (j == "RightForeArm")
+            return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()));
+        if (j == "RightArm")
+            return Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * a, Eigen::Vector3d::UnitZ()));
+        return Eigen::Quaterniond::Identity();
+    });
 }
 
 // BVH text of the default skeleton (its offsets in CMU BVH units);
