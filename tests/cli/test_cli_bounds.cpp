@@ -1,0 +1,435 @@
+// The real ictusd binary on bad input: captures out of physical bounds, zero
+// limbs, frame times and units refused at their line (exit 1), --force, and the
+// version of the program and each verb.
+#include "support/cli_test_util.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <regex>
+#include <set>
+#include <thread>
+
+#include <cstdio>
+#include <fcntl.h>
+#include <fstream>
+#include <sstream>
+
+using clitest::ictusd;
+using clitest::Run;
+using clitest::tiny_bvh;
+
+namespace
+{
+
+// The tiny clip's text with one line changed: the OFFSET of `joint` (a JOINT,
+// or "X_end" for X's End Site) set to `offset`. Returns the text; `line` gets
+// the 1-based line of that OFFSET.
+std::string with_offset(const std::string &joint, const std::string &offset, int &line)
+{
+    std::istringstream in(simtest::default_skeleton_bvh(
+        121, 1.0 / 120, [](int, const std::string &) { return Eigen::Vector3d::Zero(); }));
+    const bool end_site = joint.size() > 4 && joint.substr(joint.size() - 4) == "_end";
+    const std::string owner = end_site ? joint.substr(0, joint.size() - 4) : joint;
+    std::string text, l;
+    int n = 0, stage = 0; // 0: looking for the joint, 1: (End Site), 2: its OFFSET, 3: done
+    line = 0;
+    while (std::getline(in, l)) {
+        ++n;
+        const size_t first = l.find_first_not_of('\t');
+        const std::string trimmed = first == std::string::npos ? "" : l.substr(first);
+        if (stage == 0 && (trimmed == "JOINT " + owner || trimmed == "ROOT " + owner))
+            stage = end_site ? 1 : 2;
+        else if (stage == 1 && trimmed.rfind("JOINT", 0) == 0)
+            stage = 3; // the joint has children before an End Site: none here
+        else if (stage == 1 && trimmed == "End Site")
+            stage = 2;
+        else if (stage == 2 && trimmed.rfind("OFFSET", 0) == 0) {
+            l = l.substr(0, first) + "OFFSET " + offset;
+            line = n;
+            stage = 3;
+        }
+        text += l + "\n";
+    }
+    REQUIRE(line > 0);
+    return text;
+}
+
+// The tiny clip with the text of line `prefix...` replaced; `line` gets its number.
+std::string tiny_with_line(const std::string &prefix, const std::string &replacement, int &line)
+{
+    std::istringstream in(simtest::default_skeleton_bvh(
+        121, 1.0 / 120, [](int, const std::string &) { return Eigen::Vector3d::Zero(); }));
+    std::string text, l;
+    int n = 0;
+    line = 0;
+    while (std::getline(in, l)) {
+        ++n;
+        if (line == 0 && l.rfind(prefix, 0) == 0) {
+            l = replacement;
+            line = n;
+        }
+        text += l + "\n";
+    }
+    REQUIRE(line > 0);
+    return text;
+}
+
+} // namespace
+
+// A zero OFFSET on a limb's joint built a zero-length body, which ODE's
+// dMassCheck answers with SIGABRT: track, render and run died. Now every verb
+// refuses the file with exit 1 at FILE:LINE of that OFFSET, naming the joint.
+TEST_CASE("ictusd: a zero-length limb is refused at its OFFSET's line, by every verb",
+          "[sim][cli][bounds]")
+{
+    int line = 0;
+    const std::string bvh =
+        simtest::write_temp("zero_forearm.bvh", with_offset("LeftHand", "0 0 0", line));
+    const std::string where = bvh + ":" + std::to_string(line) +
+                              ": joint 'LeftHand': expected the "
+                              "l_forearm segment to be 0.05 to "
+                              "1 m (a human limb), got 0 m";
+    const std::string dir = simtest::temp_path("zero_out");
+    for (const std::string &args :
+         {"track --mode joint --quiet --duration 0.05 --mocap " + bvh,
+          "track --mode cartesian --quiet --duration 0.05 --mocap " + bvh, "limits " + bvh,
+          "render --mocap " + bvh + " --duration 0.05 --bvh-rate 0 --out " + dir,
+          "run --mocap " + bvh + " --duration 0.05 --port 0 --target osc.udp://127.0.0.1:9"}) {
+        const Run r = ictusd(args);
+        INFO(args << " -> " << r.status << "\n" << r.output);
+        CHECK(r.status == 1);
+        CHECK(r.output.find(where) != std::string::npos);
+    }
+}
+
+// Property over the whole skeleton: a zero OFFSET on any one joint either runs
+// (segments that carry no body, zero End Sites, the pelvis) or is refused at
+// that joint's OFFSET line (the eight limbs). Never a crash.
+TEST_CASE("ictusd track: a zero OFFSET on any joint runs or names that joint, never aborts",
+          "[sim][cli][bounds]")
+{
+    int refused = 0;
+    for (const ictus::SkeletonJoint &joint : ictus::default_skeleton().joints) {
+        if (joint.parent < 0)
+            continue; // the root's OFFSET is a position, not a segment
+        int line = 0;
+        const std::string name = joint.name;
+        const std::string bvh =
+            simtest::write_temp("zero_one.bvh", with_offset(name, "0 0 0", line));
+        const Run r = ictusd("track --mode joint --quiet --duration 0.02 --mocap " + bvh);
+        INFO(name << " -> " << r.status << "\n" << r.output);
+        CHECK((r.status == 0 || r.status == 1));
+        if (r.status == 1) {
+            ++refused;
+            CHECK(r.output.find(bvh + ":" + std::to_string(line) + ": joint '" + name + "'") !=
+                  std::string::npos);
+        }
+    }
+    CHECK(refused == 8);
+    // Zero End Sites carry no body of their own: the clip runs.
+    for (const char *site : {"Head_end", "LeftToeBase_end", "LThumb_end", "RightHandIndex1_end"}) {
+        int line = 0;
+        const std::string bvh =
+            simtest::write_temp("zero_site.bvh", with_offset(site, "0 0 0", line));
+        const Run r = ictusd("track --mode joint --quiet --duration 0.05 --mocap " + bvh);
+        INFO(site << "\n" << r.output);
+        CHECK(r.status == 0);
+    }
+}
+
+// Frame Time: 60 read as 60 s per frame: a 121-frame clip became a 2-hour run
+// (rc 0, no word), render's default duration too. Refused now at its line,
+// with --force (track, limits) to insist.
+TEST_CASE("ictusd: a frame time out of bounds is refused at its line, and --force reads it",
+          "[sim][cli][bounds]")
+{
+    int line = 0;
+    const std::string bvh =
+        simtest::write_temp("slow.bvh", tiny_with_line("Frame Time:", "Frame Time: 60", line));
+    const std::string where = bvh + ":" + std::to_string(line) +
+                              ": expected a frame time in [0.0005, 0.5] s (a capture at 2 Hz to "
+                              "2 kHz), got '60'";
+    const std::string dir = simtest::temp_path("slow_out");
+    for (const std::string &args : {"track --mode joint --quiet --duration 0.05 --mocap " + bvh,
+                                    "limits " + bvh + " --out " + dir + ".json",
+                                    "render --mocap " + bvh + " --duration 0.05 --out " + dir}) {
+        const Run r = ictusd(args);
+        INFO(args << " -> " << r.status << "\n" << r.output);
+        CHECK(r.status == 1);
+        CHECK(r.output.find(where) != std::string::npos);
+    }
+    Run r = ictusd("track --mode joint --quiet --duration 0.05 --mocap " + bvh);
+    CHECK(r.output.find("(--force reads it anyway)") != std::string::npos);
+    for (const std::string &args :
+         {"track --mode joint --quiet --duration 0.05 --force --mocap " + bvh,
+          "limits " + bvh + " --force --out " + dir + ".json"}) {
+        r = ictusd(args);
+        INFO(args << " -> " << r.status << "\n" << r.output);
+        CHECK(r.status == 0);
+        CHECK(r.output.find("ictusd: warning: " + where) != std::string::npos);
+        CHECK(r.output.find("read anyway") != std::string::npos);
+    }
+    // A root position 1e9 units away (56,000 km at the CMU scale), frame 10.
+    int frame_time_line = 0;
+    std::string text = tiny_with_line("Frame Time:", "Frame Time: 0.0083333", frame_time_line);
+    const int far_line = frame_time_line + 10;
+    {
+        std::istringstream in(text);
+        std::string l, out;
+        for (int n = 1; std::getline(in, l); ++n)
+            out += (n == far_line ? "1e9" + l.substr(l.find(' ')) : l) + "\n";
+        text = out;
+    }
+    const std::string far = simtest::write_temp("far.bvh", text);
+    r = ictusd("track --mode joint --quiet --duration 0.05 --mocap " + far);
+    INFO(r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find(far + ":" + std::to_string(far_line) +
+                        ": expected |position| * scale <= 100 m in column 0 (Hips Xposition") !=
+          std::string::npos);
+}
+
+namespace
+{
+// The stick-only capture of stick_csv() with its clock multiplied by
+// `time_unit` (1000: ms) and, when `far_row` >= 0, stick_l.z of that row set to 1e9.
+std::string stick_csv_with(double time_unit, int far_row = -1)
+{
+    std::ostringstream out;
+    out << "time,stick_l.x,stick_l.y,stick_l.z,stick_r.x,stick_r.y,stick_r.z\n";
+    for (int f = 0; f < 400; ++f) {
+        const double t = f / 200.0;
+        out << t * time_unit;
+        for (int s = 0; s < 2; ++s) {
+            const double h = 60.0 * (1 - std::cos(2 * M_PI * 2 * t + (s == 0 ? 0 : M_PI)));
+            out << ',' << (s == 0 ? 150.0 : -150.0) + 1000.0 << ',' << 2000.0 << ',';
+            if (s == 0 && f == far_row)
+                out << "1e9";
+            else
+                out << 700.0 + h;
+        }
+        out << '\n';
+    }
+    return out.str();
+}
+} // namespace
+
+// A time column in ms made a 2 s take a 33-minute run; a 1e9 mm cell put the
+// stick (and the auto drum) 1000 km away; both ran with rc 0 and no word.
+TEST_CASE("ictusd track: a stick capture in ms, or 1e9 mm away, is refused at its row",
+          "[sim][cli][bounds][cartesian]")
+{
+    const std::string base = "track --mode cartesian --quiet --units mm --up z --duration 0.05 ";
+    const std::string ms = simtest::write_temp("sticks_ms.csv", stick_csv_with(1000.0));
+    Run r = ictusd(base + "--mocap " + ms);
+    INFO(r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find(ms + ":3: expected a median time step in [0.0005, 0.5] s") !=
+          std::string::npos);
+    CHECK(r.output.find("got 5 s") != std::string::npos);
+    CHECK(r.output.find("a time column in ms or us?") != std::string::npos);
+    CHECK(r.output.find("--force") != std::string::npos);
+    r = ictusd(base + "--force --mocap " + ms);
+    CHECK(r.status == 0);
+    CHECK(r.output.find("ictusd: warning: " + ms + ":3: expected a median time step") !=
+          std::string::npos);
+
+    const std::string far = simtest::write_temp("sticks_far.csv", stick_csv_with(1.0, 4));
+    r = ictusd(base + "--mocap " + far);
+    INFO(r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find(far + ":6: expected |coordinate| <= 100 m (100000 mm) in column 4 "
+                              "(stick_l.z), got '1e9' mm") != std::string::npos);
+    // The same capture without that cell runs.
+    CHECK(ictusd(base + "--mocap " + simtest::write_temp("sticks_ok.csv", stick_csv_with(1.0)))
+              .status == 0);
+}
+
+// `limits` learned from a single frame (zero spreads, floored to the minimum
+// width) and said nothing. Now it needs kMinLimitFrames (30) frames, or --force.
+TEST_CASE("ictusd limits needs 30 frames to learn from, or --force", "[sim][cli][bounds]")
+{
+    const std::string out = simtest::temp_path("few.json");
+    // tiny_bvh: 121 frames; --skip-frames 91 leaves 30, 92 leaves 29, 120 leaves 1.
+    Run r = ictusd("limits " + tiny_bvh() + " --skip-frames 91 --out " + out);
+    INFO(r.output);
+    CHECK(r.status == 0);
+    for (const char *skip : {"92", "120"}) {
+        r = ictusd("limits " + tiny_bvh() + " --skip-frames " + skip + " --out " + out);
+        INFO(skip << ": " << r.output);
+        CHECK(r.status == 1);
+        CHECK(r.output.find(tiny_bvh() + ": " + std::to_string(121 - std::stoi(skip)) +
+                            " frame(s) after --skip-frames " + skip +
+                            ", fewer than the 30 that limits are learned from") !=
+              std::string::npos);
+        CHECK(r.output.find("--force") != std::string::npos);
+    }
+    r = ictusd("limits " + tiny_bvh() + " --skip-frames 120 --force --out " + out);
+    INFO(r.output);
+    CHECK(r.status == 0);
+    CHECK(r.output.find("ictusd: warning: " + tiny_bvh() + ": 1 frame(s)") != std::string::npos);
+    std::ifstream js(out);
+    const nlohmann::json j = nlohmann::json::parse(js);
+    CHECK(j.at("joints").size() == 19u);
+    // track learns its limits the same way: a warning, the run goes on.
+    r = ictusd("track --mode joint --quiet --duration 0.05 --skip-frames 100 --mocap " +
+               tiny_bvh());
+    INFO(r.output);
+    CHECK(r.status == 0);
+    CHECK(r.output.find("joint limits learned from 21 frame(s), fewer than 30") !=
+          std::string::npos);
+    r = ictusd("track --mode joint --quiet --duration 0.05 --skip-frames 100 --limits none "
+               "--mocap " +
+               tiny_bvh());
+    CHECK(r.output.find("fewer than 30") == std::string::npos);
+}
+
+TEST_CASE("ictusd track and limits --help document --force and the bounds", "[sim][cli][bounds]")
+{
+    for (const char *verb : {"track", "limits"}) {
+        const Run r = ictusd(std::string(verb) + " --help");
+        INFO(r.output);
+        CHECK(r.status == 0);
+        for (const char *text :
+             {"--force", "0.0005..0.5 s", "3 h", "100 m", "0.05 m", "1 m", "30 frames"})
+            CHECK(r.output.find(text) != std::string::npos);
+    }
+}
+
+namespace
+{
+
+// The version the top CMakeLists.txt declares, read from the source: the
+// number `ictusd --version` must print.
+std::string declared_version()
+{
+    std::ifstream in(std::string(ICTUS_SOURCE_DIR) + "/CMakeLists.txt");
+    REQUIRE(in);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::smatch m;
+    const std::string s = text.str();
+    REQUIRE(
+        std::regex_search(s, m, std::regex(R"(project\(ictus VERSION ([0-9]+\.[0-9]+\.[0-9]+))")));
+    return m[1];
+}
+
+// The options a --help text defines: a `--name` that starts an entry, i.e. at
+// the start of a line after two spaces, after ", " (`--units mm|m, --up y|z`)
+// or after three spaces in a line that holds two entries
+// (`--stick-length M  (default 0.406)   --stick-mass KG`). Mentions inside a
+// description (`(after --scale or --units)`) are not entries.
+std::vector<std::string> defined_options(const std::string &help)
+{
+    std::vector<std::string> found;
+    static const std::regex entry(R"((?:^  |, |   )(--[a-z][a-z0-9-]*))");
+    std::istringstream lines(help);
+    std::string line;
+    while (std::getline(lines, line)) {
+        // A continuation line (deeply indented description) defines nothing.
+        if (line.compare(0, 3, "  -") != 0)
+            continue;
+        for (std::sregex_iterator it(line.begin(), line.end(), entry), end; it != end; ++it)
+            found.push_back((*it)[1]);
+    }
+    return found;
+}
+
+const char *const kVerbs[] = {"track", "limits", "run", "render", "gestures"};
+
+} // namespace
+
+TEST_CASE("ictusd --version prints the project's version, for the program and each verb",
+          "[sim][cli]")
+{
+    const std::string expected = "ictusd " + declared_version() + "\n";
+    Run r = ictusd("--version");
+    CHECK(r.status == 0);
+    CHECK(r.output == expected);
+    for (const char *verb : kVerbs) {
+        r = ictusd(std::string(verb) + " --version");
+        INFO(verb);
+        CHECK(r.status == 0);
+        CHECK(r.output == expected);
+    }
+    // Among a verb's other options it is an unknown option, as any other.
+    r = ictusd("render --out /nonexistent/x --version");
+    CHECK(r.status == 2);
+    CHECK(r.output.find("unknown option '--version'") != std::string::npos);
+    // The main help names it.
+    CHECK(ictusd("--help").output.find("--version") != std::string::npos);
+}
+
+TEST_CASE("ictusd: a score or database that cannot be read is a file error (exit 1), as the "
+          "help says",
+          "[sim][cli]")
+{
+    const Run help = ictusd("--help");
+    REQUIRE(help.output.find("1 error in a file or the data, 2 usage error") != std::string::npos);
+    const std::string empty = simtest::write_temp("empty.score", "");
+    const std::string out = simtest::write_temp("unused.txt", "") + ".out";
+    struct Case {
+        std::string args, names;
+    };
+    // run stops after a hundredth of a second, on any free port, should it start at all.
+    const std::string run = "run --port 0 --pose-rate 0 --duration 0.01 ";
+    for (const Case &c : std::vector<Case>{
+             {run + "--score /nonexistent/a.score", "/nonexistent/a.score"},
+             {run + "--score " + empty, empty},
+             {run + "--gestures /nonexistent/db.json", "/nonexistent/db.json"},
+             {"render --score /nonexistent/a.score --out " + out, "/nonexistent/a.score"},
+             {"render --score " + empty + " --out " + out, empty},
+             {"render --gestures /nonexistent/db.json --out " + out, "/nonexistent/db.json"},
+             {"render --mocap /nonexistent/clip.bvh --out " + out, "/nonexistent/clip.bvh"},
+             {"limits /nonexistent/clip.bvh", "/nonexistent/clip.bvh"},
+             {"gestures --list --db /nonexistent/db.json", "/nonexistent/db.json"},
+             {"gestures --export /nonexistent/dir/db.json", "/nonexistent/dir/db.json"},
+             {"track --mode joint --quiet --mocap /nonexistent/clip.bvh", "/nonexistent/clip.bvh"},
+         }) {
+        const Run r = ictusd(c.args);
+        INFO(c.args << "\n" << r.output);
+        CHECK(r.status == 1);
+        CHECK(r.output.find(c.names) != std::string::npos);
+    }
+}
+
+TEST_CASE("ictusd: every --help lists each option once, and its examples name files that exist",
+          "[sim][cli]")
+{
+    std::vector<std::string> helps = {"--help"};
+    for (const char *verb : kVerbs)
+        helps.push_back(std::string(verb) + " --help");
+    for (const std::string &args : helps) {
+        const Run r = ictusd(args);
+        INFO(args << "\n" << r.output);
+        REQUIRE(r.status == 0);
+        const std::vector<std::string> options = defined_options(r.output);
+        if (args != "--help")
+            CHECK(options.size() >= 3); // the parser sees the entries at all
+        std::set<std::string> seen;
+        for (const std::string &o : options) {
+            INFO("option " << o);
+            CHECK(seen.insert(o).second);
+        }
+        // A path into the repository's examples/ must be there (the CMU clip
+        // under ../shared/data is data, not part of the repository).
+        static const std::regex example(R"(examples/[A-Za-z0-9_./-]+)");
+        for (std::sregex_iterator it(r.output.begin(), r.output.end(), example), end; it != end;
+             ++it) {
+            const std::string path = std::string(ICTUS_SOURCE_DIR) + "/" + it->str();
+            INFO("example file " << path);
+            CHECK(std::filesystem::is_regular_file(path));
+        }
+    }
+    // run's and render's help between them name an example score.
+    CHECK((ictusd("run --help").output + ictusd("render --help").output).find("examples/scores/") !=
+          std::string::npos);
+}
