@@ -31,7 +31,7 @@ template <typename A, typename B> bool same_bits(const A &a, const B &b)
 }
 } // namespace
 
-TEST_CASE("Cholesky3 solves bit for bit as Eigen::LLT<Matrix3d>", "[kinematics]")
+TEST_CASE("Cholesky3 solves bit for bit as Eigen::LLT<Matrix3d>", "[base]")
 {
     std::mt19937_64 rng(7);
     std::normal_distribution<double> normal(0.0, 1.0);
@@ -64,7 +64,7 @@ TEST_CASE("Cholesky3 solves bit for bit as Eigen::LLT<Matrix3d>", "[kinematics]"
 }
 
 TEST_CASE("Cholesky3 gives Eigen's answer for matrices that are not positive definite",
-          "[kinematics]")
+          "[base]")
 {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     Eigen::Matrix3d zero = Eigen::Matrix3d::Zero(), indefinite,

@@ -12,7 +12,7 @@
 
 using namespace ictus;
 
-TEST_CASE("de Leva's male mass fractions of the whole body add up to 1", "[sim][character]")
+TEST_CASE("de Leva's male mass fractions of the whole body add up to 1", "[character]")
 {
     // Head + trunk (three parts) + 2 x (upper arm, forearm, hand, thigh, shank, foot).
     double sum = de_leva_male(DeLevaSegment::head).mass_fraction;
@@ -30,7 +30,7 @@ TEST_CASE("de Leva's male mass fractions of the whole body add up to 1", "[sim][
           Approx(0.4346).margin(1e-4));
 }
 
-TEST_CASE("the character has 19 three-DoF joints with CMU segment lengths", "[sim][character]")
+TEST_CASE("the character has 19 three-DoF joints with CMU segment lengths", "[character]")
 {
     const Skeleton skel = default_skeleton();
     CharacterOptions opt;
@@ -66,7 +66,7 @@ TEST_CASE("the character has 19 three-DoF joints with CMU segment lengths", "[si
     CHECK(m.joint_index("nonsense") == -1);
 }
 
-TEST_CASE("a missing CMU joint or a bad option is refused with its name", "[sim][character]")
+TEST_CASE("a missing CMU joint or a bad option is refused with its name", "[character]")
 {
     Skeleton skel = default_skeleton();
     skel.joints[skel.find("LeftForeArm")].name = "LeftLowerArm";
@@ -86,7 +86,7 @@ TEST_CASE("a missing CMU joint or a bad option is refused with its name", "[sim]
 }
 
 TEST_CASE("grips: German sticks lie in the palm plane, French ones in the finger-palm plane",
-          "[sim][character]")
+          "[character]")
 {
     const Skeleton skel = default_skeleton();
     for (Grip grip : {Grip::german, Grip::french}) {
@@ -120,7 +120,7 @@ TEST_CASE("grips: German sticks lie in the palm plane, French ones in the finger
 }
 
 TEST_CASE("reference motion: composed rotations, slerp in time, ping-pong past the end",
-          "[sim][character]")
+          "[character]")
 {
     const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
@@ -146,7 +146,7 @@ TEST_CASE("reference motion: composed rotations, slerp in time, ping-pong past t
 
 TEST_CASE("reference clean-up: the Butterworth kernel has the zero-phase 2nd-order Butterworth "
           "response, flat through a drummer's strokes",
-          "[sim][character][track]")
+          "[character][track]")
 {
     // The taps' transfer function H(f) = w0 + 2 sum w_k cos(2 pi f k / fs)
     // against the response it is made from, G(f) = 1 / (1 + (f / fc)^4): the
@@ -237,7 +237,7 @@ void require_physical_bodies(const CharacterModel &m)
 // A BVH with a zero OFFSET on a limb's joint built a forearm of length 0,
 // inertia 0: ODE's dMassCheck aborted the process (SIGABRT) in track, render
 // and run. Now the builder refuses it, naming the joint and its OFFSET's line.
-TEST_CASE("a limb of zero length is refused at its OFFSET, naming the joint", "[sim][character]")
+TEST_CASE("a limb of zero length is refused at its OFFSET, naming the joint", "[character]")
 {
     const struct {
         const char *joint; // whose OFFSET ends the limb
@@ -284,7 +284,7 @@ TEST_CASE("a limb of zero length is refused at its OFFSET, naming the joint", "[
 // naming that joint (the eight limbs), or every body is physical and the ODE
 // scene builds and steps.
 TEST_CASE("zeroing any one OFFSET either names the joint or builds a physical body",
-          "[sim][character]")
+          "[character]")
 {
     const Skeleton good = default_skeleton();
     int refused = 0;
@@ -316,7 +316,7 @@ TEST_CASE("zeroing any one OFFSET either names the joint or builds a physical bo
 // shortest limb (forearm, 3.6 units) is >= 0.05 m and its longest segment
 // (shank, |(2.6, -7, 0)| units) <= 1 m; every body built is physical.
 TEST_CASE("a skeleton at any scale is built exactly within the bounds of a human body",
-          "[sim][character]")
+          "[character]")
 {
     const double shortest_limb = 3.6, longest = Eigen::Vector3d(2.6, -7.0, 0).norm();
     std::mt19937 rng(4242);

@@ -31,7 +31,7 @@ Eigen::Quaterniond mirror(const Eigen::Quaterniond &q)
 } // namespace
 
 TEST_CASE("range of motion: coordinates recompose, the clamp lands inside, inside is kept",
-          "[sim][limits]")
+          "[character][limits]")
 {
     const CharacterModel model = CharacterModel::from_skeleton(default_skeleton());
     const RangeOfMotion rom(model);
@@ -62,7 +62,7 @@ TEST_CASE("range of motion: coordinates recompose, the clamp lands inside, insid
 }
 
 TEST_CASE("range of motion: the IK's narrowed ranges keep a rotation the margin inside the range",
-          "[sim][limits]")
+          "[character][limits]")
 {
     // A rotation clamped into the narrowed ranges has every coordinate at
     // least the margin inside the true range (or at its middle, for a range
@@ -98,7 +98,7 @@ TEST_CASE("range of motion: the IK's narrowed ranges keep a rotation the margin 
     CHECK_THROWS_AS(RangeOfMotion(model, -0.01), CharacterError);
 }
 
-TEST_CASE("range of motion: the left side is the mirror image of the right", "[sim][limits]")
+TEST_CASE("range of motion: the left side is the mirror image of the right", "[character][limits]")
 {
     const CharacterModel model = CharacterModel::from_skeleton(default_skeleton());
     const RangeOfMotion rom(model);
@@ -118,7 +118,7 @@ TEST_CASE("range of motion: the left side is the mirror image of the right", "[s
 }
 
 TEST_CASE("range of motion: a real drummer's arms and trunk stay inside (CMU 80_13)",
-          "[sim][limits][data]")
+          "[character][limits][data]")
 {
     const std::string path = simtest::data_file("cmu/80_13.bvh");
     if (path.empty())
@@ -151,7 +151,7 @@ TEST_CASE("range of motion: a real drummer's arms and trunk stay inside (CMU 80_
 // call a rotation inside that is not: rotations built from known coordinates
 // just inside and just outside each bound, the others anywhere in range.
 TEST_CASE("range of motion: inside and outside at the bounds, from known coordinates",
-          "[sim][limits]")
+          "[character][limits]")
 {
     const CharacterModel model = CharacterModel::from_skeleton(default_skeleton());
     const RangeOfMotion rom(model);

@@ -25,7 +25,7 @@ using clitest::ictusd;
 using clitest::Run;
 using clitest::tiny_bvh;
 
-TEST_CASE("ictusd --help and per-verb help exit 0 with examples", "[sim][cli]")
+TEST_CASE("ictusd --help and per-verb help exit 0 with examples", "[cli]")
 {
     for (const char *args : {"--help", "track --help", "limits --help"}) {
         const Run r = ictusd(args);
@@ -36,7 +36,7 @@ TEST_CASE("ictusd --help and per-verb help exit 0 with examples", "[sim][cli]")
     }
 }
 
-TEST_CASE("ictusd: unknown verbs and options are usage errors (exit 2)", "[sim][cli]")
+TEST_CASE("ictusd: unknown verbs and options are usage errors (exit 2)", "[cli]")
 {
     Run r = ictusd("");
     CHECK(r.status == 2);
@@ -58,7 +58,7 @@ TEST_CASE("ictusd: unknown verbs and options are usage errors (exit 2)", "[sim][
     CHECK(r.status == 2);
 }
 
-TEST_CASE("ictusd track: every option refuses a bad value, naming it", "[sim][cli]")
+TEST_CASE("ictusd track: every option refuses a bad value, naming it", "[cli]")
 {
     const std::string base = "track --mode joint --quiet --mocap " + tiny_bvh() + " ";
     // option, bad value, text the message must contain
@@ -115,7 +115,7 @@ TEST_CASE("ictusd track: every option refuses a bad value, naming it", "[sim][cl
     CHECK(tip.output.find("tip radius") != std::string::npos);
 }
 
-TEST_CASE("ictusd: missing and malformed files are errors naming the file (exit 1)", "[sim][cli]")
+TEST_CASE("ictusd: missing and malformed files are errors naming the file (exit 1)", "[cli]")
 {
     Run r = ictusd("track --mode joint --quiet --mocap /nonexistent/clip.bvh");
     CHECK(r.status == 1);
@@ -142,7 +142,7 @@ TEST_CASE("ictusd: missing and malformed files are errors naming the file (exit 
     CHECK(r.output.find("--out") != std::string::npos);
 }
 
-TEST_CASE("ictusd track --out writes the CSV and a summary with the required fields", "[sim][cli]")
+TEST_CASE("ictusd track --out writes the CSV and a summary with the required fields", "[cli]")
 {
     const std::string dir = simtest::temp_path("out");
     const Run r =
@@ -175,7 +175,7 @@ TEST_CASE("ictusd track --out writes the CSV and a summary with the required fie
 }
 
 TEST_CASE("ictusd track --mode cartesian writes the same outputs plus IK statistics",
-          "[sim][cli][cartesian]")
+          "[cli][cartesian]")
 {
     const std::string dir = simtest::temp_path("out_cartesian");
     const Run r = ictusd("track --mode cartesian --quiet --mocap " + tiny_bvh() + " --out " + dir +
@@ -225,7 +225,7 @@ std::string stick_csv()
 } // namespace
 
 TEST_CASE("ictusd track: a stick-only capture runs in Cartesian mode, drum fitted",
-          "[sim][cli][cartesian]")
+          "[cli][cartesian]")
 {
     const std::string csv = stick_csv();
     const std::string dir = simtest::temp_path("out_sticks");
@@ -287,7 +287,7 @@ TEST_CASE("ictusd track: a stick-only capture runs in Cartesian mode, drum fitte
     CHECK(bad.status == 2);
 }
 
-TEST_CASE("ictusd track --gains overrides one joint and refuses bad files", "[sim][cli]")
+TEST_CASE("ictusd track --gains overrides one joint and refuses bad files", "[cli]")
 {
     const std::string base = "track --mode joint --quiet --duration 0.5 --mocap " + tiny_bvh();
     const std::string good = simtest::write_temp(
@@ -323,7 +323,7 @@ TEST_CASE("ictusd track --gains overrides one joint and refuses bad files", "[si
     CHECK(r.output.find("/nonexistent/gains.json") != std::string::npos);
 }
 
-TEST_CASE("ictusd track stops cleanly on SIGINT and writes what it simulated", "[sim][cli]")
+TEST_CASE("ictusd track stops cleanly on SIGINT and writes what it simulated", "[cli]")
 {
     const std::string dir = simtest::temp_path("sigint_out");
     const std::string mocap = tiny_bvh();
@@ -361,7 +361,7 @@ TEST_CASE("ictusd track stops cleanly on SIGINT and writes what it simulated", "
     CHECK(s.at("duration_s").get<double>() < 3600.0);
 }
 
-TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[sim][cli]")
+TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[cli]")
 {
     const std::string out = simtest::temp_path("limits.json");
     const Run r = ictusd("limits " + tiny_bvh() + " --out " + out);
@@ -392,7 +392,7 @@ TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[sim][cli]")
 
 TEST_CASE("ictusd gestures is a verb of ictusd: help, export of the built-in database, usage "
           "errors",
-          "[sim][cli]")
+          "[cli]")
 {
     Run r = ictusd("--help");
     CHECK(r.output.find("gestures") != std::string::npos);
@@ -458,7 +458,7 @@ CsvRows read_csv(const std::string &path)
 // Performance of run/render): on the same drum, with the same sticks (track's
 // are rigid in the hand; render's on their fulcrum unless --sticks rigid),
 // both must log the same strikes.
-TEST_CASE("ictusd track --out writes strikes.csv, the same strikes render finds", "[sim][cli]")
+TEST_CASE("ictusd track --out writes strikes.csv, the same strikes render finds", "[cli]")
 {
     const std::string bvh = simtest::data_file("cmu/80_13.bvh");
     if (bvh.empty())

@@ -88,7 +88,7 @@ std::string tiny_with_line(const std::string &prefix, const std::string &replace
 // dMassCheck answers with SIGABRT: track, render and run died. Now every verb
 // refuses the file with exit 1 at FILE:LINE of that OFFSET, naming the joint.
 TEST_CASE("ictusd: a zero-length limb is refused at its OFFSET's line, by every verb",
-          "[sim][cli][bounds]")
+          "[cli][bounds]")
 {
     int line = 0;
     const std::string bvh =
@@ -114,7 +114,7 @@ TEST_CASE("ictusd: a zero-length limb is refused at its OFFSET's line, by every 
 // (segments that carry no body, zero End Sites, the pelvis) or is refused at
 // that joint's OFFSET line (the eight limbs). Never a crash.
 TEST_CASE("ictusd track: a zero OFFSET on any joint runs or names that joint, never aborts",
-          "[sim][cli][bounds]")
+          "[cli][bounds]")
 {
     int refused = 0;
     for (const ictus::SkeletonJoint &joint : ictus::default_skeleton().joints) {
@@ -149,7 +149,7 @@ TEST_CASE("ictusd track: a zero OFFSET on any joint runs or names that joint, ne
 // (rc 0, no word), render's default duration too. Refused now at its line,
 // with --force (track, limits) to insist.
 TEST_CASE("ictusd: a frame time out of bounds is refused at its line, and --force reads it",
-          "[sim][cli][bounds]")
+          "[cli][bounds]")
 {
     int line = 0;
     const std::string bvh =
@@ -225,7 +225,7 @@ std::string stick_csv_with(double time_unit, int far_row = -1)
 // A time column in ms made a 2 s take a 33-minute run; a 1e9 mm cell put the
 // stick (and the auto drum) 1000 km away; both ran with rc 0 and no word.
 TEST_CASE("ictusd track: a stick capture in ms, or 1e9 mm away, is refused at its row",
-          "[sim][cli][bounds][cartesian]")
+          "[cli][bounds][cartesian]")
 {
     const std::string base = "track --mode cartesian --quiet --units mm --up z --duration 0.05 ";
     const std::string ms = simtest::write_temp("sticks_ms.csv", stick_csv_with(1000.0));
@@ -255,7 +255,7 @@ TEST_CASE("ictusd track: a stick capture in ms, or 1e9 mm away, is refused at it
 
 // `limits` learned from a single frame (zero spreads, floored to the minimum
 // width) and said nothing. Now it needs kMinLimitFrames (30) frames, or --force.
-TEST_CASE("ictusd limits needs 30 frames to learn from, or --force", "[sim][cli][bounds]")
+TEST_CASE("ictusd limits needs 30 frames to learn from, or --force", "[cli][bounds]")
 {
     const std::string out = simtest::temp_path("few.json");
     // tiny_bvh: 121 frames; --skip-frames 91 leaves 30, 92 leaves 29, 120 leaves 1.
@@ -292,7 +292,7 @@ TEST_CASE("ictusd limits needs 30 frames to learn from, or --force", "[sim][cli]
     CHECK(r.output.find("fewer than 30") == std::string::npos);
 }
 
-TEST_CASE("ictusd track and limits --help document --force and the bounds", "[sim][cli][bounds]")
+TEST_CASE("ictusd track and limits --help document --force and the bounds", "[cli][bounds]")
 {
     for (const char *verb : {"track", "limits"}) {
         const Run r = ictusd(std::string(verb) + " --help");
@@ -348,7 +348,7 @@ const char *const kVerbs[] = {"track", "limits", "run", "render", "gestures"};
 } // namespace
 
 TEST_CASE("ictusd --version prints the project's version, for the program and each verb",
-          "[sim][cli]")
+          "[cli]")
 {
     const std::string expected = "ictusd " + declared_version() + "\n";
     Run r = ictusd("--version");
@@ -370,7 +370,7 @@ TEST_CASE("ictusd --version prints the project's version, for the program and ea
 
 TEST_CASE("ictusd: a score or database that cannot be read is a file error (exit 1), as the "
           "help says",
-          "[sim][cli]")
+          "[cli]")
 {
     const Run help = ictusd("--help");
     REQUIRE(help.output.find("1 error in a file or the data, 2 usage error") != std::string::npos);
@@ -402,7 +402,7 @@ TEST_CASE("ictusd: a score or database that cannot be read is a file error (exit
 }
 
 TEST_CASE("ictusd: every --help lists each option once, and its examples name files that exist",
-          "[sim][cli]")
+          "[cli]")
 {
     std::vector<std::string> helps = {"--help"};
     for (const char *verb : kVerbs)

@@ -14,7 +14,7 @@
 using namespace ictus;
 using namespace ictus::cli;
 
-TEST_CASE("midi: zones, notes and velocities at their boundaries", "[midi]")
+TEST_CASE("midi: zones, notes and velocities at their boundaries", "[cli][midi]")
 {
     CHECK(midi_zone(0.0) == 0);
     CHECK(midi_zone(0.2499) == 0);
@@ -61,7 +61,7 @@ std::string bytes(std::initializer_list<int> v)
 }
 } // namespace
 
-TEST_CASE("midi: a stroke and its bounce, byte by byte", "[midi]")
+TEST_CASE("midi: a stroke and its bounce, byte by byte", "[cli][midi]")
 {
     // 60 bpm: 3840 ticks a second. The stroke at 0.5 s = tick 1920, the bounce
     // at 0.52 s = 1996.8 -> 1997, which also ends the stroke (the same note);
@@ -83,7 +83,7 @@ TEST_CASE("midi: a stroke and its bounce, byte by byte", "[midi]")
     CHECK(standard_midi_file(s, {{0.0, 60.0}}, 9) == want);
 }
 
-TEST_CASE("midi: a tempo change lands on a tick and later notes follow it", "[midi]")
+TEST_CASE("midi: a tempo change lands on a tick and later notes follow it", "[cli][midi]")
 {
     // 60 bpm to 0.5 s (1920 ticks), then 120 bpm (7680 ticks a second): the
     // note at 1.0 s is 3840 ticks after the tempo change, and lasts 768.

@@ -198,7 +198,7 @@ void check_whole_lines(const std::string &text, size_t &rows)
 } // namespace
 
 TEST_CASE("render: two renders give identical bytes, the events add up to the strike times",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     const std::string clip = clip_or_skip();
     if (clip.empty())
@@ -267,7 +267,7 @@ TEST_CASE("render: two renders give identical bytes, the events add up to the st
 
 TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked rate, and oscsend "
           "drives it",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     const std::string clip = clip_or_skip();
     if (clip.empty())
@@ -353,7 +353,7 @@ TEST_CASE("run: every strike recorded reaches oscdump, with poses at the asked r
 // docs/osc.md: drum parameters sent while a clip plays take effect at once (not at
 // the next play): the scene's contact law and the detector's membrane follow.
 TEST_CASE("clip mode: drum radius and tension apply at once, to the scene and the detector",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     const std::string clip = clip_or_skip();
     if (clip.empty())
@@ -401,7 +401,7 @@ TEST_CASE("clip mode: drum radius and tension apply at once, to the scene and th
 // the whole clip: no runaway, no divergence, the mimed strokes still strike.
 TEST_CASE("clip mode: a tempo change at any time leaves the physics sound (no runaway, no "
           "divergence)",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     const std::string clip = clip_or_skip();
     if (clip.empty())
@@ -439,7 +439,7 @@ TEST_CASE("clip mode: a tempo change at any time leaves the physics sound (no ru
 // word. Now an empty list or item is a usage error, 'any' is said in full,
 // and 'any' beyond the loopback warns.
 TEST_CASE("run: --allow refuses an empty list (exit 2), 'any' beyond the loopback warns",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     osctest::Peer sink;
     const std::string target = "osc.udp://127.0.0.1:" + std::to_string(sink.port());
@@ -466,7 +466,7 @@ TEST_CASE("run: --allow refuses an empty list (exit 2), 'any' beyond the loopbac
 // [::1] were taken and every send failed, exit 0. Now the URL is checked
 // before the clip or score loads: a usage error naming the option.
 TEST_CASE("run: --target and --port are checked up front (exit 2, naming the option)",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     const std::pair<std::vector<std::string>, std::string> bad[] = {
         {{"--target", "osc.udp://127.0.0.1:99999"}, "--target 'osc.udp://127.0.0.1:99999': port"},
@@ -494,7 +494,7 @@ TEST_CASE("run: --target and --port are checked up front (exit 2, naming the opt
 // per second; the rest are counted, and the summary says how many.
 TEST_CASE("run: error replies to a flooding peer stay within its budget, the rest are counted "
           "in the summary",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     osctest::Peer sink, flooder("127.0.0.1"), other("127.0.0.2");
     const int port = osctest::free_udp_port();
@@ -550,7 +550,7 @@ TEST_CASE("run: error replies to a flooding peer stay within its budget, the res
 // the file keeps whole lines only.
 TEST_CASE("run: a full disk under strikes.csv stops the run, exit 1, naming the file and the "
           "error, the rows written are whole",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     const fs::path dir = scratch("run-full");
     osctest::Peer sink;
@@ -591,7 +591,7 @@ TEST_CASE("run: a full disk under strikes.csv stops the run, exit 1, naming the 
 
 // After a SIGKILL the last row of strikes.csv was cut (a buffered stream).
 // Now each row is one write(2) of the whole line, made as it is released.
-TEST_CASE("run: killed with SIGKILL mid-run, strikes.csv holds whole lines only", "[osc][verbs]")
+TEST_CASE("run: killed with SIGKILL mid-run, strikes.csv holds whole lines only", "[cli][verbs]")
 {
     const fs::path dir = scratch("run-kill");
     osctest::Peer sink;
@@ -621,7 +621,7 @@ TEST_CASE("run: killed with SIGKILL mid-run, strikes.csv holds whole lines only"
 // folder is refused (exit 1, as other file errors), and --force removes
 // render's own files there, never another.
 TEST_CASE("render: --out refuses a used folder, --force replaces render's own files only",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     const fs::path dir = scratch("render-out");
     const std::string score = four_notes(dir).string();
@@ -670,7 +670,7 @@ TEST_CASE("render: --out refuses a used folder, --force replaces render's own fi
 // A drum out of the sticks' reach played nothing, and render said only "0
 // strikes" on stdout (the count of missed notes was in render.json alone).
 TEST_CASE("render: missed notes and a score without notes are said on stderr, exit 0",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     const fs::path dir = scratch("render-missed");
     const std::string score = four_notes(dir).string();
@@ -696,7 +696,7 @@ TEST_CASE("render: missed notes and a score without notes are said on stderr, ex
 // --wav-bits 8 was refused as "got '8.000000'", --wav-rate 44100.5 was cut to
 // 44100 without a word, and --score given a folder said it was empty.
 TEST_CASE("render: a bad value is quoted as typed, a fractional rate refused, a folder is no score",
-          "[osc][verbs]")
+          "[cli][verbs]")
 {
     const fs::path dir = scratch("render-values");
     fs::create_directories(dir);
@@ -723,7 +723,7 @@ TEST_CASE("render: a bad value is quoted as typed, a fractional rate refused, a 
     fs::remove_all(dir);
 }
 
-TEST_CASE("render: a write error names the file and the system's reason, exit 1", "[osc][verbs]")
+TEST_CASE("render: a write error names the file and the system's reason, exit 1", "[cli][verbs]")
 {
     const fs::path dir = scratch("render-full");
     const std::string score = four_notes(dir).string();

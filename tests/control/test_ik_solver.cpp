@@ -62,7 +62,7 @@ static void print_histogram(const char *title, const std::vector<int> &iteration
     std::printf("\n");
 }
 
-TEST_CASE("IK converges on reachable targets from a cold start", "[ik]")
+TEST_CASE("IK converges on reachable targets from a cold start", "[control][ik]")
 {
     std::mt19937 rng(42);
     ictus::KinematicChain chain = arm::make();
@@ -104,7 +104,7 @@ static Vector3d drum_tip(double t_s)
 }
 
 TEST_CASE("warm-started IK along a smooth drumming trajectory at 1 kHz needs 1-3 iterations",
-          "[ik]")
+          "[control][ik]")
 {
     ictus::KinematicChain chain = arm::make();
     ChainIkSolverPos_dls solver(4);
@@ -128,7 +128,7 @@ TEST_CASE("warm-started IK along a smooth drumming trajectory at 1 kHz needs 1-3
     CHECK(*std::max_element(iterations.begin(), iterations.end()) <= 3);
 }
 
-TEST_CASE("IK warm-started from a lagging state on a swaying torso converges within budget", "[ik]")
+TEST_CASE("IK warm-started from a lagging state on a swaying torso converges within budget", "[control][ik]")
 {
     // In Algorithm 2 the warm start is the simulated state, which trails the IK targets by
     // the PD controllers' lag. Model that as the solution of `lag` steps ago (10 ms: ~2 cm at
@@ -164,7 +164,7 @@ TEST_CASE("IK warm-started from a lagging state on a swaying torso converges wit
     CHECK(*std::max_element(iterations.begin(), iterations.end()) <= 3);
 }
 
-TEST_CASE("IK on unreachable targets stretches the arm along the ray at full reach", "[ik]")
+TEST_CASE("IK on unreachable targets stretches the arm along the ray at full reach", "[control][ik]")
 {
     std::mt19937 rng(3);
     std::normal_distribution<double> gauss;
@@ -205,7 +205,7 @@ TEST_CASE("IK on unreachable targets stretches the arm along the ray at full rea
                     "calls (16 iterations each) to full stretch");
 }
 
-TEST_CASE("IK tracking a target that leaves and re-enters the workspace has no jumps", "[ik]")
+TEST_CASE("IK tracking a target that leaves and re-enters the workspace has no jumps", "[control][ik]")
 {
     ictus::KinematicChain chain = arm::make();
     ChainIkSolverPos_dls solver(4);
@@ -286,7 +286,7 @@ static ictus::KinematicChain straight_chain()
     return chain;
 }
 
-TEST_CASE("IK at a singularity takes finite, bounded steps", "[ik]")
+TEST_CASE("IK at a singularity takes finite, bounded steps", "[control][ik]")
 {
     ictus::KinematicChain chain = straight_chain();
     ictus::IkParams one_step;
@@ -337,7 +337,7 @@ TEST_CASE("IK at a singularity takes finite, bounded steps", "[ik]")
     }
 }
 
-TEST_CASE("IK respects joint limits", "[ik]")
+TEST_CASE("IK respects joint limits", "[control][ik]")
 {
     // Limits narrower than the poses the targets come from, so many targets need a limit.
     const arm::AngleLimit limits[4] = {{0.2}, {1.2}, {1.3}, {0.8}};
@@ -392,7 +392,7 @@ TEST_CASE("IK respects joint limits", "[ik]")
     CHECK(limited > 0);
 }
 
-TEST_CASE("stick direction as a secondary task does not cost tip accuracy", "[ik]")
+TEST_CASE("stick direction as a secondary task does not cost tip accuracy", "[control][ik]")
 {
     std::mt19937 rng(5);
     ictus::KinematicChain chain = arm::make();
@@ -450,7 +450,7 @@ TEST_CASE("stick direction as a secondary task does not cost tip accuracy", "[ik
     CHECK(with_task.back() < 0.1 * without_task[100]);
 }
 
-TEST_CASE("IK refuses bad input and leaves the warm start", "[ik]")
+TEST_CASE("IK refuses bad input and leaves the warm start", "[control][ik]")
 {
     ictus::KinematicChain chain = arm::make();
     std::mt19937 rng(9);
@@ -520,7 +520,7 @@ TEST_CASE("IK refuses bad input and leaves the warm start", "[ik]")
     CHECK(all_finite(out, 4));
 }
 
-TEST_CASE("solve() makes no heap allocation", "[ik]")
+TEST_CASE("solve() makes no heap allocation", "[control][ik]")
 {
     const arm::AngleLimit limits[4] = {{0.3}, {1.5}, {1.5}, {1.0}};
     ictus::JointLimitRef refs[4];
@@ -542,7 +542,7 @@ TEST_CASE("solve() makes no heap allocation", "[ik]")
     CHECK(g_operator_new_calls.load() == before);
 }
 
-TEST_CASE("the hand's whole rotation as a secondary task: reached with the tip kept", "[ik]")
+TEST_CASE("the hand's whole rotation as a secondary task: reached with the tip kept", "[control][ik]")
 {
     std::mt19937 rng(11);
     ictus::KinematicChain chain = arm::make();
@@ -586,7 +586,7 @@ TEST_CASE("the hand's whole rotation as a secondary task: reached with the tip k
     CHECK(with_task[180] < 0.01);
 }
 
-TEST_CASE("posture task: the null space turns toward the posture, the tip stays", "[ik]")
+TEST_CASE("posture task: the null space turns toward the posture, the tip stays", "[control][ik]")
 {
     std::mt19937 rng(7);
     ictus::KinematicChain chain = arm::make();

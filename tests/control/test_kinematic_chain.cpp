@@ -11,7 +11,7 @@ using Eigen::Vector3d;
 
 static const double kPi = std::acos(-1.0);
 
-TEST_CASE("quaternion exp and log are inverse and match axis-angle", "[kinematics]")
+TEST_CASE("quaternion exp and log are inverse and match axis-angle", "[control]")
 {
     const Quaterniond q = ictus::exp_map(Vector3d(0.0, 0.0, kPi / 2));
     // A quarter turn about z takes x to y.
@@ -30,7 +30,7 @@ TEST_CASE("quaternion exp and log are inverse and match axis-angle", "[kinematic
     CHECK(ictus::rotation_angle_between(Quaterniond::Identity(), q) == Approx(kPi / 2));
 }
 
-TEST_CASE("chain capacity and bad joints are refused", "[kinematics]")
+TEST_CASE("chain capacity and bad joints are refused", "[control]")
 {
     ictus::KinematicChain chain;
     CHECK(chain.add_joint(Vector3d(std::nan(""), 0, 0)) == -1);
@@ -41,7 +41,7 @@ TEST_CASE("chain capacity and bad joints are refused", "[kinematics]")
     CHECK(chain.joints() == ictus::KinematicChain::kMaxJoints);
 }
 
-TEST_CASE("forward kinematics of the arm matches hand computation", "[kinematics]")
+TEST_CASE("forward kinematics of the arm matches hand computation", "[control]")
 {
     ictus::KinematicChain chain = arm::make();
     CHECK(chain.reach_m() == Approx(0.15 + 0.29 + 0.27 + std::sqrt(0.08 * 0.08 + 0.4 * 0.4)));
@@ -75,7 +75,7 @@ TEST_CASE("forward kinematics of the arm matches hand computation", "[kinematics
     CHECK((chain.tip_position() - (shift + turn * tip_before)).norm() < 1e-14);
 }
 
-TEST_CASE("tip Jacobian matches central finite differences", "[kinematics]")
+TEST_CASE("tip Jacobian matches central finite differences", "[control]")
 {
     std::mt19937 rng(7);
     ictus::KinematicChain chain = arm::make();

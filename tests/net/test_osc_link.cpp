@@ -105,7 +105,7 @@ ictus::StrikeEvent sample_strike(long seq, double time_s)
 
 TEST_CASE("osc out: strike bundles reach oscdump with the fixed layout and timetag = epoch + "
           "time + lookahead",
-          "[osc][link]")
+          "[net][link]")
 {
     int port = 0;
     auto dump = start_oscdump(port);
@@ -193,7 +193,7 @@ TEST_CASE("osc out: strike bundles reach oscdump with the fixed layout and timet
 }
 
 TEST_CASE("osc out: /ictus/strike/end carries the field table's end fields, at the release",
-          "[osc][link]")
+          "[net][link]")
 {
     int port = 0;
     auto dump = start_oscdump(port);
@@ -235,7 +235,7 @@ TEST_CASE("osc out: /ictus/strike/end carries the field table's end fields, at t
     CHECK(sender.counters().strikes_sent == 0);
 }
 
-TEST_CASE("osc out: a receiver holds a strike bundle until its timetag", "[osc][link]")
+TEST_CASE("osc out: a receiver holds a strike bundle until its timetag", "[net][link]")
 {
     // liblo's server (oscdump) dispatches a bundle at its timetag: the
     // strike at simulation time 0.05 s with 0.25 s lookahead arrives at
@@ -261,7 +261,7 @@ TEST_CASE("osc out: a receiver holds a strike bundle until its timetag", "[osc][
     CHECK(arrived < 0.6);
 }
 
-TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OSC", "[osc][link]")
+TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OSC", "[net][link]")
 {
     int dump_port = 0;
     auto dump = start_oscdump(dump_port);
@@ -363,7 +363,7 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
 
 TEST_CASE("osc in: score statements, score clear and the cartesian mode pass through to the "
           "physics thread, too-long statements and wrong type tags are refused",
-          "[osc][link]")
+          "[net][link]")
 {
     // oscsend (liblo's tool) sends, a plain socket receives the replies.
     Peer replies;
@@ -473,7 +473,7 @@ TEST_CASE("osc in: score statements, score clear and the cartesian mode pass thr
 
 TEST_CASE("osc in: 10^5 random and malformed packets are counted, each answered or counted "
           "unanswered (the error-reply budget), the server keeps answering",
-          "[osc][link]")
+          "[net][link]")
 {
     ictus::LiveStatus status;
     ictus::OscServerOptions so;
@@ -588,7 +588,7 @@ TEST_CASE("osc in: 10^5 random and malformed packets are counted, each answered 
 // pings are answered still; and no reply grows with what it answers.
 TEST_CASE("osc in: error replies are limited per peer address, the rest counted, replies stay "
           "small",
-          "[osc][link]")
+          "[net][link]")
 {
     ictus::OscServerOptions so;
     so.port = 0;
@@ -673,7 +673,7 @@ TEST_CASE("osc in: error replies are limited per peer address, the rest counted,
     CHECK(k.malformed + k.unknown_address == k.errors());
 }
 
-TEST_CASE("osc in: the allow-list refuses other peers without answering them", "[osc][link]")
+TEST_CASE("osc in: the allow-list refuses other peers without answering them", "[net][link]")
 {
     ictus::OscServerOptions so;
     so.port = 0;
@@ -692,7 +692,7 @@ TEST_CASE("osc in: the allow-list refuses other peers without answering them", "
     CHECK(k.replies == 1);
 }
 
-TEST_CASE("osc in: the server listens on its bind address only", "[osc][link]")
+TEST_CASE("osc in: the server listens on its bind address only", "[net][link]")
 {
     ictus::OscServerOptions so;
     so.port = 0;

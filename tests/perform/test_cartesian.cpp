@@ -19,7 +19,7 @@
 using namespace ictus;
 
 TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than joint space",
-          "[sim][track][cartesian][data]")
+          "[perform][track][cartesian][data]")
 {
     const std::string path = simtest::data_file("cmu/80_13.bvh");
     if (path.empty())
@@ -122,7 +122,7 @@ TEST_CASE("CMU 80_13: Cartesian tracking holds the tips to 5 mm RMS, better than
 }
 
 TEST_CASE("Cartesian tracking of a synthetic swing: tips within millimetres",
-          "[sim][track][cartesian]")
+          "[perform][track][cartesian]")
 {
     const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
@@ -157,7 +157,7 @@ TEST_CASE("Cartesian tracking of a synthetic swing: tips within millimetres",
     CHECK(header.find("r_elbow_flexion_target_deg") != std::string::npos);
 }
 
-TEST_CASE("Cartesian options are validated, naming the option", "[sim][track][cartesian]")
+TEST_CASE("Cartesian options are validated, naming the option", "[perform][track][cartesian]")
 {
     TrackOptions o;
     o.cartesian.gain = 0.0;
@@ -211,7 +211,7 @@ CharacterPose held_pose(const CharacterModel &m)
 
 } // namespace
 
-TEST_CASE("stick-only: the sticks are found by name, or by the default names", "[sim][cartesian]")
+TEST_CASE("stick-only: the sticks are found by name, or by the default names", "[perform][cartesian]")
 {
     MarkerCapture c = synthetic_strokes(0.1);
     CHECK(find_stick_tracks(c, "", "") == std::array<int, 2>{0, 1});
@@ -228,7 +228,7 @@ TEST_CASE("stick-only: the sticks are found by name, or by the default names", "
 }
 
 TEST_CASE("stick-only: placement behind the sticks and the drum under the strokes",
-          "[sim][cartesian]")
+          "[perform][cartesian]")
 {
     const CharacterModel m = CharacterModel::from_skeleton(default_skeleton());
     const MarkerCapture c = synthetic_strokes();
@@ -273,7 +273,7 @@ TEST_CASE("stick-only: placement behind the sticks and the drum under the stroke
 }
 
 TEST_CASE("stick-only: the default body tracks synthetic strokes to a few millimetres",
-          "[sim][cartesian]")
+          "[perform][cartesian]")
 {
     const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);
@@ -328,7 +328,7 @@ double stroke_height(double t, double t0_s, double period_s, double v_mps, doubl
 } // namespace
 
 TEST_CASE("drum auto: the membrane at the strokes' turnarounds within 5 mm, one impact each",
-          "[sim][cartesian][drum]")
+          "[perform][cartesian][drum]")
 {
     // The bead's radius: the sticks meet the membrane 30 degrees below the
     // horizontal, their tracked end r / 2 above it (kImpactPitchFactor).
@@ -397,7 +397,7 @@ TEST_CASE("drum auto: the membrane at the strokes' turnarounds within 5 mm, one 
 
 TEST_CASE("drum auto: a capture whose tips pass through the drum at the turnarounds (a kit) "
           "gets it under the lowest tips",
-          "[sim][cartesian][drum]")
+          "[perform][cartesian][drum]")
 {
     const double r = 0.007;
     // The right stick strikes a drum at 0.7 m, at (-0.1, 0.4); the left plays a
@@ -444,7 +444,7 @@ TEST_CASE("drum auto: a capture whose tips pass through the drum at the turnarou
 }
 
 TEST_CASE("drum auto on a full-body capture: the turnaround rule, as for stick-only captures",
-          "[sim][cartesian][drum]")
+          "[perform][cartesian][drum]")
 {
     // A body that plays the strokes by bending at the lower back (the arms held
     // still, the pelvis anchored): bend phi(t) = 0.6 rad - 1.5 rad/m h(t), h(t) >= 0
@@ -494,7 +494,7 @@ TEST_CASE("drum auto on a full-body capture: the turnaround rule, as for stick-o
 }
 
 TEST_CASE("drum auto on the TrajOptDrums stroke: its turnaround at the paper's drum height",
-          "[sim][cartesian][drum][data]")
+          "[perform][cartesian][drum][data]")
 {
     const std::string xs = simtest::data_file("trajoptdrums/JointCenters_XPose_cm.csv");
     const std::string ys = simtest::data_file("trajoptdrums/JointCenters_YPose_cm.csv");
@@ -637,7 +637,7 @@ void check_stick_only_tracking(const CharacterModel &m, const ReferenceMotion &r
 } // namespace
 
 TEST_CASE("stick-only: synthetic strokes up to 8 m/s, drum found within 5 mm, free flight to 5 mm",
-          "[sim][cartesian][drum]")
+          "[perform][cartesian][drum]")
 {
     const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);

@@ -121,7 +121,7 @@ int terminate_within(pid_t pid, double seconds)
 
 TEST_CASE("run: repeats nested around no note are refused to the client, the daemon keeps "
           "playing and answering, and SIGTERM ends it",
-          "[osc][live]")
+          "[perform][live]")
 {
     // The score of the report: repeat 1000 four deep around a grip line,
     // sent ten times, then play. Before the statement budget the planner
@@ -182,7 +182,7 @@ TEST_CASE("run: repeats nested around no note are refused to the client, the dae
 
 TEST_CASE("run: without --autoplay the performer waits for /ictus/play: the clock runs, nothing "
           "plays, no strike, then play starts the score",
-          "[osc][live]")
+          "[perform][live]")
 {
     LiveDaemon d;
     // Status until the simulation clock has passed 1.5 s (the built-in
@@ -212,7 +212,7 @@ TEST_CASE("run: without --autoplay the performer waits for /ictus/play: the cloc
 
 TEST_CASE("run: refusals of the physics thread and of the planner reach the client as "
           "/ictus/error",
-          "[osc][live]")
+          "[perform][live]")
 {
     LiveDaemon d;
     std::string why;
@@ -250,7 +250,7 @@ TEST_CASE("run: refusals of the physics thread and of the planner reach the clie
     CHECK(d.pong_within(10.0));
 }
 
-TEST_CASE("run: a drum slider at 20 messages a second loses no strike", "[osc][live]")
+TEST_CASE("run: a drum slider at 20 messages a second loses no strike", "[perform][live]")
 {
     // Eight notes, one primary strike each, while /ictus/drum/radius sweeps
     // 0.15 -> 0.30 -> 0.15 m at 20 messages per second: each message is

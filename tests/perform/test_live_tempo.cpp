@@ -33,7 +33,7 @@ Command command(CommandKind kind, double value = 0.0, const char *text = "")
 TEST_CASE("perform: /ictus/tempo in score mode scales the tempo map from the first beat not "
           "yet begun: the strokes under way keep their times, every note is struck on its "
           "new beat",
-          "[osc][perform][tempo]")
+          "[perform][tempo]")
 {
     PerformanceOptions o;
     // 100 bpm: 0.6 s a beat, R on even beats, L on odd ones.
@@ -125,7 +125,7 @@ TEST_CASE("perform: /ictus/tempo in score mode scales the tempo map from the fir
 
 TEST_CASE("perform: a live tempo that would take the score's tempo map past 400 bpm is "
           "refused, naming the tempo, and the plan goes on unchanged",
-          "[osc][perform][tempo]")
+          "[perform][tempo]")
 {
     PerformanceOptions o;
     o.score.score_text = "tempo 100, repeat 4, R, L, end, tempo 300, R, L";
@@ -145,7 +145,7 @@ TEST_CASE("perform: a live tempo that would take the score's tempo map past 400 
 
 TEST_CASE("perform: /ictus/nuance in score mode sets the nuance of the statements that follow "
           "and name none, also after a score/clear",
-          "[osc][perform][nuance]")
+          "[perform][nuance]")
 {
     PerformanceOptions o;
     o.score.score_text = "R, L";

@@ -35,7 +35,7 @@ Clip load_cmu(const std::string &path)
 
 } // namespace
 
-TEST_CASE("CMU 80_13: joint-space tracking stays within the stated bounds", "[sim][track][data]")
+TEST_CASE("CMU 80_13: joint-space tracking stays within the stated bounds", "[perform][track][data]")
 {
     const std::string path = simtest::data_file("cmu/80_13.bvh");
     if (path.empty())
@@ -67,7 +67,7 @@ TEST_CASE("CMU 80_13: joint-space tracking stays within the stated bounds", "[si
 }
 
 TEST_CASE("CMU 80_13 played back and forth for ten simulated minutes never diverges",
-          "[sim][track][data][long]")
+          "[perform][track][data][long]")
 {
     const std::string path = simtest::data_file("cmu/80_13.bvh");
     if (path.empty())
@@ -89,7 +89,7 @@ TEST_CASE("CMU 80_13 played back and forth for ten simulated minutes never diver
 }
 
 TEST_CASE("track: a slow synthetic swing is followed closely, the CSV has one row per sample",
-          "[sim][track]")
+          "[perform][track]")
 {
     const Skeleton skel = default_skeleton();
     const CharacterModel m = CharacterModel::from_skeleton(skel);

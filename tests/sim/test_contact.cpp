@@ -74,7 +74,7 @@ double theory(double m, double k, double c)
 
 TEST_CASE("contact: with the implicit step's numerical damping taken out, a ball bounces off "
           "the soft contact as off the continuous spring-damper",
-          "[scene][contact]")
+          "[sim][scene][contact]")
 {
     OdeInit ode;
     const double h = 0.001;
@@ -114,7 +114,7 @@ TEST_CASE("contact: with the implicit step's numerical damping taken out, a ball
 }
 
 TEST_CASE("contact: an undamped head keeps a finite contact that does not gain energy",
-          "[scene][contact]")
+          "[sim][scene][contact]")
 {
     OdeInit ode;
     const SoftContact sc = soft_contact(0.001, 5825.0, 0.0, true);

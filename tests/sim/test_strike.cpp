@@ -86,7 +86,7 @@ std::vector<StrikeEvent> run_detector(StrikeDetector &det, int hand,
 } // namespace
 
 TEST_CASE("strike: a bead on a linear spring gives the analytic duration, impulse and peak",
-          "[osc][strike]")
+          "[sim][strike]")
 {
     const AnalyticContact a;
     const double duration_ms = M_PI / a.omega() * 1e3; // half a period of sqrt(k/m)
@@ -139,7 +139,7 @@ TEST_CASE("strike: a bead on a linear spring gives the analytic duration, impuls
 
 TEST_CASE("strike: the onset is reported in the sample that crosses the head, with the fields "
           "a sound needs, and equals the strike reported at the release",
-          "[osc][strike]")
+          "[sim][strike]")
 {
     // ictusd run sends a strike at its onset (docs/osc.md): the detector
     // hands the onset out once, in the update() whose sample first touches,
@@ -185,7 +185,7 @@ TEST_CASE("strike: the onset is reported in the sample that crosses the head, wi
     CHECK(end.duration_ms > 0.0);
 }
 
-TEST_CASE("strike: membrane coordinates in all four quadrants", "[osc][strike]")
+TEST_CASE("strike: membrane coordinates in all four quadrants", "[sim][strike]")
 {
     // x_m along world +X, y_m along world -Z (docs/osc.md).
     struct P {
@@ -214,7 +214,7 @@ TEST_CASE("strike: membrane coordinates in all four quadrants", "[osc][strike]")
     }
 }
 
-TEST_CASE("strike: no strike outside the disk, nor above the membrane", "[osc][strike]")
+TEST_CASE("strike: no strike outside the disk, nor above the membrane", "[sim][strike]")
 {
     StrikeDetector det(flat_membrane(5000.0, 0.0));
     StrikeEvent e;
@@ -234,7 +234,7 @@ TEST_CASE("strike: no strike outside the disk, nor above the membrane", "[osc][s
 }
 
 TEST_CASE("strike: bounces of a dropped bead are tagged by the apex heights between contacts",
-          "[osc][strike]")
+          "[sim][strike]")
 {
     // A bead of 30 g under gravity dropped from 10 cm on a damped spring:
     // integrated finely here (semi-implicit Euler, 10 us) with the same law;
@@ -310,7 +310,7 @@ TEST_CASE("strike: bounces of a dropped bead are tagged by the apex heights betw
     CHECK(events.back().bounce);
 }
 
-TEST_CASE("strike: a re-contact after a long low hover is a new stroke", "[osc][strike]")
+TEST_CASE("strike: a re-contact after a long low hover is a new stroke", "[sim][strike]")
 {
     StrikeDetector det(flat_membrane(5000.0, 0.0));
     // Two dips 400 ms apart, hovering 5 mm above between them: below the
@@ -330,7 +330,7 @@ TEST_CASE("strike: a re-contact after a long low hover is a new stroke", "[osc][
     CHECK(ev[1].seq == 1);
 }
 
-TEST_CASE("strike: CSV and events lines have fixed, documented formats", "[osc][strike]")
+TEST_CASE("strike: CSV and events lines have fixed, documented formats", "[sim][strike]")
 {
     StrikeEvent e;
     e.seq = 3;
@@ -390,7 +390,7 @@ std::vector<TipSample> semi_implicit(double h, double gap0, const std::vector<do
 } // namespace
 
 TEST_CASE("strike: a re-contact after a lift of less than one step has the velocity that crossed",
-          "[osc][strike]")
+          "[sim][strike]")
 {
     // A press, a release rising at 1 m/s to a gap of 0.2 mm, and at once a
     // re-contact moving down at 0.7 m/s (a stick the arm holds against the
@@ -432,7 +432,7 @@ TEST_CASE("strike: a re-contact after a lift of less than one step has the veloc
 
 TEST_CASE("strike: every onset's normal velocity is > 0, from physics steps it is the velocity "
           "that crossed, from a continuous motion within one step's change of it",
-          "[osc][strike]")
+          "[sim][strike]")
 {
     // 10^4 random steps that cross the plane, sampled as the Scene's
     // integrator moves the bead: the free sample (gap 0 to 2 mm, vertical
@@ -480,7 +480,7 @@ TEST_CASE("strike: every onset's normal velocity is > 0, from physics steps it i
 }
 
 TEST_CASE("strike: a tip first seen below the membrane plane is no strike until it lifts",
-          "[osc][strike]")
+          "[sim][strike]")
 {
     // Resting pressed into the head when watching starts (e.g. after a
     // rebuild): no approach was seen, so no onset velocity exists to report.
@@ -501,7 +501,7 @@ TEST_CASE("strike: a tip first seen below the membrane plane is no strike until 
 
 TEST_CASE("strike log: strikes reported at release come out in onset order, none lost, none held "
           "longer than an open contact",
-          "[osc][strike]")
+          "[sim][strike]")
 {
     // Two hands with random, overlapping contacts (seeded): a contact of one
     // hand ends after later ones of the other, so the detector reports out of
@@ -584,7 +584,7 @@ TEST_CASE("strike log: strikes reported at release come out in onset order, none
 }
 
 TEST_CASE("strike: a stick bouncing on its fulcrum while the hand stays down is one stroke",
-          "[osc][strike]")
+          "[sim][strike]")
 {
     // Two contacts 40 ms apart; between them the bead flies 2 cm high (over
     // the 1 cm bounce height). When the hand (the held bead) stayed below the
