@@ -347,8 +347,7 @@ const char *const kVerbs[] = {"track", "limits", "run", "render", "gestures"};
 
 } // namespace
 
-TEST_CASE("ictusd --version prints the project's version, for the program and each verb",
-          "[cli]")
+TEST_CASE("ictusd --version prints the project's version, for the program and each verb", "[cli]")
 {
     const std::string expected = "ictusd " + declared_version() + "\n";
     Run r = ictusd("--version");

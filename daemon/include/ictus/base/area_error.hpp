@@ -3,7 +3,8 @@
 
 #include <stdexcept>
 
-namespace ictus {
+namespace ictus
+{
 
 /// An error thrown by one area of the daemon, told apart from the others' by its tag: each
 /// area names its own (`using SimError = AreaError<struct SimArea>;` in

@@ -3,7 +3,8 @@
 
 #include "ictus/base/area_error.hpp"
 
-namespace ictus {
+namespace ictus
+{
 
 /// What the control area throws: a chain, gain or limit that the controllers refuse.
 using ControlError = AreaError<struct ControlArea>;

@@ -3,7 +3,8 @@
 
 #include "ictus/base/area_error.hpp"
 
-namespace ictus {
+namespace ictus
+{
 
 /// What the perform area throws: a score, clip or command that the performance refuses.
 using PerformError = AreaError<struct PerformArea>;

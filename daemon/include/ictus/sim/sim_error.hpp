@@ -3,7 +3,8 @@
 
 #include "ictus/base/area_error.hpp"
 
-namespace ictus {
+namespace ictus
+{
 
 /// What the sim area throws: a scene, drum or control input that the simulation refuses.
 using SimError = AreaError<struct SimArea>;
