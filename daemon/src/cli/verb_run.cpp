@@ -249,42 +249,36 @@ void parse_allow(const std::string &v, OscServerOptions &io)
 }
 
 // False: --help was given (the usage is printed).
+// run's own options (parse_performance_option has the shared ones).
+OptionTable run_options(RunOptions &r)
+{
+    return {
+        {"--target", store_text(r.sender.target_url)},
+        {"--port", store(r.server.port, parse_int, 0, 65535)},
+        {"--bind", store_text(r.server.bind_address)},
+        {"--allow",
+         [&r](const std::string &a, Args &args) { parse_allow(args.value(a), r.server); }},
+        {"--reply", store_text(r.server.reply_url)},
+        {"--lookahead", store(r.sender.lookahead_s, parse_number, 0.0, 10.0)},
+        {"--pose-rate", store(r.loop.pose_rate_hz, parse_number, 0.0, 1000.0)},
+        {"--tip-rate", store(r.loop.tip_rate_hz, parse_number, 0.0, 1000.0)},
+        {"--realtime", store_flag(r.loop.realtime)},
+        {"--paused", [&r](const std::string &, Args &) { r.autoplay = false; }},
+        {"--autoplay", [&r](const std::string &, Args &) { r.autoplay = true; }},
+        {"--out", store_text(r.out_dir)},
+    };
+}
+
 bool parse_run_args(Args &args, RunOptions &r)
 {
-    while (!args.done()) {
-        const std::string a = args.next();
-        auto value = [&]() { return args.value(a); };
-        if (a == "--help" || a == "-h") {
-            run_usage(std::cout);
-            return false;
-        } else if (a == "--target") {
-            r.sender.target_url = value();
-        } else if (a == "--port") {
-            r.server.port = parse_int(a, value(), 0, 65535);
-        } else if (a == "--bind") {
-            r.server.bind_address = value();
-        } else if (a == "--allow") {
-            parse_allow(value(), r.server);
-        } else if (a == "--reply") {
-            r.server.reply_url = value();
-        } else if (a == "--lookahead") {
-            r.sender.lookahead_s = parse_number(a, value(), 0, 10);
-        } else if (a == "--pose-rate") {
-            r.loop.pose_rate_hz = parse_number(a, value(), 0, 1000);
-        } else if (a == "--tip-rate") {
-            r.loop.tip_rate_hz = parse_number(a, value(), 0, 1000);
-        } else if (a == "--realtime") {
-            r.loop.realtime = true;
-        } else if (a == "--paused") {
-            r.autoplay = false;
-        } else if (a == "--autoplay") {
-            r.autoplay = true;
-        } else if (a == "--out") {
-            r.out_dir = value();
-        } else if (!parse_performance_option(a, args, r.performance, r.loop.duration_s)) {
+    const OptionTable options = run_options(r);
+    const bool go_on = walk_args(args, run_usage, [&](const std::string &a) {
+        if (!dispatch_option(options, a, args) &&
+            !parse_performance_option(a, args, r.performance, r.loop.duration_s))
             throw UsageError("unknown option '" + a + "' (see ictusd run --help)");
-        }
-    }
+    });
+    if (!go_on)
+        return false;
     const PerformanceOptions &o = r.performance;
     if (!o.mocap.empty() && !o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
