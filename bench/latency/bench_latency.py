@@ -66,7 +66,7 @@ def run_once():
             proc.communicate()
         reports.close()
     rec = fudi_records(reports.snapshot())
-    offset = wall_of_logical(rec)
+    offset = wall_of_logical(rec, sr=args.sr)
     fire = {int(a[10]): (t, a[1]) for t, a in rec if a[0] == "fire"}
     plain = {int(a[2]): a[1] for t, a in rec if a[0] == "plain"}
     sched = np.array([(offset + fire[s][1] / 1000.0 - tag) * 1e3

@@ -13,21 +13,31 @@
  * logical time runs off the scheduler (the audio device, or the system clock
  * with -nosound), so the object estimates the offset
  *     O = wall - logical
- * from samples (wall now - logical now) taken every ICTUS_TIMETAG_SAMPLE_MS and
- * on each packet. Pd never runs a logical time before its wall time, only late
- * (scheduling, polling, load), so every sample is an upper bound of O at its
- * time. The two clocks may drift apart by at most ICTUS_TIMETAG_DRIFT (ms per
- * ms: 100 ppm, more than a sound card's crystal), so a sample s taken at
- * logical time t also bounds O now:  O(now) <= s + DRIFT * (now - t). The
- * estimate is the tightest such bound over the samples of the last
- * ICTUS_TIMETAG_BUCKETS buckets of ICTUS_TIMETAG_BUCKET_MS (each bucket keeps
- * its smallest sample and when it was taken). It is never below the true O
- * (no message fires early), it follows any drift within DRIFT, and a stretch of
- * load that delays every sample for a while does not move it: a quiet sample a
- * few seconds old still bounds O within DRIFT * its age (0.1 ms per second).
- * A wall clock step forward is followed within min(step / DRIFT, window); one
- * backwards at once. A message in a bundle with timetag T then takes effect at
- * logical time T - O - latency, i.e. its delay is
+ * from samples. Pd computes in ticks of 64 samples and starts the tick that
+ * begins at logical time B no earlier than wall time B + O (never before, only
+ * late: scheduling, polling, load); every clock and message handled in that tick
+ * sees a logical time in [B, B + tick], ahead of the wall clock by up to one tick
+ * (1.33 ms at 48 kHz). So a sample is (wall now - B), B the start of the tick
+ * being computed, taken from the object's own clock in the middle of a tick
+ * (where B is unambiguous: Pd's ticks start at multiples of the tick length),
+ * about every ICTUS_TIMETAG_SAMPLE_MS: each is an upper bound of O at its time.
+ * No sample is taken before the scheduler runs (at creation during a patch's
+ * load the wall clock is not yet tied to logical time) nor between ticks (on a
+ * packet, logical time is already the next tick's start). The two clocks may
+ * drift apart by at most ICTUS_TIMETAG_DRIFT (ms per ms: 100 ppm, more than a
+ * sound card's crystal), so a sample s taken at logical time t also bounds O
+ * now:  O(now) <= s + DRIFT * (now - t). The estimate is the tightest such
+ * bound over the samples of the last ICTUS_TIMETAG_BUCKETS buckets of
+ * ICTUS_TIMETAG_BUCKET_MS (each bucket keeps its smallest sample and when it was
+ * taken). It is never below the true O (no message fires early), it follows
+ * any drift within DRIFT, and a stretch of load that delays every sample for a
+ * while does not move it: a quiet sample a few seconds old still bounds O
+ * within DRIFT * its age (0.1 ms per second). A wall clock step forward is
+ * followed within min(step / DRIFT, window); one backwards at once. Until the
+ * first sample (the first tick after creation or `reset`), the estimate is the
+ * looser bound (wall now - (logical now - one tick)). A message in a bundle
+ * with timetag T then takes effect at logical time T - O - latency, i.e. its
+ * delay is
  *     delay = T - latency - O - logical_now  (ms)
  * where `latency` (message, default 0) is the audio output latency to subtract
  * so that the sound, not the computation, lands at T. A bundle already due
@@ -53,14 +63,15 @@
 #define ICTUS_TIMETAG_EXPORT
 #endif
 
-#define ICTUS_TIMETAG_SAMPLE_MS  2.0   /* offset sampling period */
-#define ICTUS_TIMETAG_BUCKET_MS  500.0 /* one bucket of the offset history */
-#define ICTUS_TIMETAG_BUCKETS    16    /* history = 15..16 buckets = 7.5..8 s */
-#define ICTUS_TIMETAG_DRIFT      1e-4  /* largest wall/logical drift, ms per ms */
-#define ICTUS_TIMETAG_MAX_BYTES  65536 /* larger than any UDP datagram */
-#define ICTUS_TIMETAG_MAX_DEPTH  8     /* nested bundles */
-#define ICTUS_TIMETAG_MAX_POSTS  5     /* malformed packets reported in full */
-#define ICTUS_TIMETAG_MAX_EXPECT 16    /* `expect` rules */
+#define ICTUS_TIMETAG_SAMPLE_MS    2.0   /* offset sampling period (at least) */
+#define ICTUS_TIMETAG_TICK_SAMPLES 64    /* Pd's scheduler tick (DEFDACBLKSIZE) */
+#define ICTUS_TIMETAG_BUCKET_MS    500.0 /* one bucket of the offset history */
+#define ICTUS_TIMETAG_BUCKETS      16    /* history = 15..16 buckets = 7.5..8 s */
+#define ICTUS_TIMETAG_DRIFT        1e-4  /* largest wall/logical drift, ms per ms */
+#define ICTUS_TIMETAG_MAX_BYTES    65536 /* larger than any UDP datagram */
+#define ICTUS_TIMETAG_MAX_DEPTH    8     /* nested bundles */
+#define ICTUS_TIMETAG_MAX_POSTS    5     /* malformed packets reported in full */
+#define ICTUS_TIMETAG_MAX_EXPECT   16    /* `expect` rules */
 /* Seconds from the NTP epoch (1900) to the Unix epoch (1970). */
 #define ICTUS_NTP_UNIX_OFFSET 2208988800.0
 
@@ -73,7 +84,6 @@ typedef struct _ictus_timetag {
     t_outlet *x_info_out;
     t_clock *x_sample_clock;
     double x_wall_base_s;                       /* CLOCK_REALTIME seconds at creation (whole) */
-    double x_logical_base;                      /* clock_getlogicaltime() at creation */
     double x_bucket_min[ICTUS_TIMETAG_BUCKETS]; /* min offset per bucket (ms) */
     double x_bucket_at[ICTUS_TIMETAG_BUCKETS];  /* logical time of that sample (ms) */
     long x_bucket_index;                        /* index of the current bucket */
@@ -101,15 +111,28 @@ static double ictus_timetag_wall_ms(const t_ictus_timetag *x)
     return ((double)ts.tv_sec - x->x_wall_base_s) * 1000.0 + (double)ts.tv_nsec * 1e-6;
 }
 
-static double ictus_timetag_logical_ms(const t_ictus_timetag *x)
+/* Logical time in ms since Pd started (the origin of its tick grid). */
+static double ictus_timetag_logical_ms(void)
 {
-    return clock_gettimesince(x->x_logical_base);
+    return clock_gettimesince(0);
 }
 
-/* One offset sample into its bucket of the history. */
+/* Length of Pd's scheduler tick in ms, computed as Pd does (m_sched.c: the
+ * block size over the sample rate in single precision). */
+static double ictus_timetag_tick_ms(void)
+{
+    t_float sr = sys_getsr();
+    if (!(sr > 0))
+        sr = 44100;
+    return (double)((t_float)ICTUS_TIMETAG_TICK_SAMPLES / sr) * 1000.0;
+}
+
+/* One offset sample (wall now - start of the tick being computed) into its
+ * bucket of the history; called from the sample clock only, mid-tick. */
 static void ictus_timetag_sample(t_ictus_timetag *x)
 {
-    double logical = ictus_timetag_logical_ms(x);
+    double tick = ictus_timetag_tick_ms();
+    double logical = floor(ictus_timetag_logical_ms() / tick) * tick;
     double offset = ictus_timetag_wall_ms(x) - logical;
     long bucket = (long)floor(logical / ICTUS_TIMETAG_BUCKET_MS);
     int i, slot = (int)(bucket % ICTUS_TIMETAG_BUCKETS);
@@ -134,11 +157,14 @@ static void ictus_timetag_sample(t_ictus_timetag *x)
 }
 
 /* The tightest bound of O now: min over the buckets of
- * (smallest sample + DRIFT * its age). */
+ * (smallest sample + DRIFT * its age); before the first sample, the bound
+ * from the wall clock now and the earliest start of the current tick. */
 static double ictus_timetag_offset(const t_ictus_timetag *x)
 {
-    double now = ictus_timetag_logical_ms(x), m = 0;
+    double now = ictus_timetag_logical_ms(), m = 0;
     int i;
+    if (!x->x_have_offset)
+        return ictus_timetag_wall_ms(x) - (now - ictus_timetag_tick_ms());
     for (i = 0; i < ICTUS_TIMETAG_BUCKETS; i++) {
         double age = now - x->x_bucket_at[i];
         double bound = x->x_bucket_min[i] + ICTUS_TIMETAG_DRIFT * (age > 0 ? age : 0);
@@ -148,10 +174,21 @@ static double ictus_timetag_offset(const t_ictus_timetag *x)
     return m;
 }
 
+/* Sets the sample clock to the middle of the tick that ends at least
+ * `after_ms` from now (0: the next mid-tick point). */
+static void ictus_timetag_schedule(t_ictus_timetag *x, double after_ms)
+{
+    double tick = ictus_timetag_tick_ms(), now = ictus_timetag_logical_ms();
+    double at = ceil((now + after_ms) / tick) * tick - 0.5 * tick;
+    if (at <= now)
+        at += tick;
+    clock_delay(x->x_sample_clock, at - now);
+}
+
 static void ictus_timetag_tick(t_ictus_timetag *x)
 {
     ictus_timetag_sample(x);
-    clock_delay(x->x_sample_clock, ICTUS_TIMETAG_SAMPLE_MS);
+    ictus_timetag_schedule(x, ICTUS_TIMETAG_SAMPLE_MS);
 }
 
 static void ictus_timetag_malformed(t_ictus_timetag *x, const char *reason, int offset)
@@ -261,7 +298,7 @@ static t_float ictus_timetag_delay(t_ictus_timetag *x, uint32_t seconds, uint32_
         return 0; /* "immediately" */
     tag_ms = ((double)seconds - ICTUS_NTP_UNIX_OFFSET - x->x_wall_base_s) * 1000.0 +
              (double)fraction * (1000.0 / 4294967296.0);
-    delay = tag_ms - x->x_latency_ms - ictus_timetag_offset(x) - ictus_timetag_logical_ms(x);
+    delay = tag_ms - x->x_latency_ms - ictus_timetag_offset(x) - ictus_timetag_logical_ms();
     if (delay < 0) {
         t_atom info[2];
         x->x_late_count++;
@@ -352,7 +389,6 @@ static void ictus_timetag_list(t_ictus_timetag *x, t_symbol *s, int argc, t_atom
     const char *why;
     (void)s;
     x->x_packet_count++;
-    ictus_timetag_sample(x);
     if (argc < 1 || argc > ICTUS_TIMETAG_MAX_BYTES) {
         ictus_timetag_malformed(x, "packet-size", argc);
         return;
@@ -392,8 +428,8 @@ static void ictus_timetag_latency(t_ictus_timetag *x, t_floatarg ms)
 }
 
 /* status: `status offset_ms late malformed packets latency_ms` on the info outlet;
- * offset_ms is the current estimate of wall - logical time (relative to the
- * object's creation). */
+ * offset_ms is the current estimate of wall - logical time (wall time from the
+ * whole second before the object's creation, logical time from Pd's start). */
 static void ictus_timetag_status(t_ictus_timetag *x)
 {
     t_atom info[5];
@@ -434,7 +470,7 @@ static void ictus_timetag_reset(t_ictus_timetag *x)
 {
     x->x_late_count = x->x_malformed_count = x->x_packet_count = 0;
     x->x_have_offset = 0;
-    ictus_timetag_sample(x);
+    ictus_timetag_schedule(x, 0);
 }
 
 static void *ictus_timetag_new(t_floatarg latency_ms)
@@ -443,7 +479,6 @@ static void *ictus_timetag_new(t_floatarg latency_ms)
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     x->x_wall_base_s = (double)ts.tv_sec;
-    x->x_logical_base = clock_getlogicaltime();
     x->x_bytes_out = outlet_new(&x->x_obj, &s_list);
     x->x_delay_out = outlet_new(&x->x_obj, &s_float);
     x->x_info_out = outlet_new(&x->x_obj, 0);
@@ -456,9 +491,8 @@ static void *ictus_timetag_new(t_floatarg latency_ms)
     x->x_expect_count = 0;
     x->x_late_count = x->x_malformed_count = x->x_packet_count = 0;
     ictus_timetag_latency(x, latency_ms);
-    ictus_timetag_sample(x);
     x->x_sample_clock = clock_new(x, (t_method)ictus_timetag_tick);
-    clock_delay(x->x_sample_clock, ICTUS_TIMETAG_SAMPLE_MS);
+    ictus_timetag_schedule(x, 0);
     return x;
 }
 

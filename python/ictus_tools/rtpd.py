@@ -12,10 +12,12 @@ Each report is stamped with CLOCK_REALTIME on arrival by the kernel
 (SO_TIMESTAMPNS: when the datagram reached the socket, not when this Python
 thread woke up to read it, which on a loaded machine was milliseconds later
 and moved the mapping below by as much). The smallest
-(arrival - logical_ms) over the ticks maps logical time to wall time,
-independently of [ictus_timetag] (another process, another clock read, another
-path): Pd runs a logical time no earlier than its wall time, so the smallest
-observed difference is the mapping (plus the loopback's few tens of us)."""
+(arrival - start of the report's scheduler tick) over the ticks maps logical
+time to wall time, independently of [ictus_timetag] (another process, another
+clock read, another path): Pd starts a tick no earlier than its wall time, so
+the smallest observed difference is the mapping (plus the loopback's few tens
+of us)."""
+import math
 import os
 import re
 import socket
@@ -99,7 +101,7 @@ def fudi_records(items):
 
 
 def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=None,
-                control_msgs=(), listen_later=False, fudi_in_port=None):
+                control_msgs=(), listen_later=False, fudi_in_port=None, ballast=0):
     """The real-time test patch (see the module doc). control_msgs go into
     ictus-receive's inlet at 300 ms (after 'connect localhost ctl_port'). With
     listen_later, [ictus-receive] starts without a port and gets 'listen
@@ -175,6 +177,8 @@ def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=
         p.connect(nr, 0, rp, 0)
         stamped(rp, 0, "probe")
         p.connect(rp, 1, recv, 0)
+    if ballast:
+        p.obj("array define ictus-test-ballast %d" % ballast)
     end = p.obj("delay %d" % int(seconds * 1000))
     q = p.msg("\\; pd quit")
     p.connect(t, 0, end, 0)
@@ -221,7 +225,14 @@ def unexplained_late(late_strikes, reported_ms, tolerance_ms):
     return unexplained
 
 
-def wall_of_logical(records):
+def wall_of_logical(records, sr=48000):
     """Offset (s) such that wall = offset + logical_ms / 1000: the minimum of
-    arrival - logical over the tick reports."""
-    return min(t - a[1] / 1000.0 for t, a in records if a[0] == "tick")
+    arrival - B over the tick reports, B the start of the scheduler tick (64
+    samples) in which the report was made. Pd starts the tick at B no earlier
+    than its wall time; the clocks and messages inside it see logical times up
+    to one tick later than B, ahead of the wall clock (a [metro 2] report at 2 ms
+    runs 0.67 ms into a tick of 1.33 ms), so the report's own logical time would
+    bound the mapping from below, not above."""
+    tick_ms = 64.0 / sr * 1000.0
+    return min(t - math.floor(a[1] / tick_ms + 1e-6) * tick_ms / 1000.0
+               for t, a in records if a[0] == "tick")

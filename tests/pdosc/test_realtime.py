@@ -9,7 +9,10 @@ echoed by the patch) bound it: the transit is at most the shortest round trip,
 and each strike's error is known to lie in [e - rtt_min, e]. Also: strike fields come out in the documented order, a
 late bundle fires at once and is counted, pose/reply messages pass through,
 and control messages reach the daemon side as /ictus/<name> OSC. The
-receiver starts without a port and gets `listen PORT` from its inlet."""
+receiver starts without a port and gets `listen PORT` from its inlet.
+With --slow-load, the patch creates a large array after [ictus-receive] (tens of
+ms of loading before Pd's scheduler ties logical time to the wall clock): the
+mapping must not take the wall clock at creation for logical time 0."""
 import argparse
 import json
 import os
@@ -25,6 +28,7 @@ from ictus_tools.pdrun import error_lines
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
+ap.add_argument("--slow-load", action="store_true")
 args = ap.parse_args()
 build = os.path.abspath(args.build)
 
@@ -41,7 +45,7 @@ ctl.settimeout(0.1)
 pd_port, fudi_port = free_udp_port(), free_udp_port()
 patch = build_patch(build, pd_port, reports.port, SECONDS, ctl_port=ctl.getsockname()[1],
                     control_msgs=["tempo 96", "grip french", "ping"], listen_later=True,
-                    fudi_in_port=fudi_port)
+                    fudi_in_port=fudi_port, ballast=30000000 if args.slow_load else 0)
 proc, work = start_pd(patch, build)
 out = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 try:
