@@ -44,6 +44,8 @@ extern "C" {
 #define MEMBRANE_T60_MAX        60.0  /* s */
 #define MEMBRANE_HF_DAMPING_MIN 0.0   /* docs/membrane.md */
 #define MEMBRANE_HF_DAMPING_MAX 1000.0
+#define MEMBRANE_TENSION_MOD_MIN 0.0 /* 0: linear head (constant tension) */
+#define MEMBRANE_TENSION_MOD_MAX 100.0
 #define MEMBRANE_GAIN_MIN       -1.0e6 /* s/m; negative inverts */
 #define MEMBRANE_GAIN_MAX       1.0e6
 #define MEMBRANE_R_OVER_A_MIN   0.0 /* points: pickups, strikes, contacts */
@@ -61,6 +63,13 @@ extern "C" {
 #define MEMBRANE_DEFAULT_MODES      128
 #define MEMBRANE_DEFAULT_T60        1.0
 #define MEMBRANE_DEFAULT_HF_DAMPING 1.0
+/* Tension modulation (docs/membrane.md, "Tension modulation"): 1 = a Mylar head. */
+#define MEMBRANE_DEFAULT_TENSION_MOD 1.0
+/* Mylar (PET film), for the tension modulation: Young's modulus (Pa), Poisson's ratio
+ * and density (kg/m^3); the head's thickness is its areal density / MEMBRANE_MYLAR_RHO. */
+#define MEMBRANE_MYLAR_YOUNG   4.5e9
+#define MEMBRANE_MYLAR_POISSON 0.38
+#define MEMBRANE_MYLAR_RHO     1390.0
 /* A forte hit (0.05 kg stick at 5 m/s, default head, r/a = 0.3) peaks near 0.5 full
  * scale with this gain (measured by tests/core, docs/membrane.md#output-scale). */
 #define MEMBRANE_DEFAULT_GAIN 0.16
@@ -82,6 +91,11 @@ typedef enum membrane_param {
     MEMBRANE_PARAM_T60,
     MEMBRANE_PARAM_HF_DAMPING,
     MEMBRANE_PARAM_GAIN, /* output gain applied to the pickups (docs/membrane.md) */
+    /* Tension modulation, dimensionless: the stretch of a Mylar head raises its tension
+     * with the vibration energy E (J), T = T0 (1 + tensionmod kappa E), kappa from
+     * Young's modulus, thickness and T0 (docs/membrane.md); every mode's frequency
+     * follows sqrt(T / T0). 1 = Mylar, 0 = a linear head (constant tension). */
+    MEMBRANE_PARAM_TENSION_MOD,
     MEMBRANE_PARAM_COUNT
 } membrane_param;
 
@@ -142,6 +156,11 @@ double membrane_displacement_at(const membrane *m, double r_over_a, double theta
 double membrane_velocity_at(const membrane *m, double r_over_a, double theta_deg);
 /* Total vibrational energy of the modes (J). */
 double membrane_energy(const membrane *m);
+/* Tension modulation: the coefficient kappa (1/J) of T = T0 (1 + kappa E) at the
+ * current parameters (tensionmod included), and the frequency factor sqrt(T / T0)
+ * the modes ring with now (1 for a linear head). */
+double membrane_tension_kappa(const membrane *m);
+double membrane_frequency_factor(const membrane *m);
 /* Strikes dropped because the queue was full. */
 long membrane_dropped_strikes(const membrane *m);
 

@@ -52,6 +52,10 @@ void membrane_update_coefficients_(membrane *m, int rescale)
         double b = (2.0 / T) * sin(v2) / den;
         double wm = sqrt(a * a + b * b); /* model stiffness w' */
         double sm = -a;                  /* model damping s' */
+        m->wm0[k] = (float)wm;
+        m->sm0[k] = (float)sm;
+        if (!fading)
+            wm *= m->tm_g; /* tension modulation (membrane_tension_update_) */
         double D = 1.0 + 2.0 * h * sm + h * h * wm * wm;
         /* In q, p: q+ = q - c1 q + c2 p + eq u, p+ = p - c2 q - c3 p + ep u with
          * c2 = 2 h w' / D and eq = h w' ep. With r = q / (h w') (c2 h w' = c1,
@@ -98,6 +102,8 @@ enum {
     ARR_EP_K,
     ARR_PICK_K0,
     ARR_PICK_K1,
+    ARR_WM0,
+    ARR_SM0,
     ARR_COUNT
 };
 
@@ -161,6 +167,7 @@ void membrane_free_mode_arrays_(membrane *m)
     free(m->q), free(m->p), free(m->c1), free(m->cd), free(m->c3);
     free(m->ep), free(m->psi_strike);
     free(m->sc), free(m->ep_k);
+    free(m->wm0), free(m->sm0);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
         free(m->psi_pick[i]);
         free(m->psi_pick_old[i]);
@@ -196,6 +203,7 @@ static void mode_arrays_install(membrane *m, mode_arrays *a, int cap)
     m->sc = f[ARR_SC], m->ep_k = f[ARR_EP_K];
     m->pick_k[0] = f[ARR_PICK_K0];
     m->pick_k[1] = f[ARR_PICK_K1];
+    m->wm0 = f[ARR_WM0], m->sm0 = f[ARR_SM0];
     for (int i = 0; i < MEMBRANE_PICKUPS; i++)
         m->pick_fade_left[i] = 0;
     for (int i = 0; i < IMPULSE_CACHE; i++) {
@@ -292,5 +300,95 @@ int membrane_get_mode(const membrane *m, int k, double *freq_hz, double *t60_s, 
         *bessel_n = m->table.n[k];
     if (sin_partner)
         *sin_partner = m->table.sin[k];
+    return 1;
+}
+
+/* ---------------------------------------------------------------- tension modulation
+ *
+ * The averaged-tension model (docs/membrane.md, "Tension modulation"): the head's
+ * mean stretch raises its tension, T = T0 (1 + kappa E), and every mode's w' follows
+ * g = sqrt(T / T0). */
+
+double membrane_tension_kappa(const membrane *m)
+{
+    /* Biaxial strain eps = (1/4A) int |grad w|^2 dA, dT = Y H eps / (1 - nu); the
+     * strain integral is 2 V / T0 (V the potential energy), and V averages E / 2:
+     * kappa = Y H / (4 (1 - nu) pi a^2 T0^2), H = density / rho. */
+    const double H = m->density / MEMBRANE_MYLAR_RHO;
+    const double area = M_PI * m->radius * m->radius;
+    return m->tension_mod * MEMBRANE_MYLAR_YOUNG * H /
+           (4.0 * (1.0 - MEMBRANE_MYLAR_POISSON) * area * m->tension * m->tension);
+}
+
+double membrane_frequency_factor(const membrane *m)
+{
+    return m->tm_g;
+}
+
+/* Energy of the sounding modes (J) from the stored state, without the pending
+ * point forces (the caller has flushed them). */
+static double stored_energy(const membrane *m)
+{
+    const float h = (float)m->coef_h;
+    double e = 0.0;
+    for (int k = 0; k < m->modes && k < m->count; k++) {
+        float hw = h * (float)m->omega_model[k] * m->sc[k];
+        float pk = m->sc[k] * m->p[k], qk = hw * m->q[k];
+        e += 0.5 * ((double)qk * qk + (double)pk * pk);
+    }
+    return e;
+}
+
+/* The coefficients of the sounding modes at factor g, the stored state converted so
+ * that each mode's energy (q, p) is kept, and the pickups' shapes in the new sc.
+ * Float: the coefficients as membrane_update_coefficients_ makes them, with w' = g wm0. */
+static void rebuild_coefficients(membrane *m, float g)
+{
+    const float h = (float)m->coef_h;
+    const float ept = (float)(m->mass_scale / m->sample_rate); /* ep = scale T / D */
+    const int n = m->modes < m->count ? m->modes : m->count;
+    for (int k = 0; k < n; k++) {
+        if (m->omega_model[k] <= 0.0)
+            continue;
+        float wm = g * m->wm0[k], hw = h * wm, hs = h * m->sm0[k];
+        float hw2 = hw * hw, d = 1.0f + 2.0f * hs + hw2, inv = 1.0f / d;
+        float y = sqrtf(2.0f * inv);
+        float old_sc = m->sc[k], old_w = (float)m->omega_model[k];
+        m->c1[k] = 2.0f * hw2 * inv;
+        m->cd[k] = 2.0f * inv;
+        m->c3[k] = (2.0f * hw2 + 4.0f * hs) * inv;
+        m->ep[k] = ept * inv;
+        m->sc[k] = y;
+        m->ep_k[k] = 0.5f * ept * y; /* ep / sc = (scale T / D) sqrt(D / 2) */
+        /* q = h w' sc (stored r) and p = sc (stored p) are kept. */
+        m->q[k] *= (old_w * old_sc) / (wm * y);
+        m->p[k] *= old_sc / y;
+        m->omega_model[k] = wm;
+    }
+}
+
+int membrane_tension_update_(membrane *m)
+{
+    const double kappa = membrane_tension_kappa(m);
+    if (kappa <= 0.0 && m->tm_g == 1.0)
+        return 1;
+    /* Not during a stroke (a stick touching, or flying close above the head): the
+     * update keeps each mode's energy, so the displacement under the stick moves by a
+     * fraction of the change of g, which a stiff contact would turn into a force step
+     * and the contact's potential into energy from nowhere. The tension follows on
+     * the first sample after the stroke (the stick 5 mm clear, docs/membrane.md). */
+    for (int i = 0; i < m->point_count; i++)
+        if (m->points[i]->active || m->points[i]->force_pending != 0.0)
+            return 0;
+    double g = sqrt(1.0 + kappa * stored_energy(m));
+    if (!(g <= TM_G_MAX))
+        g = TM_G_MAX; /* also NaN */
+    if (fabs(g - m->tm_g) <= TM_THRESHOLD * m->tm_g && !(g == 1.0 && m->tm_g != 1.0))
+        return 1;
+    if (fabs(g - 1.0) <= TM_THRESHOLD)
+        g = 1.0;
+    m->tm_g = g;
+    rebuild_coefficients(m, (float)g);
+    membrane_refresh_couplings_(m);
     return 1;
 }

@@ -73,7 +73,7 @@ static void membrane_tilde_check_silent(t_membrane_tilde *x)
     x->x_silent = silent;
 }
 
-/* radius, tension, density, mass, modes, t60, hfdamp, gain: one number each. */
+/* radius, tension, density, mass, modes, t60, hfdamp, gain, tensionmod: one number each. */
 static void membrane_tilde_setparam(t_membrane_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
     ictus_params_message(x, &membrane_tilde_params, x->x_core, s, argc, argv);
@@ -133,7 +133,7 @@ static void membrane_tilde_print(t_membrane_tilde *x)
     const membrane *core = x->x_core;
     int k, count = membrane_get_modes(core);
     post("membrane~ %s: radius %g m, tension %g N/m, density %g kg/m^2 (mass %g kg), "
-         "%d modes, t60 %g s, hfdamp %g, gain %g, sr %g Hz",
+         "%d modes, t60 %g s, hfdamp %g, gain %g, tensionmod %g, sr %g Hz",
          x->x_name != &s_ ? x->x_name->s_name : "(no name)",
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_RADIUS),
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_TENSION),
@@ -142,6 +142,7 @@ static void membrane_tilde_print(t_membrane_tilde *x)
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_T60),
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_HF_DAMPING),
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_GAIN),
+         ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_TENSION_MOD),
          membrane_get_sample_rate(core));
     for (k = 0; k < count && k < 12; k++) {
         double f, t60;
