@@ -42,6 +42,8 @@ membrane *membrane_new(double sample_rate_hz)
     m->t60 = MEMBRANE_DEFAULT_T60;
     m->hf_damping = MEMBRANE_DEFAULT_HF_DAMPING;
     m->tension_mod = MEMBRANE_DEFAULT_TENSION_MOD;
+    m->radiation = MEMBRANE_DEFAULT_RADIATION;
+    m->loss_factor = MEMBRANE_DEFAULT_LOSS_FACTOR;
     m->tm_g = 1.0;
     m->output_gain = MEMBRANE_DEFAULT_GAIN;
     m->gain_smoothed = MEMBRANE_DEFAULT_GAIN;

@@ -6,16 +6,70 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Damping law sigma_k = s0 + s1 w_k^2 with s0 + s1 w_1^2 = ln(1000)/t60 and
- * s1 w_ref^2 = hf * s0 at w_ref = 2 pi 1 kHz. */
-static double mode_decay_rate(const membrane *m, double omega)
+/* Air radiation of mode k of a head in an infinite baffle (1/s): the Rayleigh integral
+ * of the mode shape J_m(j r/a) cos(m phi) gives the far field, whose power over the
+ * half space, divided by twice the mode's energy, is
+ *     sigma_rad = rho w^2 a^2 j^2 / (c sigma) int_0^{pi/2} J_m(x)^2 / (j^2 - x^2)^2 sin(t) dt,
+ * x = k a sin(t), k = w / c (docs/membrane.md, "Losses"). At low ka the (0, n) modes
+ * radiate as monopoles, rho T / (c sigma^2), and the m >= 1 modes (ka)^(2m) less. */
+static double radiation_integral(const membrane *m, int k, double omega)
+{
+    const int order = m->table.m[k];
+    const double j = m->table.j[k], ka = omega / MEMBRANE_AIR_C * m->radius;
+    const double dj = ictus_bessel_j(order + 1, j); /* |J_m'(j)| at a zero of J_m */
+    const int steps = 64;
+    double sum = 0.0;
+    for (int i = 0; i < steps; i++) {
+        double t = (i + 0.5) * (0.5 * M_PI / steps), x = ka * sin(t);
+        double den = j * j - x * x;
+        /* Near x = j the ratio tends to J_m'(j)^2 / (2 j)^2. */
+        double v;
+        if (fabs(den) < 1e-6 * j * j) {
+            v = dj * dj / (4.0 * j * j);
+        } else {
+            double ratio = ictus_bessel_j(order, x) / den;
+            v = ratio * ratio;
+        }
+        sum += v * sin(t);
+    }
+    return sum * (0.5 * M_PI / steps);
+}
+
+static double radiation_rate(const membrane *m, int k, double omega)
+{
+    membrane *mm = (membrane *)m; /* the cache only */
+    const double c = sqrt(m->tension / m->density), j = m->table.j[k];
+    if (c != m->rad_c) {
+        mm->rad_c = c;
+        mm->rad_valid = 0;
+    }
+    double in;
+    if (m->rad_int && k < m->capacity) {
+        for (; m->rad_valid <= k; mm->rad_valid++)
+            mm->rad_int[m->rad_valid] =
+                radiation_integral(m, m->rad_valid, m->table.j[m->rad_valid] * c / m->radius);
+        in = m->rad_int[k];
+    } else {
+        in = radiation_integral(m, k, omega);
+    }
+    return MEMBRANE_AIR_RHO * omega * omega * m->radius * m->radius * j * j /
+           (MEMBRANE_AIR_C * m->density) * in;
+}
+
+/* Decay rate of mode k (1/s): the law sigma_k = s0 + s1 w_k^2 with s0 + s1 w_1^2 =
+ * ln(1000)/t60 and s1 w_ref^2 = hf * s0 at w_ref = 2 pi 1 kHz, plus the air radiation
+ * and the internal loss eta w / 2. */
+static double mode_decay_rate(const membrane *m, int k, double omega)
 {
     double omega1 = m->table.j[0] * sqrt(m->tension / m->density) / m->radius;
     double w_ref = 2.0 * M_PI * 1000.0;
     double rate1 = log(1000.0) / m->t60;
     double s0 = rate1 / (1.0 + m->hf_damping * (omega1 / w_ref) * (omega1 / w_ref));
     double s1 = m->hf_damping * s0 / (w_ref * w_ref);
-    return s0 + s1 * omega * omega;
+    double rate = s0 + s1 * omega * omega + 0.5 * m->loss_factor * omega;
+    if (m->radiation > 0.0)
+        rate += m->radiation * radiation_rate(m, k, omega);
+    return rate;
 }
 
 /* Recomputes every coefficient from the physics. When rescale is set, the modal
@@ -42,7 +96,7 @@ void membrane_update_coefficients_(membrane *m, int rescale)
             continue;
         }
         double omega = 2.0 * M_PI * freq;
-        double sigma = fading ? log(1000.0) / FADE_S : mode_decay_rate(m, omega);
+        double sigma = fading ? log(1000.0) / FADE_S : mode_decay_rate(m, k, omega);
         /* Inverse bilinear map of the wanted discrete poles z = exp((-sigma +- i w) T):
          * s = (2/T) tanh((-sigma +- i w) T / 2) = a +- i b, so the midpoint rule's poles
          * land exactly on the target pitch and decay. */
@@ -110,7 +164,7 @@ enum {
 /* A new set of the arrays that depend on the capacity, before it replaces the old. */
 typedef struct mode_arrays {
     mode_table table;
-    double *omega_model;
+    double *omega_model, *rad_int;
     float *f[ARR_COUNT];
     float *impulse[IMPULSE_CACHE];
     float *point_psi[MEMBRANE_MAX_POINTS][3]; /* psi, psi_next, psi_k of each point */
@@ -120,6 +174,7 @@ static void mode_arrays_free(mode_arrays *a)
 {
     mode_table_free(&a->table);
     free(a->omega_model);
+    free(a->rad_int);
     for (int i = 0; i < ARR_COUNT; i++)
         free(a->f[i]);
     for (int i = 0; i < IMPULSE_CACHE; i++)
@@ -135,7 +190,8 @@ static int mode_arrays_alloc(mode_arrays *a, int cap, int points)
 {
     memset(a, 0, sizeof(*a));
     a->omega_model = calloc((size_t)cap, sizeof(double));
-    int ok = a->omega_model != NULL;
+    a->rad_int = calloc((size_t)cap, sizeof(double));
+    int ok = a->omega_model != NULL && a->rad_int != NULL;
     for (int i = 0; i < ARR_COUNT; i++) {
         a->f[i] = membrane_alloc_floats_(cap);
         ok = ok && a->f[i];
@@ -164,6 +220,9 @@ void membrane_free_mode_arrays_(membrane *m)
 {
     mode_table_free(&m->table);
     free(m->omega_model);
+    free(m->rad_int);
+    m->rad_int = NULL;
+    m->rad_valid = 0;
     free(m->q), free(m->p), free(m->c1), free(m->cd), free(m->c3);
     free(m->ep), free(m->psi_strike);
     free(m->sc), free(m->ep_k);
@@ -193,6 +252,8 @@ static void mode_arrays_install(membrane *m, mode_arrays *a, int cap)
     membrane_free_mode_arrays_(m);
     m->table = a->table;
     m->omega_model = a->omega_model;
+    m->rad_int = a->rad_int;
+    m->rad_valid = 0;
     m->q = f[ARR_Q], m->p = f[ARR_P], m->c1 = f[ARR_C1], m->cd = f[ARR_CD];
     m->c3 = f[ARR_C3], m->ep = f[ARR_EP];
     m->psi_strike = f[ARR_PSI_STRIKE];
@@ -293,7 +354,7 @@ int membrane_get_mode(const membrane *m, int k, double *freq_hz, double *t60_s, 
     if (freq_hz)
         *freq_hz = omega / (2.0 * M_PI);
     if (t60_s)
-        *t60_s = log(1000.0) / mode_decay_rate(m, omega);
+        *t60_s = log(1000.0) / mode_decay_rate(m, k, omega);
     if (bessel_m)
         *bessel_m = m->table.m[k];
     if (bessel_n)

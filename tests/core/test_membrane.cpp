@@ -29,13 +29,17 @@ struct membrane_deleter {
 };
 using membrane_ptr = std::unique_ptr<membrane, membrane_deleter>;
 
-// The linear head of the Bessel tests (the `paper` head): no tension modulation,
-// so every partial rings at j_mn c / (2 pi a) whatever the amplitude.
+// The head of the Bessel tests (the `paper` head): no tension modulation, so every
+// partial rings at j_mn c / (2 pi a) whatever the amplitude, and the t60/hfdamp law
+// alone sets the decay (no radiation, no internal loss).
 membrane *linear_membrane(double fs)
 {
     membrane *m = membrane_new(fs);
-    if (m)
+    if (m) {
         ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION_MOD, 0.0);
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_RADIATION, 0.0);
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_LOSS_FACTOR, 0.0);
+    }
     return m;
 }
 
@@ -402,7 +406,7 @@ TEST_CASE("Modes above 0.95 Nyquist are silent", "[core][membrane]")
     // At 1 kHz only (0,1) at 230 Hz and (1,1) at 367 Hz lie below 475 Hz; (2,1) at
     // 491 Hz and (0,2) at 528 Hz (alias at 472 Hz) must not sound.
     const double fs = 1000.0;
-    membrane_ptr m(membrane_new(fs));
+    membrane_ptr m(linear_membrane(fs));
     membrane_set_modes(m.get(), 10);
     ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 20.0);
     membrane_set_pickup(m.get(), 0, 0.4, 20.0);
