@@ -47,8 +47,8 @@ extern "C" {
 #define MEMBRANE_HF_DAMPING_MAX 1000.0
 #define MEMBRANE_TENSION_MOD_MIN 0.0 /* 0: linear head (constant tension) */
 #define MEMBRANE_TENSION_MOD_MAX 100.0
-#define MEMBRANE_RADIATION_MIN  0.0 /* 0: no air radiation loss */
-#define MEMBRANE_RADIATION_MAX  100.0
+#define MEMBRANE_RADIATION_MIN   0.0 /* 0: no air radiation loss */
+#define MEMBRANE_RADIATION_MAX   100.0
 #define MEMBRANE_LOSS_FACTOR_MIN 0.0 /* 0: no internal loss */
 #define MEMBRANE_LOSS_FACTOR_MAX 0.5
 #define MEMBRANE_GAIN_MIN       -1.0e6 /* s/m; negative inverts */

@@ -84,14 +84,14 @@ typedef struct membrane_point membrane_point;
 
 struct membrane {
     double sample_rate, radius, tension, density, t60, hf_damping, output_gain;
-    double tension_mod; /* dimensionless, MEMBRANE_PARAM_TENSION_MOD */
+    double tension_mod;            /* dimensionless, MEMBRANE_PARAM_TENSION_MOD */
     double radiation, loss_factor; /* MEMBRANE_PARAM_RADIATION, MEMBRANE_PARAM_LOSS_FACTOR */
     /* The radiation integral of each mode depends on ka = j c / c_air alone: kept for
      * rad_valid modes at the wave speed rad_c (recomputed when either changes). */
     double *rad_int, rad_c;
     int rad_valid;
-    double tm_g;        /* frequency factor sqrt(T / T0) in the coefficients now */
-    int tm_countdown;   /* samples until the next tension update */
+    double tm_g;          /* frequency factor sqrt(T / T0) in the coefficients now */
+    int tm_countdown;     /* samples until the next tension update */
     double gain_smoothed; /* output gain as applied, follows output_gain in ~5 ms */
     int modes;            /* requested mode count */
     /* After the count shrinks, the dropped modes ring out over FADE_S (no input,

@@ -23,8 +23,8 @@ double rate_theory(int m, double j)
     double sum = 0.0;
     for (int i = 0; i <= n; i++) {
         double t = 0.5 * M_PI * i / n, x = ka * std::sin(t), den = j * j - x * x;
-        double f = std::fabs(den) < 1e-9 ? 0.0
-                                         : std::pow(std::cyl_bessel_j(m, x) / den, 2) * std::sin(t);
+        double f =
+            std::fabs(den) < 1e-9 ? 0.0 : std::pow(std::cyl_bessel_j(m, x) / den, 2) * std::sin(t);
         sum += f * (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0));
     }
     double integral = sum * (0.5 * M_PI / n) / 3.0;
@@ -98,8 +98,10 @@ TEST_CASE("Losses: each mode's T60 from the output matches the radiation + inter
     // (1,1) and (3,1): struck on the 0 degree diameter, heard at 45 degrees, where
     // the (2,1) cos mode has its nodal line.
     const std::vector<float> side = render(0.5, 0.0, 0.5, 45.0, 3.0);
-    const row rows[] = {{0, 1, 2.4048255576957729}, {0, 2, 5.5200781102863106},
-                        {0, 3, 8.6537279129110125}, {1, 1, 3.8317059702075125},
+    const row rows[] = {{0, 1, 2.4048255576957729},
+                        {0, 2, 5.5200781102863106},
+                        {0, 3, 8.6537279129110125},
+                        {1, 1, 3.8317059702075125},
                         {3, 1, 6.3801618959239841}};
     double t01 = 0.0, t11 = 0.0;
     for (const row &r : rows) {

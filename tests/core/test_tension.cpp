@@ -59,7 +59,7 @@ double peak_hz(const std::vector<float> &x, size_t start, size_t len, double lo,
 struct glide {
     double early_hz, late_hz, cents, predicted_cents;
     double mid_cents, predicted_mid; // 200-260 ms against 400-460 ms
-    double energy_growth; // worst relative step up of the modal energy after the stroke
+    double energy_growth;            // worst relative step up of the modal energy after the stroke
     bool finite;
 };
 
@@ -100,8 +100,8 @@ glide strike(double speed, double tension_mod)
     g.early_hz = peak_hz(out, (size_t)(0.005 * kFs), win, 0.97 * f0, 1.2 * f0);
     g.late_hz = peak_hz(out, (size_t)(0.400 * kFs), win, 0.97 * f0, 1.2 * f0);
     g.cents = 1200.0 * std::log2(g.early_hz / g.late_hz);
-    g.mid_cents = 1200.0 * std::log2(peak_hz(out, (size_t)(0.2 * kFs), win, 0.97 * f0, 1.2 * f0) /
-                                     g.late_hz);
+    g.mid_cents =
+        1200.0 * std::log2(peak_hz(out, (size_t)(0.2 * kFs), win, 0.97 * f0, 1.2 * f0) / g.late_hz);
     // The law's prediction from the energy over each window, weighted as the window
     // weighs the instantaneous frequency of a slow chirp.
     auto mean_cents = [&](double t0) {
@@ -122,7 +122,8 @@ glide strike(double speed, double tension_mod)
 }
 } // namespace
 
-TEST_CASE("Tension modulation: ff glides down >= 10 cents, pp <= 2 (the (1,1) pitch)", "[core][membrane][tension]")
+TEST_CASE("Tension modulation: ff glides down >= 10 cents, pp <= 2 (the (1,1) pitch)",
+          "[core][membrane][tension]")
 {
     glide pp = strike(0.3, 1.0), ff = strike(10.0, 1.0), lin = strike(10.0, 0.0),
           lin_pp = strike(0.3, 0.0);
