@@ -77,9 +77,9 @@ typedef struct membrane_point membrane_point;
 
 /* Tension modulation: the frequency factor is recomputed from the modal energy every
  * TM_INTERVAL samples of absolute time (block-size independent), and the coefficients
- * rebuilt when it moved by more than TM_THRESHOLD (relative; 0.017 cent). */
-#define TM_INTERVAL  64
-#define TM_THRESHOLD 1.0e-5
+ * rebuilt when it moved by more than TM_THRESHOLD (relative; 0.035 cent). */
+#define TM_INTERVAL  128
+#define TM_THRESHOLD 2.0e-5
 #define TM_G_MAX     2.0 /* frequency factor cap: tension at most 4 T0 */
 
 struct membrane {
