@@ -87,6 +87,7 @@ struct membrane {
     int capacity; /* floats allocated per array */
     /* Mode table, capacity entries; entries >= modes are padding. */
     mode_table table;
+    mode_tuning tuning;  /* frequency and decay corrections (count 0: the ideal membrane) */
     double *omega_model; /* model stiffness w' per mode (0: silent) */
     /* SoA float state and coefficients (see membrane_kernel.inc): q holds the
      * scaled displacement r = q / (h w'), h = T / 2 (the energy coordinate q is

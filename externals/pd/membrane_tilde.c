@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "ictus_pd.h"
+#include "membrane_presets.h"
 #include "m_imp.h" /* obj_starttraverseoutlet: is the second outlet connected? */
 
 #if PD_FLOATSIZE != 32
@@ -77,6 +78,30 @@ static void membrane_tilde_check_silent(t_membrane_tilde *x)
 static void membrane_tilde_setparam(t_membrane_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
     ictus_params_message(x, &membrane_tilde_params, x->x_core, s, argc, argv);
+    membrane_tilde_check_silent(x);
+}
+
+/* preset NAME: a drum modelled on a measured instrument (membrane_presets.h). */
+static void membrane_tilde_preset(t_membrane_tilde *x, t_symbol *s, int argc, t_atom *argv)
+{
+    const char *sep = x->x_name != &s_ ? " " : "",
+               *name = x->x_name != &s_ ? x->x_name->s_name : "";
+    const membrane_preset *p;
+    (void)s;
+    if (argc < 1 || argv[0].a_type != A_SYMBOL) {
+        pd_error(x, "membrane~%s%s: preset: expected a name (%s)", sep, name,
+                 membrane_preset_names());
+        return;
+    }
+    p = membrane_preset_find(atom_getsymbol(&argv[0])->s_name);
+    if (!p) {
+        pd_error(x, "membrane~%s%s: preset: unknown '%s'; the presets are %s", sep, name,
+                 atom_getsymbol(&argv[0])->s_name, membrane_preset_names());
+        return;
+    }
+    if (membrane_apply_preset(x->x_core, p) == ICTUS_ENOMEM)
+        pd_error(x, "membrane~%s%s: preset %s: out of memory for %d modes; kept %d", sep, name,
+                 p->name, p->modes, membrane_get_modes(x->x_core));
     membrane_tilde_check_silent(x);
 }
 
@@ -285,6 +310,8 @@ void ictus_membrane_tilde_setup(void)
                     0);
     ictus_params_addmethods(ictus_membrane_tilde_class, &membrane_tilde_params,
                             (t_method)membrane_tilde_setparam);
+    class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_preset, gensym("preset"),
+                    A_GIMME, 0);
     class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_pickup, gensym("pickup"),
                     A_GIMME, 0);
     class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_position,
