@@ -34,6 +34,7 @@ typedef struct membrane_preset {
     int ratio_count;
     double ratio_m1[MEMBRANE_PRESET_RATIOS];
     double decay_01; /* (0, 1) decays this many times faster (1: as the damping law) */
+    int wires;       /* snare wires on the head (snare_wires.h; the Pd wrapper lays them) */
 } membrane_preset;
 
 /* The presets, in the order the docs list them; count via membrane_preset_count(). */
