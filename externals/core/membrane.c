@@ -301,7 +301,32 @@ static inline void solve_points(membrane *m, membrane_point **act, int na, membr
             K[r][c] = s * wscale;
         }
     }
-    act[0]->ops->solve(act, nact, a->point_w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i, extra);
+    /* Points of one kind (the same ops: sticks, snare wires) are solved together; the
+     * kinds see each other's forces through the modes a sample later. */
+    int done = 0;
+    for (int g = 0; g < nact; g++) {
+        if (done & (1 << g))
+            continue;
+        membrane_point *sub[MEMBRANE_MAX_POINTS];
+        double subw[MEMBRANE_MAX_POINTS], subK[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
+        int idx[MEMBRANE_MAX_POINTS], ns = 0;
+        for (int c = g; c < nact; c++)
+            if (act[c]->ops == act[g]->ops) {
+                idx[ns] = c;
+                sub[ns] = act[c];
+                subw[ns++] = a->point_w[c];
+                done |= 1 << c;
+            }
+        if (ns == nact) {
+            act[0]->ops->solve(act, nact, a->point_w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
+                               extra);
+            return;
+        }
+        for (int r = 0; r < ns; r++)
+            for (int c = 0; c < ns; c++)
+                subK[r][c] = K[idx[r]][idx[c]];
+        sub[0]->ops->solve(sub, ns, subw, (const double(*)[MEMBRANE_MAX_POINTS])subK, T, i, extra);
+    }
 }
 
 /* After a block of n: pending strikes and moves carry past it, and modes that have

@@ -102,6 +102,7 @@ struct membrane {
     int capacity; /* floats allocated per array */
     /* Mode table, capacity entries; entries >= modes are padding. */
     mode_table table;
+    mode_tuning tuning;  /* frequency and decay corrections (count 0: the ideal membrane) */
     double *omega_model; /* model stiffness w' per mode (0: silent) */
     /* w' and the damping s' of each mode at the base tension T0 (float, for the
      * tension update's vector loop); w' = tm_g wm0 for the sounding modes. */

@@ -86,7 +86,9 @@ void membrane_update_coefficients_(membrane *m, int rescale)
     for (int k = 0; k < m->capacity; k++) {
         double old_omega = m->omega_model[k];
         int fading = k >= m->modes;
-        double freq = (k < m->fading_modes) ? m->table.j[k] * c / (2.0 * M_PI * m->radius) : 0.0;
+        double freq = (k < m->fading_modes) ? mode_table_tuned_j(&m->table, k, &m->tuning) * c /
+                                                  (2.0 * M_PI * m->radius)
+                                            : 0.0;
         if (k >= m->fading_modes || freq >= 0.95 * 0.5 * m->sample_rate || freq <= 0.0) {
             /* Silent: frozen at zero, no input, no output. */
             m->c1[k] = m->cd[k] = m->c3[k] = m->ep[k] = 0.0f;
@@ -97,6 +99,8 @@ void membrane_update_coefficients_(membrane *m, int rescale)
         }
         double omega = 2.0 * M_PI * freq;
         double sigma = fading ? log(1000.0) / FADE_S : mode_decay_rate(m, k, omega);
+        if (!fading)
+            sigma *= mode_table_decay_factor(&m->table, k, &m->tuning);
         /* Inverse bilinear map of the wanted discrete poles z = exp((-sigma +- i w) T):
          * s = (2/T) tanh((-sigma +- i w) T / 2) = a +- i b, so the midpoint rule's poles
          * land exactly on the target pitch and decay. */
@@ -350,11 +354,13 @@ int membrane_get_mode(const membrane *m, int k, double *freq_hz, double *t60_s, 
 {
     if (k < 0 || k >= m->modes)
         return 0;
-    double omega = m->table.j[k] * sqrt(m->tension / m->density) / m->radius;
+    double omega =
+        mode_table_tuned_j(&m->table, k, &m->tuning) * sqrt(m->tension / m->density) / m->radius;
     if (freq_hz)
         *freq_hz = omega / (2.0 * M_PI);
     if (t60_s)
-        *t60_s = log(1000.0) / mode_decay_rate(m, k, omega);
+        *t60_s = log(1000.0) /
+                 (mode_decay_rate(m, k, omega) * mode_table_decay_factor(&m->table, k, &m->tuning));
     if (bessel_m)
         *bessel_m = m->table.m[k];
     if (bessel_n)
