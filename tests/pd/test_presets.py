@@ -4,7 +4,8 @@
   picking on the output, lie within 2.5 % of 1 : 1.50 : 1.98 : 2.44 (T. D. Rossing,
   Science of Percussion Instruments, 2000: a kettle-loaded head). The ideal membrane's
   1 : 1.340 : 1.665 : 1.980 misses (2,1) and (3,1) by far more.
-- paper after another preset renders the same samples as a fresh membrane~.
+- paper after another preset renders the same samples as a fresh membrane~ made linear
+  (tensionmod, radiation and lossfactor 0).
 - An unknown name is an error that names membrane~ and lists the presets."""
 import argparse
 import os
@@ -29,7 +30,7 @@ fresh = p.obj("membrane~ fresh")
 again = p.obj("membrane~ again")
 trig = recorder(p, [(timp, 0, "timp"), (fresh, 0, "fresh"), (again, 0, "again")], seconds, sr, wav)
 t_msg = p.msg("preset timpani \\, strike 0.75 0 0.01")
-f_msg = p.msg("strike 0.3 20 0.01")
+f_msg = p.msg("tensionmod 0 \\, radiation 0 \\, lossfactor 0 \\, strike 0.3 20 0.01")
 a_msg = p.msg("preset timpani \\, preset paper \\, strike 0.3 20 0.01 \\, preset bongo")
 for msg, obj in ((t_msg, timp), (f_msg, fresh), (a_msg, again)):
     p.connect(trig, 1, msg, 0)
@@ -44,9 +45,9 @@ check(len(errors) == 1 and "membrane~ again: preset: unknown 'bongo'" in errors[
 x, wsr = read_wav_float(wav)
 check(wsr == sr and x.shape[0] == int(seconds * sr), "recorded %d samples" % x.shape[0])
 
-# paper is today's default head: the same samples as a fresh membrane~.
+# paper is the linear head: the same samples as a fresh membrane~ made linear.
 check(np.max(np.abs(x[:, 1])) > 0 and np.array_equal(x[:, 1], x[:, 2]),
-      "preset paper renders the fresh membrane~'s samples exactly (max |diff| %g)"
+      "preset paper renders the linear fresh membrane~'s samples exactly (max |diff| %g)"
       % np.max(np.abs(x[:, 1] - x[:, 2])))
 
 # timpani: peak picking. Hann window, zero-padded FFT, parabolic interpolation.
