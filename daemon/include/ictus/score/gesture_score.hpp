@@ -103,9 +103,10 @@ struct PlanOptions {
     // A hand with no stroke for longer than this goes back to its rest tip.
     double idle_return_s = 4.0;
     double return_time_s = 0.6; // the move between the rest tip and a stroke
-    // Two strokes of one hand closer than this are refused (no hand plays
-    // single strokes that fast; use the other hand).
-    double min_stroke_interval_s = 0.1;
+    // Two strokes of one hand closer than this are refused: the shortest
+    // interval the simulated body plays as two strokes (docs/score.md,
+    // "Rebound strokes", measured).
+    double min_stroke_interval_s = 0.04;
     double max_duration_s = 900.0; // longer performances are refused
 };
 
