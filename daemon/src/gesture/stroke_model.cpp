@@ -35,6 +35,9 @@ constexpr double kMaxPress_s = 0.3;         // buzz: the longest press
 constexpr double kReboundPeriod_s = 0.1;    // shorter periods: rebound strokes
 constexpr double kReboundGainFrom_s = 0.2;
 constexpr double kReboundGainExponent = 0.4;
+// The lowest stroke: above the 1 cm a stick must rise between two strokes
+// for the second to be a stroke, not a bounce (docs/osc.md).
+constexpr double kMinHeight_m = 0.015;
 
 struct NuanceShape {
     double height_scale;  // preparation height relative to legato
@@ -68,6 +71,10 @@ const NuanceShape kShapes[kNuances] = {
     // of the lift time (a loose grip then bounces the stick there), lifted low
     {0.75, 0.35, 3.0, 2.0, 1.0, 0.60, 0.00, 0.0, 0.02, 0.6},
 };
+
+// Impact speed per nuance relative to legato at the same dynamics (enum
+// order): within 0.85..1.3, narrower than one dynamics level.
+const double kSpeedScale[kNuances] = {1.0, 0.85, 1.2, 1.3, 1.1, 0.9};
 
 struct GripShape {
     double pivot_to_tip_m;   // wrist to stick tip
@@ -152,11 +159,21 @@ GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double prep_
     const int lift_samples =
         std::max(2, static_cast<int>(std::lround(period * rate)) - downswing_samples(period));
     const double D = strike_index / rate, L = lift_samples / rate;
-    const double H = kLegatoHeightFff_m * s.height_scale * dynamics_height_factor(d) *
-                     std::min(1.0, prep_period / kNominalPeriod_s) * rebound_gain(prep_period);
-    const double H_lift = s.lift_ratio * kLegatoHeightFff_m * s.height_scale *
-                          dynamics_height_factor(d) * std::min(1.0, period / kNominalPeriod_s) *
-                          rebound_gain(period);
+    // Dynamics set the impact speed (p H / D), the nuance only within a
+    // narrow band (kSpeedScale): its own height scale is kept in shape but
+    // brought to that speed.
+    const NuanceShape &leg = kShapes[0];
+    const double speed_norm = kSpeedScale[static_cast<int>(n)] *
+                              (leg.exponent / leg.prep_fraction) /
+                              (s.height_scale * s.exponent / s.prep_fraction);
+    const double H =
+        std::max(kMinHeight_m,
+                 kLegatoHeightFff_m * s.height_scale * speed_norm * dynamics_height_factor(d) *
+                     std::min(1.0, prep_period / kNominalPeriod_s) * rebound_gain(prep_period));
+    const double H_lift =
+        std::max(kMinHeight_m, s.lift_ratio * kLegatoHeightFff_m * s.height_scale * speed_norm *
+                                   dynamics_height_factor(d) *
+                                   std::min(1.0, period / kNominalPeriod_s) * rebound_gain(period));
 
     // Stick at the strike (right hand): forward, yawed inward (-x), pitched down.
     const Eigen::Vector3d dir0(-std::sin(gs.inward_yaw_rad) * std::cos(gs.strike_pitch_rad),

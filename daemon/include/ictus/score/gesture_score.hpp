@@ -89,6 +89,10 @@ struct PlanOptions {
     // (deeper, they press on it).
     double strike_aim_s = 0.0;
     double strike_aim_from_mps = 0.0;
+    // The stick meets the head this far (m) before the plan's tip reaches its
+    // target: each unit is placed later by this over its planned downward
+    // impact speed, so that soft strokes touch on the beat too.
+    double contact_lead_m = 0.0;
     // Co-articulation: the blend between two units of one hand spans the
     // middle of the gap between their strikes, leaving this fraction of the
     // gap at each end to the units alone (0 < f < 0.5).
