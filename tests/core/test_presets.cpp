@@ -47,12 +47,16 @@ TEST_CASE("Every preset is found by its name, and the names line lists them all"
     CHECK(membrane_preset_at(-1) == nullptr);
 }
 
-TEST_CASE("paper is the default head exactly, after any other preset", "[core][presets]")
+TEST_CASE("paper is the default head made linear, exactly, after any other preset",
+          "[core][presets]")
 {
     membrane *fresh = membrane_new(48000.0);
     membrane *m = membrane_new(48000.0);
     REQUIRE(fresh);
     REQUIRE(m);
+    // the paper's head: no tension modulation, radiation or internal loss
+    for (int id : {MEMBRANE_PARAM_TENSION_MOD, MEMBRANE_PARAM_RADIATION, MEMBRANE_PARAM_LOSS_FACTOR})
+        REQUIRE(ictus_param_set(&membrane_params, fresh, id, 0.0) == ICTUS_OK);
     REQUIRE(membrane_apply_preset(m, membrane_preset_find("timpani")) == ICTUS_OK);
     REQUIRE(membrane_apply_preset(m, membrane_preset_find("paper")) == ICTUS_OK);
     for (int id = 0; id < MEMBRANE_PARAM_COUNT; id++)
