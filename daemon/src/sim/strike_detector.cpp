@@ -206,6 +206,7 @@ void StrikeDetector::begin_contact(Hand &h, int hand, const TipSample &s, double
                (h.max_gap_since_release < options_.bounce_height_m ||
                 h.max_held_gap_since_release < options_.bounce_height_m || !driven);
     e.stick_mass_kg = s.effective_mass_kg;
+    e.zone = s.on_rim ? kZoneRim : kZoneHead;
     if (!e.bounce)
         ++h.stroke;
     e.stroke = std::max(h.stroke, 0L);
@@ -230,6 +231,8 @@ void StrikeDetector::continue_contact(Hand &h, const TipSample &s, double gap, d
 {
     const double f = normal_force_n(-gap, depth_rate);
     const double dt = s.time_s - h.last_time_s;
+    if (s.on_rim)
+        h.event.zone = kZoneRim;
     h.event.impulse_n_s += 0.5 * (h.last_force_n + f) * dt;
     // Kinetic friction on the membrane along the tip's sliding direction.
     const Eigen::Vector3d vt = s.velocity_mps - s.velocity_mps.dot(kNormal) * kNormal;
@@ -262,6 +265,8 @@ void StrikeDetector::end_contact(Hand &h, const TipSample &s, double gap, double
         frac = -g0 / (gap - g0);
     const double t_rel = h.previous.time_s + frac * (s.time_s - h.previous.time_s);
     const double f_rel = normal_force_n(0.0, depth_rate);
+    if (s.on_rim) // the step that ends the episode: its contacts were during it
+        h.event.zone = kZoneRim;
     const double dt = t_rel - h.last_time_s;
     h.event.impulse_n_s += 0.5 * (h.last_force_n + f_rel) * dt;
     if (!h.peak_has_after && h.peak_t[1] == h.last_time_s) {
@@ -342,6 +347,26 @@ MembraneGeometry membrane_of(const Scene &scene, int drum_id)
     return m;
 }
 
+bool stick_on_hoop(const Scene &scene, int hand, const MembraneGeometry &membrane)
+{
+    const Side side = static_cast<Side>(hand & 1);
+    if (scene.drum_contact(side).rim_points > 0)
+        return true;
+    const StickParams &stick = scene.model().options().stick;
+    const Eigen::Vector3d bead = scene.bead_position(side) - membrane.center_m;
+    const Eigen::Vector3d back = -scene.stick_axis(side); // from the bead toward the butt
+    // Horizontal: where |b + s d| = R along the shaft, s > 0 (metres along the stick).
+    const Eigen::Vector2d b(bead.x(), bead.z()), d(back.x(), back.z());
+    const double dd = d.squaredNorm(), bd = b.dot(d), c = b.squaredNorm() - membrane.radius_m * membrane.radius_m;
+    if (!(dd > 1e-12) || c > 0.0)
+        return false; // a vertical stick, or the bead outside the rim
+    const double s = (-bd + std::sqrt(bd * bd - dd * c)) / dd;
+    if (!(s <= stick.length_m))
+        return false; // the stick ends inside the rim
+    const double underside = bead.y() + s * back.y() - stick.shaft_radius_m;
+    return underside < kHoopHeight_m;
+}
+
 int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out[2],
                    double time_offset_s)
 {
@@ -353,6 +378,7 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
         s.center_m = scene.bead_position(side);
         s.velocity_mps = scene.bead_velocity(side);
         s.held_center_m = scene.held_bead_position(side);
+        s.on_rim = stick_on_hoop(scene, hand, detector.membrane());
         // Only near the head, where a contact may begin (a 7 x 7 solve).
         if (detector.gap_m(s.center_m) < 0.02)
             s.effective_mass_kg = scene.effective_mass_kg(side, Eigen::Vector3d::UnitY());

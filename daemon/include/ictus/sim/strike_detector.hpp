@@ -80,6 +80,10 @@ struct TipSample {
     // The stick's effective mass at the bead along the normal (kg; 0: not
     // known), copied into a strike that begins at this sample.
     double effective_mass_kg = 0.0;
+    // The stick is on the drum's rim at this sample (stick_on_hoop): a
+    // contact episode with such a sample is a strike on the rim
+    // (StrikeEvent::zone).
+    bool on_rim = false;
 };
 
 class StrikeDetector
@@ -184,5 +188,15 @@ MembraneGeometry membrane_of(const Scene &scene, int drum_id = 0);
 // the scene's clock (a run that rebuilt its scene keeps one clock).
 int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out[2],
                    double time_offset_s = 0.0);
+
+// The hoop of a real drum: a ring at the head's radius standing this far above
+// the head (a 14 in triple-flanged snare hoop: about 1 cm, an estimate). The
+// Scene's drum is a plain cylinder; the detector puts the hoop back.
+constexpr double kHoopHeight_m = 0.010;
+// Whether the stick of `hand` (0 left, 1 right) of `scene` is on the rim: it touches the cylinder's top
+// edge (StickDrumContact::rim_points), or its shaft, followed from the bead
+// back toward the butt, passes over the head's edge with its underside lower
+// than kHoopHeight_m above the head (it would meet the hoop).
+bool stick_on_hoop(const Scene &scene, int hand, const MembraneGeometry &membrane);
 
 } // namespace ictus

@@ -33,7 +33,12 @@ struct StrikeEvent {
     // onset (the stick on its fulcrum, the grip and the hand: Scene::
     // effective_mass_kg), kg: what a sound model's stick (contact~) weighs.
     double stick_mass_kg = 0.0;
+    // Where the stick landed: 0 the head, 1 the rim (the stick touched the
+    // drum's top edge during the contact, Scene's StickDrumContact::
+    // rim_points; docs/osc.md). Known at the release.
+    int zone = 0;
 };
+constexpr int kZoneHead = 0, kZoneRim = 1;
 
 // The fields of a StrikeEvent, in strikes.csv's column order (and the OSC message's).
 enum class StrikeField {
@@ -56,8 +61,9 @@ enum class StrikeField {
     force_dir_y,
     force_dir_z,
     stick_mass_kg,
+    zone,
 };
-constexpr int kStrikeFieldCount = static_cast<int>(StrikeField::stick_mass_kg) + 1;
+constexpr int kStrikeFieldCount = static_cast<int>(StrikeField::zone) + 1;
 
 struct StrikeFieldInfo {
     const char *name; // column name, with its unit
@@ -74,7 +80,7 @@ long strike_field_integer(const StrikeEvent &event, StrikeField field);
 // The layouts: strikes.csv has every field in StrikeField's order; the
 // /ictus/strike OSC message those with in_osc and /ictus/strike/end those with
 // in_osc_end, in the same order; the events file's `hit` line these, after "hit":
-extern const StrikeField kEventsStrikeFields[12];
+extern const StrikeField kEventsStrikeFields[13];
 
 // strikes.csv: a header line and one line per event, fixed precision (so that
 // equal runs give equal bytes).
