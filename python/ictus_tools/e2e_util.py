@@ -255,3 +255,23 @@ def judge_departures(departures, strikes, sr):
         elif e != 0:
             notes.append((k, what + ": %+.4f ms" % e))
     return errors, failures, notes
+
+
+def pd_spawning_env(work):
+    """The environment for a program that runs pd itself (ictusd render --wav,
+    scripts/main.sh): pd found on PATH; under the ASan build (ICTUS_PD_PRELOAD)
+    a wrapper named pd first in PATH preloads the runtime into pd and nothing
+    else."""
+    env = dict(os.environ)
+    env.pop("LD_PRELOAD", None)
+    if os.environ.get("ICTUS_PD_PRELOAD"):
+        bindir = os.path.join(work, "bin")
+        os.makedirs(bindir, exist_ok=True)
+        with open(os.path.join(bindir, "pd"), "w") as f:
+            f.write("#!/bin/sh\nLD_PRELOAD=%s exec %s \"$@\"\n" % (os.environ["ICTUS_PD_PRELOAD"],
+                                                                  PD))
+        os.chmod(os.path.join(bindir, "pd"), 0o755)
+        env["PATH"] = bindir + os.pathsep + env["PATH"]
+    elif os.path.dirname(PD):
+        env["PATH"] = os.path.dirname(PD) + os.pathsep + env["PATH"]
+    return env
