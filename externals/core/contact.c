@@ -63,6 +63,7 @@ contact *contact_new(void)
     c->alpha = CONTACT_DEFAULT_ALPHA;
     c->damping = CONTACT_DEFAULT_DAMPING;
     c->point.ops = &contact_point_ops;
+    c->point.static_correction = 1;
     c->point.r_over_a = 0.3;
     return c;
 }
@@ -149,6 +150,14 @@ double contact_stick_position(const contact *c)
 double contact_stick_velocity(const contact *c)
 {
     return c->stick_v;
+}
+double contact_compression(const contact *c)
+{
+    return c->compression;
+}
+double contact_residual_compliance(const contact *c)
+{
+    return c->point.owner ? c->point.residual_compliance : 0.0;
 }
 double contact_last_force(const contact *c)
 {

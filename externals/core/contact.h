@@ -106,6 +106,12 @@ int contact_take_report(contact *c, contact_report *report);
 double contact_stick_position(const contact *c);
 double contact_stick_velocity(const contact *c);
 double contact_last_force(const contact *c);
+/* The compression of the contact law (m): the stick's position less the head's over the
+ * patch (modes and the static compliance of the modes left out, membrane.h). */
+double contact_compression(const contact *c);
+/* The static compliance of the modes left out at the stick's point (m/N; 0 on a
+ * point-like or detached head): it stores residual_compliance F^2 / 2. */
+double contact_residual_compliance(const contact *c);
 
 /* Stick on a rigid, immovable target: the same contact law and discretisation
  * with no membrane. Simulates one stroke at sample_rate_hz and fills *report.
