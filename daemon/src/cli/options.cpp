@@ -272,6 +272,13 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.drum_given |= kGivenDensity;
     } else if (a == "--drum-preset") {
         apply_drum_preset(a, value(), o);
+    } else if (a == "--kit") {
+        const std::string v = value();
+        try {
+            o.kit = kit_named(v);
+        } catch (const PerformError &e) {
+            throw UsageError("--kit: " + std::string(e.what()));
+        }
     } else if (a == "--sticks") {
         const std::string v = value();
         if (v == "fulcrum")

@@ -118,6 +118,10 @@ void render_usage(std::ostream &out)
            "                      defaults), snare, tom, floor-tom, timpani, frame; sets\n"
            "                      radius, tension, density (unless given) and, in Pd, the\n"
            "                      head's T60, modes, pickups and tuning (docs/sound.md)\n"
+           "  --kit NAME          several drums (score mode): standard (snare, tom1, tom2,\n"
+           "                      floor), standard-timpani (and timpani), timpani (timpani1,\n"
+           "                      timpani2); the first where the drum goes, the score's\n"
+           "                      'drum NAME' and 'on NAME' choose (docs/perform.md)\n"
            "  --bounce-height M   bounce rule height (default 0.01)\n"
            "  --bounce-window S   bounce rule window (default 0.15)\n"
            "\n"
@@ -287,6 +291,28 @@ nlohmann::json drum_json(const Performance &p)
     j["contact_stiffness_n_per_m"] = p.detector().membrane().stiffness_n_per_m;
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
     return j;
+}
+
+// A kit's drums as placed, and the stick parts that met a shell from the
+// side (Scene::shell_passes: none when every stroke reached its head from above).
+nlohmann::json kit_json(const Performance &p)
+{
+    const Scene &scene = p.scene();
+    const Kit &kit = p.options().kit;
+    nlohmann::json drums = nlohmann::json::array();
+    for (int i = 0; i < scene.drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
+        const DrumParams &d = scene.drum(i);
+        const KitDrum &k = kit.drums[static_cast<size_t>(i)];
+        drums.push_back({{"name", k.name},
+                         {"preset", k.preset},
+                         {"center_m", {d.center_m.x(), d.center_m.y(), d.center_m.z()}},
+                         {"radius_m", d.radius_m},
+                         {"tension_n_per_m", d.tension_n_per_m},
+                         {"shell_depth_m", d.shell_depth_m},
+                         {"midi_note", k.midi_note},
+                         {"shell_passes", scene.shell_passes(i)}});
+    }
+    return {{"name", kit.name}, {"drums", drums}, {"shell_passes", scene.shell_passes()}};
 }
 
 // render.json's "performance": how the strikes met the notes (docs/perform.md).
@@ -576,6 +602,8 @@ nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool
     if (!score_mode)
         j["tempo_bpm"] = r.o.tempo_bpm;
     j["drum"] = drum_json(perf);
+    if (!perf.options().kit.empty())
+        j["kit"] = kit_json(perf);
     j["midi"] = {{"file", "performance.mid"},
                  {"channel", static_cast<int>(r.midi_channel)},
                  {"notes", strikes},
