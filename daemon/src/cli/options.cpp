@@ -279,6 +279,8 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         } catch (const PerformError &e) {
             throw UsageError("--kit: " + std::string(e.what()));
         }
+        // The first drum's head and sound are its preset's (as --drum-preset).
+        apply_drum_preset(a, o.kit.drums.front().preset, o);
     } else if (a == "--sticks") {
         const std::string v = value();
         if (v == "fulcrum")
