@@ -53,9 +53,11 @@ PerformerFrame kit_frame()
 
 } // namespace
 
-TEST_CASE("score: 'drum NAME' sets the drum of the notes after it, 'on NAME' one note's", "[score][kit]")
+TEST_CASE("score: 'drum NAME' sets the drum of the notes after it, 'on NAME' one note's",
+          "[score][kit]")
 {
-    const Score s = parse_score("R\ndrum Tom1\nL, R on floor\nrepeat 2\nL\nend\ndrum snare\nR", "t");
+    const Score s =
+        parse_score("R\ndrum Tom1\nL, R on floor\nrepeat 2\nL\nend\ndrum snare\nR", "t");
     REQUIRE(s.notes.size() == 6);
     CHECK(s.notes[0].drum.empty());
     CHECK(s.notes[1].drum == "tom1"); // case-insensitive, kept lower case
@@ -131,13 +133,15 @@ TEST_CASE("plan: moves between drums never pass through a shell", "[score][kit]"
     const char *names[] = {"snare", "tom1", "tom2", "floor", "timpani"};
     for (const char *dyn : {"pp", "ff"}) {
         for (double bpm : {60.0, 120.0}) {
-            std::string text = "tempo " + std::to_string(bpm) + "\nbeats 1/2\ndynamics " + dyn + "\n";
+            std::string text =
+                "tempo " + std::to_string(bpm) + "\nbeats 1/2\ndynamics " + dyn + "\n";
             // Every ordered pair of drums, the right hand then the left.
             for (const char *a : names)
                 for (const char *b : names)
                     if (std::string(a) != b)
                         text += std::string("R on ") + a + "\nrest 1/2\nR on " + b + "\nrest 1/2\n";
-            text += "L on timpani at 0.6 180\nrest\nL on tom1\nrest\nL on floor at 0.3 0\nrest\nL\n";
+            text +=
+                "L on timpani at 0.6 180\nrest\nL on tom1\nrest\nL on floor at 0.3 0\nrest\nL\n";
             INFO(dyn << " at " << bpm << " bpm");
             const GesturePlan plan = plan_performance(parse_score(text, "t"), db(), f);
             double worst = 0.0;

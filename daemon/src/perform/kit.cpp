@@ -86,7 +86,8 @@ double kit_min_gap_m(const Kit &kit)
     for (size_t i = 0; i < kit.drums.size(); ++i)
         for (size_t j = i + 1; j < kit.drums.size(); ++j) {
             const KitDrum &a = kit.drums[i], &b = kit.drums[j];
-            const double d = std::hypot(a.place_m.x() - b.place_m.x(), a.place_m.z() - b.place_m.z());
+            const double d =
+                std::hypot(a.place_m.x() - b.place_m.x(), a.place_m.z() - b.place_m.z());
             gap = std::min(gap, d - a.radius_m - b.radius_m);
         }
     return gap;
@@ -111,8 +112,8 @@ void validate_kit(const Kit &kit)
         const std::string who = what + "drum '" + d.name + "': ";
         bool name_ok = !d.name.empty() && d.name.size() <= 32;
         for (char c : d.name)
-            name_ok = name_ok && ((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
-                                  c == '-');
+            name_ok = name_ok &&
+                      ((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-');
         if (!name_ok)
             throw PerformError(what + "drum name '" + d.name +
                                "': expected lower-case letters, digits, '_' and '-' (1..32)");
@@ -149,8 +150,8 @@ std::vector<DrumParams> place_kit(const Kit &kit, const DrumParams &base,
     std::vector<DrumParams> out;
     for (const KitDrum &d : kit.drums) {
         DrumParams p = base;
-        p.center_m = first_center_m + d.place_m.x() * right + d.place_m.y() * up +
-                     d.place_m.z() * forward;
+        p.center_m =
+            first_center_m + d.place_m.x() * right + d.place_m.y() * up + d.place_m.z() * forward;
         p.radius_m = d.radius_m;
         p.tension_n_per_m = d.tension_n_per_m;
         p.shell_depth_m = d.shell_depth_m;

@@ -243,6 +243,20 @@ void check_unit(const Eigen::Vector3d &v, const char *name)
                                     " must be a unit vector");
 }
 
+// A kit's drums in the frame and the planner's margins for it.
+void validate_kit(const PerformerFrame &f, const PlanOptions &o)
+{
+    for (const PerformerFrame::Drum &d : f.drums)
+        if (!d.membrane_center_m.allFinite() || !(d.membrane_radius_m > 0.0) ||
+            !std::isfinite(d.membrane_radius_m))
+            throw std::invalid_argument("PerformerFrame: kit drum '" + d.name +
+                                        "' needs a finite centre and a radius > 0");
+    if (!(o.kit_clearance_m >= 0.0 && o.kit_clearance_m <= 0.5 && o.kit_margin_m >= 0.0 &&
+          o.kit_margin_m <= 0.5))
+        throw std::invalid_argument(
+            "PlanOptions: kit_clearance_m and kit_margin_m must be 0..0.5 m");
+}
+
 void validate(const PerformerFrame &f, const PlanOptions &o)
 {
     check_unit(f.right, "right");
@@ -256,14 +270,7 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
     if (!f.membrane_center_m.allFinite() || !f.rest_tip_m[0].allFinite() ||
         !f.rest_tip_m[1].allFinite())
         throw std::invalid_argument("PerformerFrame: positions must be finite");
-    for (const PerformerFrame::Drum &d : f.drums)
-        if (!d.membrane_center_m.allFinite() || !(d.membrane_radius_m > 0.0) ||
-            !std::isfinite(d.membrane_radius_m))
-            throw std::invalid_argument("PerformerFrame: kit drum '" + d.name +
-                                        "' needs a finite centre and a radius > 0");
-    if (!(o.kit_clearance_m >= 0.0 && o.kit_clearance_m <= 0.5 && o.kit_margin_m >= 0.0 &&
-          o.kit_margin_m <= 0.5))
-        throw std::invalid_argument("PlanOptions: kit_clearance_m and kit_margin_m must be 0..0.5 m");
+    validate_kit(f, o);
     auto bad = [](const char *what, double v) {
         std::ostringstream s;
         s << "PlanOptions: " << what << ", got " << v;

@@ -441,14 +441,14 @@ class LineParser
     // A drum's name: letters, digits, '_' and '-' (the kit's names, docs/perform.md).
     void drum_name(const Token &t, Statement &st) const
     {
-        const bool ok = !t.lower.empty() && t.lower.size() <= 32 &&
-                        std::all_of(t.lower.begin(), t.lower.end(), [](char c) {
-                            return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
-                                   c == '-';
-                        });
+        const bool ok =
+            !t.lower.empty() && t.lower.size() <= 32 &&
+            std::all_of(t.lower.begin(), t.lower.end(), [](char c) {
+                return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+            });
         if (!ok)
-            fail(t.column, "malformed drum name '" + t.text +
-                               "' (letters, digits, '_' and '-', at most 32)");
+            fail(t.column,
+                 "malformed drum name '" + t.text + "' (letters, digits, '_' and '-', at most 32)");
         st.drum = t.lower;
         st.drum_column = t.column;
     }

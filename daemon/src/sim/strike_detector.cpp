@@ -87,8 +87,8 @@ int StrikeDetector::drum_under(const Eigen::Vector3d &c) const
     double best_out = std::numeric_limits<double>::infinity(), best_gap = best_out;
     for (int d = 0; d < drum_count_; ++d) {
         const MembraneGeometry &m = membranes_[static_cast<size_t>(d)];
-        const double out = std::max(0.0, std::hypot(c.x() - m.center_m.x(), c.z() - m.center_m.z()) -
-                                             m.radius_m);
+        const double out =
+            std::max(0.0, std::hypot(c.x() - m.center_m.x(), c.z() - m.center_m.z()) - m.radius_m);
         const double gap = std::abs(gap_m(c, d));
         if (out < best_out || (out == 0.0 && best_out == 0.0 && gap < best_gap)) {
             best = d;
@@ -125,8 +125,8 @@ void StrikeDetector::reset(const MembraneGeometry &membrane)
 double StrikeDetector::normal_force_n(double depth_m, double depth_rate_mps) const
 {
     // One-sided spring-damper: the membrane pushes, never pulls.
-    return std::max(0.0, cur().stiffness_n_per_m * depth_m +
-                             cur().damping_n_s_per_m * depth_rate_mps);
+    return std::max(0.0,
+                    cur().stiffness_n_per_m * depth_m + cur().damping_n_s_per_m * depth_rate_mps);
 }
 
 double StrikeDetector::gap_m(const Eigen::Vector3d &center_m) const
