@@ -69,10 +69,10 @@ Kit kit_named(const std::string &name)
         kit.drums = standard_drums();
         kit.drums.push_back(drum("timpani", "timpani", 0.0, 24.0, {-0.57, 0.0, 0.06}, 45));
     } else if (name == "timpani") {
-        // Two 26-inch timpani side by side, heads level, the player between
-        // and behind them (the default drum's place is the left one's).
-        kit.drums = {drum("timpani1", "timpani", 0.0, 24.0, {0.0, 0.0, 0.0}, 45),
-                     drum("timpani2", "timpani", 0.0, 24.0, {0.70, 0.0, 0.0}, 45)};
+        // Two 26-inch timpani side by side, heads level, the player behind
+        // and between them: the kit's anchor (where the one drum goes) midway.
+        kit.drums = {drum("timpani1", "timpani", 0.0, 24.0, {-0.36, 0.0, 0.05}, 45),
+                     drum("timpani2", "timpani", 0.0, 24.0, {0.36, 0.0, 0.05}, 45)};
     } else {
         throw PerformError("unknown kit '" + name + "' (valid: " + kit_names() + ")");
     }
@@ -143,7 +143,7 @@ void validate_kit(const Kit &kit)
 }
 
 std::vector<DrumParams> place_kit(const Kit &kit, const DrumParams &base,
-                                  const Eigen::Vector3d &first_center_m,
+                                  const Eigen::Vector3d &anchor_m,
                                   const Eigen::Vector3d &right, const Eigen::Vector3d &up,
                                   const Eigen::Vector3d &forward)
 {
@@ -151,7 +151,7 @@ std::vector<DrumParams> place_kit(const Kit &kit, const DrumParams &base,
     for (const KitDrum &d : kit.drums) {
         DrumParams p = base;
         p.center_m =
-            first_center_m + d.place_m.x() * right + d.place_m.y() * up + d.place_m.z() * forward;
+            anchor_m + d.place_m.x() * right + d.place_m.y() * up + d.place_m.z() * forward;
         p.radius_m = d.radius_m;
         p.tension_n_per_m = d.tension_n_per_m;
         p.shell_depth_m = d.shell_depth_m;

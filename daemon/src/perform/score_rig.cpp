@@ -34,6 +34,11 @@ PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eige
     f.right = right;
     f.forward = forward;
     if (kit && !kit->empty()) {
+        // The rest tips before the kit's anchor (where the one drum goes),
+        // not its first drum, which may stand to a side (two timpani).
+        const Eigen::Vector3d &p0 = kit->drums.front().place_m;
+        const Eigen::Vector3d anchor = drum.center_m - p0.x() * right - p0.y() * up - p0.z() * forward;
+        f.rest_tip_m = performer_frame_for_drum(anchor + raise, drum.radius_m).rest_tip_m;
         for (size_t i = 0; i < kit->drums.size(); ++i) {
             const DrumParams &d =
                 i == 0 || !kit_drums || i - 1 >= kit_drums->size() ? drum : (*kit_drums)[i - 1];
@@ -84,9 +89,16 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
                               options.score.drum_forward_m * forward -
                               options.score.drum_below_m * up;
     if (!options.kit.empty()) {
-        // The kit from the first drum's place, in the performer's frame.
+        // The kit from its anchor, in the performer's frame: the automatic
+        // drum's place, or (a given or live centre) the first drum's centre
+        // less its place.
+        const Eigen::Vector3d &p0 = options.kit.drums.front().place_m;
+        const Eigen::Vector3d anchor =
+            options.drum_auto ? scene.drum.center_m
+                              : Eigen::Vector3d(scene.drum.center_m + p0.x() * left -
+                                                p0.y() * up - p0.z() * forward);
         const std::vector<DrumParams> placed =
-            place_kit(options.kit, scene.drum, scene.drum.center_m, -left, up, forward);
+            place_kit(options.kit, scene.drum, anchor, -left, up, forward);
         scene.drum = placed.front();
         scene.extra_drums.assign(placed.begin() + 1, placed.end());
         r.kit_drums = scene.extra_drums;

@@ -1,9 +1,9 @@
 // kit.hpp -- several drums in the scene (docs/perform.md, "A kit"): each with
 // a name (the score's `drum NAME`, `on NAME`), a head and sound (a membrane
 // preset, externals/core/membrane_presets.h), a place before the performer,
-// its shell and its General MIDI note. The first drum is the scene's drum 0,
-// placed where the one drum goes; the others are placed from it in the
-// performer's frame.
+// its shell and its General MIDI note. The drums are placed from the kit's
+// anchor (where the one drum goes) in the performer's frame; the first is
+// the scene's drum 0.
 #pragma once
 
 #include "ictus/sim/scene.hpp"
@@ -18,8 +18,8 @@ namespace ictus
 struct KitDrum {
     std::string name;   // lower case letters, digits, '_' and '-'
     std::string preset; // membrane preset: the head (radius, tension) and the sound
-    // The membrane's centre from the first drum's, in the performer's frame:
-    // x to the performer's right, y up, z forward (m).
+    // The membrane's centre from the kit's anchor (where the one drum goes),
+    // in the performer's frame: x to the performer's right, y up, z forward (m).
     Eigen::Vector3d place_m = Eigen::Vector3d::Zero();
     double radius_m = 0.1778;
     double tension_n_per_m = 3603.0;
@@ -54,10 +54,10 @@ double kit_min_gap_m(const Kit &kit);
 int kit_drum_index(const Kit &kit, const std::string &name);
 
 // The kit in the world: drum i's scene parameters (`base`'s damping and
-// friction, the kit's radius, tension and shell), the first at `first_center_m`,
-// the others at first_center_m + place_m in the frame (right, up, forward).
+// friction, the kit's radius, tension and shell), each at
+// anchor_m + place_m in the frame (right, up, forward).
 std::vector<DrumParams> place_kit(const Kit &kit, const DrumParams &base,
-                                  const Eigen::Vector3d &first_center_m,
+                                  const Eigen::Vector3d &anchor_m,
                                   const Eigen::Vector3d &right, const Eigen::Vector3d &up,
                                   const Eigen::Vector3d &forward);
 
