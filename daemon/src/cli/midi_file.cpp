@@ -156,8 +156,14 @@ std::string channel_message(int status, int channel, int a, int b)
 } // namespace
 
 std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
-                               const std::vector<MidiTempo> &tempo, int channel)
+                               const std::vector<MidiTempo> &tempo, int channel,
+                               const std::vector<int> *drum_notes)
 {
+    auto note_of = [drum_notes](const StrikeEvent &e) {
+        if (drum_notes && e.drum >= 0 && e.drum < static_cast<int>(drum_notes->size()))
+            return (*drum_notes)[static_cast<size_t>(e.drum)];
+        return midi_note(e.hand, e.r_over_a);
+    };
     if (channel < 0 || channel > 15)
         throw std::invalid_argument("standard_midi_file: channel must be 0..15");
     const TempoMap map(tempo);
@@ -168,12 +174,12 @@ std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
         events.push_back({s.tick, 0, -1, tempo_meta(s.us_per_quarter)});
     for (size_t i = 0; i < strikes.size(); ++i) {
         const StrikeEvent &e = strikes[i];
-        const int note = midi_note(e.hand, e.r_over_a);
+        const int note = note_of(e);
         const long on = map.tick_of(std::max(0.0, e.time_s));
         // The note ends after kMidiNoteLength_s, or where the same note strikes again.
         double off_s = e.time_s + kMidiNoteLength_s;
         for (size_t j = i + 1; j < strikes.size(); ++j)
-            if (midi_note(strikes[j].hand, strikes[j].r_over_a) == note) {
+            if (note_of(strikes[j]) == note) {
                 off_s = std::min(off_s, strikes[j].time_s);
                 break;
             }

@@ -186,6 +186,39 @@ MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o
         [&](MocapWarnings *warnings) { return read_marker_csv(path, o, warnings); });
 }
 
+// The drum's and the kit's options (parse_performance_option's).
+static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptions &o)
+{
+    auto value = [&]() { return args.value(a); };
+    if (a == "--drum-pos") {
+        o.scene.drum.center_m = parse_vec3(a, value(), -kMaxDrumDistance_m, kMaxDrumDistance_m);
+        o.drum_auto = false;
+    } else if (a == "--drum-radius") {
+        o.scene.drum.radius_m = parse_number(a, value(), 0.05, 1.0);
+        o.drum_given |= kGivenRadius;
+    } else if (a == "--drum-tension") {
+        o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
+        o.drum_given |= kGivenTension;
+    } else if (a == "--drum-density") {
+        o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
+        o.drum_given |= kGivenDensity;
+    } else if (a == "--drum-preset") {
+        apply_drum_preset(a, value(), o);
+    } else if (a == "--kit") {
+        const std::string v = value();
+        try {
+            o.kit = kit_named(v);
+        } catch (const PerformError &e) {
+            throw UsageError("--kit: " + std::string(e.what()));
+        }
+        // The first drum's head and sound are its preset's (as --drum-preset).
+        apply_drum_preset(a, o.kit.drums.front().preset, o);
+    } else {
+        return false;
+    }
+    return true;
+}
+
 // Options shared by run and render. Returns false when `a` is not one of them.
 bool parse_performance_option(const std::string &a, Args &args, PerformanceOptions &o,
                               double &duration)
@@ -258,20 +291,8 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.tempo_bpm = parse_number(a, value(), 20, 400);
     else if (a == "--clip-bpm")
         o.clip_bpm = parse_number(a, value(), 20, 400);
-    else if (a == "--drum-pos") {
-        o.scene.drum.center_m = parse_vec3(a, value(), -kMaxDrumDistance_m, kMaxDrumDistance_m);
-        o.drum_auto = false;
-    } else if (a == "--drum-radius") {
-        o.scene.drum.radius_m = parse_number(a, value(), 0.05, 1.0);
-        o.drum_given |= kGivenRadius;
-    } else if (a == "--drum-tension") {
-        o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
-        o.drum_given |= kGivenTension;
-    } else if (a == "--drum-density") {
-        o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
-        o.drum_given |= kGivenDensity;
-    } else if (a == "--drum-preset") {
-        apply_drum_preset(a, value(), o);
+    else if (parse_drum_option(a, args, o)) {
+        // the drum or the kit
     } else if (a == "--sticks") {
         const std::string v = value();
         if (v == "fulcrum")

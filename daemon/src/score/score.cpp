@@ -76,6 +76,7 @@ enum class Kind {
     default_dynamics,
     default_firmness,
     default_nuance,
+    drum,
     repeat,
     end
 };
@@ -98,6 +99,10 @@ struct Statement {
     double ramp_beats = 0.0;
     Grip grip = Grip::french;
     int count = 0; // repeat
+    // drum (the current drum) and a note's `on NAME`: the name, lower case,
+    // and its column
+    std::optional<std::string> drum;
+    int drum_column = 0;
 };
 
 const Nuance kNuances[] = {Nuance::legato,          Nuance::tenuto,   Nuance::accent,
@@ -401,6 +406,10 @@ class LineParser
             st.firmness =
                 one_value(tk, st, Kind::default_firmness, "'firmness' needs a value 0..1",
                           "the firmness", [&](const Token &t) { return firmness_value(t); });
+        } else if (key == "drum") {
+            st.kind = Kind::drum;
+            drum_name(need(tk, 1, "'drum' needs a drum's name, e.g. 'drum snare'"), st);
+            no_more(tk, 2, "the drum's name");
         } else if (key == "repeat") {
             st.kind = Kind::repeat;
             const Token &n = need(tk, 1, "repeat needs a count, e.g. 'repeat 4'");
@@ -416,7 +425,7 @@ class LineParser
             fail(tk[0].column,
                  "unknown statement '" + tk[0].text +
                      "' (expected a hand R, L, right, left, R+L, or tempo, grip, rest, "
-                     "beats, dynamics, firmness, nuance, repeat, end)");
+                     "beats, dynamics, firmness, nuance, drum, repeat, end)");
         }
         return st;
     }
@@ -427,6 +436,21 @@ class LineParser
         if (!nuance)
             fail(t.column, "unknown nuance '" + t.text + "' (valid: " + nuance_list() + ")");
         return *nuance;
+    }
+
+    // A drum's name: letters, digits, '_' and '-' (the kit's names, docs/perform.md).
+    void drum_name(const Token &t, Statement &st) const
+    {
+        const bool ok =
+            !t.lower.empty() && t.lower.size() <= 32 &&
+            std::all_of(t.lower.begin(), t.lower.end(), [](char c) {
+                return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+            });
+        if (!ok)
+            fail(t.column,
+                 "malformed drum name '" + t.text + "' (letters, digits, '_' and '-', at most 32)");
+        st.drum = t.lower;
+        st.drum_column = t.column;
     }
 
     double firmness_value(const Token &t) const
@@ -462,6 +486,11 @@ class LineParser
                 st.firmness = firmness_value(
                     need(tk, i + 1, "'firmness' needs a value 0..1 (0 loose, 1 firm)"));
                 ++i;
+            } else if (t.lower == "on") {
+                if (st.drum)
+                    fail(t.column, "second drum in one note");
+                drum_name(need(tk, i + 1, "'on' needs a drum's name, e.g. 'on tom1'"), st);
+                ++i;
             } else if (t.lower == "at") {
                 if (st.r_over_a)
                     fail(t.column, "second position in one note");
@@ -496,8 +525,8 @@ class LineParser
             } else {
                 fail(t.column, "unexpected '" + t.text + "' in a note: expected a nuance (" +
                                    nuance_list() + "), dynamics (0..1 or " + dynamics_list() +
-                                   "), a duration (N/D or 'beats X'), 'at R/A THETA' or "
-                                   "'firmness F'");
+                                   "), a duration (N/D or 'beats X'), 'at R/A THETA', "
+                                   "'firmness F' or 'on DRUM'");
             }
         }
     }
@@ -604,6 +633,8 @@ Score ScoreBuilder::finish() const
     double default_dynamics = kDefaultDynamics;
     double default_firmness = -1.0; // the performance's
     Nuance default_nuance = Nuance::legato;
+    std::string drum; // the current drum ("": the kit's first)
+    int drum_line = 0, drum_column = 0;
     struct Loop {
         size_t body; // first statement of the body
         int left;    // passes still to play after this one
@@ -637,6 +668,9 @@ Score ScoreBuilder::finish() const
             n.firmness = st.firmness.value_or(default_firmness);
             n.line = st.line;
             n.column = st.column;
+            n.drum = st.drum.value_or(drum);
+            n.drum_line = st.drum ? st.line : drum_line;
+            n.drum_column = st.drum ? st.drum_column : drum_column;
             for (Side hand : {Side::right, Side::left}) {
                 if (!st.both_hands && hand != st.hand)
                     continue;
@@ -667,6 +701,11 @@ Score ScoreBuilder::finish() const
             default_dynamics = st.dynamics.value_or(default_dynamics);
             default_firmness = st.firmness.value_or(default_firmness);
             default_nuance = st.nuance.value_or(default_nuance);
+            break;
+        case Kind::drum:
+            drum = *st.drum;
+            drum_line = st.line;
+            drum_column = st.drum_column;
             break;
         case Kind::repeat:
             loops.push_back({pc + 1, st.count - 1});

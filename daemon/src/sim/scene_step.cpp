@@ -51,11 +51,20 @@ void Scene::set_joint_targets(const std::vector<Eigen::Quaterniond> &local,
 void Scene::near_callback(void *data, dGeomID a, dGeomID b)
 {
     Scene *self = static_cast<Scene *>(data);
-    // Only sticks meet the drum (category bits). The stick's geom goes first,
+    // Only sticks meet drums (category bits). The stick's geom goes first,
     // so that its body is the contact joint's body 1 and the joint feedback's
     // f1 is the force on the stick (the normal then points into the stick).
-    if (a == self->drum_)
-        std::swap(a, b);
+    int drum = -1;
+    for (int i = 0; i < self->drum_count(); ++i) {
+        if (a == self->drum_geom_[i]) {
+            std::swap(a, b);
+            drum = i;
+        } else if (b == self->drum_geom_[i]) {
+            drum = i;
+        }
+    }
+    if (drum < 0)
+        return;
     int side = -1;
     bool bead = false;
     for (int s = 0; s < 2; ++s) {
@@ -76,7 +85,7 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
     // under a drum placed for its strokes) passes through the drum until it
     // is clear of it. Blocked there, the hand would drive the stick against
     // the shell with the arm's whole strength and wrench it round its fulcrum.
-    const int part = 2 * side + (bead ? 1 : 0);
+    const int part = 4 * drum + 2 * side + (bead ? 1 : 0);
     self->part_touching_now_[static_cast<size_t>(part)] = true;
     if (!self->part_touching_[static_cast<size_t>(part)]) {
         int deepest = 0;
@@ -87,8 +96,10 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         // head, outward and up on the rim's edge, level on the shell's side.
         const bool from_above = geoms[deepest].normal[1] > kHeadNormalMin;
         self->part_through_[static_cast<size_t>(part)] = !from_above;
-        if (!from_above)
+        if (!from_above) {
             ++self->shell_passes_;
+            ++self->drum_shell_passes_[static_cast<size_t>(drum)];
+        }
     }
     if (self->part_through_[static_cast<size_t>(part)])
         return;
@@ -96,9 +107,9 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         dContact contact;
         contact.geom = geoms[i];
         contact.surface.mode = dContactSoftERP | dContactSoftCFM | dContactApprox1;
-        contact.surface.mu = self->options_.drum.friction;
-        contact.surface.soft_erp = self->contact_erp_;
-        contact.surface.soft_cfm = self->contact_cfm_;
+        contact.surface.mu = self->drum(drum).friction;
+        contact.surface.soft_erp = self->contact_erp_[static_cast<size_t>(drum)];
+        contact.surface.soft_cfm = self->contact_cfm_[static_cast<size_t>(drum)];
         dJointID joint = dJointCreateContact(self->world_, self->contacts_, &contact);
         dJointAttach(joint, dGeomGetBody(a), dGeomGetBody(b));
         if (self->contact_slots_used_ < static_cast<int>(self->contact_slot_.size())) {

@@ -44,8 +44,11 @@ struct MidiTempo {
 // (0..15) at its time_s, preceded by a text event "bounce" at the same tick
 // when it is a bounce, and its note-off. Times are rounded to the nearest
 // tick of the tempo map (3840 per quarter: within 0.4 ms at 20 bpm and faster).
+// With a kit, `drum_notes` gives each drum's note (StrikeEvent::drum indexes
+// it: the General MIDI drum map, docs/midi.md); without, midi_note().
 std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
-                               const std::vector<MidiTempo> &tempo, int channel);
+                               const std::vector<MidiTempo> &tempo, int channel,
+                               const std::vector<int> *drum_notes = nullptr);
 
 } // namespace cli
 } // namespace ictus

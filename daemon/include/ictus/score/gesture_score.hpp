@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 namespace ictus
@@ -36,6 +37,15 @@ struct PerformerFrame {
     // Where each stick tip waits when its hand has nothing to play [Side].
     std::array<Eigen::Vector3d, 2> rest_tip_m = {Eigen::Vector3d(0.1, 0.85, 0.4),
                                                  Eigen::Vector3d(-0.1, 0.85, 0.4)};
+    // A kit (docs/perform.md, "A kit"): its drums by name, the first the
+    // membrane above (its centre and radius equal membrane_center_m and
+    // membrane_radius_m). Empty: the one drum, whose notes name none.
+    struct Drum {
+        std::string name;
+        Eigen::Vector3d membrane_center_m = Eigen::Vector3d::Zero(); // raised as membrane_center_m
+        double membrane_radius_m = 0.178;
+    };
+    std::vector<Drum> drums;
 };
 
 // The shared frames (docs/perform.md; the character faces +Z: right = world -X),
@@ -52,8 +62,9 @@ PerformerFrame performer_frame_for_drum(const Eigen::Vector3d &membrane_center_m
 Eigen::Vector3d rest_stick_direction(const PerformerFrame &frame, int side);
 
 // A point of the head from the membrane frame of docs/osc.md (x_m = world
-// +X, y_m = world -Z, around the centre).
-Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg);
+// +X, y_m = world -Z, around the centre); of a kit's drum `drum` (0: the first).
+Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg,
+                               int drum = 0);
 
 // One note as it will be played.
 struct PlannedNote {
@@ -71,6 +82,7 @@ struct PlannedNote {
     double r_over_a = 0.0;
     double theta_deg = 0.0;
     double firmness = -1.0; // ScoreNote::firmness
+    int drum = 0;           // the kit's drum (PerformerFrame::drums), 0: the first or only
     int line = 0;           // where the note is written
     int column = 0;
 };
@@ -104,6 +116,12 @@ struct PlanOptions {
     // which the arm tracks closely (docs/score.md, "From score to motion").
     double move_margin_after = 0.05;
     double move_margin_before = 0.1;
+    // A move between two drums of a kit lifts the tip so that, wherever it
+    // is over a drum's head (that head's radius and this margin), it stays
+    // above it, and this clearance above any drum but the two it plays
+    // (docs/score.md, "A kit"): it never meets a shell from the side.
+    double kit_clearance_m = 0.03;
+    double kit_margin_m = 0.03;
     // A hand with no stroke for longer than this goes back to its rest tip.
     double idle_return_s = 4.0;
     double return_time_s = 0.6; // the move between the rest tip and a stroke

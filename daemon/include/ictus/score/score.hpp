@@ -74,6 +74,12 @@ struct ScoreNote {
     double firmness = -1.0;
     int line = 0; // where the note was written
     int column = 0;
+    // The drum of a kit it is played on (`drum NAME`, `on NAME`; lower
+    // case), "" for the kit's first (or the one drum); where the name was
+    // written (the note's line, or the `drum` statement's), for the
+    // planner's error when the kit has no such drum.
+    std::string drum;
+    int drum_line = 0, drum_column = 0;
 };
 
 // Tempo as a function of score position: a list of changes, each setting the

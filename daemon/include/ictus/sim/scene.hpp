@@ -9,6 +9,7 @@
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/character/joint_limit_ref.hpp"
 #include "ictus/sim/sim_error.hpp"
+#include "ictus/sim/strike_event.hpp" // kMaxDrums
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -76,7 +77,10 @@ struct SceneOptions {
     // exclusive; ODE's default is 1.3.
     double quickstep_w = 1.3;
     double gravity_mps2 = 9.81;
-    DrumParams drum;
+    DrumParams drum; // drum 0
+    // A kit's further drums, 1 .. kMaxDrums - 1 (empty: the one drum). Each
+    // is a static cylinder with its own contact law, created after drum 0.
+    std::vector<DrumParams> extra_drums;
     // Divergence: any non-finite state, a body faster than these, or a ball
     // joint pulled apart by more than max_joint_separation_m.
     double max_linear_speed_mps = 50.0;
@@ -200,9 +204,9 @@ class Scene
     int divergences() const { return divergences_; }
     int contacts_last_step() const { return contacts_last_step_; }
     long contact_steps() const { return contact_steps_; }
-    // Times a stick part (bead or shaft) met the drum other than from above:
+    // Times a stick part (bead or shaft) met a drum other than from above:
     // through the shell's side or bottom (docs/character.md, "Drum"). Such a
-    // part passes through the drum until it is clear of it.
+    // part passes through the drum until it is clear of it. All drums.
     long shell_passes() const { return shell_passes_; }
     int stops_active_last_step() const { return stops_active_; }
     // Motor torque of each joint in the last step (N m, on the child, world
@@ -254,7 +258,8 @@ class Scene
     // by s = k_g / (k_g + k), k_g = k_f / l^2 the grip's stiffness seen at the
     // bead (l its distance from the fulcrum axis) and k the drum's contact
     // stiffness. Rigid mount: the hand and stick as one body.
-    double effective_mass_kg(Side side, const Eigen::Vector3d &normal) const;
+    // `drum`: whose contact stiffness k (0: drum 0).
+    double effective_mass_kg(Side side, const Eigen::Vector3d &normal, int drum = 0) const;
     // The drum's action on each stick in the last step (see StickDrumContact).
     const StickDrumContact &drum_contact(Side side) const
     {
@@ -275,6 +280,14 @@ class Scene
     const DrumParams &drum() const { return options_.drum; }
     // The contact law's stiffness k in use, N/m.
     double drum_contact_stiffness_n_per_m() const;
+    // A kit: drum_count() drums, drum(0) the one above; index checked
+    // (SimError). set_drum(i, d) changes drum i as set_drum(d) does drum 0.
+    int drum_count() const { return 1 + static_cast<int>(options_.extra_drums.size()); }
+    const DrumParams &drum(int index) const;
+    void set_drum(int index, const DrumParams &drum);
+    double drum_contact_stiffness_n_per_m(int index) const;
+    // Shell passes of one drum (shell_passes() is their sum).
+    long shell_passes(int index) const { return drum_shell_passes_.at(static_cast<size_t>(index)); }
     double max_linear_speed_mps() const;
     double max_angular_speed_rad_s() const;
     // Adds a velocity change to a body's centre of mass (tests: injected
@@ -309,7 +322,7 @@ class Scene
     void drive_motor(int joint, const MotorCommand &command, const LimitStop &stop);
     bool check() const;
     static void near_callback(void *data, dxGeom *a, dxGeom *b);
-    void place_drum();
+    void place_drum(int index);
     void gather_contact_forces();
     CharacterPose target_pose() const;
     void place_kinematic_bodies();
@@ -365,7 +378,7 @@ class Scene
     double pelvis_mass_kg_ = 0.0;
     std::array<std::array<Eigen::Vector3d, 3>, CharacterModel::kJoints> motor_axes_{};
     dxJoint *pelvis_weld_ = nullptr;
-    dxGeom *drum_ = nullptr;
+    std::array<dxGeom *, kMaxDrums> drum_geom_{}; // [drum]
     std::array<dxGeom *, 2> stick_shaft_{};
     std::array<dxGeom *, 2> stick_tip_{};
     // Fulcrum mount: the sticks' bodies (their frame = the hand's frame at
@@ -375,17 +388,19 @@ class Scene
     void apply_grip(int side);
     dxBody *tip_body(Side side) const;
     Eigen::Vector3d tip_body_com(Side side) const; // its CoM in the hand frame
-    double contact_erp_ = 0.0, contact_cfm_ = 0.0;
+    std::array<double, kMaxDrums> contact_erp_{}, contact_cfm_{}; // [drum]
 
     double time_s_ = 0.0;
     long steps_ = 0;
     int divergences_ = 0;
     int contacts_last_step_ = 0;
     long contact_steps_ = 0;
-    // Per stick part [side * 2 + bead]: touching the drum in the last step,
-    // in this one, and passing through its shell (near_callback).
-    std::array<bool, 4> part_touching_{}, part_touching_now_{}, part_through_{};
+    // Per drum and stick part [drum * 4 + side * 2 + bead]: touching the
+    // drum in the last step, in this one, and passing through its shell
+    // (near_callback).
+    std::array<bool, 4 * kMaxDrums> part_touching_{}, part_touching_now_{}, part_through_{};
     long shell_passes_ = 0;
+    std::array<long, kMaxDrums> drum_shell_passes_{};
     int stops_active_ = 0;
 };
 
