@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """Seeded rudiment scores (ictus_tools.rudiments) played by the real `ictusd render` and judged by
-ictus_tools.render_check against the generator's own note times: every written note one primary
-strike of its hand within +-5 ms, no extra primary strike. Doubles and paradiddles at mf (and
-the other dynamics: every note of a same-hand pair is judged alike) also keep the second impact
-speed of each same-hand pair within 20 % of the first. Prints the timing-error p99 and worst.
+ictus_tools.render_check against the generator's own note times: every written note and every
+grace stroke one primary strike of its hand within +-5 ms, no extra primary strike. Each grace
+stroke of a flam or a drag strikes 10..45 ms before the stroke it leads into (its note, or a
+drag's second grace), and notes.csv marks exactly the grace strokes. Doubles, paradiddles and
+double-stroke rolls also keep the second impact speed of each same-hand pair within 20 % of the
+first. Prints the timing-error p99 and worst, and the grace leads' range.
 
     PYTHONPATH=python python3 tests/perform/test_rudiments.py --ictusd build/ictusd --count 60
 """
@@ -39,6 +41,10 @@ def main():
           " worst %.2f ms; %d failed" % (len(results), len(errors), closest * 1000,
                                          percentile(errors, 0.99), max(errors or [float("nan")]),
                                          len(failed)))
+    leads = [x for r in results for x in getattr(r, "grace_leads_ms", [])]
+    if leads:
+        print("%d grace strokes: struck %.1f .. %.1f ms before the stroke they lead into"
+              % (len(leads), min(leads), max(leads)))
     return 1 if failed else 0
 
 
