@@ -28,7 +28,7 @@ NUANCES = ["legato", "staccato"]
 # FLAM_LEAD_S before its note, a drag's two at FLAM_LEAD_S + DRAG_SPACING_S and FLAM_LEAD_S,
 # legato at GRACE_DYNAMICS (or half the note's).
 FLAM_LEAD_S = 0.030
-DRAG_SPACING_S = 0.045
+DRAG_SPACING_S = 0.040
 GRACE_DYNAMICS = 0.15
 GRACE_WINDOW_MS = (10.0, 45.0)  # a grace stroke's strike this long before its note's (the acceptance)
 

@@ -377,7 +377,7 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         const std::vector<size_t> &same = by_hand[static_cast<int>(n.hand)];
         if (!same.empty()) {
             const PlannedNote &prev = plan.notes[same.back()];
-            if (p.time_s - prev.time_s < opt.min_stroke_interval_s) {
+            if (p.time_s - prev.time_s < opt.min_stroke_interval_s - 1e-9) {
                 auto what = [](const PlannedNote &q) {
                     return q.grace == Grace::none
                                ? std::string()

@@ -66,7 +66,7 @@ constexpr double kDefaultThetaDeg[2] = {0.0, 180.0}; // [Side::left, Side::right
 // body's 40 ms same-hand limit). Played at kGraceDynamics, or half the
 // note's dynamics if that is less, legato, on the hand's default spot.
 constexpr double kFlamGraceLead_s = 0.030;
-constexpr double kDragGraceSpacing_s = 0.045;
+constexpr double kDragGraceSpacing_s = 0.040;
 constexpr double kGraceDynamics = 0.15;
 // Meters (`meter N/D`): N 1..kMaxMeterNumerator, D a power of two 1..kMaxMeterDenominator.
 constexpr int kMaxMeterNumerator = 64;
