@@ -10,10 +10,38 @@ first. Prints the timing-error p99 and worst, and the grace leads' range.
     PYTHONPATH=python python3 tests/perform/test_rudiments.py --ictusd build/ictusd --count 60
 """
 import argparse
+import copy
 import os
+import shutil
 import sys
 
-from ictus_tools.rudiments import percentile, play
+from ictus_tools.rudiments import grace_problems, percentile, play
+
+
+def planted(results, workdir):
+    """The grace checks can fail: on a copy of a render with grace strokes that played right, a
+    grace struck 20 ms earlier, and notes.csv's grace column cleared, must each be named."""
+    res = next((r for r in results if r.ok and r.grace_leads_ms), None)
+    if res is None:
+        return ["no render with grace strokes played right to plant faults in"]
+    out = os.path.join(workdir, "seed-%d" % res.seed, "out")
+    moved = copy.deepcopy(res)
+    g = next(n for n in moved.notes if n["grace"] and n["strike"])
+    g["strike"]["time_s"] -= 0.020
+    missing = []
+    if not any("struck" in p for p in grace_problems(moved, out)[0]):
+        missing.append("a grace struck 20 ms early was not named")
+    cleared = out + "-planted-grace"
+    shutil.rmtree(cleared, ignore_errors=True)
+    shutil.copytree(out, cleared)
+    with open(os.path.join(out, "notes.csv")) as f:
+        text = f.read().replace(",1\n", ",0\n")
+    with open(os.path.join(cleared, "notes.csv"), "w") as f:
+        f.write(text)
+    if not any("notes.csv row" in p for p in grace_problems(res, cleared)[0]):
+        missing.append("notes.csv without its grace marks was not named")
+    shutil.rmtree(cleared, ignore_errors=True)
+    return missing
 
 
 def main():
@@ -45,7 +73,10 @@ def main():
     if leads:
         print("%d grace strokes: struck %.1f .. %.1f ms before the stroke they lead into"
               % (len(leads), min(leads), max(leads)))
-    return 1 if failed else 0
+    missing = [] if a.same_hand_ms else planted(results, a.workdir)
+    for m in missing:
+        print("planted fault: " + m)
+    return 1 if failed or missing else 0
 
 
 if __name__ == "__main__":
