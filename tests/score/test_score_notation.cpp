@@ -285,3 +285,31 @@ TEST_CASE("score: the rudiments example plays every ornament and roll", "[score]
     const GesturePlan plan = plan_performance(s, GestureDatabase::builtin(), PerformerFrame());
     CHECK(plan.notes.size() == s.notes.size());
 }
+
+TEST_CASE("score: the notation one statement at a time (a Pd message box) equals the file",
+          "[score][notation]")
+{
+    const std::vector<std::string> lines = {
+        "meter 3/4", "beats 1/4", "dynamics p -> f over 1", "roll single 1",
+        "R flam",    "L drag ff", "dynamics -> pp over 2",  "roll buzz 1/2"};
+    ScoreBuilder b("osc");
+    std::string text;
+    for (const std::string &l : lines) {
+        b.add_statement(l);
+        text += l + "\n";
+    }
+    const Score x = b.finish(), y = parse_score(text, "t.txt");
+    REQUIRE(x.notes.size() == y.notes.size());
+    for (size_t i = 0; i < x.notes.size(); ++i) {
+        CHECK(x.notes[i].hand == y.notes[i].hand);
+        CHECK(x.notes[i].grace == y.notes[i].grace);
+        CHECK(x.notes[i].dynamics == y.notes[i].dynamics);
+        CHECK(x.note_time_s(x.notes[i]) == y.note_time_s(y.notes[i]));
+    }
+    CHECK(x.meters.size() == 1);
+    // A roll that does not fit the subdivision is refused when the score is finished.
+    ScoreBuilder c("osc");
+    c.add_statement("beats 1/2");
+    c.add_statement("roll double 3/4");
+    CHECK_THROWS_WITH(c.finish(), Contains("osc:2:1: a roll of 0.75 beats"));
+}
