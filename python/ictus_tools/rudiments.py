@@ -7,10 +7,13 @@
 
 (with python/ on PYTHONPATH). Each score is one rudiment, a constant tempo and a subdivision,
 a dynamics and a nuance, repeated a few times: singles (R L R L) in 16ths up to 240 bpm, doubles
-(R R L L) and paradiddles (R L R R L R L L) with same-hand strokes MIN_SAME_HAND_S .. 0.1 s apart
-(and slower). The notes (times from beat 0, at a constant tempo t = beat * 60 / bpm) are
-computed here, not taken from the daemon, so that ictus_tools.render_check can judge a render
-of the score against them. The same seed gives the same bytes (random.Random(seed)).
+(R R L L), paradiddles (R L R R L R L L) and `roll double` with same-hand strokes
+MIN_SAME_HAND_S .. 0.1 s apart (and slower), alternating flams, flam taps (R flam, R, L flam, L),
+alternating drags and `roll buzz` (RUDIMENTS). The notes (times from beat 0, at a constant tempo
+t = beat * 60 / bpm, grace strokes FLAM_LEAD_S and DRAG_SPACING_S before, as docs/score.md
+defines them) are computed here, not taken from the daemon, so that ictus_tools.render_check
+can judge a render of the score against them. The same seed gives the same bytes
+(random.Random(seed)).
 """
 import argparse
 import csv
