@@ -123,3 +123,25 @@ TEST_CASE("midi: with a kit each strike is its drum's General MIDI note", "[cli]
     CHECK(standard_midi_file(s, {{0.0, 60.0}}, 9, &notes) == want);
     CHECK(standard_midi_file(s, {{0.0, 60.0}}, 9) != want);
 }
+
+TEST_CASE("midi: the score's meters as time signatures, 4/4 without one", "[cli][midi]")
+{
+    // 60 bpm, 3840 ticks a second. 6/8 from 0 s replaces the 4/4 (FF 58 04
+    // 06 03 18 08: 6, 2^3, 24 clocks a click, 8 32nds a quarter), 3/4 at 0.5 s
+    // = tick 1920 (FF 58 04 03 02 18 08), after the tempo at tick 0.
+    const std::vector<StrikeEvent> none;
+    const std::string head = bytes({0x00, 0xff, 0x03, 0x05}) + "ictus";
+    const std::string f = standard_midi_file(none, {{0.0, 60.0}}, 0, nullptr, {{0.0, 6, 8}, {0.5, 3, 4}});
+    const std::string track = head + bytes({0x00, 0xff, 0x58, 0x04, 0x06, 0x03, 0x18, 0x08}) +
+                              bytes({0x00, 0xff, 0x51, 0x03, 0x0f, 0x42, 0x40}) +
+                              bytes({0x8f, 0x00, 0xff, 0x58, 0x04, 0x03, 0x02, 0x18, 0x08}) +
+                              bytes({0x00, 0xff, 0x2f, 0x00});
+    CHECK(f.substr(22) == track);
+    // A first meter after 0 s: 4/4 at tick 0, then 5/4 at 0.25 s = tick 960 (0x87 0x40).
+    const std::string g = standard_midi_file(none, {{0.0, 60.0}}, 0, nullptr, {{0.25, 5, 4}});
+    CHECK(g.substr(22) == head + bytes({0x00, 0xff, 0x58, 0x04, 0x04, 0x02, 0x18, 0x08}) +
+                              bytes({0x00, 0xff, 0x51, 0x03, 0x0f, 0x42, 0x40}) +
+                              bytes({0x87, 0x40, 0xff, 0x58, 0x04, 0x05, 0x02, 0x18, 0x08}) +
+                              bytes({0x00, 0xff, 0x2f, 0x00}));
+    CHECK_THROWS(standard_midi_file(none, {{0.0, 60.0}}, 0, nullptr, {{0.0, 3, 6}}));
+}

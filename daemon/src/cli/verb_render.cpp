@@ -261,7 +261,7 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
                      double origin_s, const Kit &kit)
 {
     out << "index,time_s,hand,nuance,grip,dynamics,beats,tempo_bpm,line,strike_seq,strike_time_s,"
-           "error_ms,normal_velocity_mps,duration_ms"
+           "error_ms,normal_velocity_mps,duration_ms,grace"
         << (kit.empty() ? "\n" : ",drum\n");
     char buf[256];
     for (size_t i = 0; i < plan.notes.size(); ++i) {
@@ -272,11 +272,11 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
                       to_string(n.grip), n.dynamics, n.beats, n.tempo_bpm, n.line, k.strike_seq);
         out << buf;
         if (k.strike_seq >= 0)
-            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f", k.strike_time_s, k.error_ms,
+            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f,", k.strike_time_s, k.error_ms,
                           k.normal_velocity_mps, k.duration_ms);
         else
-            std::snprintf(buf, sizeof buf, ",,,");
-        out << buf;
+            std::snprintf(buf, sizeof buf, ",,,,");
+        out << buf << (n.grace == Grace::none ? 0 : 1);
         if (!kit.empty() && n.drum >= 0 && n.drum < static_cast<int>(kit.drums.size()))
             out << ',' << kit.drums[static_cast<size_t>(n.drum)].name;
         out << '\n';
@@ -381,6 +381,7 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
                             {"nuance", to_string(p.nuance)},
                             {"dynamics", p.dynamics},
                             {"line", p.line},
+                            {"grace", to_string(p.grace)},
                             {"planned_impact_speed_mps", perf.planned_impact_speed_mps(i)}};
         if (k.strike_seq >= 0) {
             e["strike_seq"] = k.strike_seq;
@@ -589,9 +590,16 @@ std::string render_midi(const Performance &perf, const RenderArgs &r, bool score
                         const StrikeLog &log)
 {
     std::vector<MidiTempo> tempo;
+    std::vector<MidiMeter> meter;
     if (score_mode) {
+        // A grace stroke is not on a beat: the tempo is its note's.
         for (const PlannedNote &n : perf.plan()->notes)
-            tempo.push_back({perf.plan_origin_s() + n.time_s, n.tempo_bpm});
+            if (n.grace == Grace::none)
+                tempo.push_back({perf.plan_origin_s() + n.time_s, n.tempo_bpm});
+        // The score's meters; one at its beat 0 from the file's start.
+        for (const PlannedMeter &m : perf.plan()->meters)
+            meter.push_back({m.beat <= 0.0 ? 0.0 : perf.plan_origin_s() + m.time_s, m.numerator,
+                             m.denominator});
     }
     if (tempo.empty())
         tempo.push_back({0.0, score_mode ? 120.0 : r.o.tempo_bpm});
@@ -599,7 +607,7 @@ std::string render_midi(const Performance &perf, const RenderArgs &r, bool score
     for (const KitDrum &d : perf.options().kit.drums)
         drum_notes.push_back(d.midi_note);
     return standard_midi_file(log.strikes(), tempo, midi_channel(r, perf) - 1,
-                              drum_notes.empty() ? nullptr : &drum_notes);
+                              drum_notes.empty() ? nullptr : &drum_notes, meter);
 }
 
 // render.json but its "performance" (score mode).

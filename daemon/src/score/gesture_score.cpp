@@ -427,15 +427,24 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         p.tip_target_m = p.strike_point_m - opt.strike_depth_m * frame.up;
         p.line = n.line;
         p.column = n.column;
+        p.grace = n.grace;
         const std::vector<size_t> &same = by_hand[static_cast<int>(n.hand)];
         if (!same.empty()) {
             const PlannedNote &prev = plan.notes[same.back()];
-            if (p.time_s - prev.time_s < opt.min_stroke_interval_s) {
+            if (p.time_s - prev.time_s < opt.min_stroke_interval_s - 1e-9) {
+                auto what = [](const PlannedNote &q) {
+                    return q.grace == Grace::none
+                               ? std::string()
+                               : std::string(", a ") + to_string(q.grace) + "'s grace stroke";
+                };
                 std::ostringstream m;
-                m << "this " << (n.hand == Side::right ? "right" : "left") << "-hand stroke comes "
-                  << (p.time_s - prev.time_s) * 1000.0 << " ms after the previous one (line "
-                  << prev.line << "), faster than one hand plays (minimum "
-                  << opt.min_stroke_interval_s * 1000.0
+                m << "this " << (n.hand == Side::right ? "right" : "left") << "-hand stroke"
+                  << (n.grace == Grace::none
+                          ? std::string()
+                          : std::string(" (the ") + to_string(n.grace) + "'s grace stroke)")
+                  << " comes " << (p.time_s - prev.time_s) * 1000.0
+                  << " ms after the previous one (line " << prev.line << what(prev)
+                  << "), faster than one hand plays (minimum " << opt.min_stroke_interval_s * 1000.0
                   << " ms): give it to the other hand or slow down";
                 throw ScoreError(score.source, n.line, n.column, m.str());
             }
@@ -743,6 +752,9 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
     plan.score_start_s = opt.lead_in_s;
     UnitCache units(db); // the timelines' items point into it
     const HandNotes by_hand = time_notes(score, frame, opt, plan);
+    for (const ScoreMeter &m : score.meters)
+        plan.meters.push_back(
+            {opt.lead_in_s + score.tempo.time_at_beat(m.beat), m.beat, m.numerator, m.denominator});
 
     std::array<HandTimeline, 2> timelines;
     double last_motion_end = 0.0;

@@ -85,6 +85,15 @@ struct PlannedNote {
     int drum = 0;           // the kit's drum (PerformerFrame::drums), 0: the first or only
     int line = 0;           // where the note is written
     int column = 0;
+    Grace grace = Grace::none; // a flam's or a drag's grace stroke (ScoreNote::grace)
+};
+
+// A meter of the score (ScoreMeter) from plan time time_s on.
+struct PlannedMeter {
+    double time_s = 0.0;
+    double beat = 0.0; // in the score
+    int numerator = 4;
+    int denominator = 4;
 };
 
 struct PlanOptions {
@@ -140,6 +149,7 @@ struct GesturePlan {
     TipTrajectory tips;
     std::array<std::vector<Eigen::Vector3d>, 2> stick_dir; // [side][frame], unit, butt -> tip
     std::vector<PlannedNote> notes;                        // in time order
+    std::vector<PlannedMeter> meters;                      // the score's, in order
     double duration_s = 0.0;
     double score_start_s = 0.0; // plan time of the score's beat 0 (= lead_in_s)
 };
