@@ -19,6 +19,7 @@
  */
 #include "contact.h"
 #include "membrane_internal.h"
+#include "stick_tip.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -65,6 +66,17 @@ contact *contact_new(void)
     c->point.ops = &contact_point_ops;
     c->point.r_over_a = 0.3;
     return c;
+}
+
+ictus_status contact_set_tip(contact *c, const char *name)
+{
+    const stick_tip *tip = stick_tip_find(name);
+    if (!c || !tip)
+        return ICTUS_CLAMPED;
+    c->alpha = tip->alpha;
+    c->stiffness = tip->stiffness;
+    c->damping = tip->mu * tip->stiffness;
+    return ICTUS_OK;
 }
 
 void contact_free(contact *c)

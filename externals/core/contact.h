@@ -4,8 +4,10 @@
  * compression x = stick position - membrane displacement at the contact point
  * (positive into the membrane), the contact force is
  *     F = k x^alpha + lambda x^alpha dx/dt     for x > 0, else 0, and F >= 0
- * (Hunt & Crossley; lambda in N s / m^(alpha+1)). The ratio mu = lambda / k (s/m)
- * is the damping per unit stiffness; the default lambda gives mu = 0.5 s/m.
+ * (Hunt & Crossley; lambda in N s / m^(alpha+1)), the law of stick_tip.h, which
+ * the daemon's physics uses too. The ratio mu = lambda / k (s/m) is the damping
+ * per unit stiffness. contact_set_tip() takes alpha, k and lambda from the table
+ * of stick tips (stick_tip.h: wood, nylon, felt).
  * The contact is solved jointly with the membrane's modes, sample by sample
  * (Avanzini & Rocchesso), with an energy-consistent discretisation: the
  * spring term is a discrete gradient of V(x) = k x^(alpha+1)/(alpha+1) and the
@@ -40,7 +42,9 @@ extern "C" {
 /* Contacts attached to one membrane at once: each is one of its coupling points. */
 #define MEMBRANE_MAX_CONTACTS MEMBRANE_MAX_POINTS
 
-/* Defaults: a 50 g snare stick with a felt-free wooden tip on Mylar. */
+/* Defaults: a 50 g snare stick, a tip 47 times softer than the "wood" of
+ * stick_tip.h (docs/sound.md, "Stick tips": with the Hertz stiffness of wood on
+ * Mylar the head's compliance is all there is, and a harder hit is no brighter). */
 #define CONTACT_DEFAULT_MASS      0.05
 #define CONTACT_DEFAULT_STIFFNESS 1.0e7
 #define CONTACT_DEFAULT_ALPHA     1.5
@@ -71,6 +75,11 @@ typedef struct contact_report {
 
 /* Allocates. Returns NULL when memory cannot be had. */
 contact *contact_new(void);
+
+/* alpha, stiffness and damping (lambda = mu k) from the stick tip called name
+ * (stick_tip.h). Returns ICTUS_CLAMPED and changes nothing for an unknown name.
+ * The mass stays: it is the stick's, set with the hit or the "mass" parameter. */
+ictus_status contact_set_tip(contact *c, const char *name);
 void contact_free(contact *c);
 
 /* Attach / detach a contact (at most MEMBRANE_MAX_CONTACTS per membrane). A contact

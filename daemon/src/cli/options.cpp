@@ -244,6 +244,12 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
     else if (a == "--drum-density")
         o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
+    else if (a == "--stick-tip") {
+        const std::string v = value();
+        if (!is_stick_tip(v))
+            throw UsageError("--stick-tip: expected wood, nylon or felt, got '" + v + "'");
+        o.scene.drum.stick_tip = v;
+    }
     else if (a == "--sticks") {
         const std::string v = value();
         if (v == "fulcrum")

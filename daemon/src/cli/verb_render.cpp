@@ -114,6 +114,8 @@ void render_usage(std::ostream &out)
            "  --drum-radius M     (default 0.178)\n"
            "  --drum-tension N/M  (default 3000)\n"
            "  --drum-density KG/M2  for the sound (default 0.26)\n"
+           "  --stick-tip NAME    wood, nylon or felt: the tip's law in series with the head\n"
+           "                      (default: none, the head's spring alone; docs/sound.md)\n"
            "  --bounce-height M   bounce rule height (default 0.01)\n"
            "  --bounce-window S   bounce rule window (default 0.15)\n"
            "\n"
@@ -280,6 +282,7 @@ nlohmann::json drum_json(const Performance &p)
     j["density_kg_per_m2"] = p.options().drum_density_kg_per_m2;
     j["contact_stiffness_n_per_m"] = p.detector().membrane().stiffness_n_per_m;
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
+    j["stick_tip"] = d.stick_tip; // "": none
     return j;
 }
 

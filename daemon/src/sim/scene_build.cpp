@@ -3,6 +3,7 @@
 // grip). Stepping is in scene_step.cpp, the state read back in scene_state.cpp.
 #include "ictus/sim/scene.hpp"
 #include "scene_ode.hpp"
+#include "stick_tip.h"
 
 #include <ode/ode.h>
 
@@ -70,6 +71,11 @@ double DrumParams::stiffness_n_per_m(double tip_radius_m) const
     return 2.0 * M_PI * tension_n_per_m / std::log(radius_m / tip_radius_m);
 }
 
+bool is_stick_tip(const std::string &name)
+{
+    return stick_tip_find(name.c_str()) != nullptr;
+}
+
 void validate(const SceneOptions &o)
 {
     check_finite_positive("physics step (s)", o.step_s, 0.05);
@@ -87,6 +93,8 @@ void validate(const SceneOptions &o)
     if (!(std::isfinite(o.drum.contact_damping_n_s_per_m) &&
           o.drum.contact_damping_n_s_per_m >= 0.0))
         throw SimError("drum contact damping: expected a finite value >= 0");
+    if (!o.drum.stick_tip.empty() && !stick_tip_find(o.drum.stick_tip.c_str()))
+        throw SimError("stick tip: expected wood, nylon or felt, got '" + o.drum.stick_tip + "'");
     if (!(std::isfinite(o.drum.friction) && o.drum.friction >= 0.0))
         throw SimError("drum friction: expected a finite value >= 0");
     if (!o.drum.center_m.allFinite())
@@ -369,6 +377,9 @@ void Scene::place_drum()
                                         options_.contact_numerical_damping_compensated);
     contact_erp_ = sc.erp;
     contact_cfm_ = sc.cfm;
+    const stick_tip *tip = drum.stick_tip.empty() ? nullptr : stick_tip_find(drum.stick_tip.c_str());
+    tip_stiffness_ = tip ? tip->stiffness : 0.0;
+    tip_alpha_ = tip ? tip->alpha : 1.0;
 }
 
 // ERP = h k / (h k + c), CFM = 1 / (h k + c) is the implicit (backward)

@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <limits>
+#include <string>
 #include <vector>
 
 // ODE's opaque handles, so that users of the scene need not include ode.h.
@@ -39,6 +40,10 @@ struct DrumParams {
     double tension_n_per_m = 3000.0;
     double contact_damping_n_s_per_m = 3.0;
     double friction = 0.3;
+    // The stick tip (externals/core/stick_tip.h: wood, nylon, felt), in series
+    // with the head's spring: "" for none (the head's spring alone). Scene::
+    // near_callback has the law.
+    std::string stick_tip;
     // k = 2 pi T / ln(R / r_tip), N/m.
     double stiffness_n_per_m(double tip_radius_m) const;
 };
@@ -123,6 +128,8 @@ struct SceneOptions {
 };
 // Throws SimError naming the first bad option.
 void validate(const SceneOptions &options);
+// Whether name is a stick tip of the table (DrumParams::stick_tip).
+bool is_stick_tip(const std::string &name);
 
 enum class StepResult { ok, diverged };
 
@@ -141,6 +148,13 @@ struct SoftContact {
     double cfm = 0.0;
 };
 SoftContact soft_contact(double h_s, double k_n_per_m, double c_n_s_per_m, bool compensated);
+
+// The bead on the head with a stick tip (DrumParams::stick_tip): the tip's law
+// F = k_tip x^alpha (externals/core/stick_tip.h, the law contact~ plays) in series
+// with the head's spring k_head (N/m, massless). Returns the pair's secant
+// stiffness F / depth (N/m) at the given depth (m): k_head for depth <= 0 or
+// k_tip <= 0. The scene gives it to ODE's soft contact each step.
+double series_contact_stiffness(double k_head, double k_tip, double alpha, double depth);
 
 struct StickDrumContact {
     Eigen::Vector3d bead_force_n = Eigen::Vector3d::Zero();  // through the bead (tip sphere)
@@ -376,6 +390,8 @@ class Scene
     dxBody *tip_body(Side side) const;
     Eigen::Vector3d tip_body_com(Side side) const; // its CoM in the hand frame
     double contact_erp_ = 0.0, contact_cfm_ = 0.0;
+    // The stick tip's law (DrumParams::stick_tip), 0 stiffness: none.
+    double tip_stiffness_ = 0.0, tip_alpha_ = 1.0;
 
     double time_s_ = 0.0;
     long steps_ = 0;
