@@ -15,6 +15,7 @@
 #
 # usage: scripts/main.sh [--build DIR] [--out DIR] [--score FILE] [--no-deps] [--no-build]
 #                        [--mix stereo|pickups] [--bits 16|24|32] [--gain DB]
+#                        [--drum-preset NAME]
 #        scripts/main.sh [BUILD_DIR]            (as before: the build folder)
 #   --build DIR   build folder (default build/)
 #   --out DIR     output folder (default out/)
@@ -25,6 +26,8 @@
 #                 pickups (the membrane's two raw pickups)
 #   --bits N      16 or 24 (integer PCM) or 32 (float, the default)
 #   --gain DB     output gain before the soft limiter (default 0)
+#   --drum-preset NAME  the drum (ictusd render --drum-preset; docs/sound.md): paper,
+#                 snare, tom, floor-tom, timpani, frame (default tom)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build
@@ -35,6 +38,7 @@ do_build=1
 mix=stereo
 bits=32
 gain=0
+drum_preset=tom
 while [[ $# -gt 0 ]]; do
     case $1 in
     --build) build=$2; shift 2 ;;
@@ -45,7 +49,8 @@ while [[ $# -gt 0 ]]; do
     --mix) mix=$2; shift 2 ;;
     --bits) bits=$2; shift 2 ;;
     --gain) gain=$2; shift 2 ;;
-    -h | --help) sed -n '2,30p' "$0"; exit 0 ;;
+    --drum-preset) drum_preset=$2; shift 2 ;;
+    -h | --help) sed -n '2,32p' "$0"; exit 0 ;;
     -*) echo "main.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
     *) build=$1; shift ;;
     esac
@@ -91,7 +96,7 @@ rm -f "$out"/{strikes.csv,events.txt,render.json,tips.csv,notes.csv,performance.
 # batch mode (patches/ictus-render.pd; pd's output in OUT/pd.log)
 wav=$out/performance.wav
 render=("$ictusd" render --out "$out" --force --wav "$wav" --wav-mix "$mix" --wav-bits "$bits"
-        --wav-gain "$gain")
+        --wav-gain "$gain" --drum-preset "$drum_preset")
 [[ -n $score ]] && render+=(--score "$score")
 "${render[@]}" || {
     [[ -f $out/pd.log ]] && cat "$out/pd.log" >&2

@@ -41,6 +41,10 @@ membrane *membrane_new(double sample_rate_hz)
     m->density = MEMBRANE_DEFAULT_DENSITY;
     m->t60 = MEMBRANE_DEFAULT_T60;
     m->hf_damping = MEMBRANE_DEFAULT_HF_DAMPING;
+    m->tension_mod = MEMBRANE_DEFAULT_TENSION_MOD;
+    m->radiation = MEMBRANE_DEFAULT_RADIATION;
+    m->loss_factor = MEMBRANE_DEFAULT_LOSS_FACTOR;
+    m->tm_g = 1.0;
     m->output_gain = MEMBRANE_DEFAULT_GAIN;
     m->gain_smoothed = MEMBRANE_DEFAULT_GAIN;
     m->strike_r = 0.3;
@@ -202,6 +206,8 @@ static int pair_ok(const membrane *m, const float *force_in, int i, int n, int n
 {
     if (i + 1 >= n || next_landing == i + 1 || m->pick_fade_left[0] > 0 || m->pick_fade_left[1] > 0)
         return 0;
+    if (m->tm_countdown == 1 && (m->tension_mod > 0.0 || m->tm_g != 1.0))
+        return 0; /* a tension update comes before sample i + 1 */
     if (force_in && (force_in[i] != 0.0f || force_in[i + 1] != 0.0f))
         return 0; /* NaN and inf (read as 0) take the one-sample path too */
     for (int s = 0; s < m->queued; s++)
@@ -295,7 +301,32 @@ static inline void solve_points(membrane *m, membrane_point **act, int na, membr
             K[r][c] = s * wscale;
         }
     }
-    act[0]->ops->solve(act, nact, a->point_w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i, extra);
+    /* Points of one kind (the same ops: sticks, snare wires) are solved together; the
+     * kinds see each other's forces through the modes a sample later. */
+    int done = 0;
+    for (int g = 0; g < nact; g++) {
+        if (done & (1 << g))
+            continue;
+        membrane_point *sub[MEMBRANE_MAX_POINTS];
+        double subw[MEMBRANE_MAX_POINTS], subK[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
+        int idx[MEMBRANE_MAX_POINTS], ns = 0;
+        for (int c = g; c < nact; c++)
+            if (act[c]->ops == act[g]->ops) {
+                idx[ns] = c;
+                sub[ns] = act[c];
+                subw[ns++] = a->point_w[c];
+                done |= 1 << c;
+            }
+        if (ns == nact) {
+            act[0]->ops->solve(act, nact, a->point_w, (const double(*)[MEMBRANE_MAX_POINTS])K, T, i,
+                               extra);
+            return;
+        }
+        for (int r = 0; r < ns; r++)
+            for (int c = 0; c < ns; c++)
+                subK[r][c] = K[idx[r]][idx[c]];
+        sub[0]->ops->solve(sub, ns, subw, (const double(*)[MEMBRANE_MAX_POINTS])subK, T, i, extra);
+    }
 }
 
 /* After a block of n: pending strikes and moves carry past it, and modes that have
@@ -359,6 +390,11 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             fin = 0.0f;
         if (i == next_landing)
             next_landing = land_points(m, i, n);
+        if (m->tension_mod > 0.0 || m->tm_g != 1.0) {
+            /* Every TM_INTERVAL samples of absolute time: block-size independent. */
+            if (m->tm_countdown <= 0 && membrane_tension_update_(m))
+                m->tm_countdown = TM_INTERVAL;
+        }
         membrane_point *act[MEMBRANE_MAX_POINTS];
         int na = gather_points(m, &a, act);
         a.points = na;
@@ -366,6 +402,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
         if (na == 0 && pair_ok(m, force_in, i, n, next_landing)) {
             /* Ringing freely: samples i and i + 1 in one pass, bit-identical to two. */
             m->kernel_pair(&a);
+            if (m->tm_countdown > 0)
+                m->tm_countdown -= 2;
             const double none[MEMBRANE_PICKUPS] = {0};
             if (emit_sample(m, a.pick_sum, none, picks, out, i, gain_coef)) {
                 i++;
@@ -375,6 +413,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             continue;
         }
         m->kernel(&a);
+        if (m->tm_countdown > 0)
+            m->tm_countdown--;
         for (int c = 0; c < na; c++)
             act[c]->force_pending = 0.0;
         land_strikes(m, i, T, &a);

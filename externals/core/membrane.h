@@ -13,8 +13,9 @@
  * membrane_process().
  *
  * Damping law (documented in docs/membrane.md):
- *     sigma_k = sigma0 + sigma1 * omega_k^2     (decay rate, 1/s; T60 = ln(1000)/sigma_k)
- * set by the fundamental's T60 and a high-frequency damping control.
+ *     sigma_k = sigma0 + sigma1 * omega_k^2 + radiation sigma_rad,k + eta omega_k / 2
+ * (decay rate, 1/s; T60 = ln(1000)/sigma_k): sigma0 and sigma1 set by the t60 and
+ * hfdamp controls, sigma_rad,k the mode's air radiation, eta the internal loss.
  *
  * Threading: one instance is used by one thread at a time. Setters may be
  * called between membrane_process() calls while sounding; they never click,
@@ -44,6 +45,12 @@ extern "C" {
 #define MEMBRANE_T60_MAX        60.0  /* s */
 #define MEMBRANE_HF_DAMPING_MIN 0.0   /* docs/membrane.md */
 #define MEMBRANE_HF_DAMPING_MAX 1000.0
+#define MEMBRANE_TENSION_MOD_MIN 0.0 /* 0: linear head (constant tension) */
+#define MEMBRANE_TENSION_MOD_MAX 100.0
+#define MEMBRANE_RADIATION_MIN   0.0 /* 0: no air radiation loss */
+#define MEMBRANE_RADIATION_MAX   100.0
+#define MEMBRANE_LOSS_FACTOR_MIN 0.0 /* 0: no internal loss */
+#define MEMBRANE_LOSS_FACTOR_MAX 0.5
 #define MEMBRANE_GAIN_MIN       -1.0e6 /* s/m; negative inverts */
 #define MEMBRANE_GAIN_MAX       1.0e6
 #define MEMBRANE_R_OVER_A_MIN   0.0 /* points: pickups, strikes, contacts */
@@ -61,6 +68,20 @@ extern "C" {
 #define MEMBRANE_DEFAULT_MODES      128
 #define MEMBRANE_DEFAULT_T60        1.0
 #define MEMBRANE_DEFAULT_HF_DAMPING 1.0
+/* Tension modulation (docs/membrane.md, "Tension modulation"): 1 = a Mylar head. */
+#define MEMBRANE_DEFAULT_TENSION_MOD 1.0
+/* Losses from physics (docs/membrane.md, "Losses"): air radiation of a baffled head
+ * (1 = a head in an infinite baffle, 0.5 = the same head radiating into free space on
+ * one side) and the film's internal loss factor eta (decay rate eta w / 2). */
+#define MEMBRANE_DEFAULT_RADIATION   0.5
+#define MEMBRANE_DEFAULT_LOSS_FACTOR 0.002
+#define MEMBRANE_AIR_RHO             1.2   /* kg/m^3 */
+#define MEMBRANE_AIR_C               343.0 /* m/s */
+/* Mylar (PET film), for the tension modulation: Young's modulus (Pa), Poisson's ratio
+ * and density (kg/m^3); the head's thickness is its areal density / MEMBRANE_MYLAR_RHO. */
+#define MEMBRANE_MYLAR_YOUNG   4.5e9
+#define MEMBRANE_MYLAR_POISSON 0.38
+#define MEMBRANE_MYLAR_RHO     1390.0
 /* A forte hit (0.05 kg stick at 5 m/s, default head, r/a = 0.3) peaks near 0.5 full
  * scale with this gain (measured by tests/core, docs/membrane.md#output-scale). */
 #define MEMBRANE_DEFAULT_GAIN 0.16
@@ -82,6 +103,16 @@ typedef enum membrane_param {
     MEMBRANE_PARAM_T60,
     MEMBRANE_PARAM_HF_DAMPING,
     MEMBRANE_PARAM_GAIN, /* output gain applied to the pickups (docs/membrane.md) */
+    /* Tension modulation, dimensionless: the stretch of a Mylar head raises its tension
+     * with the vibration energy E (J), T = T0 (1 + tensionmod kappa E), kappa from
+     * Young's modulus, thickness and T0 (docs/membrane.md); every mode's frequency
+     * follows sqrt(T / T0). 1 = Mylar, 0 = a linear head (constant tension). */
+    MEMBRANE_PARAM_TENSION_MOD,
+    /* Losses added to the t60/hfdamp law: the air radiation of each mode (a factor
+     * on the baffled-membrane radiation rate, 1 = air) and the film's internal loss
+     * factor eta (decay rate eta w / 2). Both 0: the t60/hfdamp law alone. */
+    MEMBRANE_PARAM_RADIATION,
+    MEMBRANE_PARAM_LOSS_FACTOR,
     MEMBRANE_PARAM_COUNT
 } membrane_param;
 
@@ -142,6 +173,11 @@ double membrane_displacement_at(const membrane *m, double r_over_a, double theta
 double membrane_velocity_at(const membrane *m, double r_over_a, double theta_deg);
 /* Total vibrational energy of the modes (J). */
 double membrane_energy(const membrane *m);
+/* Tension modulation: the coefficient kappa (1/J) of T = T0 (1 + kappa E) at the
+ * current parameters (tensionmod included), and the frequency factor sqrt(T / T0)
+ * the modes ring with now (1 for a linear head). */
+double membrane_tension_kappa(const membrane *m);
+double membrane_frequency_factor(const membrane *m);
 /* Strikes dropped because the queue was full. */
 long membrane_dropped_strikes(const membrane *m);
 

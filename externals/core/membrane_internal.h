@@ -75,8 +75,23 @@ typedef struct impulse_shape {
 
 typedef struct membrane_point membrane_point;
 
+/* Tension modulation: the frequency factor is recomputed from the modal energy every
+ * TM_INTERVAL samples of absolute time (block-size independent), and the coefficients
+ * rebuilt when it moved by more than TM_THRESHOLD (relative; 0.035 cent). */
+#define TM_INTERVAL  128
+#define TM_THRESHOLD 2.0e-5
+#define TM_G_MAX     2.0 /* frequency factor cap: tension at most 4 T0 */
+
 struct membrane {
     double sample_rate, radius, tension, density, t60, hf_damping, output_gain;
+    double tension_mod;            /* dimensionless, MEMBRANE_PARAM_TENSION_MOD */
+    double radiation, loss_factor; /* MEMBRANE_PARAM_RADIATION, MEMBRANE_PARAM_LOSS_FACTOR */
+    /* The radiation integral of each mode depends on ka = j c / c_air alone: kept for
+     * rad_valid modes at the wave speed rad_c (recomputed when either changes). */
+    double *rad_int, rad_c;
+    int rad_valid;
+    double tm_g;          /* frequency factor sqrt(T / T0) in the coefficients now */
+    int tm_countdown;     /* samples until the next tension update */
     double gain_smoothed; /* output gain as applied, follows output_gain in ~5 ms */
     int modes;            /* requested mode count */
     /* After the count shrinks, the dropped modes ring out over FADE_S (no input,
@@ -87,7 +102,11 @@ struct membrane {
     int capacity; /* floats allocated per array */
     /* Mode table, capacity entries; entries >= modes are padding. */
     mode_table table;
+    mode_tuning tuning;  /* frequency and decay corrections (count 0: the ideal membrane) */
     double *omega_model; /* model stiffness w' per mode (0: silent) */
+    /* w' and the damping s' of each mode at the base tension T0 (float, for the
+     * tension update's vector loop); w' = tm_g wm0 for the sounding modes. */
+    float *wm0, *sm0;
     /* SoA float state and coefficients (see membrane_kernel.inc): q holds the
      * scaled displacement r = q / (h w'), h = T / 2 (the energy coordinate q is
      * h w' r); cd = 2 / D is r's coefficient of p; ep the input gain of both. */
@@ -154,6 +173,12 @@ void membrane_update_coefficients_(membrane *m, int rescale);
 ictus_status membrane_build_modes_(membrane *m, int modes);
 /* Frees the arrays built for the capacity (not the points'). */
 void membrane_free_mode_arrays_(membrane *m);
+
+/* The tension update (membrane_modes.c): from the modal energy, the frequency factor,
+ * and when it moved, the coefficients, the state (energy kept: passive) and the
+ * couplings. Audio thread: no allocation, O(modes). 0 when it has to wait (a point
+ * carries a force), 1 when done. */
+int membrane_tension_update_(membrane *m);
 
 /* membrane_points.c. The points' pending forces into the state (message time only:
  * before coefficients or shapes change). */

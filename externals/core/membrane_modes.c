@@ -6,16 +6,70 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Damping law sigma_k = s0 + s1 w_k^2 with s0 + s1 w_1^2 = ln(1000)/t60 and
- * s1 w_ref^2 = hf * s0 at w_ref = 2 pi 1 kHz. */
-static double mode_decay_rate(const membrane *m, double omega)
+/* Air radiation of mode k of a head in an infinite baffle (1/s): the Rayleigh integral
+ * of the mode shape J_m(j r/a) cos(m phi) gives the far field, whose power over the
+ * half space, divided by twice the mode's energy, is
+ *     sigma_rad = rho w^2 a^2 j^2 / (c sigma) int_0^{pi/2} J_m(x)^2 / (j^2 - x^2)^2 sin(t) dt,
+ * x = k a sin(t), k = w / c (docs/membrane.md, "Losses"). At low ka the (0, n) modes
+ * radiate as monopoles, rho T / (c sigma^2), and the m >= 1 modes (ka)^(2m) less. */
+static double radiation_integral(const membrane *m, int k, double omega)
+{
+    const int order = m->table.m[k];
+    const double j = m->table.j[k], ka = omega / MEMBRANE_AIR_C * m->radius;
+    const double dj = ictus_bessel_j(order + 1, j); /* |J_m'(j)| at a zero of J_m */
+    const int steps = 64;
+    double sum = 0.0;
+    for (int i = 0; i < steps; i++) {
+        double t = (i + 0.5) * (0.5 * M_PI / steps), x = ka * sin(t);
+        double den = j * j - x * x;
+        /* Near x = j the ratio tends to J_m'(j)^2 / (2 j)^2. */
+        double v;
+        if (fabs(den) < 1e-6 * j * j) {
+            v = dj * dj / (4.0 * j * j);
+        } else {
+            double ratio = ictus_bessel_j(order, x) / den;
+            v = ratio * ratio;
+        }
+        sum += v * sin(t);
+    }
+    return sum * (0.5 * M_PI / steps);
+}
+
+static double radiation_rate(const membrane *m, int k, double omega)
+{
+    membrane *mm = (membrane *)m; /* the cache only */
+    const double c = sqrt(m->tension / m->density), j = m->table.j[k];
+    if (c != m->rad_c) {
+        mm->rad_c = c;
+        mm->rad_valid = 0;
+    }
+    double in;
+    if (m->rad_int && k < m->capacity) {
+        for (; m->rad_valid <= k; mm->rad_valid++)
+            mm->rad_int[m->rad_valid] =
+                radiation_integral(m, m->rad_valid, m->table.j[m->rad_valid] * c / m->radius);
+        in = m->rad_int[k];
+    } else {
+        in = radiation_integral(m, k, omega);
+    }
+    return MEMBRANE_AIR_RHO * omega * omega * m->radius * m->radius * j * j /
+           (MEMBRANE_AIR_C * m->density) * in;
+}
+
+/* Decay rate of mode k (1/s): the law sigma_k = s0 + s1 w_k^2 with s0 + s1 w_1^2 =
+ * ln(1000)/t60 and s1 w_ref^2 = hf * s0 at w_ref = 2 pi 1 kHz, plus the air radiation
+ * and the internal loss eta w / 2. */
+static double mode_decay_rate(const membrane *m, int k, double omega)
 {
     double omega1 = m->table.j[0] * sqrt(m->tension / m->density) / m->radius;
     double w_ref = 2.0 * M_PI * 1000.0;
     double rate1 = log(1000.0) / m->t60;
     double s0 = rate1 / (1.0 + m->hf_damping * (omega1 / w_ref) * (omega1 / w_ref));
     double s1 = m->hf_damping * s0 / (w_ref * w_ref);
-    return s0 + s1 * omega * omega;
+    double rate = s0 + s1 * omega * omega + 0.5 * m->loss_factor * omega;
+    if (m->radiation > 0.0)
+        rate += m->radiation * radiation_rate(m, k, omega);
+    return rate;
 }
 
 /* Recomputes every coefficient from the physics. When rescale is set, the modal
@@ -32,7 +86,9 @@ void membrane_update_coefficients_(membrane *m, int rescale)
     for (int k = 0; k < m->capacity; k++) {
         double old_omega = m->omega_model[k];
         int fading = k >= m->modes;
-        double freq = (k < m->fading_modes) ? m->table.j[k] * c / (2.0 * M_PI * m->radius) : 0.0;
+        double freq = (k < m->fading_modes) ? mode_table_tuned_j(&m->table, k, &m->tuning) * c /
+                                                  (2.0 * M_PI * m->radius)
+                                            : 0.0;
         if (k >= m->fading_modes || freq >= 0.95 * 0.5 * m->sample_rate || freq <= 0.0) {
             /* Silent: frozen at zero, no input, no output. */
             m->c1[k] = m->cd[k] = m->c3[k] = m->ep[k] = 0.0f;
@@ -42,7 +98,9 @@ void membrane_update_coefficients_(membrane *m, int rescale)
             continue;
         }
         double omega = 2.0 * M_PI * freq;
-        double sigma = fading ? log(1000.0) / FADE_S : mode_decay_rate(m, omega);
+        double sigma = fading ? log(1000.0) / FADE_S : mode_decay_rate(m, k, omega);
+        if (!fading)
+            sigma *= mode_table_decay_factor(&m->table, k, &m->tuning);
         /* Inverse bilinear map of the wanted discrete poles z = exp((-sigma +- i w) T):
          * s = (2/T) tanh((-sigma +- i w) T / 2) = a +- i b, so the midpoint rule's poles
          * land exactly on the target pitch and decay. */
@@ -52,6 +110,10 @@ void membrane_update_coefficients_(membrane *m, int rescale)
         double b = (2.0 / T) * sin(v2) / den;
         double wm = sqrt(a * a + b * b); /* model stiffness w' */
         double sm = -a;                  /* model damping s' */
+        m->wm0[k] = (float)wm;
+        m->sm0[k] = (float)sm;
+        if (!fading)
+            wm *= m->tm_g; /* tension modulation (membrane_tension_update_) */
         double D = 1.0 + 2.0 * h * sm + h * h * wm * wm;
         /* In q, p: q+ = q - c1 q + c2 p + eq u, p+ = p - c2 q - c3 p + ep u with
          * c2 = 2 h w' / D and eq = h w' ep. With r = q / (h w') (c2 h w' = c1,
@@ -98,13 +160,15 @@ enum {
     ARR_EP_K,
     ARR_PICK_K0,
     ARR_PICK_K1,
+    ARR_WM0,
+    ARR_SM0,
     ARR_COUNT
 };
 
 /* A new set of the arrays that depend on the capacity, before it replaces the old. */
 typedef struct mode_arrays {
     mode_table table;
-    double *omega_model;
+    double *omega_model, *rad_int;
     float *f[ARR_COUNT];
     float *impulse[IMPULSE_CACHE];
     float *point_psi[MEMBRANE_MAX_POINTS][3]; /* psi, psi_next, psi_k of each point */
@@ -114,6 +178,7 @@ static void mode_arrays_free(mode_arrays *a)
 {
     mode_table_free(&a->table);
     free(a->omega_model);
+    free(a->rad_int);
     for (int i = 0; i < ARR_COUNT; i++)
         free(a->f[i]);
     for (int i = 0; i < IMPULSE_CACHE; i++)
@@ -129,7 +194,8 @@ static int mode_arrays_alloc(mode_arrays *a, int cap, int points)
 {
     memset(a, 0, sizeof(*a));
     a->omega_model = calloc((size_t)cap, sizeof(double));
-    int ok = a->omega_model != NULL;
+    a->rad_int = calloc((size_t)cap, sizeof(double));
+    int ok = a->omega_model != NULL && a->rad_int != NULL;
     for (int i = 0; i < ARR_COUNT; i++) {
         a->f[i] = membrane_alloc_floats_(cap);
         ok = ok && a->f[i];
@@ -158,9 +224,13 @@ void membrane_free_mode_arrays_(membrane *m)
 {
     mode_table_free(&m->table);
     free(m->omega_model);
+    free(m->rad_int);
+    m->rad_int = NULL;
+    m->rad_valid = 0;
     free(m->q), free(m->p), free(m->c1), free(m->cd), free(m->c3);
     free(m->ep), free(m->psi_strike);
     free(m->sc), free(m->ep_k);
+    free(m->wm0), free(m->sm0);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
         free(m->psi_pick[i]);
         free(m->psi_pick_old[i]);
@@ -186,6 +256,8 @@ static void mode_arrays_install(membrane *m, mode_arrays *a, int cap)
     membrane_free_mode_arrays_(m);
     m->table = a->table;
     m->omega_model = a->omega_model;
+    m->rad_int = a->rad_int;
+    m->rad_valid = 0;
     m->q = f[ARR_Q], m->p = f[ARR_P], m->c1 = f[ARR_C1], m->cd = f[ARR_CD];
     m->c3 = f[ARR_C3], m->ep = f[ARR_EP];
     m->psi_strike = f[ARR_PSI_STRIKE];
@@ -196,6 +268,7 @@ static void mode_arrays_install(membrane *m, mode_arrays *a, int cap)
     m->sc = f[ARR_SC], m->ep_k = f[ARR_EP_K];
     m->pick_k[0] = f[ARR_PICK_K0];
     m->pick_k[1] = f[ARR_PICK_K1];
+    m->wm0 = f[ARR_WM0], m->sm0 = f[ARR_SM0];
     for (int i = 0; i < MEMBRANE_PICKUPS; i++)
         m->pick_fade_left[i] = 0;
     for (int i = 0; i < IMPULSE_CACHE; i++) {
@@ -281,16 +354,108 @@ int membrane_get_mode(const membrane *m, int k, double *freq_hz, double *t60_s, 
 {
     if (k < 0 || k >= m->modes)
         return 0;
-    double omega = m->table.j[k] * sqrt(m->tension / m->density) / m->radius;
+    double omega =
+        mode_table_tuned_j(&m->table, k, &m->tuning) * sqrt(m->tension / m->density) / m->radius;
     if (freq_hz)
         *freq_hz = omega / (2.0 * M_PI);
     if (t60_s)
-        *t60_s = log(1000.0) / mode_decay_rate(m, omega);
+        *t60_s = log(1000.0) /
+                 (mode_decay_rate(m, k, omega) * mode_table_decay_factor(&m->table, k, &m->tuning));
     if (bessel_m)
         *bessel_m = m->table.m[k];
     if (bessel_n)
         *bessel_n = m->table.n[k];
     if (sin_partner)
         *sin_partner = m->table.sin[k];
+    return 1;
+}
+
+/* ---------------------------------------------------------------- tension modulation
+ *
+ * The averaged-tension model (docs/membrane.md, "Tension modulation"): the head's
+ * mean stretch raises its tension, T = T0 (1 + kappa E), and every mode's w' follows
+ * g = sqrt(T / T0). */
+
+double membrane_tension_kappa(const membrane *m)
+{
+    /* Biaxial strain eps = (1/4A) int |grad w|^2 dA, dT = Y H eps / (1 - nu); the
+     * strain integral is 2 V / T0 (V the potential energy), and V averages E / 2:
+     * kappa = Y H / (4 (1 - nu) pi a^2 T0^2), H = density / rho. */
+    const double H = m->density / MEMBRANE_MYLAR_RHO;
+    const double area = M_PI * m->radius * m->radius;
+    return m->tension_mod * MEMBRANE_MYLAR_YOUNG * H /
+           (4.0 * (1.0 - MEMBRANE_MYLAR_POISSON) * area * m->tension * m->tension);
+}
+
+double membrane_frequency_factor(const membrane *m)
+{
+    return m->tm_g;
+}
+
+/* Energy of the sounding modes (J) from the stored state, without the pending
+ * point forces (the caller has flushed them). */
+static double stored_energy(const membrane *m)
+{
+    const float h = (float)m->coef_h;
+    double e = 0.0;
+    for (int k = 0; k < m->modes && k < m->count; k++) {
+        float hw = h * (float)m->omega_model[k] * m->sc[k];
+        float pk = m->sc[k] * m->p[k], qk = hw * m->q[k];
+        e += 0.5 * ((double)qk * qk + (double)pk * pk);
+    }
+    return e;
+}
+
+/* The coefficients of the sounding modes at factor g, the stored state converted so
+ * that each mode's energy (q, p) is kept, and the pickups' shapes in the new sc.
+ * Float: the coefficients as membrane_update_coefficients_ makes them, with w' = g wm0. */
+static void rebuild_coefficients(membrane *m, float g)
+{
+    const float h = (float)m->coef_h;
+    const float ept = (float)(m->mass_scale / m->sample_rate); /* ep = scale T / D */
+    const int n = m->modes < m->count ? m->modes : m->count;
+    for (int k = 0; k < n; k++) {
+        if (m->omega_model[k] <= 0.0)
+            continue;
+        float wm = g * m->wm0[k], hw = h * wm, hs = h * m->sm0[k];
+        float hw2 = hw * hw, d = 1.0f + 2.0f * hs + hw2, inv = 1.0f / d;
+        float y = sqrtf(2.0f * inv);
+        float old_sc = m->sc[k], old_w = (float)m->omega_model[k];
+        m->c1[k] = 2.0f * hw2 * inv;
+        m->cd[k] = 2.0f * inv;
+        m->c3[k] = (2.0f * hw2 + 4.0f * hs) * inv;
+        m->ep[k] = ept * inv;
+        m->sc[k] = y;
+        m->ep_k[k] = 0.5f * ept * y; /* ep / sc = (scale T / D) sqrt(D / 2) */
+        /* q = h w' sc (stored r) and p = sc (stored p) are kept. */
+        m->q[k] *= (old_w * old_sc) / (wm * y);
+        m->p[k] *= old_sc / y;
+        m->omega_model[k] = wm;
+    }
+}
+
+int membrane_tension_update_(membrane *m)
+{
+    const double kappa = membrane_tension_kappa(m);
+    if (kappa <= 0.0 && m->tm_g == 1.0)
+        return 1;
+    /* Not during a stroke (a stick touching, or flying close above the head): the
+     * update keeps each mode's energy, so the displacement under the stick moves by a
+     * fraction of the change of g, which a stiff contact would turn into a force step
+     * and the contact's potential into energy from nowhere. The tension follows on
+     * the first sample after the stroke (the stick 5 mm clear, docs/membrane.md). */
+    for (int i = 0; i < m->point_count; i++)
+        if (m->points[i]->active || m->points[i]->force_pending != 0.0)
+            return 0;
+    double g = sqrt(1.0 + kappa * stored_energy(m));
+    if (!(g <= TM_G_MAX))
+        g = TM_G_MAX; /* also NaN */
+    if (fabs(g - m->tm_g) <= TM_THRESHOLD * m->tm_g && !(g == 1.0 && m->tm_g != 1.0))
+        return 1;
+    if (fabs(g - 1.0) <= TM_THRESHOLD)
+        g = 1.0;
+    m->tm_g = g;
+    rebuild_coefficients(m, (float)g);
+    membrane_refresh_couplings_(m);
     return 1;
 }

@@ -112,6 +112,12 @@ static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
     [MEMBRANE_PARAM_HF_DAMPING] = {"hfdamp", "", RANGE(HF_DAMPING), FIELD(hf_damping),
                                    physics_changed},
     [MEMBRANE_PARAM_GAIN] = {"gain", "", RANGE(GAIN), FIELD(output_gain), NULL},
+    /* Takes effect at the next tension update (TM_INTERVAL samples at most). */
+    [MEMBRANE_PARAM_TENSION_MOD] = {"tensionmod", "", RANGE(TENSION_MOD), FIELD(tension_mod), NULL},
+    [MEMBRANE_PARAM_RADIATION] = {"radiation", "", RANGE(RADIATION), FIELD(radiation),
+                                  physics_changed},
+    [MEMBRANE_PARAM_LOSS_FACTOR] = {"lossfactor", "", RANGE(LOSS_FACTOR), FIELD(loss_factor),
+                                    physics_changed},
 };
 #undef RANGE
 #undef FIELD

@@ -92,3 +92,17 @@ double mode_table_shape(const mode_table *t, int k, double r_over_a, double thet
     return ictus_bessel_j(t->m[k], t->j[k] * r_over_a) * t->norm[k] *
            (t->sin[k] ? sin(t->m[k] * theta_rad) : cos(t->m[k] * theta_rad));
 }
+
+double mode_table_tuned_j(const mode_table *t, int k, const mode_tuning *u)
+{
+    if (!u || t->n[k] != 1 || t->m[k] >= u->count)
+        return t->j[k];
+    return t->j[k] * u->factor_m1[t->m[k]];
+}
+
+double mode_table_decay_factor(const mode_table *t, int k, const mode_tuning *u)
+{
+    if (!u || u->count == 0 || t->n[k] != 1 || t->m[k] != 0)
+        return 1.0;
+    return u->decay_01;
+}

@@ -32,4 +32,21 @@ void mode_table_shapes(const mode_table *t, int live, double r_over_a, double th
 /* The same for mode k alone, in double (theta in radians). */
 double mode_table_shape(const mode_table *t, int k, double r_over_a, double theta_rad);
 
+/* A correction of the ideal membrane's frequencies and decays for what loads the
+ * head (a timpani's kettle: membrane_presets.c, docs/sound.md). The (m, 1) mode rings
+ * at factor_m1[m] times its ideal frequency for m < MODE_TUNING_M (1 for the other
+ * modes), and the (0, 1) mode decays decay_01 times faster than the damping law says.
+ * count 0: no correction (the ideal membrane). The shapes stay the ideal ones. */
+#define MODE_TUNING_M 8
+typedef struct mode_tuning {
+    int count; /* factor_m1[0 .. count-1] are set, count <= MODE_TUNING_M */
+    double factor_m1[MODE_TUNING_M];
+    double decay_01; /* >= 1 */
+} mode_tuning;
+
+/* The zero that sets mode k's frequency under tuning u (u NULL or count 0: j[k]). */
+double mode_table_tuned_j(const mode_table *t, int k, const mode_tuning *u);
+/* The factor on mode k's decay rate under tuning u (1 but for a tuned (0, 1) mode). */
+double mode_table_decay_factor(const mode_table *t, int k, const mode_tuning *u);
+
 #endif

@@ -15,6 +15,8 @@
 #include <string.h>
 
 #include "ictus_pd.h"
+#include "membrane_presets.h"
+#include "snare_wires.h"
 #include "m_imp.h" /* obj_starttraverseoutlet: is the second outlet connected? */
 
 #if PD_FLOATSIZE != 32
@@ -40,6 +42,7 @@ struct _membrane_tilde {
     t_ictus_clock x_clock;
     t_membrane_tilde_attached x_attached[MEMBRANE_MAX_CONTACTS];
     int x_silent; /* every mode above Nyquist: said once, when it became so */
+    snare_wires *x_wires; /* NULL: no wires on the head */
 };
 
 t_class *ictus_membrane_tilde_class;
@@ -73,10 +76,76 @@ static void membrane_tilde_check_silent(t_membrane_tilde *x)
     x->x_silent = silent;
 }
 
-/* radius, tension, density, mass, modes, t60, hfdamp, gain: one number each. */
+/* radius, tension, density, mass, modes, t60, hfdamp, gain, tensionmod: one number each. */
 static void membrane_tilde_setparam(t_membrane_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
     ictus_params_message(x, &membrane_tilde_params, x->x_core, s, argc, argv);
+    membrane_tilde_check_silent(x);
+}
+
+/* Lays the snare wires on the head (on) or lifts them (off); 1 when done. */
+static int membrane_tilde_set_wires(t_membrane_tilde *x, int on)
+{
+    const char *sep = x->x_name != &s_ ? " " : "",
+               *name = x->x_name != &s_ ? x->x_name->s_name : "";
+    if (!on) {
+        snare_wires_free(x->x_wires);
+        x->x_wires = 0;
+        return 1;
+    }
+    if (x->x_wires)
+        return 1;
+    x->x_wires = snare_wires_new();
+    if (!x->x_wires || snare_wires_attach(x->x_wires, x->x_core) != ICTUS_OK) {
+        pd_error(x,
+                 "membrane~%s%s: wires: no room for the wires' %d coupling points (at most %d "
+                 "with the sticks) or out of memory: no wires",
+                 sep, name, SNARE_WIRES_MASSES, MEMBRANE_MAX_POINTS);
+        snare_wires_free(x->x_wires);
+        x->x_wires = 0;
+        return 0;
+    }
+    return 1;
+}
+
+/* wires on|off (or 1|0): the snare wires, colliding with the head (snare_wires.h). */
+static void membrane_tilde_wires(t_membrane_tilde *x, t_symbol *s, int argc, t_atom *argv)
+{
+    (void)s;
+    if (argc == 1 && argv[0].a_type == A_SYMBOL &&
+        (argv[0].a_w.w_symbol == gensym("on") || argv[0].a_w.w_symbol == gensym("off")))
+        membrane_tilde_set_wires(x, argv[0].a_w.w_symbol == gensym("on"));
+    else if (argc == 1 && argv[0].a_type == A_FLOAT &&
+             (argv[0].a_w.w_float == 0 || argv[0].a_w.w_float == 1))
+        membrane_tilde_set_wires(x, argv[0].a_w.w_float == 1);
+    else
+        pd_error(x, "membrane~%s%s: wires: expected on or off (1 or 0)",
+                 x->x_name != &s_ ? " " : "", x->x_name != &s_ ? x->x_name->s_name : "");
+}
+
+/* preset NAME: a drum modelled on a measured instrument (membrane_presets.h). */
+static void membrane_tilde_preset(t_membrane_tilde *x, t_symbol *s, int argc, t_atom *argv)
+{
+    const char *sep = x->x_name != &s_ ? " " : "",
+               *name = x->x_name != &s_ ? x->x_name->s_name : "";
+    const membrane_preset *p;
+    (void)s;
+    if (argc < 1 || argv[0].a_type != A_SYMBOL) {
+        pd_error(x, "membrane~%s%s: preset: expected a name (%s)", sep, name,
+                 membrane_preset_names());
+        return;
+    }
+    p = membrane_preset_find(atom_getsymbol(&argv[0])->s_name);
+    if (!p) {
+        pd_error(x, "membrane~%s%s: preset: unknown '%s'; the presets are %s", sep, name,
+                 atom_getsymbol(&argv[0])->s_name, membrane_preset_names());
+        return;
+    }
+    membrane_tilde_set_wires(x, 0); /* the points' shapes follow the new modes */
+    if (membrane_apply_preset(x->x_core, p) == ICTUS_ENOMEM)
+        pd_error(x, "membrane~%s%s: preset %s: out of memory for %d modes; kept %d", sep, name,
+                 p->name, p->modes, membrane_get_modes(x->x_core));
+    membrane_tilde_set_wires(x, p->wires);
     membrane_tilde_check_silent(x);
 }
 
@@ -133,7 +202,7 @@ static void membrane_tilde_print(t_membrane_tilde *x)
     const membrane *core = x->x_core;
     int k, count = membrane_get_modes(core);
     post("membrane~ %s: radius %g m, tension %g N/m, density %g kg/m^2 (mass %g kg), "
-         "%d modes, t60 %g s, hfdamp %g, gain %g, sr %g Hz",
+         "%d modes, t60 %g s, hfdamp %g, gain %g, tensionmod %g, sr %g Hz",
          x->x_name != &s_ ? x->x_name->s_name : "(no name)",
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_RADIUS),
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_TENSION),
@@ -142,6 +211,7 @@ static void membrane_tilde_print(t_membrane_tilde *x)
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_T60),
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_HF_DAMPING),
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_GAIN),
+         ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_TENSION_MOD),
          membrane_get_sample_rate(core));
     for (k = 0; k < count && k < 12; k++) {
         double f, t60;
@@ -235,6 +305,7 @@ static void *membrane_tilde_new(t_symbol *s, int argc, t_atom *argv)
     x->x_name = &s_;
     memset(&x->x_clock, 0, sizeof(x->x_clock));
     memset(x->x_attached, 0, sizeof(x->x_attached));
+    x->x_wires = 0;
     if (argc > 0 && argv[0].a_type == A_SYMBOL) {
         x->x_name = atom_getsymbol(&argv[0]);
         pd_bind(&x->x_obj.ob_pd, x->x_name);
@@ -272,6 +343,7 @@ static void membrane_tilde_free(t_membrane_tilde *x)
         }
     if (x->x_name != &s_)
         pd_unbind(&x->x_obj.ob_pd, x->x_name);
+    snare_wires_free(x->x_wires);
     membrane_free(x->x_core);
 }
 
@@ -285,6 +357,10 @@ void ictus_membrane_tilde_setup(void)
                     0);
     ictus_params_addmethods(ictus_membrane_tilde_class, &membrane_tilde_params,
                             (t_method)membrane_tilde_setparam);
+    class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_preset, gensym("preset"),
+                    A_GIMME, 0);
+    class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_wires, gensym("wires"),
+                    A_GIMME, 0);
     class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_pickup, gensym("pickup"),
                     A_GIMME, 0);
     class_addmethod(ictus_membrane_tilde_class, (t_method)membrane_tilde_position,

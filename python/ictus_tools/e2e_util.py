@@ -91,10 +91,12 @@ def hit_times_us(events):
 
 def drum_lines(render_json):
     """The drum of render.json as render-drum lines for ictus-render (membrane~
-    parameters; the simulation's contact law is its own and is not copied)."""
+    parameters: the preset first, when there is one, then the head's numbers; the
+    simulation's contact law is its own and is not copied)."""
     with open(render_json) as f:
         drum = json.load(f)["drum"]
-    return ["render-drum radius %.6g" % drum["radius_m"],
+    preset = ["render-drum preset %s" % drum["preset"]] if drum.get("preset") else []
+    return preset + ["render-drum radius %.6g" % drum["radius_m"],
             "render-drum tension %.6g" % drum["tension_n_per_m"],
             "render-drum density %.6g" % drum["density_kg_per_m2"]]
 

@@ -22,8 +22,9 @@ THETA`. Here: tempi 40..220 bpm (the brief; the language allows 20..400), durati
 musical fractions below (whole notes to 1/32, triplets, dotted values, non-reduced forms).
 
 Validity. The parser's ranges are kept by construction. The planner (gesture_score.cpp,
-`plan_performance`) also refuses a stroke that comes less than `min_stroke_interval_s` = 0.1 s
-after the previous stroke of the same hand, and plans over 900 s. The generator follows the
+`plan_performance`) also refuses a stroke that comes less than `min_stroke_interval_s` = 40 ms
+after the previous stroke of the same hand, and plans over 900 s; here a hand's strokes are kept
+at least 0.1 s apart (closer ones, doubles and paradiddles, are ictus_tools.rudiments'). The generator follows the
 tempo map itself (the closed-form integral of docs/score.md, written here again, not taken from
 the daemon) and keeps every hand's strokes >= MIN_STROKE_INTERVAL_S + 1 us apart: a note whose
 hand would come too soon goes to the other hand, and if neither hand can play it a rest comes
@@ -50,7 +51,7 @@ import tempfile
 
 from ictus_tools import ROOT
 
-MIN_STROKE_INTERVAL_S = 0.1   # PlanOptions::min_stroke_interval_s (docs/score.md, "Errors")
+MIN_STROKE_INTERVAL_S = 0.1   # >= PlanOptions::min_stroke_interval_s (docs/score.md, "Errors")
 INTERVAL_MARGIN_S = 1e-6      # our tempo map and the daemon's differ by ~1e-15 s
 TEMPO_RANGE = (40.0, 220.0)   # the brief's range (the language's: 20..400)
 SCORE_BUDGET_S = 6.0          # at most this much score (beat 0 to the end of the last note)

@@ -432,3 +432,40 @@ TEST_CASE("ictusd: every --help lists each option once, and its examples name fi
     CHECK((ictusd("run --help").output + ictusd("render --help").output).find("examples/scores/") !=
           std::string::npos);
 }
+
+// --drum-preset NAME: the head of externals/core/membrane_presets.c in the physics and
+// in render.json (a 26-inch timpani: radius 13 x 0.0254 m, 0.19 mm Mylar at
+// 1380 kg/m^3), an explicit --drum-tension winning whatever the order, and an unknown
+// name a usage error (exit 2) that lists the presets.
+TEST_CASE("ictusd render --drum-preset: the preset's head, recorded in render.json",
+          "[cli][bounds]")
+{
+    const std::string bvh = tiny_bvh();
+    int renders = 0;
+    auto drum_of = [&](const std::string &extra) {
+        const std::string dir = simtest::temp_path("preset_out" + std::to_string(renders++));
+        const Run r =
+            ictusd("render --mocap " + bvh + " --duration 0.05 --out " + dir + " " + extra);
+        INFO(extra << " -> " << r.status << "\n" << r.output);
+        REQUIRE(r.status == 0);
+        std::ifstream in(dir + "/render.json");
+        return nlohmann::json::parse(in)["drum"];
+    };
+    nlohmann::json d = drum_of("--drum-preset timpani");
+    CHECK(d["preset"] == "timpani");
+    CHECK(d["radius_m"].get<double>() == Approx(13 * 0.0254).epsilon(1e-9));
+    CHECK(d["density_kg_per_m2"].get<double>() == Approx(1380 * 0.19e-3).epsilon(2e-3));
+    d = drum_of("--drum-tension 2000 --drum-preset timpani");
+    CHECK(d["tension_n_per_m"].get<double>() == 2000.0);
+    CHECK(d["radius_m"].get<double>() == Approx(13 * 0.0254).epsilon(1e-9));
+    d = drum_of("");
+    CHECK(d["preset"].is_null());
+    CHECK(d["radius_m"].get<double>() == 0.178);
+
+    const Run r = ictusd("render --mocap " + bvh + " --duration 0.05 --drum-preset bongo --out " +
+                         simtest::temp_path("preset_bad"));
+    INFO(r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find("--drum-preset: unknown preset 'bongo'") != std::string::npos);
+    CHECK(r.output.find("floor-tom") != std::string::npos);
+}

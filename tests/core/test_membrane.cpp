@@ -29,6 +29,20 @@ struct membrane_deleter {
 };
 using membrane_ptr = std::unique_ptr<membrane, membrane_deleter>;
 
+// The head of the Bessel tests (the `paper` head): no tension modulation, so every
+// partial rings at j_mn c / (2 pi a) whatever the amplitude, and the t60/hfdamp law
+// alone sets the decay (no radiation, no internal loss).
+membrane *linear_membrane(double fs)
+{
+    membrane *m = membrane_new(fs);
+    if (m) {
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION_MOD, 0.0);
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_RADIATION, 0.0);
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_LOSS_FACTOR, 0.0);
+    }
+    return m;
+}
+
 double theory_hz(const membrane *m, double j)
 {
     double c = std::sqrt(ictus_param_get(&membrane_params, m, MEMBRANE_PARAM_TENSION) /
@@ -40,7 +54,7 @@ double theory_hz(const membrane *m, double j)
 TEST_CASE("First 20 partials within 0.1 cent of j_mn c / (2 pi a)", "[core][membrane]")
 {
     const double fs = 48000.0;
-    membrane_ptr m(membrane_new(fs));
+    membrane_ptr m(linear_membrane(fs));
     REQUIRE(m);
     membrane_set_modes(m.get(), 20);
     ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 60.0);
@@ -76,7 +90,7 @@ TEST_CASE("Low modes at 96 kHz: pitch within 0.1 cent, T60 and hf law within 2 %
     const double fs = 96000.0;
     SECTION("fundamental near 50 Hz, t60 only")
     {
-        membrane_ptr m(membrane_new(fs));
+        membrane_ptr m(linear_membrane(fs));
         membrane_set_modes(m.get(), 3); // (0,1) and the (1,1) pair
         // c = 2 pi a f / j01 for f = 50 Hz.
         double c = 2.0 * M_PI * ictus_param_get(&membrane_params, m.get(), MEMBRANE_PARAM_RADIUS) *
@@ -103,7 +117,7 @@ TEST_CASE("Low modes at 96 kHz: pitch within 0.1 cent, T60 and hf law within 2 %
     }
     SECTION("single mode: log-envelope slope gives the T60")
     {
-        membrane_ptr m(membrane_new(fs));
+        membrane_ptr m(linear_membrane(fs));
         membrane_set_modes(m.get(), 1);
         double c = 2.0 * M_PI * ictus_param_get(&membrane_params, m.get(), MEMBRANE_PARAM_RADIUS) *
                    50.0 / 2.4048255576957729;
@@ -133,7 +147,7 @@ TEST_CASE("Low modes at 96 kHz: pitch within 0.1 cent, T60 and hf law within 2 %
     }
     SECTION("hf_damping law sigma = s0 + s1 w^2, s1 w_1k^2 = hf s0")
     {
-        membrane_ptr m(membrane_new(fs));
+        membrane_ptr m(linear_membrane(fs));
         membrane_set_modes(m.get(), 3);
         // Fundamental at 1 kHz so that the air-like term matters.
         double c = 2.0 * M_PI * ictus_param_get(&membrane_params, m.get(), MEMBRANE_PARAM_RADIUS) *
@@ -170,7 +184,7 @@ TEST_CASE("Low modes at 96 kHz: pitch within 0.1 cent, T60 and hf law within 2 %
 TEST_CASE("Centre strike excites no m >= 1 mode", "[core][membrane]")
 {
     const double fs = 48000.0;
-    membrane_ptr m(membrane_new(fs));
+    membrane_ptr m(linear_membrane(fs));
     membrane_set_modes(m.get(), 20);
     ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 30.0);
     ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_HF_DAMPING, 0.0);
@@ -207,7 +221,7 @@ TEST_CASE("A pickup on a nodal line does not hear that mode", "[core][membrane]"
     const size_t n = 1u << 16;
     const double bin = fs / (double)(n * 4);
     auto level_at = [&](double pr, double pt, double sr, double st, double j) {
-        membrane_ptr m(membrane_new(fs));
+        membrane_ptr m(linear_membrane(fs));
         membrane_set_modes(m.get(), 8);
         ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 30.0);
         ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_HF_DAMPING, 0.0);
@@ -392,7 +406,7 @@ TEST_CASE("Modes above 0.95 Nyquist are silent", "[core][membrane]")
     // At 1 kHz only (0,1) at 230 Hz and (1,1) at 367 Hz lie below 475 Hz; (2,1) at
     // 491 Hz and (0,2) at 528 Hz (alias at 472 Hz) must not sound.
     const double fs = 1000.0;
-    membrane_ptr m(membrane_new(fs));
+    membrane_ptr m(linear_membrane(fs));
     membrane_set_modes(m.get(), 10);
     ictus_param_set(&membrane_params, m.get(), MEMBRANE_PARAM_T60, 20.0);
     membrane_set_pickup(m.get(), 0, 0.4, 20.0);

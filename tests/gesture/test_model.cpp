@@ -158,7 +158,11 @@ TEST_CASE("units are C1 except at the strike, where the velocity reverses", "[ge
                     max_jump =
                         std::max(max_jump, (fd_velocity(u, k + 1) - fd_velocity(u, k)).norm());
                 }
-                CHECK(max_jump < 0.1 * v_impact);
+                // The press has its own speed scale, 2 cm / 12 ms (docs/gestures.md),
+                // whatever the impact speed: a soft buzz presses as a loud one does.
+                const double v_scale =
+                    n == Nuance::buzz ? std::max(v_impact, 0.02 / 0.012) : v_impact;
+                CHECK(max_jump < 0.1 * v_scale);
                 // The corner at the strike is there, and as big as a reversal (the
                 // buzz does not reverse: the hand presses on).
                 if (n != Nuance::buzz)
@@ -205,24 +209,50 @@ TEST_CASE("impact speed from the interpolant agrees with the sampled approach", 
 
 TEST_CASE("impact speed is monotonic in loudness order and dynamics", "[gesture][model]")
 {
+    // Dynamics set the height (d^1.1, floor 1.5 cm), the nuance brings it to
+    // k_n x legato's impact speed (docs/gestures.md, "Dynamics rule"). Above
+    // the floor (legato reaches it near d = 0.056) both orders are strict;
+    // under it the strokes are all 1.5 cm high and may tie.
     const GestureDatabase db = GestureDatabase::builtin();
     for (Grip g : kGrips)
         for (Side h : kHands) {
-            double previous_row[kNuances] = {0, 0, 0, 0, 0};
+            double previous_row[kNuances] = {0, 0, 0, 0, 0, 0};
             for (int step = 0; step <= 100; ++step) {
                 const double d = step / 100.0;
+                const bool above_floor = d >= 0.1;
                 double previous = 0.0;
                 for (int rank = 0; rank < kNuances; ++rank) {
                     const Nuance n = kLoudnessOrder[rank];
                     INFO(to_string(g) << " " << to_string(h) << " " << to_string(n) << " d=" << d);
                     const double v = db.instantiate(g, n, h, d).impact_speed_mps();
-                    REQUIRE(v > previous);           // louder nuance, same dynamics
-                    REQUIRE(v > previous_row[rank]); // same nuance, louder dynamics
+                    if (above_floor) {
+                        REQUIRE(v > previous);           // louder nuance, same dynamics
+                        REQUIRE(v > previous_row[rank]); // same nuance, louder dynamics
+                    } else {
+                        REQUIRE(v >= previous_row[rank]);
+                    }
                     previous = v;
                     previous_row[rank] = v;
                 }
             }
         }
+    // The nuance's band: impact speed k_n x legato's at the same dynamics
+    // (the table in docs/gestures.md), within the 250 Hz sampling of the
+    // downswing (a few per cent).
+    const std::pair<Nuance, double> bands[] = {{Nuance::tenuto, 0.85},
+                                               {Nuance::buzz, 0.9},
+                                               {Nuance::staccato, 1.1},
+                                               {Nuance::accent, 1.2},
+                                               {Nuance::vertical_accent, 1.3}};
+    for (double d : {0.3, 0.6, 1.0}) {
+        const double v_leg =
+            db.instantiate(Grip::german, Nuance::legato, Side::right, d).impact_speed_mps();
+        for (const auto &[n, k] : bands) {
+            INFO(to_string(n) << " d=" << d);
+            CHECK(db.instantiate(Grip::german, n, Side::right, d).impact_speed_mps() / v_leg ==
+                  Approx(k).epsilon(0.05));
+        }
+    }
     // Clamped outside [0, 1].
     const double v1 =
         db.instantiate(Grip::french, Nuance::accent, Side::right, 1.0).impact_speed_mps();
@@ -236,26 +266,31 @@ TEST_CASE("impact speed is monotonic in loudness order and dynamics", "[gesture]
         REQUIRE(p.allFinite());
 }
 
-TEST_CASE("preparation heights follow the loudness order", "[gesture][model]")
+TEST_CASE("preparation heights follow the dynamics and the accents", "[gesture][model]")
 {
-    // tenuto < legato < staccato < accent < vertical accent (Dahl 2000, 2004:
-    // accents are prepared from higher; tenuto stays close to the head).
+    // Accents are prepared from higher than the legato at the same dynamics
+    // (Dahl 2000, 2004), the vertical accent highest.
     for (Grip g : kGrips)
         for (double d : {0.1, 0.6, 1.0}) {
-            double previous = 0.0;
-            for (Nuance n : kLoudnessOrder) {
-                const double H = stroke_model(g, n, Side::right, d).preparation_height_m();
-                INFO(to_string(g) << " " << to_string(n) << " d=" << d << " H=" << H);
-                CHECK(H > previous);
-                previous = H;
-            }
+            const double leg =
+                stroke_model(g, Nuance::legato, Side::right, d).preparation_height_m();
+            const double acc =
+                stroke_model(g, Nuance::accent, Side::right, d).preparation_height_m();
+            const double ver =
+                stroke_model(g, Nuance::vertical_accent, Side::right, d).preparation_height_m();
+            INFO(to_string(g) << " d=" << d);
+            CHECK(acc > leg);
+            CHECK(ver > acc);
         }
-    // Dynamics: the height grows with d, by the documented factor 0.3 + 0.7 d.
-    const double h_low =
-        stroke_model(Grip::german, Nuance::legato, Side::right, 0.0).preparation_height_m();
-    const double h_high =
-        stroke_model(Grip::german, Nuance::legato, Side::right, 1.0).preparation_height_m();
-    CHECK(h_high / h_low == Approx(1.0 / 0.3).epsilon(1e-9));
+    // Dynamics: the height grows as d^1.1 (the stroke-height principle), from
+    // 0.36 m at d = 1 down to the 1.5 cm floor.
+    const auto legato_height = [](double d) {
+        return stroke_model(Grip::german, Nuance::legato, Side::right, d).preparation_height_m();
+    };
+    CHECK(legato_height(1.0) == Approx(0.36).epsilon(1e-9));
+    CHECK(legato_height(1.0) / legato_height(0.5) == Approx(std::pow(2.0, 1.1)).epsilon(1e-9));
+    CHECK(legato_height(0.2) / legato_height(0.1) == Approx(std::pow(2.0, 1.1)).epsilon(1e-9));
+    CHECK(legato_height(0.0) == Approx(0.015).epsilon(1e-9));
 }
 
 TEST_CASE("nuance path features: vertical accent, staccato, tenuto", "[gesture][model]")
@@ -284,7 +319,8 @@ TEST_CASE("nuance path features: vertical accent, staccato, tenuto", "[gesture][
             // Tenuto stays close to the head after the hit.
             CHECK(height_at(tenuto, t) / tenuto.tip_m.back().y() <
                   0.7 * height_at(legato, t) / legato.tip_m.back().y());
-            CHECK(height_at(tenuto, t) < 0.5 * height_at(legato, t));
+            // (Not lower in absolute terms: at the same dynamics its slower,
+            // less whipped downswing needs a higher start for its impact speed.)
         }
 }
 
@@ -364,7 +400,7 @@ TEST_CASE("instantiate: model units regenerated, imported units scaled, fallback
     for (int k = 0; k < fb.samples(); ++k)
         REQUIRE(fb.tip_m[k] == direct.tip_m[k]);
 
-    // An imported unit: heights scale by (0.3 + 0.7 d) / (0.3 + 0.7 d0).
+    // An imported unit: heights scale by (d / d0)^1.1 (d clamped to 0.04 .. 1).
     GestureUnit imported = stroke_model(Grip::french, Nuance::legato, Side::right, 0.6);
     imported.source = "mine.csv";
     for (auto &p : imported.tip_m)
@@ -377,10 +413,10 @@ TEST_CASE("instantiate: model units regenerated, imported units scaled, fallback
     const GestureUnit loud = db.instantiate(Grip::french, Nuance::legato, Side::right, 1.0);
     CHECK(loud.source == "mine.csv");
     CHECK(loud.preparation_height_m() ==
-          Approx(imported.preparation_height_m() * 1.0 / (0.3 + 0.7 * 0.6)));
+          Approx(imported.preparation_height_m() * std::pow(1.0 / 0.6, 1.1)));
     CHECK(loud.tip_m[3].x() == imported.tip_m[3].x());
     double previous = 0.0;
-    for (int step = 0; step <= 50; ++step) {
+    for (int step = 2; step <= 50; ++step) { // from d = 0.04, where the clamp ends
         const double v = db.instantiate(Grip::french, Nuance::legato, Side::right, step / 50.0)
                              .impact_speed_mps();
         REQUIRE(v > previous);

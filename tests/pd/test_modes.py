@@ -34,7 +34,9 @@ wav = os.path.join(work, "modes.wav")
 p = Patch(declare="-path %s/ictus" % args.build)
 m = p.obj("membrane~ drum")
 trig = recorder(p, [(m, 0, "pick1")], seconds, sr, wav)
+# The paper head: linear (tensionmod 0), decay by the t60/hfdamp law alone.
 setup = p.msg("radius %g \\, tension %g \\, density %g \\, modes 256 \\, t60 4 \\, hfdamp 0"
+              " \\, tensionmod 0 \\, radiation 0 \\, lossfactor 0"
               " \\, pickup 1 %g 0 \\, strike %g 0 0.01 \\, print" % (radius, tension, density, pickup_r,
                                                           strike_r))
 p.connect(trig, 1, setup, 0)

@@ -33,6 +33,11 @@ def render(name, second):
     # "later": [tabwrite~ right] records a [sig~ 0] until membrane~'s outlet 2 joins it
     right = (mem, 1, "right") if second == "always" else (p.obj("sig~ 0"), 0, "right")
     trig = recorder(p, [(mem, 0, "left"), right], seconds, sr, wav)
+    # A linear head: with tension modulation the rebuild's float rounding would move
+    # the energy, hence the pitch, and grow into a phase drift over the run.
+    lin = p.msg("tensionmod 0")
+    p.connect(trig, 0, lin, 0)
+    p.connect(lin, 0, mem, 0)
     for delay_ms, text in ((5.0, "hit 2 0.3 0"), (61.3, "hit 0.8 0.6 45"),
                            (150.7, "mass 1 \\, hit 1.5 0.2 100"), (260.1, "hit 3 0.7 300"),
                            (380.9, "hit 1 0.4 30")):

@@ -503,6 +503,14 @@ TEST_CASE("plan: refuses what a hand cannot play and bad options or frames",
         CHECK(e.column() == 1);
         CHECK_THAT(e.message(), Catch::Matchers::Contains("faster than one hand plays"));
     }
+    // A double in 32nds at 125 bpm: the right hand's strokes 60 ms apart, above the
+    // 40 ms limit (docs/score.md, "Rebound strokes"): planned, both strikes on their beats.
+    {
+        const GesturePlan p =
+            plan_performance(score_of("tempo 125\nR 1/8\nR 1/8\n"), db(), frame());
+        REQUIRE(p.notes.size() == 2);
+        CHECK(std::abs(p.notes[1].time_s - p.notes[0].time_s - 0.06) < 1e-9);
+    }
     // Alternating hands, each hand's strokes are a beat (150 ms) apart: fine.
     CHECK_NOTHROW(plan_performance(score_of("tempo 400\nR 1/2\nL 1/2\nR 1/2\n"), db(), frame()));
     // Far too long.

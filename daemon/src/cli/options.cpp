@@ -10,6 +10,10 @@
 #include <iostream>
 #include <sstream>
 
+extern "C" {
+#include "membrane_presets.h"
+}
+
 namespace ictus
 {
 namespace cli
@@ -22,6 +26,25 @@ std::string after_name(const std::string &message)
 {
     const size_t colon = message.find(':');
     return colon == std::string::npos ? ": " + message : message.substr(colon);
+}
+
+constexpr int kGivenRadius = 1, kGivenTension = 2, kGivenDensity = 4;
+
+// --drum-preset NAME: the head of a preset (membrane_presets.h) in the physics and the
+// sound; a --drum-radius, --drum-tension or --drum-density given too wins over it.
+void apply_drum_preset(const std::string &option, const std::string &name, PerformanceOptions &o)
+{
+    const membrane_preset *p = membrane_preset_find(name.c_str());
+    if (!p)
+        throw UsageError(option + ": unknown preset '" + name + "'; the presets are " +
+                         membrane_preset_names());
+    o.drum_preset = p->name;
+    if (!(o.drum_given & kGivenRadius))
+        o.scene.drum.radius_m = p->radius_m;
+    if (!(o.drum_given & kGivenTension))
+        o.scene.drum.tension_n_per_m = p->tension_n_per_m;
+    if (!(o.drum_given & kGivenDensity))
+        o.drum_density_kg_per_m2 = p->density_kg_per_m2;
 }
 } // namespace
 
@@ -238,19 +261,23 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
     else if (a == "--drum-pos") {
         o.scene.drum.center_m = parse_vec3(a, value(), -kMaxDrumDistance_m, kMaxDrumDistance_m);
         o.drum_auto = false;
-    } else if (a == "--drum-radius")
+    } else if (a == "--drum-radius") {
         o.scene.drum.radius_m = parse_number(a, value(), 0.05, 1.0);
-    else if (a == "--drum-tension")
+        o.drum_given |= kGivenRadius;
+    } else if (a == "--drum-tension") {
         o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
-    else if (a == "--drum-density")
+        o.drum_given |= kGivenTension;
+    } else if (a == "--drum-density") {
         o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
-    else if (a == "--stick-tip") {
+        o.drum_given |= kGivenDensity;
+    } else if (a == "--drum-preset") {
+        apply_drum_preset(a, value(), o);
+    } else if (a == "--stick-tip") {
         const std::string v = value();
         if (!is_stick_tip(v))
             throw UsageError("--stick-tip: expected wood, nylon or felt, got '" + v + "'");
         o.scene.drum.stick_tip = v;
-    }
-    else if (a == "--sticks") {
+    } else if (a == "--sticks") {
         const std::string v = value();
         if (v == "fulcrum")
             o.scene.sticks = StickMount::fulcrum;

@@ -120,7 +120,10 @@ std::vector<std::string> pd_command_line(const PdRenderOptions &o, const std::st
     std::vector<std::string> argv = {pd,       "-nogui",  "-nosound", "-nomidi",
                                      "-batch", "-stderr", "-r",       std::to_string(o.sample_rate),
                                      "-path",  lib,       "-open",    lib + "/ictus-render.pd"};
-    const std::vector<std::string> sends = {
+    std::vector<std::string> sends;
+    if (!o.preset.empty()) // first: radius, tension and density below win over it
+        sends.push_back("render-drum preset " + o.preset);
+    const std::vector<std::string> rest = {
         "render-drum radius " + format("%.9g", o.radius_m),
         "render-drum tension " + format("%.9g", o.tension_n_per_m),
         "render-drum density " + format("%.9g", o.density_kg_per_m2),
@@ -130,6 +133,7 @@ std::vector<std::string> pd_command_line(const PdRenderOptions &o, const std::st
         "render-file " + o.events,
         "render-out " + o.wav,
         "render-seconds " + format("%.3f", o.seconds)};
+    sends.insert(sends.end(), rest.begin(), rest.end());
     for (const std::string &s : sends) {
         argv.push_back("-send");
         argv.push_back(s);

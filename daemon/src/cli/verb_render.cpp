@@ -114,6 +114,10 @@ void render_usage(std::ostream &out)
            "  --drum-radius M     (default 0.178)\n"
            "  --drum-tension N/M  (default 3000)\n"
            "  --drum-density KG/M2  for the sound (default 0.26)\n"
+           "  --drum-preset NAME  a drum modelled on a measured instrument: paper (the\n"
+           "                      defaults), snare, tom, floor-tom, timpani, frame; sets\n"
+           "                      radius, tension, density (unless given) and, in Pd, the\n"
+           "                      head's T60, modes, pickups and tuning (docs/sound.md)\n"
            "  --stick-tip NAME    wood, nylon or felt: the tip's law in series with the head\n"
            "                      (default: none, the head's spring alone; docs/sound.md)\n"
            "  --bounce-height M   bounce rule height (default 0.01)\n"
@@ -280,6 +284,8 @@ nlohmann::json drum_json(const Performance &p)
     j["radius_m"] = d.radius_m;
     j["tension_n_per_m"] = d.tension_n_per_m;
     j["density_kg_per_m2"] = p.options().drum_density_kg_per_m2;
+    j["preset"] = p.options().drum_preset.empty() ? nlohmann::json(nullptr)
+                                                  : nlohmann::json(p.options().drum_preset);
     j["contact_stiffness_n_per_m"] = p.detector().membrane().stiffness_n_per_m;
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
     j["stick_tip"] = d.stick_tip; // "": none
@@ -654,6 +660,7 @@ int render_wav(RenderArgs &r, const Performance &perf)
     pd.radius_m = d.radius_m;
     pd.tension_n_per_m = d.tension_n_per_m;
     pd.density_kg_per_m2 = perf.options().drum_density_kg_per_m2;
+    pd.preset = perf.options().drum_preset;
     std::cout << "render: pd: " << pd.seconds << " s of sound into " << r.wav << " ..."
               << std::endl;
     const PdRenderResult result = run_pd_render(pd, [&](double s) {

@@ -32,6 +32,12 @@ constexpr double kNominalPeriod_s = 0.5;    // 120 bpm: the period the shapes ar
 constexpr double kLegatoHeightFff_m = 0.36; // legato preparation height at d = 1
 constexpr double kPressTau_s = 0.012;       // buzz: how fast the hand presses in
 constexpr double kMaxPress_s = 0.3;         // buzz: the longest press
+constexpr double kReboundPeriod_s = 0.1;    // shorter periods: rebound strokes
+constexpr double kReboundGainFrom_s = 0.2;
+constexpr double kReboundGainExponent = 0.4;
+// The lowest stroke: above the 1 cm a stick must rise between two strokes
+// for the second to be a stroke, not a bounce (docs/osc.md).
+constexpr double kMinHeight_m = 0.015;
 
 struct NuanceShape {
     double height_scale;  // preparation height relative to legato
@@ -66,6 +72,10 @@ const NuanceShape kShapes[kNuances] = {
     {0.75, 0.35, 3.0, 2.0, 1.0, 0.60, 0.00, 0.0, 0.02, 0.6},
 };
 
+// Impact speed per nuance relative to legato at the same dynamics (enum
+// order): within 0.85..1.3, narrower than one dynamics level.
+const double kSpeedScale[kNuances] = {1.0, 0.85, 1.2, 1.3, 1.1, 0.9};
+
 struct GripShape {
     double pivot_to_tip_m;   // wrist to stick tip
     double rotation_share;   // fraction of the height made by turning the stick
@@ -76,6 +86,18 @@ struct GripShape {
 
 const GripShape kGerman = {0.35, 0.85, 0.0, 20.0 * kPi / 180.0, 8.0 * kPi / 180.0};
 const GripShape kFrench = {0.33, 0.70, 25.0 * kPi / 180.0, 25.0 * kPi / 180.0, 8.0 * kPi / 180.0};
+
+// Rebound strokes: below kReboundGainFrom_s the height is raised by
+// (kReboundGainFrom_s / period)^kReboundGainExponent, so that the short,
+// quick strokes of a double land as fast as the first one (the arm tracks
+// their larger accelerations with a lag that costs impact speed:
+// docs/score.md, "Rebound strokes").
+double rebound_gain(double period_s)
+{
+    return period_s < kReboundGainFrom_s
+               ? std::pow(kReboundGainFrom_s / period_s, kReboundGainExponent)
+               : 1.0;
+}
 
 // Height profile at time t from the strike (s): prep over [-D, 0], lift over [0, L].
 double height(const NuanceShape &s, double H, double H_lift, double D, double L, double t)
@@ -112,11 +134,13 @@ GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double prep_
     const GripShape &gs = g == Grip::german ? kGerman : kFrench;
     const double d = std::isfinite(dynamics) ? std::clamp(dynamics, 0.0, 1.0) : 0.6;
     const auto clamp_period = [](double p) {
-        return std::isfinite(p) ? std::clamp(p, 0.1, 4.0) : 0.5;
+        return std::isfinite(p) ? std::clamp(p, 0.03, 4.0) : 0.5;
     };
     const double prep_period = clamp_period(prep_period_s);
     const double period = clamp_period(lift_period_s);
-    const double rate = 250.0;
+    // Rebound strokes (a period under kReboundPeriod_s) are sampled finer:
+    // their downswing lasts a few 4 ms samples only.
+    const double rate = std::min(prep_period, period) < kReboundPeriod_s ? 1000.0 : 250.0;
 
     // Timing: the downswing lasts prep_fraction of the period up to the
     // nominal period; at slower tempi the extra time is spent in the lift.
@@ -135,10 +159,21 @@ GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double prep_
     const int lift_samples =
         std::max(2, static_cast<int>(std::lround(period * rate)) - downswing_samples(period));
     const double D = strike_index / rate, L = lift_samples / rate;
-    const double H = kLegatoHeightFff_m * s.height_scale * dynamics_height_factor(d) *
-                     std::min(1.0, prep_period / kNominalPeriod_s);
-    const double H_lift = s.lift_ratio * kLegatoHeightFff_m * s.height_scale *
-                          dynamics_height_factor(d) * std::min(1.0, period / kNominalPeriod_s);
+    // Dynamics set the impact speed (p H / D), the nuance only within a
+    // narrow band (kSpeedScale): its own height scale is kept in shape but
+    // brought to that speed.
+    const NuanceShape &leg = kShapes[0];
+    const double speed_norm = kSpeedScale[static_cast<int>(n)] *
+                              (leg.exponent / leg.prep_fraction) /
+                              (s.height_scale * s.exponent / s.prep_fraction);
+    const double H =
+        std::max(kMinHeight_m,
+                 kLegatoHeightFff_m * s.height_scale * speed_norm * dynamics_height_factor(d) *
+                     std::min(1.0, prep_period / kNominalPeriod_s) * rebound_gain(prep_period));
+    const double H_lift =
+        std::max(kMinHeight_m, s.lift_ratio * kLegatoHeightFff_m * s.height_scale * speed_norm *
+                                   dynamics_height_factor(d) *
+                                   std::min(1.0, period / kNominalPeriod_s) * rebound_gain(period));
 
     // Stick at the strike (right hand): forward, yawed inward (-x), pitched down.
     const Eigen::Vector3d dir0(-std::sin(gs.inward_yaw_rad) * std::cos(gs.strike_pitch_rad),

@@ -40,6 +40,11 @@ ScorePerformOptions::ScorePerformOptions()
     // 200 random scores, docs/perform.md.
     plan.strike_aim_s = 0.0025;
     plan.strike_aim_from_mps = 1.5;
+    // The bead meets the head 2.2 mm before the held tip's target does: a
+    // stroke at v landed 2.2 mm / v early (10.9 ms at 0.2 m/s, 4.6 ms at
+    // 0.48 m/s, 0.4 ms at 5.9 m/s; docs/gestures.md, "Dynamics rule"), so each
+    // unit is placed that much later.
+    plan.contact_lead_m = 0.0022;
     time_advance_s = 0.0;
     // Algorithm 2 for strokes: `ictusd track`'s CMU-tuned velocity term
     // (c = 0.1 s) feeds the 1 kHz tip velocity back and makes the tip chatter

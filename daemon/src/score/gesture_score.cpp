@@ -261,6 +261,8 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("strike_aim_s must be within 0..0.01 s", o.strike_aim_s);
     if (!(o.strike_aim_from_mps >= 0.0 && o.strike_aim_from_mps <= 20.0))
         bad("strike_aim_from_mps must be within 0..20 m/s", o.strike_aim_from_mps);
+    if (!(o.contact_lead_m >= 0.0 && o.contact_lead_m <= 0.01))
+        bad("contact_lead_m must be within 0..0.01 m", o.contact_lead_m);
     if (!(o.blend_margin > 0.0 && o.blend_margin < 0.5))
         bad("blend_margin must be in (0, 0.5)", o.blend_margin);
     if (!(o.move_margin_after >= 0.0 && o.move_margin_before >= 0.0 &&
@@ -439,6 +441,19 @@ void choose_units(HandStrokes &h, const std::vector<size_t> &idx, const GestureP
                                       : (has_prev ? before : kNominalPeriod_s);
         const PlannedNote &p = plan.notes[idx[k]];
         placed[k].curve = &units.unit_for(p.grip, p.nuance, p.hand, p.dynamics, before, after);
+    }
+}
+
+// Each unit placed later by the contact lead over its downward impact speed
+// (PlanOptions::contact_lead_m), keeping the hand's strokes in order.
+void delay_for_contact(HandStrokes &h, const PlanOptions &opt, const PerformerFrame &frame,
+                       const Eigen::Matrix3d &to_world)
+{
+    if (opt.contact_lead_m <= 0.0)
+        return;
+    for (Item &it : h.placed) {
+        const double down = -(to_world * it.curve->impact_velocity()).dot(frame.up);
+        it.strike_t += std::min(opt.contact_lead_m / std::max(down, 0.05), 0.02);
     }
 }
 
@@ -635,6 +650,7 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
         }
         HandStrokes strokes = place_strokes(idx, plan, opt, to_world);
         choose_units(strokes, idx, plan, units);
+        delay_for_contact(strokes, opt, frame, to_world);
         warp_units(strokes, idx, frame, opt, to_world, plan);
         last_motion_end =
             std::max(last_motion_end, build_timeline(strokes, frame, s, opt, timelines[s]));

@@ -22,6 +22,7 @@ struct PdRenderOptions {
     double radius_m = 0.178; // the drum: render-drum radius / tension / density
     double tension_n_per_m = 3000.0;
     double density_kg_per_m2 = 0.26;
+    std::string preset; // render-drum preset NAME first, when not empty (membrane~)
     int sample_rate = 48000;
     std::string mix = "stereo"; // render-mix
     int bits = 32;              // render-bits

@@ -72,6 +72,12 @@ struct PerformanceOptions {
     double clip_bpm = 120.0; // tempo at which the clip plays at its own speed
     double tempo_bpm = 120.0;
     double drum_density_kg_per_m2 = 0.26; // for the sound only (membrane~)
+    // --drum-preset: the head's name (externals/core/membrane_presets.h), "" for none;
+    // the sound takes the rest of the preset (T60, modes, pickups, tuning) from it.
+    std::string drum_preset;
+    // Which of --drum-radius, --drum-tension, --drum-density were given (bits 1, 2, 4):
+    // they win over the preset's, whatever the order of the options.
+    int drum_given = 0;
     StrikeDetectorOptions strikes;
     ScorePerformOptions score; // score mode (no mocap)
     // The grip's firmness 0..1 (Scene's grip_spring()): the notes' default,

@@ -89,6 +89,10 @@ struct PlanOptions {
     // (deeper, they press on it).
     double strike_aim_s = 0.0;
     double strike_aim_from_mps = 0.0;
+    // The stick meets the head this far (m) before the plan's tip reaches its
+    // target: each unit is placed later by this over its planned downward
+    // impact speed, so that soft strokes touch on the beat too.
+    double contact_lead_m = 0.0;
     // Co-articulation: the blend between two units of one hand spans the
     // middle of the gap between their strikes, leaving this fraction of the
     // gap at each end to the units alone (0 < f < 0.5).
@@ -103,9 +107,10 @@ struct PlanOptions {
     // A hand with no stroke for longer than this goes back to its rest tip.
     double idle_return_s = 4.0;
     double return_time_s = 0.6; // the move between the rest tip and a stroke
-    // Two strokes of one hand closer than this are refused (no hand plays
-    // single strokes that fast; use the other hand).
-    double min_stroke_interval_s = 0.1;
+    // Two strokes of one hand closer than this are refused: the shortest
+    // interval the simulated body plays as two strokes (docs/score.md,
+    // "Rebound strokes", measured).
+    double min_stroke_interval_s = 0.04;
     double max_duration_s = 900.0; // longer performances are refused
 };
 

@@ -1,0 +1,59 @@
+/* membrane_presets.h -- drum heads modelled on measured instruments, by name: one table
+ * for membrane~'s "preset NAME", the ictus-drum abstraction and ictusd's --drum-preset
+ * (docs/sound.md, "Presets", gives each value's source). Plain C99, no Pd.
+ *
+ * The table (membrane_presets.c) is data only, so that the daemon can link it without
+ * the DSP core; membrane_preset_apply() (membrane_preset_apply.c) sets a membrane to a
+ * preset through the parameter table (ictus_param.h) and the mode table's tuning
+ * (mode_table.h). */
+#ifndef ICTUS_MEMBRANE_PRESETS_H
+#define ICTUS_MEMBRANE_PRESETS_H
+
+#include "membrane.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The largest m whose (m, 1) ratio a preset may give, plus one. */
+#define MEMBRANE_PRESET_RATIOS 8
+
+typedef struct membrane_preset {
+    const char *name; /* the one name: membrane~ "preset NAME", ictusd --drum-preset NAME */
+    const char *what; /* the instrument, in a few words */
+    double radius_m, tension_n_per_m, density_kg_per_m2;
+    double t60_s;              /* T60 of the lowest mode before any tuning (membrane.h) */
+    double hf_damping;         /* membrane.h's high-frequency damping control */
+    int modes;                 /* mode count; 0: the membrane's default (MEMBRANE_DEFAULT_MODES) */
+    double strike_r_over_a;    /* where the force inlet strikes (theta 0) */
+    double pickup_r_over_a[2]; /* pickups 1 and 2 */
+    double pickup_theta_deg[2];
+    /* Air loading: measured frequency ratios of the (m, 1) modes to (1, 1), for
+     * m = 1 .. ratio_count - 1 (ratio_m1[0] unused); ratio_count 0: an ideal membrane.
+     * The highest given mode keeps its ideal frequency, the others move to the ratios. */
+    int ratio_count;
+    double ratio_m1[MEMBRANE_PRESET_RATIOS];
+    double decay_01; /* (0, 1) decays this many times faster (1: as the damping law) */
+    int wires;       /* snare wires on the head (snare_wires.h; the Pd wrapper lays them) */
+    int linear;      /* 1: no tension modulation, radiation or internal loss (the paper's
+                      * head); 0: membrane.h's Mylar defaults for the three */
+} membrane_preset;
+
+/* The presets, in the order the docs list them; count via membrane_preset_count(). */
+int membrane_preset_count(void);
+const membrane_preset *membrane_preset_at(int index);
+/* The preset named `name`, or NULL. */
+const membrane_preset *membrane_preset_find(const char *name);
+/* "snare, tom, ...": the names, for error messages. */
+const char *membrane_preset_names(void);
+
+/* Sets m to preset p: radius, tension, density, T60, hfdamp, mode count, strike point,
+ * pickups and the tuning of its modes; gain is left as it is (it is the mix, not the
+ * head). Allocates when the mode count grows: message time only, never from audio.
+ * ICTUS_ENOMEM when the modes could not be had (the other values are set). */
+ictus_status membrane_apply_preset(membrane *m, const membrane_preset *p);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,125 @@
+// The drum presets (membrane_presets.h): found by their one name, "paper" is the
+// default head exactly, the heads' densities are Mylar's at the documented thickness,
+// the lowest partials sit at the documented tunings, and the timpani's (m,1) partials
+// follow the ratios Rossing measured on kettle-loaded heads (written out here).
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <string>
+
+#include "signal_tools.hpp"
+
+extern "C" {
+#include "membrane_presets.h"
+}
+
+namespace
+{
+// The frequency of the first mode with indices (bm, bn) (cos partner), or 0.
+double mode_freq(const membrane *m, int bm, int bn, double *t60 = nullptr)
+{
+    for (int k = 0; k < membrane_get_modes(m); k++) {
+        double f, t;
+        int mm, nn, s;
+        if (membrane_get_mode(m, k, &f, &t, &mm, &nn, &s) && mm == bm && nn == bn && !s) {
+            if (t60)
+                *t60 = t;
+            return f;
+        }
+    }
+    return 0.0;
+}
+} // namespace
+
+TEST_CASE("Every preset is found by its name, and the names line lists them all", "[core][presets]")
+{
+    const std::string names = membrane_preset_names();
+    const char *expected[] = {"paper", "snare", "tom", "floor-tom", "timpani", "frame"};
+    REQUIRE(membrane_preset_count() == 6);
+    for (const char *name : expected) {
+        const membrane_preset *p = membrane_preset_find(name);
+        REQUIRE(p);
+        CHECK(std::string(p->name) == name);
+        CHECK(names.find(name) != std::string::npos);
+    }
+    CHECK(membrane_preset_find("bongo") == nullptr);
+    CHECK(membrane_preset_find(nullptr) == nullptr);
+    CHECK(membrane_preset_at(6) == nullptr);
+    CHECK(membrane_preset_at(-1) == nullptr);
+}
+
+TEST_CASE("paper is the default head made linear, exactly, after any other preset",
+          "[core][presets]")
+{
+    membrane *fresh = membrane_new(48000.0);
+    membrane *m = membrane_new(48000.0);
+    REQUIRE(fresh);
+    REQUIRE(m);
+    // the paper's head: no tension modulation, radiation or internal loss
+    for (int id : {MEMBRANE_PARAM_TENSION_MOD, MEMBRANE_PARAM_RADIATION, MEMBRANE_PARAM_LOSS_FACTOR})
+        REQUIRE(ictus_param_set(&membrane_params, fresh, id, 0.0) == ICTUS_OK);
+    REQUIRE(membrane_apply_preset(m, membrane_preset_find("timpani")) == ICTUS_OK);
+    REQUIRE(membrane_apply_preset(m, membrane_preset_find("paper")) == ICTUS_OK);
+    for (int id = 0; id < MEMBRANE_PARAM_COUNT; id++)
+        CHECK(ictus_param_get(&membrane_params, m, id) ==
+              ictus_param_get(&membrane_params, fresh, id));
+    REQUIRE(membrane_get_modes(m) == 128);
+    for (int k = 0; k < 128; k++) {
+        double f0, f1, t0, t1;
+        membrane_get_mode(fresh, k, &f0, &t0, nullptr, nullptr, nullptr);
+        membrane_get_mode(m, k, &f1, &t1, nullptr, nullptr, nullptr);
+        CHECK(f1 == f0);
+        CHECK(t1 == t0);
+    }
+    // Bessel: (1,1) / (0,1) = j11 / j01 = 3.8317060 / 2.4048256.
+    CHECK(mode_freq(m, 1, 1) / mode_freq(m, 0, 1) == Approx(3.8317060 / 2.4048256).epsilon(1e-6));
+    membrane_free(m);
+    membrane_free(fresh);
+}
+
+TEST_CASE("Preset heads: Mylar densities and the documented tunings", "[core][presets]")
+{
+    // name, radius (m, the inch size), Mylar thickness (mm), lowest partial: (m, n), Hz.
+    struct expect {
+        const char *name;
+        double radius, thickness_mm;
+        int bm;
+        double hz;
+    };
+    const expect e[] = {{"snare", 14 * 0.0127, 0.25, 0, 220.0},
+                        {"tom", 12 * 0.0127, 0.25, 0, 150.0},
+                        {"floor-tom", 16 * 0.0127, 0.25, 0, 95.0},
+                        {"timpani", 26 * 0.0127, 0.19, 1, 110.0},
+                        {"frame", 18 * 0.0127, 0.19, 0, 80.0}};
+    for (const expect &x : e) {
+        INFO(x.name);
+        membrane *m = membrane_new(48000.0);
+        REQUIRE(membrane_apply_preset(m, membrane_preset_find(x.name)) == ICTUS_OK);
+        CHECK(ictus_param_get(&membrane_params, m, MEMBRANE_PARAM_RADIUS) ==
+              Approx(x.radius).epsilon(1e-3));
+        CHECK(ictus_param_get(&membrane_params, m, MEMBRANE_PARAM_DENSITY) ==
+              Approx(1380.0 * x.thickness_mm * 1e-3).epsilon(2e-3));
+        CHECK(mode_freq(m, x.bm, 1) == Approx(x.hz).epsilon(0.005));
+        membrane_free(m);
+    }
+}
+
+TEST_CASE("timpani: (m,1) partials at Rossing's ratios, (0,1) damped hard", "[core][presets]")
+{
+    // T. D. Rossing, Science of Percussion Instruments (2000): a kettle-loaded head.
+    const double rossing[] = {1.0, 1.50, 1.98, 2.44, 2.90};
+    membrane *m = membrane_new(48000.0);
+    REQUIRE(membrane_apply_preset(m, membrane_preset_find("timpani")) == ICTUS_OK);
+    double t11 = 0, t01 = 0;
+    const double f11 = mode_freq(m, 1, 1, &t11);
+    mode_freq(m, 0, 1, &t01);
+    for (int bm = 1; bm <= 5; bm++)
+        CHECK(mode_freq(m, bm, 1) / f11 == Approx(rossing[bm - 1]).epsilon(1e-4));
+    // The ideal membrane's (2,1)/(1,1) = 1.340 would miss by 11 %.
+    CHECK(std::fabs(ictus_bessel_zero(2, 1) / ictus_bessel_zero(1, 1) - 1.50) > 0.1);
+    CHECK(t01 < 0.2 * t11);
+    // Back to an untuned head: the ideal ratios return.
+    REQUIRE(membrane_apply_preset(m, membrane_preset_find("tom")) == ICTUS_OK);
+    CHECK(mode_freq(m, 2, 1) / mode_freq(m, 1, 1) ==
+          Approx(ictus_bessel_zero(2, 1) / ictus_bessel_zero(1, 1)).epsilon(1e-9));
+    membrane_free(m);
+}
