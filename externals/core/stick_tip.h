@@ -75,6 +75,63 @@ static inline double stick_tip_force(double k, double alpha, double lambda, doub
     return f > 0.0 ? f : 0.0;
 }
 
+/* The head's point stiffness with its stretching: a clamped circular membrane of
+ * pre-tension T under a central point load deflects y (m) with
+ *     F_head(y) = k1 y + k3 y^3,   k3 = E h q^3 / a^2,   q = 1 / (1.05 - 0.15 nu - 0.16 nu^2)
+ * (large-deflection membrane under a point load: Begley & Mackin, J. Mech. Phys.
+ * Solids 52, 2004, 2005-2023; the form used by Lee, Wei, Kysar & Hone, Science 321,
+ * 2008, 385). E (Pa), nu, thickness h (m), radius a (m); k1 is the linear point
+ * stiffness the caller has (2 pi T / ln(a / r_tip)). Returns k3 in N/m^3. */
+static inline double stick_tip_head_k3(double e, double nu, double thickness_m, double radius_m)
+{
+    double q = 1.0 / (1.05 - 0.15 * nu - 0.16 * nu * nu);
+    return e * thickness_m * q * q * q / (radius_m * radius_m);
+}
+
+/* The default head's stretching (N/m^3): a 14-inch Mylar head, radius 0.178 m,
+ * 0.262 kg/m^2 over PET's 1390 kg/m^3 = 0.188 mm thick, E 4.5 GPa, nu 0.38 (the
+ * film constants membrane.h's tension modulation uses): 2.93e7 N/m^3. The
+ * physics' default drum (DrumParams) has the same. */
+#define STICK_TIP_HEAD_K3_DEFAULT (stick_tip_head_k3(4.5e9, 0.38, 0.262 / 1390.0, 0.178))
+
+/* The tip's law k x^alpha in series with the head's F_head(y) = k1 y + k3 y^3 at a
+ * total depth d = x + y (m): both carry the same force. Returns that force (N) and,
+ * when head_y is not NULL, the head's share y (m). k <= 0: the head alone. The root
+ * of g(y) = k1 y + k3 y^3 - k (d - y)^alpha, increasing on [0, d], by Newton's
+ * method kept inside its bracket (bisection where it leaves it). */
+static inline double stick_tip_series_force(double k, double alpha, double k1, double k3, double d,
+                                            double *head_y)
+{
+    double y = d;
+    if (!(d > 0.0)) {
+        y = 0.0;
+    } else if (k > 0.0) {
+        double lo = 0.0, hi = d;
+        y = d * 0.5;
+        for (int it = 0; it < 100; it++) {
+            double x = d - y;
+            double xa = x > 0.0 ? pow(x, alpha) : 0.0;
+            double g = k1 * y + k3 * y * y * y - k * xa;
+            double dg = k1 + 3.0 * k3 * y * y + (x > 0.0 ? k * alpha * xa / x : 0.0);
+            if (g > 0.0)
+                hi = y;
+            else
+                lo = y;
+            double next = dg > 0.0 ? y - g / dg : 0.5 * (lo + hi);
+            if (!(next > lo && next < hi))
+                next = 0.5 * (lo + hi);
+            if (fabs(next - y) <= 1.0e-14 * d || hi - lo <= 1.0e-14 * d) {
+                y = next;
+                break;
+            }
+            y = next;
+        }
+    }
+    if (head_y)
+        *head_y = y;
+    return y > 0.0 ? k1 * y + k3 * y * y * y : 0.0;
+}
+
 #ifdef __cplusplus
 }
 #endif

@@ -239,6 +239,8 @@ static void *contact_tilde_new(t_symbol *s, int argc, t_atom *argv)
     x->x_force_size = 0;
     memset(&x->x_report, 0, sizeof(x->x_report));
     x->x_name = &s_;
+    /* The head's stretching under the stick: the default head's, as the physics'. */
+    ictus_param_set(&contact_params, core, CONTACT_PARAM_STRETCH, STICK_TIP_HEAD_K3_DEFAULT);
     if (argc > 0 && argv[0].a_type == A_SYMBOL)
         x->x_name = atom_getsymbol(&argv[0]);
     else

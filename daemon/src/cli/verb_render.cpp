@@ -288,7 +288,8 @@ nlohmann::json drum_json(const Performance &p)
                                                   : nlohmann::json(p.options().drum_preset);
     j["contact_stiffness_n_per_m"] = p.detector().membrane().stiffness_n_per_m;
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
-    j["stick_tip"] = d.stick_tip; // "": none
+    j["contact_stretch_n_per_m3"] = d.stretch_n_per_m3(); // the head's k3 (docs/sound.md)
+    j["stick_tip"] = d.stick_tip;                         // "": none
     return j;
 }
 
@@ -661,6 +662,7 @@ int render_wav(RenderArgs &r, const Performance &perf)
     pd.tension_n_per_m = d.tension_n_per_m;
     pd.density_kg_per_m2 = perf.options().drum_density_kg_per_m2;
     pd.preset = perf.options().drum_preset;
+    pd.stick_tip = d.stick_tip;
     std::cout << "render: pd: " << pd.seconds << " s of sound into " << r.wav << " ..."
               << std::endl;
     const PdRenderResult result = run_pd_render(pd, [&](double s) {

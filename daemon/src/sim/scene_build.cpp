@@ -71,6 +71,11 @@ double DrumParams::stiffness_n_per_m(double tip_radius_m) const
     return 2.0 * M_PI * tension_n_per_m / std::log(radius_m / tip_radius_m);
 }
 
+double DrumParams::stretch_n_per_m3() const
+{
+    return stick_tip_head_k3(head_young_pa, head_poisson, head_thickness_m, radius_m);
+}
+
 bool is_stick_tip(const std::string &name)
 {
     return stick_tip_find(name.c_str()) != nullptr;
@@ -380,6 +385,7 @@ void Scene::place_drum()
     const stick_tip *tip = drum.stick_tip.empty() ? nullptr : stick_tip_find(drum.stick_tip.c_str());
     tip_stiffness_ = tip ? tip->stiffness : 0.0;
     tip_alpha_ = tip ? tip->alpha : 1.0;
+    head_k3_ = drum.stretch_n_per_m3();
 }
 
 // ERP = h k / (h k + c), CFM = 1 / (h k + c) is the implicit (backward)

@@ -31,33 +31,18 @@ constexpr double kHeadNormalMin = 0.2;
 } // namespace
 
 // The bead's contact with the head: the tip's law (stick_tip.h, the law contact~
-// plays: F = k x^alpha) in series with the head's spring k_h (the membrane's
-// static point stiffness, massless). At a depth d the two carry the same force,
-// k x^alpha = k_h (d - x), which is increasing and convex in the tip's
-// compression x, so Newton's method from x = d falls monotonically onto the root.
-// Returns the pair's secant stiffness F / d (N/m): ODE's soft contact is a linear
-// spring-damper per step, and with the secant of the depth it has now, the
-// contact's force at that depth is the law's. The law's Hunt-Crossley term is left
-// out: the head's damper c is the contact's loss (docs/character.md, "Drum").
-double series_contact_stiffness(double k_head, double k_tip, double alpha, double depth)
+// plays: F = k x^alpha) in series with the head's point stiffness with its
+// stretching, F = k_h y + k3 y^3 (massless). Returns the pair's secant stiffness
+// F / d (N/m) at the depth d: ODE's soft contact is a linear spring-damper per
+// step, and with the secant of the depth it has now, the contact's force at that
+// depth is the law's. The law's Hunt-Crossley term is left out: the head's damper
+// c is the contact's loss (docs/character.md, "Drum").
+double series_contact_stiffness(double k_head, double k3, double k_tip, double alpha, double depth)
 {
-    if (!(depth > 0.0) || !(k_tip > 0.0))
+    if (!(depth > 0.0))
         return k_head;
-    double x = depth;
-    for (int it = 0; it < 60; ++it) {
-        const double f_tip = stick_tip_force(k_tip, alpha, 0.0, x, 0.0);
-        const double g = f_tip + k_head * (x - depth);
-        const double dg = alpha * f_tip / x + k_head;
-        const double next = x - g / dg;
-        if (!(next > 0.0) || std::fabs(next - x) <= 1e-12 * depth) {
-            x = next > 0.0 ? next : 0.5 * x;
-            break;
-        }
-        x = next;
-    }
-    return k_head * (depth - x) / depth;
+    return stick_tip_series_force(k_tip, alpha, k_head, k3, depth, nullptr) / depth;
 }
-
 
 void Scene::set_joint_targets(const std::vector<Eigen::Quaterniond> &local,
                               const std::vector<Eigen::Vector3d> &rate_parent)
@@ -129,14 +114,14 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         contact.surface.mu = self->options_.drum.friction;
         contact.surface.soft_erp = self->contact_erp_;
         contact.surface.soft_cfm = self->contact_cfm_;
-        if (bead && self->tip_stiffness_ > 0.0) {
+        if (bead && (self->tip_stiffness_ > 0.0 || self->head_k3_ > 0.0)) {
             const double k_head = self->drum_contact_stiffness_n_per_m();
-            const SoftContact sc = soft_contact(
-                self->options_.step_s,
-                series_contact_stiffness(k_head, self->tip_stiffness_, self->tip_alpha_,
-                                        geoms[i].depth),
-                self->options_.drum.contact_damping_n_s_per_m,
-                self->options_.contact_numerical_damping_compensated);
+            const SoftContact sc =
+                soft_contact(self->options_.step_s,
+                             series_contact_stiffness(k_head, self->head_k3_, self->tip_stiffness_,
+                                                      self->tip_alpha_, geoms[i].depth),
+                             self->options_.drum.contact_damping_n_s_per_m,
+                             self->options_.contact_numerical_damping_compensated);
             contact.surface.soft_erp = sc.erp;
             contact.surface.soft_cfm = sc.cfm;
         }

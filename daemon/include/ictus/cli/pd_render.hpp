@@ -23,6 +23,7 @@ struct PdRenderOptions {
     double tension_n_per_m = 3000.0;
     double density_kg_per_m2 = 0.26;
     std::string preset; // render-drum preset NAME first, when not empty (membrane~)
+    std::string stick_tip; // render-drum left|right tip NAME, when not empty (contact~)
     int sample_rate = 48000;
     std::string mix = "stereo"; // render-mix
     int bits = 32;              // render-bits

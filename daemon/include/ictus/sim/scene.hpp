@@ -44,8 +44,16 @@ struct DrumParams {
     // with the head's spring: "" for none (the head's spring alone). Scene::
     // near_callback has the law.
     std::string stick_tip;
+    // The head's film (Mylar: E, nu; thickness = 0.262 kg/m^2 / 1390 kg/m^3, the
+    // membrane~ default head), for its stretching under the stick.
+    double head_young_pa = 4.5e9;
+    double head_poisson = 0.38;
+    double head_thickness_m = 0.262 / 1390.0;
     // k = 2 pi T / ln(R / r_tip), N/m.
     double stiffness_n_per_m(double tip_radius_m) const;
+    // The stretching's cubic term k3 (N/m^3): F = k y + k3 y^3 under a point load
+    // (stick_tip_head_k3 in externals/core/stick_tip.h, Begley & Mackin 2004).
+    double stretch_n_per_m3() const;
 };
 
 enum class Stepper { quick, direct }; // dWorldQuickStep or dWorldStep
@@ -149,12 +157,12 @@ struct SoftContact {
 };
 SoftContact soft_contact(double h_s, double k_n_per_m, double c_n_s_per_m, bool compensated);
 
-// The bead on the head with a stick tip (DrumParams::stick_tip): the tip's law
-// F = k_tip x^alpha (externals/core/stick_tip.h, the law contact~ plays) in series
-// with the head's spring k_head (N/m, massless). Returns the pair's secant
-// stiffness F / depth (N/m) at the given depth (m): k_head for depth <= 0 or
-// k_tip <= 0. The scene gives it to ODE's soft contact each step.
-double series_contact_stiffness(double k_head, double k_tip, double alpha, double depth);
+// The bead on the head: the stick tip's law F = k_tip x^alpha (DrumParams::stick_tip,
+// externals/core/stick_tip.h, the law contact~ plays; k_tip 0: no tip) in series with
+// the head's stiffening spring F = k_head y + k3 y^3 (massless; N/m, N/m^3). Returns
+// the pair's secant stiffness F / depth (N/m) at the given depth (m): k_head for
+// depth <= 0. The scene gives it to ODE's soft contact each step.
+double series_contact_stiffness(double k_head, double k3, double k_tip, double alpha, double depth);
 
 struct StickDrumContact {
     Eigen::Vector3d bead_force_n = Eigen::Vector3d::Zero();  // through the bead (tip sphere)
@@ -392,6 +400,7 @@ class Scene
     double contact_erp_ = 0.0, contact_cfm_ = 0.0;
     // The stick tip's law (DrumParams::stick_tip), 0 stiffness: none.
     double tip_stiffness_ = 0.0, tip_alpha_ = 1.0;
+    double head_k3_ = 0.0; // DrumParams::stretch_n_per_m3()
 
     double time_s_ = 0.0;
     long steps_ = 0;
