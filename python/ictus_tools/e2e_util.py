@@ -91,14 +91,16 @@ def hit_times_us(events):
 
 def drum_lines(render_json):
     """The drum of render.json as render-drum lines for ictus-render (membrane~
-    parameters: the preset first, when there is one, then the head's numbers; the
-    simulation's contact law is its own and is not copied)."""
+    parameters: the preset first, when there is one, then the head's numbers; and
+    the stick tip to both contact~, when the physics has one)."""
     with open(render_json) as f:
         drum = json.load(f)["drum"]
     preset = ["render-drum preset %s" % drum["preset"]] if drum.get("preset") else []
+    tip = drum.get("stick_tip") or ""
+    tips = ["render-drum %s tip %s" % (hand, tip) for hand in ("left", "right")] if tip else []
     return preset + ["render-drum radius %.6g" % drum["radius_m"],
             "render-drum tension %.6g" % drum["tension_n_per_m"],
-            "render-drum density %.6g" % drum["density_kg_per_m2"]]
+            "render-drum density %.6g" % drum["density_kg_per_m2"]] + tips
 
 
 def write_events(path, header_lines, events, keep=None):

@@ -204,6 +204,11 @@ static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptio
         o.drum_given |= kGivenDensity;
     } else if (a == "--drum-preset") {
         apply_drum_preset(a, value(), o);
+    } else if (a == "--stick-tip") {
+        const std::string v = value();
+        if (!is_stick_tip(v))
+            throw UsageError("--stick-tip: expected wood, nylon or felt, got '" + v + "'");
+        o.scene.drum.stick_tip = v;
     } else if (a == "--kit") {
         const std::string v = value();
         try {

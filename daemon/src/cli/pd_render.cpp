@@ -144,6 +144,10 @@ std::vector<std::string> pd_command_line(const PdRenderOptions &o, const std::st
         sends.push_back(to + "pan " + format("%.6g", k.pan));
         sends.push_back(to + "dsp 1");
     }
+    if (!o.stick_tip.empty()) { // the physics' tip on both sticks (contact~ tip NAME)
+        sends.push_back("render-drum left tip " + o.stick_tip);
+        sends.push_back("render-drum right tip " + o.stick_tip);
+    }
     for (const std::string &s : sends) {
         argv.push_back("-send");
         argv.push_back(s);

@@ -122,6 +122,8 @@ void render_usage(std::ostream &out)
            "                      floor), standard-timpani (and timpani), timpani (timpani1,\n"
            "                      timpani2); the first where the drum goes, the score's\n"
            "                      'drum NAME' and 'on NAME' choose (docs/perform.md)\n"
+           "  --stick-tip NAME    wood, nylon or felt: the tip's law in series with the head\n"
+           "                      (default: none, the head's spring alone; docs/sound.md)\n"
            "  --bounce-height M   bounce rule height (default 0.01)\n"
            "  --bounce-window S   bounce rule window (default 0.15)\n"
            "\n"
@@ -295,6 +297,8 @@ nlohmann::json drum_json(const Performance &p)
                                                   : nlohmann::json(p.options().drum_preset);
     j["contact_stiffness_n_per_m"] = p.detector().membrane().stiffness_n_per_m;
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
+    j["contact_stretch_n_per_m3"] = d.stretch_n_per_m3(); // the head's k3 (docs/sound.md)
+    j["stick_tip"] = d.stick_tip;                         // "": none
     return j;
 }
 
@@ -723,6 +727,7 @@ int render_wav(RenderArgs &r, const Performance &perf)
         const double pan = std::clamp(-k.place_m.x() / 0.8, -0.6, 0.6);
         pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, pan});
     }
+    pd.stick_tip = d.stick_tip;
     std::cout << "render: pd: " << pd.seconds << " s of sound into " << r.wav << " ..."
               << std::endl;
     const PdRenderResult result = run_pd_render(pd, [&](double s) {

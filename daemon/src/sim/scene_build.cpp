@@ -3,6 +3,7 @@
 // grip). Stepping is in scene_step.cpp, the state read back in scene_state.cpp.
 #include "ictus/sim/scene.hpp"
 #include "scene_ode.hpp"
+#include "stick_tip.h"
 
 #include <ode/ode.h>
 
@@ -70,6 +71,16 @@ double DrumParams::stiffness_n_per_m(double tip_radius_m) const
     return 2.0 * M_PI * tension_n_per_m / std::log(radius_m / tip_radius_m);
 }
 
+double DrumParams::stretch_n_per_m3() const
+{
+    return stick_tip_head_k3(head_young_pa, head_poisson, head_thickness_m, radius_m);
+}
+
+bool is_stick_tip(const std::string &name)
+{
+    return stick_tip_find(name.c_str()) != nullptr;
+}
+
 namespace
 {
 void validate_drum(const DrumParams &d, const std::string &which)
@@ -103,6 +114,8 @@ void validate(const SceneOptions &o)
                        std::to_string(o.extra_drums.size() + 1));
     for (size_t i = 0; i < o.extra_drums.size(); ++i)
         validate_drum(o.extra_drums[i], "drum " + std::to_string(i + 1));
+    if (!o.drum.stick_tip.empty() && !stick_tip_find(o.drum.stick_tip.c_str()))
+        throw SimError("stick tip: expected wood, nylon or felt, got '" + o.drum.stick_tip + "'");
     check_finite_positive("divergence speed bound (m/s)", o.max_linear_speed_mps);
     check_finite_positive("divergence angular speed bound (rad/s)", o.max_angular_speed_rad_s);
     check_finite_positive("divergence joint separation bound (m)", o.max_joint_separation_m);
@@ -388,6 +401,11 @@ void Scene::place_drum(int index)
                                         options_.contact_numerical_damping_compensated);
     contact_erp_[index] = sc.erp;
     contact_cfm_[index] = sc.cfm;
+    const stick_tip *tip =
+        options_.drum.stick_tip.empty() ? nullptr : stick_tip_find(options_.drum.stick_tip.c_str());
+    tip_stiffness_ = tip ? tip->stiffness : 0.0;
+    tip_alpha_ = tip ? tip->alpha : 1.0;
+    head_k3_[index] = drum.stretch_n_per_m3();
 }
 
 // ERP = h k / (h k + c), CFM = 1 / (h k + c) is the implicit (backward)

@@ -5,6 +5,7 @@
 #include "ictus/base/rotation.hpp"
 #include "ictus/sim/scene.hpp"
 #include "scene_ode.hpp"
+#include "stick_tip.h"
 
 #include <ode/ode.h>
 
@@ -28,6 +29,20 @@ using ode::to_ode;
 constexpr double kHeadNormalMin = 0.2;
 
 } // namespace
+
+// The bead's contact with the head: the tip's law (stick_tip.h, the law contact~
+// plays: F = k x^alpha) in series with the head's point stiffness with its
+// stretching, F = k_h y + k3 y^3 (massless). Returns the pair's secant stiffness
+// F / d (N/m) at the depth d: ODE's soft contact is a linear spring-damper per
+// step, and with the secant of the depth it has now, the contact's force at that
+// depth is the law's. The law's Hunt-Crossley term is left out: the head's damper
+// c is the contact's loss (docs/character.md, "Drum").
+double series_contact_stiffness(double k_head, double k3, double k_tip, double alpha, double depth)
+{
+    if (!(depth > 0.0))
+        return k_head;
+    return stick_tip_series_force(k_tip, alpha, k_head, k3, depth, nullptr) / depth;
+}
 
 void Scene::set_joint_targets(const std::vector<Eigen::Quaterniond> &local,
                               const std::vector<Eigen::Vector3d> &rate_parent)
@@ -110,6 +125,18 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         contact.surface.mu = self->drum(drum).friction;
         contact.surface.soft_erp = self->contact_erp_[static_cast<size_t>(drum)];
         contact.surface.soft_cfm = self->contact_cfm_[static_cast<size_t>(drum)];
+        const double k3 = self->head_k3_[static_cast<size_t>(drum)];
+        if (bead && (self->tip_stiffness_ > 0.0 || k3 > 0.0)) {
+            const double k_head = self->drum_contact_stiffness_n_per_m(drum);
+            const SoftContact sc =
+                soft_contact(self->options_.step_s,
+                             series_contact_stiffness(k_head, k3, self->tip_stiffness_,
+                                                      self->tip_alpha_, geoms[i].depth),
+                             self->drum(drum).contact_damping_n_s_per_m,
+                             self->options_.contact_numerical_damping_compensated);
+            contact.surface.soft_erp = sc.erp;
+            contact.surface.soft_cfm = sc.cfm;
+        }
         dJointID joint = dJointCreateContact(self->world_, self->contacts_, &contact);
         dJointAttach(joint, dGeomGetBody(a), dGeomGetBody(b));
         if (self->contact_slots_used_ < static_cast<int>(self->contact_slot_.size())) {

@@ -34,6 +34,7 @@ struct PdRenderOptions {
         double pan = 0.0;
     };
     std::vector<KitDrumSound> kit;
+    std::string stick_tip; // render-drum left|right tip NAME, when not empty (contact~)
     int sample_rate = 48000;
     std::string mix = "stereo"; // render-mix
     int bits = 32;              // render-bits

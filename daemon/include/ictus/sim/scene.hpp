@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <limits>
+#include <string>
 #include <vector>
 
 // ODE's opaque handles, so that users of the scene need not include ode.h.
@@ -40,8 +41,20 @@ struct DrumParams {
     double tension_n_per_m = 3000.0;
     double contact_damping_n_s_per_m = 3.0;
     double friction = 0.3;
+    // The stick tip (externals/core/stick_tip.h: wood, nylon, felt), in series
+    // with the head's spring: "" for none (the head's spring alone). Scene::
+    // near_callback has the law.
+    std::string stick_tip;
+    // The head's film (Mylar: E, nu; thickness = 0.262 kg/m^2 / 1390 kg/m^3, the
+    // membrane~ default head), for its stretching under the stick.
+    double head_young_pa = 4.5e9;
+    double head_poisson = 0.38;
+    double head_thickness_m = 0.262 / 1390.0;
     // k = 2 pi T / ln(R / r_tip), N/m.
     double stiffness_n_per_m(double tip_radius_m) const;
+    // The stretching's cubic term k3 (N/m^3): F = k y + k3 y^3 under a point load
+    // (stick_tip_head_k3 in externals/core/stick_tip.h, Begley & Mackin 2004).
+    double stretch_n_per_m3() const;
 };
 
 enum class Stepper { quick, direct }; // dWorldQuickStep or dWorldStep
@@ -127,6 +140,8 @@ struct SceneOptions {
 };
 // Throws SimError naming the first bad option.
 void validate(const SceneOptions &options);
+// Whether name is a stick tip of the table (DrumParams::stick_tip).
+bool is_stick_tip(const std::string &name);
 
 enum class StepResult { ok, diverged };
 
@@ -145,6 +160,13 @@ struct SoftContact {
     double cfm = 0.0;
 };
 SoftContact soft_contact(double h_s, double k_n_per_m, double c_n_s_per_m, bool compensated);
+
+// The bead on the head: the stick tip's law F = k_tip x^alpha (DrumParams::stick_tip,
+// externals/core/stick_tip.h, the law contact~ plays; k_tip 0: no tip) in series with
+// the head's stiffening spring F = k_head y + k3 y^3 (massless; N/m, N/m^3). Returns
+// the pair's secant stiffness F / depth (N/m) at the given depth (m): k_head for
+// depth <= 0. The scene gives it to ODE's soft contact each step.
+double series_contact_stiffness(double k_head, double k3, double k_tip, double alpha, double depth);
 
 struct StickDrumContact {
     Eigen::Vector3d bead_force_n = Eigen::Vector3d::Zero();  // through the bead (tip sphere)
@@ -389,6 +411,10 @@ class Scene
     dxBody *tip_body(Side side) const;
     Eigen::Vector3d tip_body_com(Side side) const; // its CoM in the hand frame
     std::array<double, kMaxDrums> contact_erp_{}, contact_cfm_{}; // [drum]
+    // The stick tip's law (the first drum's DrumParams::stick_tip: the sticks' tip, on
+    // every drum), 0 stiffness: none; each head's stretching (stretch_n_per_m3()).
+    double tip_stiffness_ = 0.0, tip_alpha_ = 1.0;
+    std::array<double, kMaxDrums> head_k3_{}; // [drum]
 
     double time_s_ = 0.0;
     long steps_ = 0;
