@@ -77,7 +77,8 @@ enum class Kind {
     default_firmness,
     default_nuance,
     repeat,
-    end
+    end,
+    humanize
 };
 
 struct Statement {
@@ -98,6 +99,7 @@ struct Statement {
     double ramp_beats = 0.0;
     Grip grip = Grip::french;
     int count = 0; // repeat
+    double humanize = 0.0;
 };
 
 const Nuance kNuances[] = {Nuance::legato,          Nuance::tenuto,   Nuance::accent,
@@ -401,6 +403,16 @@ class LineParser
             st.firmness =
                 one_value(tk, st, Kind::default_firmness, "'firmness' needs a value 0..1",
                           "the firmness", [&](const Token &t) { return firmness_value(t); });
+        } else if (key == "humanize") {
+            st.humanize = one_value(tk, st, Kind::humanize, "'humanize' needs an amount, e.g. 'humanize 1'",
+                                    "the amount", [&](const Token &t) {
+                                        const double a = number(t, "humanize");
+                                        if (!(a >= 0.0 && a <= kMaxHumanize))
+                                            fail(t.column, "humanize " + t.text +
+                                                               " is out of range (0..4; 1: a "
+                                                               "drummer's hand, 0: no noise)");
+                                        return a;
+                                    });
         } else if (key == "repeat") {
             st.kind = Kind::repeat;
             const Token &n = need(tk, 1, "repeat needs a count, e.g. 'repeat 4'");
@@ -416,7 +428,7 @@ class LineParser
             fail(tk[0].column,
                  "unknown statement '" + tk[0].text +
                      "' (expected a hand R, L, right, left, R+L, or tempo, grip, rest, "
-                     "beats, dynamics, firmness, nuance, repeat, end)");
+                     "beats, dynamics, firmness, nuance, humanize, repeat, end)");
         }
         return st;
     }
@@ -667,6 +679,9 @@ Score ScoreBuilder::finish() const
             default_dynamics = st.dynamics.value_or(default_dynamics);
             default_firmness = st.firmness.value_or(default_firmness);
             default_nuance = st.nuance.value_or(default_nuance);
+            break;
+        case Kind::humanize:
+            score.humanize = st.humanize;
             break;
         case Kind::repeat:
             loops.push_back({pc + 1, st.count - 1});
