@@ -404,15 +404,16 @@ class LineParser
                 one_value(tk, st, Kind::default_firmness, "'firmness' needs a value 0..1",
                           "the firmness", [&](const Token &t) { return firmness_value(t); });
         } else if (key == "humanize") {
-            st.humanize = one_value(tk, st, Kind::humanize, "'humanize' needs an amount, e.g. 'humanize 1'",
-                                    "the amount", [&](const Token &t) {
-                                        const double a = number(t, "humanize");
-                                        if (!(a >= 0.0 && a <= kMaxHumanize))
-                                            fail(t.column, "humanize " + t.text +
-                                                               " is out of range (0..4; 1: a "
-                                                               "drummer's hand, 0: no noise)");
-                                        return a;
-                                    });
+            st.humanize =
+                one_value(tk, st, Kind::humanize, "'humanize' needs an amount, e.g. 'humanize 1'",
+                          "the amount", [&](const Token &t) {
+                              const double a = number(t, "humanize");
+                              if (!(a >= 0.0 && a <= kMaxHumanize))
+                                  fail(t.column, "humanize " + t.text +
+                                                     " is out of range (0..4; 1: a "
+                                                     "drummer's hand, 0: no noise)");
+                              return a;
+                          });
         } else if (key == "repeat") {
             st.kind = Kind::repeat;
             const Token &n = need(tk, 1, "repeat needs a count, e.g. 'repeat 4'");

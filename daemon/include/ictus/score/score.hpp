@@ -43,7 +43,7 @@ constexpr double kMaxNoteBeats = 64.0;
 constexpr double kMaxRampBeats = 1024.0;
 constexpr double kMaxRadiusFraction = 0.95; // r/a: the bead must land on the head
 constexpr int kMaxRepeat = 1000;
-constexpr double kMaxHumanize = 4.0; // `humanize AMOUNT`: 0..4
+constexpr double kMaxHumanize = 4.0;   // `humanize AMOUNT`: 0..4
 constexpr int kMaxScoreNotes = 100000; // after repeats are expanded
 constexpr double kMaxScoreBeats = 100000.0;
 // Statements executed while repeats are expanded: bounds the work of scores
