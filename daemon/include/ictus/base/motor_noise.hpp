@@ -1,5 +1,5 @@
 // motor_noise.hpp -- the seeded generator of the performer's motor noise
-// (`humanize`, docs/perform.md "A human hand"): std::mt19937_64 streams,
+// (`humanize`, docs/humanize.md): std::mt19937_64 streams,
 // each seeded from (seed, stream) by SplitMix64, and standard normal draws
 // by the Box-Muller transform on 53-bit uniforms, so a seed gives the same
 // numbers with any standard library.

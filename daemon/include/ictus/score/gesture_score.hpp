@@ -113,14 +113,14 @@ struct PlanOptions {
     // "Rebound strokes", measured).
     double min_stroke_interval_s = 0.04;
     double max_duration_s = 900.0; // longer performances are refused
-    // Motor noise (docs/perform.md, "A human hand"): the amount, 0 for none;
+    // Motor noise (docs/humanize.md): the amount, 0 for none;
     // < 0: the score's `humanize` statement (0 when it has none). The seed
     // picks the noise (each note draws its own stream of it).
     double humanize = -1.0;
     std::uint64_t seed = 1;
 };
 
-// The motor noise at amount 1 (docs/perform.md, "A human hand"): each
+// The motor noise at amount 1 (docs/humanize.md): each
 // stroke's timing is shifted by a normal draw of SD kHumanizeTimingSd_s and
 // its dynamics (the motor command) scaled by 1 + a normal draw of SD
 // kHumanizeForceCv (signal-dependent noise: its SD grows with the command).

@@ -113,7 +113,7 @@ struct Score {
     std::vector<ScoreNote> notes; // in onset order (ties: in the order written)
     TempoMap tempo;               // beat -> time
     double length_beats = 0.0;    // end of the last statement (note or rest)
-    // `humanize AMOUNT` (docs/perform.md, "A human hand"); < 0: not written
+    // `humanize AMOUNT` (docs/humanize.md); < 0: not written
     // (the performance's amount, 0 by default). The last statement wins.
     double humanize = -1.0;
     double duration_s() const { return tempo.time_at_beat(length_beats); }

@@ -244,7 +244,7 @@ class Scene
     const GripSpring &grip(Side side) const { return options_.grip[static_cast<int>(side)]; }
     // The grip as a firmness 0..1 (grip_spring()), for this scene's stick.
     void set_grip_firmness(Side side, double firmness);
-    // Motor noise (docs/perform.md, "A human hand"): each physics step every
+    // Motor noise (docs/humanize.md): each physics step every
     // driven joint gets a torque (on the child, its reaction on the parent)
     // whose SD per axis is amount x kTorqueNoiseCv x the joint's commanded
     // stiffness torque kp |error|, drawn from the seeded stream `seed`
