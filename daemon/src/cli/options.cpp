@@ -288,7 +288,15 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.cartesian.max_joint_speed_rad_s = parse_number(a, value(), 0, 1000);
     else if (a == "--ik-limit-margin")
         o.score.ik_limit_margin_deg = parse_number(a, value(), 0, 10);
-    else if (a == "--rebound")
+    else if (a == "--humanize")
+        o.score.plan.humanize = parse_number(a, value(), 0, kMaxHumanize);
+    else if (a == "--seed") {
+        const std::string value_text = value();
+        const double seed = parse_number(a, value_text, 0, 9007199254740992.0); // 2^53
+        if (seed != std::floor(seed))
+            throw UsageError("--seed: expected a whole number, got '" + value_text + "'");
+        o.score.plan.seed = static_cast<std::uint64_t>(seed);
+    } else if (a == "--rebound")
         o.score.rebound_s = parse_number(a, value(), 0, 0.5);
     else if (a == "--lead-in")
         o.score.plan.lead_in_s = parse_number(a, value(), 0.2, 60);

@@ -267,6 +267,11 @@ bool Performance::apply(const Command &c, std::string *why)
             options_.grip_firmness = c.value;
             mode_->firmness_changed();
             return true;
+        case CommandKind::humanize:
+            // The controller's noise at once; the plan's from the next play.
+            options_.score.plan.humanize = c.value;
+            mode_->scene().set_motor_noise(c.value, options_.score.plan.seed);
+            return true;
         case CommandKind::score:
         case CommandKind::score_clear:
             return mode_->score(c, why);

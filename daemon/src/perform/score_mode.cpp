@@ -121,6 +121,10 @@ void ScoreMode::install_plan(std::unique_ptr<ScorePlan> plan, bool start_now)
         perf_.playing_ = true;
         plan_time_s_ = 0.0;
         plan_origin_s_ = perf_.time_s();
+        // The controller's motor noise restarts with the plan's amount and seed.
+        const PlanOptions &po = perf_.options_.score.plan;
+        if (plan_ && plan_->score)
+            rig_->tracker->scene().set_motor_noise(humanize_amount(*plan_->score, po), po.seed);
     }
     // else: a plan under way goes on from where it was (the notes keep their times)
     if (plan && perf_.worker_)

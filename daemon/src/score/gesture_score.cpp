@@ -20,6 +20,8 @@
 // Kovar & Gleicher 2003 registration curves, cross-fades with ease curves).
 #include "ictus/score/gesture_score.hpp"
 
+#include "ictus/base/motor_noise.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -280,6 +282,8 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("lead_in_s must be 0.2..60 s", o.lead_in_s);
     if (!(o.tail_s >= 0.0 && o.tail_s <= 60.0))
         bad("tail_s must be 0..60 s", o.tail_s);
+    if (!(o.humanize <= kMaxHumanize)) // < 0: the score's
+        bad("humanize must be 0..4", o.humanize);
     if (!(o.rate_hz >= 50.0 && o.rate_hz <= 20000.0))
         bad("rate_hz must be 50..20000", o.rate_hz);
     if (!(std::abs(o.strike_depth_m) <= 0.1))
@@ -410,13 +414,22 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
                      GesturePlan &plan)
 {
     HandNotes by_hand;
-    for (const ScoreNote &n : score.notes) {
+    const double amount = humanize_amount(score, opt);
+    for (size_t k = 0; k < score.notes.size(); ++k) {
+        const ScoreNote &n = score.notes[k];
         PlannedNote p;
         p.time_s = opt.lead_in_s + score.note_time_s(n);
         p.hand = n.hand;
         p.nuance = n.nuance;
         p.grip = n.grip;
         p.dynamics = n.dynamics;
+        if (amount > 0.0) {
+            // Note k's own stream: a replan (a tempo change) draws the same.
+            MotorNoise noise(opt.seed, k + 1);
+            p.time_s += amount * kHumanizeTimingSd_s * noise.normal();
+            const double scale = 1.0 + amount * kHumanizeForceCv * noise.normal();
+            p.dynamics = std::clamp(n.dynamics * scale, 0.0, 1.0);
+        }
         p.beats = n.beats;
         p.tempo_bpm = score.tempo.tempo_at_beat(n.beat);
         p.r_over_a = n.r_over_a;
@@ -738,6 +751,11 @@ void sample_hand(const std::vector<double> &times, const HandTimeline &line,
 }
 
 } // namespace
+
+double humanize_amount(const Score &score, const PlanOptions &options)
+{
+    return options.humanize >= 0.0 ? options.humanize : std::max(0.0, score.humanize);
+}
 
 GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
                              const PerformerFrame &frame, const PlanOptions &opt)

@@ -398,6 +398,17 @@ class LineParser
             st.kind = Kind::drum;
             drum_name(need(tk, 1, "'drum' needs a drum's name, e.g. 'drum snare'"), st);
             no_more(tk, 2, "the drum's name");
+        } else if (key == "humanize") {
+            st.humanize =
+                one_value(tk, st, Kind::humanize, "'humanize' needs an amount, e.g. 'humanize 1'",
+                          "the amount", [&](const Token &t) {
+                              const double a = number(t, "humanize");
+                              if (!(a >= 0.0 && a <= kMaxHumanize))
+                                  fail(t.column, "humanize " + t.text +
+                                                     " is out of range (0..4; 1: a "
+                                                     "drummer's hand, 0: no noise)");
+                              return a;
+                          });
         } else if (key == "repeat") {
             st.kind = Kind::repeat;
             const Token &n = need(tk, 1, "repeat needs a count, e.g. 'repeat 4'");
@@ -413,7 +424,7 @@ class LineParser
             fail(tk[0].column,
                  "unknown statement '" + tk[0].text +
                      "' (expected a hand R, L, right, left, R+L, or tempo, grip, rest, "
-                     "beats, dynamics, firmness, nuance, roll, meter, drum, repeat, end)");
+                     "beats, dynamics, firmness, nuance, roll, meter, drum, humanize, repeat, end)");
         }
         return st;
     }

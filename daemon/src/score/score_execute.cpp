@@ -214,6 +214,9 @@ class Executor
         case Kind::grip:
             grip_ = st.grip;
             break;
+        case Kind::humanize:
+            score_.humanize = st.humanize;
+            break;
         case Kind::drum:
             drum_ = *st.drum;
             drum_line_ = st.line;

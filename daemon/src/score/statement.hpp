@@ -27,6 +27,7 @@ enum class Kind {
     roll,
     meter,
     drum,
+    humanize,
     repeat,
     end
 };
@@ -63,6 +64,7 @@ struct Statement {
     // and its column
     std::optional<std::string> drum;
     int drum_column = 0;
+    double humanize = 0.0; // humanize
 };
 
 // Runs `statements` (parsed, repeat/end balanced) into a score: repeats

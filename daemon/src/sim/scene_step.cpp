@@ -180,7 +180,27 @@ void Scene::apply_control()
         const MotorCommand cmd = pd_motor_command(qp, qc, target_[j], target_rate_[j], gains_[j],
                                                   options_.rate_feedforward);
         drive_motor(j, cmd, limit_stop(j, qp, qc, cmd));
+        if (motor_noise_ > 0.0) {
+            // Signal-dependent noise (Harris & Wolpert 1998): its SD grows
+            // with the commanded torque, here the PD's stiffness part.
+            const double command_nm =
+                std::min(gains_[j].kp_nm_per_rad * cmd.error_parent.norm(), cmd.fmax);
+            const double sd = motor_noise_ * kTorqueNoiseCv * command_nm;
+            const Eigen::Vector3d n(sd * motor_noise_stream_.normal(),
+                                    sd * motor_noise_stream_.normal(),
+                                    sd * motor_noise_stream_.normal());
+            dBodyAddTorque(body_[child], n.x(), n.y(), n.z());
+            dBodyAddTorque(body_[parent], -n.x(), -n.y(), -n.z());
+        }
     }
+}
+
+void Scene::set_motor_noise(double amount, std::uint64_t seed)
+{
+    if (!(amount >= 0.0 && std::isfinite(amount)))
+        throw SimError("motor noise: the amount must be >= 0, got " + std::to_string(amount));
+    motor_noise_ = amount;
+    motor_noise_stream_ = MotorNoise(seed, 0); // stream 0: the controller's
 }
 
 // The joint's present rate (child relative to parent, world).

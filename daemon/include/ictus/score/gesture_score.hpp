@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -139,7 +140,22 @@ struct PlanOptions {
     // "Rebound strokes", measured).
     double min_stroke_interval_s = 0.04;
     double max_duration_s = 900.0; // longer performances are refused
+    // Motor noise (docs/humanize.md): the amount, 0 for none;
+    // < 0: the score's `humanize` statement (0 when it has none). The seed
+    // picks the noise (each note draws its own stream of it).
+    double humanize = -1.0;
+    std::uint64_t seed = 1;
 };
+
+// The motor noise at amount 1 (docs/humanize.md): each
+// stroke's timing is shifted by a normal draw of SD kHumanizeTimingSd_s and
+// its dynamics (the motor command) scaled by 1 + a normal draw of SD
+// kHumanizeForceCv (signal-dependent noise: its SD grows with the command).
+// Both SDs grow in proportion to the amount.
+constexpr double kHumanizeTimingSd_s = 0.0025;
+constexpr double kHumanizeForceCv = 0.05;
+// The amount a plan uses: options.humanize when >= 0, else the score's.
+double humanize_amount(const Score &score, const PlanOptions &options);
 
 // The gesture score, ready for the controller.
 struct GesturePlan {

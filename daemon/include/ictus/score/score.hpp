@@ -43,6 +43,7 @@ constexpr double kMaxNoteBeats = 64.0;
 constexpr double kMaxRampBeats = 1024.0;
 constexpr double kMaxRadiusFraction = 0.95; // r/a: the bead must land on the head
 constexpr int kMaxRepeat = 1000;
+constexpr double kMaxHumanize = 4.0;   // `humanize AMOUNT`: 0..4
 constexpr int kMaxScoreNotes = 100000; // after repeats are expanded
 constexpr double kMaxScoreBeats = 100000.0;
 // Statements executed while repeats are expanded: bounds the work of scores
@@ -149,6 +150,9 @@ struct Score {
     TempoMap tempo;               // beat -> time
     std::vector<ScoreMeter> meters; // in beat order; none: 4/4
     double length_beats = 0.0;    // end of the last statement (note or rest)
+    // `humanize AMOUNT` (docs/humanize.md); < 0: not written
+    // (the performance's amount, 0 by default). The last statement wins.
+    double humanize = -1.0;
     double duration_s() const { return tempo.time_at_beat(length_beats); }
     double note_time_s(const ScoreNote &note) const
     {

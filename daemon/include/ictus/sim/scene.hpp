@@ -5,6 +5,7 @@
 // See docs/character.md.
 #pragma once
 
+#include "ictus/base/motor_noise.hpp"
 #include "ictus/character/character.hpp"
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/character/joint_limit_ref.hpp"
@@ -269,6 +270,15 @@ class Scene
     const GripSpring &grip(Side side) const { return options_.grip[static_cast<int>(side)]; }
     // The grip as a firmness 0..1 (grip_spring()), for this scene's stick.
     void set_grip_firmness(Side side, double firmness);
+    // Motor noise (docs/humanize.md): each physics step every
+    // driven joint gets a torque (on the child, its reaction on the parent)
+    // whose SD per axis is amount x kTorqueNoiseCv x the joint's commanded
+    // stiffness torque kp |error|, drawn from the seeded stream `seed`
+    // (the physics thread only). 0: no torque and no draw. Restarts the
+    // stream.
+    static constexpr double kTorqueNoiseCv = 0.02;
+    void set_motor_noise(double amount, std::uint64_t seed);
+    double motor_noise() const { return motor_noise_; }
     // The stick's moment of inertia about its fulcrum axis, kg m^2.
     double fulcrum_inertia_kg_m2(Side side) const;
     // The stick's effective mass at the bead along `normal` (unit, world), kg:
@@ -319,6 +329,8 @@ class Scene
               const Eigen::Vector3d &delta_angular_rad_s);
 
   private:
+    double motor_noise_ = 0.0;
+    MotorNoise motor_noise_stream_;
     // Building (scene_build.cpp), in the order ODE gets it.
     void build(const CharacterPose &initial);
     void create_world();
