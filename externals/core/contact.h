@@ -52,7 +52,7 @@ extern "C" {
 #define MEMBRANE_MAX_CONTACTS MEMBRANE_MAX_POINTS
 
 /* Defaults: a 50 g snare stick, a tip 47 times softer than the "wood" of
- * stick_tip.h (docs/sound.md, "Stick tips": with the Hertz stiffness of wood on
+ * stick_tip.h (docs/contact.md, "Stick tips": with the Hertz stiffness of wood on
  * Mylar the head's compliance is all there is, and a harder hit is no brighter). */
 #define CONTACT_DEFAULT_MASS      0.05
 #define CONTACT_DEFAULT_STIFFNESS 1.0e7

@@ -1,4 +1,4 @@
-/* stick_tip.c -- the table of stick tips (stick_tip.h; sources in docs/sound.md,
+/* stick_tip.c -- the table of stick tips (stick_tip.h; sources in docs/contact.md,
  * "Stick tips"). */
 #include "stick_tip.h"
 

@@ -8,7 +8,7 @@
  * mu = lambda / k in s/m). stick_tip_force() is that law; contact.c integrates
  * it with an energy-consistent discretisation of the same terms (contact.h).
  *
- * The tips (docs/sound.md, "Stick tips", has the sources and the arithmetic):
+ * The tips (docs/contact.md, "Stick tips", has the sources and the arithmetic):
  *   wood   hickory bead (radius 7 mm) on a Mylar head: Hertz sphere on a half-space
  *   nylon  nylon 6/6 bead (radius 7 mm) on Mylar: the same formula
  *   felt   a felt mallet: the power law of hammer felt (Chaigne & Askenfelt 1994)
@@ -41,7 +41,7 @@ static inline double stick_tip_hertz_k(double e1, double nu1, double e2, double 
     return 4.0 / 3.0 / ((1.0 - nu1 * nu1) / e1 + (1.0 - nu2 * nu2) / e2) * sqrt(r);
 }
 
-/* The material constants behind the table (docs/sound.md, "Stick tips"). */
+/* The material constants behind the table (docs/contact.md, "Stick tips"). */
 #define STICK_TIP_RADIUS_M   0.007 /* a snare stick's bead */
 #define STICK_TIP_MYLAR_E    4.9e9 /* Pa, PET film (DuPont Teijin, Mylar datasheet) */
 #define STICK_TIP_MYLAR_NU   0.38

@@ -10,7 +10,7 @@ law    synthetic events files, no daemon: sticks of 0.01-0.05 kg at 0.5-10 m/s
        density 0.26 kg/m^2), against the duration of the physics' contact law
        integrated here: the bead of mass m lands at v0 on the spring-damper
        F = max(0, k d + k3 d^3 + c d') (docs/osc.md, k = 2 pi T / ln(R / r_tip),
-       r_tip 7 mm, k3 the head's stretching (docs/sound.md, "Stick tips"), c the
+       r_tip 7 mm, k3 the head's stretching (docs/contact.md, "Stick tips"), c the
        drum's contact damping, a massless head; the integrator is checked
        against the closed form of k3 = 0), the bead then flies free and the
        contact ends when it is back at the membrane plane, which is where the
@@ -88,7 +88,7 @@ def physics_duration_ms(m, k, c):
     return (t_f + d / -v) * 1e3
 
 
-# The head's stretching under the stick (docs/sound.md, "Stick tips"): F = k d + K3 d^3,
+# The head's stretching under the stick (docs/contact.md, "Stick tips"): F = k d + K3 d^3,
 # K3 = E h q^3 / a^2, q = 1 / (1.05 - 0.15 nu - 0.16 nu^2) (Begley & Mackin 2004), for
 # the default Mylar head: E 4.5 GPa, nu 0.38, h = 0.262 kg/m^2 / 1390 kg/m^3, a 0.178 m.
 _Q = 1.0 / (1.05 - 0.15 * 0.38 - 0.16 * 0.38 ** 2)

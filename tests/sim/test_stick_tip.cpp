@@ -2,7 +2,7 @@
 // and the stiffening head (series_contact_stiffness) against its parts, and a bead
 // thrown at the head through ODE's soft contact with the scene's per-step secant,
 // against the continuous model integrated here, over a seeded set of impact speeds.
-// The constants are the published ones (docs/sound.md, "Stick tips"), written out
+// The constants are the published ones (docs/contact.md, "Stick tips"), written out
 // here, not read from the code.
 #include "ictus/sim/scene.hpp"
 
@@ -224,7 +224,7 @@ TEST_CASE("stick tip: a bead on the head through ODE's soft contact lasts as the
             CHECK(s_ode == Approx(s_law).margin(0.02));
             // The stretching shortens the contact with speed (slope < 0), but over
             // the ladder's speeds it stays short of Hertz's -0.2 (the linear head
-            // outweighs it below ~8 mm of deflection: docs/sound.md, "Stick tips").
+            // outweighs it below ~8 mm of deflection: docs/contact.md, "Stick tips").
             CHECK(s_law < -0.01);
             CHECK(s_law > -0.2);
         }
