@@ -78,9 +78,11 @@ extern "C" {
 #define MEMBRANE_DEFAULT_RADIATION   0.5
 #define MEMBRANE_DEFAULT_LOSS_FACTOR 0.002
 /* The contact patch (docs/membrane.md, "The contact patch"): forces come in spread
- * evenly over a disc of this radius, the stick bead's (the physics' tip radius), and a
- * stick feels the static compliance of the modes left out. 0: a point, no correction. */
-#define MEMBRANE_DEFAULT_PATCH       0.007
+ * evenly over a disc of this radius and a stick feels the static compliance of the modes
+ * left out. 0 (the bare head's default): a point, no correction; the drum presets take
+ * the stick bead's radius, the physics' tip radius. */
+#define MEMBRANE_DEFAULT_PATCH       0.0
+#define MEMBRANE_PATCH_BEAD          0.007
 #define MEMBRANE_AIR_RHO             1.2   /* kg/m^3 */
 #define MEMBRANE_AIR_C               343.0 /* m/s */
 /* Mylar (PET film), for the tension modulation: Young's modulus (Pa), Poisson's ratio

@@ -86,8 +86,9 @@ TEST_CASE("score: the kit's statements refuse what they cannot use, at the word"
     require_error("R\nL on tom(1)", 2, 6, "malformed drum name");
 }
 
-TEST_CASE("plan: a note on a drum of the kit strikes that drum's spot; unknown drums are refused",
-          "[score][kit]")
+TEST_CASE(
+    "plan: a note on a drum of the kit strikes that drum's spot and unknown drums are refused",
+    "[score][kit]")
 {
     const PerformerFrame f = kit_frame();
     const Score s = parse_score("tempo 90\nR, L on tom1, R on tom2 at 0.4 90\ndrum floor\nL", "t");

@@ -109,7 +109,7 @@ class GestureDatabase
 };
 
 // The dynamics rule: preparation height (and so impact speed) is proportional
-// to d^1.3 (d clamped to [0.04, 1]; the 1.5 cm floor binds below d ~ 0.09; docs/gestures.md).
+// to d^1.1 (d clamped to [0.04, 1]: 25x from d = 0.05 to 1, docs/gestures.md).
 double dynamics_height_factor(double dynamics);
 
 // The parametric stroke model behind builtin(): one unit at dynamics d,
