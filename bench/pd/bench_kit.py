@@ -15,7 +15,7 @@ import shutil
 import subprocess
 import tempfile
 
-from pdbench import Bench
+from pdbench import Bench, bp_bank
 
 KIT = os.environ.get("ICTUS_BENCH_KIT", "snare,tom,floor-tom,timpani").split(",")
 
@@ -69,14 +69,6 @@ def mode_counts():
     if len(counts) != len(KIT):
         raise SystemExit("could not read the mode counts:\n" + err[-2000:])
     return counts
-
-
-def bp_bank(n):
-    def body(lines, i):
-        for k in range(n):
-            lines.append("#X obj %d %d bp~ %g 10;" % (200 + k % 40 * 10, 10 + k // 40, 100 + 5 * k))
-            lines.append("#X connect 4 0 %d 0;" % (i + k))
-    return body
 
 
 counts = mode_counts()

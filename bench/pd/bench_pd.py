@@ -23,7 +23,7 @@ import os
 import shutil
 import tempfile
 
-from pdbench import Bench
+from pdbench import Bench, bp_bank
 
 ap = argparse.ArgumentParser()
 ap.add_argument("build")
@@ -71,15 +71,6 @@ def membrane(n, hits=None):
 
 PRESSED = ("mass 10 \\, stiffness 1e+06 \\, hit 0.5 0.3 0", 100)
 ROLL = ("hit 1 \\$1 0", 5)
-
-
-def bp_bank(n):
-    def body(lines, i):
-        for k in range(n):
-            # centre frequencies spread like a membrane's partials, Q 10
-            lines.append("#X obj %d %d bp~ %g 10;" % (200 + k % 40 * 10, 10 + k // 40, 100 + 5 * k))
-            lines.append("#X connect 4 0 %d 0;" % (i + k))
-    return body
 
 
 

@@ -44,3 +44,13 @@ class Bench:
                 raise SystemExit("%s failed:\n%s" % (name, err))
             best = cpu if best is None else min(best, cpu)
         return best
+
+
+def bp_bank(n):
+    """A patch body of n vanilla [bp~ f 10] fed by the header's noise~ (the reference):
+    centre frequencies spread like a membrane's partials."""
+    def body(lines, i):
+        for k in range(n):
+            lines.append("#X obj %d %d bp~ %g 10;" % (200 + k % 40 * 10, 10 + k // 40, 100 + 5 * k))
+            lines.append("#X connect 4 0 %d 0;" % (i + k))
+    return body

@@ -10,8 +10,11 @@
 #include <cmath>
 #include <string>
 
+#include "support/score_test_util.hpp"
+
 using namespace ictus;
 using Catch::Matchers::Contains;
+using ictus_test::require_error;
 
 namespace
 {
@@ -20,19 +23,6 @@ const GestureDatabase &db()
 {
     static const GestureDatabase d = GestureDatabase::builtin();
     return d;
-}
-
-void require_error(const std::string &text, int line, int column, const std::string &words)
-{
-    try {
-        parse_score(text, "t.txt");
-        FAIL("no error for: " << text);
-    } catch (const ScoreError &e) {
-        INFO(e.what());
-        CHECK(e.line() == line);
-        CHECK(e.column() == column);
-        CHECK_THAT(e.message(), Contains(words));
-    }
 }
 
 // A kit of four drums at different heights around a snare at (0, 0.7, 0.45),

@@ -11,24 +11,14 @@
 #include <string>
 #include <vector>
 
+#include "support/score_test_util.hpp"
+
 using namespace ictus;
 using Catch::Matchers::Contains;
+using ictus_test::require_error;
 
 namespace
 {
-
-void require_error(const std::string &text, int line, int column, const std::string &words)
-{
-    try {
-        parse_score(text, "t.txt");
-        FAIL("no error for: " << text);
-    } catch (const ScoreError &e) {
-        INFO(e.what());
-        CHECK(e.line() == line);
-        CHECK(e.column() == column);
-        CHECK_THAT(e.message(), Contains(words));
-    }
-}
 
 std::vector<ScoreNote> graces(const Score &s)
 {

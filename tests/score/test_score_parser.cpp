@@ -9,28 +9,14 @@
 #include <random>
 #include <string>
 
+#include "support/score_test_util.hpp"
+
 using namespace ictus;
 using Catch::Matchers::Contains;
+using ictus_test::require_error;
 
 namespace
 {
-
-// The error a score gives, checked for its position and a word of its message.
-void require_error(const std::string &text, int line, int column, const std::string &words)
-{
-    try {
-        parse_score(text, "t.txt");
-        FAIL("no error for: " << text);
-    } catch (const ScoreError &e) {
-        INFO(e.what());
-        CHECK(e.source() == "t.txt");
-        CHECK(e.line() == line);
-        CHECK(e.column() == column);
-        CHECK_THAT(e.message(), Contains(words));
-        CHECK(std::string(e.what()) ==
-              "t.txt:" + std::to_string(line) + ":" + std::to_string(column) + ": " + e.message());
-    }
-}
 
 bool same_notes(const Score &a, const Score &b)
 {
