@@ -20,6 +20,7 @@ import struct
 import subprocess
 import sys
 
+from ictus_tools import e2e_util
 from ictus_tools.checks import check
 
 SCORE = """tempo 100
@@ -134,7 +135,9 @@ def main():
     wav = os.path.join(out, "kit.wav")
     cmd = [args.ictusd, "render", "--kit", "standard-timpani", "--score", score, "--out", out,
            "--force", "--wav", wav]
-    run = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    # ictusd runs pd itself (under the ASan build through a wrapper that preloads the runtime)
+    env = e2e_util.pd_spawning_env(os.path.abspath(args.workdir))
+    run = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env)
     ok = check(run.returncode == 0, "ictusd render --kit: exit %d %s" % (run.returncode, run.stderr))
     if not ok:
         return 1
