@@ -144,10 +144,6 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
             slot.feedback = Feedback{};
             slot.side = side;
             slot.bead = bead;
-            const Eigen::Vector3d pos = to_eigen3(geoms[i].pos);
-            const Eigen::Vector3d &axis_at = self->drum(drum).center_m;
-            slot.rim = std::hypot(pos.x() - axis_at.x(), pos.z() - axis_at.z()) >=
-                       self->drum(drum).radius_m - kRimEdgeTolerance_m;
             dJointSetFeedback(joint, reinterpret_cast<dJointFeedback *>(&slot.feedback));
         }
     }
@@ -168,8 +164,6 @@ void Scene::gather_contact_forces()
             c.shaft_force_n += f;
             ++c.shaft_points;
         }
-        if (slot.rim)
-            ++c.rim_points;
     }
 }
 

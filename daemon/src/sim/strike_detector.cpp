@@ -393,24 +393,54 @@ MembraneGeometry membrane_of(const Scene &scene, int drum_id)
     return m;
 }
 
-bool stick_on_hoop(const Scene &scene, int hand, const MembraneGeometry &membrane)
+double distance_to_rim_m(const MembraneGeometry &membrane, const Eigen::Vector3d &point_m)
+{
+    const Eigen::Vector3d d = point_m - membrane.center_m;
+    const double h = d.dot(kNormal);
+    const double rho = (d - h * kNormal).norm();
+    return std::hypot(rho - membrane.radius_m, h);
+}
+
+bool stick_on_rim(const Scene &scene, int hand, const MembraneGeometry &membrane)
 {
     const Side side = static_cast<Side>(hand & 1);
-    if (scene.drum_contact(side).rim_points > 0)
+    const StickDrumContact &c = scene.drum_contact(side);
+    if (c.bead_points + c.shaft_points == 0)
+        return false;
+    const StickParams &sp = scene.model().options().stick;
+    const StickInHand &st = scene.model().stick(side);
+    const Eigen::Vector3d bead = scene.bead_position(side);
+    if (distance_to_rim_m(membrane, bead) < sp.tip_radius_m)
         return true;
-    const StickParams &stick = scene.model().options().stick;
-    const Eigen::Vector3d bead = scene.bead_position(side) - membrane.center_m;
-    const Eigen::Vector3d back = -scene.stick_axis(side); // from the bead toward the butt
-    // Horizontal: where |b + s d| = R along the shaft, s > 0 (metres along the stick).
-    const Eigen::Vector2d b(bead.x(), bead.z()), d(back.x(), back.z());
-    const double dd = d.squaredNorm(), bd = b.dot(d), c = b.squaredNorm() - membrane.radius_m * membrane.radius_m;
-    if (!(dd > 1e-12) || c > 0.0)
-        return false; // a vertical stick, or the bead outside the rim
-    const double s = (-bd + std::sqrt(bd * bd - dd * c)) / dd;
-    if (!(s <= stick.length_m))
-        return false; // the stick ends inside the rim
-    const double underside = bead.y() + s * back.y() - stick.shaft_radius_m;
-    return underside < kHoopHeight_m;
+    // The shaft's segment (Scene's capsule): from one shaft radius behind the
+    // bead's centre to one shaft radius before the butt. The distance to the
+    // circle along it: 64 samples, then a golden-section search around the
+    // nearest (the distance is smooth along the segment).
+    const Eigen::Vector3d back = -scene.stick_axis(side);
+    const double r = sp.shaft_radius_m;
+    const double len = (st.tip_m - sp.tip_radius_m * st.axis - st.butt_m).norm() - 2.0 * r;
+    auto dist = [&](double s) { return distance_to_rim_m(membrane, bead + (r + s) * back); };
+    constexpr int kSamples = 64;
+    int best = 0;
+    double best_d = dist(0.0);
+    for (int i = 1; i <= kSamples; ++i) {
+        const double d = dist(len * i / kSamples);
+        if (d < best_d) {
+            best_d = d;
+            best = i;
+        }
+    }
+    double lo = len * std::max(best - 1, 0) / kSamples,
+           hi = len * std::min(best + 1, kSamples) / kSamples;
+    constexpr double kGolden = 0.6180339887498949;
+    for (int it = 0; it < 40; ++it) {
+        const double a = hi - kGolden * (hi - lo), b = lo + kGolden * (hi - lo);
+        if (dist(a) < dist(b))
+            hi = b;
+        else
+            lo = a;
+    }
+    return std::min(best_d, dist(0.5 * (lo + hi))) < r;
 }
 
 void load_membranes(StrikeDetector &detector, const Scene &scene)
@@ -433,7 +463,7 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
         s.held_center_m = scene.held_bead_position(side);
         // Only near the head, where a contact may begin (a 7 x 7 solve).
         const int drum = detector.drum_under(s.center_m);
-        s.on_rim = stick_on_hoop(scene, hand, detector.membrane(drum));
+        s.on_rim = stick_on_rim(scene, hand, detector.membrane(drum));
         if (detector.gap_m(s.center_m, drum) < 0.02)
             s.effective_mass_kg = scene.effective_mass_kg(side, Eigen::Vector3d::UnitY(), drum);
         if (detector.update(hand, s, out[n]))

@@ -162,10 +162,6 @@ struct SoftContact {
 };
 SoftContact soft_contact(double h_s, double k_n_per_m, double c_n_s_per_m, bool compensated);
 
-// A contact point of a stick with the drum is on the cylinder's top edge (a
-// real drum's hoop) when its distance from the drum's axis is within this of
-// the radius (the strike detector's zone, docs/osc.md).
-constexpr double kRimEdgeTolerance_m = 1e-4;
 // The bead on the head: the stick tip's law F = k_tip x^alpha (DrumParams::stick_tip,
 // externals/core/stick_tip.h, the law contact~ plays; k_tip 0: no tip) in series with
 // the head's stiffening spring F = k_head y + k3 y^3 (massless; N/m, N/m^3). Returns
@@ -177,8 +173,6 @@ struct StickDrumContact {
     Eigen::Vector3d bead_force_n = Eigen::Vector3d::Zero();  // through the bead (tip sphere)
     Eigen::Vector3d shaft_force_n = Eigen::Vector3d::Zero(); // through the shaft (capsule)
     int bead_points = 0, shaft_points = 0;                   // contact points in the step
-    // Of those, the points on the cylinder's top edge (kRimEdgeTolerance_m).
-    int rim_points = 0;
     Eigen::Vector3d force_n() const { return bead_force_n + shaft_force_n; }
 };
 
@@ -408,7 +402,6 @@ class Scene
         Feedback feedback;
         int side = 0;
         bool bead = false;
-        bool rim = false; // on the rim (StickDrumContact::rim_points)
     };
     std::array<ContactSlot, 16> contact_slot_{};
     int contact_slots_used_ = 0;

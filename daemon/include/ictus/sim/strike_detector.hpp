@@ -80,7 +80,7 @@ struct TipSample {
     // The stick's effective mass at the bead along the normal (kg; 0: not
     // known), copied into a strike that begins at this sample.
     double effective_mass_kg = 0.0;
-    // The stick is on the drum's rim at this sample (stick_on_hoop): a
+    // The stick is on the drum's rim at this sample (stick_on_rim): a
     // contact episode with such a sample is a strike on the rim
     // (StrikeEvent::zone).
     bool on_rim = false;
@@ -210,14 +210,15 @@ void load_membranes(StrikeDetector &detector, const Scene &scene);
 int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out[2],
                    double time_offset_s = 0.0);
 
-// The hoop of a real drum: a ring at the head's radius standing this far above
-// the head (a 14 in triple-flanged snare hoop: about 1 cm, an estimate). The
-// Scene's drum is a plain cylinder; the detector puts the hoop back.
-constexpr double kHoopHeight_m = 0.010;
-// Whether the stick of `hand` (0 left, 1 right) of `scene` is on the rim: it touches the cylinder's top
-// edge (StickDrumContact::rim_points), or its shaft, followed from the bead
-// back toward the butt, passes over the head's edge with its underside lower
-// than kHoopHeight_m above the head (it would meet the hoop).
-bool stick_on_hoop(const Scene &scene, int hand, const MembraneGeometry &membrane);
+// The distance (m) from a point to the rim of `membrane`: the circle of its
+// radius in the membrane plane, where the drum's shell and hoop hold the head.
+double distance_to_rim_m(const MembraneGeometry &membrane, const Eigen::Vector3d &point_m);
+// Whether the stick of `hand` (0 left, 1 right) of `scene` is on the rim of
+// `membrane` now: it touches the drum (Scene::drum_contact) and its geometry,
+// the collider's (the bead, a sphere of the tip radius, and the shaft, a
+// capsule of the shaft radius from the bead back to the butt), reaches the
+// rim circle. The head, a spring, yields under the bead; the rim does not: a
+// stick that meets it is on the rim (StrikeEvent::zone, docs/osc.md).
+bool stick_on_rim(const Scene &scene, int hand, const MembraneGeometry &membrane);
 
 } // namespace ictus
