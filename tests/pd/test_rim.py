@@ -119,3 +119,33 @@ check(c_rim >= 1.5 * c_head, "the rim click is brighter: centroid %.0f Hz >= 1.5
 first = int(np.flatnonzero(hoop)[0])
 check(first - onset in (0, 1), "the click starts on the strike's sample: %d (strike %d)"
       % (first, onset))
+
+# ---- 3: the render plays the zone -------------------------------------------------
+# patches/ictus-render.pd: the same hit line with zone 0 and zone 1 (the 13th number), each
+# alone in an events file: the rim line is the brighter, and differs from the head line from
+# the strike's sample on (100 ms: sample 4800), not before.
+import shutil
+import subprocess
+
+render = {}
+for zone in (0, 1):
+    ev = os.path.join(work, "ev%d.txt" % zone)
+    with open(ev, "w") as f:
+        f.write("100.000 hit 1 0 0 3.0000 0.93000 0.00 25.000 0.060000 4.500 0.0000 0.100000 "
+                "0.03000 %d;\n" % zone)
+    out = os.path.join(work, "ev%d.wav" % zone)
+    r = subprocess.run([shutil.which("pd") or "pd", "-nogui", "-nosound", "-batch", "-r",
+                        str(sr), "-path", lib, "-open", os.path.join(lib, "ictus-render.pd"),
+                        "-send", "render-file " + ev, "-send", "render-out " + out,
+                        "-send", "render-seconds 1", "-send", "render-mix pickups"],
+                       capture_output=True, text=True, timeout=120)
+    check(r.returncode == 0 and "error" not in r.stderr.lower(),
+          "ictus-render, zone %d: %s" % (zone, r.stderr.strip()[-200:]))
+    render[zone] = read_wav_float(out)[0][:, 0].astype(np.float64)
+onset = int(round(0.100 * sr))
+c0, c1 = centroid(render[0]), centroid(render[1])
+check(c1 >= 1.5 * c0, "ictus-render: zone 1 centroid %.0f Hz >= 1.5 x zone 0's %.0f Hz" % (c1, c0))
+diff = np.flatnonzero(render[1] - render[0])
+check(len(diff) > 0 and diff[0] - onset in (0, 1),
+      "ictus-render: the click starts on the strike's sample %d (first difference %s)"
+      % (onset, diff[:1]))
