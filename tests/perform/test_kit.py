@@ -168,6 +168,15 @@ def main():
     ok &= check(run.returncode == 0, "ictusd render --kit timpani: exit %d %s"
                 % (run.returncode, run.stderr))
     ok &= played_right(out, ["timpani1", "timpani2"])[4]
+    # The installed example (no sound): a groove and a fill on the standard kit.
+    example = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "examples",
+                           "scores", "kit.txt")
+    out = os.path.join(args.workdir, "example")
+    run = subprocess.run([args.ictusd, "render", "--kit", "standard", "--score", example, "--out",
+                          out, "--force"], capture_output=True, text=True, timeout=600)
+    ok &= check(run.returncode == 0, "ictusd render --kit standard examples/scores/kit.txt: "
+                "exit %d %s" % (run.returncode, run.stderr))
+    ok &= played_right(out, ["floor", "snare", "tom1", "tom2"])[4]
     return 0 if ok else 1
 
 
