@@ -2,7 +2,7 @@
 duration: the sound's stick against the physics'"): through the real pd in batch
 mode (patches/ictus-render.pd, its render-reports file: contact~'s duration of
 every stroke), the sound's contact durations are within 25 % of the physics'.
-Two parts (--part):
+Three parts (--part):
 
 law    synthetic events files, no daemon: sticks of 0.01-0.05 kg at 0.5-10 m/s
        (each line carrying its stick_mass_kg, as ictusd writes them) on the
