@@ -91,13 +91,16 @@ def hit_times_us(events):
 
 def drum_lines(render_json):
     """The drum of render.json as render-drum lines for ictus-render (membrane~
-    parameters: the preset first, when there is one, then the head's numbers; and
-    the stick tip to both contact~, when the physics has one)."""
+    parameters: the preset first, when there is one, then the head's numbers; the
+    head's stretching k3 and the stick tip to both contact~, when the physics has them)."""
     with open(render_json) as f:
         drum = json.load(f)["drum"]
     preset = ["render-drum preset %s" % drum["preset"]] if drum.get("preset") else []
     tip = drum.get("stick_tip") or ""
     tips = ["render-drum %s tip %s" % (hand, tip) for hand in ("left", "right")] if tip else []
+    k3 = drum.get("contact_stretch_n_per_m3") or 0.0
+    if k3 > 0.0:
+        tips = ["render-drum %s stretch %.9g" % (hand, k3) for hand in ("left", "right")] + tips
     return preset + ["render-drum radius %.6g" % drum["radius_m"],
             "render-drum tension %.6g" % drum["tension_n_per_m"],
             "render-drum density %.6g" % drum["density_kg_per_m2"]] + tips

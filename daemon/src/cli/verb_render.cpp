@@ -731,6 +731,7 @@ int render_wav(RenderArgs &r, const Performance &perf)
         pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, pan});
     }
     pd.stick_tip = d.stick_tip;
+    pd.stretch_n_per_m3 = d.stretch_n_per_m3();
     std::cout << "render: pd: " << pd.seconds << " s of sound into " << r.wav << " ..."
               << std::endl;
     const PdRenderResult result = run_pd_render(pd, [&](double s) {
