@@ -23,6 +23,7 @@ struct KitDrum {
     Eigen::Vector3d place_m = Eigen::Vector3d::Zero();
     double radius_m = 0.1778;
     double tension_n_per_m = 3603.0;
+    double density_kg_per_m2 = 0.345; // the head's areal density (its film's thickness)
     double shell_depth_m = 0.14;
     int midi_note = 38; // General MIDI drum map (docs/midi.md)
 };
