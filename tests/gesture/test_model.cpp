@@ -305,6 +305,25 @@ TEST_CASE("preparation heights follow the dynamics and the accents", "[gesture][
     CHECK(legato_height(0.0) == Approx(0.015).epsilon(1e-9));
 }
 
+TEST_CASE("a tenuto is not softer than a legato written one level softer", "[gesture][model]")
+{
+    // The score's dynamics words pp .. ff (docs/score.md): the nuance shapes the motion, the
+    // dynamics set the loudness, so each word's tenuto (the softest nuance) lands at least as
+    // fast as the legato of the word below it.
+    const double words[] = {0.2, 0.3, 0.45, 0.6, 0.8, 1.0};
+    const GestureDatabase db = GestureDatabase::builtin();
+    for (Grip g : kGrips)
+        for (Side h : kHands)
+            for (int k = 1; k < 6; ++k) {
+                const double ten = db.instantiate(g, Nuance::tenuto, h, words[k]).impact_speed_mps();
+                const double leg =
+                    db.instantiate(g, Nuance::legato, h, words[k - 1]).impact_speed_mps();
+                INFO(to_string(g) << " " << to_string(h) << " tenuto " << words[k] << ": " << ten
+                                  << " m/s, legato " << words[k - 1] << ": " << leg << " m/s");
+                CHECK(ten >= leg);
+            }
+}
+
 TEST_CASE("nuance path features: vertical accent, staccato, tenuto", "[gesture][model]")
 {
     for (Grip g : kGrips)
