@@ -315,7 +315,8 @@ TEST_CASE("a tenuto is not softer than a legato written one level softer", "[ges
     for (Grip g : kGrips)
         for (Side h : kHands)
             for (int k = 1; k < 6; ++k) {
-                const double ten = db.instantiate(g, Nuance::tenuto, h, words[k]).impact_speed_mps();
+                const double ten =
+                    db.instantiate(g, Nuance::tenuto, h, words[k]).impact_speed_mps();
                 const double leg =
                     db.instantiate(g, Nuance::legato, h, words[k - 1]).impact_speed_mps();
                 INFO(to_string(g) << " " << to_string(h) << " tenuto " << words[k] << ": " << ten
