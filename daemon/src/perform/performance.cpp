@@ -61,6 +61,14 @@ ScorePerformOptions::ScorePerformOptions()
     cartesian.max_joint_speed_rad_s = 35.0;
 }
 
+PlanOptions ScorePerformOptions::plan_for(TrackMode m) const
+{
+    PlanOptions p = plan;
+    if (m == TrackMode::joint && p.contact_lead_m > 0.0)
+        p.contact_lead_m += joint_contact_lead_m;
+    return p;
+}
+
 Performance::Performance(const PerformanceOptions &options)
     : options_(options), detector_(MembraneGeometry{}, options.strikes)
 {

@@ -151,7 +151,9 @@ void ScoreMode::start_score()
 {
     if (perf_.work_pending())
         throw PerformError("play: background work under way; use apply()");
-    install_plan(make_score_plan(score_, *db_, rig_->frame, perf_.options_.score.plan), true);
+    install_plan(make_score_plan(score_, *db_, rig_->frame,
+                                 perf_.options_.score.plan_for(rig_->tracker->mode())),
+                 true);
 }
 
 // ---- background work -----------------------------------------------------------
@@ -162,7 +164,7 @@ std::unique_ptr<ScoreMode::Job> ScoreMode::plan_job(const Command &origin, Work:
     if (kind == Work::Kind::play && builder_->statements() > 0)
         job->statements = std::make_unique<ScoreBuilder>(*builder_);
     job->frame = rig_->frame;
-    job->options.score.plan = perf_.options_.score.plan;
+    job->options.score.plan = perf_.options_.score.plan_for(rig_->tracker->mode());
     job->tempo_scale = tempo_scale_;
     return job;
 }

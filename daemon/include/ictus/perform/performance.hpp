@@ -58,6 +58,13 @@ struct ScorePerformOptions {
     // motion on every side; the scene's stops and the excursion measured
     // stay at the true limits (docs/perform.md, "Joint limits").
     double ik_limit_margin_deg = 3.0;
+    // Joint mode (eq. 1 alone) holds the tip lower than the Cartesian mode
+    // does: its PD carries the arm's weight on a static error that no
+    // Cartesian feedback corrects. The plan's contact lead adds this much
+    // there (docs/perform.md, "Contact on the beat").
+    double joint_contact_lead_m = 0.0018;
+    // The plan options for a control mode: `plan` with the mode's contact lead.
+    PlanOptions plan_for(TrackMode m) const;
     ScorePerformOptions();
 };
 
