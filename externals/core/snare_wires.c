@@ -1,47 +1,73 @@
-/* snare_wires.c -- lumped snare wires colliding with a membrane (snare_wires.h).
+/* snare_wires.c -- the snare side of a snare drum under a batter membrane
+ * (snare_wires.h). Values and sources: docs/sound.md, "The snare".
  *
- * Sign: the membrane's displacement w grows along the force a stick pushes it with;
- * the wires lie on the far side, at y >= w while apart. Compression d = w - y; when
- * d > 0 the head pushes the wire with F = V'(d), V(d) = k/(alpha+1) d+^(alpha+1), and
- * the wire pushes the head back with -F.
+ * Signs: every displacement grows along the force a stick pushes the batter with (into
+ * the drum, down); the snare head lies below the batter and the wires below the snare
+ * head, at y >= w while apart.
  *
- * One sample (T): the head's displacement at the mass is w1 = w_free - K F (K: the
- * membrane's compliance there over the sample); the wire, mass M on a spring k_s with
- * damping c, by the midpoint rule:
- *     M (v1 - v0) / T = F - k_s (y0 + y1) / 2 - c (v0 + v1) / 2,  y1 = y0 + T (v0 + v1) / 2
- * so y1 = y_free + G F, G = 1 / (2M/T^2 + k_s/2 + c/T). The collision force is the
- * discrete gradient F = (V(d1) - V(d0)) / (d1 - d0), which makes the scheme pass the
- * energy exactly (losses: c only), and d1 = (w_free - y_free) - (K + G) F: one scalar
- * equation, increasing in d1, solved by Newton inside a bracket. */
+ * The snare head's modes (mass-normalised shapes psi_k, physical units), each a
+ * damped oscillator x'' + 2 s x' + W^2 x = f, advance by the trapezoidal rule (W
+ * prewarped so that it rings at its frequency; passive: the energy
+ * (v^2 + W^2 x^2) / 2 changes by the forces' work and the damping only). Over one
+ * sample x1 = xf + g f, xf = A x0 + B v0, g = T / D, D = 2/T + T W^2 / 2 + 2 s.
+ *
+ * The forces of one sample, solved together (Gauss-Seidel, to convergence):
+ * - the air, F_a = k_air (D0 + D1) / 2 on the snare head's mean displacement and -F_a
+ *   on the batter's, D = u_batter - u_snare (the midpoint of a linear spring: exact
+ *   energy);
+ * - wire i, F_i >= 0 on the wire and -F_i on the head, the discrete gradient of the
+ *   collision potential V(d) = k / (alpha + 1) d+^(alpha + 1), d = w_head - y_wire.
+ * The wire, mass M on a spring k_s with damping c, by the midpoint rule:
+ * y1 = y_free + G F, G = 1 / (2M/T^2 + k_s/2 + c/T). */
 #include "snare_wires.h"
 #include "membrane_internal.h"
 
 #include <stdlib.h>
+#include <string.h>
 
-/* Values: docs/sound.md, "Snare wires". */
-#define WIRE_MASS_KG   0.001 /* per lumped mass: the moving part of a few strands */
-#define WIRE_SPRING_HZ 150.0 /* the mass on the strainer's pull */
-#define WIRE_T60_S     0.1   /* of that motion, away from the head */
-#define WIRE_STIFFNESS 1.0e9 /* N / m^alpha: steel wire on Mylar (a choice) */
+#define HEAD_DENSITY   0.105  /* kg/m^2: 0.076 mm (3 mil) Mylar, 1380 kg/m^3 */
+#define HEAD_F01       330.0  /* Hz: the snare head's (0, 1) alone (a tuning choice) */
+#define HEAD_T60       0.5    /* s, the t60 part of the decay (as the batter's) */
+#define HEAD_ETA       0.002  /* the film's internal loss factor (as the batter's) */
+#define SHELL_DEPTH    0.1397 /* m: a 14 x 5.5 inch snare drum */
+#define WIRE_MASS_KG   2.0e-4 /* per segment: the part of the strands that moves alone */
+#define WIRE_SPRING_HZ 150.0  /* a segment on the strands' tension */
+#define WIRE_T60_S     0.1    /* of that motion, away from the head */
+#define WIRE_STIFFNESS 1.0e9  /* N / m^alpha: steel wire on Mylar (a choice) */
 #define WIRE_ALPHA     1.5
-#define WIRE_THETA_DEG 90.0 /* the wires lie along this diameter */
+#define PICK_R         0.5 /* the snare head's pickups: r/a, and degrees off the wires */
+#define MAX_SWEEPS     50
 
-static const double wire_r_over_a[SNARE_WIRES_MASSES] = {0.25, 0.6};
+/* Along the diameter the wires lie on (theta 0 and 180 degrees), x / a. */
+static const double wire_x[SNARE_WIRE_SEGMENTS] = {-0.7, -0.5, -0.3, -0.1, 0.1, 0.3, 0.5, 0.7};
+static const double pick_deg[MEMBRANE_PICKUPS] = {45.0, 135.0};
 
-typedef struct wire_mass {
+typedef struct air_point {
     membrane_point point; /* first member: the membrane sees only this */
-    double y, v;          /* m, m/s */
-    double d;             /* compression at the end of the last sample, m */
     struct snare_wires *set;
-} wire_mass;
+} air_point;
 
 struct snare_wires {
-    wire_mass mass[SNARE_WIRES_MASSES];
+    air_point air;
+    /* The snare head: n modes, SoA (double: the state runs for seconds). */
+    int n, cap;
+    double sr, radius, tension, k_air;
+    double *x, *v, *xf, *ca, *cb, *g, *w2; /* state, free move, coefficients, W^2 */
+    double *mean;                          /* mean of each shape over the head */
+    double *psi[SNARE_WIRE_SEGMENTS];      /* shapes at the wire segments */
+    double *pick[MEMBRANE_PICKUPS];        /* shapes at the snare head's pickups */
+    double Kww[SNARE_WIRE_SEGMENTS][SNARE_WIRE_SEGMENTS], Kmw[SNARE_WIRE_SEGMENTS], Kmm;
+    /* Wires. */
+    int engaged;
+    double y[SNARE_WIRE_SEGMENTS], yv[SNARE_WIRE_SEGMENTS], d[SNARE_WIRE_SEGMENTS];
     double mass_kg, spring, damping, k, alpha;
+    double gap0; /* D at the end of the last sample */
     long contact_samples;
 };
 
-static const membrane_point_ops wire_ops;
+static const membrane_point_ops air_ops;
+
+/* ---------------------------------------------------------------- collisions */
 
 static double potential(const snare_wires *w, double d)
 {
@@ -78,12 +104,12 @@ static double solve_force(const snare_wires *w, double d0, double d_free, double
     double hi = d_free, lo = d_free - C * f_hi, d = 0.5 * (lo + hi);
     for (int it = 0; it < 60; it++) {
         double f = grad_force(w, d0, v0, d, &df);
-        double g = d - d_free + C * f;
-        if (g > 0.0)
+        double gd = d - d_free + C * f;
+        if (gd > 0.0)
             hi = d;
         else
             lo = d;
-        double next = d - g / (1.0 + C * df);
+        double next = d - gd / (1.0 + C * df);
         if (!(next > lo && next < hi))
             next = 0.5 * (lo + hi);
         if (fabs(next - d) <= 1.0e-13 * (fabs(d) + 1.0e-9) || hi - lo <= 1.0e-15)
@@ -93,74 +119,279 @@ static double solve_force(const snare_wires *w, double d0, double d_free, double
     return grad_force(w, d0, v0, d, &df);
 }
 
-/* The masses' forces for this sample (Gauss-Seidel over the masses, which couple
- * through the head), then their motion. */
-static void wires_solve(membrane_point *const *pts, int count, const double *w_free,
-                        const double (*K)[MEMBRANE_MAX_POINTS], double T, int sample,
-                        double extra[MEMBRANE_PICKUPS])
+/* ---------------------------------------------------------------- one sample */
+
+/* The forces of this sample: F[0 .. SEGMENTS) on the wires, *fa the air's. uf, wf: the
+ * free mean displacement and the free displacements at the wires; ub, kb: the
+ * batter's free mean displacement and its compliance. */
+static void solve_forces(snare_wires *w, double ub, double kb, double uf, const double *wf,
+                         const double *yfree, double G, double *F, double *fa)
 {
-    (void)sample;
-    double F[MEMBRANE_MAX_POINTS] = {0}, yfree[MEMBRANE_MAX_POINTS];
-    snare_wires *w = ((wire_mass *)pts[0])->set;
+    const double ka = w->k_air;
+    double air = 0.0;
+    for (int sweep = 0; sweep < MAX_SWEEPS; sweep++) {
+        double e = ub - uf, change = 0.0, scale = 1e-30;
+        for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
+            e += w->Kmw[i] * F[i];
+        double a1 = ka * (w->gap0 + e) / (2.0 + ka * (kb + w->Kmm));
+        change += fabs(a1 - air), scale += fabs(a1);
+        air = a1;
+        if (!w->engaged)
+            break;
+        for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++) {
+            double wi = wf[i] + w->Kmw[i] * air;
+            for (int j = 0; j < SNARE_WIRE_SEGMENTS; j++)
+                if (j != i)
+                    wi -= w->Kww[i][j] * F[j];
+            double f1 = solve_force(w, w->d[i], wi - yfree[i], w->Kww[i][i] + G);
+            change += fabs(f1 - F[i]), scale += fabs(f1);
+            F[i] = f1;
+        }
+        if (change <= 1e-12 * scale)
+            break;
+    }
+    *fa = air;
+}
+
+/* Advances the snare side one sample against the batter's free mean displacement ub
+ * (compliance kb): the air force on the batter goes to its point, both heads' sound
+ * into extra. */
+static void snare_step(snare_wires *w, double ub, double kb, double T,
+                       double extra[MEMBRANE_PICKUPS])
+{
+    const int n = w->n;
+    double uf = 0.0, wf[SNARE_WIRE_SEGMENTS] = {0}, yfree[SNARE_WIRE_SEGMENTS];
+    double F[SNARE_WIRE_SEGMENTS] = {0}, fa;
+    /* The free move and its displacements at the wires, in one pass (8 wires). */
+    const double *p0 = w->psi[0], *p1 = w->psi[1], *p2 = w->psi[2], *p3 = w->psi[3],
+                 *p4 = w->psi[4], *p5 = w->psi[5], *p6 = w->psi[6], *p7 = w->psi[7];
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0;
+    for (int k = 0; k < n; k++) {
+        const double xf = w->ca[k] * w->x[k] + w->cb[k] * w->v[k];
+        w->xf[k] = xf;
+        uf += w->mean[k] * xf;
+        s0 += p0[k] * xf, s1 += p1[k] * xf, s2 += p2[k] * xf, s3 += p3[k] * xf;
+        s4 += p4[k] * xf, s5 += p5[k] * xf, s6 += p6[k] * xf, s7 += p7[k] * xf;
+    }
+    if (w->engaged) {
+        const double sums[SNARE_WIRE_SEGMENTS] = {s0, s1, s2, s3, s4, s5, s6, s7};
+        memcpy(wf, sums, sizeof(sums));
+    }
     const double A = 2.0 * w->mass_kg / (T * T) + 0.5 * w->spring + w->damping / T;
     const double B = 2.0 * w->mass_kg / (T * T) - 0.5 * w->spring + w->damping / T;
     const double G = 1.0 / A;
-    for (int i = 0; i < count; i++) {
-        wire_mass *m = (wire_mass *)pts[i];
-        yfree[i] = G * (B * m->y + 2.0 * w->mass_kg * m->v / T);
-    }
-    for (int sweep = 0; sweep < (count > 1 ? 4 : 1); sweep++) {
-        for (int i = 0; i < count; i++) {
-            wire_mass *m = (wire_mass *)pts[i];
-            double wf = w_free[i];
-            for (int j = 0; j < count; j++)
-                if (j != i)
-                    wf -= K[i][j] * F[j];
-            F[i] = solve_force(w, m->d, wf - yfree[i], K[i][i] + G);
-        }
-    }
-    for (int i = 0; i < count; i++) {
-        wire_mass *m = (wire_mass *)pts[i];
-        double wf = w_free[i];
-        for (int j = 0; j < count; j++)
-            wf -= K[i][j] * F[j];
-        double y1 = yfree[i] + G * F[i];
-        m->v = 2.0 * (y1 - m->y) / T - m->v;
-        m->y = y1;
-        m->d = wf - y1;
-        m->point.force_pending = -F[i];
-        if (F[i] > 0.0)
-            w->contact_samples++;
+    for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
+        yfree[i] = G * (B * w->y[i] + 2.0 * w->mass_kg * w->yv[i] / T);
+    solve_forces(w, ub, kb, uf, wf, yfree, G, F, &fa);
+    /* The forces into the snare head's modes, and its velocity at the pickups. */
+    double pv[MEMBRANE_PICKUPS] = {0};
+    const double two_over_t = 2.0 / T;
+    int hit[SNARE_WIRE_SEGMENTS], nh = 0;
+    for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++)
+        if (F[i] != 0.0)
+            hit[nh++] = i;
+    for (int k = 0; k < n; k++) {
+        double f = w->mean[k] * fa;
+        for (int h = 0; h < nh; h++)
+            f -= w->psi[hit[h]][k] * F[hit[h]];
+        double x1 = w->xf[k] + w->g[k] * f;
+        w->v[k] = two_over_t * (x1 - w->x[k]) - w->v[k];
+        w->x[k] = x1;
         for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-            extra[j] += -F[i] * m->point.pick_coupling[j];
+            pv[j] += w->pick[j][k] * w->v[k];
+    }
+    /* The displacements after the forces, from the couplings (no more dot products). */
+    double u1 = uf + w->Kmm * fa;
+    for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++)
+        u1 -= w->Kmw[i] * F[i];
+    w->gap0 = (ub - kb * fa) - u1;
+    int touching = 0;
+    for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++) {
+        double y1 = yfree[i] + G * F[i], wh = wf[i] + w->Kmw[i] * fa;
+        for (int j = 0; j < SNARE_WIRE_SEGMENTS; j++)
+            wh -= w->Kww[i][j] * F[j];
+        w->yv[i] = two_over_t * (y1 - w->y[i]) - w->yv[i];
+        w->y[i] = y1;
+        w->d[i] = wh - y1;
+        touching |= F[i] > 0.0;
+    }
+    w->contact_samples += touching;
+    membrane_point *pt = &w->air.point;
+    pt->force_pending = -fa;
+    /* The batter's pickups are in units of 1 / mass_scale (membrane.c, emit_sample). */
+    const double to_batter = 1.0 / pt->owner->mass_scale;
+    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+        extra[j] += -fa * pt->pick_coupling[j] + pv[j] * to_batter;
+}
+
+static void air_solve(membrane_point *const *pts, int count, const double *w_free,
+                      const double (*K)[MEMBRANE_MAX_POINTS], double T, int sample,
+                      double extra[MEMBRANE_PICKUPS])
+{
+    (void)sample;
+    for (int i = 0; i < count; i++)
+        snare_step(((air_point *)pts[i])->set, w_free[i], K[i][i], T, extra);
+}
+
+/* ---------------------------------------------------------------- the point's ops */
+
+/* Each batter mode's mean over the head: for (0, n), norm 2 J1(j) / j; else 0. */
+static void air_shapes(const membrane *m, const membrane_point *pt, int live, float *psi)
+{
+    (void)pt;
+    for (int k = 0; k < m->capacity; k++) {
+        psi[k] = 0.0f;
+        if (k < live && m->table.m[k] == 0) {
+            double j = m->table.j[k];
+            psi[k] = (float)(m->table.norm[k] * 2.0 * ictus_bessel_j(1, j) / j);
+        }
     }
 }
 
-static void wires_landed(membrane_point *pt, double displacement_m)
+static void air_landed(membrane_point *pt, double displacement_m)
 {
     (void)pt, (void)displacement_m;
 }
 
-static void wires_block_begin(membrane_point *pt, int n)
+static void air_block_begin(membrane_point *pt, int n)
 {
     (void)pt, (void)n;
 }
 
-/* membrane_clear(): the head is still; so are the wires, touching it. */
-static void wires_cleared(membrane_point *pt)
+static void snare_rest(snare_wires *w)
 {
-    wire_mass *m = (wire_mass *)pt;
-    m->y = m->v = m->d = 0.0;
-    m->point.active = 1;
+    if (w->x) {
+        memset(w->x, 0, sizeof(double) * w->cap);
+        memset(w->v, 0, sizeof(double) * w->cap);
+    }
+    memset(w->y, 0, sizeof(w->y));
+    memset(w->yv, 0, sizeof(w->yv));
+    memset(w->d, 0, sizeof(w->d));
+    w->gap0 = 0.0;
 }
 
-static void wires_detached(membrane_point *pt)
+/* membrane_clear(): the batter is still; so is the snare side (the air at rest with it). */
+static void air_cleared(membrane_point *pt)
+{
+    snare_wires *w = ((air_point *)pt)->set;
+    snare_rest(w);
+    pt->active = 1;
+}
+
+static void air_detached(membrane_point *pt)
 {
     (void)pt;
 }
 
-static const membrane_point_ops wire_ops = {wires_landed, wires_solve, wires_block_begin,
-                                            wires_cleared, wires_detached};
+static const membrane_point_ops air_ops = {air_landed,  air_solve,    air_block_begin,
+                                           air_cleared, air_detached, air_shapes};
+
+/* ---------------------------------------------------------------- the snare head */
+
+static void free_head(snare_wires *w)
+{
+    double **arrs[] = {&w->x, &w->v, &w->xf, &w->ca, &w->cb, &w->g, &w->w2, &w->mean};
+    for (size_t i = 0; i < sizeof(arrs) / sizeof(arrs[0]); i++)
+        free(*arrs[i]), *arrs[i] = NULL;
+    for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
+        free(w->psi[i]), w->psi[i] = NULL;
+    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+        free(w->pick[j]), w->pick[j] = NULL;
+    w->n = w->cap = 0;
+}
+
+/* The cos(m theta) modes of a head of this wave speed below f_max, into (m, j). */
+static int list_modes(double c, double a, double f_max, int *mm, double *jj, int cap)
+{
+    int n = 0;
+    const double j_max = 2.0 * M_PI * a * f_max / c;
+    for (int m = 0; ictus_bessel_zero(m, 1) < j_max; m++)
+        for (int k = 1;; k++) {
+            double j = ictus_bessel_zero(m, k);
+            if (j >= j_max)
+                break;
+            if (mm && n < cap)
+                mm[n] = m, jj[n] = j;
+            n++;
+        }
+    return n;
+}
+
+static double shape(int m, double j, double norm, double r, double theta)
+{
+    return norm * ictus_bessel_j(m, j * r) * cos(m * theta);
+}
+
+static void head_couplings(snare_wires *w)
+{
+    w->Kmm = 0.0;
+    for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++) {
+        w->Kmw[i] = 0.0;
+        for (int j = 0; j < SNARE_WIRE_SEGMENTS; j++)
+            w->Kww[i][j] = 0.0;
+    }
+    for (int k = 0; k < w->n; k++) {
+        w->Kmm += w->mean[k] * w->mean[k] * w->g[k];
+        for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++) {
+            w->Kmw[i] += w->mean[k] * w->psi[i][k] * w->g[k];
+            for (int j = 0; j < SNARE_WIRE_SEGMENTS; j++)
+                w->Kww[i][j] += w->psi[i][k] * w->psi[j][k] * w->g[k];
+        }
+    }
+}
+
+/* Builds the snare head for a batter of radius a at sample rate sr. Allocates. */
+static ictus_status build_head(snare_wires *w, double sr, double a)
+{
+    const double T = 1.0 / sr, c01 = 2.0 * M_PI * a * HEAD_F01 / ictus_bessel_zero(0, 1);
+    const double f_max = fmin(SNARE_HEAD_F_MAX, 0.4 * sr);
+    free_head(w);
+    int n = list_modes(c01, a, f_max, NULL, NULL, 0);
+    int *mm = malloc(sizeof(int) * (size_t)n);
+    double *jj = malloc(sizeof(double) * (size_t)n);
+    int ok = mm && jj;
+    double **arrs[] = {&w->x, &w->v, &w->xf, &w->ca, &w->cb, &w->g, &w->w2, &w->mean};
+    for (size_t i = 0; i < sizeof(arrs) / sizeof(arrs[0]); i++)
+        ok = ok && (*arrs[i] = calloc((size_t)n, sizeof(double)));
+    for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
+        ok = ok && (w->psi[i] = calloc((size_t)n, sizeof(double)));
+    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+        ok = ok && (w->pick[j] = calloc((size_t)n, sizeof(double)));
+    if (!ok) {
+        free(mm), free(jj), free_head(w);
+        return ICTUS_ENOMEM;
+    }
+    list_modes(c01, a, f_max, mm, jj, n);
+    w->n = w->cap = n;
+    w->sr = sr, w->radius = a;
+    w->tension = HEAD_DENSITY * c01 * c01;
+    w->k_air = MEMBRANE_AIR_RHO * MEMBRANE_AIR_C * MEMBRANE_AIR_C * M_PI * a * a / SHELL_DEPTH;
+    const double mass_norm = 1.0 / sqrt(HEAD_DENSITY * a * a);
+    for (int k = 0; k < n; k++) {
+        const int m = mm[k];
+        const double j = jj[k], om = j * c01 / a;
+        const double norm =
+            sqrt((m ? 2.0 : 1.0) / M_PI) / fabs(ictus_bessel_j(m + 1, j)) * mass_norm;
+        const double s = log(1000.0) / HEAD_T60 + 0.5 * HEAD_ETA * om;
+        const double wm = 2.0 / T * tan(0.5 * om * T); /* prewarped */
+        const double D = 2.0 / T + 0.5 * T * wm * wm + 2.0 * s;
+        w->w2[k] = wm * wm;
+        w->ca[k] = (2.0 / T - 0.5 * T * wm * wm + 2.0 * s) / D;
+        w->cb[k] = 2.0 / D;
+        w->g[k] = T / D;
+        w->mean[k] = m == 0 ? norm * 2.0 * ictus_bessel_j(1, j) / j : 0.0;
+        for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
+            w->psi[i][k] = shape(m, j, norm, fabs(wire_x[i]), wire_x[i] < 0.0 ? M_PI : 0.0);
+        for (int p = 0; p < MEMBRANE_PICKUPS; p++)
+            w->pick[p][k] = shape(m, j, norm, PICK_R, pick_deg[p] * M_PI / 180.0);
+    }
+    free(mm), free(jj);
+    head_couplings(w);
+    snare_rest(w);
+    return ICTUS_OK;
+}
+
+/* ---------------------------------------------------------------- the API */
 
 snare_wires *snare_wires_new(void)
 {
@@ -168,35 +399,29 @@ snare_wires *snare_wires_new(void)
     if (!w)
         return NULL;
     w->mass_kg = WIRE_MASS_KG;
-    w->spring = WIRE_MASS_KG * pow(2.0 * M_PI * WIRE_SPRING_HZ, 2.0);
+    w->spring = w->mass_kg * pow(2.0 * M_PI * WIRE_SPRING_HZ, 2.0);
     /* c = 2 M sigma, sigma = ln(1000) / T60 */
-    w->damping = 2.0 * WIRE_MASS_KG * log(1000.0) / WIRE_T60_S;
+    w->damping = 2.0 * w->mass_kg * log(1000.0) / WIRE_T60_S;
     w->k = WIRE_STIFFNESS;
     w->alpha = WIRE_ALPHA;
-    for (int i = 0; i < SNARE_WIRES_MASSES; i++) {
-        w->mass[i].point.ops = &wire_ops;
-        w->mass[i].point.r_over_a = wire_r_over_a[i];
-        w->mass[i].point.theta_deg = WIRE_THETA_DEG;
-        w->mass[i].set = w;
-    }
+    w->engaged = 1;
+    w->air.point.ops = &air_ops;
+    w->air.set = w;
     return w;
 }
 
 void snare_wires_detach(snare_wires *w)
 {
-    if (!w)
-        return;
-    for (int i = 0; i < SNARE_WIRES_MASSES; i++)
-        if (w->mass[i].point.owner)
-            membrane_point_detach_(w->mass[i].point.owner, &w->mass[i].point);
+    if (w && w->air.point.owner)
+        membrane_point_detach_(w->air.point.owner, &w->air.point);
 }
 
 void snare_wires_free(snare_wires *w)
 {
     if (!w)
         return;
-    for (int i = 0; i < SNARE_WIRES_MASSES; i++)
-        membrane_point_free_(&w->mass[i].point);
+    membrane_point_free_(&w->air.point);
+    free_head(w);
     free(w);
 }
 
@@ -204,42 +429,74 @@ ictus_status snare_wires_attach(snare_wires *w, membrane *m)
 {
     if (!w || !m)
         return ICTUS_CLAMPED;
-    if (w->mass[0].point.owner == m)
+    if (w->air.point.owner == m)
         return ICTUS_OK;
     snare_wires_detach(w);
-    if (m->point_count + SNARE_WIRES_MASSES > MEMBRANE_MAX_POINTS)
+    if (m->point_count + SNARE_POINTS > MEMBRANE_MAX_POINTS)
         return ICTUS_ENOMEM;
-    for (int i = 0; i < SNARE_WIRES_MASSES; i++) {
-        ictus_status s = membrane_point_attach_(m, &w->mass[i].point);
-        if (s != ICTUS_OK) {
-            snare_wires_detach(w);
-            return s;
-        }
-        wire_mass *wm = &w->mass[i];
-        wm->y = membrane_displacement_at(m, wm->point.r_over_a, wm->point.theta_deg);
-        wm->v = 0.0;
-        wm->d = 0.0;
-        wm->point.active = 1;
-    }
+    ictus_status s = build_head(w, m->sample_rate, m->radius);
+    if (s != ICTUS_OK)
+        return s;
+    if ((s = membrane_point_attach_(m, &w->air.point)) != ICTUS_OK)
+        return s;
+    /* The air at rest with the batter (a preset is set on a still head). */
+    snare_rest(w);
+    w->air.point.active = 1;
     return ICTUS_OK;
 }
 
 membrane *snare_wires_membrane(const snare_wires *w)
 {
-    return w ? w->mass[0].point.owner : NULL;
+    return w ? w->air.point.owner : NULL;
+}
+
+void snare_wires_engage(snare_wires *w, int on)
+{
+    if (!w || w->engaged == (on != 0))
+        return;
+    w->engaged = on != 0;
+    for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++) {
+        double wh = 0.0;
+        for (int k = 0; k < w->n; k++)
+            wh += w->psi[i][k] * w->x[k];
+        w->y[i] = w->engaged ? wh : 0.0;
+        w->yv[i] = w->d[i] = 0.0;
+    }
+}
+
+int snare_wires_engaged(const snare_wires *w)
+{
+    return w ? w->engaged : 0;
 }
 
 double snare_wires_energy(const snare_wires *w)
 {
-    double e = 0.0;
-    for (int i = 0; i < SNARE_WIRES_MASSES; i++) {
-        const wire_mass *m = &w->mass[i];
-        e += 0.5 * w->mass_kg * m->v * m->v + 0.5 * w->spring * m->y * m->y + potential(w, m->d);
-    }
+    double e = 0.5 * w->k_air * w->gap0 * w->gap0;
+    for (int k = 0; k < w->n; k++)
+        e += 0.5 * (w->v[k] * w->v[k] + w->w2[k] * w->x[k] * w->x[k]);
+    for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++)
+        e += 0.5 * w->mass_kg * w->yv[i] * w->yv[i] + 0.5 * w->spring * w->y[i] * w->y[i] +
+             potential(w, w->d[i]);
     return e;
 }
 
 long snare_wires_contact_samples(const snare_wires *w)
 {
     return w->contact_samples;
+}
+
+int snare_wires_head_modes(const snare_wires *w)
+{
+    return w->n;
+}
+
+double snare_wires_head_f01(const snare_wires *w)
+{
+    (void)w;
+    return HEAD_F01;
+}
+
+double snare_wires_air_stiffness(const snare_wires *w)
+{
+    return w->k_air;
 }
