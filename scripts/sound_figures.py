@@ -9,7 +9,7 @@ broadband T60 measured from the render (Schroeder backward integral, a line fitt
 -5 to -25 dB and extrapolated to -60 dB) and the first modes' frequencies and T60 the
 membrane's damping law gives (membrane~ "print").
 
-Usage: scripts/sound_figures.py --build BUILD [--out docs/img]
+Usage: PYTHONPATH=python scripts/sound_figures.py --build BUILD [--out docs/img]
 Needs python3-matplotlib and numpy (Debian packages)."""
 import argparse
 import os
@@ -18,10 +18,9 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from ictus_tools.pdrun import Patch, make_workdir, read_wav_float, recorder, run_pd  # noqa: E402
+from ictus_tools.pdrun import Patch, make_workdir, read_wav_float, recorder, run_pd
 
-import matplotlib  # noqa: E402
+import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
