@@ -35,8 +35,8 @@
 #define WIRE_SPRING_HZ 150.0  /* a segment on the strands' tension */
 #define WIRE_T60_S     0.1    /* of that motion, away from the head */
 #define WIRE_STIFFNESS 1.0e9  /* N / m^alpha: steel wire on Mylar (a choice) */
-#define WIRE_ALPHA     1.5
-#define PICK_R         0.5 /* the snare head's pickups: r/a, and degrees off the wires */
+#define WIRE_ALPHA     1.5    /* the law's exponent (potential(), grad_force()) */
+#define PICK_R         0.5    /* the snare head's pickups: r/a, and degrees off the wires */
 #define MAX_SWEEPS     50
 
 /* Along the diameter the wires lie on (theta 0 and 180 degrees), x / a. */
@@ -61,7 +61,7 @@ struct snare_wires {
     /* Wires. */
     int engaged;
     double y[SNARE_WIRE_SEGMENTS], yv[SNARE_WIRE_SEGMENTS], d[SNARE_WIRE_SEGMENTS];
-    double mass_kg, spring, damping, k, alpha;
+    double mass_kg, spring, damping, k;
     double gap0; /* D at the end of the last sample */
     long contact_samples;
 };
@@ -90,9 +90,11 @@ static double *alloc_doubles(int n)
 
 /* ---------------------------------------------------------------- collisions */
 
+/* The collision law with alpha = 1.5 (WIRE_ALPHA), by square roots: pow() took a third
+ * of the snare's time. V(d) = k / 2.5 d^2.5, V' = k d^1.5, V'' = 1.5 k d^0.5. */
 static double potential(const snare_wires *w, double d)
 {
-    return d > 0.0 ? w->k / (w->alpha + 1.0) * pow(d, w->alpha + 1.0) : 0.0;
+    return d > 0.0 ? w->k / 2.5 * d * d * sqrt(d) : 0.0;
 }
 
 /* The discrete-gradient force between d0 and d1, and dF/dd1. */
@@ -105,13 +107,13 @@ static double grad_force(const snare_wires *w, double d0, double v0, double d1, 
     }
     if (fabs(dx) > 1.0e-6 * scale) {
         double f = (potential(w, d1) - v0) / dx;
-        double f1 = d1 > 0.0 ? w->k * pow(d1, w->alpha) : 0.0;
+        double f1 = d1 > 0.0 ? w->k * d1 * sqrt(d1) : 0.0;
         *df = (f1 - f) / dx;
         return f > 0.0 ? f : 0.0;
     }
     double mid = 0.5 * (d0 + d1);
-    *df = mid > 0.0 ? 0.5 * w->k * w->alpha * pow(mid, w->alpha - 1.0) : 0.0;
-    return mid > 0.0 ? w->k * pow(mid, w->alpha) : 0.0;
+    *df = mid > 0.0 ? 0.75 * w->k * sqrt(mid) : 0.0;
+    return mid > 0.0 ? w->k * mid * sqrt(mid) : 0.0;
 }
 
 /* Solves d1 = d_free - C F(d0, d1) for F >= 0. */
@@ -430,7 +432,6 @@ snare_wires *snare_wires_new(void)
     /* c = 2 M sigma, sigma = ln(1000) / T60 */
     w->damping = 2.0 * w->mass_kg * log(1000.0) / WIRE_T60_S;
     w->k = WIRE_STIFFNESS;
-    w->alpha = WIRE_ALPHA;
     w->engaged = 1;
     w->air.point.ops = &air_ops;
     w->air.set = w;
