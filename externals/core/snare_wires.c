@@ -53,10 +53,10 @@ struct snare_wires {
     /* The snare head: n modes, SoA (double: the state runs for seconds). */
     int n, cap, live; /* n = cap: live modes padded to a multiple of four */
     double sr, radius, tension, k_air;
-    double *x, *v, *xf, *ca, *cb, *g, *w2; /* state, free move, coefficients, W^2 */
-    double *mean;                          /* mean of each shape over the head */
-    double *psi[SNARE_WIRE_SEGMENTS];      /* shapes at the wire segments */
-    double *pick[MEMBRANE_PICKUPS];        /* shapes at the snare head's pickups */
+    double *x, *v, *xf, *ca, *cb, *g, *w2, *om; /* state, free move, coefficients, W^2, w */
+    double *mean;                               /* mean of each shape over the head */
+    double *psi[SNARE_WIRE_SEGMENTS];           /* shapes at the wire segments */
+    double *pick[MEMBRANE_PICKUPS];             /* shapes at the snare head's pickups */
     double Kww[SNARE_WIRE_SEGMENTS][SNARE_WIRE_SEGMENTS], Kmw[SNARE_WIRE_SEGMENTS], Kmm;
     /* Wires. */
     int engaged;
@@ -67,6 +67,7 @@ struct snare_wires {
 };
 
 static const membrane_point_ops air_ops;
+static void head_coefficients(snare_wires *w, double sr);
 
 /* Four doubles (GCC/Clang vector extension): the snare head's loops run four modes a
  * step, on arrays aligned to 32 bytes and padded to a multiple of four. */
@@ -285,9 +286,14 @@ static void air_landed(membrane_point *pt, double displacement_m)
     (void)pt, (void)displacement_m;
 }
 
+/* The batter's sample rate changed (DSP restarted at another rate): the snare head's
+ * coefficients follow, its modes kept. */
 static void air_block_begin(membrane_point *pt, int n)
 {
-    (void)pt, (void)n;
+    snare_wires *w = ((air_point *)pt)->set;
+    (void)n;
+    if (pt->owner && pt->owner->sample_rate != w->sr)
+        head_coefficients(w, pt->owner->sample_rate);
 }
 
 static void snare_rest(snare_wires *w)
@@ -322,7 +328,7 @@ static const membrane_point_ops air_ops = {air_landed,  air_solve,    air_block_
 
 static void free_head(snare_wires *w)
 {
-    double **arrs[] = {&w->x, &w->v, &w->xf, &w->ca, &w->cb, &w->g, &w->w2, &w->mean};
+    double **arrs[] = {&w->x, &w->v, &w->xf, &w->ca, &w->cb, &w->g, &w->w2, &w->om, &w->mean};
     for (size_t i = 0; i < sizeof(arrs) / sizeof(arrs[0]); i++)
         free(*arrs[i]), *arrs[i] = NULL;
     for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
@@ -367,10 +373,32 @@ static void head_couplings(snare_wires *w)
     }
 }
 
+/* The modes' coefficients at sample rate sr, and the couplings; modes above 0.45 sr
+ * fall silent. No allocation (also from the audio thread, when the rate changed). */
+static void head_coefficients(snare_wires *w, double sr)
+{
+    const double T = 1.0 / sr;
+    for (int k = 0; k < w->live; k++) {
+        const double om = w->om[k], s = log(1000.0) / HEAD_T60 + 0.5 * HEAD_ETA * om;
+        if (om >= 0.9 * M_PI * sr) {
+            w->ca[k] = w->cb[k] = w->g[k] = w->w2[k] = w->x[k] = w->v[k] = 0.0;
+            continue;
+        }
+        const double wm = 2.0 / T * tan(0.5 * om * T); /* prewarped */
+        const double D = 2.0 / T + 0.5 * T * wm * wm + 2.0 * s;
+        w->w2[k] = wm * wm;
+        w->ca[k] = (2.0 / T - 0.5 * T * wm * wm + 2.0 * s) / D;
+        w->cb[k] = 2.0 / D;
+        w->g[k] = T / D;
+    }
+    w->sr = sr;
+    head_couplings(w);
+}
+
 /* Builds the snare head for a batter of radius a at sample rate sr. Allocates. */
 static ictus_status build_head(snare_wires *w, double sr, double a)
 {
-    const double T = 1.0 / sr, c01 = 2.0 * M_PI * a * HEAD_F01 / ictus_bessel_zero(0, 1);
+    const double c01 = 2.0 * M_PI * a * HEAD_F01 / ictus_bessel_zero(0, 1);
     const double f_max = fmin(SNARE_HEAD_F_MAX, 0.4 * sr);
     free_head(w);
     int n = list_modes(c01, a, f_max, NULL, NULL, 0), npad = (n + 3) / 4 * 4;
@@ -379,7 +407,7 @@ static ictus_status build_head(snare_wires *w, double sr, double a)
     int *mm = malloc(sizeof(int) * (size_t)n);
     double *jj = malloc(sizeof(double) * (size_t)n);
     int ok = mm && jj;
-    double **arrs[] = {&w->x, &w->v, &w->xf, &w->ca, &w->cb, &w->g, &w->w2, &w->mean};
+    double **arrs[] = {&w->x, &w->v, &w->xf, &w->ca, &w->cb, &w->g, &w->w2, &w->om, &w->mean};
     for (size_t i = 0; i < sizeof(arrs) / sizeof(arrs[0]); i++)
         ok = ok && (*arrs[i] = alloc_doubles(npad));
     for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
@@ -392,7 +420,7 @@ static ictus_status build_head(snare_wires *w, double sr, double a)
     }
     list_modes(c01, a, f_max, mm, jj, n);
     w->n = w->cap = npad, w->live = n; /* modes n .. npad - 1: all zero, at rest */
-    w->sr = sr, w->radius = a;
+    w->radius = a;
     w->tension = HEAD_DENSITY * c01 * c01;
     w->k_air = MEMBRANE_AIR_RHO * MEMBRANE_AIR_C * MEMBRANE_AIR_C * M_PI * a * a / SHELL_DEPTH;
     const double mass_norm = 1.0 / sqrt(HEAD_DENSITY * a * a);
@@ -401,13 +429,7 @@ static ictus_status build_head(snare_wires *w, double sr, double a)
         const double j = jj[k], om = j * c01 / a;
         const double norm =
             sqrt((m ? 2.0 : 1.0) / M_PI) / fabs(ictus_bessel_j(m + 1, j)) * mass_norm;
-        const double s = log(1000.0) / HEAD_T60 + 0.5 * HEAD_ETA * om;
-        const double wm = 2.0 / T * tan(0.5 * om * T); /* prewarped */
-        const double D = 2.0 / T + 0.5 * T * wm * wm + 2.0 * s;
-        w->w2[k] = wm * wm;
-        w->ca[k] = (2.0 / T - 0.5 * T * wm * wm + 2.0 * s) / D;
-        w->cb[k] = 2.0 / D;
-        w->g[k] = T / D;
+        w->om[k] = om;
         w->mean[k] = m == 0 ? norm * 2.0 * ictus_bessel_j(1, j) / j : 0.0;
         for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
             w->psi[i][k] = shape(m, j, norm, fabs(wire_x[i]), wire_x[i] < 0.0 ? M_PI : 0.0);
@@ -415,7 +437,7 @@ static ictus_status build_head(snare_wires *w, double sr, double a)
             w->pick[p][k] = shape(m, j, norm, PICK_R, pick_deg[p] * M_PI / 180.0);
     }
     free(mm), free(jj);
-    head_couplings(w);
+    head_coefficients(w, sr);
     snare_rest(w);
     return ICTUS_OK;
 }
