@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """Rudiment scores through the real `ictusd render`: timing p99 and worst over many scores.
 
-Renders N seeded rudiment scores (ictus_tools.rudiments: singles, doubles, paradiddles at
-drummers' tempi, same-hand strokes down to 60 ms apart), judges each as
+Renders N seeded rudiment scores (ictus_tools.rudiments: singles, doubles, paradiddles, flams,
+flam taps, drags, double-stroke and buzz rolls at drummers' tempi, same-hand strokes down to
+60 ms apart), judges each as
 tests/perform/test_rudiments.py does, and prints the timing error's p50, p99 and worst (with its
-seed), by rudiment, and the failing seeds.
+seed), by rudiment, the grace strokes' leads (p1, p50, p99 before the stroke they lead into)
+and the failing seeds.
 
 usage (python/ on PYTHONPATH, docs/python.md):
        bench/rudiments.py ICTUSD [--count 500] [--first 1] [--jobs N] [--workdir DIR]
@@ -39,6 +41,12 @@ def main():
               % (name, len(rs), len(errs), percentile([e for e, _ in errs], 0.5),
                  percentile([e for e, _ in errs], 0.99), worst[0], worst[1],
                  sum(1 for r in rs if not r.ok)))
+    leads = [x for r in results for x in getattr(r, "grace_leads_ms", [])]
+    if leads:
+        print("grace strokes: %d, struck before the stroke they lead into p1 %.1f / p50 %.1f / "
+              "p99 %.1f ms (min %.1f, max %.1f)"
+              % (len(leads), percentile(leads, 0.01), percentile(leads, 0.5),
+                 percentile(leads, 0.99), min(leads), max(leads)))
     failed = [r.seed for r in results if not r.ok]
     print("failing seeds: %s" % (", ".join(map(str, failed)) or "none"))
     print("renders in %s" % workdir)

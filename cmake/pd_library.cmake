@@ -31,6 +31,7 @@ install(FILES ${ICTUS_SOURCE_ROOT}/patches/ictus.pd
         DESTINATION ${ictus_pd_dest} COMPONENT pd_library)
 install(FILES ${ICTUS_SOURCE_ROOT}/examples/scores/figure5.txt
               ${ICTUS_SOURCE_ROOT}/examples/scores/nuances.txt
+              ${ICTUS_SOURCE_ROOT}/examples/scores/rudiments.txt
               ${ICTUS_SOURCE_ROOT}/examples/scores/tempo_ramp.txt
         DESTINATION ${ictus_pd_dest}/examples/scores COMPONENT pd_library)
 install(FILES ${ICTUS_SOURCE_ROOT}/README.md ${ICTUS_SOURCE_ROOT}/LICENSE

@@ -20,10 +20,10 @@ Cases, for N = 16, 256, 1024, 4096:
 Best (smallest) of R runs each. Usage: bench_pd.py BUILD_DIR [--runs R]"""
 import argparse
 import os
-import resource
 import shutil
-import subprocess
 import tempfile
+
+from pdbench import Bench, bp_bank
 
 ap = argparse.ArgumentParser()
 ap.add_argument("build")
@@ -34,19 +34,8 @@ args = ap.parse_args()
 lib = os.path.join(os.path.abspath(args.build), "ictus")
 sr = args.sr
 work = tempfile.mkdtemp(prefix="ictus-bench-")
-
-
-def patch(seconds, body):
-    """body(lines, first_index) appends objects after the fixed header; returns text."""
-    lines = ["#N canvas 0 0 600 400 12;", "#X declare -path %s;" % lib,
-             "#X obj 10 10 loadbang;",                     # 0
-             "#X msg 10 40 \\; pd dsp 1;",                 # 1
-             "#X obj 10 70 delay %.17g;" % (seconds * 1000.0),  # 2
-             "#X msg 10 100 \\; pd quit;",                 # 3
-             "#X obj 10 130 noise~;",                      # 4
-             "#X connect 0 0 1 0;", "#X connect 0 0 2 0;", "#X connect 2 0 3 0;"]
-    body(lines, 5)
-    return "\n".join(lines) + "\n"
+bench = Bench(lib, sr, args.runs, work)
+patch, run = bench.patch, bench.run
 
 
 def empty(lines, i):
@@ -84,38 +73,6 @@ PRESSED = ("mass 10 \\, stiffness 1e+06 \\, hit 0.5 0.3 0", 100)
 ROLL = ("hit 1 \\$1 0", 5)
 
 
-def bp_bank(n):
-    def body(lines, i):
-        for k in range(n):
-            # centre frequencies spread like a membrane's partials, Q 10
-            lines.append("#X obj %d %d bp~ %g 10;" % (200 + k % 40 * 10, 10 + k // 40, 100 + 5 * k))
-            lines.append("#X connect 4 0 %d 0;" % (i + k))
-    return body
-
-
-def run(text, name):
-    """Best (smallest) CPU time (user + sys, s) of pd over the runs. CPU time
-    rather than wall time: other processes on the machine then inflate the
-    figures much less (they still share caches and memory bandwidth)."""
-    path = os.path.join(work, name + ".pd")
-    with open(path, "w") as f:
-        f.write(text)
-    best = None
-    for _ in range(args.runs):
-        proc = subprocess.Popen(["pd", "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr),
-                                 "-open", path], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                text=True)
-        _, err = proc.communicate(timeout=1200)
-        usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = usage.ru_utime + usage.ru_stime - run.cpu_so_far
-        run.cpu_so_far = usage.ru_utime + usage.ru_stime
-        if proc.returncode != 0 or "error" in err.lower() or "couldn't" in err:
-            raise SystemExit("%s failed:\n%s" % (name, err))
-        best = cpu if best is None else min(best, cpu)
-    return best
-
-
-run.cpu_so_far = 0.0
 
 
 print("membrane~ in Pd: CPU ns per mode per sample, sr %d Hz, best of %d runs" % (sr, args.runs))

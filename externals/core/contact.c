@@ -19,6 +19,7 @@
  */
 #include "contact.h"
 #include "membrane_internal.h"
+#include "stick_tip.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -29,7 +30,8 @@
 
 struct contact {
     membrane_point point; /* first: a membrane_point * is a contact * (contact_point_ops) */
-    double mass_kg, stiffness, alpha, damping;
+    double mass_kg, stiffness, alpha, damping, stretch;
+    double stretch_force; /* N, the stretching's force on the stick in the last sample */
     double hit_velocity; /* m/s, of the hit waiting to land (point.move_pending) */
     double hit_mass_kg;  /* the stick's mass from that hit on; 0: unchanged */
     /* Stroke state (double: the contact law is stiff and nonlinear). */
@@ -62,9 +64,22 @@ contact *contact_new(void)
     c->stiffness = CONTACT_DEFAULT_STIFFNESS;
     c->alpha = CONTACT_DEFAULT_ALPHA;
     c->damping = CONTACT_DEFAULT_DAMPING;
+    c->stretch = CONTACT_DEFAULT_STRETCH;
     c->point.ops = &contact_point_ops;
+    c->point.static_correction = 1;
     c->point.r_over_a = 0.3;
     return c;
+}
+
+ictus_status contact_set_tip(contact *c, const char *name)
+{
+    const stick_tip *tip = stick_tip_find(name);
+    if (!c || !tip)
+        return ICTUS_CLAMPED;
+    c->alpha = tip->alpha;
+    c->stiffness = tip->stiffness;
+    c->damping = tip->mu * tip->stiffness;
+    return ICTUS_OK;
 }
 
 void contact_free(contact *c)
@@ -87,6 +102,8 @@ static const ictus_param_def contact_param_def[CONTACT_PARAM_COUNT] = {
     [CONTACT_PARAM_ALPHA] = {"alpha", "", RANGE(ALPHA), offsetof(contact, alpha), NULL},
     [CONTACT_PARAM_DAMPING] = {"damping", "N s/m^(alpha+1)", RANGE(DAMPING),
                                offsetof(contact, damping), NULL},
+    [CONTACT_PARAM_STRETCH] = {"stretch", "N/m^3", RANGE(STRETCH), offsetof(contact, stretch),
+                               NULL},
 };
 #undef RANGE
 
@@ -149,6 +166,14 @@ double contact_stick_position(const contact *c)
 double contact_stick_velocity(const contact *c)
 {
     return c->stick_v;
+}
+double contact_compression(const contact *c)
+{
+    return c->compression;
+}
+double contact_residual_compliance(const contact *c)
+{
+    return c->point.owner ? c->point.residual_compliance : 0.0;
 }
 double contact_last_force(const contact *c)
 {
@@ -396,6 +421,7 @@ static void contact_landed(membrane_point *pt, double displacement_m)
     c->compression = c->compression_before = 0.0;
     c->lin_valid = 0;
     c->force = 0.0;
+    c->stretch_force = 0.0;
     c->point.active = 1;
     c->touching = 0;
     c->ever_touched = 0;
@@ -416,6 +442,64 @@ static void finish_stroke(contact *c, double dt)
     c->touching = 0;
 }
 
+/* The stretching's force on the stick over a step of its depth s0 -> s1 (m): the
+ * discrete gradient of U(s) = k3 s+^4 / 4, so that its work is U's change. */
+static double stretch_step_force(double k3, double s0, double s1)
+{
+    if (!(k3 > 0.0) || (s0 <= 0.0 && s1 <= 0.0))
+        return 0.0;
+    double a = s0 > 0.0 ? s0 : 0.0, b = s1 > 0.0 ? s1 : 0.0;
+    if (fabs(b - a) > 1.0e-9 * (a + b)) {
+        double a2 = a * a, b2 = b * b;
+        return 0.25 * k3 * (b2 * b2 - a2 * a2) / (s1 - s0);
+    }
+    double m = 0.5 * (a + b);
+    return k3 * m * m * m;
+}
+
+/* One stick alone: the scalar solve of its compression, and (stretch > 0) the
+ * stretching's force G on the stick, made consistent with the stick's new depth by
+ * re-solving until that depth stops moving (2-3 solves). Returns F; *g gets G. */
+static double contact_solve_one(contact *c, double xfree, double K, double T, double *x1, double *g)
+{
+    double C = T * T / (2.0 * c->mass_kg) + K;
+    double h = T * T / (2.0 * c->mass_kg); /* depth moved per N of force on the stick */
+    double s0 = c->stick_x, s_coast = s0 + T * c->stick_v;
+    double s1 = s_coast - h * (c->force + c->stretch_force); /* the last sample's forces */
+    double G = 0.0, F = 0.0;
+    for (int pass = 0; pass < 4; pass++) {
+        G = stretch_step_force(c->stretch, s0, s1);
+        double ug = -1.0;
+        if (c->force > 0.0 && c->lin_valid && pass == 0) {
+            /* The last sample's force law, linearised, in x1 = x_free - C F: the
+             * membrane's part of the move (x_free) is exact, the law's curvature
+             * is the error. */
+            double Cd1 = C * c->lin_d1;
+            ug = (xfree - h * G - C * (c->lin_f + c->lin_d0 * (c->compression - c->lin_x0)) +
+                  Cd1 * c->lin_u) /
+                 (1.0 + Cd1);
+        } else if (c->force > 0.0 && c->compression > 0.0 && c->compression_before > 0.0) {
+            ug = 2.0 * c->compression - c->compression_before;
+        }
+        contact_lin lin = {0, 0.0, 0.0, 0.0, 0.0};
+        double x0 = c->compression;
+        F = contact_solve(c, x0, xfree - h * G, C, T, c->force, ug, x1, &lin);
+        c->lin_valid = lin.valid;
+        c->lin_x0 = x0;
+        c->lin_u = lin.u;
+        c->lin_f = lin.f;
+        c->lin_d0 = lin.d0;
+        c->lin_d1 = lin.d1;
+        double s_new = s_coast - h * (F + G);
+        double moved = fabs(s_new - s1);
+        s1 = s_new;
+        if (!(c->stretch > 0.0) || moved <= 1.0e-13 + 1.0e-10 * fabs(s1))
+            break;
+    }
+    *g = G;
+    return F;
+}
+
 /* Joint implicit solve of every active contact for this sample (Gauss-Seidel
  * over contacts, up to 30 sweeps; a single contact needs none). */
 static void contact_solve_points(membrane_point *const *pts, int na, const double *w_free,
@@ -429,32 +513,19 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
         xfree[i] = c->stick_x + T * c->stick_v - w_free[i];
         x1[i] = xfree[i];
     }
+    double G[MEMBRANE_MAX_POINTS] = {0};
     if (na == 1) {
         /* One stick, the common case: the scalar solve is exact, nothing to sweep. */
-        contact *c = point_contact(pts[0]);
-        double C = T * T / (2.0 * c->mass_kg) + K[0][0];
-        double ug = -1.0;
-        if (c->force > 0.0 && c->lin_valid) {
-            /* The last sample's force law, linearised, in x1 = x_free - C F: the
-             * membrane's part of the move (x_free) is exact, the law's curvature
-             * is the error. */
-            double Cd1 = C * c->lin_d1;
-            ug = (xfree[0] - C * (c->lin_f + c->lin_d0 * (c->compression - c->lin_x0)) +
-                  Cd1 * c->lin_u) /
-                 (1.0 + Cd1);
-        } else if (c->force > 0.0 && c->compression > 0.0 && c->compression_before > 0.0) {
-            ug = 2.0 * c->compression - c->compression_before;
-        }
-        contact_lin lin = {0, 0.0, 0.0, 0.0, 0.0};
-        double x0 = c->compression;
-        F[0] = contact_solve(c, x0, xfree[0], C, T, c->force, ug, &x1[0], &lin);
-        c->lin_valid = lin.valid;
-        c->lin_x0 = x0;
-        c->lin_u = lin.u;
-        c->lin_f = lin.f;
-        c->lin_d0 = lin.d0;
-        c->lin_d1 = lin.d1;
+        F[0] = contact_solve_one(point_contact(pts[0]), xfree[0], K[0][0], T, &x1[0], &G[0]);
     } else {
+        for (int i = 0; i < na; i++) {
+            /* The stretching at the depth the last sample's forces predict. */
+            contact *c = point_contact(pts[i]);
+            double h = T * T / (2.0 * c->mass_kg);
+            double s1 = c->stick_x + T * c->stick_v - h * (c->force + c->stretch_force);
+            G[i] = stretch_step_force(c->stretch, c->stick_x, s1);
+            xfree[i] -= h * G[i];
+        }
         for (int s = 0; s < 30; s++) {
             double change = 0.0;
             for (int i = 0; i < na; i++) {
@@ -477,8 +548,9 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
     for (int i = 0; i < na; i++) {
         contact *c = point_contact(pts[i]);
         double Fi = F[i];
-        /* Midpoint rule for the stick: m (v+ - v) = -T F, x+ = x + T (v + v+) / 2. */
-        double v1 = c->stick_v - T * Fi / c->mass_kg;
+        /* Midpoint rule for the stick: m (v+ - v) = -T (F + G), x+ = x + T (v + v+) / 2. */
+        double v1 = c->stick_v - T * (Fi + G[i]) / c->mass_kg;
+        c->stretch_force = G[i];
         c->stick_x += 0.5 * T * (c->stick_v + v1);
         c->stick_v = v1;
         double xw = x1[i], xprev = c->compression;

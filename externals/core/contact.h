@@ -4,8 +4,17 @@
  * compression x = stick position - membrane displacement at the contact point
  * (positive into the membrane), the contact force is
  *     F = k x^alpha + lambda x^alpha dx/dt     for x > 0, else 0, and F >= 0
- * (Hunt & Crossley; lambda in N s / m^(alpha+1)). The ratio mu = lambda / k (s/m)
- * is the damping per unit stiffness; the default lambda gives mu = 0.5 s/m.
+ * (Hunt & Crossley; lambda in N s / m^(alpha+1)), the law of stick_tip.h, which
+ * the daemon's physics uses too. The ratio mu = lambda / k (s/m) is the damping
+ * per unit stiffness. contact_set_tip() takes alpha, k and lambda from the table
+ * of stick tips (stick_tip.h: wood, nylon, felt).
+ * The head's stretching under a point load (stick_tip_head_k3 in stick_tip.h: a
+ * force k3 y^3 on top of the modes' linear stiffness, y the head's deflection under
+ * the stick) is the "stretch" parameter, k3 in N/m^3. It is carried on the stick:
+ * the stick feels the potential k3 s^4 / 4 of its depth s below the rest plane
+ * (s > 0), and the modes take the contact force F alone, i.e. the force net of the
+ * stretching's push-back, so that with a stiff tip the stick meets F + k3 s^3,
+ * the physics' head F = k1 y + k3 y^3 (daemon/src/sim) with the modes as k1.
  * The contact is solved jointly with the membrane's modes, sample by sample
  * (Avanzini & Rocchesso), with an energy-consistent discretisation: the
  * spring term is a discrete gradient of V(x) = k x^(alpha+1)/(alpha+1) and the
@@ -36,15 +45,22 @@ extern "C" {
 #define CONTACT_DAMPING_MIN   0.0 /* lambda, N s / m^(alpha+1) */
 #define CONTACT_DAMPING_MAX   1.0e13
 #define CONTACT_VELOCITY_MAX  50.0 /* m/s, |hit velocity| */
+#define CONTACT_STRETCH_MIN   0.0  /* k3, N/m^3 */
+#define CONTACT_STRETCH_MAX   1.0e12
 
 /* Contacts attached to one membrane at once: each is one of its coupling points. */
 #define MEMBRANE_MAX_CONTACTS MEMBRANE_MAX_POINTS
 
-/* Defaults: a 50 g snare stick with a felt-free wooden tip on Mylar. */
+/* Defaults: a 50 g snare stick, a tip 47 times softer than the "wood" of
+ * stick_tip.h (docs/contact.md, "Stick tips": with the Hertz stiffness of wood on
+ * Mylar the head's compliance is all there is, and a harder hit is no brighter). */
 #define CONTACT_DEFAULT_MASS      0.05
 #define CONTACT_DEFAULT_STIFFNESS 1.0e7
 #define CONTACT_DEFAULT_ALPHA     1.5
 #define CONTACT_DEFAULT_DAMPING   5.0e6 /* mu = lambda / k = 0.5 s/m */
+/* The head's stretching under the stick, off in the core (contact~ sets the
+ * default head's value, STICK_TIP_HEAD_K3_DEFAULT in stick_tip.h). */
+#define CONTACT_DEFAULT_STRETCH 0.0
 
 /* The one-number parameters, set, read and ranged through contact_params
  * (ictus_param.h): ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS, 0.05). */
@@ -53,6 +69,7 @@ typedef enum contact_param {
     CONTACT_PARAM_STIFFNESS, /* k, N/m^alpha */
     CONTACT_PARAM_ALPHA,     /* the exponent alpha */
     CONTACT_PARAM_DAMPING,   /* lambda, N s/m^(alpha+1) */
+    CONTACT_PARAM_STRETCH,   /* k3, N/m^3: the head's stretching (below) */
     CONTACT_PARAM_COUNT
 } contact_param;
 
@@ -71,6 +88,11 @@ typedef struct contact_report {
 
 /* Allocates. Returns NULL when memory cannot be had. */
 contact *contact_new(void);
+
+/* alpha, stiffness and damping (lambda = mu k) from the stick tip called name
+ * (stick_tip.h). Returns ICTUS_CLAMPED and changes nothing for an unknown name.
+ * The mass stays: it is the stick's, set with the hit or the "mass" parameter. */
+ictus_status contact_set_tip(contact *c, const char *name);
 void contact_free(contact *c);
 
 /* Attach / detach a contact (at most MEMBRANE_MAX_CONTACTS per membrane). A contact
@@ -106,6 +128,12 @@ int contact_take_report(contact *c, contact_report *report);
 double contact_stick_position(const contact *c);
 double contact_stick_velocity(const contact *c);
 double contact_last_force(const contact *c);
+/* The compression of the contact law (m): the stick's position less the head's over the
+ * patch (modes and the static compliance of the modes left out, membrane.h). */
+double contact_compression(const contact *c);
+/* The static compliance of the modes left out at the stick's point (m/N; 0 on a
+ * point-like or detached head): it stores residual_compliance F^2 / 2. */
+double contact_residual_compliance(const contact *c);
 
 /* Stick on a rigid, immovable target: the same contact law and discretisation
  * with no membrane. Simulates one stroke at sample_rate_hz and fills *report.

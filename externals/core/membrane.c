@@ -44,6 +44,7 @@ membrane *membrane_new(double sample_rate_hz)
     m->tension_mod = MEMBRANE_DEFAULT_TENSION_MOD;
     m->radiation = MEMBRANE_DEFAULT_RADIATION;
     m->loss_factor = MEMBRANE_DEFAULT_LOSS_FACTOR;
+    m->patch = MEMBRANE_DEFAULT_PATCH;
     m->tm_g = 1.0;
     m->output_gain = MEMBRANE_DEFAULT_GAIN;
     m->gain_smoothed = MEMBRANE_DEFAULT_GAIN;
@@ -289,7 +290,7 @@ static inline void solve_points(membrane *m, membrane_point **act, int na, membr
         return;
     double K[MEMBRANE_MAX_POINTS][MEMBRANE_MAX_POINTS];
     for (int r = 0; r < nact; r++) {
-        K[r][r] = act[r]->self_compliance;
+        K[r][r] = act[r]->self_compliance + act[r]->residual_compliance;
         /* Cross-compliance between two sticks on the same head (rare: only
          * while two strokes overlap), sum psi_r dm psi_c eq. */
         for (int c = 0; c < nact; c++) {

@@ -51,6 +51,8 @@ extern "C" {
 #define MEMBRANE_RADIATION_MAX   100.0
 #define MEMBRANE_LOSS_FACTOR_MIN 0.0 /* 0: no internal loss */
 #define MEMBRANE_LOSS_FACTOR_MAX 0.5
+#define MEMBRANE_PATCH_MIN       0.0 /* m; 0: a point */
+#define MEMBRANE_PATCH_MAX       0.05
 #define MEMBRANE_GAIN_MIN       -1.0e6 /* s/m; negative inverts */
 #define MEMBRANE_GAIN_MAX       1.0e6
 #define MEMBRANE_R_OVER_A_MIN   0.0 /* points: pickups, strikes, contacts */
@@ -75,6 +77,12 @@ extern "C" {
  * one side) and the film's internal loss factor eta (decay rate eta w / 2). */
 #define MEMBRANE_DEFAULT_RADIATION   0.5
 #define MEMBRANE_DEFAULT_LOSS_FACTOR 0.002
+/* The contact patch (docs/membrane.md, "The contact patch"): forces come in spread
+ * evenly over a disc of this radius and a stick feels the static compliance of the modes
+ * left out. 0 (the bare head's default): a point, no correction; the drum presets take
+ * the stick bead's radius, the physics' tip radius. */
+#define MEMBRANE_DEFAULT_PATCH       0.0
+#define MEMBRANE_PATCH_BEAD          0.007
 #define MEMBRANE_AIR_RHO             1.2   /* kg/m^3 */
 #define MEMBRANE_AIR_C               343.0 /* m/s */
 /* Mylar (PET film), for the tension modulation: Young's modulus (Pa), Poisson's ratio
@@ -113,6 +121,8 @@ typedef enum membrane_param {
      * factor eta (decay rate eta w / 2). Both 0: the t60/hfdamp law alone. */
     MEMBRANE_PARAM_RADIATION,
     MEMBRANE_PARAM_LOSS_FACTOR,
+    /* m: radius of the disc a strike's or a stick's force is spread over (0: a point) */
+    MEMBRANE_PARAM_PATCH,
     MEMBRANE_PARAM_COUNT
 } membrane_param;
 

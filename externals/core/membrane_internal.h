@@ -86,6 +86,7 @@ struct membrane {
     double sample_rate, radius, tension, density, t60, hf_damping, output_gain;
     double tension_mod;            /* dimensionless, MEMBRANE_PARAM_TENSION_MOD */
     double radiation, loss_factor; /* MEMBRANE_PARAM_RADIATION, MEMBRANE_PARAM_LOSS_FACTOR */
+    double patch;                  /* m, MEMBRANE_PARAM_PATCH */
     /* The radiation integral of each mode depends on ka = j c / c_air alone: kept for
      * rad_valid modes at the wave speed rad_c (recomputed when either changes). */
     double *rad_int, rad_c;
@@ -163,6 +164,7 @@ static inline void membrane_input_shapes_(const membrane *m, double r_over_a, do
                                           float *psi)
 {
     mode_table_shapes(&m->table, m->modes, r_over_a, theta_deg, psi);
+    mode_table_patch_filter(&m->table, m->modes, m->patch / m->radius, psi);
 }
 
 /* The shapes of coupling point pt, at its place or its own (membrane_point_ops.shapes). */
@@ -174,6 +176,9 @@ void membrane_update_coefficients_(membrane *m, int rescale);
 /* Builds the mode arrays for `modes` modes, keeping the state of the modes in both
  * the old and the new table. Allocates when growing. */
 ictus_status membrane_build_modes_(membrane *m, int modes);
+/* The shapes at the strike point, the pickups and the points, for the modes now in
+ * place, and the strikes' cache emptied (membrane_modes.c). */
+void membrane_refresh_shapes_(membrane *m);
 /* Frees the arrays built for the capacity (not the points'). */
 void membrane_free_mode_arrays_(membrane *m);
 
@@ -249,6 +254,10 @@ struct membrane_point {
     int active;             /* set by the object: solve this point every sample */
     double force_pending;   /* N, the last force, not yet added to the modal state */
     double self_compliance; /* K = d w / d F over one sample (m/N) */
+    /* Set by the object: the point is a stick's contact, which feels the static
+     * compliance of the modes left out (residual_compliance, m/N, membrane_points.c). */
+    int static_correction;
+    double residual_compliance;
     double pick_coupling[MEMBRANE_PICKUPS];
 };
 

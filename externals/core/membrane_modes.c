@@ -305,9 +305,10 @@ static void set_mode_count(membrane *m, int modes)
         m->q[k] = m->p[k] = 0.0f;
 }
 
-/* The shapes at the strike point, the pickups and the points, for the modes now in place. */
-static void refresh_shapes(membrane *m)
+void membrane_refresh_shapes_(membrane *m)
 {
+    for (int i = 0; i < IMPULSE_CACHE; i++)
+        m->impulse_cache[i].valid = 0;
     membrane_input_shapes_(m, m->strike_r, m->strike_theta, m->psi_strike);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++)
         membrane_mode_shapes_(m, m->pick_r[i], m->pick_theta[i], m->psi_pick[i]);
@@ -336,7 +337,7 @@ ictus_status membrane_build_modes_(membrane *m, int modes)
     }
     set_mode_count(m, modes);
     membrane_update_coefficients_(m, 1);
-    refresh_shapes(m);
+    membrane_refresh_shapes_(m);
     membrane_refresh_couplings_(m);
     return ICTUS_OK;
 }

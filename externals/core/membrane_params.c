@@ -16,6 +16,17 @@ static ictus_status physics_changed(void *m, ictus_status s)
     return s;
 }
 
+/* After the radius or the contact patch changed: the input shapes follow (their
+ * patch is relative to the radius), then as physics_changed. */
+static ictus_status geometry_changed(void *mv, ictus_status s)
+{
+    membrane *m = mv;
+    membrane_flush_points_(m);
+    if (m->table.j)
+        membrane_refresh_shapes_(m);
+    return physics_changed(m, s);
+}
+
 ictus_status membrane_set_sample_rate(membrane *m, double sr)
 {
     ictus_status s = ictus_clamp(&sr, MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, 48000.0);
@@ -102,7 +113,7 @@ static double get_mass(const void *obj)
 #define FIELD(f) offsetof(membrane, f)
 /* clang-format on */
 static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
-    [MEMBRANE_PARAM_RADIUS] = {"radius", "m", RANGE(RADIUS), FIELD(radius), physics_changed},
+    [MEMBRANE_PARAM_RADIUS] = {"radius", "m", RANGE(RADIUS), FIELD(radius), geometry_changed},
     [MEMBRANE_PARAM_TENSION] = {"tension", "N/m", RANGE(TENSION), FIELD(tension), physics_changed},
     [MEMBRANE_PARAM_DENSITY] = {"density", "kg/m^2", RANGE(DENSITY), FIELD(density),
                                 physics_changed},
@@ -118,6 +129,7 @@ static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
                                   physics_changed},
     [MEMBRANE_PARAM_LOSS_FACTOR] = {"lossfactor", "", RANGE(LOSS_FACTOR), FIELD(loss_factor),
                                     physics_changed},
+    [MEMBRANE_PARAM_PATCH] = {"patch", "m", RANGE(PATCH), FIELD(patch), geometry_changed},
 };
 #undef RANGE
 #undef FIELD

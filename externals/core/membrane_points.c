@@ -3,6 +3,7 @@
  * (membrane_internal.h): their shapes, couplings, and forces folded into the modes. */
 #include "membrane_internal.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -38,6 +39,25 @@ static double dot_psi(const membrane *m, const float *a, const float *b, const f
     return s;
 }
 
+/* The static compliance a stick feels from the modes left out: the whole head's, for a
+ * force spread over the patch and the displacement averaged over it (the membrane's
+ * Green's function, (ln((1 - u^2) / eps) + 1/4) / (2 pi T) at u = r/a, eps = patch/a;
+ * exact at the centre, the disc's own mean log distance giving the 1/4), less the
+ * modes' own, sum psi_k^2 / (T j_k^2) (psi mass-normalised over the unit disc, the
+ * patch's means included). Quasi-static: it acts at once, in series with the modes
+ * (docs/membrane.md, "The contact patch"). */
+static double residual_compliance(const membrane *m, const membrane_point *pt)
+{
+    const double eps = m->patch / m->radius, u = pt->r_over_a;
+    if (!pt->static_correction || !(eps > 0.0) || u * u >= 1.0 - eps)
+        return 0.0;
+    double modal = 0.0;
+    for (int k = 0; k < m->modes && k < m->table.size; k++)
+        modal += (double)pt->psi[k] * pt->psi[k] / (m->table.j[k] * m->table.j[k]);
+    const double whole = (log((1.0 - u * u) / eps) + 0.25) / (2.0 * M_PI);
+    return whole > modal ? (whole - modal) / m->tension : 0.0;
+}
+
 static void point_couplings(membrane *m, membrane_point *pt)
 {
     /* w changes by K F over a sample: K = sum psi dm psi eq = scale h sum psi^2 ep
@@ -46,6 +66,7 @@ static void point_couplings(membrane *m, membrane_point *pt)
     for (int k = 0; k < m->count; k++)
         K += (double)pt->psi[k] * pt->psi[k] * m->ep[k];
     pt->self_compliance = K * membrane_displacement_scale_(m);
+    pt->residual_compliance = residual_compliance(m, pt);
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
         pt->pick_coupling[j] = dot_psi(m, m->psi_pick[j], pt->psi, m->ep);
     for (int k = 0; k < m->capacity; k++)

@@ -47,6 +47,7 @@ ictus_status membrane_apply_preset(membrane *m, const membrane_preset *p)
         {MEMBRANE_PARAM_TENSION_MOD, p->linear ? 0.0 : MEMBRANE_DEFAULT_TENSION_MOD},
         {MEMBRANE_PARAM_RADIATION, p->linear ? 0.0 : MEMBRANE_DEFAULT_RADIATION},
         {MEMBRANE_PARAM_LOSS_FACTOR, p->linear ? 0.0 : MEMBRANE_DEFAULT_LOSS_FACTOR},
+        {MEMBRANE_PARAM_PATCH, p->linear ? 0.0 : MEMBRANE_PATCH_BEAD},
     };
     for (int i = 0; i < (int)(sizeof(sets) / sizeof(sets[0])); i++)
         if ((e = ictus_param_set(t, m, sets[i].id, sets[i].value)) > s)

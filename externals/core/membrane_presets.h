@@ -35,8 +35,8 @@ typedef struct membrane_preset {
     double ratio_m1[MEMBRANE_PRESET_RATIOS];
     double decay_01; /* (0, 1) decays this many times faster (1: as the damping law) */
     int wires;       /* snare wires on the head (snare_wires.h; the Pd wrapper lays them) */
-    int linear;      /* 1: no tension modulation, radiation or internal loss (the paper's
-                      * head); 0: membrane.h's Mylar defaults for the three */
+    int linear;      /* 1: no tension modulation, radiation or internal loss, forces at a
+                      * point (the paper's head); 0: membrane.h's defaults for the four */
 } membrane_preset;
 
 /* The presets, in the order the docs list them; count via membrane_preset_count(). */

@@ -87,6 +87,20 @@ void mode_table_shapes(const mode_table *t, int live, double r_over_a, double th
     }
 }
 
+void mode_table_patch_filter(const mode_table *t, int live, double eps, float *psi)
+{
+    if (!(eps > 0.0))
+        return;
+    double mean = 1.0;
+    for (int k = 0; k < live && k < t->size; k++) {
+        if (!(k > 0 && t->j[k] == t->j[k - 1])) {
+            double x = t->j[k] * eps;
+            mean = 2.0 * ictus_bessel_j(1, x) / x;
+        }
+        psi[k] = (float)(psi[k] * mean);
+    }
+}
+
 double mode_table_shape(const mode_table *t, int k, double r_over_a, double theta_rad)
 {
     return ictus_bessel_j(t->m[k], t->j[k] * r_over_a) * t->norm[k] *

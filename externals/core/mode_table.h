@@ -29,6 +29,12 @@ void mode_table_free(mode_table *t);
 void mode_table_shapes(const mode_table *t, int live, double r_over_a, double theta_deg,
                        float *psi);
 
+/* A force spread evenly over a disc of radius eps (relative to the head's) instead
+ * of a point: every shape times its mean over the disc, 2 J1(j eps) / (j eps) (the
+ * mean value theorem of the Helmholtz equation, which each mode shape solves), for
+ * k < live. eps <= 0: unchanged. O(live) Bessel calls. */
+void mode_table_patch_filter(const mode_table *t, int live, double eps, float *psi);
+
 /* The same for mode k alone, in double (theta in radians). */
 double mode_table_shape(const mode_table *t, int k, double r_over_a, double theta_rad);
 

@@ -1,7 +1,9 @@
 /* contact~ -- a stick that hits a membrane~ (Hunt-Crossley contact,
  * externals/core/contact.h), solved jointly with the membrane's modes.
  *
- * [contact~ NAME] plays the membrane~ named NAME. It finds it in its dsp
+ * [contact~ NAME [TIP]] plays the membrane~ named NAME with the stick tip TIP
+ * (stick_tip.h: wood, nylon, felt; message "tip NAME"; without
+ * TIP, contact.h's defaults). It finds it in its dsp
  * method with pd_findbyclass(), as delread~ finds delwrite~, and attaches its
  * core contact to the membrane's core. The membrane's perform computes the
  * stroke and writes the contact force into a buffer owned here; contact~'s
@@ -15,6 +17,7 @@
 #include <string.h>
 
 #include "ictus_pd.h"
+#include "stick_tip.h"
 
 typedef struct _contact_tilde {
     t_object x_obj;
@@ -39,6 +42,21 @@ static const t_ictus_params contact_tilde_params = {"contact~", &contact_params}
 static void contact_tilde_setparam(t_contact_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
     ictus_params_message(x, &contact_tilde_params, x->x_core, s, argc, argv);
+}
+
+/* tip NAME: alpha, stiffness and damping from the table of stick tips (stick_tip.h). */
+static void contact_tilde_tip(t_contact_tilde *x, t_symbol *name)
+{
+    int i;
+    char known[64] = "";
+    if (contact_set_tip(x->x_core, name->s_name) == ICTUS_OK)
+        return;
+    for (i = 0; i < STICK_TIP_COUNT; i++) {
+        strncat(known, i ? ", " : "", sizeof(known) - strlen(known) - 1);
+        strncat(known, stick_tips[i].name, sizeof(known) - strlen(known) - 1);
+    }
+    pd_error(x, "contact~: tip: no stick tip named '%s' (%s); the tip is unchanged",
+             name->s_name, known);
 }
 
 /* The membrane~ whose sample clock times our messages: the attached one, else
@@ -221,13 +239,23 @@ static void *contact_tilde_new(t_symbol *s, int argc, t_atom *argv)
     x->x_force_size = 0;
     memset(&x->x_report, 0, sizeof(x->x_report));
     x->x_name = &s_;
+    /* The head's stretching under the stick: the default head's, as the physics'. */
+    ictus_param_set(&contact_params, core, CONTACT_PARAM_STRETCH, STICK_TIP_HEAD_K3_DEFAULT);
     if (argc > 0 && argv[0].a_type == A_SYMBOL)
         x->x_name = atom_getsymbol(&argv[0]);
     else
         pd_error(x, "contact~: needs the name of a membrane~ as argument ([contact~ NAME]); "
                     "silent until 'set NAME'");
-    if (argc > 1)
-        pd_error(x, "contact~: takes one argument, a membrane~ name; extra arguments ignored");
+    if (argc > 1) {
+        if (argv[1].a_type == A_SYMBOL)
+            contact_tilde_tip(x, atom_getsymbol(&argv[1]));
+        else
+            pd_error(x, "contact~: the second argument is a stick tip name (wood, nylon, felt); "
+                        "ignored");
+    }
+    if (argc > 2)
+        pd_error(x, "contact~: takes two arguments, a membrane~ name and a stick tip; extra "
+                    "arguments ignored");
     outlet_new(&x->x_obj, &s_signal);
     x->x_report_out = outlet_new(&x->x_obj, &s_list);
     x->x_report_clock = clock_new(x, (t_method)contact_tilde_report_tick);
@@ -258,5 +286,7 @@ void ictus_contact_tilde_setup(void)
     class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_hit, gensym("hit"), A_GIMME,
                     0);
     class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_set, gensym("set"), A_DEFSYM,
+                    0);
+    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_tip, gensym("tip"), A_DEFSYM,
                     0);
 }

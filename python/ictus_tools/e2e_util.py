@@ -91,14 +91,16 @@ def hit_times_us(events):
 
 def drum_lines(render_json):
     """The drum of render.json as render-drum lines for ictus-render (membrane~
-    parameters: the preset first, when there is one, then the head's numbers; the
-    simulation's contact law is its own and is not copied)."""
+    parameters: the preset first, when there is one, then the head's numbers; and
+    the stick tip to both contact~, when the physics has one)."""
     with open(render_json) as f:
         drum = json.load(f)["drum"]
     preset = ["render-drum preset %s" % drum["preset"]] if drum.get("preset") else []
+    tip = drum.get("stick_tip") or ""
+    tips = ["render-drum %s tip %s" % (hand, tip) for hand in ("left", "right")] if tip else []
     return preset + ["render-drum radius %.6g" % drum["radius_m"],
             "render-drum tension %.6g" % drum["tension_n_per_m"],
-            "render-drum density %.6g" % drum["density_kg_per_m2"]]
+            "render-drum density %.6g" % drum["density_kg_per_m2"]] + tips
 
 
 def write_events(path, header_lines, events, keep=None):
@@ -255,3 +257,23 @@ def judge_departures(departures, strikes, sr):
         elif e != 0:
             notes.append((k, what + ": %+.4f ms" % e))
     return errors, failures, notes
+
+
+def pd_spawning_env(work):
+    """The environment for a program that runs pd itself (ictusd render --wav,
+    scripts/main.sh): pd found on PATH; under the ASan build (ICTUS_PD_PRELOAD)
+    a wrapper named pd first in PATH preloads the runtime into pd and nothing
+    else."""
+    env = dict(os.environ)
+    env.pop("LD_PRELOAD", None)
+    if os.environ.get("ICTUS_PD_PRELOAD"):
+        bindir = os.path.join(work, "bin")
+        os.makedirs(bindir, exist_ok=True)
+        with open(os.path.join(bindir, "pd"), "w") as f:
+            f.write("#!/bin/sh\nLD_PRELOAD=%s exec %s \"$@\"\n" % (os.environ["ICTUS_PD_PRELOAD"],
+                                                                  PD))
+        os.chmod(os.path.join(bindir, "pd"), 0o755)
+        env["PATH"] = bindir + os.pathsep + env["PATH"]
+    elif os.path.dirname(PD):
+        env["PATH"] = os.path.dirname(PD) + os.pathsep + env["PATH"]
+    return env

@@ -99,3 +99,49 @@ TEST_CASE("midi: a tempo change lands on a tick and later notes follow it", "[cl
     CHECK_THROWS(standard_midi_file(s, {}, 0));
     CHECK_THROWS(standard_midi_file(s, {{0.0, 60.0}}, 16));
 }
+
+TEST_CASE("midi: with a kit each strike is its drum's General MIDI note", "[cli][midi]")
+{
+    // The right hand on the snare (drum 0: 38) at 0.5 s, then on tom1 (drum
+    // 1: 48) at 0.52 s: two notes, so the snare's is not cut by the tom's and
+    // lasts its 0.1 s (0.6 s = tick 2304); the tom's ends at 0.62 s = 2380.8
+    // -> 2381. Without the kit both would be note 52 (hand 1, zone 0).
+    std::vector<StrikeEvent> s = {strike(1, 0.5, 0.1, 1.0, false),
+                                  strike(1, 0.52, 0.1, 1.0, false)};
+    s[1].drum = 1;
+    const std::vector<int> notes = {38, 48};
+    const std::string track = bytes({0x00, 0xff, 0x03, 0x05}) + "ictus" +
+                              bytes({0x00, 0xff, 0x58, 0x04, 0x04, 0x02, 0x18, 0x08}) +
+                              bytes({0x00, 0xff, 0x51, 0x03, 0x0f, 0x42, 0x40}) +
+                              bytes({0x8f, 0x00, 0x99, 38, 64}) + // +1920, the snare
+                              bytes({0x4d, 0x99, 48, 64}) +       // +77, tom1
+                              bytes({0x82, 0x33, 0x89, 38, 0}) +  // +307, the snare ends
+                              bytes({0x4d, 0x89, 48, 0}) +        // +77, tom1 ends
+                              bytes({0x00, 0xff, 0x2f, 0x00});
+    const std::string want = std::string("MThd") + bytes({0, 0, 0, 6, 0, 0, 0, 1, 0x0f, 0x00}) +
+                             "MTrk" + bytes({0, 0, 0, static_cast<int>(track.size())}) + track;
+    CHECK(standard_midi_file(s, {{0.0, 60.0}}, 9, &notes) == want);
+    CHECK(standard_midi_file(s, {{0.0, 60.0}}, 9) != want);
+}
+
+TEST_CASE("midi: the score's meters as time signatures, 4/4 without one", "[cli][midi]")
+{
+    // 60 bpm, 3840 ticks a second. 6/8 from 0 s replaces the 4/4 (FF 58 04
+    // 06 03 18 08: 6, 2^3, 24 clocks a click, 8 32nds a quarter), 3/4 at 0.5 s
+    // = tick 1920 (FF 58 04 03 02 18 08), after the tempo at tick 0.
+    const std::vector<StrikeEvent> none;
+    const std::string head = bytes({0x00, 0xff, 0x03, 0x05}) + "ictus";
+    const std::string f = standard_midi_file(none, {{0.0, 60.0}}, 0, nullptr, {{0.0, 6, 8}, {0.5, 3, 4}});
+    const std::string track = head + bytes({0x00, 0xff, 0x58, 0x04, 0x06, 0x03, 0x18, 0x08}) +
+                              bytes({0x00, 0xff, 0x51, 0x03, 0x0f, 0x42, 0x40}) +
+                              bytes({0x8f, 0x00, 0xff, 0x58, 0x04, 0x03, 0x02, 0x18, 0x08}) +
+                              bytes({0x00, 0xff, 0x2f, 0x00});
+    CHECK(f.substr(22) == track);
+    // A first meter after 0 s: 4/4 at tick 0, then 5/4 at 0.25 s = tick 960 (0x87 0x40).
+    const std::string g = standard_midi_file(none, {{0.0, 60.0}}, 0, nullptr, {{0.25, 5, 4}});
+    CHECK(g.substr(22) == head + bytes({0x00, 0xff, 0x58, 0x04, 0x04, 0x02, 0x18, 0x08}) +
+                              bytes({0x00, 0xff, 0x51, 0x03, 0x0f, 0x42, 0x40}) +
+                              bytes({0x87, 0x40, 0xff, 0x58, 0x04, 0x05, 0x02, 0x18, 0x08}) +
+                              bytes({0x00, 0xff, 0x2f, 0x00}));
+    CHECK_THROWS(standard_midi_file(none, {{0.0, 60.0}}, 0, nullptr, {{0.0, 3, 6}}));
+}

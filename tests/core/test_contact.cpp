@@ -167,9 +167,14 @@ TEST_CASE("Passivity with the membrane: total discrete energy never grows", "[co
     std::uniform_real_distribution<double> u01(0.0, 1.0);
     auto logu = [&](double lo, double hi) { return lo * std::pow(hi / lo, u01(rng)); };
     const int modes = 8;
+    // A point contact, whose compression this test computes itself from the head's
+    // displacement at the point; and a stick bead's patch, where the contact also
+    // feels the static compliance C of the modes left out, which stores C F^2 / 2.
+    const double patch = GENERATE(0.0, MEMBRANE_PATCH_BEAD);
     for (int trial = 0; trial < 150; trial++) {
         membrane *m = membrane_new(logu(22050.0, 192000.0));
         membrane_set_modes(m, modes);
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_PATCH, patch);
         ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_RADIUS, logu(0.05, 0.5));
         ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION, logu(100.0, 1e5));
         ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_DENSITY, logu(0.05, 5.0));
@@ -202,12 +207,16 @@ TEST_CASE("Passivity with the membrane: total discrete energy never grows", "[co
         int steps = 0;
         for (int s = 0; s < 20000 && contact_is_active(c); s++, steps++) {
             membrane_process(m, nullptr, outs, 1);
-            double x = contact_stick_position(c) - membrane_displacement_at(m, r, th);
+            double x = patch == 0.0 ? contact_stick_position(c) - membrane_displacement_at(m, r, th)
+                                    : contact_compression(c);
             double V = x > 0 ? k * std::pow(x, a + 1.0) / (a + 1.0) : 0.0;
+            double F = contact_last_force(c);
+            V += 0.5 * contact_residual_compliance(c) * F * F;
             double sv = contact_stick_velocity(c);
             double e = 0.5 * mass * sv * sv + membrane_energy(m) + V;
             worst = std::max(worst, (e - prev) / e0);
-            INFO("trial " << trial << " sample " << s << " E " << e << " prev " << prev);
+            INFO("patch " << patch << " trial " << trial << " sample " << s << " E " << e
+                          << " prev " << prev);
             REQUIRE(e <= prev + slack);
             prev = e;
         }
@@ -217,6 +226,56 @@ TEST_CASE("Passivity with the membrane: total discrete energy never grows", "[co
             double bound = std::sqrt(v * v + 2.0 * steps * slack / mass);
             CHECK(rep.rebound_velocity_mps <= bound);
         }
+        membrane_free(m);
+        contact_free(c);
+    }
+}
+
+TEST_CASE("Passivity with the head's stretching: the stick's U = k3 s^4 / 4 counted",
+          "[core][contact]")
+{
+    // The stretch parameter puts the potential k3 s+^4 / 4 of the stick's depth s on
+    // the stick (contact.h); with it in the total, the discrete energy never grows.
+    std::mt19937_64 rng(4242);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    auto logu = [&](double lo, double hi) { return lo * std::pow(hi / lo, u01(rng)); };
+    const int modes = 8;
+    for (int trial = 0; trial < 40; trial++) {
+        membrane *m = membrane_new(logu(22050.0, 192000.0));
+        membrane_set_modes(m, modes);
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION, logu(300.0, 1e4));
+        // A point contact: the compression below is computed from the head at the point.
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_PATCH, 0.0);
+        contact *c = contact_new();
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_MASS, logu(0.005, 0.2));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_STIFFNESS, logu(1e5, 1e9));
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_DAMPING, u01(rng) < 0.5 ? 0.0 : 1e6);
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_STRETCH, logu(1e5, 1e10));
+        membrane_attach_contact(m, c);
+        double v = logu(0.1, 20.0), r = 0.9 * u01(rng), th = 360.0 * u01(rng);
+        contact_hit(c, v, r, th, 0);
+        const double mass = ictus_param_get(&contact_params, c, CONTACT_PARAM_MASS),
+                     k = ictus_param_get(&contact_params, c, CONTACT_PARAM_STIFFNESS),
+                     k3 = ictus_param_get(&contact_params, c, CONTACT_PARAM_STRETCH), a = 1.5;
+        const double e0 = 0.5 * mass * v * v;
+        // The float rounding of the modes, as in the test above.
+        const double slack = (2.0 + (a + 1.0) * modes) * FLT_EPSILON * e0;
+        float o0[1], o1[1];
+        float *outs[2] = {o0, o1};
+        double prev = e0;
+        for (int s = 0; s < 20000 && contact_is_active(c); s++) {
+            membrane_process(m, nullptr, outs, 1);
+            double depth = contact_stick_position(c);
+            double x = depth - membrane_displacement_at(m, r, th);
+            double V = x > 0 ? k * std::pow(x, a + 1.0) / (a + 1.0) : 0.0;
+            double U = depth > 0 ? 0.25 * k3 * depth * depth * depth * depth : 0.0;
+            double sv = contact_stick_velocity(c);
+            double e = 0.5 * mass * sv * sv + membrane_energy(m) + V + U;
+            INFO("trial " << trial << " sample " << s << " E " << e << " prev " << prev);
+            REQUIRE(e <= prev + slack);
+            prev = e;
+        }
+        CHECK_FALSE(contact_is_active(c));
         membrane_free(m);
         contact_free(c);
     }
@@ -268,6 +327,7 @@ TEST_CASE("Two sticks at once: joint solve stays passive and both report", "[cor
 {
     membrane *m = membrane_new(48000.0);
     membrane_set_modes(m, 24);
+    ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_PATCH, 0.0); // point contacts
     contact *c[2] = {contact_new(), contact_new()};
     const double r[2] = {0.2, 0.45}, th[2] = {0.0, 120.0}, v[2] = {3.0, 2.0};
     double e0 = 0.0;

@@ -31,7 +31,7 @@ using membrane_ptr = std::unique_ptr<membrane, membrane_deleter>;
 
 // The head of the Bessel tests (the `paper` head): no tension modulation, so every
 // partial rings at j_mn c / (2 pi a) whatever the amplitude, and the t60/hfdamp law
-// alone sets the decay (no radiation, no internal loss).
+// alone sets the decay (no radiation, no internal loss), and forces act at a point.
 membrane *linear_membrane(double fs)
 {
     membrane *m = membrane_new(fs);
@@ -39,6 +39,7 @@ membrane *linear_membrane(double fs)
         ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION_MOD, 0.0);
         ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_RADIATION, 0.0);
         ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_LOSS_FACTOR, 0.0);
+        ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_PATCH, 0.0);
     }
     return m;
 }

@@ -54,8 +54,9 @@ TEST_CASE("paper is the default head made linear, exactly, after any other prese
     membrane *m = membrane_new(48000.0);
     REQUIRE(fresh);
     REQUIRE(m);
-    // the paper's head: no tension modulation, radiation or internal loss
-    for (int id : {MEMBRANE_PARAM_TENSION_MOD, MEMBRANE_PARAM_RADIATION, MEMBRANE_PARAM_LOSS_FACTOR})
+    // the paper's head: no tension modulation, radiation or internal loss, point forces
+    for (int id : {MEMBRANE_PARAM_TENSION_MOD, MEMBRANE_PARAM_RADIATION, MEMBRANE_PARAM_LOSS_FACTOR,
+                   MEMBRANE_PARAM_PATCH})
         REQUIRE(ictus_param_set(&membrane_params, fresh, id, 0.0) == ICTUS_OK);
     REQUIRE(membrane_apply_preset(m, membrane_preset_find("timpani")) == ICTUS_OK);
     REQUIRE(membrane_apply_preset(m, membrane_preset_find("paper")) == ICTUS_OK);

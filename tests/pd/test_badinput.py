@@ -65,6 +65,9 @@ contact_cases = [
     ("hit 1 0.5", "contact~: hit: missing theta (deg)"),
     ("hit foo 0.5 0", "contact~: hit: velocity (m/s) must be a number, got 'foo'"),
     ("set", "contact~: set: needs the name of a membrane~"),
+    ("tip steel", "contact~: tip: no stick tip named 'steel' (wood, nylon, felt); the tip is "
+                  "unchanged"),
+    ("tip felt", None),
     ("hit 2 0.3 0", None),
 ]
 
@@ -76,6 +79,7 @@ mem = p.obj("membrane~ bad-drum 1e+30 -5 nan")
 con = p.obj("contact~ bad-drum")
 p.obj("contact~")                       # no name
 p.obj("contact~ no-such-drum")          # nothing to play
+p.obj("contact~ no-such-drum granite")  # no such tip
 trig = recorder(p, [(mem, 0, "left"), (mem, 1, "right"), (con, 0, "force")], 0.5, sr, wav)
 for k, (text, _) in enumerate(membrane_cases):
     d = p.obj("delay %g" % (5 + 3 * k))
@@ -99,7 +103,8 @@ for expect in ["membrane~: radius must be in [0.01, 2] m, got 1e+30; using 2",
                "membrane~: tension must be in [1, 100000] N/m, got -5; using 1",
                "membrane~: creation argument: density must be a number, got 'nan'",
                "contact~: needs the name of a membrane~",
-               "contact~: no membrane~ named 'no-such-drum'"]:
+               "contact~: no membrane~ named 'no-such-drum'",
+               "contact~: tip: no stick tip named 'granite' (wood, nylon, felt)"]:
     check(expect in log, "creation: '%s'" % expect)
 x, _ = read_wav_float(wav)
 check(np.all(np.isfinite(x)), "output finite (%d samples)" % x.shape[0])

@@ -30,7 +30,7 @@ fresh = p.obj("membrane~ fresh")
 again = p.obj("membrane~ again")
 trig = recorder(p, [(timp, 0, "timp"), (fresh, 0, "fresh"), (again, 0, "again")], seconds, sr, wav)
 t_msg = p.msg("preset timpani \\, strike 0.75 0 0.01")
-f_msg = p.msg("tensionmod 0 \\, radiation 0 \\, lossfactor 0 \\, strike 0.3 20 0.01")
+f_msg = p.msg("tensionmod 0 \\, radiation 0 \\, lossfactor 0 \\, patch 0 \\, strike 0.3 20 0.01")
 a_msg = p.msg("preset timpani \\, preset paper \\, strike 0.3 20 0.01 \\, preset bongo")
 for msg, obj in ((t_msg, timp), (f_msg, fresh), (a_msg, again)):
     p.connect(trig, 1, msg, 0)

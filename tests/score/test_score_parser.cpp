@@ -9,28 +9,14 @@
 #include <random>
 #include <string>
 
+#include "support/score_test_util.hpp"
+
 using namespace ictus;
 using Catch::Matchers::Contains;
+using ictus_test::require_error;
 
 namespace
 {
-
-// The error a score gives, checked for its position and a word of its message.
-void require_error(const std::string &text, int line, int column, const std::string &words)
-{
-    try {
-        parse_score(text, "t.txt");
-        FAIL("no error for: " << text);
-    } catch (const ScoreError &e) {
-        INFO(e.what());
-        CHECK(e.source() == "t.txt");
-        CHECK(e.line() == line);
-        CHECK(e.column() == column);
-        CHECK_THAT(e.message(), Contains(words));
-        CHECK(std::string(e.what()) ==
-              "t.txt:" + std::to_string(line) + ":" + std::to_string(column) + ": " + e.message());
-    }
-}
 
 bool same_notes(const Score &a, const Score &b)
 {
@@ -181,6 +167,21 @@ TEST_CASE("score: grip firmness per note and as a default, the performance's whe
     require_error("R firmness 0.5 firmness 0.4", 1, 16, "second firmness");
     require_error("firmness -0.1", 1, 10, "out of range");
     require_error("firmness x", 1, 10, "firmness");
+}
+
+TEST_CASE("score: humanize sets the performance's motor noise, the last statement wins",
+          "[score][parser]")
+{
+    CHECK(parse_score("R, L\n", "t.txt").humanize < 0.0); // not written: the performance's
+    const Score s = parse_score("humanize 1.5, R\nhumanize 0.5\nL\n", "t.txt");
+    CHECK(s.humanize == 0.5);
+    REQUIRE(s.notes.size() == 2); // it plays no note and takes no time
+    CHECK(s.notes[1].beat == 1.0);
+    CHECK(parse_score("humanize 0\nR\n", "t.txt").humanize == 0.0);
+    require_error("R\nhumanize -1", 2, 10, "humanize -1 is out of range (0..4");
+    require_error("humanize 4.5", 1, 10, "out of range");
+    require_error("humanize", 1, 9, "'humanize' needs an amount");
+    require_error("humanize 1 2", 1, 12, "unexpected '2'");
 }
 
 TEST_CASE("score: a default nuance for the notes that name none (the panel's nuance selector)",

@@ -256,6 +256,7 @@ TEST_CASE("drum contact forces: a stick resting on the membrane feels k d, and t
           "[sim][scene]")
 {
     PressedStick p(0.005);
+    p.options.drum.head_thickness_m = 0.0; // the linear head: no stretching (k3 = 0)
     Scene scene(p.model, p.options, p.pose, default_gains(p.model, p.pose));
     settle(scene, p.pose, 2000);
     const double r = p.model.options().stick.tip_radius_m;
@@ -395,6 +396,7 @@ TEST_CASE("a simulated strike: each step's contact-joint force is the membrane l
     // 1.5 m/s: one stroke on the drum, seen by the detector on the scene's
     // beads and felt by ODE's contact joints.
     PressedStick p(-0.01);
+    p.options.drum.head_thickness_m = 0.0; // the linear head: no stretching (k3 = 0)
     Scene scene(p.model, p.options, p.pose, default_gains(p.model, p.pose));
     StrikeDetector detector(membrane_of(scene));
     const double k = scene.drum_contact_stiffness_n_per_m(),

@@ -144,6 +144,26 @@ std::string tempo_meta(uint32_t us)
     return meta(0x51, d);
 }
 
+// FF 58 04 nn dd cc bb: N/D (dd = log2 D), a click every quarter (24 MIDI
+// clocks), 8 32nd notes per quarter.
+std::string time_signature_meta(int numerator, int denominator)
+{
+    if (numerator < 1 || numerator > 255 || denominator < 1 || denominator > 64 ||
+        (denominator & (denominator - 1)) != 0)
+        throw std::invalid_argument("standard_midi_file: meter " + std::to_string(numerator) + "/" +
+                                    std::to_string(denominator) +
+                                    " (N 1..255, D a power of two 1..64)");
+    int log2 = 0;
+    while ((1 << log2) < denominator)
+        ++log2;
+    std::string d;
+    d += static_cast<char>(numerator);
+    d += static_cast<char>(log2);
+    d += static_cast<char>(24);
+    d += static_cast<char>(8);
+    return meta(0x58, d);
+}
+
 std::string channel_message(int status, int channel, int a, int b)
 {
     std::string e;
@@ -156,24 +176,35 @@ std::string channel_message(int status, int channel, int a, int b)
 } // namespace
 
 std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
-                               const std::vector<MidiTempo> &tempo, int channel)
+                               const std::vector<MidiTempo> &tempo, int channel,
+                               const std::vector<int> *drum_notes,
+                               const std::vector<MidiMeter> &meter)
 {
+    auto note_of = [drum_notes](const StrikeEvent &e) {
+        if (drum_notes && e.drum >= 0 && e.drum < static_cast<int>(drum_notes->size()))
+            return (*drum_notes)[static_cast<size_t>(e.drum)];
+        return midi_note(e.hand, e.r_over_a);
+    };
     if (channel < 0 || channel > 15)
         throw std::invalid_argument("standard_midi_file: channel must be 0..15");
     const TempoMap map(tempo);
     std::vector<TrackEvent> events;
     events.push_back({0, 0, -3, meta(0x03, "ictus")});
-    events.push_back({0, 0, -2, meta(0x58, std::string("\x04\x02\x18\x08", 4))});
+    if (meter.empty() || meter.front().time_s > 0.0)
+        events.push_back({0, 0, -2, time_signature_meta(4, 4)});
+    for (const MidiMeter &m : meter)
+        events.push_back({m.time_s > 0.0 ? map.tick_of(m.time_s) : 0, 0, -2,
+                          time_signature_meta(m.numerator, m.denominator)});
     for (const TempoSegment &s : map.segments())
         events.push_back({s.tick, 0, -1, tempo_meta(s.us_per_quarter)});
     for (size_t i = 0; i < strikes.size(); ++i) {
         const StrikeEvent &e = strikes[i];
-        const int note = midi_note(e.hand, e.r_over_a);
+        const int note = note_of(e);
         const long on = map.tick_of(std::max(0.0, e.time_s));
         // The note ends after kMidiNoteLength_s, or where the same note strikes again.
         double off_s = e.time_s + kMidiNoteLength_s;
         for (size_t j = i + 1; j < strikes.size(); ++j)
-            if (midi_note(strikes[j].hand, strikes[j].r_over_a) == note) {
+            if (note_of(strikes[j]) == note) {
                 off_s = std::min(off_s, strikes[j].time_s);
                 break;
             }

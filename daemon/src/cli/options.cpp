@@ -186,6 +186,44 @@ MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o
         [&](MocapWarnings *warnings) { return read_marker_csv(path, o, warnings); });
 }
 
+// The drum's and the kit's options (parse_performance_option's).
+static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptions &o)
+{
+    auto value = [&]() { return args.value(a); };
+    if (a == "--drum-pos") {
+        o.scene.drum.center_m = parse_vec3(a, value(), -kMaxDrumDistance_m, kMaxDrumDistance_m);
+        o.drum_auto = false;
+    } else if (a == "--drum-radius") {
+        o.scene.drum.radius_m = parse_number(a, value(), 0.05, 1.0);
+        o.drum_given |= kGivenRadius;
+    } else if (a == "--drum-tension") {
+        o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
+        o.drum_given |= kGivenTension;
+    } else if (a == "--drum-density") {
+        o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
+        o.drum_given |= kGivenDensity;
+    } else if (a == "--drum-preset") {
+        apply_drum_preset(a, value(), o);
+    } else if (a == "--stick-tip") {
+        const std::string v = value();
+        if (!is_stick_tip(v))
+            throw UsageError("--stick-tip: expected wood, nylon or felt, got '" + v + "'");
+        o.scene.drum.stick_tip = v;
+    } else if (a == "--kit") {
+        const std::string v = value();
+        try {
+            o.kit = kit_named(v);
+        } catch (const PerformError &e) {
+            throw UsageError("--kit: " + std::string(e.what()));
+        }
+        // The first drum's head and sound are its preset's (as --drum-preset).
+        apply_drum_preset(a, o.kit.drums.front().preset, o);
+    } else {
+        return false;
+    }
+    return true;
+}
+
 // Options shared by run and render. Returns false when `a` is not one of them.
 bool parse_performance_option(const std::string &a, Args &args, PerformanceOptions &o,
                               double &duration)
@@ -250,7 +288,15 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.cartesian.max_joint_speed_rad_s = parse_number(a, value(), 0, 1000);
     else if (a == "--ik-limit-margin")
         o.score.ik_limit_margin_deg = parse_number(a, value(), 0, 10);
-    else if (a == "--rebound")
+    else if (a == "--humanize")
+        o.score.plan.humanize = parse_number(a, value(), 0, kMaxHumanize);
+    else if (a == "--seed") {
+        const std::string value_text = value();
+        const double seed = parse_number(a, value_text, 0, 9007199254740992.0); // 2^53
+        if (seed != std::floor(seed))
+            throw UsageError("--seed: expected a whole number, got '" + value_text + "'");
+        o.score.plan.seed = static_cast<std::uint64_t>(seed);
+    } else if (a == "--rebound")
         o.score.rebound_s = parse_number(a, value(), 0, 0.5);
     else if (a == "--lead-in")
         o.score.plan.lead_in_s = parse_number(a, value(), 0.2, 60);
@@ -258,20 +304,8 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.tempo_bpm = parse_number(a, value(), 20, 400);
     else if (a == "--clip-bpm")
         o.clip_bpm = parse_number(a, value(), 20, 400);
-    else if (a == "--drum-pos") {
-        o.scene.drum.center_m = parse_vec3(a, value(), -kMaxDrumDistance_m, kMaxDrumDistance_m);
-        o.drum_auto = false;
-    } else if (a == "--drum-radius") {
-        o.scene.drum.radius_m = parse_number(a, value(), 0.05, 1.0);
-        o.drum_given |= kGivenRadius;
-    } else if (a == "--drum-tension") {
-        o.scene.drum.tension_n_per_m = parse_number(a, value(), 10, 1e5);
-        o.drum_given |= kGivenTension;
-    } else if (a == "--drum-density") {
-        o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
-        o.drum_given |= kGivenDensity;
-    } else if (a == "--drum-preset") {
-        apply_drum_preset(a, value(), o);
+    else if (parse_drum_option(a, args, o)) {
+        // the drum or the kit
     } else if (a == "--sticks") {
         const std::string v = value();
         if (v == "fulcrum")

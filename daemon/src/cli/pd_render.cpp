@@ -134,6 +134,20 @@ std::vector<std::string> pd_command_line(const PdRenderOptions &o, const std::st
         "render-out " + o.wav,
         "render-seconds " + format("%.3f", o.seconds)};
     sends.insert(sends.end(), rest.begin(), rest.end());
+    for (size_t i = 0; i < o.kit.size(); ++i) {
+        const std::string to = "render-kit-" + std::to_string(i + 1) + " ";
+        const PdRenderOptions::KitDrumSound &k = o.kit[i];
+        if (!k.preset.empty())
+            sends.push_back(to + "preset " + k.preset);
+        sends.push_back(to + "radius " + format("%.9g", k.radius_m));
+        sends.push_back(to + "tension " + format("%.9g", k.tension_n_per_m));
+        sends.push_back(to + "pan " + format("%.6g", k.pan));
+        sends.push_back(to + "dsp 1");
+    }
+    if (!o.stick_tip.empty()) { // the physics' tip on both sticks (contact~ tip NAME)
+        sends.push_back("render-drum left tip " + o.stick_tip);
+        sends.push_back("render-drum right tip " + o.stick_tip);
+    }
     for (const std::string &s : sends) {
         argv.push_back("-send");
         argv.push_back(s);

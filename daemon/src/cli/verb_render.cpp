@@ -86,6 +86,9 @@ void render_usage(std::ostream &out)
            "  --move-margins A,B  a move to another spot spans the gap between the two\n"
            "                      strikes but these fractions after and before (0.05,0.1)\n"
            "  --advance S         tip targets sampled S ahead: the tracking lag (default 0)\n"
+           "  --humanize A        motor noise, 0..4 (0: none; 1: a drummer's hand); given,\n"
+           "                      it replaces the score's `humanize` statement\n"
+           "  --seed N            the noise's seed, a whole number (default 1)\n"
            "  --rebound S         a scripted rebound of the target after each beat, time\n"
            "                      constant (default 0: off, the stick rebounds by itself)\n"
            "  --ik-gain G         Algorithm 2's gain on the tip error (default 4)\n"
@@ -118,6 +121,12 @@ void render_usage(std::ostream &out)
            "                      defaults), snare, tom, floor-tom, timpani, frame; sets\n"
            "                      radius, tension, density (unless given) and, in Pd, the\n"
            "                      head's T60, modes, pickups and tuning (docs/sound.md)\n"
+           "  --kit NAME          several drums (score mode): standard (snare, tom1, tom2,\n"
+           "                      floor), standard-timpani (and timpani), timpani (timpani1,\n"
+           "                      timpani2); the first where the drum goes, the score's\n"
+           "                      'drum NAME' and 'on NAME' choose (docs/perform.md)\n"
+           "  --stick-tip NAME    wood, nylon or felt: the tip's law in series with the head\n"
+           "                      (default: none, the head's spring alone; docs/sound.md)\n"
            "  --bounce-height M   bounce rule height (default 0.01)\n"
            "  --bounce-window S   bounce rule window (default 0.15)\n"
            "\n"
@@ -251,12 +260,14 @@ void write_tips_row(std::ostream &out, const Performance &perf)
     out << '\n';
 }
 
-// notes.csv: the planned notes and the strike each one got.
+// notes.csv: the planned notes and the strike each one got; with a kit, each
+// note's drum last (the strike matched is on it).
 void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSummary &m,
-                     double origin_s)
+                     double origin_s, const Kit &kit)
 {
     out << "index,time_s,hand,nuance,grip,dynamics,beats,tempo_bpm,line,strike_seq,strike_time_s,"
-           "error_ms,normal_velocity_mps,duration_ms\n";
+           "error_ms,normal_velocity_mps,duration_ms,grace"
+        << (kit.empty() ? "\n" : ",drum\n");
     char buf[256];
     for (size_t i = 0; i < plan.notes.size(); ++i) {
         const PlannedNote &n = plan.notes[i];
@@ -266,11 +277,14 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
                       to_string(n.grip), n.dynamics, n.beats, n.tempo_bpm, n.line, k.strike_seq);
         out << buf;
         if (k.strike_seq >= 0)
-            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f\n", k.strike_time_s, k.error_ms,
+            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f,", k.strike_time_s, k.error_ms,
                           k.normal_velocity_mps, k.duration_ms);
         else
-            std::snprintf(buf, sizeof buf, ",,,\n");
-        out << buf;
+            std::snprintf(buf, sizeof buf, ",,,,");
+        out << buf << (n.grace == Grace::none ? 0 : 1);
+        if (!kit.empty() && n.drum >= 0 && n.drum < static_cast<int>(kit.drums.size()))
+            out << ',' << kit.drums[static_cast<size_t>(n.drum)].name;
+        out << '\n';
     }
 }
 
@@ -286,7 +300,31 @@ nlohmann::json drum_json(const Performance &p)
                                                   : nlohmann::json(p.options().drum_preset);
     j["contact_stiffness_n_per_m"] = p.detector().membrane().stiffness_n_per_m;
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
+    j["contact_stretch_n_per_m3"] = d.stretch_n_per_m3(); // the head's k3 (docs/sound.md)
+    j["stick_tip"] = d.stick_tip;                         // "": none
     return j;
+}
+
+// A kit's drums as placed, and the stick parts that met a shell from the
+// side (Scene::shell_passes: none when every stroke reached its head from above).
+nlohmann::json kit_json(const Performance &p)
+{
+    const Scene &scene = p.scene();
+    const Kit &kit = p.options().kit;
+    nlohmann::json drums = nlohmann::json::array();
+    for (int i = 0; i < scene.drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
+        const DrumParams &d = scene.drum(i);
+        const KitDrum &k = kit.drums[static_cast<size_t>(i)];
+        drums.push_back({{"name", k.name},
+                         {"preset", k.preset},
+                         {"center_m", {d.center_m.x(), d.center_m.y(), d.center_m.z()}},
+                         {"radius_m", d.radius_m},
+                         {"tension_n_per_m", d.tension_n_per_m},
+                         {"shell_depth_m", d.shell_depth_m},
+                         {"midi_note", k.midi_note},
+                         {"shell_passes", scene.shell_passes(i)}});
+    }
+    return {{"name", kit.name}, {"drums", drums}, {"shell_passes", scene.shell_passes()}};
 }
 
 // render.json's "performance": how the strikes met the notes (docs/perform.md).
@@ -350,6 +388,7 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
                             {"nuance", to_string(p.nuance)},
                             {"dynamics", p.dynamics},
                             {"line", p.line},
+                            {"grace", to_string(p.grace)},
                             {"planned_impact_speed_mps", perf.planned_impact_speed_mps(i)}};
         if (k.strike_seq >= 0) {
             e["strike_seq"] = k.strike_seq;
@@ -369,6 +408,7 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
 struct RenderArgs {
     PerformanceOptions o;
     double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0, midi_channel = 1.0;
+    bool midi_channel_given = false; // else 1, or 10 with a kit (General MIDI's drums)
     std::string out_dir;
     bool force = false;
     double progress_every = 2.0;
@@ -388,6 +428,7 @@ OptionTable render_options(RenderArgs &r)
          [&r](const std::string &a, Args &args) {
              const std::string text = args.value(a);
              r.midi_channel = parse_number(a, text, 1, 16);
+             r.midi_channel_given = true;
              if (r.midi_channel != std::floor(r.midi_channel))
                  throw UsageError("--midi-channel: expected a whole number 1..16, got '" + text +
                                   "'");
@@ -541,19 +582,39 @@ void simulate(Performance &perf, const RenderArgs &r, bool score_mode, RenderRec
     rec.wall_s = seconds_since(wall0);
 }
 
+// The MIDI channel, 1..16: --midi-channel, else 1, or with a kit 10 (the
+// General MIDI drum channel its notes are for, docs/midi.md).
+int midi_channel(const RenderArgs &r, const Performance &perf)
+{
+    if (!r.midi_channel_given && !perf.options().kit.empty())
+        return 10;
+    return static_cast<int>(r.midi_channel);
+}
+
 // performance.mid: the strikes as notes at the score's tempo at each note (a
 // clip: --tempo).
 std::string render_midi(const Performance &perf, const RenderArgs &r, bool score_mode,
                         const StrikeLog &log)
 {
     std::vector<MidiTempo> tempo;
+    std::vector<MidiMeter> meter;
     if (score_mode) {
+        // A grace stroke is not on a beat: the tempo is its note's.
         for (const PlannedNote &n : perf.plan()->notes)
-            tempo.push_back({perf.plan_origin_s() + n.time_s, n.tempo_bpm});
+            if (n.grace == Grace::none)
+                tempo.push_back({perf.plan_origin_s() + n.time_s, n.tempo_bpm});
+        // The score's meters; one at its beat 0 from the file's start.
+        for (const PlannedMeter &m : perf.plan()->meters)
+            meter.push_back({m.beat <= 0.0 ? 0.0 : perf.plan_origin_s() + m.time_s, m.numerator,
+                             m.denominator});
     }
     if (tempo.empty())
         tempo.push_back({0.0, score_mode ? 120.0 : r.o.tempo_bpm});
-    return standard_midi_file(log.strikes(), tempo, static_cast<int>(r.midi_channel) - 1);
+    std::vector<int> drum_notes;
+    for (const KitDrum &d : perf.options().kit.drums)
+        drum_notes.push_back(d.midi_note);
+    return standard_midi_file(log.strikes(), tempo, midi_channel(r, perf) - 1,
+                              drum_notes.empty() ? nullptr : &drum_notes, meter);
 }
 
 // render.json but its "performance" (score mode).
@@ -576,8 +637,10 @@ nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool
     if (!score_mode)
         j["tempo_bpm"] = r.o.tempo_bpm;
     j["drum"] = drum_json(perf);
+    if (!perf.options().kit.empty())
+        j["kit"] = kit_json(perf);
     j["midi"] = {{"file", "performance.mid"},
-                 {"channel", static_cast<int>(r.midi_channel)},
+                 {"channel", midi_channel(r, perf)},
                  {"notes", strikes},
                  {"ticks_per_quarter", kMidiTicksPerQuarter}};
     return j;
@@ -610,7 +673,7 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
         count.notes = static_cast<long>(plan.notes.size());
         count.missed = count.notes - m.matched_notes;
         text.str("");
-        write_notes_csv(text, plan, m, perf.plan_origin_s());
+        write_notes_csv(text, plan, m, perf.plan_origin_s(), perf.options().kit);
         files.notes_csv->write_and_close(text.str());
         files.tips_csv->write_and_close(rec.tips.str());
         j["performance"] = performance_json(r.o, perf, m);
@@ -658,6 +721,16 @@ int render_wav(RenderArgs &r, const Performance &perf)
     pd.tension_n_per_m = d.tension_n_per_m;
     pd.density_kg_per_m2 = perf.options().drum_density_kg_per_m2;
     pd.preset = perf.options().drum_preset;
+    const Kit &kit = perf.options().kit;
+    pd.kit.clear();
+    for (int i = 1; i < perf.scene().drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
+        const KitDrum &k = kit.drums[static_cast<size_t>(i)];
+        const DrumParams &kd = perf.scene().drum(i);
+        // Panned by its place: the performer's left (-x) to the left channel.
+        const double pan = std::clamp(-k.place_m.x() / 0.8, -0.6, 0.6);
+        pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, pan});
+    }
+    pd.stick_tip = d.stick_tip;
     std::cout << "render: pd: " << pd.seconds << " s of sound into " << r.wav << " ..."
               << std::endl;
     const PdRenderResult result = run_pd_render(pd, [&](double s) {

@@ -32,6 +32,10 @@ constexpr double kNominalPeriod_s = 0.5;    // 120 bpm: the period the shapes ar
 constexpr double kLegatoHeightFff_m = 0.36; // legato preparation height at d = 1
 constexpr double kPressTau_s = 0.012;       // buzz: how fast the hand presses in
 constexpr double kMaxPress_s = 0.3;         // buzz: the longest press
+// The longest lift: at slower tempi the stick waits at the apex. A lift drawn
+// out over the whole period leaves a soft stroke's stick on the head (30 bpm,
+// pp legato: it fell back 24 ms after the strike and rested 38 ms).
+constexpr double kMaxLift_s = 0.4;
 constexpr double kReboundPeriod_s = 0.1;    // shorter periods: rebound strokes
 constexpr double kReboundGainFrom_s = 0.2;
 constexpr double kReboundGainExponent = 0.4;
@@ -114,7 +118,8 @@ double height(const NuanceShape &s, double H, double H_lift, double D, double L,
         return -s.press_depth_m * (1.0 - std::exp(-t / kPressTau_s)) *
                (1.0 - x * x * (3.0 - 2.0 * x));
     }
-    const double w = std::clamp((t - P) / (L - P), 0.0, 1.0);
+    const double lift_end = std::min(L, P + kMaxLift_s);
+    const double w = std::clamp((t - P) / (lift_end - P), 0.0, 1.0);
     const double rebound = 1.0 - std::pow(1.0 - w, s.lift_exponent);
     const double held = w * w * (3.0 - 2.0 * w);
     return H_lift * (s.lift_hold * held + (1.0 - s.lift_hold) * rebound);

@@ -7,6 +7,7 @@
 #include "ictus/net/osc_server.hpp"
 #include "ictus/character/character.hpp"
 #include "ictus/perform/tracker.hpp"
+#include "ictus/score/score.hpp"
 
 #include <lo/lo.h>
 
@@ -526,6 +527,7 @@ const Method kMethods[] = {
     {"/ictus/score",         "s",  handle_command, {CommandKind::score, 0, 0, "score statement"}},
     {"/ictus/score/clear",   "",   handle_command, {CommandKind::score_clear}},
     {"/ictus/grip/firmness", "f",  handle_command, {CommandKind::grip_firmness, 0.0, 1.0, "grip firmness (0..1)"}},
+    {"/ictus/humanize",      "f",  handle_command, {CommandKind::humanize, 0.0, kMaxHumanize, "humanize (0..4)"}},
 };
 // clang-format on
 

@@ -68,6 +68,15 @@ Performance::Performance(const PerformanceOptions &options)
         throw PerformError("clip tempo: expected a finite value > 0 bpm");
     if (!(options_.tempo_bpm >= 20.0 && options_.tempo_bpm <= 400.0))
         throw PerformError("tempo: expected 20 to 400 bpm");
+    if (!options_.kit.empty()) {
+        if (!score_mode())
+            throw PerformError("kit: a kit is played from a score (not with a clip)");
+        validate_kit(options_.kit);
+        const KitDrum &first = options_.kit.drums.front();
+        options_.scene.drum.radius_m = first.radius_m;
+        options_.scene.drum.tension_n_per_m = first.tension_n_per_m;
+        options_.scene.drum.shell_depth_m = first.shell_depth_m;
+    }
     if (score_mode()) {
         auto mode = std::make_unique<ScoreMode>(*this);
         score_ = mode.get();
@@ -195,7 +204,7 @@ void Performance::took_over(double previous_time_s)
     apply_gains();
     set_grips(options_.grip_firmness);
     time_offset_s_ = previous_time_s;
-    detector_.reset(membrane_of(scene()));
+    load_membranes(detector_, scene());
 }
 
 int Performance::guard_runaway(int k)
@@ -257,6 +266,11 @@ bool Performance::apply(const Command &c, std::string *why)
         case CommandKind::grip_firmness:
             options_.grip_firmness = c.value;
             mode_->firmness_changed();
+            return true;
+        case CommandKind::humanize:
+            // The controller's noise at once; the plan's from the next play.
+            options_.score.plan.humanize = c.value;
+            mode_->scene().set_motor_noise(c.value, options_.score.plan.seed);
             return true;
         case CommandKind::score:
         case CommandKind::score_clear:

@@ -103,8 +103,8 @@ void ScoreMode::install_rig(std::unique_ptr<ScoreRig> rig, bool keep_pose)
     use_rig(r.model, *r.tracker, r.base_gains, r.gains);
     // The live drum and gains win over those the rig was built with.
     o.scene.drum.center_m = r.drum_center_m;
-    r.frame =
-        frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right, r.frame.forward);
+    r.frame = frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right,
+                        r.frame.forward, &o.kit, &r.kit_drums);
     r.tracker->set_mode(mode);
     if (!keep_pose)
         rest_from_m_ = r.frame.rest_tip_m;
@@ -121,6 +121,10 @@ void ScoreMode::install_plan(std::unique_ptr<ScorePlan> plan, bool start_now)
         perf_.playing_ = true;
         plan_time_s_ = 0.0;
         plan_origin_s_ = perf_.time_s();
+        // The controller's motor noise restarts with the plan's amount and seed.
+        const PlanOptions &po = perf_.options_.score.plan;
+        if (plan_ && plan_->score)
+            rig_->tracker->scene().set_motor_noise(humanize_amount(*plan_->score, po), po.seed);
     }
     // else: a plan under way goes on from where it was (the notes keep their times)
     if (plan && perf_.worker_)
@@ -442,8 +446,8 @@ bool ScoreMode::drum_changed(const Command &c, std::string *why)
     // keep their times). No rebuild.
     const PerformanceOptions &o = perf_.options_;
     ScoreRig &r = *rig_;
-    r.frame =
-        frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right, r.frame.forward);
+    r.frame = frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right,
+                        r.frame.forward, &o.kit, &r.kit_drums);
     if (plan_active_ || perf_.work_pending())
         return perf_.submit(plan_job(c, Work::Kind::replan), why);
     return true;

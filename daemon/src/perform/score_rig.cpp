@@ -25,13 +25,26 @@ double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_wo
 } // namespace
 
 PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
-                         const Eigen::Vector3d &forward)
+                         const Eigen::Vector3d &forward, const Kit *kit,
+                         const std::vector<DrumParams> *kit_drums)
 {
     const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
-    PerformerFrame f = performer_frame_for_drum(
-        drum.center_m + contact_height_m(tip_radius_m, kDefaultStickDirection) * up, drum.radius_m);
+    const Eigen::Vector3d raise = contact_height_m(tip_radius_m, kDefaultStickDirection) * up;
+    PerformerFrame f = performer_frame_for_drum(drum.center_m + raise, drum.radius_m);
     f.right = right;
     f.forward = forward;
+    if (kit && !kit->empty()) {
+        // The rest tips before the kit's anchor (where the one drum goes),
+        // not its first drum, which may stand to a side (two timpani).
+        const Eigen::Vector3d &p0 = kit->drums.front().place_m;
+        const Eigen::Vector3d anchor = drum.center_m - p0.x() * right - p0.y() * up - p0.z() * forward;
+        f.rest_tip_m = performer_frame_for_drum(anchor + raise, drum.radius_m).rest_tip_m;
+        for (size_t i = 0; i < kit->drums.size(); ++i) {
+            const DrumParams &d =
+                i == 0 || !kit_drums || i - 1 >= kit_drums->size() ? drum : (*kit_drums)[i - 1];
+            f.drums.push_back({kit->drums[i].name, d.center_m + raise, d.radius_m});
+        }
+    }
     return f;
 }
 
@@ -75,8 +88,24 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
         scene.drum.center_m = 0.5 * (shoulder[0] + shoulder[1]) +
                               options.score.drum_forward_m * forward -
                               options.score.drum_below_m * up;
+    if (!options.kit.empty()) {
+        // The kit from its anchor, in the performer's frame: the automatic
+        // drum's place, or (a given or live centre) the first drum's centre
+        // less its place.
+        const Eigen::Vector3d &p0 = options.kit.drums.front().place_m;
+        const Eigen::Vector3d anchor =
+            options.drum_auto ? scene.drum.center_m
+                              : Eigen::Vector3d(scene.drum.center_m + p0.x() * left -
+                                                p0.y() * up - p0.z() * forward);
+        const std::vector<DrumParams> placed =
+            place_kit(options.kit, scene.drum, anchor, -left, up, forward);
+        scene.drum = placed.front();
+        scene.extra_drums.assign(placed.begin() + 1, placed.end());
+        r.kit_drums = scene.extra_drums;
+    }
     r.drum_center_m = scene.drum.center_m;
-    r.frame = frame_for(scene.drum, options.character.stick.tip_radius_m, -left, forward);
+    r.frame = frame_for(scene.drum, options.character.stick.tip_radius_m, -left, forward,
+                        &options.kit, &r.kit_drums);
 
     // Start: the arms solved to hold the sticks at the rest tips (or the
     // pose the old rig was in, when a grip change rebuilds it).

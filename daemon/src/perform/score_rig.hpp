@@ -25,6 +25,7 @@ struct ScoreRig {
     CharacterPose step_body; // body with the trunk's synergy of this step
     PerformerFrame frame;
     Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero(); // where the drum goes
+    std::vector<DrumParams> kit_drums; // a kit's drums after the first, placed
     TipTargets tips;
     ScoreRig(const CharacterModel &m, double ik_limit_margin_rad)
         : model(m), range_of_motion(model), ik_range_of_motion(model, ik_limit_margin_rad)
@@ -50,7 +51,10 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
 // The plan's frame for a drum: the shared frames of docs/perform.md, facing
 // `forward` with `right` to the performer's right, the membrane raised by the
 // tip's contact height.
+// With a kit, the frame's drums (PerformerFrame::drums): `drum` first, then
+// `kit_drums`, named as the kit's, each raised so.
 PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
-                         const Eigen::Vector3d &forward);
+                         const Eigen::Vector3d &forward, const Kit *kit = nullptr,
+                         const std::vector<DrumParams> *kit_drums = nullptr);
 
 } // namespace ictus

@@ -19,11 +19,11 @@ MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
             continue;
         }
         ++m.primary_strikes;
-        // The nearest note of the strike's hand.
+        // The nearest note of the strike's hand on the strike's drum.
         long nearest = -1;
         double nearest_d = std::numeric_limits<double>::infinity();
         for (size_t i = 0; i < notes.size(); ++i) {
-            if (static_cast<int>(notes[i].hand) != e.hand)
+            if (static_cast<int>(notes[i].hand) != e.hand || notes[i].drum != e.drum)
                 continue;
             const double d = std::abs(e.time_s - (origin_s + notes[i].time_s));
             if (d < nearest_d) {

@@ -20,6 +20,8 @@
 // Kovar & Gleicher 2003 registration curves, cross-fades with ease curves).
 #include "ictus/score/gesture_score.hpp"
 
+#include "ictus/base/motor_noise.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -157,6 +159,7 @@ struct Item {
     Eigen::Vector3d start_pos = Eigen::Vector3d::Zero(), start_vel = Eigen::Vector3d::Zero();
     Eigen::Vector3d end_pos = Eigen::Vector3d::Zero(), end_vel = Eigen::Vector3d::Zero();
     Eigen::Vector3d start_dir = Eigen::Vector3d::UnitZ(), end_dir = Eigen::Vector3d::UnitZ();
+    int drum = 0; // the note's drum of a kit
 
     // The warped unit inside its own time span [strike - prep_t, strike + lift_t].
     void warped(double tau, Eigen::Vector3d &pos, Eigen::Vector3d &vel) const
@@ -215,6 +218,9 @@ struct Window {
     // window to or from the rest tip), spread over [move_begin, move_end].
     Eigen::Vector3d across = Eigen::Vector3d::Zero();
     double move_begin = 0.0, move_end = 0.0;
+    // A move between two drums of a kit: lifted by lift times kit_bump()
+    // over [move_begin, move_end] (kit_lift()).
+    Eigen::Vector3d lift = Eigen::Vector3d::Zero();
 };
 
 // Quintic smoothstep: 0 -> 1 with zero slope and curvature at both ends.
@@ -224,11 +230,33 @@ double smoothstep5(double x)
     return x * x * x * (10.0 + x * (-15.0 + 6.0 * x));
 }
 
+// The lift's shape over a move between drums: 0 -> 1 -> 0 with zero slope at
+// both ends (C1 with the units), 1 at the middle.
+double kit_bump(double x)
+{
+    x = std::clamp(x, 0.0, 1.0);
+    return 16.0 * x * x * (1.0 - x) * (1.0 - x);
+}
+
 void check_unit(const Eigen::Vector3d &v, const char *name)
 {
     if (!v.allFinite() || std::abs(v.norm() - 1.0) > 1e-6)
         throw std::invalid_argument(std::string("PerformerFrame: ") + name +
                                     " must be a unit vector");
+}
+
+// A kit's drums in the frame and the planner's margins for it.
+void validate_kit(const PerformerFrame &f, const PlanOptions &o)
+{
+    for (const PerformerFrame::Drum &d : f.drums)
+        if (!d.membrane_center_m.allFinite() || !(d.membrane_radius_m > 0.0) ||
+            !std::isfinite(d.membrane_radius_m))
+            throw std::invalid_argument("PerformerFrame: kit drum '" + d.name +
+                                        "' needs a finite centre and a radius > 0");
+    if (!(o.kit_clearance_m >= 0.0 && o.kit_clearance_m <= 0.5 && o.kit_margin_m >= 0.0 &&
+          o.kit_margin_m <= 0.5))
+        throw std::invalid_argument(
+            "PlanOptions: kit_clearance_m and kit_margin_m must be 0..0.5 m");
 }
 
 void validate(const PerformerFrame &f, const PlanOptions &o)
@@ -244,6 +272,7 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
     if (!f.membrane_center_m.allFinite() || !f.rest_tip_m[0].allFinite() ||
         !f.rest_tip_m[1].allFinite())
         throw std::invalid_argument("PerformerFrame: positions must be finite");
+    validate_kit(f, o);
     auto bad = [](const char *what, double v) {
         std::ostringstream s;
         s << "PlanOptions: " << what << ", got " << v;
@@ -253,6 +282,8 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("lead_in_s must be 0.2..60 s", o.lead_in_s);
     if (!(o.tail_s >= 0.0 && o.tail_s <= 60.0))
         bad("tail_s must be 0..60 s", o.tail_s);
+    if (!(o.humanize <= kMaxHumanize)) // < 0: the score's
+        bad("humanize must be 0..4", o.humanize);
     if (!(o.rate_hz >= 50.0 && o.rate_hz <= 20000.0))
         bad("rate_hz must be 50..20000", o.rate_hz);
     if (!(std::abs(o.strike_depth_m) <= 0.1))
@@ -305,11 +336,16 @@ Eigen::Vector3d rest_stick_direction(const PerformerFrame &frame, int side)
         .normalized();
 }
 
-Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg)
+Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg,
+                               int drum)
 {
     // docs/osc.md: x_m along world +X, y_m along world -Z.
-    const double r = r_over_a * frame.membrane_radius_m, th = theta_deg * kPi / 180.0;
-    return frame.membrane_center_m + Eigen::Vector3d(r * std::cos(th), 0.0, -r * std::sin(th));
+    const bool kit = drum > 0 && drum < static_cast<int>(frame.drums.size());
+    const PerformerFrame::Drum *d = kit ? &frame.drums[static_cast<size_t>(drum)] : nullptr;
+    const double radius = d ? d->membrane_radius_m : frame.membrane_radius_m;
+    const Eigen::Vector3d &centre = d ? d->membrane_center_m : frame.membrane_center_m;
+    const double r = r_over_a * radius, th = theta_deg * kPi / 180.0;
+    return centre + Eigen::Vector3d(r * std::cos(th), 0.0, -r * std::sin(th));
 }
 
 namespace
@@ -351,37 +387,77 @@ class UnitCache
 
 using HandNotes = std::array<std::vector<size_t>, 2>; // each hand's notes, indices into plan.notes
 
+// The index of the note's drum in the frame's kit; a ScoreError where the
+// drum was named when the kit has none of that name.
+int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &frame)
+{
+    if (n.drum.empty())
+        return 0;
+    std::string names;
+    for (size_t i = 0; i < frame.drums.size(); ++i) {
+        if (frame.drums[i].name == n.drum)
+            return static_cast<int>(i);
+        names += (i ? ", " : "") + frame.drums[i].name;
+    }
+    if (frame.drums.empty())
+        throw ScoreError(score.source, n.drum_line, n.drum_column,
+                         "drum '" + n.drum +
+                             "': there is one drum and no kit (give the performance a kit, "
+                             "e.g. --kit standard: docs/perform.md)");
+    throw ScoreError(score.source, n.drum_line, n.drum_column,
+                     "unknown drum '" + n.drum + "' (the kit: " + names + ")");
+}
+
 // The notes, timed by the tempo map, into plan.notes (score order); a hand
 // asked to play faster than one hand plays is a ScoreError.
 HandNotes time_notes(const Score &score, const PerformerFrame &frame, const PlanOptions &opt,
                      GesturePlan &plan)
 {
     HandNotes by_hand;
-    for (const ScoreNote &n : score.notes) {
+    const double amount = humanize_amount(score, opt);
+    for (size_t k = 0; k < score.notes.size(); ++k) {
+        const ScoreNote &n = score.notes[k];
         PlannedNote p;
         p.time_s = opt.lead_in_s + score.note_time_s(n);
         p.hand = n.hand;
         p.nuance = n.nuance;
         p.grip = n.grip;
         p.dynamics = n.dynamics;
+        if (amount > 0.0) {
+            // Note k's own stream: a replan (a tempo change) draws the same.
+            MotorNoise noise(opt.seed, k + 1);
+            p.time_s += amount * kHumanizeTimingSd_s * noise.normal();
+            const double scale = 1.0 + amount * kHumanizeForceCv * noise.normal();
+            p.dynamics = std::clamp(n.dynamics * scale, 0.0, 1.0);
+        }
         p.beats = n.beats;
         p.tempo_bpm = score.tempo.tempo_at_beat(n.beat);
         p.r_over_a = n.r_over_a;
         p.theta_deg = n.theta_deg;
         p.firmness = n.firmness;
-        p.strike_point_m = membrane_point(frame, n.r_over_a, n.theta_deg);
+        p.drum = drum_index(score, n, frame);
+        p.strike_point_m = membrane_point(frame, n.r_over_a, n.theta_deg, p.drum);
         p.tip_target_m = p.strike_point_m - opt.strike_depth_m * frame.up;
         p.line = n.line;
         p.column = n.column;
+        p.grace = n.grace;
         const std::vector<size_t> &same = by_hand[static_cast<int>(n.hand)];
         if (!same.empty()) {
             const PlannedNote &prev = plan.notes[same.back()];
-            if (p.time_s - prev.time_s < opt.min_stroke_interval_s) {
+            if (p.time_s - prev.time_s < opt.min_stroke_interval_s - 1e-9) {
+                auto what = [](const PlannedNote &q) {
+                    return q.grace == Grace::none
+                               ? std::string()
+                               : std::string(", a ") + to_string(q.grace) + "'s grace stroke";
+                };
                 std::ostringstream m;
-                m << "this " << (n.hand == Side::right ? "right" : "left") << "-hand stroke comes "
-                  << (p.time_s - prev.time_s) * 1000.0 << " ms after the previous one (line "
-                  << prev.line << "), faster than one hand plays (minimum "
-                  << opt.min_stroke_interval_s * 1000.0
+                m << "this " << (n.hand == Side::right ? "right" : "left") << "-hand stroke"
+                  << (n.grace == Grace::none
+                          ? std::string()
+                          : std::string(" (the ") + to_string(n.grace) + "'s grace stroke)")
+                  << " comes " << (p.time_s - prev.time_s) * 1000.0
+                  << " ms after the previous one (line " << prev.line << what(prev)
+                  << "), faster than one hand plays (minimum " << opt.min_stroke_interval_s * 1000.0
                   << " ms): give it to the other hand or slow down";
                 throw ScoreError(score.source, n.line, n.column, m.str());
             }
@@ -414,6 +490,7 @@ HandStrokes place_strokes(const std::vector<size_t> &idx, const GesturePlan &pla
         it.to_world = to_world;
         it.origin = p.tip_target_m;
         it.strike_t = p.time_s;
+        it.drum = p.drum;
     }
     const double tr = opt.return_time_s;
     for (size_t k = 0; k + 1 < n; ++k) {
@@ -488,6 +565,57 @@ void warp_units(HandStrokes &h, const std::vector<size_t> &idx, const PerformerF
     }
 }
 
+// The tip between two units of one hand at t in the move window: the units'
+// cross-fade and the move across (as sample_hand makes it), without a lift.
+Eigen::Vector3d pair_position(const Item &a, const Item &b, const Window &w, double t)
+{
+    Eigen::Vector3d p0, d0;
+    a.eval(t, p0, d0);
+    if (t >= w.begin && w.end > w.begin) {
+        Eigen::Vector3d p1, d1;
+        b.eval(t, p1, d1);
+        const double wt = t > w.end ? 1.0 : smoothstep5((t - w.begin) / (w.end - w.begin));
+        p0 = (1.0 - wt) * p0 + wt * p1;
+    }
+    const double made = t < w.begin ? 0.0
+                        : t > w.end ? 1.0
+                                    : smoothstep5((t - w.begin) / (w.end - w.begin));
+    const double x = (t - w.move_begin) / (w.move_end - w.move_begin);
+    return p0 + (smoothstep5(x) - made) * w.across;
+}
+
+// How far a move from drum a.drum to b.drum must rise (m): wherever the tip
+// is over a drum's disk (its radius plus kit_margin_m, in plan), it must be
+// above that head, and kit_clearance_m above it for a drum it does not play
+// here. The lift is applied as kit_bump(), so it is the largest shortfall
+// over kit_bump at 48 points of the move (kit_bump taken as >= 0.05 near the
+// ends, where the tip is over its own drums' heads).
+double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFrame &frame,
+                const PlanOptions &opt)
+{
+    if (!(w.move_end > w.move_begin) || frame.drums.size() < 2)
+        return 0.0;
+    double lift = 0.0;
+    constexpr int kPoints = 48;
+    for (int i = 1; i < kPoints; ++i) {
+        const double x = static_cast<double>(i) / kPoints;
+        const Eigen::Vector3d p =
+            pair_position(a, b, w, w.move_begin + x * (w.move_end - w.move_begin));
+        double short_m = 0.0;
+        for (size_t k = 0; k < frame.drums.size(); ++k) {
+            const PerformerFrame::Drum &d = frame.drums[k];
+            const Eigen::Vector3d rel = p - d.membrane_center_m;
+            const double height = rel.dot(frame.up);
+            if ((rel - height * frame.up).norm() > d.membrane_radius_m + opt.kit_margin_m)
+                continue;
+            const bool played = static_cast<int>(k) == a.drum || static_cast<int>(k) == b.drum;
+            short_m = std::max(short_m, (played ? 0.0 : opt.kit_clearance_m) - height);
+        }
+        lift = std::max(lift, short_m / std::max(kit_bump(x), 0.05));
+    }
+    return lift;
+}
+
 // A hand's timeline: rest, unit, [rest,] unit, ..., rest, and the
 // cross-fade windows between consecutive items.
 struct HandTimeline {
@@ -532,6 +660,8 @@ double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
             w.across = move - move.dot(frame.up) * frame.up;
             w.move_begin = it.strike_t + opt.move_margin_after * gap;
             w.move_end = placed[k + 1].strike_t - opt.move_margin_before * gap;
+            if (it.drum != placed[k + 1].drum)
+                w.lift = kit_lift(it, placed[k + 1], w, frame, opt) * frame.up;
             line.windows.push_back(w);
         }
     }
@@ -613,7 +743,7 @@ void sample_hand(const std::vector<double> &times, const HandTimeline &line,
                                 : t > mv.end ? 1.0
                                              : smoothstep5((t - mv.begin) / (mv.end - mv.begin));
             const double x = (t - mv.move_begin) / (mv.move_end - mv.move_begin);
-            p0 += (smoothstep5(x) - made) * mv.across;
+            p0 += (smoothstep5(x) - made) * mv.across + kit_bump(x) * mv.lift;
         }
         tip[i] = p0;
         dir[i] = d0;
@@ -621,6 +751,11 @@ void sample_hand(const std::vector<double> &times, const HandTimeline &line,
 }
 
 } // namespace
+
+double humanize_amount(const Score &score, const PlanOptions &options)
+{
+    return options.humanize >= 0.0 ? options.humanize : std::max(0.0, score.humanize);
+}
 
 GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
                              const PerformerFrame &frame, const PlanOptions &opt)
@@ -635,6 +770,9 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
     plan.score_start_s = opt.lead_in_s;
     UnitCache units(db); // the timelines' items point into it
     const HandNotes by_hand = time_notes(score, frame, opt, plan);
+    for (const ScoreMeter &m : score.meters)
+        plan.meters.push_back(
+            {opt.lead_in_s + score.tempo.time_at_beat(m.beat), m.beat, m.numerator, m.denominator});
 
     std::array<HandTimeline, 2> timelines;
     double last_motion_end = 0.0;

@@ -5,6 +5,7 @@
 // every statement is parsed and range-checked first (add_line), and only a
 // complete, balanced statement list is executed into a Score (finish).
 #include "ictus/score/score.hpp"
+#include "statement.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -48,6 +49,19 @@ ScoreError::ScoreError(const std::string &source, int line, int column, const st
 {
 }
 
+const char *to_string(Grace grace)
+{
+    switch (grace) {
+    case Grace::flam:
+        return "flam";
+    case Grace::drag:
+        return "drag";
+    case Grace::none:
+        break;
+    }
+    return "none";
+}
+
 const std::vector<DynamicsWord> &dynamics_words()
 {
     // Evenly spread over the range, mf = the default 0.6 and ff = the loudest.
@@ -58,6 +72,10 @@ const std::vector<DynamicsWord> &dynamics_words()
 
 // ---------------------------------------------------------------- statements
 
+using score_detail::Kind;
+using score_detail::Roll;
+using score_detail::Statement;
+
 namespace
 {
 
@@ -65,39 +83,6 @@ struct Token {
     std::string text;
     std::string lower;
     int column = 0;
-};
-
-enum class Kind {
-    note,
-    rest,
-    tempo,
-    grip,
-    default_beats,
-    default_dynamics,
-    default_firmness,
-    default_nuance,
-    repeat,
-    end
-};
-
-struct Statement {
-    Kind kind = Kind::note;
-    int line = 0;
-    int column = 0;
-    // note
-    Side hand = Side::right;
-    bool both_hands = false;        // R+L: one stroke of each hand on the same beat
-    std::optional<Nuance> nuance;   // note, default_nuance
-    std::optional<double> beats;    // note, rest, default_beats
-    std::optional<double> dynamics; // note, default_dynamics
-    std::optional<double> r_over_a, theta_deg;
-    std::optional<double> firmness; // note, default_firmness
-    // tempo: start_bpm absent means "from the current tempo"
-    std::optional<double> start_bpm;
-    double end_bpm = 0.0;
-    double ramp_beats = 0.0;
-    Grip grip = Grip::french;
-    int count = 0; // repeat
 };
 
 const Nuance kNuances[] = {Nuance::legato,          Nuance::tenuto,   Nuance::accent,
@@ -336,6 +321,12 @@ class LineParser
             st.kind = Kind::note;
             st.both_hands = true;
             note_options(tk, st);
+            if (st.ornament != Grace::none)
+                fail(st.ornament_column, std::string("a ") + to_string(st.ornament) +
+                                             "'s grace strokes are the other hand's; " +
+                                             tk[0].text + " plays both: write R " +
+                                             to_string(st.ornament) + " or L " +
+                                             to_string(st.ornament));
             if (st.r_over_a)
                 fail(tk[0].column, "'at' places one stick; " + tk[0].text +
                                        " plays each hand on its default spot");
@@ -390,9 +381,11 @@ class LineParser
                 one_value(tk, st, Kind::default_beats, "'beats' needs a duration, e.g. 'beats 1/2'",
                           "the duration", [&](const Token &t) { return duration(t, "beats"); });
         } else if (key == "dynamics") {
-            st.dynamics =
-                one_value(tk, st, Kind::default_dynamics, "'dynamics' needs a value 0..1 or pp..ff",
-                          "the dynamics", [&](const Token &t) { return dynamics_value(t); });
+            dynamics_statement(tk, st);
+        } else if (key == "roll") {
+            roll_statement(tk, st);
+        } else if (key == "meter") {
+            meter_statement(tk, st);
         } else if (key == "nuance") {
             st.nuance = one_value(tk, st, Kind::default_nuance,
                                   "'nuance' needs a nuance, e.g. 'nuance accent'", "the nuance",
@@ -401,6 +394,21 @@ class LineParser
             st.firmness =
                 one_value(tk, st, Kind::default_firmness, "'firmness' needs a value 0..1",
                           "the firmness", [&](const Token &t) { return firmness_value(t); });
+        } else if (key == "drum") {
+            st.kind = Kind::drum;
+            drum_name(need(tk, 1, "'drum' needs a drum's name, e.g. 'drum snare'"), st);
+            no_more(tk, 2, "the drum's name");
+        } else if (key == "humanize") {
+            st.humanize =
+                one_value(tk, st, Kind::humanize, "'humanize' needs an amount, e.g. 'humanize 1'",
+                          "the amount", [&](const Token &t) {
+                              const double a = number(t, "humanize");
+                              if (!(a >= 0.0 && a <= kMaxHumanize))
+                                  fail(t.column, "humanize " + t.text +
+                                                     " is out of range (0..4; 1: a "
+                                                     "drummer's hand, 0: no noise)");
+                              return a;
+                          });
         } else if (key == "repeat") {
             st.kind = Kind::repeat;
             const Token &n = need(tk, 1, "repeat needs a count, e.g. 'repeat 4'");
@@ -416,9 +424,84 @@ class LineParser
             fail(tk[0].column,
                  "unknown statement '" + tk[0].text +
                      "' (expected a hand R, L, right, left, R+L, or tempo, grip, rest, "
-                     "beats, dynamics, firmness, nuance, repeat, end)");
+                     "beats, dynamics, firmness, nuance, roll, meter, drum, humanize, repeat, end)");
         }
         return st;
+    }
+
+    // `dynamics D`, or a hairpin `dynamics [D] -> D2 over BEATS`.
+    void dynamics_statement(const std::vector<Token> &tk, Statement &st) const
+    {
+        st.kind = Kind::default_dynamics;
+        size_t i = 1;
+        const Token &first = need(tk, i,
+                                  "'dynamics' needs a value 0..1 or pp..ff, or a hairpin: "
+                                  "'dynamics p -> f over 4'");
+        if (first.lower != "->" && first.lower != "to") {
+            st.dynamics = dynamics_value(first);
+            ++i;
+        }
+        if (i < tk.size() && (tk[i].lower == "->" || tk[i].lower == "to")) {
+            st.dynamics_end =
+                dynamics_value(need(tk, i + 1, "a hairpin needs the target dynamics after '->'"));
+            const Token &over = need(tk, i + 2, "a hairpin needs 'over BEATS'");
+            if (over.lower != "over")
+                fail(over.column,
+                     "expected 'over BEATS' after the target dynamics, got '" + over.text + "'");
+            const Token &len = need(tk, i + 3, "a hairpin needs the number of beats after 'over'");
+            st.ramp_beats = duration(len, "hairpin length");
+            i += 4;
+        }
+        no_more(tk, i, "the dynamics");
+    }
+
+    // `roll single|double|buzz BEATS`.
+    void roll_statement(const std::vector<Token> &tk, Statement &st) const
+    {
+        st.kind = Kind::roll;
+        const Token &k = need(tk, 1,
+                              "roll needs a kind and a length in beats: 'roll single 2' (single, "
+                              "double or buzz)");
+        if (k.lower == "single")
+            st.roll = Roll::single;
+        else if (k.lower == "double")
+            st.roll = Roll::double_stroke;
+        else if (k.lower == "buzz")
+            st.roll = Roll::buzz;
+        else
+            fail(k.column, "unknown roll '" + k.text + "' (valid: single, double, buzz)");
+        st.ramp_beats = duration(need(tk, 2,
+                                      "roll needs its length in beats after the kind: "
+                                      "'roll single 2'"),
+                                 "roll length");
+        no_more(tk, 3, "the roll length");
+    }
+
+    // `meter N/D`: N 1..64, D a power of two 1..64.
+    void meter_statement(const std::vector<Token> &tk, Statement &st) const
+    {
+        st.kind = Kind::meter;
+        const Token &m = need(tk, 1, "meter needs N/D, e.g. 'meter 3/4'");
+        const size_t slash = m.text.find('/');
+        auto whole = [](const std::string &s) {
+            return !s.empty() && s.size() <= 4 && std::all_of(s.begin(), s.end(), [](char c) {
+                return std::isdigit(static_cast<unsigned char>(c));
+            });
+        };
+        if (slash == std::string::npos || !whole(m.text.substr(0, slash)) ||
+            !whole(m.text.substr(slash + 1)))
+            fail(m.column, "malformed meter '" + m.text +
+                               "' (write N/D with whole numbers, e.g. 'meter 3/4')");
+        st.numerator = std::atoi(m.text.substr(0, slash).c_str());
+        st.denominator = std::atoi(m.text.substr(slash + 1).c_str());
+        if (st.numerator < 1 || st.numerator > kMaxMeterNumerator)
+            fail(m.column, "meter '" + m.text + "': " + std::to_string(st.numerator) +
+                               " beats in a bar is out of range (1..64)");
+        const int d = st.denominator;
+        if (d < 1 || d > kMaxMeterDenominator || (d & (d - 1)) != 0)
+            fail(m.column, "meter '" + m.text + "': the note value " + std::to_string(d) +
+                               " must be a power of two (1, 2, 4, 8, 16, 32, 64)");
+        no_more(tk, 2, "the meter");
     }
 
     Nuance nuance_value(const Token &t) const
@@ -427,6 +510,21 @@ class LineParser
         if (!nuance)
             fail(t.column, "unknown nuance '" + t.text + "' (valid: " + nuance_list() + ")");
         return *nuance;
+    }
+
+    // A drum's name: letters, digits, '_' and '-' (the kit's names, docs/kit.md).
+    void drum_name(const Token &t, Statement &st) const
+    {
+        const bool ok =
+            !t.lower.empty() && t.lower.size() <= 32 &&
+            std::all_of(t.lower.begin(), t.lower.end(), [](char c) {
+                return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+            });
+        if (!ok)
+            fail(t.column,
+                 "malformed drum name '" + t.text + "' (letters, digits, '_' and '-', at most 32)");
+        st.drum = t.lower;
+        st.drum_column = t.column;
     }
 
     double firmness_value(const Token &t) const
@@ -447,6 +545,12 @@ class LineParser
                     fail(t.column, "second nuance '" + t.text + "' in one note");
                 st.nuance = *n;
                 has_nuance = true;
+            } else if (t.lower == "flam" || t.lower == "drag") {
+                if (st.ornament != Grace::none)
+                    fail(t.column, "second ornament '" + t.text +
+                                       "' in one note (a note has one flam or one drag)");
+                st.ornament = t.lower == "flam" ? Grace::flam : Grace::drag;
+                st.ornament_column = t.column;
             } else if (auto d = dynamics_word(t.lower)) {
                 if (st.dynamics)
                     fail(t.column, "second dynamics '" + t.text + "' in one note");
@@ -461,6 +565,11 @@ class LineParser
                     fail(t.column, "second firmness in one note");
                 st.firmness = firmness_value(
                     need(tk, i + 1, "'firmness' needs a value 0..1 (0 loose, 1 firm)"));
+                ++i;
+            } else if (t.lower == "on") {
+                if (st.drum)
+                    fail(t.column, "second drum in one note");
+                drum_name(need(tk, i + 1, "'on' needs a drum's name, e.g. 'on tom1'"), st);
                 ++i;
             } else if (t.lower == "at") {
                 if (st.r_over_a)
@@ -496,8 +605,8 @@ class LineParser
             } else {
                 fail(t.column, "unexpected '" + t.text + "' in a note: expected a nuance (" +
                                    nuance_list() + "), dynamics (0..1 or " + dynamics_list() +
-                                   "), a duration (N/D or 'beats X'), 'at R/A THETA' or "
-                                   "'firmness F'");
+                                   "), a duration (N/D or 'beats X'), 'at R/A THETA', "
+                                   "'firmness F', 'on DRUM', 'flam' or 'drag'");
             }
         }
     }
@@ -595,94 +704,7 @@ Score ScoreBuilder::finish() const
         const Statement &r = s.statements[s.open_repeats.back()];
         throw ScoreError(s.source, r.line, r.column, "'repeat' without 'end'");
     }
-
-    Score score;
-    score.source = s.source;
-    double beat = 0.0;
-    Grip grip = Grip::french;
-    double default_beats = kDefaultNoteBeats;
-    double default_dynamics = kDefaultDynamics;
-    double default_firmness = -1.0; // the performance's
-    Nuance default_nuance = Nuance::legato;
-    struct Loop {
-        size_t body; // first statement of the body
-        int left;    // passes still to play after this one
-    };
-    std::vector<Loop> loops;
-    auto advance = [&](const Statement &st, double beats) {
-        beat += beats;
-        if (beat > kMaxScoreBeats)
-            throw ScoreError(s.source, st.line, st.column,
-                             "the score is longer than 100000 beats (check the repeat counts)");
-    };
-    long steps = 0;
-    for (size_t pc = 0; pc < s.statements.size(); ++pc) {
-        const Statement &st = s.statements[pc];
-        if (++steps > kMaxScoreSteps)
-            throw ScoreError(s.source, st.line, st.column,
-                             "the score executes more than 1000000 statements (check the repeat "
-                             "counts: repeats nested around no note or rest)");
-        switch (st.kind) {
-        case Kind::note: {
-            if (score.notes.size() >= static_cast<size_t>(kMaxScoreNotes))
-                throw ScoreError(s.source, st.line, st.column,
-                                 "the score has more than 100000 notes (check the repeat counts)");
-            ScoreNote n;
-            n.beat = beat;
-            n.beats = st.beats.value_or(default_beats);
-            n.nuance = st.nuance.value_or(default_nuance);
-            n.grip = grip;
-            n.dynamics = st.dynamics.value_or(default_dynamics);
-            n.r_over_a = st.r_over_a.value_or(kDefaultRadiusFraction);
-            n.firmness = st.firmness.value_or(default_firmness);
-            n.line = st.line;
-            n.column = st.column;
-            for (Side hand : {Side::right, Side::left}) {
-                if (!st.both_hands && hand != st.hand)
-                    continue;
-                n.hand = hand;
-                n.theta_deg = st.theta_deg.value_or(kDefaultThetaDeg[static_cast<int>(hand)]);
-                score.notes.push_back(n);
-            }
-            advance(st, n.beats);
-            break;
-        }
-        case Kind::rest:
-            advance(st, st.beats.value_or(default_beats));
-            break;
-        case Kind::tempo: {
-            const double start = st.start_bpm.value_or(score.tempo.tempo_at_beat(beat));
-            score.tempo.add(beat, start, st.end_bpm, st.ramp_beats);
-            break;
-        }
-        case Kind::grip:
-            grip = st.grip;
-            break;
-        case Kind::default_beats:
-        case Kind::default_dynamics:
-        case Kind::default_firmness:
-        case Kind::default_nuance:
-            // A default statement carries its one value; the others stay.
-            default_beats = st.beats.value_or(default_beats);
-            default_dynamics = st.dynamics.value_or(default_dynamics);
-            default_firmness = st.firmness.value_or(default_firmness);
-            default_nuance = st.nuance.value_or(default_nuance);
-            break;
-        case Kind::repeat:
-            loops.push_back({pc + 1, st.count - 1});
-            break;
-        case Kind::end:
-            if (loops.back().left > 0) {
-                --loops.back().left;
-                pc = loops.back().body - 1;
-            } else {
-                loops.pop_back();
-            }
-            break;
-        }
-    }
-    score.length_beats = beat;
-    return score;
+    return score_detail::execute_statements(s.source, s.statements);
 }
 
 Score parse_score(const std::string &text, const std::string &source_name)

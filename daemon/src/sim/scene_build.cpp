@@ -3,6 +3,7 @@
 // grip). Stepping is in scene_step.cpp, the state read back in scene_state.cpp.
 #include "ictus/sim/scene.hpp"
 #include "scene_ode.hpp"
+#include "stick_tip.h"
 
 #include <ode/ode.h>
 
@@ -70,6 +71,32 @@ double DrumParams::stiffness_n_per_m(double tip_radius_m) const
     return 2.0 * M_PI * tension_n_per_m / std::log(radius_m / tip_radius_m);
 }
 
+double DrumParams::stretch_n_per_m3() const
+{
+    return stick_tip_head_k3(head_young_pa, head_poisson, head_thickness_m, radius_m);
+}
+
+bool is_stick_tip(const std::string &name)
+{
+    return stick_tip_find(name.c_str()) != nullptr;
+}
+
+namespace
+{
+void validate_drum(const DrumParams &d, const std::string &which)
+{
+    check_finite_positive((which + " radius (m)").c_str(), d.radius_m, 5.0);
+    check_finite_positive((which + " shell depth (m)").c_str(), d.shell_depth_m, 5.0);
+    check_finite_positive((which + " tension (N/m)").c_str(), d.tension_n_per_m, 1e7);
+    if (!(std::isfinite(d.contact_damping_n_s_per_m) && d.contact_damping_n_s_per_m >= 0.0))
+        throw SimError(which + " contact damping: expected a finite value >= 0");
+    if (!(std::isfinite(d.friction) && d.friction >= 0.0))
+        throw SimError(which + " friction: expected a finite value >= 0");
+    if (!d.center_m.allFinite())
+        throw SimError(which + " position: expected finite coordinates");
+}
+} // namespace
+
 void validate(const SceneOptions &o)
 {
     check_finite_positive("physics step (s)", o.step_s, 0.05);
@@ -81,16 +108,14 @@ void validate(const SceneOptions &o)
                        std::to_string(o.quickstep_w));
     if (!(std::isfinite(o.gravity_mps2) && o.gravity_mps2 >= 0.0))
         throw SimError("gravity: expected a finite value >= 0");
-    check_finite_positive("drum radius (m)", o.drum.radius_m, 5.0);
-    check_finite_positive("drum shell depth (m)", o.drum.shell_depth_m, 5.0);
-    check_finite_positive("drum tension (N/m)", o.drum.tension_n_per_m, 1e7);
-    if (!(std::isfinite(o.drum.contact_damping_n_s_per_m) &&
-          o.drum.contact_damping_n_s_per_m >= 0.0))
-        throw SimError("drum contact damping: expected a finite value >= 0");
-    if (!(std::isfinite(o.drum.friction) && o.drum.friction >= 0.0))
-        throw SimError("drum friction: expected a finite value >= 0");
-    if (!o.drum.center_m.allFinite())
-        throw SimError("drum position: expected finite coordinates");
+    validate_drum(o.drum, "drum");
+    if (o.extra_drums.size() + 1 > static_cast<size_t>(kMaxDrums))
+        throw SimError("kit: at most " + std::to_string(kMaxDrums) + " drums, got " +
+                       std::to_string(o.extra_drums.size() + 1));
+    for (size_t i = 0; i < o.extra_drums.size(); ++i)
+        validate_drum(o.extra_drums[i], "drum " + std::to_string(i + 1));
+    if (!o.drum.stick_tip.empty() && !stick_tip_find(o.drum.stick_tip.c_str()))
+        throw SimError("stick tip: expected wood, nylon or felt, got '" + o.drum.stick_tip + "'");
     check_finite_positive("divergence speed bound (m/s)", o.max_linear_speed_mps);
     check_finite_positive("divergence angular speed bound (rad/s)", o.max_angular_speed_rad_s);
     check_finite_positive("divergence joint separation bound (m)", o.max_joint_separation_m);
@@ -131,8 +156,10 @@ Scene::Scene(const CharacterModel &model, const SceneOptions &options, const Cha
     validate(options_);
     if (initial.local.size() != static_cast<size_t>(CharacterModel::kJoints))
         throw SimError("scene: initial pose must have 19 joint rotations");
-    if (options_.drum.radius_m <= model_.options().stick.tip_radius_m)
-        throw SimError("drum radius: must exceed the stick tip radius");
+    for (int i = 0; i < drum_count(); ++i)
+        if (drum(i).radius_m <= model_.options().stick.tip_radius_m)
+            throw SimError("drum " + std::to_string(i) +
+                           " radius: must exceed the stick tip radius");
     set_gains(gains);
     ensure_ode();
     target_ = initial.local;
@@ -341,34 +368,44 @@ void Scene::create_stick(int side, const BodyFrames &frames)
     dGeomSetOffsetPosition(stick_tip_[side], tip_off.x(), tip_off.y(), tip_off.z());
 }
 
-// Drum: a static cylinder whose top face is the membrane.
+// Drums: each a static cylinder whose top face is the membrane; drum 0
+// first, a kit's others after it.
 void Scene::create_drum()
 {
-    drum_ = dCreateCylinder(space_, options_.drum.radius_m, options_.drum.shell_depth_m);
-    dGeomSetCategoryBits(drum_, kDrumCategory);
-    dGeomSetCollideBits(drum_, kStickCategory);
-    place_drum();
+    for (int i = 0; i < drum_count(); ++i) {
+        const DrumParams &d = drum(i);
+        drum_geom_[i] = dCreateCylinder(space_, d.radius_m, d.shell_depth_m);
+        dGeomSetCategoryBits(drum_geom_[i], kDrumCategory);
+        dGeomSetCollideBits(drum_geom_[i], kStickCategory);
+        place_drum(i);
+    }
 
     static_assert(sizeof(Feedback) == sizeof(dJointFeedback), "feedback layout");
     if (pelvis_weld_)
         dJointSetFeedback(pelvis_weld_, reinterpret_cast<dJointFeedback *>(&weld_feedback_));
 }
 
-void Scene::place_drum()
+void Scene::place_drum(int index)
 {
-    const DrumParams &drum = options_.drum;
-    dGeomCylinderSetParams(drum_, drum.radius_m, drum.shell_depth_m);
+    const DrumParams &drum = this->drum(index);
+    dGeomID geom = drum_geom_[index];
+    dGeomCylinderSetParams(geom, drum.radius_m, drum.shell_depth_m);
     const Eigen::Vector3d c = drum.center_m - Eigen::Vector3d(0, 0.5 * drum.shell_depth_m, 0);
-    dGeomSetPosition(drum_, c.x(), c.y(), c.z());
-    set_rotation(drum_, z_onto(Eigen::Vector3d::UnitY()), false);
+    dGeomSetPosition(geom, c.x(), c.y(), c.z());
+    set_rotation(geom, z_onto(Eigen::Vector3d::UnitY()), false);
 
     // Soft contact from the membrane's spring-damper, the implicit step's
     // numerical damping taken back out by default (soft_contact()).
-    const SoftContact sc = soft_contact(options_.step_s, drum_contact_stiffness_n_per_m(),
+    const SoftContact sc = soft_contact(options_.step_s, drum_contact_stiffness_n_per_m(index),
                                         drum.contact_damping_n_s_per_m,
                                         options_.contact_numerical_damping_compensated);
-    contact_erp_ = sc.erp;
-    contact_cfm_ = sc.cfm;
+    contact_erp_[index] = sc.erp;
+    contact_cfm_[index] = sc.cfm;
+    const stick_tip *tip =
+        options_.drum.stick_tip.empty() ? nullptr : stick_tip_find(options_.drum.stick_tip.c_str());
+    tip_stiffness_ = tip ? tip->stiffness : 0.0;
+    tip_alpha_ = tip ? tip->alpha : 1.0;
+    head_k3_[index] = drum.stretch_n_per_m3();
 }
 
 // ERP = h k / (h k + c), CFM = 1 / (h k + c) is the implicit (backward)
@@ -387,18 +424,37 @@ SoftContact soft_contact(double h, double k, double c, bool compensated)
 
 double Scene::drum_contact_stiffness_n_per_m() const
 {
-    return options_.drum.stiffness_n_per_m(model_.options().stick.tip_radius_m);
+    return drum_contact_stiffness_n_per_m(0);
+}
+
+double Scene::drum_contact_stiffness_n_per_m(int index) const
+{
+    return drum(index).stiffness_n_per_m(model_.options().stick.tip_radius_m);
+}
+
+const DrumParams &Scene::drum(int index) const
+{
+    if (index < 0 || index >= drum_count())
+        throw SimError("drum " + std::to_string(index) + ": the scene has " +
+                       std::to_string(drum_count()) + " drum(s)");
+    return index == 0 ? options_.drum : options_.extra_drums[static_cast<size_t>(index - 1)];
 }
 
 void Scene::set_drum(const DrumParams &drum)
 {
+    set_drum(0, drum);
+}
+
+void Scene::set_drum(int index, const DrumParams &drum)
+{
+    this->drum(index); // throws for a bad index
     SceneOptions candidate = options_;
-    candidate.drum = drum;
+    (index == 0 ? candidate.drum : candidate.extra_drums[static_cast<size_t>(index - 1)]) = drum;
     validate(candidate); // throws naming the value; nothing changed yet
     if (drum.radius_m <= model_.options().stick.tip_radius_m)
         throw SimError("drum radius: must exceed the stick tip radius");
-    options_.drum = drum;
-    place_drum();
+    (index == 0 ? options_.drum : options_.extra_drums[static_cast<size_t>(index - 1)]) = drum;
+    place_drum(index);
 }
 
 // The grip's spring-damper as the fulcrum's soft stop at 0 rad: with lo ==

@@ -187,7 +187,7 @@ void body_mass(dBodyID body, Eigen::Matrix<double, 6, 6> &out)
 }
 } // namespace
 
-double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in) const
+double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in, int drum) const
 {
     const Eigen::Vector3d n = normal_in.normalized();
     const int s = static_cast<int>(side);
@@ -235,7 +235,7 @@ double Scene::effective_mass_kg(Side side, const Eigen::Vector3d &normal_in) con
     const double m_rigid = 1.0 / inverse_effective_mass<12, 6>(J_rigid, M, g_rigid);
     const double lever = a.cross(bead - p).norm();
     const double k_grip = options_.grip[s].stiffness_nm_per_rad / std::max(lever * lever, 1e-6);
-    const double k_drum = drum_contact_stiffness_n_per_m();
+    const double k_drum = drum_contact_stiffness_n_per_m(drum);
     const double w = k_grip / (k_grip + k_drum);
     return m_pivot + w * (m_rigid - m_pivot);
 }

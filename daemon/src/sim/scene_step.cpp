@@ -5,6 +5,7 @@
 #include "ictus/base/rotation.hpp"
 #include "ictus/sim/scene.hpp"
 #include "scene_ode.hpp"
+#include "stick_tip.h"
 
 #include <ode/ode.h>
 
@@ -29,6 +30,20 @@ constexpr double kHeadNormalMin = 0.2;
 
 } // namespace
 
+// The bead's contact with the head: the tip's law (stick_tip.h, the law contact~
+// plays: F = k x^alpha) in series with the head's point stiffness with its
+// stretching, F = k_h y + k3 y^3 (massless). Returns the pair's secant stiffness
+// F / d (N/m) at the depth d: ODE's soft contact is a linear spring-damper per
+// step, and with the secant of the depth it has now, the contact's force at that
+// depth is the law's. The law's Hunt-Crossley term is left out: the head's damper
+// c is the contact's loss (docs/character.md, "Drum").
+double series_contact_stiffness(double k_head, double k3, double k_tip, double alpha, double depth)
+{
+    if (!(depth > 0.0))
+        return k_head;
+    return stick_tip_series_force(k_tip, alpha, k_head, k3, depth, nullptr) / depth;
+}
+
 void Scene::set_joint_targets(const std::vector<Eigen::Quaterniond> &local,
                               const std::vector<Eigen::Vector3d> &rate_parent)
 {
@@ -51,11 +66,20 @@ void Scene::set_joint_targets(const std::vector<Eigen::Quaterniond> &local,
 void Scene::near_callback(void *data, dGeomID a, dGeomID b)
 {
     Scene *self = static_cast<Scene *>(data);
-    // Only sticks meet the drum (category bits). The stick's geom goes first,
+    // Only sticks meet drums (category bits). The stick's geom goes first,
     // so that its body is the contact joint's body 1 and the joint feedback's
     // f1 is the force on the stick (the normal then points into the stick).
-    if (a == self->drum_)
-        std::swap(a, b);
+    int drum = -1;
+    for (int i = 0; i < self->drum_count(); ++i) {
+        if (a == self->drum_geom_[i]) {
+            std::swap(a, b);
+            drum = i;
+        } else if (b == self->drum_geom_[i]) {
+            drum = i;
+        }
+    }
+    if (drum < 0)
+        return;
     int side = -1;
     bool bead = false;
     for (int s = 0; s < 2; ++s) {
@@ -76,7 +100,7 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
     // under a drum placed for its strokes) passes through the drum until it
     // is clear of it. Blocked there, the hand would drive the stick against
     // the shell with the arm's whole strength and wrench it round its fulcrum.
-    const int part = 2 * side + (bead ? 1 : 0);
+    const int part = 4 * drum + 2 * side + (bead ? 1 : 0);
     self->part_touching_now_[static_cast<size_t>(part)] = true;
     if (!self->part_touching_[static_cast<size_t>(part)]) {
         int deepest = 0;
@@ -87,8 +111,10 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         // head, outward and up on the rim's edge, level on the shell's side.
         const bool from_above = geoms[deepest].normal[1] > kHeadNormalMin;
         self->part_through_[static_cast<size_t>(part)] = !from_above;
-        if (!from_above)
+        if (!from_above) {
             ++self->shell_passes_;
+            ++self->drum_shell_passes_[static_cast<size_t>(drum)];
+        }
     }
     if (self->part_through_[static_cast<size_t>(part)])
         return;
@@ -96,9 +122,21 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         dContact contact;
         contact.geom = geoms[i];
         contact.surface.mode = dContactSoftERP | dContactSoftCFM | dContactApprox1;
-        contact.surface.mu = self->options_.drum.friction;
-        contact.surface.soft_erp = self->contact_erp_;
-        contact.surface.soft_cfm = self->contact_cfm_;
+        contact.surface.mu = self->drum(drum).friction;
+        contact.surface.soft_erp = self->contact_erp_[static_cast<size_t>(drum)];
+        contact.surface.soft_cfm = self->contact_cfm_[static_cast<size_t>(drum)];
+        const double k3 = self->head_k3_[static_cast<size_t>(drum)];
+        if (bead && (self->tip_stiffness_ > 0.0 || k3 > 0.0)) {
+            const double k_head = self->drum_contact_stiffness_n_per_m(drum);
+            const SoftContact sc =
+                soft_contact(self->options_.step_s,
+                             series_contact_stiffness(k_head, k3, self->tip_stiffness_,
+                                                      self->tip_alpha_, geoms[i].depth),
+                             self->drum(drum).contact_damping_n_s_per_m,
+                             self->options_.contact_numerical_damping_compensated);
+            contact.surface.soft_erp = sc.erp;
+            contact.surface.soft_cfm = sc.cfm;
+        }
         dJointID joint = dJointCreateContact(self->world_, self->contacts_, &contact);
         dJointAttach(joint, dGeomGetBody(a), dGeomGetBody(b));
         if (self->contact_slots_used_ < static_cast<int>(self->contact_slot_.size())) {
@@ -142,7 +180,27 @@ void Scene::apply_control()
         const MotorCommand cmd = pd_motor_command(qp, qc, target_[j], target_rate_[j], gains_[j],
                                                   options_.rate_feedforward);
         drive_motor(j, cmd, limit_stop(j, qp, qc, cmd));
+        if (motor_noise_ > 0.0) {
+            // Signal-dependent noise (Harris & Wolpert 1998): its SD grows
+            // with the commanded torque, here the PD's stiffness part.
+            const double command_nm =
+                std::min(gains_[j].kp_nm_per_rad * cmd.error_parent.norm(), cmd.fmax);
+            const double sd = motor_noise_ * kTorqueNoiseCv * command_nm;
+            const Eigen::Vector3d n(sd * motor_noise_stream_.normal(),
+                                    sd * motor_noise_stream_.normal(),
+                                    sd * motor_noise_stream_.normal());
+            dBodyAddTorque(body_[child], n.x(), n.y(), n.z());
+            dBodyAddTorque(body_[parent], -n.x(), -n.y(), -n.z());
+        }
     }
+}
+
+void Scene::set_motor_noise(double amount, std::uint64_t seed)
+{
+    if (!(amount >= 0.0 && std::isfinite(amount)))
+        throw SimError("motor noise: the amount must be >= 0, got " + std::to_string(amount));
+    motor_noise_ = amount;
+    motor_noise_stream_ = MotorNoise(seed, 0); // stream 0: the controller's
 }
 
 // The joint's present rate (child relative to parent, world).

@@ -66,13 +66,43 @@ Eigen::Vector3d approach_velocity(const TipSample &free, double g0, const TipSam
 
 StrikeDetector::StrikeDetector(const MembraneGeometry &membrane,
                                const StrikeDetectorOptions &options)
-    : membrane_(membrane), options_(options)
+    : options_(options)
 {
+    membranes_[0] = membrane;
 }
 
 void StrikeDetector::set_membrane(const MembraneGeometry &membrane)
 {
-    membrane_ = membrane;
+    const int d = std::clamp(membrane.drum_id, 0, kMaxDrums - 1);
+    membranes_[static_cast<size_t>(d)] = membrane;
+    membranes_[static_cast<size_t>(d)].drum_id = d;
+    drum_count_ = std::max(drum_count_, d + 1);
+}
+
+int StrikeDetector::drum_under(const Eigen::Vector3d &c) const
+{
+    if (drum_count_ == 1)
+        return 0;
+    int best = 0;
+    double best_out = std::numeric_limits<double>::infinity(), best_gap = best_out;
+    for (int d = 0; d < drum_count_; ++d) {
+        const MembraneGeometry &m = membranes_[static_cast<size_t>(d)];
+        const double out =
+            std::max(0.0, std::hypot(c.x() - m.center_m.x(), c.z() - m.center_m.z()) - m.radius_m);
+        const double gap = std::abs(gap_m(c, d));
+        if (out < best_out || (out == 0.0 && best_out == 0.0 && gap < best_gap)) {
+            best = d;
+            best_out = out;
+            best_gap = gap;
+        }
+    }
+    return best;
+}
+
+double StrikeDetector::gap_m(const Eigen::Vector3d &center_m, int drum) const
+{
+    const MembraneGeometry &m = membranes_.at(static_cast<size_t>(drum));
+    return (center_m - m.center_m).dot(kNormal) - m.tip_radius_m;
 }
 
 long StrikeDetector::first_open_seq() const
@@ -86,32 +116,34 @@ long StrikeDetector::first_open_seq() const
 
 void StrikeDetector::reset(const MembraneGeometry &membrane)
 {
-    membrane_ = membrane;
+    membranes_[0] = membrane;
+    membranes_[0].drum_id = 0;
+    drum_count_ = 1;
     hands_ = {};
 }
 
 double StrikeDetector::normal_force_n(double depth_m, double depth_rate_mps) const
 {
     // One-sided spring-damper: the membrane pushes, never pulls.
-    return std::max(0.0, membrane_.stiffness_n_per_m * depth_m +
-                             membrane_.damping_n_s_per_m * depth_rate_mps);
+    return std::max(0.0,
+                    cur().stiffness_n_per_m * depth_m + cur().damping_n_s_per_m * depth_rate_mps);
 }
 
 double StrikeDetector::gap_m(const Eigen::Vector3d &center_m) const
 {
-    return (center_m - membrane_.center_m).dot(kNormal) - membrane_.tip_radius_m;
+    return (center_m - cur().center_m).dot(kNormal) - cur().tip_radius_m;
 }
 
 bool StrikeDetector::over_membrane(const Eigen::Vector3d &center_m) const
 {
     double x, y;
     to_membrane(center_m, x, y);
-    return x * x + y * y <= membrane_.radius_m * membrane_.radius_m;
+    return x * x + y * y <= cur().radius_m * cur().radius_m;
 }
 
 void StrikeDetector::to_membrane(const Eigen::Vector3d &world_m, double &x_m, double &y_m) const
 {
-    const Eigen::Vector3d d = world_m - membrane_.center_m;
+    const Eigen::Vector3d d = world_m - cur().center_m;
     x_m = d.x();
     y_m = -d.z();
 }
@@ -127,6 +159,20 @@ bool StrikeDetector::held_driving(const TipSample &a, const TipSample &b) const
 bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
 {
     Hand &h = hands_[static_cast<size_t>(hand & 1)];
+    if (drum_count_ > 1 && !h.in_contact && !h.side_entry) {
+        const int d = drum_under(s.center_m);
+        if (d != h.drum && h.has_previous)
+            h.previous_gap = gap_m(h.previous.center_m, d);
+        h.drum = d;
+    }
+    cur_ = h.drum;
+    const bool ended = update_hand(h, hand, s, out);
+    cur_ = 0;
+    return ended;
+}
+
+bool StrikeDetector::update_hand(Hand &h, int hand, const TipSample &s, StrikeEvent &out)
+{
     const double gap = gap_m(s.center_m);
     const bool touching = gap < 0.0 && over_membrane(s.center_m);
     const double depth_rate = -s.velocity_mps.dot(kNormal);
@@ -183,14 +229,14 @@ void StrikeDetector::begin_contact(Hand &h, int hand, const TipSample &s, double
     const double frac = g0 > 0.0 ? g0 / (g0 - gap) : 0.0;
     const double t_on = before.time_s + frac * (s.time_s - before.time_s);
     const Eigen::Vector3d p_on =
-        before.center_m + frac * (s.center_m - before.center_m) - membrane_.tip_radius_m * kNormal;
+        before.center_m + frac * (s.center_m - before.center_m) - cur().tip_radius_m * kNormal;
     StrikeEvent &e = h.event;
     e = StrikeEvent();
     e.hand = hand & 1;
-    e.drum = membrane_.drum_id;
+    e.drum = cur().drum_id;
     e.time_s = t_on;
     to_membrane(p_on, e.x_m, e.y_m);
-    e.r_over_a = std::hypot(e.x_m, e.y_m) / membrane_.radius_m;
+    e.r_over_a = std::hypot(e.x_m, e.y_m) / cur().radius_m;
     e.theta_deg = std::atan2(e.y_m, e.x_m) * 180.0 / M_PI;
     if (e.theta_deg <= -180.0)
         e.theta_deg += 360.0;
@@ -234,7 +280,7 @@ void StrikeDetector::continue_contact(Hand &h, const TipSample &s, double gap, d
     // Kinetic friction on the membrane along the tip's sliding direction.
     const Eigen::Vector3d vt = s.velocity_mps - s.velocity_mps.dot(kNormal) * kNormal;
     if (vt.norm() > 1e-6)
-        h.friction_sum += membrane_.friction * 0.5 * (h.last_force_n + f) * dt * vt.normalized();
+        h.friction_sum += cur().friction * 0.5 * (h.last_force_n + f) * dt * vt.normalized();
     if (f > h.peak_f[1]) {
         h.peak_t[0] = h.last_time_s;
         h.peak_f[0] = h.last_force_n;
@@ -331,15 +377,22 @@ bool StrikeDetector::flush(StrikeEvent &out)
 MembraneGeometry membrane_of(const Scene &scene, int drum_id)
 {
     MembraneGeometry m;
-    const DrumParams &d = scene.drum();
+    const DrumParams &d = scene.drum(drum_id);
     m.center_m = d.center_m;
     m.radius_m = d.radius_m;
     m.tip_radius_m = scene.model().options().stick.tip_radius_m;
-    m.stiffness_n_per_m = scene.drum_contact_stiffness_n_per_m();
+    m.stiffness_n_per_m = scene.drum_contact_stiffness_n_per_m(drum_id);
     m.damping_n_s_per_m = d.contact_damping_n_s_per_m;
     m.friction = d.friction;
     m.drum_id = drum_id;
     return m;
+}
+
+void load_membranes(StrikeDetector &detector, const Scene &scene)
+{
+    detector.reset(membrane_of(scene, 0));
+    for (int i = 1; i < scene.drum_count(); ++i)
+        detector.set_membrane(membrane_of(scene, i));
 }
 
 int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out[2],
@@ -354,8 +407,9 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
         s.velocity_mps = scene.bead_velocity(side);
         s.held_center_m = scene.held_bead_position(side);
         // Only near the head, where a contact may begin (a 7 x 7 solve).
-        if (detector.gap_m(s.center_m) < 0.02)
-            s.effective_mass_kg = scene.effective_mass_kg(side, Eigen::Vector3d::UnitY());
+        const int drum = detector.drum_under(s.center_m);
+        if (detector.gap_m(s.center_m, drum) < 0.02)
+            s.effective_mass_kg = scene.effective_mass_kg(side, Eigen::Vector3d::UnitY(), drum);
         if (detector.update(hand, s, out[n]))
             ++n;
     }

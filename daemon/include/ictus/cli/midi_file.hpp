@@ -39,13 +39,26 @@ struct MidiTempo {
     double bpm = 120.0;
 };
 
-// The file: track name, 4/4, the tempo map (at least one entry; the first
+// A time signature N/D from time_s on (D a power of two, 1..64; N 1..255).
+struct MidiMeter {
+    double time_s = 0.0;
+    int numerator = 4;
+    int denominator = 4;
+};
+
+// The file: track name, the time signature (the first of `meter` if it is at
+// 0 s, else 4/4; the others at their ticks, FF 58 nn dd 24 8: a metronome
+// click per quarter), the tempo map (at least one entry; the first
 // applies from 0), then for each strike in order a note-on on `channel`
 // (0..15) at its time_s, preceded by a text event "bounce" at the same tick
 // when it is a bounce, and its note-off. Times are rounded to the nearest
 // tick of the tempo map (3840 per quarter: within 0.4 ms at 20 bpm and faster).
+// With a kit, `drum_notes` gives each drum's note (StrikeEvent::drum indexes
+// it: the General MIDI drum map, docs/midi.md); without, midi_note().
 std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
-                               const std::vector<MidiTempo> &tempo, int channel);
+                               const std::vector<MidiTempo> &tempo, int channel,
+                               const std::vector<int> *drum_notes = nullptr,
+                               const std::vector<MidiMeter> &meter = {});
 
 } // namespace cli
 } // namespace ictus

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace ictus
 {
@@ -23,6 +24,17 @@ struct PdRenderOptions {
     double tension_n_per_m = 3000.0;
     double density_kg_per_m2 = 0.26;
     std::string preset; // render-drum preset NAME first, when not empty (membrane~)
+    // A kit's drums after the first (drum 0 is the drum above): each played
+    // by its own ictus-kit-drum N (N = 1, 2 ...), configured by render-kit-N
+    // messages: preset, radius, tension, pan (+: the left channel), dsp 1.
+    struct KitDrumSound {
+        std::string preset;
+        double radius_m = 0.178;
+        double tension_n_per_m = 3000.0;
+        double pan = 0.0;
+    };
+    std::vector<KitDrumSound> kit;
+    std::string stick_tip; // render-drum left|right tip NAME, when not empty (contact~)
     int sample_rate = 48000;
     std::string mix = "stereo"; // render-mix
     int bits = 32;              // render-bits

@@ -46,6 +46,7 @@ enum class CommandKind {
     score,         // text = one score statement, e.g. "L accent 0.8" (docs/score.md)
     score_clear,   // forget the statements received so far
     grip_firmness, // value = 0 (loose) .. 1 (firm): the notes' default grip
+    humanize,      // value = motor noise amount 0..4 (docs/humanize.md)
 };
 
 struct Command {

@@ -15,6 +15,7 @@
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/perform/body_stats.hpp"
 #include "ictus/perform/commands.hpp"
+#include "ictus/perform/kit.hpp"
 #include "ictus/sim/scene.hpp"
 #include "ictus/score/score.hpp"
 #include "ictus/sim/strike_detector.hpp"
@@ -83,6 +84,10 @@ struct PerformanceOptions {
     // The grip's firmness 0..1 (Scene's grip_spring()): the notes' default,
     // changed live by /ictus/grip/firmness; a note may give its own.
     double grip_firmness = kDefaultGripFirmness;
+    // A kit (score mode; kit.hpp, docs/perform.md "A kit"); empty: the one
+    // drum. Its first drum is scene.drum, placed as the one drum is; the
+    // Performance takes its head (radius, tension, shell) from the kit.
+    Kit kit;
     PerformanceOptions(); // the sticks on their fulcrum (SceneOptions::sticks)
 };
 

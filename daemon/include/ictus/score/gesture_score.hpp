@@ -14,6 +14,8 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
+#include <string>
 #include <vector>
 
 namespace ictus
@@ -36,6 +38,15 @@ struct PerformerFrame {
     // Where each stick tip waits when its hand has nothing to play [Side].
     std::array<Eigen::Vector3d, 2> rest_tip_m = {Eigen::Vector3d(0.1, 0.85, 0.4),
                                                  Eigen::Vector3d(-0.1, 0.85, 0.4)};
+    // A kit (docs/perform.md, "A kit"): its drums by name, the first the
+    // membrane above (its centre and radius equal membrane_center_m and
+    // membrane_radius_m). Empty: the one drum, whose notes name none.
+    struct Drum {
+        std::string name;
+        Eigen::Vector3d membrane_center_m = Eigen::Vector3d::Zero(); // raised as membrane_center_m
+        double membrane_radius_m = 0.178;
+    };
+    std::vector<Drum> drums;
 };
 
 // The shared frames (docs/perform.md; the character faces +Z: right = world -X),
@@ -52,8 +63,9 @@ PerformerFrame performer_frame_for_drum(const Eigen::Vector3d &membrane_center_m
 Eigen::Vector3d rest_stick_direction(const PerformerFrame &frame, int side);
 
 // A point of the head from the membrane frame of docs/osc.md (x_m = world
-// +X, y_m = world -Z, around the centre).
-Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg);
+// +X, y_m = world -Z, around the centre); of a kit's drum `drum` (0: the first).
+Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg,
+                               int drum = 0);
 
 // One note as it will be played.
 struct PlannedNote {
@@ -71,8 +83,18 @@ struct PlannedNote {
     double r_over_a = 0.0;
     double theta_deg = 0.0;
     double firmness = -1.0; // ScoreNote::firmness
+    int drum = 0;           // the kit's drum (PerformerFrame::drums), 0: the first or only
     int line = 0;           // where the note is written
     int column = 0;
+    Grace grace = Grace::none; // a flam's or a drag's grace stroke (ScoreNote::grace)
+};
+
+// A meter of the score (ScoreMeter) from plan time time_s on.
+struct PlannedMeter {
+    double time_s = 0.0;
+    double beat = 0.0; // in the score
+    int numerator = 4;
+    int denominator = 4;
 };
 
 struct PlanOptions {
@@ -104,6 +126,12 @@ struct PlanOptions {
     // which the arm tracks closely (docs/score.md, "From score to motion").
     double move_margin_after = 0.05;
     double move_margin_before = 0.1;
+    // A move between two drums of a kit lifts the tip so that, wherever it
+    // is over a drum's head (that head's radius and this margin), it stays
+    // above it, and this clearance above any drum but the two it plays
+    // (docs/score.md, "A kit"): it never meets a shell from the side.
+    double kit_clearance_m = 0.03;
+    double kit_margin_m = 0.03;
     // A hand with no stroke for longer than this goes back to its rest tip.
     double idle_return_s = 4.0;
     double return_time_s = 0.6; // the move between the rest tip and a stroke
@@ -112,7 +140,22 @@ struct PlanOptions {
     // "Rebound strokes", measured).
     double min_stroke_interval_s = 0.04;
     double max_duration_s = 900.0; // longer performances are refused
+    // Motor noise (docs/humanize.md): the amount, 0 for none;
+    // < 0: the score's `humanize` statement (0 when it has none). The seed
+    // picks the noise (each note draws its own stream of it).
+    double humanize = -1.0;
+    std::uint64_t seed = 1;
 };
+
+// The motor noise at amount 1 (docs/humanize.md): each
+// stroke's timing is shifted by a normal draw of SD kHumanizeTimingSd_s and
+// its dynamics (the motor command) scaled by 1 + a normal draw of SD
+// kHumanizeForceCv (signal-dependent noise: its SD grows with the command).
+// Both SDs grow in proportion to the amount.
+constexpr double kHumanizeTimingSd_s = 0.0025;
+constexpr double kHumanizeForceCv = 0.05;
+// The amount a plan uses: options.humanize when >= 0, else the score's.
+double humanize_amount(const Score &score, const PlanOptions &options);
 
 // The gesture score, ready for the controller.
 struct GesturePlan {
@@ -122,6 +165,7 @@ struct GesturePlan {
     TipTrajectory tips;
     std::array<std::vector<Eigen::Vector3d>, 2> stick_dir; // [side][frame], unit, butt -> tip
     std::vector<PlannedNote> notes;                        // in time order
+    std::vector<PlannedMeter> meters;                      // the score's, in order
     double duration_s = 0.0;
     double score_start_s = 0.0; // plan time of the score's beat 0 (= lead_in_s)
 };

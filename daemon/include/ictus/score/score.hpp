@@ -43,6 +43,7 @@ constexpr double kMaxNoteBeats = 64.0;
 constexpr double kMaxRampBeats = 1024.0;
 constexpr double kMaxRadiusFraction = 0.95; // r/a: the bead must land on the head
 constexpr int kMaxRepeat = 1000;
+constexpr double kMaxHumanize = 4.0;   // `humanize AMOUNT`: 0..4
 constexpr int kMaxScoreNotes = 100000; // after repeats are expanded
 constexpr double kMaxScoreBeats = 100000.0;
 // Statements executed while repeats are expanded: bounds the work of scores
@@ -59,6 +60,23 @@ constexpr double kDefaultRadiusFraction = 0.3;
 // spot: the right hand plays on the performer's right (x_m < 0).
 constexpr double kDefaultThetaDeg[2] = {0.0, 180.0}; // [Side::left, Side::right]
 
+// Grace strokes (docs/score.md, "Flams, drags and rolls"): a flam's one
+// grace stroke of the other hand kFlamGraceLead_s before its note; a drag's
+// two, the second kFlamGraceLead_s before the note and the first
+// kDragGraceSpacing_s before that (a double of the other hand, above the
+// body's 40 ms same-hand limit). Played at kGraceDynamics, or half the
+// note's dynamics if that is less, legato, on the hand's default spot.
+constexpr double kFlamGraceLead_s = 0.030;
+constexpr double kDragGraceSpacing_s = 0.040;
+constexpr double kGraceDynamics = 0.15;
+// Meters (`meter N/D`): N 1..kMaxMeterNumerator, D a power of two 1..kMaxMeterDenominator.
+constexpr int kMaxMeterNumerator = 64;
+constexpr int kMaxMeterDenominator = 64;
+
+// What a note is: a written stroke, or a grace stroke of a flam or a drag.
+enum class Grace { none, flam, drag };
+const char *to_string(Grace grace);
+
 // One stroke of the score, in beats (times come from the tempo map).
 struct ScoreNote {
     double beat = 0.0;  // onset (the strike), beats from the start of the score
@@ -74,6 +92,25 @@ struct ScoreNote {
     double firmness = -1.0;
     int line = 0; // where the note was written
     int column = 0;
+    // The drum of a kit it is played on (`drum NAME`, `on NAME`; lower
+    // case), "" for the kit's first (or the one drum); where the name was
+    // written (the note's line, or the `drum` statement's), for the
+    // planner's error when the kit has no such drum.
+    std::string drum;
+    int drum_line = 0, drum_column = 0;
+    // A grace stroke (its ornament; none: a written note) is played
+    // grace_lead_s before `beat`, the beat of the note it ornaments.
+    Grace grace = Grace::none;
+    double grace_lead_s = 0.0;
+};
+
+// A `meter N/D` statement: from `beat` on (carried to MIDI; the beat stays
+// the tempo's beat).
+struct ScoreMeter {
+    double beat = 0.0;
+    int numerator = 4;
+    int denominator = 4;
+    int line = 0;
 };
 
 // Tempo as a function of score position: a list of changes, each setting the
@@ -109,11 +146,18 @@ class TempoMap
 // A whole parsed score.
 struct Score {
     std::string source;           // file name or "osc", for messages
-    std::vector<ScoreNote> notes; // in onset order (ties: in the order written)
+    std::vector<ScoreNote> notes; // in onset time order (ties: in the order written)
     TempoMap tempo;               // beat -> time
+    std::vector<ScoreMeter> meters; // in beat order; none: 4/4
     double length_beats = 0.0;    // end of the last statement (note or rest)
+    // `humanize AMOUNT` (docs/humanize.md); < 0: not written
+    // (the performance's amount, 0 by default). The last statement wins.
+    double humanize = -1.0;
     double duration_s() const { return tempo.time_at_beat(length_beats); }
-    double note_time_s(const ScoreNote &note) const { return tempo.time_at_beat(note.beat); }
+    double note_time_s(const ScoreNote &note) const
+    {
+        return tempo.time_at_beat(note.beat) - note.grace_lead_s;
+    }
 };
 
 // The live tempo scale (docs/osc.md, /ictus/tempo in score mode): the tempo

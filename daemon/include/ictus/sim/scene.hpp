@@ -5,15 +5,18 @@
 // See docs/character.md.
 #pragma once
 
+#include "ictus/base/motor_noise.hpp"
 #include "ictus/character/character.hpp"
 #include "ictus/control/joint_controller.hpp"
 #include "ictus/character/joint_limit_ref.hpp"
 #include "ictus/sim/sim_error.hpp"
+#include "ictus/sim/strike_event.hpp" // kMaxDrums
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
 #include <limits>
+#include <string>
 #include <vector>
 
 // ODE's opaque handles, so that users of the scene need not include ode.h.
@@ -39,8 +42,20 @@ struct DrumParams {
     double tension_n_per_m = 3000.0;
     double contact_damping_n_s_per_m = 3.0;
     double friction = 0.3;
+    // The stick tip (externals/core/stick_tip.h: wood, nylon, felt), in series
+    // with the head's spring: "" for none (the head's spring alone). Scene::
+    // near_callback has the law.
+    std::string stick_tip;
+    // The head's film (Mylar: E, nu; thickness = 0.262 kg/m^2 / 1390 kg/m^3, the
+    // membrane~ default head), for its stretching under the stick.
+    double head_young_pa = 4.5e9;
+    double head_poisson = 0.38;
+    double head_thickness_m = 0.262 / 1390.0;
     // k = 2 pi T / ln(R / r_tip), N/m.
     double stiffness_n_per_m(double tip_radius_m) const;
+    // The stretching's cubic term k3 (N/m^3): F = k y + k3 y^3 under a point load
+    // (stick_tip_head_k3 in externals/core/stick_tip.h, Begley & Mackin 2004).
+    double stretch_n_per_m3() const;
 };
 
 enum class Stepper { quick, direct }; // dWorldQuickStep or dWorldStep
@@ -76,7 +91,10 @@ struct SceneOptions {
     // exclusive; ODE's default is 1.3.
     double quickstep_w = 1.3;
     double gravity_mps2 = 9.81;
-    DrumParams drum;
+    DrumParams drum; // drum 0
+    // A kit's further drums, 1 .. kMaxDrums - 1 (empty: the one drum). Each
+    // is a static cylinder with its own contact law, created after drum 0.
+    std::vector<DrumParams> extra_drums;
     // Divergence: any non-finite state, a body faster than these, or a ball
     // joint pulled apart by more than max_joint_separation_m.
     double max_linear_speed_mps = 50.0;
@@ -123,6 +141,8 @@ struct SceneOptions {
 };
 // Throws SimError naming the first bad option.
 void validate(const SceneOptions &options);
+// Whether name is a stick tip of the table (DrumParams::stick_tip).
+bool is_stick_tip(const std::string &name);
 
 enum class StepResult { ok, diverged };
 
@@ -141,6 +161,13 @@ struct SoftContact {
     double cfm = 0.0;
 };
 SoftContact soft_contact(double h_s, double k_n_per_m, double c_n_s_per_m, bool compensated);
+
+// The bead on the head: the stick tip's law F = k_tip x^alpha (DrumParams::stick_tip,
+// externals/core/stick_tip.h, the law contact~ plays; k_tip 0: no tip) in series with
+// the head's stiffening spring F = k_head y + k3 y^3 (massless; N/m, N/m^3). Returns
+// the pair's secant stiffness F / depth (N/m) at the given depth (m): k_head for
+// depth <= 0. The scene gives it to ODE's soft contact each step.
+double series_contact_stiffness(double k_head, double k3, double k_tip, double alpha, double depth);
 
 struct StickDrumContact {
     Eigen::Vector3d bead_force_n = Eigen::Vector3d::Zero();  // through the bead (tip sphere)
@@ -200,9 +227,9 @@ class Scene
     int divergences() const { return divergences_; }
     int contacts_last_step() const { return contacts_last_step_; }
     long contact_steps() const { return contact_steps_; }
-    // Times a stick part (bead or shaft) met the drum other than from above:
+    // Times a stick part (bead or shaft) met a drum other than from above:
     // through the shell's side or bottom (docs/character.md, "Drum"). Such a
-    // part passes through the drum until it is clear of it.
+    // part passes through the drum until it is clear of it. All drums.
     long shell_passes() const { return shell_passes_; }
     int stops_active_last_step() const { return stops_active_; }
     // Motor torque of each joint in the last step (N m, on the child, world
@@ -243,6 +270,15 @@ class Scene
     const GripSpring &grip(Side side) const { return options_.grip[static_cast<int>(side)]; }
     // The grip as a firmness 0..1 (grip_spring()), for this scene's stick.
     void set_grip_firmness(Side side, double firmness);
+    // Motor noise (docs/humanize.md): each physics step every
+    // driven joint gets a torque (on the child, its reaction on the parent)
+    // whose SD per axis is amount x kTorqueNoiseCv x the joint's commanded
+    // stiffness torque kp |error|, drawn from the seeded stream `seed`
+    // (the physics thread only). 0: no torque and no draw. Restarts the
+    // stream.
+    static constexpr double kTorqueNoiseCv = 0.02;
+    void set_motor_noise(double amount, std::uint64_t seed);
+    double motor_noise() const { return motor_noise_; }
     // The stick's moment of inertia about its fulcrum axis, kg m^2.
     double fulcrum_inertia_kg_m2(Side side) const;
     // The stick's effective mass at the bead along `normal` (unit, world), kg:
@@ -254,7 +290,8 @@ class Scene
     // by s = k_g / (k_g + k), k_g = k_f / l^2 the grip's stiffness seen at the
     // bead (l its distance from the fulcrum axis) and k the drum's contact
     // stiffness. Rigid mount: the hand and stick as one body.
-    double effective_mass_kg(Side side, const Eigen::Vector3d &normal) const;
+    // `drum`: whose contact stiffness k (0: drum 0).
+    double effective_mass_kg(Side side, const Eigen::Vector3d &normal, int drum = 0) const;
     // The drum's action on each stick in the last step (see StickDrumContact).
     const StickDrumContact &drum_contact(Side side) const
     {
@@ -275,6 +312,14 @@ class Scene
     const DrumParams &drum() const { return options_.drum; }
     // The contact law's stiffness k in use, N/m.
     double drum_contact_stiffness_n_per_m() const;
+    // A kit: drum_count() drums, drum(0) the one above; index checked
+    // (SimError). set_drum(i, d) changes drum i as set_drum(d) does drum 0.
+    int drum_count() const { return 1 + static_cast<int>(options_.extra_drums.size()); }
+    const DrumParams &drum(int index) const;
+    void set_drum(int index, const DrumParams &drum);
+    double drum_contact_stiffness_n_per_m(int index) const;
+    // Shell passes of one drum (shell_passes() is their sum).
+    long shell_passes(int index) const { return drum_shell_passes_.at(static_cast<size_t>(index)); }
     double max_linear_speed_mps() const;
     double max_angular_speed_rad_s() const;
     // Adds a velocity change to a body's centre of mass (tests: injected
@@ -284,6 +329,8 @@ class Scene
               const Eigen::Vector3d &delta_angular_rad_s);
 
   private:
+    double motor_noise_ = 0.0;
+    MotorNoise motor_noise_stream_;
     // Building (scene_build.cpp), in the order ODE gets it.
     void build(const CharacterPose &initial);
     void create_world();
@@ -309,7 +356,7 @@ class Scene
     void drive_motor(int joint, const MotorCommand &command, const LimitStop &stop);
     bool check() const;
     static void near_callback(void *data, dxGeom *a, dxGeom *b);
-    void place_drum();
+    void place_drum(int index);
     void gather_contact_forces();
     CharacterPose target_pose() const;
     void place_kinematic_bodies();
@@ -365,7 +412,7 @@ class Scene
     double pelvis_mass_kg_ = 0.0;
     std::array<std::array<Eigen::Vector3d, 3>, CharacterModel::kJoints> motor_axes_{};
     dxJoint *pelvis_weld_ = nullptr;
-    dxGeom *drum_ = nullptr;
+    std::array<dxGeom *, kMaxDrums> drum_geom_{}; // [drum]
     std::array<dxGeom *, 2> stick_shaft_{};
     std::array<dxGeom *, 2> stick_tip_{};
     // Fulcrum mount: the sticks' bodies (their frame = the hand's frame at
@@ -375,17 +422,23 @@ class Scene
     void apply_grip(int side);
     dxBody *tip_body(Side side) const;
     Eigen::Vector3d tip_body_com(Side side) const; // its CoM in the hand frame
-    double contact_erp_ = 0.0, contact_cfm_ = 0.0;
+    std::array<double, kMaxDrums> contact_erp_{}, contact_cfm_{}; // [drum]
+    // The stick tip's law (the first drum's DrumParams::stick_tip: the sticks' tip, on
+    // every drum), 0 stiffness: none; each head's stretching (stretch_n_per_m3()).
+    double tip_stiffness_ = 0.0, tip_alpha_ = 1.0;
+    std::array<double, kMaxDrums> head_k3_{}; // [drum]
 
     double time_s_ = 0.0;
     long steps_ = 0;
     int divergences_ = 0;
     int contacts_last_step_ = 0;
     long contact_steps_ = 0;
-    // Per stick part [side * 2 + bead]: touching the drum in the last step,
-    // in this one, and passing through its shell (near_callback).
-    std::array<bool, 4> part_touching_{}, part_touching_now_{}, part_through_{};
+    // Per drum and stick part [drum * 4 + side * 2 + bead]: touching the
+    // drum in the last step, in this one, and passing through its shell
+    // (near_callback).
+    std::array<bool, 4 * kMaxDrums> part_touching_{}, part_touching_now_{}, part_through_{};
     long shell_passes_ = 0;
+    std::array<long, kMaxDrums> drum_shell_passes_{};
     int stops_active_ = 0;
 };
 

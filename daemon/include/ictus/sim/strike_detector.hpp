@@ -89,11 +89,23 @@ class StrikeDetector
                             const StrikeDetectorOptions &options = {});
 
     // Changes take effect for the next contact (an ongoing one keeps its law).
+    // Sets the membrane of drum membrane.drum_id (0 .. kMaxDrums - 1; a kit
+    // gives each of its drums so, drum 0 first after a reset).
     void set_membrane(const MembraneGeometry &membrane);
-    // A new membrane and no contact history (the scene was rebuilt); strike
-    // numbers continue.
+    // A new membrane (drum 0, the only one) and no contact history (the
+    // scene was rebuilt); strike numbers continue.
     void reset(const MembraneGeometry &membrane);
-    const MembraneGeometry &membrane() const { return membrane_; }
+    const MembraneGeometry &membrane() const { return membranes_[0]; }
+    // A kit: each hand's contacts are with the drum under its bead
+    // (drum_under()), which it keeps through a contact; a strike carries its
+    // index (StrikeEvent::drum).
+    int drum_count() const { return drum_count_; }
+    const MembraneGeometry &membrane(int drum) const { return membranes_.at(drum); }
+    // The drum whose disk the point is over (of two, the one whose membrane
+    // is nearest below it), else the one whose rim is nearest in plan view.
+    int drum_under(const Eigen::Vector3d &center_m) const;
+    // gap_m() to drum `drum`'s membrane.
+    double gap_m(const Eigen::Vector3d &center_m, int drum) const;
     const StrikeDetectorOptions &options() const { return options_; }
 
     // Feeds one sample per hand per physics step, times increasing. Returns
@@ -108,7 +120,8 @@ class StrikeDetector
     // per call, release at the last sample's time.
     bool flush(StrikeEvent &out);
 
-    // Contact force law at penetration d (m, > 0 inside) and rate d' (m/s).
+    // Contact force law at penetration d (m, > 0 inside) and rate d' (m/s),
+    // and the gap and disk below, of drum 0 (inside update(): of the hand's drum).
     double normal_force_n(double depth_m, double depth_rate_mps) const;
     // Gap between the bead and the membrane plane (m, < 0: penetrating), and
     // whether the bead is over the membrane disk.
@@ -153,10 +166,13 @@ class StrikeDetector
         double last_driven_s = -std::numeric_limits<double>::infinity();
         long stroke = -1;
         bool onset_new = false; // take_onset() has not seen this contact yet
+        int drum = 0;           // the drum under the bead (kept through a contact)
     };
+    const MembraneGeometry &cur() const { return membranes_[static_cast<size_t>(cur_)]; }
     // update()'s parts: a tip below the plane that came in from the side, a
     // contact's onset, a sample inside it, its release, and the heights
     // since the release (the bounce rule's).
+    bool update_hand(Hand &h, int hand, const TipSample &s, StrikeEvent &out);
     bool entered_from_side(Hand &h, const TipSample &s, double gap, bool touching);
     void begin_contact(Hand &h, int hand, const TipSample &s, double gap);
     void continue_contact(Hand &h, const TipSample &s, double gap, double depth_rate);
@@ -165,7 +181,9 @@ class StrikeDetector
     void finish(Hand &h, double release_time_s, StrikeEvent &out);
     void to_membrane(const Eigen::Vector3d &world_m, double &x_m, double &y_m) const;
 
-    MembraneGeometry membrane_;
+    std::array<MembraneGeometry, kMaxDrums> membranes_{};
+    int drum_count_ = 1;
+    int cur_ = 0; // the drum update() works on (0 outside it)
     StrikeDetectorOptions options_;
     std::array<Hand, 2> hands_;
     long next_seq_ = 0;
@@ -177,6 +195,9 @@ class Scene;
 // The membrane of a Scene's drum as the detector sees it: the same disk and the
 // same contact law (k, c, friction, the sticks' bead radius).
 MembraneGeometry membrane_of(const Scene &scene, int drum_id = 0);
+// The detector reset to all the scene's drums (reset() with drum 0, then
+// set_membrane() with each other): no allocation.
+void load_membranes(StrikeDetector &detector, const Scene &scene);
 
 // Feeds the detector both beads of `scene` (Scene::bead_position/velocity) at
 // the scene's time, once after each of its steps; writes the strikes ended in

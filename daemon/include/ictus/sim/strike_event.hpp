@@ -11,11 +11,15 @@
 namespace ictus
 {
 
+// A scene holds at most this many drums (a kit, docs/perform.md "A kit"); a
+// strike's drum is its index, 0 .. kMaxDrums - 1 (0: the one drum).
+constexpr int kMaxDrums = 8;
+
 // One contact episode of a stick tip with the membrane (one row of strikes.csv).
 struct StrikeEvent {
     long seq = 0;        // 0, 1, 2 ... in order of onset within a run
     int hand = 0;        // 0 left, 1 right
-    int drum = 0;        // drum id
+    int drum = 0;        // the drum's index in the scene (0: the one drum, a kit's first)
     bool bounce = false; // a re-contact of the same stroke
     long stroke = 0;     // per hand: increments on every non-bounce strike
     double time_s = 0.0; // onset, simulation clock, interpolated within the step

@@ -1,0 +1,56 @@
+"""What the Pd benchmarks share: a generated patch that switches DSP on at load and quits
+after S seconds of audio, and the CPU time (user + sys) pd takes to run it in batch mode,
+best of R runs. Used by bench_pd.py and bench_kit.py."""
+import os
+import resource
+import subprocess
+
+
+class Bench:
+    def __init__(self, lib, sr, runs, work):
+        self.lib, self.sr, self.runs, self.work = lib, sr, runs, work
+        self.cpu_so_far = 0.0
+
+    def patch(self, seconds, body):
+        """body(lines, first_index) appends objects after the fixed header (loadbang 0, dsp
+        message 1, delay 2, quit 3, noise~ 4); returns the patch text."""
+        lines = ["#N canvas 0 0 600 400 12;", "#X declare -path %s;" % self.lib,
+                 "#X obj 10 10 loadbang;",                     # 0
+                 "#X msg 10 40 \\; pd dsp 1;",                 # 1
+                 "#X obj 10 70 delay %.17g;" % (seconds * 1000.0),  # 2
+                 "#X msg 10 100 \\; pd quit;",                 # 3
+                 "#X obj 10 130 noise~;",                      # 4
+                 "#X connect 0 0 1 0;", "#X connect 0 0 2 0;", "#X connect 2 0 3 0;"]
+        body(lines, 5)
+        return "\n".join(lines) + "\n"
+
+    def run(self, text, name):
+        """Best (smallest) CPU time (user + sys, s) of pd over the runs. CPU time rather than
+        wall time: other processes on the machine then inflate the figures much less (they
+        still share caches and memory bandwidth)."""
+        path = os.path.join(self.work, name + ".pd")
+        with open(path, "w") as f:
+            f.write(text)
+        best = None
+        for _ in range(self.runs):
+            proc = subprocess.Popen(["pd", "-nogui", "-nosound", "-batch", "-stderr", "-r",
+                                     str(self.sr), "-open", path], stdout=subprocess.PIPE,
+                                    stderr=subprocess.PIPE, text=True)
+            _, err = proc.communicate(timeout=1200)
+            usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = usage.ru_utime + usage.ru_stime - self.cpu_so_far
+            self.cpu_so_far = usage.ru_utime + usage.ru_stime
+            if proc.returncode != 0 or "error" in err.lower() or "couldn't" in err:
+                raise SystemExit("%s failed:\n%s" % (name, err))
+            best = cpu if best is None else min(best, cpu)
+        return best
+
+
+def bp_bank(n):
+    """A patch body of n vanilla [bp~ f 10] fed by the header's noise~ (the reference):
+    centre frequencies spread like a membrane's partials."""
+    def body(lines, i):
+        for k in range(n):
+            lines.append("#X obj %d %d bp~ %g 10;" % (200 + k % 40 * 10, 10 + k // 40, 100 + 5 * k))
+            lines.append("#X connect 4 0 %d 0;" % (i + k))
+    return body

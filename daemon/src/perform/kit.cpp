@@ -1,0 +1,163 @@
+// The built-in kits and their checks (kit.hpp, docs/perform.md "A kit").
+#include "ictus/perform/kit.hpp"
+
+#include "ictus/perform/perform_error.hpp"
+#include "membrane_presets.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace ictus
+{
+
+namespace
+{
+
+constexpr double kInch_m = 0.0254;
+
+// A drum of the preset `preset`, its diameter in inches (the preset's radius
+// when 0) and shell depth in inches, at `place` (right, up, forward; m).
+KitDrum drum(const char *name, const char *preset, double diameter_in, double depth_in,
+             const Eigen::Vector3d &place, int midi_note)
+{
+    const membrane_preset *p = membrane_preset_find(preset);
+    if (!p)
+        throw PerformError(std::string("kit: no membrane preset '") + preset + "'");
+    KitDrum d;
+    d.name = name;
+    d.preset = preset;
+    d.place_m = place;
+    d.radius_m = diameter_in > 0.0 ? 0.5 * diameter_in * kInch_m : p->radius_m;
+    d.tension_n_per_m = p->tension_n_per_m;
+    d.shell_depth_m = depth_in * kInch_m;
+    d.midi_note = midi_note;
+    return d;
+}
+
+// A right-handed four-piece (docs/perform.md, "A kit", gives the sources):
+// the snare where the one drum goes; the rack toms beyond it, a little
+// higher, small to the left and large to the right; the floor tom to the
+// snare's right, a little lower. Sizes: 14x5.5 snare, 10x8 and 12x9 rack
+// toms, 16x16 floor tom. MIDI: General MIDI's snare and toms (38, 48, 47, 43).
+std::vector<KitDrum> standard_drums()
+{
+    return {drum("snare", "snare", 14.0, 5.5, {0.0, 0.0, 0.0}, 38),
+            drum("tom1", "tom", 10.0, 8.0, {-0.15, 0.10, 0.30}, 48),
+            drum("tom2", "tom", 12.0, 9.0, {0.19, 0.08, 0.32}, 47),
+            drum("floor", "floor-tom", 16.0, 16.0, {0.40, 0.0, -0.05}, 43)};
+}
+
+} // namespace
+
+std::string kit_names()
+{
+    return "standard, standard-timpani, timpani";
+}
+
+Kit kit_named(const std::string &name)
+{
+    Kit kit;
+    kit.name = name;
+    if (name == "standard") {
+        kit.drums = standard_drums();
+    } else if (name == "standard-timpani") {
+        // A 26-inch timpani (its kettle 0.6 m deep) where a hi-hat would
+        // stand, left of the snare, its head level with the snare's. No
+        // General MIDI drum sounds a timpani: its note is its pitch, A2 (45;
+        // docs/midi.md).
+        kit.drums = standard_drums();
+        kit.drums.push_back(drum("timpani", "timpani", 0.0, 24.0, {-0.57, 0.0, 0.06}, 45));
+    } else if (name == "timpani") {
+        // Two 26-inch timpani side by side, heads level, the player behind
+        // and between them: the kit's anchor (where the one drum goes) midway.
+        kit.drums = {drum("timpani1", "timpani", 0.0, 24.0, {-0.36, 0.0, 0.05}, 45),
+                     drum("timpani2", "timpani", 0.0, 24.0, {0.36, 0.0, 0.05}, 45)};
+    } else {
+        throw PerformError("unknown kit '" + name + "' (valid: " + kit_names() + ")");
+    }
+    validate_kit(kit);
+    return kit;
+}
+
+double kit_min_gap_m(const Kit &kit)
+{
+    double gap = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < kit.drums.size(); ++i)
+        for (size_t j = i + 1; j < kit.drums.size(); ++j) {
+            const KitDrum &a = kit.drums[i], &b = kit.drums[j];
+            const double d =
+                std::hypot(a.place_m.x() - b.place_m.x(), a.place_m.z() - b.place_m.z());
+            gap = std::min(gap, d - a.radius_m - b.radius_m);
+        }
+    return gap;
+}
+
+int kit_drum_index(const Kit &kit, const std::string &name)
+{
+    for (size_t i = 0; i < kit.drums.size(); ++i)
+        if (kit.drums[i].name == name)
+            return static_cast<int>(i);
+    return -1;
+}
+
+void validate_kit(const Kit &kit)
+{
+    const std::string what = "kit '" + kit.name + "': ";
+    if (kit.drums.empty() || kit.drums.size() > static_cast<size_t>(kMaxDrums))
+        throw PerformError(what + "expected 1.." + std::to_string(kMaxDrums) + " drums, got " +
+                           std::to_string(kit.drums.size()));
+    for (size_t i = 0; i < kit.drums.size(); ++i) {
+        const KitDrum &d = kit.drums[i];
+        const std::string who = what + "drum '" + d.name + "': ";
+        bool name_ok = !d.name.empty() && d.name.size() <= 32;
+        for (char c : d.name)
+            name_ok = name_ok &&
+                      ((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-');
+        if (!name_ok)
+            throw PerformError(what + "drum name '" + d.name +
+                               "': expected lower-case letters, digits, '_' and '-' (1..32)");
+        if (kit_drum_index(kit, d.name) != static_cast<int>(i))
+            throw PerformError(who + "the name is given twice");
+        if (!membrane_preset_find(d.preset.c_str()))
+            throw PerformError(who + "unknown preset '" + d.preset +
+                               "' (valid: " + membrane_preset_names() + ")");
+        if (!(d.radius_m >= 0.05 && d.radius_m <= 1.0))
+            throw PerformError(who + "radius must be 0.05..1 m");
+        if (!(d.tension_n_per_m >= 10.0 && d.tension_n_per_m <= 1e5))
+            throw PerformError(who + "tension must be 10..1e5 N/m");
+        if (!(d.shell_depth_m >= 0.01 && d.shell_depth_m <= 1.5))
+            throw PerformError(who + "shell depth must be 0.01..1.5 m");
+        if (!(d.place_m.allFinite() && d.place_m.cwiseAbs().maxCoeff() <= 2.0))
+            throw PerformError(who + "place must be within 2 m of the first drum");
+        if (d.midi_note < 0 || d.midi_note > 127)
+            throw PerformError(who + "MIDI note must be 0..127");
+    }
+    const double gap = kit_min_gap_m(kit);
+    if (gap < kKitMinGap_m) {
+        std::ostringstream m;
+        m << what << "two shells are " << gap * 100.0 << " cm apart in plan (at least "
+          << kKitMinGap_m * 100.0 << " cm: a stick must reach each head from above)";
+        throw PerformError(m.str());
+    }
+}
+
+std::vector<DrumParams> place_kit(const Kit &kit, const DrumParams &base,
+                                  const Eigen::Vector3d &anchor_m,
+                                  const Eigen::Vector3d &right, const Eigen::Vector3d &up,
+                                  const Eigen::Vector3d &forward)
+{
+    std::vector<DrumParams> out;
+    for (const KitDrum &d : kit.drums) {
+        DrumParams p = base;
+        p.center_m =
+            anchor_m + d.place_m.x() * right + d.place_m.y() * up + d.place_m.z() * forward;
+        p.radius_m = d.radius_m;
+        p.tension_n_per_m = d.tension_n_per_m;
+        p.shell_depth_m = d.shell_depth_m;
+        out.push_back(p);
+    }
+    return out;
+}
+
+} // namespace ictus

@@ -1,0 +1,157 @@
+// A kit (docs/perform.md, "A kit"): the built-in kits' layouts (no two shells
+// closer than 2 cm in plan, every drum within the arms' and sticks' reach of
+// a shoulder), the checks that refuse a bad kit, the scene built with every
+// drum, and the strike detector giving each strike its drum.
+#include "ictus/perform/kit.hpp"
+#include "ictus/perform/performance.hpp"
+#include "ictus/perform/perform_error.hpp"
+#include "ictus/sim/strike_detector.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+using namespace ictus;
+using Catch::Matchers::Contains;
+
+namespace
+{
+
+void require_refused(const Kit &kit, const std::string &words)
+{
+    try {
+        validate_kit(kit);
+        FAIL("kit accepted");
+    } catch (const PerformError &e) {
+        CHECK_THAT(e.what(), Contains(words));
+    }
+}
+
+} // namespace
+
+TEST_CASE("kit: the built-in kits placed in the scene: no shells within 2 cm, all within reach",
+          "[perform][kit]")
+{
+    for (const char *name : {"standard", "standard-timpani", "timpani"}) {
+        INFO(name);
+        PerformanceOptions o;
+        o.kit = kit_named(name);
+        o.score.score_text = "R";
+        Performance perf(o);
+        const Scene &scene = perf.scene();
+        REQUIRE(scene.drum_count() == static_cast<int>(o.kit.drums.size()));
+        // Shells in plan view: centre distance less the two radii, from the
+        // placed scene (world frame, y up).
+        for (int i = 0; i < scene.drum_count(); ++i)
+            for (int j = i + 1; j < scene.drum_count(); ++j) {
+                const Eigen::Vector3d d = scene.drum(i).center_m - scene.drum(j).center_m;
+                CHECK(std::hypot(d.x(), d.z()) - scene.drum(i).radius_m - scene.drum(j).radius_m >=
+                      0.02);
+            }
+        // Reach: the clavicle's root to the shoulder, elbow, wrist and the
+        // stick's tip, straightened, from the body at rest (its frames and
+        // tips), against the distance from the nearer root to the head's
+        // nearest point at r/a 0.3: at most 95 % of it (the arm a little bent).
+        const CharacterModel &m = scene.model();
+        BodyFrames f;
+        scene.body_frames(f);
+        double reach[2];
+        Eigen::Vector3d shoulder[2];
+        for (int s = 0; s < 2; ++s) {
+            const std::string p = s == 0 ? "l_" : "r_";
+            shoulder[s] = f.origin_m[m.body_index(p + "clavicle")]; // the arm's chain from here
+            const Eigen::Vector3d arm = f.origin_m[m.body_index(p + "upper_arm")];
+            const Eigen::Vector3d elbow = f.origin_m[m.body_index(p + "forearm")];
+            const Eigen::Vector3d wrist = f.origin_m[m.body_index(p + "hand")];
+            reach[s] = (arm - shoulder[s]).norm() + (elbow - arm).norm() + (wrist - elbow).norm() +
+                       (scene.tip_position(static_cast<Side>(s)) - wrist).norm();
+        }
+        for (int i = 0; i < scene.drum_count(); ++i) {
+            const DrumParams &d = scene.drum(i);
+            double best = 1e9;
+            for (int s = 0; s < 2; ++s) {
+                Eigen::Vector3d toward = shoulder[s] - d.center_m;
+                toward.y() = 0.0;
+                const Eigen::Vector3d spot = d.center_m + 0.3 * d.radius_m * toward.normalized();
+                best = std::min(best, (spot - shoulder[s]).norm() / reach[s]);
+            }
+            INFO("drum " << i);
+            CHECK(best < 0.95);
+        }
+    }
+}
+
+TEST_CASE("kit: a bad kit is refused naming the drum and the fault", "[perform][kit]")
+{
+    Kit k = kit_named("standard");
+    k.drums[3].place_m.x() = 0.3; // the floor tom into the snare
+    require_refused(k, "two shells are");
+    k = kit_named("standard");
+    k.drums[2].name = "tom1";
+    require_refused(k, "drum 'tom1': the name is given twice");
+    k = kit_named("standard");
+    k.drums[1].preset = "cowbell";
+    require_refused(k, "unknown preset 'cowbell'");
+    k = kit_named("standard");
+    k.drums[1].name = "Tom 1";
+    require_refused(k, "drum name 'Tom 1'");
+    k = kit_named("standard");
+    k.drums[0].midi_note = 128;
+    require_refused(k, "MIDI note must be 0..127");
+    k.drums.assign(9, k.drums[0]);
+    require_refused(k, "expected 1..8 drums, got 9");
+    CHECK_THROWS_WITH(kit_named("jazz"), Contains("unknown kit 'jazz' (valid: standard"));
+    // The standard kit's sizes (inches to m) and General MIDI notes.
+    const Kit s = kit_named("standard");
+    REQUIRE(s.drums.size() == 4);
+    const double inch = 0.0254;
+    CHECK(s.drums[0].radius_m == Approx(7.0 * inch));
+    CHECK(s.drums[1].radius_m == Approx(5.0 * inch));
+    CHECK(s.drums[2].radius_m == Approx(6.0 * inch));
+    CHECK(s.drums[3].radius_m == Approx(8.0 * inch));
+    CHECK(s.drums[0].midi_note == 38);
+    CHECK(s.drums[3].midi_note == 43);
+}
+
+TEST_CASE("kit: the detector gives a strike the drum its bead came down on", "[perform][kit]")
+{
+    MembraneGeometry a, b;
+    a.center_m = Eigen::Vector3d(0.0, 0.7, 0.45);
+    a.radius_m = 0.178;
+    b.center_m = Eigen::Vector3d(-0.4, 0.8, 0.45);
+    b.radius_m = 0.2;
+    b.drum_id = 1;
+    StrikeDetectorOptions so;
+    so.semi_implicit_samples = false;
+    StrikeDetector det(a, so);
+    det.set_membrane(b);
+    REQUIRE(det.drum_count() == 2);
+    // The right hand comes down at 2 m/s onto drum 1, 5 cm from its centre
+    // toward world +X (x_m = 0.05), then the left onto drum 0.
+    auto drop = [&](int hand, const Eigen::Vector3d &over, double plane_y, double t0) {
+        StrikeEvent out, got;
+        bool ended = false;
+        for (int k = 0; k < 200 && !ended; ++k) {
+            TipSample s;
+            s.time_s = t0 + k * 0.001;
+            const double y = plane_y + 0.007 + 0.05 - 2.0 * k * 0.001; // bead centre
+            s.center_m = Eigen::Vector3d(over.x(), k < 40 ? y : plane_y + 0.1, over.z());
+            s.velocity_mps = Eigen::Vector3d(0.0, k < 40 ? -2.0 : 2.0, 0.0);
+            ended = det.update(hand, s, out);
+            if (ended)
+                got = out;
+        }
+        REQUIRE(ended);
+        return got;
+    };
+    const StrikeEvent e1 = drop(1, Eigen::Vector3d(-0.35, 0.0, 0.45), 0.8, 0.0);
+    CHECK(e1.drum == 1);
+    CHECK(e1.x_m == Approx(0.05).margin(1e-9));
+    CHECK(e1.r_over_a == Approx(0.05 / 0.2));
+    CHECK(e1.time_s == Approx(0.025)); // 5 cm at 2 m/s
+    const StrikeEvent e0 = drop(0, Eigen::Vector3d(0.0, 0.0, 0.40), 0.7, 1.0);
+    CHECK(e0.drum == 0);
+    CHECK(e0.y_m == Approx(0.05).margin(1e-9));
+    CHECK(e0.seq == e1.seq + 1);
+}

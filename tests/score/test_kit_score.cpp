@@ -1,0 +1,153 @@
+// A kit in the score (docs/score.md, "A kit"): the statement `drum NAME` and
+// the note option `on NAME`, their errors, and the planner's part: each
+// note at its spot on its own drum, an unknown drum refused where it was
+// named with the kit's drums listed, and the moves between drums never
+// through a shell (the planned tip never inside a drum's cylinder).
+#include "ictus/score/gesture_score.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+#include "support/score_test_util.hpp"
+
+using namespace ictus;
+using Catch::Matchers::Contains;
+using ictus_test::require_error;
+
+namespace
+{
+
+const GestureDatabase &db()
+{
+    static const GestureDatabase d = GestureDatabase::builtin();
+    return d;
+}
+
+// A kit of four drums at different heights around a snare at (0, 0.7, 0.45),
+// the performer facing +Z (right = world -X): a high small drum beyond on
+// the left, a higher one beyond on the right, a low one to the right, and a
+// large one to the left, each 2 cm or more from the others in plan.
+PerformerFrame kit_frame()
+{
+    const Eigen::Vector3d c(0.0, 0.7, 0.45);
+    PerformerFrame f = performer_frame_for_drum(c, 0.178);
+    f.drums = {{"snare", c, 0.178},
+               {"tom1", c + Eigen::Vector3d(0.15, 0.10, 0.30), 0.127},
+               {"tom2", c + Eigen::Vector3d(-0.19, 0.08, 0.32), 0.152},
+               {"floor", c + Eigen::Vector3d(-0.40, -0.06, -0.05), 0.203},
+               {"timpani", c + Eigen::Vector3d(0.57, 0.0, 0.06), 0.330}};
+    return f;
+}
+
+} // namespace
+
+TEST_CASE("score: 'drum NAME' sets the drum of the notes after it, 'on NAME' one note's",
+          "[score][kit]")
+{
+    const Score s =
+        parse_score("R\ndrum Tom1\nL, R on floor\nrepeat 2\nL\nend\ndrum snare\nR", "t");
+    REQUIRE(s.notes.size() == 6);
+    CHECK(s.notes[0].drum.empty());
+    CHECK(s.notes[1].drum == "tom1"); // case-insensitive, kept lower case
+    CHECK(s.notes[1].drum_line == 2);
+    CHECK(s.notes[1].drum_column == 6);
+    CHECK(s.notes[2].drum == "floor");
+    CHECK(s.notes[2].drum_line == 3);
+    CHECK(s.notes[2].drum_column == 9);
+    CHECK(s.notes[3].drum == "tom1"); // inside a repeat, the drum set before it
+    CHECK(s.notes[4].drum == "tom1");
+    CHECK(s.notes[5].drum == "snare");
+    // R+L plays both hands on the drum.
+    const Score both = parse_score("R+L on tom2", "t");
+    REQUIRE(both.notes.size() == 2);
+    CHECK(both.notes[0].drum == "tom2");
+    CHECK(both.notes[1].drum == "tom2");
+}
+
+TEST_CASE("score: the kit's statements refuse what they cannot use, at the word", "[score][kit]")
+{
+    require_error("drum", 1, 5, "'drum' needs a drum's name");
+    require_error("drum snare tom1", 1, 12, "unexpected 'tom1' after the drum's name");
+    require_error("drum sn@re", 1, 6, "malformed drum name 'sn@re'");
+    require_error("R on", 1, 5, "'on' needs a drum's name");
+    require_error("R on tom1 on tom2", 1, 11, "second drum in one note");
+    require_error("R\nL on tom(1)", 2, 6, "malformed drum name");
+}
+
+TEST_CASE(
+    "plan: a note on a drum of the kit strikes that drum's spot and unknown drums are refused",
+    "[score][kit]")
+{
+    const PerformerFrame f = kit_frame();
+    const Score s = parse_score("tempo 90\nR, L on tom1, R on tom2 at 0.4 90\ndrum floor\nL", "t");
+    const GesturePlan plan = plan_performance(s, db(), f);
+    REQUIRE(plan.notes.size() == 4);
+    const int expect[4] = {0, 1, 2, 3};
+    for (size_t i = 0; i < 4; ++i) {
+        const PlannedNote &n = plan.notes[i];
+        CHECK(n.drum == expect[i]);
+        // The spot, from the drum's centre in the membrane frame of docs/osc.md.
+        const PerformerFrame::Drum &d = f.drums[static_cast<size_t>(expect[i])];
+        const double r = n.r_over_a * d.membrane_radius_m, th = n.theta_deg * M_PI / 180.0;
+        const Eigen::Vector3d spot =
+            d.membrane_center_m + Eigen::Vector3d(r * std::cos(th), 0.0, -r * std::sin(th));
+        CHECK((n.strike_point_m - spot).norm() < 1e-12);
+    }
+    try {
+        plan_performance(parse_score("R\ndrum tom3\nL", "t.txt"), db(), f);
+        FAIL("tom3 planned");
+    } catch (const ScoreError &e) {
+        CHECK(e.line() == 2);
+        CHECK(e.column() == 6);
+        CHECK_THAT(e.message(),
+                   Contains("unknown drum 'tom3' (the kit: snare, tom1, tom2, floor, timpani)"));
+    }
+    PerformerFrame one = performer_frame_for_drum(Eigen::Vector3d(0.0, 0.7, 0.45), 0.178);
+    try {
+        plan_performance(parse_score("R on tom1", "t.txt"), db(), one);
+        FAIL("a drum planned without a kit");
+    } catch (const ScoreError &e) {
+        CHECK(e.column() == 6);
+        CHECK_THAT(e.message(), Contains("there is one drum and no kit"));
+    }
+}
+
+// The path rule: a hand going from drum to drum at a drummer's tempo, soft
+// (low strokes, where a straight move would pass through the higher drum's
+// shell) and loud. Every planned tip sample over a drum's disk (plus the
+// bead's radius) is above that head, except within 1 mm at its own strikes.
+TEST_CASE("plan: moves between drums never pass through a shell", "[score][kit]")
+{
+    const PerformerFrame f = kit_frame();
+    const char *names[] = {"snare", "tom1", "tom2", "floor", "timpani"};
+    for (const char *dyn : {"pp", "ff"}) {
+        for (double bpm : {60.0, 120.0}) {
+            std::string text =
+                "tempo " + std::to_string(bpm) + "\nbeats 1/2\ndynamics " + dyn + "\n";
+            // Every ordered pair of drums, the right hand then the left.
+            for (const char *a : names)
+                for (const char *b : names)
+                    if (std::string(a) != b)
+                        text += std::string("R on ") + a + "\nrest 1/2\nR on " + b + "\nrest 1/2\n";
+            text +=
+                "L on timpani at 0.6 180\nrest\nL on tom1\nrest\nL on floor at 0.3 0\nrest\nL\n";
+            INFO(dyn << " at " << bpm << " bpm");
+            const GesturePlan plan = plan_performance(parse_score(text, "t"), db(), f);
+            double worst = 0.0;
+            for (int s = 0; s < 2; ++s)
+                for (size_t i = 0; i < plan.tips.time_s.size(); ++i) {
+                    const Eigen::Vector3d &p = plan.tips.tip_m[s][i];
+                    for (const PerformerFrame::Drum &d : f.drums) {
+                        const Eigen::Vector3d rel = p - d.membrane_center_m;
+                        const double plan_r = std::hypot(rel.x(), rel.z());
+                        if (plan_r > d.membrane_radius_m + 0.007)
+                            continue;
+                        worst = std::min(worst, rel.y());
+                    }
+                }
+            CHECK(worst > -1e-3);
+        }
+    }
+}
