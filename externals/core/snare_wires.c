@@ -22,6 +22,7 @@
 #include "snare_wires.h"
 #include "bessel_internal.h"
 #include "membrane_internal.h"
+#include "snare_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -39,9 +40,13 @@
 #define PICK_R         0.5    /* the snare head's pickups: r/a, and degrees off the wires */
 #define MAX_SWEEPS     50
 
-/* Along the diameter the wires lie on (theta 0 and 180 degrees), x / a. */
-static const double wire_x[SNARE_WIRE_SEGMENTS] = {-0.7, -0.5, -0.3, -0.1, 0.1, 0.3, 0.5, 0.7};
-static const double pick_deg[MEMBRANE_PICKUPS] = {45.0, 135.0};
+/* Along the diameter the wires lie on (theta 0 and 180 degrees), x / a: segment i lies
+ * at -radius[3 - i] (i < 4) or +radius[i - 4]. */
+static const double wire_r[SNARE_RADII] = {0.1, 0.3, 0.5, 0.7};
+#define WIRE_RADIUS(i) ((i) < SNARE_RADII ? SNARE_RADII - 1 - (i) : (i)-SNARE_RADII)
+#define WIRE_MINUS(i)  ((i) < SNARE_RADII)
+/* The pickups: 45 degrees off the wires, and 135 (the same shape times (-1)^m). */
+#define PICK_DEG 45.0
 
 typedef struct air_point {
     membrane_point point; /* first member: the membrane sees only this */
@@ -50,13 +55,18 @@ typedef struct air_point {
 
 struct snare_wires {
     air_point air;
-    /* The snare head: n modes, SoA (double: the state runs for seconds). */
-    int n, cap, live; /* n = cap: live modes padded to a multiple of four */
+    /* The snare head: live modes in n slots, float, in the kernel's three groups
+     * (snare_internal.h: (0, n), other even m, odd m; padding all zero). */
+    int n, live;
     double sr, radius, tension, k_air;
-    double *x, *v, *xf, *ca, *cb, *g, *w2, *om; /* state, free move, coefficients, W^2, w */
-    double *mean;                               /* mean of each shape over the head */
-    double *psi[SNARE_WIRE_SEGMENTS];           /* shapes at the wire segments */
-    double *pick[MEMBRANE_PICKUPS];             /* shapes at the snare head's pickups */
+    float *x, *v, *xf, *ca, *cb, *g; /* state, free move, coefficients */
+    float *mean;                     /* mean of each shape over the head */
+    float *psi[SNARE_RADII];         /* shapes at the wire radii, theta 0 */
+    float *pick;                     /* shape at the pickup (PICK_R, PICK_DEG) */
+    double *w2, *om;                 /* W^2 (prewarped), w; 0 in the padding */
+    snare_kernel_args ka;
+    snare_kernel_free_fn kfree;
+    snare_kernel_force_fn kforce;
     double Kww[SNARE_WIRE_SEGMENTS][SNARE_WIRE_SEGMENTS], Kmw[SNARE_WIRE_SEGMENTS], Kmm;
     /* Wires. */
     int engaged;
@@ -69,24 +79,29 @@ struct snare_wires {
 static const membrane_point_ops air_ops;
 static void head_coefficients(snare_wires *w, double sr);
 
-/* Four doubles (GCC/Clang vector extension): the snare head's loops run four modes a
- * step, on arrays aligned to 32 bytes and padded to a multiple of four. */
-typedef double v4d __attribute__((vector_size(32)));
-
-static inline double hsum(v4d a)
-{
-    return (a[0] + a[1]) + (a[2] + a[3]);
-}
-
-/* n doubles, zeroed, aligned for v4d (NULL when memory cannot be had). Allocates. */
-static double *alloc_doubles(int n)
+/* n elements of size `size`, zeroed, 32-byte aligned (NULL when memory cannot be had).
+ * Allocates. */
+static void *alloc_aligned(int n, size_t size)
 {
     void *p = NULL;
-    size_t bytes = sizeof(double) * (size_t)((n + 3) / 4 * 4);
-    if (posix_memalign(&p, 32, bytes ? bytes : 32) != 0)
+    size_t bytes = size * (size_t)(n > 0 ? n : 1);
+    bytes = (bytes + 31) / 32 * 32;
+    if (posix_memalign(&p, 32, bytes) != 0)
         return NULL;
     memset(p, 0, bytes);
     return p;
+}
+
+/* The snare head's displacement at wire segment i (state x, or the free move). */
+static double wire_displacement(const snare_wires *w, const float *x, int i)
+{
+    const int j = WIRE_RADIUS(i);
+    double e = 0.0, o = 0.0;
+    for (int k = 0; k < w->ka.ne; k++)
+        e += (double)w->psi[j][k] * x[k];
+    for (int k = w->ka.ne; k < w->n; k++)
+        o += (double)w->psi[j][k] * x[k];
+    return WIRE_MINUS(i) ? e - o : e + o;
 }
 
 /* ---------------------------------------------------------------- collisions */
@@ -145,6 +160,108 @@ static double solve_force(const snare_wires *w, double d0, double d_free, double
 
 /* ---------------------------------------------------------------- one sample */
 
+/* Solves the n x n system A x = b in place (partial pivoting); 0 when singular. */
+static int solve_linear(double A[SNARE_WIRE_SEGMENTS][SNARE_WIRE_SEGMENTS], double *b, int n)
+{
+    for (int c = 0; c < n; c++) {
+        int piv = c;
+        for (int r = c + 1; r < n; r++)
+            if (fabs(A[r][c]) > fabs(A[piv][c]))
+                piv = r;
+        if (!(fabs(A[piv][c]) > 0.0))
+            return 0;
+        if (piv != c) {
+            for (int k = c; k < n; k++) {
+                double t = A[c][k];
+                A[c][k] = A[piv][k], A[piv][k] = t;
+            }
+            double t = b[c];
+            b[c] = b[piv], b[piv] = t;
+        }
+        for (int r = c + 1; r < n; r++) {
+            const double f = A[r][c] / A[c][c];
+            for (int k = c; k < n; k++)
+                A[r][k] -= f * A[c][k];
+            b[r] -= f * b[c];
+        }
+    }
+    for (int r = n - 1; r >= 0; r--) {
+        double s = b[r];
+        for (int k = r + 1; k < n; k++)
+            s -= A[r][k] * b[k];
+        b[r] = s / A[r][r];
+    }
+    return 1;
+}
+
+/* The wires' forces by Newton's method on the joint system, the air eliminated (it is
+ * linear): fa = alpha + beta sum_j Kmw_j F_j, and the gaps after the sample
+ *     d = a - C F(d),   a_i = wf_i - yfree_i + Kmw_i alpha,
+ *     C_ij = Kww_ij + G delta_ij - beta Kmw_i Kmw_j
+ * (the head's, the wire's and the air's compliances), F_i(d_i) the discrete gradient
+ * (grad_force), increasing and C^1 in d_i. Newton on R(d) = d - a + C F(d), J = I + C
+ * diag(F'), from d = a, to |R| <= 1e-15 m. The same solution as the Gauss-Seidel sweeps
+ * (solve_forces), in a few 8 x 8 solves instead of many scalar ones. 1 when converged
+ * (F set), 0 to fall back to the sweeps. */
+static int newton_forces(const snare_wires *w, double alpha, double beta, const double *wf,
+                         const double *yfree, double G, double *F)
+{
+    enum { N = SNARE_WIRE_SEGMENTS };
+    double a[N], C[N][N], d[N], v0[N], df[N];
+    int any = 0;
+    for (int i = 0; i < N; i++) {
+        a[i] = wf[i] - yfree[i] + w->Kmw[i] * alpha;
+        for (int j = 0; j < N; j++)
+            C[i][j] = w->Kww[i][j] + (i == j ? G : 0.0) - beta * w->Kmw[i] * w->Kmw[j];
+        d[i] = a[i];
+        v0[i] = potential(w, w->d[i]);
+        any |= a[i] > 0.0 || w->d[i] > 0.0;
+    }
+    if (!any) { /* every gap stays open: no force */
+        for (int i = 0; i < N; i++)
+            F[i] = 0.0;
+        return 1;
+    }
+    for (int it = 0; it < 40; it++) {
+        /* J's column j is the unit vector where F_j' = 0 (the gap open at both ends of
+         * the sample): the step solves on the other, active, gaps alone. */
+        double R[N], J[N][N], worst = 0.0, Ra[N];
+        int act[N], na = 0;
+        for (int i = 0; i < N; i++) {
+            F[i] = grad_force(w, w->d[i], v0[i], d[i], &df[i]);
+            if (df[i] != 0.0)
+                act[na++] = i;
+        }
+        for (int i = 0; i < N; i++) {
+            double cf = 0.0;
+            for (int j = 0; j < N; j++)
+                cf += C[i][j] * F[j];
+            R[i] = d[i] - a[i] + cf;
+            worst = fabs(R[i]) > worst ? fabs(R[i]) : worst;
+        }
+        if (worst <= 1.0e-15)
+            return 1;
+        for (int r = 0; r < na; r++) {
+            for (int c = 0; c < na; c++)
+                J[r][c] = C[act[r]][act[c]] * df[act[c]] + (r == c ? 1.0 : 0.0);
+            Ra[r] = R[act[r]];
+        }
+        if (!solve_linear(J, Ra, na))
+            return 0;
+        for (int i = 0; i < N; i++) { /* the open gaps: R_i less the active steps' share */
+            if (df[i] != 0.0)
+                continue;
+            double s = R[i];
+            for (int r = 0; r < na; r++)
+                s -= C[i][act[r]] * df[act[r]] * Ra[r];
+            d[i] -= s;
+        }
+        for (int r = 0; r < na; r++)
+            d[act[r]] -= Ra[r];
+    }
+    return 0;
+}
+
 /* The forces of this sample: F[0 .. SEGMENTS) on the wires, *fa the air's. uf, wf: the
  * free mean displacement and the free displacements at the wires; ub, kb: the
  * batter's free mean displacement and its compliance. */
@@ -152,6 +269,17 @@ static void solve_forces(snare_wires *w, double ub, double kb, double uf, const 
                          const double *yfree, double G, double *F, double *fa)
 {
     const double ka = w->k_air;
+    /* The air alone is linear: fa = alpha + beta sum_i Kmw_i F_i. */
+    const double beta = ka / (2.0 + ka * (kb + w->Kmm)), alpha = beta * (w->gap0 + ub - uf);
+    if (!w->engaged || newton_forces(w, alpha, beta, wf, yfree, G, F)) {
+        double air = alpha;
+        for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++)
+            air += beta * w->Kmw[i] * F[i];
+        *fa = air;
+        return;
+    }
+    for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
+        F[i] = 0.0;
     double air = 0.0;
     for (int sweep = 0; sweep < MAX_SWEEPS; sweep++) {
         double e = ub - uf, change = 0.0, scale = 1e-30;
@@ -183,56 +311,29 @@ static void solve_forces(snare_wires *w, double ub, double kb, double uf, const 
 static void snare_step(snare_wires *w, double ub, double kb, double T,
                        double extra[MEMBRANE_PICKUPS])
 {
-    const int n = w->n;
-    double uf = 0.0, wf[SNARE_WIRE_SEGMENTS] = {0}, yfree[SNARE_WIRE_SEGMENTS];
-    double F[SNARE_WIRE_SEGMENTS] = {0}, fa;
-    /* The free move and its displacements at the wires, in one pass, four modes a
-     * step (the arrays are padded to a multiple of four and aligned). */
-    v4d su = {0}, sw[SNARE_WIRE_SEGMENTS];
-    for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
-        sw[i] = su;
-    for (int k = 0; k < n; k += 4) {
-        const v4d xf = *(const v4d *)(w->ca + k) * *(const v4d *)(w->x + k) +
-                       *(const v4d *)(w->cb + k) * *(const v4d *)(w->v + k);
-        *(v4d *)(w->xf + k) = xf;
-        su += *(const v4d *)(w->mean + k) * xf;
-        for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
-            sw[i] += *(const v4d *)(w->psi[i] + k) * xf;
+    double uf, E[SNARE_RADII], O[SNARE_RADII], wf[SNARE_WIRE_SEGMENTS] = {0};
+    double yfree[SNARE_WIRE_SEGMENTS], F[SNARE_WIRE_SEGMENTS] = {0}, fa;
+    /* The free move, its mean and its displacements at the wires (snare_kernel.inc). */
+    w->kfree(&w->ka, &uf, E, O);
+    for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++) {
+        const int j = WIRE_RADIUS(i);
+        wf[i] = WIRE_MINUS(i) ? E[j] - O[j] : E[j] + O[j];
     }
-    uf = hsum(su);
-    for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++)
-        wf[i] = hsum(sw[i]);
     const double A = 2.0 * w->mass_kg / (T * T) + 0.5 * w->spring + w->damping / T;
     const double B = 2.0 * w->mass_kg / (T * T) - 0.5 * w->spring + w->damping / T;
     const double G = 1.0 / A;
     for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
         yfree[i] = G * (B * w->y[i] + 2.0 * w->mass_kg * w->yv[i] / T);
     solve_forces(w, ub, kb, uf, wf, yfree, G, F, &fa);
-    /* The forces into the snare head's modes, and its velocity at the pickups. */
-    double pv[MEMBRANE_PICKUPS] = {0};
-    const double two_over_t = 2.0 / T;
-    int hit[SNARE_WIRE_SEGMENTS], nh = 0;
-    for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++)
-        if (F[i] != 0.0)
-            hit[nh++] = i;
-    const v4d vfa = {fa, fa, fa, fa}, vt = {two_over_t, two_over_t, two_over_t, two_over_t};
-    v4d pk[MEMBRANE_PICKUPS] = {{0}};
-    for (int k = 0; k < n; k += 4) {
-        v4d f = *(const v4d *)(w->mean + k) * vfa;
-        for (int h = 0; h < nh; h++) {
-            const double fh = F[hit[h]];
-            const v4d vf = {fh, fh, fh, fh};
-            f -= *(const v4d *)(w->psi[hit[h]] + k) * vf;
-        }
-        v4d *x = (v4d *)(w->x + k), *v = (v4d *)(w->v + k);
-        const v4d x1 = *(const v4d *)(w->xf + k) + *(const v4d *)(w->g + k) * f;
-        *v = vt * (x1 - *x) - *v;
-        *x = x1;
-        for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-            pk[j] += *(const v4d *)(w->pick[j] + k) * *v;
+    /* The forces into the snare head's modes (the pair at +-r_j: their sum on the even
+     * modes, their difference on the odd), and its velocity at the pickups. */
+    double Fe[SNARE_RADII], Fo[SNARE_RADII], pe, po;
+    for (int j = 0; j < SNARE_RADII; j++) {
+        const double fp = F[SNARE_RADII + j], fm = F[SNARE_RADII - 1 - j];
+        Fe[j] = fp + fm, Fo[j] = fp - fm;
     }
-    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-        pv[j] = hsum(pk[j]);
+    w->kforce(&w->ka, fa, Fe, Fo, 2.0 / T, &pe, &po);
+    const double pv[MEMBRANE_PICKUPS] = {pe + po, pe - po};
     /* The displacements after the forces, from the couplings (no more dot products). */
     double u1 = uf + w->Kmm * fa;
     for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++)
@@ -243,7 +344,7 @@ static void snare_step(snare_wires *w, double ub, double kb, double T,
         double y1 = yfree[i] + G * F[i], wh = wf[i] + w->Kmw[i] * fa;
         for (int j = 0; j < SNARE_WIRE_SEGMENTS; j++)
             wh -= w->Kww[i][j] * F[j];
-        w->yv[i] = two_over_t * (y1 - w->y[i]) - w->yv[i];
+        w->yv[i] = 2.0 / T * (y1 - w->y[i]) - w->yv[i];
         w->y[i] = y1;
         w->d[i] = wh - y1;
         touching |= F[i] > 0.0;
@@ -299,8 +400,8 @@ static void air_block_begin(membrane_point *pt, int n)
 static void snare_rest(snare_wires *w)
 {
     if (w->x) {
-        memset(w->x, 0, sizeof(double) * w->cap);
-        memset(w->v, 0, sizeof(double) * w->cap);
+        memset(w->x, 0, sizeof(float) * (size_t)w->n);
+        memset(w->v, 0, sizeof(float) * (size_t)w->n);
     }
     memset(w->y, 0, sizeof(w->y));
     memset(w->yv, 0, sizeof(w->yv));
@@ -326,16 +427,25 @@ static const membrane_point_ops air_ops = {air_landed,  air_solve,    air_block_
 
 /* ---------------------------------------------------------------- the snare head */
 
+/* The float arrays of the head, for freeing and allocating together. */
+#define HEAD_FLOATS (8 + SNARE_RADII)
+static void head_floats(snare_wires *w, float **arrs[HEAD_FLOATS])
+{
+    float **f[8] = {&w->x, &w->v, &w->xf, &w->ca, &w->cb, &w->g, &w->mean, &w->pick};
+    for (int i = 0; i < 8; i++)
+        arrs[i] = f[i];
+    for (int j = 0; j < SNARE_RADII; j++)
+        arrs[8 + j] = &w->psi[j];
+}
+
 static void free_head(snare_wires *w)
 {
-    double **arrs[] = {&w->x, &w->v, &w->xf, &w->ca, &w->cb, &w->g, &w->w2, &w->om, &w->mean};
-    for (size_t i = 0; i < sizeof(arrs) / sizeof(arrs[0]); i++)
+    float **arrs[HEAD_FLOATS];
+    head_floats(w, arrs);
+    for (int i = 0; i < HEAD_FLOATS; i++)
         free(*arrs[i]), *arrs[i] = NULL;
-    for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
-        free(w->psi[i]), w->psi[i] = NULL;
-    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-        free(w->pick[j]), w->pick[j] = NULL;
-    w->n = w->cap = 0;
+    free(w->w2), free(w->om), w->w2 = w->om = NULL;
+    w->n = w->live = 0;
 }
 
 /* The cos(m theta) modes of a head of this wave speed below f_max, into (m, j) (when
@@ -355,6 +465,13 @@ static double shape(int m, double j, double norm, double r, double theta)
     return norm * ictus_bessel_j(m, j * r) * cos(m * theta);
 }
 
+/* The shape of slot k at wire segment i ((-1)^m at the minus side: the odd group). */
+static double wire_shape(const snare_wires *w, int i, int k)
+{
+    const double s = w->psi[WIRE_RADIUS(i)][k];
+    return WIRE_MINUS(i) && k >= w->ka.ne ? -s : s;
+}
+
 static void head_couplings(snare_wires *w)
 {
     w->Kmm = 0.0;
@@ -364,11 +481,13 @@ static void head_couplings(snare_wires *w)
             w->Kww[i][j] = 0.0;
     }
     for (int k = 0; k < w->n; k++) {
-        w->Kmm += w->mean[k] * w->mean[k] * w->g[k];
+        const double g = w->g[k], mk = w->mean[k];
+        w->Kmm += mk * mk * g;
         for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++) {
-            w->Kmw[i] += w->mean[k] * w->psi[i][k] * w->g[k];
+            const double si = wire_shape(w, i, k);
+            w->Kmw[i] += mk * si * g;
             for (int j = 0; j < SNARE_WIRE_SEGMENTS; j++)
-                w->Kww[i][j] += w->psi[i][k] * w->psi[j][k] * w->g[k];
+                w->Kww[i][j] += si * wire_shape(w, j, k) * g;
         }
     }
 }
@@ -378,65 +497,93 @@ static void head_couplings(snare_wires *w)
 static void head_coefficients(snare_wires *w, double sr)
 {
     const double T = 1.0 / sr;
-    for (int k = 0; k < w->live; k++) {
+    for (int k = 0; k < w->n; k++) {
         const double om = w->om[k], s = log(1000.0) / HEAD_T60 + 0.5 * HEAD_ETA * om;
-        if (om >= 0.9 * M_PI * sr) {
-            w->ca[k] = w->cb[k] = w->g[k] = w->w2[k] = w->x[k] = w->v[k] = 0.0;
+        if (!(om > 0.0) || om >= 0.9 * M_PI * sr) {
+            w->ca[k] = w->cb[k] = w->g[k] = w->x[k] = w->v[k] = 0.0f;
+            w->w2[k] = 0.0;
             continue;
         }
         const double wm = 2.0 / T * tan(0.5 * om * T); /* prewarped */
         const double D = 2.0 / T + 0.5 * T * wm * wm + 2.0 * s;
         w->w2[k] = wm * wm;
-        w->ca[k] = (2.0 / T - 0.5 * T * wm * wm + 2.0 * s) / D;
-        w->cb[k] = 2.0 / D;
-        w->g[k] = T / D;
+        w->ca[k] = (float)((2.0 / T - 0.5 * T * wm * wm + 2.0 * s) / D);
+        w->cb[k] = (float)(2.0 / D);
+        w->g[k] = (float)(T / D);
     }
     w->sr = sr;
     head_couplings(w);
 }
 
-/* Builds the snare head for a batter of radius a at sample rate sr. Allocates. */
+static int pad(int n)
+{
+    return (n + SNARE_KERNEL_PAD - 1) / SNARE_KERNEL_PAD * SNARE_KERNEL_PAD;
+}
+
+/* Allocates the head's arrays for n slots; 0 when memory cannot be had. */
+static int alloc_head(snare_wires *w, int n)
+{
+    float **arrs[HEAD_FLOATS];
+    head_floats(w, arrs);
+    int ok = 1;
+    for (int i = 0; i < HEAD_FLOATS; i++)
+        ok = ok && (*arrs[i] = alloc_aligned(n, sizeof(float)));
+    ok = ok && (w->w2 = alloc_aligned(n, sizeof(double)));
+    ok = ok && (w->om = alloc_aligned(n, sizeof(double)));
+    w->n = n;
+    return ok;
+}
+
+/* Mode (m, j) into slot k: its frequency and shapes (mass-normalised). */
+static void lay_mode(snare_wires *w, int k, int m, double j, double c01, double a)
+{
+    const double mass_norm = 1.0 / sqrt(HEAD_DENSITY * a * a);
+    const double norm = sqrt((m ? 2.0 : 1.0) / M_PI) / fabs(ictus_bessel_j(m + 1, j)) * mass_norm;
+    w->om[k] = j * c01 / a;
+    w->mean[k] = (float)(m == 0 ? norm * 2.0 * ictus_bessel_j(1, j) / j : 0.0);
+    for (int r = 0; r < SNARE_RADII; r++)
+        w->psi[r][k] = (float)shape(m, j, norm, wire_r[r], 0.0);
+    w->pick[k] = (float)shape(m, j, norm, PICK_R, PICK_DEG * M_PI / 180.0);
+}
+
+/* Builds the snare head for a batter of radius a at sample rate sr: the modes sorted
+ * into the kernel's groups. Allocates. */
 static ictus_status build_head(snare_wires *w, double sr, double a)
 {
     const double c01 = 2.0 * M_PI * a * HEAD_F01 / ictus_bessel_zero(0, 1);
     const double f_max = fmin(SNARE_HEAD_F_MAX, 0.4 * sr);
     free_head(w);
-    int n = list_modes(c01, a, f_max, NULL, NULL, 0), npad = (n + 3) / 4 * 4;
+    int n = list_modes(c01, a, f_max, NULL, NULL, 0);
     if (n < 0)
         return ICTUS_ENOMEM;
-    int *mm = malloc(sizeof(int) * (size_t)n);
-    double *jj = malloc(sizeof(double) * (size_t)n);
-    int ok = mm && jj;
-    double **arrs[] = {&w->x, &w->v, &w->xf, &w->ca, &w->cb, &w->g, &w->w2, &w->om, &w->mean};
-    for (size_t i = 0; i < sizeof(arrs) / sizeof(arrs[0]); i++)
-        ok = ok && (*arrs[i] = alloc_doubles(npad));
-    for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
-        ok = ok && (w->psi[i] = alloc_doubles(npad));
-    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-        ok = ok && (w->pick[j] = alloc_doubles(npad));
-    if (!ok) {
-        free(mm), free(jj), free_head(w);
+    int *mm = malloc(sizeof(int) * (size_t)(n ? n : 1));
+    double *jj = malloc(sizeof(double) * (size_t)(n ? n : 1));
+    if (!mm || !jj) {
+        free(mm), free(jj);
         return ICTUS_ENOMEM;
     }
     list_modes(c01, a, f_max, mm, jj, n);
-    w->n = w->cap = npad, w->live = n; /* modes n .. npad - 1: all zero, at rest */
+    int count[3] = {0, 0, 0}; /* (0, n), other even m, odd m */
+    for (int k = 0; k < n; k++)
+        count[mm[k] == 0 ? 0 : (mm[k] % 2 == 0 ? 1 : 2)]++;
+    const int n0 = pad(count[0]), ne = n0 + pad(count[1]), total = ne + pad(count[2]);
+    if (!alloc_head(w, total)) {
+        free(mm), free(jj), free_head(w);
+        return ICTUS_ENOMEM;
+    }
+    int next[3] = {0, n0, ne};
+    for (int k = 0; k < n; k++) {
+        const int grp = mm[k] == 0 ? 0 : (mm[k] % 2 == 0 ? 1 : 2);
+        lay_mode(w, next[grp]++, mm[k], jj[k], c01, a);
+    }
+    free(mm), free(jj);
+    w->live = n;
     w->radius = a;
     w->tension = HEAD_DENSITY * c01 * c01;
     w->k_air = MEMBRANE_AIR_RHO * MEMBRANE_AIR_C * MEMBRANE_AIR_C * M_PI * a * a / SHELL_DEPTH;
-    const double mass_norm = 1.0 / sqrt(HEAD_DENSITY * a * a);
-    for (int k = 0; k < n; k++) {
-        const int m = mm[k];
-        const double j = jj[k], om = j * c01 / a;
-        const double norm =
-            sqrt((m ? 2.0 : 1.0) / M_PI) / fabs(ictus_bessel_j(m + 1, j)) * mass_norm;
-        w->om[k] = om;
-        w->mean[k] = m == 0 ? norm * 2.0 * ictus_bessel_j(1, j) / j : 0.0;
-        for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++)
-            w->psi[i][k] = shape(m, j, norm, fabs(wire_x[i]), wire_x[i] < 0.0 ? M_PI : 0.0);
-        for (int p = 0; p < MEMBRANE_PICKUPS; p++)
-            w->pick[p][k] = shape(m, j, norm, PICK_R, pick_deg[p] * M_PI / 180.0);
-    }
-    free(mm), free(jj);
+    w->ka = (snare_kernel_args){
+        n0,    ne,    total, w->x,    w->v,    w->xf,
+        w->ca, w->cb, w->g,  w->mean, w->pick, {w->psi[0], w->psi[1], w->psi[2], w->psi[3]}};
     head_coefficients(w, sr);
     snare_rest(w);
     return ICTUS_OK;
@@ -455,6 +602,22 @@ snare_wires *snare_wires_new(void)
     w->damping = 2.0 * w->mass_kg * log(1000.0) / WIRE_T60_S;
     w->k = WIRE_STIFFNESS;
     w->engaged = 1;
+    w->kfree = snare_kernel_free_generic;
+    w->kforce = snare_kernel_force_generic;
+#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+        w->kfree = snare_kernel_free_avx2;
+        w->kforce = snare_kernel_force_avx2;
+    }
+#endif
+    /* As the batter's kernel (membrane.c): ICTUS_MEMBRANE_KERNEL=generic picks the
+     * portable one. */
+    const char *want = getenv("ICTUS_MEMBRANE_KERNEL");
+    if (want && strcmp(want, "generic") == 0) {
+        w->kfree = snare_kernel_free_generic;
+        w->kforce = snare_kernel_force_generic;
+    }
     w->air.point.ops = &air_ops;
     w->air.set = w;
     return w;
@@ -506,10 +669,7 @@ void snare_wires_engage(snare_wires *w, int on)
         return;
     w->engaged = on != 0;
     for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++) {
-        double wh = 0.0;
-        for (int k = 0; k < w->n; k++)
-            wh += w->psi[i][k] * w->x[k];
-        w->y[i] = w->engaged ? wh : 0.0;
+        w->y[i] = w->engaged && w->x ? wire_displacement(w, w->x, i) : 0.0;
         w->yv[i] = w->d[i] = 0.0;
     }
 }
@@ -523,7 +683,7 @@ double snare_wires_energy(const snare_wires *w)
 {
     double e = 0.5 * w->k_air * w->gap0 * w->gap0;
     for (int k = 0; k < w->n; k++)
-        e += 0.5 * (w->v[k] * w->v[k] + w->w2[k] * w->x[k] * w->x[k]);
+        e += 0.5 * ((double)w->v[k] * w->v[k] + w->w2[k] * (double)w->x[k] * w->x[k]);
     for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++)
         e += 0.5 * w->mass_kg * w->yv[i] * w->yv[i] + 0.5 * w->spring * w->y[i] * w->y[i] +
              potential(w, w->d[i]);
