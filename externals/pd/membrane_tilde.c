@@ -225,6 +225,10 @@ static void membrane_tilde_print(t_membrane_tilde *x)
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_GAIN),
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_TENSION_MOD),
          membrane_get_sample_rate(core));
+    if (x->x_wires)
+        post("membrane~ %s: snare head %d modes, wires %s",
+             x->x_name != &s_ ? x->x_name->s_name : "(no name)",
+             snare_wires_head_modes(x->x_wires), snare_wires_engaged(x->x_wires) ? "on" : "off");
     for (k = 0; k < count && k < 12; k++) {
         double f, t60;
         int bm, bn, sinp;
