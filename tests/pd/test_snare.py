@@ -61,13 +61,15 @@ def bandwidth95(y):
     power = np.abs(np.fft.rfft(seg)) ** 2
     cum = np.cumsum(power) / np.sum(power)
     freqs = np.fft.rfftfreq(len(seg), 1.0 / sr)
-    return freqs[np.searchsorted(cum, 0.95)], np.sqrt(np.mean(seg ** 2))
+    above = np.sum(power[freqs >= 4000.0]) / np.sum(power)
+    return freqs[np.searchsorted(cum, 0.95)], np.sqrt(np.mean(seg ** 2)), above
 
 
-bw_on, rms_on = bandwidth95(x[:, 0])
-bw_off, rms_off = bandwidth95(x[:, 1])
-print("95 %% bandwidth: wires on %.0f Hz (rms %.3g), off %.0f Hz (rms %.3g)"
-      % (bw_on, rms_on, bw_off, rms_off))
+bw_on, rms_on, hf_on = bandwidth95(x[:, 0])
+bw_off, rms_off, hf_off = bandwidth95(x[:, 1])
+print("95 %% bandwidth: wires on %.0f Hz (rms %.3g, %.2f %% of the energy above 4 kHz), "
+      "off %.0f Hz (rms %.3g, %.3f %% above 4 kHz)"
+      % (bw_on, rms_on, 100.0 * hf_on, bw_off, rms_off, 100.0 * hf_off))
 check(rms_on > 0 and rms_off > 0, "both sound")
 check(bw_off < bw_on, "the wires raise the 95 %% bandwidth (%.0f Hz off, %.0f Hz on)" % (bw_off, bw_on))
 first = np.flatnonzero(np.abs(x[:, 1]) > 0)[0]
