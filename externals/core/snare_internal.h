@@ -16,22 +16,22 @@ typedef struct snare_kernel_args {
     const float *psi[SNARE_RADII];
 } snare_kernel_args;
 
-/* xf = ca x + cb v for every mode; the sums of mean xf, and of psi_j xf over the even
- * and the odd modes apart. */
-typedef void (*snare_kernel_free_fn)(snare_kernel_args *a, double *mean, double even[SNARE_RADII],
-                                     double odd[SNARE_RADII]);
+/* xf = ca x + cb v for every mode; the sum of mean xf and, when wires is 1, those of
+ * psi_j xf over the even and the odd modes apart (0 otherwise). */
+typedef void (*snare_kernel_free_fn)(snare_kernel_args *a, int wires, double *mean,
+                                     double even[SNARE_RADII], double odd[SNARE_RADII]);
 /* The sample's forces (fa on the mean; F_+ + F_- on the even, F_+ - F_- on the odd
  * modes) into x and v; the new velocity's sums at the pickup, even and odd apart. */
 typedef void (*snare_kernel_force_fn)(snare_kernel_args *a, double fa, const double Fe[SNARE_RADII],
                                       const double Fo[SNARE_RADII], double two_over_t,
                                       double *pick_even, double *pick_odd);
 
-void snare_kernel_free_generic(snare_kernel_args *a, double *mean, double even[SNARE_RADII],
-                               double odd[SNARE_RADII]);
+void snare_kernel_free_generic(snare_kernel_args *a, int wires, double *mean,
+                               double even[SNARE_RADII], double odd[SNARE_RADII]);
 void snare_kernel_force_generic(snare_kernel_args *a, double fa, const double Fe[SNARE_RADII],
                                 const double Fo[SNARE_RADII], double two_over_t, double *pick_even,
                                 double *pick_odd);
-void snare_kernel_free_avx2(snare_kernel_args *a, double *mean, double even[SNARE_RADII],
+void snare_kernel_free_avx2(snare_kernel_args *a, int wires, double *mean, double even[SNARE_RADII],
                             double odd[SNARE_RADII]);
 void snare_kernel_force_avx2(snare_kernel_args *a, double fa, const double Fe[SNARE_RADII],
                              const double Fo[SNARE_RADII], double two_over_t, double *pick_even,

@@ -213,7 +213,6 @@ static int newton_forces(const snare_wires *w, double alpha, double beta, const 
         a[i] = wf[i] - yfree[i] + w->Kmw[i] * alpha;
         for (int j = 0; j < N; j++)
             C[i][j] = w->Kww[i][j] + (i == j ? G : 0.0) - beta * w->Kmw[i] * w->Kmw[j];
-        d[i] = a[i];
         v0[i] = potential(w, w->d[i]);
         any |= a[i] > 0.0 || w->d[i] > 0.0;
     }
@@ -222,6 +221,8 @@ static int newton_forces(const snare_wires *w, double alpha, double beta, const 
             F[i] = 0.0;
         return 1;
     }
+    for (int i = 0; i < N; i++)
+        d[i] = a[i];
     for (int it = 0; it < 40; it++) {
         /* J's column j is the unit vector where F_j' = 0 (the gap open at both ends of
          * the sample): the step solves on the other, active, gaps alone. */
@@ -314,7 +315,7 @@ static void snare_step(snare_wires *w, double ub, double kb, double T,
     double uf, E[SNARE_RADII], O[SNARE_RADII], wf[SNARE_WIRE_SEGMENTS] = {0};
     double yfree[SNARE_WIRE_SEGMENTS], F[SNARE_WIRE_SEGMENTS] = {0}, fa;
     /* The free move, its mean and its displacements at the wires (snare_kernel.inc). */
-    w->kfree(&w->ka, &uf, E, O);
+    w->kfree(&w->ka, w->engaged, &uf, E, O);
     for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++) {
         const int j = WIRE_RADIUS(i);
         wf[i] = WIRE_MINUS(i) ? E[j] - O[j] : E[j] + O[j];
