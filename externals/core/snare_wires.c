@@ -9,9 +9,11 @@
  * damped oscillator x'' + 2 s x' + W^2 x = f, advance by the trapezoidal rule (W
  * prewarped so that it rings at its frequency; passive: the energy
  * (v^2 + W^2 x^2) / 2 changes by the forces' work and the damping only). Over one
- * sample x1 = xf + g f, xf = A x0 + B v0, g = T / D, D = 2/T + T W^2 / 2 + 2 s.
+ * sample x1 = xf + g f, xf = A x0 + B v0, g = T / D, D = 2/T + T W^2 / 2 + 2 s. The
+ * modes' loops are snare_kernel.inc (float SIMD, the modes grouped by parity).
  *
- * The forces of one sample, solved together (Gauss-Seidel, to convergence):
+ * The forces of one sample, solved together (Newton on the joint system, the air
+ * eliminated; Gauss-Seidel sweeps as the fallback, to convergence):
  * - the air, F_a = k_air (D0 + D1) / 2 on the snare head's mean displacement and -F_a
  *   on the batter's, D = u_batter - u_snare (the midpoint of a linear spring: exact
  *   energy);
