@@ -27,7 +27,7 @@
 #   --bits N      16 or 24 (integer PCM) or 32 (float, the default)
 #   --gain DB     output gain before the soft limiter (default 0)
 #   --drum-preset NAME  the drum (ictusd render --drum-preset; docs/sound.md): paper,
-#                 snare, tom, floor-tom, timpani, frame (default snare: two heads, wires)
+#                 snare, tom, floor-tom, timpani, frame (default tom)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build
@@ -38,7 +38,7 @@ do_build=1
 mix=stereo
 bits=32
 gain=0
-drum_preset=snare
+drum_preset=tom
 while [[ $# -gt 0 ]]; do
     case $1 in
     --build) build=$2; shift 2 ;;
