@@ -726,9 +726,7 @@ int render_wav(RenderArgs &r, const Performance &perf)
     for (int i = 1; i < perf.scene().drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
         const KitDrum &k = kit.drums[static_cast<size_t>(i)];
         const DrumParams &kd = perf.scene().drum(i);
-        // Panned by its place: the performer's left (-x) to the left channel.
-        const double pan = std::clamp(-k.place_m.x() / 0.8, -0.6, 0.6);
-        pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, pan});
+        pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, kit_drum_pan(k)});
     }
     pd.stick_tip = d.stick_tip;
     std::cout << "render: pd: " << pd.seconds << " s of sound into " << r.wav << " ..."
