@@ -5,7 +5,8 @@ time, recording what goes to its dac~. The daemon sends its kit (/ictus/kit, /ic
 and each strike's drum; the patch plays drum 0 on its sound and drums 1..3 each on its own
 [ictus-kit-drum] (membrane~ + contact~ pair) with the kit's preset. Checked: the kit reaches
 the patch (drum 0's sound gets the snare preset, drums 1..3 are switched on), every primary
-strike of strikes.csv arrives, and each sounds loudest at its own drum's lowest mode: of the
+strike of strikes.csv arrives, with its stick tip (felt, in strikes.csv and in the strike list,
+which gives it to every drum's sticks), and each sounds loudest at its own drum's lowest mode: of the
 four drums' (0,1) frequencies, f01 = j01 / (2 pi a) sqrt(T / sigma) from each preset's head
 (externals/core/membrane_presets.c; the 10-inch tom1 is the tom preset's head on a 10-inch
 shell, docs/kit.md), the one with the most energy (Goertzel) in the 150 ms after its onset.
@@ -46,6 +47,7 @@ NOTES = 16
 # preset's head on the kit's shell.
 HEADS = [("snare", (0.1778, 3603.0, 0.345)), ("tom1", (0.127, 1231.0, 0.345)),
          ("tom2", (0.1524, 1231.0, 0.345)), ("floor", (0.2032, 878.0, 0.345))]
+TIP, TIP_CODE = "felt", 3  # the sticks' tip and its code in the strike record (docs/osc.md)
 J01 = 2.404825557695773  # first zero of the Bessel function J0
 SR = 48000
 RECORD_S = 40  # the recording's length (s): the score is 11 s after play
@@ -102,7 +104,7 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav):
              "#X obj 600 1030 timer",                                       # 9
              "#X obj 700 1030 list split 6",                                # 10
              "#X obj 700 1060 list split 3",                                # 11
-             "#X obj 600 1090 pack f 0 0 0",                                # 12
+             "#X obj 600 1090 pack f 0 0 0 0",                              # 12
              "#X obj 700 1090 unpack f f f",                                # 13
              "#X obj 600 1120 print strike",                                # 14
              "#X obj 20 1120 print test",                                   # 15
@@ -116,7 +118,9 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav):
              "#X msg 560 1150 \\; pd quit",                               # 23
              "#X obj 480 1150 soundfiler",                                  # 24
              "#X obj 20 1250 array define live-l %d" % (RECORD_S * SR),     # 25
-             "#X obj 200 1250 array define live-r %d" % (RECORD_S * SR)]    # 26
+             "#X obj 200 1250 array define live-r %d" % (RECORD_S * SR),    # 26
+             "#X obj 900 1130 list split 18",                               # 27
+             "#X obj 900 1160 list split 1"]                                # 28
     base = n
     # Recording from logical time 0 into two arrays; finish: 1.5 s of ringing on pd's clock,
     # then the arrays written (soundfiler: done when it returns), "recorded", and pd quits.
@@ -124,7 +128,8 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav):
              (7, 2, 22, 0), (22, 0, 24, 0), (7, 1, 21, 0), (21, 0, 15, 0), (7, 0, 23, 0),
              (8, 0, 9, 1), (8, 1, 10, 0), (10, 1, 11, 0), (11, 0, 13, 0), (13, 0, 12, 1),
              (13, 1, 12, 2), (13, 2, 12, 3), (9, 0, 12, 0), (12, 0, 14, 0), (0, 0, 9, 0),
-             (0, 0, 16, 0), (16, 0, 15, 0), (17, 0, 18, 0), (19, 0, 20, 0)]
+             (0, 0, 16, 0), (16, 0, 15, 0), (17, 0, 18, 0), (19, 0, 20, 0), (8, 1, 27, 0),
+             (27, 1, 28, 0), (28, 0, 12, 4)]
     links = [(base + a, o, base + b, i) for a, o, b, i in links]
     sound, kit, receive = (index[k] for k in ("ictus-sound", "ictus-kit", "ictus-receive"))
     links += [(sound, 0, base + 2, 0), (sound, 1, base + 1, 0), (kit, 1, base + 2, 0),
@@ -168,7 +173,8 @@ def main():
                                    "--port", str(daemon_port),
                                    "--target", "osc.udp://127.0.0.1:%d" % pd_port,
                                    "--reply", "osc.udp://127.0.0.1:%d" % pd_port,
-                                   "--pose-rate", "0", "--lookahead", "0.05", "--out", work],
+                                   "--pose-rate", "0", "--lookahead", "0.05", "--out", work,
+                                   "--stick-tip", TIP],
                                   stdout=log, stderr=subprocess.STDOUT, env=env)
         # the kit, sent as the daemon starts: drum 0's preset to the sound, drum 3 switched on
         lines.wait_for(lambda l: l == "drum0-preset: snare", "drum 0's sound set to snare", 120)
@@ -177,8 +183,8 @@ def main():
         primaries = 0
         while primaries < NOTES:
             line = lines.wait_for(lambda l: l.startswith("strike: "), "strike %d" % primaries, 60)
-            ms, bounce, drum, seq = (float(w) for w in line.split()[1:])
-            strikes_pd[int(seq)] = (ms, int(drum))
+            ms, bounce, drum, seq, tip = (float(w) for w in line.split()[1:])
+            strikes_pd[int(seq)] = (ms, int(drum), int(tip))
             primaries += bounce == 0
         daemon.send_signal(signal.SIGINT)  # strikes.csv complete: the daemon ends its contacts
         daemon.wait(60)
@@ -193,6 +199,13 @@ def main():
     with open(os.path.join(work, "strikes.csv")) as f:
         rows = [r for r in csv.DictReader(f) if r["bounce"] == "0"]
     check(len(rows) == NOTES, "strikes.csv: %d primary strikes for %d notes" % (len(rows), NOTES))
+    check(all(int(r["stick_tip"]) == TIP_CODE for r in rows), "strikes.csv: every strike's tip "
+          "is %s (%d)" % (TIP, TIP_CODE))
+    check(all(v[2] == TIP_CODE for v in strikes_pd.values()), "every strike list in the patch "
+          "carries the tip %d" % TIP_CODE)
+    for hand in ("left", "right"):
+        check("kit3: %s tip %s" % (hand, TIP) in lines.printed,
+              "the kit's drum 3 gets the tip on its %s stick" % hand)
     x, rate = read_wav_float(wav)
     check(rate == SR and np.all(np.isfinite(x)), "the recording: %d Hz, finite" % rate)
     mono = x.mean(axis=1)

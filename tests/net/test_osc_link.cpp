@@ -98,6 +98,8 @@ ictus::StrikeEvent sample_strike(long seq, double time_s)
     e.impulse_n_s = 0.125;
     e.duration_ms = 4.5;
     e.force_dir = Eigen::Vector3d(0.6, -0.8, 0.0);
+    e.stick_mass_kg = 0.0125;
+    e.stick_tip = static_cast<int>(seq % 4); // none, wood, nylon, felt
     return e;
 }
 
@@ -123,8 +125,8 @@ TEST_CASE("osc out: strike bundles reach oscdump with the fixed layout and timet
     for (long i = 0; i < 4; ++i) {
         DumpLine d;
         REQUIRE(next_dump(*dump, "/ictus/strike", d));
-        CHECK(d.types == "iiiiffffffffffffff");
-        REQUIRE(d.args.size() == 18);
+        CHECK(d.types == "iiiiffffffffffffffi");
+        REQUIRE(d.args.size() == 19);
         CHECK(std::stol(d.args[0]) == i);
         CHECK(std::stoi(d.args[1]) == i % 2);
         CHECK(std::stoi(d.args[2]) == 0);
@@ -134,6 +136,8 @@ TEST_CASE("osc out: strike bundles reach oscdump with the fixed layout and timet
         for (int k = 0; k < 13; ++k)
             CHECK(std::stod(d.args[4 + k]) ==
                   Approx(expected[k]).margin(2e-6 * (1 + std::fabs(expected[k]))));
+        CHECK(std::stod(d.args[17]) == Approx(0.0125).margin(1e-9)); // stick_mass_kg
+        CHECK(std::stoi(d.args[18]) == i % 4);                       // stick_tip
         // The timetag, to the last bit of the fraction: 2^-32 s steps.
         CHECK(d.timetag == hex_timetag(ictus::ntp_add_seconds(epoch, times[i] + 0.02)));
     }

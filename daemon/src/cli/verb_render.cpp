@@ -302,6 +302,7 @@ nlohmann::json drum_json(const Performance &p)
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
     j["contact_stretch_n_per_m3"] = d.stretch_n_per_m3(); // the head's k3 (docs/sound.md)
     j["stick_tip"] = d.stick_tip;                         // "": none
+    j["stick_tip_code"] = stick_tip_code(d.stick_tip);    // strikes.csv's stick_tip
     return j;
 }
 
@@ -322,6 +323,7 @@ nlohmann::json kit_json(const Performance &p)
                          {"tension_n_per_m", d.tension_n_per_m},
                          {"shell_depth_m", d.shell_depth_m},
                          {"midi_note", k.midi_note},
+                         {"stick_tip", scene.options().drum.stick_tip}, // the sticks' ("": none)
                          {"shell_passes", scene.shell_passes(i)}});
     }
     return {{"name", kit.name}, {"drums", drums}, {"shell_passes", scene.shell_passes()}};
