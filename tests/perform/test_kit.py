@@ -164,9 +164,16 @@ def main():
     with open(score, "w") as f:
         f.write(TIMPANI)
     out = os.path.join(args.workdir, "timpani")
+    # pd through a wrapper that writes down its arguments: the drums' messages ictusd gives it
+    argv_log = os.path.join(os.path.abspath(args.workdir), "pd-argv.txt")
+    wrapper = os.path.join(os.path.abspath(args.workdir), "pd-logging")
+    with open(wrapper, "w") as f:
+        f.write('#!/bin/sh\nprintf "%%s\\n" "$@" > %s\nexec pd "$@"\n' % argv_log)
+    os.chmod(wrapper, 0o755)
     run = subprocess.run([args.ictusd, "render", "--kit", "timpani", "--score", score, "--out",
-                          out, "--force", "--stick-tip", "felt"], capture_output=True, text=True,
-                         timeout=600)
+                          out, "--force", "--stick-tip", "felt", "--wav",
+                          os.path.join(out, "timpani.wav"), "--pd", wrapper],
+                         capture_output=True, text=True, timeout=600, env=env)
     ok &= check(run.returncode == 0, "ictusd render --kit timpani --stick-tip felt: exit %d %s"
                 % (run.returncode, run.stderr))
     _, strikes, _, _, played = played_right(out, ["timpani1", "timpani2"])
@@ -179,6 +186,12 @@ def main():
     ok &= check(summary["drum"]["stick_tip"] == "felt" and summary["drum"]["stick_tip_code"] == 3
                 and all(d["stick_tip"] == "felt" for d in summary["kit"]["drums"]),
                 "render.json: the drum's and each kit drum's stick tip is felt")
+    with open(argv_log) as f:
+        sends = f.read().split("\n")
+    want = ["render-drum left tip felt", "render-drum right tip felt",
+            "render-kit-1 left tip felt", "render-kit-1 right tip felt"]
+    ok &= check(all(w in sends for w in want), "the render gives every drum's sticks the tip: %s"
+                % [l for l in sends if " tip " in l])
     return 0 if ok else 1
 
 
