@@ -42,6 +42,11 @@ THRESHOLD = 1e-7    # |y| above this after silence is an onset
 QUIET_S = 0.010     # silence needed before an onset
 
 
+# strikes.csv's integer columns (docs/osc.md); the others are reals. A column this does not
+# know (a newer file) is read as a real.
+INTEGER_COLUMNS = ("seq", "hand", "drum", "bounce", "stroke", "stick_tip")
+
+
 def read_strikes(path):
     """strikes.csv -> list of dicts (numbers converted), in file order."""
     with open(path) as f:
@@ -56,7 +61,7 @@ def read_strikes(path):
             raise ValueError("%s:%d: %d columns, header has %d" % (path, n, len(cells), len(header)))
         row = {}
         for name, cell in zip(header, cells):
-            row[name] = int(cell) if name in ("seq", "hand", "drum", "bounce", "stroke") else float(cell)
+            row[name] = int(cell) if name in INTEGER_COLUMNS else float(cell)
         rows.append(row)
     return rows
 

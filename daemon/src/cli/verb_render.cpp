@@ -302,6 +302,7 @@ nlohmann::json drum_json(const Performance &p)
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
     j["contact_stretch_n_per_m3"] = d.stretch_n_per_m3(); // the head's k3 (docs/sound.md)
     j["stick_tip"] = d.stick_tip;                         // "": none
+    j["stick_tip_code"] = stick_tip_code(d.stick_tip);    // strikes.csv's stick_tip
     return j;
 }
 
@@ -322,6 +323,7 @@ nlohmann::json kit_json(const Performance &p)
                          {"tension_n_per_m", d.tension_n_per_m},
                          {"shell_depth_m", d.shell_depth_m},
                          {"midi_note", k.midi_note},
+                         {"stick_tip", scene.options().drum.stick_tip}, // the sticks' ("": none)
                          {"shell_passes", scene.shell_passes(i)}});
     }
     return {{"name", kit.name}, {"drums", drums}, {"shell_passes", scene.shell_passes()}};
@@ -726,9 +728,7 @@ int render_wav(RenderArgs &r, const Performance &perf)
     for (int i = 1; i < perf.scene().drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
         const KitDrum &k = kit.drums[static_cast<size_t>(i)];
         const DrumParams &kd = perf.scene().drum(i);
-        // Panned by its place: the performer's left (-x) to the left channel.
-        const double pan = std::clamp(-k.place_m.x() / 0.8, -0.6, 0.6);
-        pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, pan});
+        pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, kit_drum_pan(k)});
     }
     pd.stick_tip = d.stick_tip;
     pd.stretch_n_per_m3 = d.stretch_n_per_m3();

@@ -5,6 +5,7 @@
 #include "membrane.h"
 #include "membrane_presets.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -93,6 +94,11 @@ double kit_min_gap_m(const Kit &kit)
             gap = std::min(gap, d - a.radius_m - b.radius_m);
         }
     return gap;
+}
+
+double kit_drum_pan(const KitDrum &drum)
+{
+    return std::clamp(-drum.place_m.x() / 0.8, -0.6, 0.6);
 }
 
 int kit_drum_index(const Kit &kit, const std::string &name)

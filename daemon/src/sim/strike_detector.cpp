@@ -252,6 +252,7 @@ void StrikeDetector::begin_contact(Hand &h, int hand, const TipSample &s, double
                (h.max_gap_since_release < options_.bounce_height_m ||
                 h.max_held_gap_since_release < options_.bounce_height_m || !driven);
     e.stick_mass_kg = s.effective_mass_kg;
+    e.stick_tip = s.stick_tip;
     if (!e.bounce)
         ++h.stroke;
     e.stroke = std::max(h.stroke, 0L);
@@ -408,8 +409,10 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
         s.held_center_m = scene.held_bead_position(side);
         // Only near the head, where a contact may begin (a 7 x 7 solve).
         const int drum = detector.drum_under(s.center_m);
-        if (detector.gap_m(s.center_m, drum) < 0.02)
+        if (detector.gap_m(s.center_m, drum) < 0.02) {
             s.effective_mass_kg = scene.effective_mass_kg(side, Eigen::Vector3d::UnitY(), drum);
+            s.stick_tip = stick_tip_code(scene.options().drum.stick_tip); // the sticks' tip
+        }
         if (detector.update(hand, s, out[n]))
             ++n;
     }

@@ -2,6 +2,8 @@
 // (strike_event.hpp, docs/osc.md).
 #include "ictus/sim/strike_event.hpp"
 
+#include "stick_tip.h"
+
 #include <cmath>
 #include <cstdio>
 #include <ostream>
@@ -32,6 +34,7 @@ constexpr StrikeFieldInfo kInfo[kStrikeFieldCount] = {
     {"force_dir_y", false, 4, true, true},
     {"force_dir_z", false, 4, true, true},
     {"stick_mass_kg", false, 5, true, false},
+    {"stick_tip", true, 0, true, false},
 };
 
 // Fixed notation with a given number of decimals; -0 printed as 0 so that
@@ -93,6 +96,8 @@ long strike_field_integer(const StrikeEvent &e, StrikeField field)
         return e.bounce ? 1 : 0;
     case StrikeField::stroke:
         return e.stroke;
+    case StrikeField::stick_tip:
+        return e.stick_tip;
     default:
         return std::lround(strike_field(e, field));
     }
@@ -106,6 +111,7 @@ double strike_field(const StrikeEvent &e, StrikeField field)
     case StrikeField::drum:
     case StrikeField::bounce:
     case StrikeField::stroke:
+    case StrikeField::stick_tip:
         return static_cast<double>(strike_field_integer(e, field));
     case StrikeField::time_s:
         return e.time_s;
@@ -137,6 +143,17 @@ double strike_field(const StrikeEvent &e, StrikeField field)
         return e.stick_mass_kg;
     }
     return 0.0;
+}
+
+int stick_tip_code(const std::string &name)
+{
+    const stick_tip *tip = stick_tip_find(name.c_str());
+    return tip ? static_cast<int>(tip - stick_tips) + 1 : 0;
+}
+
+std::string stick_tip_name(int code)
+{
+    return code >= 1 && code <= STICK_TIP_COUNT ? stick_tips[code - 1].name : "";
 }
 
 void write_strikes_csv_header(std::ostream &out)

@@ -80,6 +80,8 @@ struct TipSample {
     // The stick's effective mass at the bead along the normal (kg; 0: not
     // known), copied into a strike that begins at this sample.
     double effective_mass_kg = 0.0;
+    // The stick's tip (StrikeEvent::stick_tip's code), copied likewise.
+    int stick_tip = 0;
 };
 
 class StrikeDetector
