@@ -77,6 +77,8 @@ void render_usage(std::ostream &out)
            "\n"
            "score mode (run and render):\n"
            "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
+           "  --midi FILE         a Standard MIDI File's drum part as the score: snares and\n"
+           "                      toms of the General MIDI drum map (docs/midi.md, MIDI in)\n"
            "  --gestures DB.json  gesture database (default: the built-in one)\n"
            "  --mode M            cartesian (default, Algorithm 2) | joint (eq. 1, joint\n"
            "                      targets from the IK of the tip targets)\n"
@@ -479,6 +481,7 @@ bool parse_render_args(Args &args, RenderArgs &r)
         return false;
     if (!r.o.mocap.empty() && !r.o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
+    load_midi_score(r.o);
     if (r.out_dir.empty())
         throw UsageError("--out DIR is required");
     if (!r.wav.empty()) {
@@ -601,7 +604,9 @@ MidiTimeline midi_timeline_of(const Performance &perf, const RenderArgs &r, bool
         return midi_timeline(score_mode ? kDefaultTempoBpm : r.o.tempo_bpm);
     const ScorePerformOptions &so = perf.options().score;
     const Score score =
-        parse_score(so.score_text.empty() ? default_score_text() : so.score_text, so.score_name);
+        so.score ? *so.score
+                 : parse_score(so.score_text.empty() ? default_score_text() : so.score_text,
+                               so.score_name);
     const double beat0_s = perf.plan_origin_s() + perf.plan()->score_start_s;
     double earliest_s = beat0_s;
     for (const StrikeEvent &e : log.strikes())
@@ -628,7 +633,8 @@ nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool
     const long strikes = static_cast<long>(log.strikes().size());
     nlohmann::json j;
     if (score_mode)
-        j["score"] = r.o.score.score_text.empty() ? "default" : r.o.score.score_name;
+        j["score"] =
+            r.o.score.score_text.empty() && !r.o.score.score ? "default" : r.o.score.score_name;
     else
         j["mocap"] = r.o.mocap;
     j["duration_s"] = perf.time_s();
