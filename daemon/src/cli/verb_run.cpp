@@ -292,6 +292,7 @@ bool parse_run_args(Args &args, RunOptions &r)
     const PerformanceOptions &o = r.performance;
     if (!o.mocap.empty() && !o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
+    load_midi_score(r.performance);
     return true;
 }
 

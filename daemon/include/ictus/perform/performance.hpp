@@ -35,6 +35,10 @@ namespace ictus
 struct ScorePerformOptions {
     std::string score_text; // the score; empty: default_score_text()
     std::string score_name = "default";
+    // A score already built (ictusd --midi: a MIDI file's drum part); when
+    // set, score_text is not read.
+    std::shared_ptr<const Score> score;
+    std::string midi_path; // --midi FILE, turned into `score` once the kit is known
     std::string gestures; // gesture database JSON; empty: GestureDatabase::builtin()
     TrackMode mode = TrackMode::cartesian;
     bool grip_given = false; // else the character holds the sticks as the score's first note
