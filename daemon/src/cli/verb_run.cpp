@@ -37,13 +37,14 @@ namespace
 
 void run_usage(std::ostream &out)
 {
-    out << "usage: ictusd run [--mocap FILE | --score FILE] [options]\n"
+    out << "usage: ictusd run [--mocap FILE | --score FILE | --midi FILE] [options]\n"
            "\n"
            "Plays in real time, sends every strike to Pd as an OSC bundle time-tagged for\n"
            "exact scheduling, streams poses for graphics, and listens for commands (play,\n"
            "stop, score statements, mode, grip, drum ...). See docs/osc.md, docs/perform.md.\n"
            "With --mocap: the clip in joint space (eq. 1). Otherwise score mode: the score\n"
-           "(--score FILE, default: the built-in score) is planned into stick-tip targets and\n"
+           "(--score FILE, or --midi FILE: a Standard MIDI File's drum part, docs/midi.md;\n"
+           "default: the built-in score) is planned into stick-tip targets and\n"
            "performed (Cartesian mode by default); /ictus/score statements replace it at the\n"
            "next /ictus/play.\n"
            "\n"
