@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the generated part of the fuzz seed corpus (fuzz/corpus/): BVH files
 of the default body's CMU hierarchy (character/stick_capture.cpp,
-default_skeleton), stick-only CSV captures, and raw OSC packets. The
+default_skeleton), stick-only CSV captures, raw OSC packets and Standard MIDI
+Files of drum parts. The
 hand-written seeds sit beside them. Deterministic: rerunning rewrites the same
 bytes. Usage: python3 fuzz/make_seeds.py
 """
@@ -140,6 +141,41 @@ def osc(address, types="", *args):
     return out
 
 
+def vlq(v):
+    out = [v & 0x7F]
+    v >>= 7
+    while v:
+        out.append(0x80 | (v & 0x7F))
+        v >>= 7
+    return bytes(reversed(out))
+
+
+def smf(fmt, tpq, tracks):
+    """A Standard MIDI File of tracks of (tick, event bytes), sorted by tick."""
+    out = b"MThd" + struct.pack(">IHHH", 6, fmt, len(tracks), tpq)
+    for events in tracks:
+        data, last = b"", 0
+        for tick, msg in sorted(events, key=lambda e: e[0]):
+            data += vlq(tick - last) + msg
+            last = tick
+        data += b"\x00\xff\x2f\x00"
+        out += b"MTrk" + struct.pack(">I", len(data)) + data
+    return out
+
+
+def drum_part():
+    """A GM drum part: 8ths of snare and hi-hat, kicks, a tom fill, a tempo ramp in steps."""
+    notes = [(k * 240, 38 if k % 2 else 40, 60 + k) for k in range(8)]
+    notes += [(k * 240, 42, 80) for k in range(8)] + [(0, 36, 100), (960, 36, 100)]
+    notes += [(1920 + 120 * k, n, 40 + 5 * k) for k, n in enumerate([50, 48, 47, 45, 43, 41, 43, 38])]
+    drums = [(t, bytes([0x99, n, v])) for t, n, v in notes] + \
+            [(t + 60, bytes([0x89, n, 0])) for t, n, v in notes]
+    tempo = [(0, b"\xff\x58\x04\x03\x02\x18\x08")] + \
+            [(480 * k, b"\xff\x51\x03" + round(60e6 / (100 + 10 * k)).to_bytes(3, "big"))
+             for k in range(6)]
+    return tempo, drums
+
+
 def main():
     # BVH: the default body, and the known troublemakers on it.
     write("bvh", "cmu_default.bvh", cmu_bvh())
@@ -200,6 +236,13 @@ def main():
     }
     for name, data in packets.items():
         write("osc_server", name, data)
+
+    # MIDI: a drum part in format 1 and the same merged in format 0 with running status.
+    tempo, drums = drum_part()
+    write("midi", "drum_part_format1.mid", smf(1, 480, [tempo, drums]))
+    write("midi", "drum_part_format0.mid", smf(0, 96, [[(t // 5, m) for t, m in tempo + drums]]))
+    write("midi", "channel1_only.mid",
+          smf(0, 480, [[(k * 120, bytes([0x90, 38, 100])) for k in range(16)]]))
 
 
 if __name__ == "__main__":

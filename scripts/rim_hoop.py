@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the hoop of patches/ictus-drum.pd (the subpatch [pd rim], docs/sound.md "The rim").
+"""Writes the hoop of patches/ictus-drum.pd (the subpatch [pd rim], docs/rim.md).
 
 The hoop of a 14 in drum is a thin steel ring. Its in-plane flexural modes (Fletcher &
 Rossing, The Physics of Musical Instruments, 2nd ed. 1998, section 2.18):
@@ -25,7 +25,7 @@ import re
 
 import mpmath
 
-# The hoop (docs/sound.md): steel, its ring radius, the radius of gyration of its section
+# The hoop (docs/rim.md): steel, its ring radius, the radius of gyration of its section
 # about the drum's axis direction, its mass, the loss factor, air.
 E, RHO, R_RING, K_GYR = 200e9, 7850.0, 0.183, 0.003
 MASS, ETA, C_AIR = 0.75, 0.02, 343.0
@@ -76,25 +76,35 @@ def subpatch(rows):
         "#X text 20 %d The hoop: a Hertz pulse (wood on steel) rings %d in-plane ring modes "
         "(biquad~: velocity per force \\, modal mass %.3f kg \\, each weighted by the square "
         "root of its radiation efficiency) \\, scaled by the hoop's side area over the head's. "
-        "Written by scripts/rim_hoop.py \\; docs/sound.md \\, The rim., f 64;"
+        "'t60 S' caps each mode's T60 at S (the drum's t60 reaches here). "
+        "Written by scripts/rim_hoop.py \\; docs/rim.md., f 64;"
         % (190 + 100 * len(rows), len(rows), m),
     ]
-    conns = ["0 0 1 0", "1 0 2 0", "2 4 3 1", "2 1 3 0", "3 0 4 0", "4 1 7 1", "4 0 5 0",
+    # After the modes: [route t60 list] (the drum's 't60 S' reaches the hoop and caps every
+    # mode's T60 at S, 0.005 s at least as membrane~'s t60; a list is a hit), [t b f] and
+    # [pack f 60] (the sample rate and the cap, to each mode's coefficients).
+    top = 13 + 3 * len(rows)
+    route, tbf, srcap = top, top + 1, top + 2
+    conns = ["0 0 %d 0" % route, "%d 1 1 0" % route, "%d 0 %d 0" % (route, tbf),
+             "%d 1 %d 1" % (tbf, srcap), "%d 0 9 0" % tbf, "9 0 %d 0" % srcap,
+             "1 0 2 0", "2 4 3 1", "2 1 3 0", "3 0 4 0", "4 1 7 1", "4 0 5 0",
              "5 0 6 0", "6 0 7 0", "8 0 9 0", "10 0 11 0"]
     for i, (n, f, _ka, _s, w, t60) in enumerate(rows):
         y = 90 + 100 * i
         g = w / m
+        t = "min(%.5f \\, max($f2 \\, 0.005))" % t60
         lines.append(
-            "#X obj 500 %d expr 2*exp(-6.9078/(%.5f*$f1))*cos(6.28319*%.2f/$f1) \\; "
-            "-exp(-13.8155/(%.5f*$f1)) \\; %.6f/$f1 \\; "
-            "-exp(-6.9078/(%.5f*$f1))*cos(6.28319*%.2f/$f1)*%.6f/$f1 \\; 0, f 70;"
-            % (y, t60, f, t60, g, t60, f, g))
+            "#X obj 500 %d expr 2*exp(-6.9078/(%s*$f1))*cos(6.28319*%.2f/$f1) \\; "
+            "-exp(-13.8155/(%s*$f1)) \\; %.6f/$f1 \\; "
+            "-exp(-6.9078/(%s*$f1))*cos(6.28319*%.2f/$f1)*%.6f/$f1 \\; 0, f 70;"
+            % (y, t, f, t, g, t, f, g))
         lines.append("#X obj 1020 %d pack f f f f f;" % y)
         lines.append("#X obj %d %d biquad~;" % (20 + 80 * (i % 6), 60 + 100 * len(rows)
                                                - 40 * (i // 6)))
         e, p, b = 13 + 3 * i, 14 + 3 * i, 15 + 3 * i
-        conns += ["9 0 %d 0" % e] + ["%d %d %d %d" % (e, k, p, k) for k in range(5)]
+        conns += ["%d 0 %d 0" % (srcap, e)] + ["%d %d %d %d" % (e, k, p, k) for k in range(5)]
         conns += ["%d 0 %d 0" % (p, b), "7 0 %d 0" % b, "%d 0 10 0" % b]
+    lines += ["#X obj 160 20 route t60 list;", "#X obj 660 20 t b f;", "#X obj 660 50 pack f 60;"]
     lines += ["#X connect %s;" % c for c in conns]
     lines.append("#X restore 480 372 pd rim;")
     return "\n".join(lines) + "\n"

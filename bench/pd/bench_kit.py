@@ -7,7 +7,7 @@ by a 14 g stick at 3 m/s every 250 ms, staggered), in `pd -batch` at 48 kHz:
 
 against a bank of N_total vanilla [bp~] in the same run (bench_pd.py's reference), with t
 the CPU time (user + sys) of pd, best of R runs. The mode counts are read from each
-membrane~'s `print`. Usage: bench_kit.py BUILD_DIR [--runs R] [--seconds S]"""
+membrane~'s `print` (a snare's: the batter's and the snare head's). Usage: bench_kit.py BUILD_DIR [--runs R] [--seconds S]"""
 import argparse
 import os
 import re
@@ -68,6 +68,9 @@ def mode_counts():
     counts = [int(m) for m in re.findall(r"membrane~ bench-kit-\d+: .*?, (\d+) modes,", err)]
     if len(counts) != len(KIT):
         raise SystemExit("could not read the mode counts:\n" + err[-2000:])
+    # A snare's second head (membrane~ prints "snare head N modes") counts as modes too.
+    for k, n in re.findall(r"membrane~ bench-kit-(\d+): snare head (\d+) modes", err):
+        counts[int(k)] += int(n)
     return counts
 
 

@@ -32,6 +32,7 @@ Performer, real-time factor (simulated s / CPU s):
   MuJoCo   dm_control's CMU humanoid, 56 DoF, root fixed, 1 ms (peer_mujoco.py)
   render   `ictusd render` of the default score, --bvh-rate 0 --tips-rate 0
            (start-up included)
+  kit      the same with `--kit standard --score examples/scores/kit.txt`
   before   with --before-ictusd FILE, another ictusd's track and render in the
            same rounds (before / after a change, alternating)
 
@@ -214,9 +215,13 @@ def track_run(r, results, binary, key, case):
                 "startup_cpu_s": cpu0, "rtf_cpu": rtf, "rtf_wall_printed": wall_rtf})
 
 
-def render_run(r, results, binary, key, case):
+KIT_SCORE = os.path.join(ROOT, "examples", "scores", "kit.txt")
+
+
+def render_run(r, results, binary, key, case, extra=()):
     out_dir = os.path.join(work, "render-%d" % r)
-    cpu, out = run_cpu([binary, "render", "--out", out_dir, "--bvh-rate", "0", "--tips-rate", "0"])
+    cpu, out = run_cpu([binary, "render", "--out", out_dir, "--bvh-rate", "0", "--tips-rate", "0"]
+                       + list(extra))
     m = re.search(r"render: ([0-9.]+) s simulated in ([0-9.]+) s \(([0-9.]+)x real time\)", out)
     if not m:
         raise SystemExit("ictusd render printed no speed:\n" + out)
@@ -245,6 +250,8 @@ def track_round(r, results):
     if args.before_ictusd:
         render_run(r, results, args.before_ictusd, "render_before", "before: ictusd render")
     render_run(r, results, ictusd, "render", "ictusd render")
+    render_run(r, results, ictusd, "render_kit", "ictusd render --kit standard, kit.txt",
+               ["--kit", "standard", "--score", KIT_SCORE])
 
 
 # ---------------------------------------------------------------- main
@@ -343,6 +350,11 @@ if "performer" not in skip:
         max(t) / max(mj), per_round_ratio(t, mj)))
     print("  ictusd render, default score:          %.1fx  [%s] (target >= 25)" % (
         max(rd), ", ".join("%.1f" % v for v in rd)))
+    print("  ratio render / MuJoCo: median of rounds %.2f (target >= 1.25)" % per_round_ratio(rd, mj))
+    rk = results["render_kit"]
+    print("  ictusd render --kit standard, examples/scores/kit.txt: %.1fx  [%s]; "
+          "ratio to MuJoCo, median of rounds %.2f (target >= 1.0)" % (
+              max(rk), ", ".join("%.1f" % v for v in rk), per_round_ratio(rk, mj)))
     if args.before_ictusd:
         tb, rb = results["track_before"], results["render_before"]
         print("  before (%s): track %.1fx [%s], ratio track / MuJoCo median %.2f; "

@@ -621,7 +621,8 @@ static void contact_detached(membrane_point *pt)
 }
 
 static const membrane_point_ops contact_point_ops = {
-    contact_landed, contact_solve_points, contact_block_begin, contact_cleared, contact_detached,
+    contact_landed,  contact_solve_points, contact_block_begin,
+    contact_cleared, contact_detached,     NULL,
 };
 
 ictus_status membrane_attach_contact(membrane *m, contact *c)

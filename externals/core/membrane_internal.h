@@ -167,6 +167,9 @@ static inline void membrane_input_shapes_(const membrane *m, double r_over_a, do
     mode_table_patch_filter(&m->table, m->modes, m->patch / m->radius, psi);
 }
 
+/* The shapes of coupling point pt, at its place or its own (membrane_point_ops.shapes). */
+void membrane_point_shapes_(const membrane *m, const membrane_point *pt, float *psi);
+
 /* membrane_modes.c. Recomputes every coefficient from the physics; with rescale, the
  * modal state follows so that each mode's displacement and velocity stay continuous. */
 void membrane_update_coefficients_(membrane *m, int rescale);
@@ -227,6 +230,10 @@ typedef struct membrane_point_ops {
     void (*cleared)(membrane_point *pt);
     /* The point has just been detached from its membrane. */
     void (*detached)(membrane_point *pt);
+    /* Optional (NULL: the shapes at r_over_a, theta_deg): the point's own mode weights
+     * for the modes of m, `live` of them (zero beyond), for a force spread over the
+     * head (the snare's air: snare_wires.c). Message time; such a point never moves. */
+    void (*shapes)(const membrane *m, const membrane_point *pt, int live, float *psi);
 } membrane_point_ops;
 
 struct membrane_point {

@@ -314,7 +314,7 @@ void membrane_refresh_shapes_(membrane *m)
         membrane_mode_shapes_(m, m->pick_r[i], m->pick_theta[i], m->psi_pick[i]);
     for (int i = 0; i < m->point_count; i++) {
         membrane_point *pt = m->points[i];
-        membrane_input_shapes_(m, pt->r_over_a, pt->theta_deg, pt->psi);
+        membrane_point_shapes_(m, pt, pt->psi);
         if (pt->move_pending)
             membrane_input_shapes_(m, pt->move_r, pt->move_theta, pt->psi_next);
     }

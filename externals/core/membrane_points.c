@@ -85,6 +85,14 @@ void membrane_refresh_couplings_(membrane *m)
             point_couplings(m, m->points[i]);
 }
 
+void membrane_point_shapes_(const membrane *m, const membrane_point *pt, float *psi)
+{
+    if (pt->ops->shapes)
+        pt->ops->shapes(m, pt, m->modes, psi);
+    else
+        membrane_input_shapes_(m, pt->r_over_a, pt->theta_deg, psi);
+}
+
 /* ---------------------------------------------------------------- attach, detach, move */
 
 ictus_status membrane_point_attach_(membrane *m, membrane_point *pt)
@@ -118,7 +126,7 @@ ictus_status membrane_point_attach_(membrane *m, membrane_point *pt)
     pt->slot = m->point_count;
     m->points[m->point_count++] = pt;
     pt->force_pending = 0.0;
-    membrane_input_shapes_(m, pt->r_over_a, pt->theta_deg, pt->psi);
+    membrane_point_shapes_(m, pt, pt->psi);
     if (pt->move_pending)
         membrane_input_shapes_(m, pt->move_r, pt->move_theta, pt->psi_next);
     point_couplings(m, pt);

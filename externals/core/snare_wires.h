@@ -1,14 +1,25 @@
-/* snare_wires.h -- snare wires against a membrane: a few lumped masses, each held by
- * a spring and a damper (the strainer's pull) and colliding one-sidedly with the head
- * under a power law, F = k [w_head - y_wire]+^alpha, solved implicitly each sample as
- * an energy-consistent discrete gradient (as contact.c; Torin, Hamilton & Bilbao,
- * DAFx-14). The collisions give the snare's buzz (docs/sound.md, "Snare wires").
- * Plain C99, no Pd.
+/* snare_wires.h -- the snare side of a snare drum, coupled to a membrane (the batter):
+ * the snare (resonant) head, the air enclosed by the shell between the two heads, and
+ * the snare wires colliding with the snare head (docs/sound.md, "The snare"). Plain C99,
+ * no Pd.
  *
- * The wires lie on the head the membrane models (one head: in a real snare drum they
- * lie under the resonant head, coupled to the batter through the shell's air; that
- * second head is not modelled). Each mass is one of the membrane's coupling points
- * (MEMBRANE_MAX_POINTS in all, with the sticks). Threading: as membrane.h. */
+ * - The snare head is a modal membrane of its own (thinner than the batter, tuned
+ *   higher), with the modes to SNARE_HEAD_F_MAX that the wires and the air can excite
+ *   (the cos(m theta) partners about the wires' line).
+ * - The air is a lumped spring between the two heads' mean displacements (their volume
+ *   displacements over the head's area): k = rho c^2 A / H for a shell of depth H. On
+ *   the batter it acts through one coupling point whose shapes are each mode's mean
+ *   over the head (a uniform pressure), so the batter's modes see it exactly as the
+ *   membrane sees a stick.
+ * - The wires are SNARE_WIRE_SEGMENTS light masses along a diameter of the snare head,
+ *   each held by the wire's tension and colliding one-sidedly with the head under a
+ *   power law, F = k [w_head - y_wire]+^alpha, solved implicitly each sample as an
+ *   energy-consistent discrete gradient (Torin, Hamilton & Bilbao, DAFx-14).
+ * The pickups hear both heads: the batter's pickups plus the snare head's velocity at
+ * its own pickup points.
+ *
+ * Threading: as membrane.h; the snare advances inside membrane_process() of the
+ * batter it is attached to (one coupling point), never allocating there. */
 #ifndef ICTUS_SNARE_WIRES_H
 #define ICTUS_SNARE_WIRES_H
 
@@ -18,26 +29,40 @@
 extern "C" {
 #endif
 
-#define SNARE_WIRES_MASSES 2
+#define SNARE_WIRE_SEGMENTS 8       /* snare_step() sums over eight at once */
+#define SNARE_POINTS        1       /* coupling points taken on the batter */
+#define SNARE_HEAD_F_MAX    10000.0 /* Hz, at most 0.4 x the sample rate */
 
 typedef struct snare_wires snare_wires;
 
-/* Wires at rest, detached. Allocates; NULL when memory cannot be had. */
+/* The snare side at rest, wires engaged, detached. Allocates; NULL when memory cannot
+ * be had. */
 snare_wires *snare_wires_new(void);
-/* Detaches them if attached, and frees them. */
+/* Detaches it if attached, and frees it. */
 void snare_wires_free(snare_wires *w);
-/* Lays the wires on m (detaching them from another membrane first): the masses start at
- * rest touching the head. ICTUS_ENOMEM when m has no room for SNARE_WIRES_MASSES more
- * coupling points or memory cannot be had (nothing attached). Allocates. */
+/* Puts the snare side under batter m (detaching it from another membrane first), at
+ * m's sample rate and radius: the heads and the wires start at rest. ICTUS_ENOMEM when
+ * m has no room for SNARE_POINTS more coupling points or memory cannot be had (nothing
+ * attached). Allocates. */
 ictus_status snare_wires_attach(snare_wires *w, membrane *m);
-/* Lifts them off their membrane (no-op when detached). */
+/* Takes it from under its membrane (no-op when detached). */
 void snare_wires_detach(snare_wires *w);
-/* The membrane they lie on, or NULL. */
+/* The membrane it is attached to, or NULL. */
 membrane *snare_wires_membrane(const snare_wires *w);
-/* Kinetic and potential energy of the masses (springs and collisions), J. */
+/* Wires on the snare head (1) or lifted off it by the strainer (0); the two heads
+ * stay coupled either way. Lifted wires come to rest at once; engaged again, they lie
+ * on the head where it is. Message time. */
+void snare_wires_engage(snare_wires *w, int on);
+int snare_wires_engaged(const snare_wires *w);
+/* Energy of the snare side (J): the snare head's modes, the air spring, the wires. */
 double snare_wires_energy(const snare_wires *w);
-/* Collisions so far (samples in which a mass was in contact), for tests. */
+/* Samples in which some wire segment touched the head, for tests. */
 long snare_wires_contact_samples(const snare_wires *w);
+/* The snare head: its mode count, and its (0, 1) frequency alone (Hz). */
+int snare_wires_head_modes(const snare_wires *w);
+double snare_wires_head_f01(const snare_wires *w);
+/* The air spring between the heads' mean displacements, N/m. */
+double snare_wires_air_stiffness(const snare_wires *w);
 
 #ifdef __cplusplus
 }

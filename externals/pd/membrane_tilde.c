@@ -83,29 +83,40 @@ static void membrane_tilde_setparam(t_membrane_tilde *x, t_symbol *s, int argc, 
     membrane_tilde_check_silent(x);
 }
 
-/* Lays the snare wires on the head (on) or lifts them (off); 1 when done. */
-static int membrane_tilde_set_wires(t_membrane_tilde *x, int on)
+/* Puts the snare side (snare head, air, wires: snare_wires.h) under the head, wires on
+ * or off (present), or takes it away (!present); 1 when done. */
+static int membrane_tilde_set_snare(t_membrane_tilde *x, int present, int on)
 {
     const char *sep = x->x_name != &s_ ? " " : "",
                *name = x->x_name != &s_ ? x->x_name->s_name : "";
-    if (!on) {
+    if (!present) {
         snare_wires_free(x->x_wires);
         x->x_wires = 0;
         return 1;
     }
-    if (x->x_wires)
-        return 1;
-    x->x_wires = snare_wires_new();
-    if (!x->x_wires || snare_wires_attach(x->x_wires, x->x_core) != ICTUS_OK) {
-        pd_error(x,
-                 "membrane~%s%s: wires: no room for the wires' %d coupling points (at most %d "
-                 "with the sticks) or out of memory: no wires",
-                 sep, name, SNARE_WIRES_MASSES, MEMBRANE_MAX_POINTS);
-        snare_wires_free(x->x_wires);
-        x->x_wires = 0;
-        return 0;
+    if (!x->x_wires) {
+        x->x_wires = snare_wires_new();
+        if (!x->x_wires || snare_wires_attach(x->x_wires, x->x_core) != ICTUS_OK) {
+            pd_error(x,
+                     "membrane~%s%s: wires: no room for the snare's %d coupling point (at most "
+                     "%d with the sticks) or out of memory: no snare",
+                     sep, name, SNARE_POINTS, MEMBRANE_MAX_POINTS);
+            snare_wires_free(x->x_wires);
+            x->x_wires = 0;
+            return 0;
+        }
     }
+    snare_wires_engage(x->x_wires, on);
     return 1;
+}
+
+/* wires on lays the snare side under the head if it is not there; off lifts the wires
+ * (the snare head and the air stay). */
+static int membrane_tilde_set_wires(t_membrane_tilde *x, int on)
+{
+    if (!on && !x->x_wires)
+        return 1;
+    return membrane_tilde_set_snare(x, 1, on);
 }
 
 /* wires on|off (or 1|0): the snare wires, colliding with the head (snare_wires.h). */
@@ -141,11 +152,12 @@ static void membrane_tilde_preset(t_membrane_tilde *x, t_symbol *s, int argc, t_
                  atom_getsymbol(&argv[0])->s_name, membrane_preset_names());
         return;
     }
-    membrane_tilde_set_wires(x, 0); /* the points' shapes follow the new modes */
+    membrane_tilde_set_snare(x, 0, 0); /* the snare follows the new head */
     if (membrane_apply_preset(x->x_core, p) == ICTUS_ENOMEM)
         pd_error(x, "membrane~%s%s: preset %s: out of memory for %d modes; kept %d", sep, name,
                  p->name, p->modes, membrane_get_modes(x->x_core));
-    membrane_tilde_set_wires(x, p->wires);
+    if (p->wires)
+        membrane_tilde_set_snare(x, 1, 1);
     membrane_tilde_check_silent(x);
 }
 
@@ -213,6 +225,10 @@ static void membrane_tilde_print(t_membrane_tilde *x)
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_GAIN),
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_TENSION_MOD),
          membrane_get_sample_rate(core));
+    if (x->x_wires)
+        post("membrane~ %s: snare head %d modes, wires %s",
+             x->x_name != &s_ ? x->x_name->s_name : "(no name)",
+             snare_wires_head_modes(x->x_wires), snare_wires_engaged(x->x_wires) ? "on" : "off");
     for (k = 0; k < count && k < 12; k++) {
         double f, t60;
         int bm, bn, sinp;

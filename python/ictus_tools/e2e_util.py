@@ -42,6 +42,11 @@ THRESHOLD = 1e-7    # |y| above this after silence is an onset
 QUIET_S = 0.010     # silence needed before an onset
 
 
+# strikes.csv's integer columns (docs/osc.md); the others are reals. A column this does not
+# know (a newer file) is read as a real.
+INTEGER_COLUMNS = ("seq", "hand", "drum", "bounce", "stroke", "stick_tip")
+
+
 def read_strikes(path):
     """strikes.csv -> list of dicts (numbers converted), in file order."""
     with open(path) as f:
@@ -56,7 +61,7 @@ def read_strikes(path):
             raise ValueError("%s:%d: %d columns, header has %d" % (path, n, len(cells), len(header)))
         row = {}
         for name, cell in zip(header, cells):
-            row[name] = int(cell) if name in ("seq", "hand", "drum", "bounce", "stroke") else float(cell)
+            row[name] = int(cell) if name in INTEGER_COLUMNS else float(cell)
         rows.append(row)
     return rows
 
@@ -91,13 +96,16 @@ def hit_times_us(events):
 
 def drum_lines(render_json):
     """The drum of render.json as render-drum lines for ictus-render (membrane~
-    parameters: the preset first, when there is one, then the head's numbers; and
-    the stick tip to both contact~, when the physics has one)."""
+    parameters: the preset first, when there is one, then the head's numbers; the
+    head's stretching k3 and the stick tip to both contact~, when the physics has them)."""
     with open(render_json) as f:
         drum = json.load(f)["drum"]
     preset = ["render-drum preset %s" % drum["preset"]] if drum.get("preset") else []
     tip = drum.get("stick_tip") or ""
     tips = ["render-drum %s tip %s" % (hand, tip) for hand in ("left", "right")] if tip else []
+    k3 = drum.get("contact_stretch_n_per_m3") or 0.0
+    if k3 > 0.0:
+        tips = ["render-drum %s stretch %.9g" % (hand, k3) for hand in ("left", "right")] + tips
     return preset + ["render-drum radius %.6g" % drum["radius_m"],
             "render-drum tension %.6g" % drum["tension_n_per_m"],
             "render-drum density %.6g" % drum["density_kg_per_m2"]] + tips

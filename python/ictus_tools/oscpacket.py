@@ -2,15 +2,16 @@
 daemon code and of liblo, for the tests and the latency benchmark.
 
 Strikes follow docs/osc.md: a bundle whose timetag is the strike time plus a
-lookahead, holding /ictus/strike ,iiiiffffffffffffff."""
+lookahead, holding /ictus/strike ,iiiiffffffffffffffi."""
 import struct
 import time
 
 NTP_UNIX_OFFSET = 2208988800  # seconds from 1900 (NTP) to 1970 (Unix)
-STRIKE_TAGS = "iiiiffffffffffffff"
+STRIKE_TAGS = "iiiiffffffffffffffi"
 STRIKE_FIELDS = ["seq", "hand", "drum", "bounce", "time_s", "x_m", "y_m", "r_over_a", "theta_deg",
                  "normal_velocity_mps", "tangential_velocity_mps", "peak_force_n", "impulse_ns",
-                 "duration_ms", "force_dir_x", "force_dir_y", "force_dir_z", "stick_mass_kg"]
+                 "duration_ms", "force_dir_x", "force_dir_y", "force_dir_z", "stick_mass_kg",
+                 "stick_tip"]
 
 
 def osc_string(s):
@@ -49,11 +50,11 @@ def bundle(tag_bytes, *elements):
 
 
 def strike(seq, hand, velocity=2.0, r_over_a=0.3, theta_deg=0.0, bounce=0, time_s=0.0,
-           peak_force_n=50.0, stick_mass_kg=0.03):
+           peak_force_n=50.0, stick_mass_kg=0.03, stick_tip=1):
     """A /ictus/strike message with plausible values for the fields not given."""
     return message("/ictus/strike", STRIKE_TAGS, seq, hand, 0, bounce, time_s, 0.05, 0.0,
                    r_over_a, theta_deg, velocity, 0.1, peak_force_n, 0.01, 1.0, 0.0, 0.0, -1.0,
-                   stick_mass_kg)
+                   stick_mass_kg, stick_tip)
 
 
 def now():

@@ -142,7 +142,7 @@ TEST_CASE("the legato unit against the real stroke (time and amplitude normalise
 
     for (Grip g : {Grip::french, Grip::german}) {
         // The recording is a full stroke (0.56 m, ~9 m/s): the loudest legato is its kin
-        // (d = 1, 0.36 m; heights follow d^1.1, docs/gestures.md).
+        // (d = 1, 0.36 m; heights follow d^1.3, docs/gestures.md).
         const GestureUnit m = stroke_model(g, Nuance::legato, Side::right, 1.0, period);
         const double H_model = m.preparation_height_m();
         Normalised mn;

@@ -98,6 +98,8 @@ ictus::StrikeEvent sample_strike(long seq, double time_s)
     e.impulse_n_s = 0.125;
     e.duration_ms = 4.5;
     e.force_dir = Eigen::Vector3d(0.6, -0.8, 0.0);
+    e.stick_mass_kg = 0.0125;
+    e.stick_tip = static_cast<int>(seq % 4); // none, wood, nylon, felt
     e.zone = seq == 3 ? ictus::kZoneRim : ictus::kZoneHead;
     return e;
 }
@@ -124,8 +126,8 @@ TEST_CASE("osc out: strike bundles reach oscdump with the fixed layout and timet
     for (long i = 0; i < 4; ++i) {
         DumpLine d;
         REQUIRE(next_dump(*dump, "/ictus/strike", d));
-        CHECK(d.types == "iiiiffffffffffffff");
-        REQUIRE(d.args.size() == 18);
+        CHECK(d.types == "iiiiffffffffffffffi");
+        REQUIRE(d.args.size() == 19);
         CHECK(std::stol(d.args[0]) == i);
         CHECK(std::stoi(d.args[1]) == i % 2);
         CHECK(std::stoi(d.args[2]) == 0);
@@ -135,6 +137,8 @@ TEST_CASE("osc out: strike bundles reach oscdump with the fixed layout and timet
         for (int k = 0; k < 13; ++k)
             CHECK(std::stod(d.args[4 + k]) ==
                   Approx(expected[k]).margin(2e-6 * (1 + std::fabs(expected[k]))));
+        CHECK(std::stod(d.args[17]) == Approx(0.0125).margin(1e-9)); // stick_mass_kg
+        CHECK(std::stoi(d.args[18]) == i % 4);                       // stick_tip
         // The timetag, to the last bit of the fraction: 2^-32 s steps.
         CHECK(d.timetag == hex_timetag(ictus::ntp_add_seconds(epoch, times[i] + 0.02)));
     }
@@ -236,6 +240,58 @@ TEST_CASE("osc out: /ictus/strike/end carries the field table's end fields, at t
     sender.stop();
     CHECK(sender.counters().strike_ends_sent == 1);
     CHECK(sender.counters().strikes_sent == 0);
+}
+
+TEST_CASE("osc out: the kit goes out as /ictus/kit and one /ictus/kit/drum per drum, at once "
+          "and again on request, never without a kit",
+          "[net][link]")
+{
+    int port = 0;
+    auto dump = start_oscdump(port);
+    ictus::OscSenderOptions o;
+    o.target_url = "osc.udp://127.0.0.1:" + std::to_string(port);
+    {
+        // No kit: a request sends nothing (the strike queued after it comes first).
+        ictus::OscSender bare(o);
+        bare.send_kit();
+        REQUIRE(bare.post_strike(sample_strike(0, 0.5)));
+        std::string line;
+        REQUIRE(dump->line(line, 3000));
+        CHECK(parse_dump(line).path == "/ictus/strike");
+        bare.stop();
+        CHECK(bare.counters().kits_sent == 0);
+    }
+    ictus::OscSender sender(o);
+    sender.set_kit("standard", {{0, "snare", "snare", 0.1778, 3603.0, 0.0},
+                                {1, "tom1", "tom", 0.127, 1231.0, 0.1875}});
+    // Set once: a second kit is ignored (the strike thread may be reading the first).
+    sender.set_kit("other", {{0, "x", "paper", 0.2, 3000.0, 0.0}});
+    for (int round = 0; round < 2; ++round) {
+        sender.send_kit();
+        DumpLine d;
+        REQUIRE(next_dump(*dump, "/ictus/kit", d));
+        CHECK(d.types == "si");
+        REQUIRE(d.args.size() == 2);
+        CHECK(d.args[0].find("standard") != std::string::npos);
+        CHECK(std::stoi(d.args[1]) == 2);
+        const char *names[] = {"tom1", "tom"};
+        const double radius[] = {0.1778, 0.127}, tension[] = {3603.0, 1231.0},
+                     pan[] = {0.0, 0.1875};
+        for (int i = 0; i < 2; ++i) {
+            REQUIRE(next_dump(*dump, "/ictus/kit/drum", d));
+            CHECK(d.types == "issfff");
+            REQUIRE(d.args.size() == 6);
+            CHECK(std::stoi(d.args[0]) == i);
+            CHECK(d.args[2].find(i ? names[1] : "snare") != std::string::npos);
+            if (i == 1)
+                CHECK(d.args[1].find(names[0]) != std::string::npos);
+            CHECK(std::stod(d.args[3]) == Approx(radius[i]).epsilon(1e-6));
+            CHECK(std::stod(d.args[4]) == Approx(tension[i]).epsilon(1e-6));
+            CHECK(std::stod(d.args[5]) == Approx(pan[i]).margin(1e-6));
+        }
+    }
+    sender.stop();
+    CHECK(sender.counters().kits_sent == 2);
 }
 
 TEST_CASE("osc out: a receiver holds a strike bundle until its timetag", "[net][link]")

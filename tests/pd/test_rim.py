@@ -1,4 +1,4 @@
-"""The rim click of ictus-drum (docs/sound.md, "The rim") in the real pd binary.
+"""The rim click of ictus-drum (docs/rim.md) in the real pd binary.
 
 1. ictus-drum: `rim <hand> <velocity> <r/a> <theta> <mass>` plays the same head stroke as
    the plain list and adds the hoop's click. The difference of the two drums' pickups is the
@@ -31,7 +31,7 @@ lib = os.path.join(build, "ictus")
 work = make_workdir("ictus-rim-")
 sr = 48000
 
-# The hoop (docs/sound.md), its modes from the ring formula.
+# The hoop (docs/rim.md), its modes from the ring formula.
 E, RHO, R, K, ETA = 200e9, 7850.0, 0.183, 0.003, 0.02
 modes = [(K / R ** 2) * math.sqrt(E / RHO) * n * (n * n - 1) / math.sqrt(n * n + 1) / (2 * math.pi)
          for n in range(2, 11)]
@@ -102,7 +102,7 @@ for f in modes[1:5]:
 
 def centroid(sig):
     """Spectral centroid of the first 50 ms from the onset (no taper: the strike starts
-    from silence), printed as a measurement for docs/sound.md."""
+    from silence), printed as a measurement for docs/rim.md."""
     seg = sig[onset:onset + int(0.05 * sr)]
     s = np.abs(np.fft.rfft(seg, 1 << 15)) ** 2
     fr = np.fft.rfftfreq(1 << 15, 1.0 / sr)

@@ -1,9 +1,11 @@
-"""The snare preset's wires in the real pd binary: a mezzo-forte stroke (a 50 g wood
-stick at 2.5 m/s through contact~, r/a 0.3) on membrane~ "preset snare", wires on and
-off. The wires collide with the head (on and off differ from the first samples of
-the stroke on), the output stays finite, and a bad "wires" argument is an error naming
-the object. The bandwidth holding 95 % of the energy of the first 50 ms is printed
-(docs/sound.md records it; a recorded snare reaches 8.2-8.6 kHz).
+"""The snare preset in the real pd binary: a mezzo-forte stroke (a 50 g wood stick at
+2.5 m/s through contact~, r/a 0.3) on membrane~ "preset snare" (batter, snare head, the
+shell's air, wires), wires on and off. The wires collide with the snare head (on and
+off differ within 5 ms of the stroke), they raise the bandwidth holding 95 % of the
+energy of the first 50 ms, the output stays finite, and a bad "wires" argument is an
+error naming the object. The bandwidths are printed (docs/sound.md records them; the
+acceptance asks >= 4 kHz with the wires, which this model does not reach; a recorded
+snare reaches 8.2-8.6 kHz).
 
 95 % bandwidth: the frequency below which the periodogram (rectangular window, the
 50 ms from the stroke's first sample) holds 95 % of the energy."""
@@ -59,14 +61,17 @@ def bandwidth95(y):
     power = np.abs(np.fft.rfft(seg)) ** 2
     cum = np.cumsum(power) / np.sum(power)
     freqs = np.fft.rfftfreq(len(seg), 1.0 / sr)
-    return freqs[np.searchsorted(cum, 0.95)], np.sqrt(np.mean(seg ** 2))
+    above = np.sum(power[freqs >= 4000.0]) / np.sum(power)
+    return freqs[np.searchsorted(cum, 0.95)], np.sqrt(np.mean(seg ** 2)), above
 
 
-bw_on, rms_on = bandwidth95(x[:, 0])
-bw_off, rms_off = bandwidth95(x[:, 1])
-print("95 %% bandwidth: wires on %.0f Hz (rms %.3g), off %.0f Hz (rms %.3g)"
-      % (bw_on, rms_on, bw_off, rms_off))
+bw_on, rms_on, hf_on = bandwidth95(x[:, 0])
+bw_off, rms_off, hf_off = bandwidth95(x[:, 1])
+print("95 %% bandwidth: wires on %.0f Hz (rms %.3g, %.2f %% of the energy above 4 kHz), "
+      "off %.0f Hz (rms %.3g, %.3f %% above 4 kHz)"
+      % (bw_on, rms_on, 100.0 * hf_on, bw_off, rms_off, 100.0 * hf_off))
 check(rms_on > 0 and rms_off > 0, "both sound")
+check(bw_off < bw_on, "the wires raise the 95 %% bandwidth (%.0f Hz off, %.0f Hz on)" % (bw_off, bw_on))
 first = np.flatnonzero(np.abs(x[:, 1]) > 0)[0]
 differ = np.flatnonzero(x[:, 0] != x[:, 1])
 check(len(differ) > 0 and differ[0] < first + int(0.005 * sr),

@@ -38,11 +38,12 @@ nested = message("/ictus/pong", "")
 for _ in range(10):  # deeper than ictus_timetag's limit of 8
     nested = bundle(timetag(now()), nested)
 bad.append(nested)
-# 18 arguments but not the fixed type tags of /ictus/strike (docs/osc.md), and the
-# 17 of the layout before stick_mass_kg
-bad.append(message("/ictus/strike", "iiiiffffffffffffff".replace("i", "f"), *range(18)))
-bad.append(message("/ictus/strike", "iiiifffffffffffffs", *range(17), "x"))
+# 19 arguments but not the fixed type tags of /ictus/strike (docs/osc.md), and the
+# 17 and 18 of the layouts before stick_mass_kg and before stick_tip
+bad.append(message("/ictus/strike", "iiiiffffffffffffffi".replace("i", "f"), *range(19)))
+bad.append(message("/ictus/strike", "iiiiffffffffffffffs", *range(18), "x"))
 bad.append(message("/ictus/strike", "iiiifffffffffffff", *range(17)))
+bad.append(message("/ictus/strike", "iiiiffffffffffffff", *range(18)))
 bad.append(bundle(timetag(now()), message("/ictus/strike", "ii", 1, 2)))  # 2 arguments
 # every truncation of a good strike bundle, except 16 bytes (a valid empty bundle)
 bad += [good[:n] for n in range(1, len(good)) if n != 16]
@@ -102,9 +103,9 @@ lines = [l for l in log.splitlines() if l.strip()]
 timetag_errors = [l for l in lines if "ictus_timetag: malformed OSC packet" in l]
 check(len(timetag_errors) == 5, "the first 5 malformed packets are reported by name (%d)"
       % len(timetag_errors))
-# the four new ones, and the ,q / ,iiii / ,i strikes above (caught by their tags first)
-check(sum(1 for m in malformed[:len(bad)] if m[3] == "unexpected-type-tags") == 7,
-      "strikes with other type tags than ,iiiiffffffffffffff are refused (unexpected-type-tags)")
+# the five new ones, and the ,q / ,iiii / ,i strikes above (caught by their tags first)
+check(sum(1 for m in malformed[:len(bad)] if m[3] == "unexpected-type-tags") == 8,
+      "strikes with other type tags than ,iiiiffffffffffffffi are refused (unexpected-type-tags)")
 # Pd's own note that a send of the report path ([netsend] to this test) took
 # long ("verbose(3): netsend/netreceive: blocked 8 msec": the process was off the
 # CPU, once under a loaded ASan run) says nothing about the packets: not counted.

@@ -81,7 +81,8 @@ try:
             time.sleep(0.0005)
         hand, vel, ra, th = seq % 2, 0.5 + 0.25 * seq, 0.01 * seq, 7.0 * seq
         mass = 0.01 + 0.001 * seq
-        out.sendto(bundle(timetag(t_next), strike(seq, hand, vel, ra, th, stick_mass_kg=mass)),
+        out.sendto(bundle(timetag(t_next), strike(seq, hand, vel, ra, th, stick_mass_kg=mass,
+                                                          stick_tip=seq % 4)),
                    ("127.0.0.1", pd_port))
         sent[seq] = (t_next, hand, vel, ra, th, mass)
         t_next += SPACING_S
@@ -132,13 +133,13 @@ for seq, (tag, hand, vel, ra, th, mass) in sorted(sent.items()):
     t_arr, a = fires[seq]
     logical_ms = a[1]
     fields = a[2:]
-    check(len(fields) == 18, "strike %d has 18 fields" % seq)
+    check(len(fields) == 19, "strike %d has 19 fields" % seq)
     # documented order: hand velocity r/a theta mass force bounce drum seq time x y vt J dur
-    # dx dy dz
+    # dx dy dz tip
     check(abs(fields[0] - hand) < 1e-6 and abs(fields[1] - vel) < 1e-4
           and abs(fields[2] - ra) < 1e-5 and abs(fields[3] - th) < 1e-3
           and abs(fields[4] - mass) < 1e-7 and abs(fields[5] - 50.0) < 1e-3 and fields[6] == 0
-          and fields[8] == seq and abs(fields[17] + 1.0) < 1e-6,
+          and fields[8] == seq and abs(fields[17] + 1.0) < 1e-6 and fields[18] == seq % 4,
           "strike %d fields in the documented order: %s" % (seq, fields))
     latency_ms = LATENCY_MS if seq > N_STRIKES // 2 else 0.0
     errors_ms.append((offset + logical_ms / 1000.0 - tag) * 1000.0 + latency_ms)

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """A kit played by the real `ictusd render --kit standard-timpani --wav` (docs/perform.md, "A kit"):
 a score on the snare, two toms and the timpani, both hands, moving between drums at 100 and
-150 bpm. Each written note gets one primary strike of its hand on its written drum within
+150 bpm (and two timpani played with felt mallets: the tip in strikes.csv and render.json).
+Each written note gets one primary strike of its hand on its written drum within
 +-5 ms (notes.csv, whose strike matching requires the drum, and strikes.csv's drum column), no
 extra primary strike, no stick part through a shell (render.json's kit.shell_passes), and each
 strike sounds from its own drum's membrane~: in the 150 ms after each strike onset, of the
@@ -163,11 +164,43 @@ def main():
     with open(score, "w") as f:
         f.write(TIMPANI)
     out = os.path.join(args.workdir, "timpani")
+    # pd through a wrapper that writes down its arguments: the drums' messages ictusd gives it
+    argv_log = os.path.join(os.path.abspath(args.workdir), "pd-argv.txt")
+    wrapper = os.path.join(os.path.abspath(args.workdir), "pd-logging")
+    with open(wrapper, "w") as f:
+        f.write('#!/bin/sh\nprintf "%%s\\n" "$@" > %s\nexec pd "$@"\n' % argv_log)
+    os.chmod(wrapper, 0o755)
     run = subprocess.run([args.ictusd, "render", "--kit", "timpani", "--score", score, "--out",
-                          out, "--force"], capture_output=True, text=True, timeout=600)
-    ok &= check(run.returncode == 0, "ictusd render --kit timpani: exit %d %s"
+                          out, "--force", "--stick-tip", "felt", "--wav",
+                          os.path.join(out, "timpani.wav"), "--pd", wrapper],
+                         capture_output=True, text=True, timeout=600, env=env)
+    ok &= check(run.returncode == 0, "ictusd render --kit timpani --stick-tip felt: exit %d %s"
                 % (run.returncode, run.stderr))
-    ok &= played_right(out, ["timpani1", "timpani2"])[4]
+    _, strikes, _, _, played = played_right(out, ["timpani1", "timpani2"])
+    ok &= played
+    # The sticks' tip in the record (docs/osc.md): felt is code 3 (stick_tip.h's order + 1), on
+    # every strike and every kit drum of render.json.
+    with open(os.path.join(out, "render.json")) as f:
+        summary = json.load(f)
+    ok &= check(all(s["stick_tip"] == "3" for s in strikes), "every strike's stick_tip is 3 (felt)")
+    ok &= check(summary["drum"]["stick_tip"] == "felt" and summary["drum"]["stick_tip_code"] == 3
+                and all(d["stick_tip"] == "felt" for d in summary["kit"]["drums"]),
+                "render.json: the drum's and each kit drum's stick tip is felt")
+    with open(argv_log) as f:
+        sends = f.read().split("\n")
+    want = ["render-drum left tip felt", "render-drum right tip felt",
+            "render-kit-1 left tip felt", "render-kit-1 right tip felt"]
+    ok &= check(all(w in sends for w in want), "the render gives every drum's sticks the tip: %s"
+                % [l for l in sends if " tip " in l])
+    # The installed example (no sound): a groove and a fill on the standard kit.
+    example = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "examples",
+                           "scores", "kit.txt")
+    out = os.path.join(args.workdir, "example")
+    run = subprocess.run([args.ictusd, "render", "--kit", "standard", "--score", example, "--out",
+                          out, "--force"], capture_output=True, text=True, timeout=600)
+    ok &= check(run.returncode == 0, "ictusd render --kit standard examples/scores/kit.txt: "
+                "exit %d %s" % (run.returncode, run.stderr))
+    ok &= played_right(out, ["floor", "snare", "tom1", "tom2"])[4]
     return 0 if ok else 1
 
 

@@ -349,6 +349,7 @@ TEST_CASE("strike: CSV and events lines have fixed, documented formats", "[sim][
     e.duration_ms = 7.1302;
     e.force_dir = Eigen::Vector3d(0.0, -1.0, 0.0);
     e.stick_mass_kg = 0.0123456;
+    e.stick_tip = ictus::stick_tip_code("felt");
     e.zone = ictus::kZoneRim;
     std::ostringstream csv;
     ictus::write_strikes_csv_header(csv);
@@ -356,9 +357,17 @@ TEST_CASE("strike: CSV and events lines have fixed, documented formats", "[sim][
     CHECK(csv.str() ==
           "seq,hand,drum,bounce,stroke,time_s,x_m,y_m,r_over_a,theta_deg,normal_velocity_mps,"
           "tangential_velocity_mps,peak_force_n,impulse_n_s,duration_ms,force_dir_x,force_dir_y,"
-          "force_dir_z,stick_mass_kg,zone\n"
+          "force_dir_z,stick_mass_kg,stick_tip,zone\n"
           "3,1,0,1,2,1.250000,0.05000,0.00000,0.28090,0.00,1.5000,0.2000,19.123,0.090000,7.130,"
-          "0.0000,-1.0000,0.0000,0.01235,1\n");
+          "0.0000,-1.0000,0.0000,0.01235,3,1\n");
+    // The tip codes: stick_tip.h's table order + 1, 0 for none (docs/osc.md).
+    CHECK(ictus::stick_tip_code("") == 0);
+    CHECK(ictus::stick_tip_code("wood") == 1);
+    CHECK(ictus::stick_tip_code("nylon") == 2);
+    CHECK(ictus::stick_tip_code("bamboo") == 0);
+    CHECK(ictus::stick_tip_name(3) == "felt");
+    CHECK(ictus::stick_tip_name(0).empty());
+    CHECK(ictus::stick_tip_name(4).empty());
     std::ostringstream ev;
     ictus::write_events_line(ev, e, 1.0);
     CHECK(ev.str() == "250.000 hit 1 0 1 1.5000 0.28090 0.00 19.123 0.090000 7.130 0.2000 1.250000 "

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 
 namespace ictus
@@ -38,69 +39,83 @@ int midi_velocity(double normal_velocity_mps)
 namespace
 {
 
-// The tempo map in ticks: each segment starts on a whole tick, at the time
-// the previous segments give that tick (so a reader's tick -> seconds is
-// exactly the map used here).
+// The file's clock: each tempo's tick at the time the previous tempi give
+// it (so a reader's tick -> seconds is exactly the map used here).
 struct TempoSegment {
     long tick;
     double time_s;
-    uint32_t us_per_quarter;
+    long us_per_quarter;
 };
 
-class TempoMap
+class FileClock
 {
   public:
-    explicit TempoMap(const std::vector<MidiTempo> &tempo)
+    explicit FileClock(const std::vector<MidiTempo> &tempo)
     {
-        if (tempo.empty())
-            throw std::invalid_argument("standard_midi_file: empty tempo map");
-        segments_.push_back({0, 0.0, us_per_quarter(tempo.front().bpm)});
-        for (size_t i = 1; i < tempo.size(); ++i) {
-            const uint32_t us = us_per_quarter(tempo[i].bpm);
-            if (us == segments_.back().us_per_quarter)
-                continue;
-            const long tick = std::max(tick_of(tempo[i].time_s), segments_.back().tick);
-            if (tick == segments_.back().tick) {
-                segments_.back().us_per_quarter = us;
+        if (tempo.empty() || tempo.front().tick != 0)
+            throw std::invalid_argument("standard_midi_file: no tempo at tick 0");
+        for (const MidiTempo &t : tempo) {
+            if (t.us_per_quarter < 1 || t.us_per_quarter > 0xffffff)
+                throw std::invalid_argument("standard_midi_file: tempo out of range");
+            if (!segments_.empty() && t.tick < segments_.back().tick)
+                throw std::invalid_argument("standard_midi_file: tempi out of order");
+            if (!segments_.empty() && t.tick == segments_.back().tick) {
+                segments_.back().us_per_quarter = t.us_per_quarter;
                 continue;
             }
-            segments_.push_back({tick, time_of(tick), us});
+            if (!segments_.empty() && t.us_per_quarter == segments_.back().us_per_quarter)
+                continue;
+            segments_.push_back({t.tick, time_of(t.tick), t.us_per_quarter});
         }
     }
     long tick_of(double time_s) const
     {
-        const TempoSegment &s = segment_at(time_s);
-        return s.tick +
-               std::lround((time_s - s.time_s) * 1e6 / s.us_per_quarter * kMidiTicksPerQuarter);
-    }
-    const std::vector<TempoSegment> &segments() const { return segments_; }
-
-  private:
-    static uint32_t us_per_quarter(double bpm)
-    {
-        if (!(bpm >= 4.0 && bpm <= 1000.0))
-            throw std::invalid_argument("standard_midi_file: tempo " + std::to_string(bpm) +
-                                        " bpm outside 4..1000");
-        return static_cast<uint32_t>(std::lround(60e6 / bpm));
-    }
-    const TempoSegment &segment_at(double time_s) const
-    {
         size_t k = 0;
         while (k + 1 < segments_.size() && segments_[k + 1].time_s <= time_s)
             ++k;
-        return segments_[k];
+        const TempoSegment &s = segments_[k];
+        return s.tick + std::lround((time_s - s.time_s) * 1e6 /
+                                    static_cast<double>(s.us_per_quarter) * kMidiTicksPerQuarter);
     }
     double time_of(long tick) const
     {
+        if (segments_.empty())
+            return 0.0;
         size_t k = 0;
         while (k + 1 < segments_.size() && segments_[k + 1].tick <= tick)
             ++k;
         const TempoSegment &s = segments_[k];
-        return s.time_s +
-               static_cast<double>(tick - s.tick) / kMidiTicksPerQuarter * s.us_per_quarter * 1e-6;
+        return s.time_s + static_cast<double>(tick - s.tick) / kMidiTicksPerQuarter *
+                              static_cast<double>(s.us_per_quarter) * 1e-6;
     }
+    const std::vector<TempoSegment> &segments() const { return segments_; }
+
+  private:
     std::vector<TempoSegment> segments_;
 };
+
+long beat_tick(double beat)
+{
+    return std::lround(beat * kMidiTicksPerQuarter);
+}
+
+// Appends the tempo events of a ramp from tick t0 to t1 (file ticks),
+// `file_s` the file's time at t0 relative to the score's beat 0, kept up to
+// date; each step's tempo lands the file's time on the score's at its end.
+void append_ramp(const TempoMap &map, long pickup, long t0, long t1, double &file_s,
+                 std::vector<MidiTempo> &out)
+{
+    for (long t = t0; t < t1;) {
+        const long next = std::min(t1, t + kMidiRampStepTicks);
+        const double target =
+            map.time_at_beat(static_cast<double>(next - pickup) / kMidiTicksPerQuarter);
+        const double quarters = static_cast<double>(next - t) / kMidiTicksPerQuarter;
+        const long us = std::clamp(std::lround((target - file_s) * 1e6 / quarters), 1L, 0xffffffL);
+        out.push_back({t, us});
+        file_s += quarters * static_cast<double>(us) * 1e-6;
+        t = next;
+    }
+}
 
 struct TrackEvent {
     long tick;
@@ -175,10 +190,70 @@ std::string channel_message(int status, int channel, int a, int b)
 
 } // namespace
 
+long midi_us_per_quarter(double bpm)
+{
+    if (!(bpm >= 4.0 && bpm <= 1000.0))
+        throw std::invalid_argument("midi: tempo " + std::to_string(bpm) + " bpm outside 4..1000");
+    return std::lround(60e6 / bpm);
+}
+
+MidiTimeline midi_timeline(double bpm)
+{
+    MidiTimeline t;
+    t.tempo.push_back({0, midi_us_per_quarter(bpm)});
+    return t;
+}
+
+MidiTimeline midi_timeline(const TempoMap &map, const std::vector<ScoreMeter> &meters,
+                           double beat0_s, double earliest_s)
+{
+    MidiTimeline t;
+    const bool first_at_0 = !meters.empty() && meters.front().beat <= 0.0;
+    const int n = first_at_0 ? meters.front().numerator : 4;
+    const int d = first_at_0 ? meters.front().denominator : 4;
+    const long bar = std::max(1L, std::lround(n * 4.0 / d * kMidiTicksPerQuarter));
+    const long us0 = midi_us_per_quarter(map.tempo_at_beat(0.0));
+    const double bar_s = static_cast<double>(bar) / kMidiTicksPerQuarter * us0 * 1e-6;
+    int bars = 1;
+    while (bars < kMidiMaxPickupBars && earliest_s < beat0_s - bars * bar_s)
+        ++bars;
+    const long pickup = bars * bar;
+    t.first_beat_tick = pickup;
+    t.start_s = beat0_s - bars * bar_s;
+    t.tempo.push_back({0, us0});
+    if (!first_at_0)
+        t.meter.push_back({0, 4, 4});
+    for (const ScoreMeter &m : meters)
+        t.meter.push_back(
+            {m.beat <= 0.0 ? 0 : pickup + beat_tick(m.beat), m.numerator, m.denominator});
+    // The file's time relative to beat 0, tempo by tempo.
+    double file_s = 0.0;
+    long tick = pickup;
+    const std::vector<TempoMap::Change> &changes = map.changes();
+    for (size_t i = 0; i < changes.size(); ++i) {
+        const TempoMap::Change &c = changes[i];
+        const long start = pickup + beat_tick(c.beat);
+        const long next = i + 1 < changes.size() ? pickup + beat_tick(changes[i + 1].beat)
+                                                 : std::numeric_limits<long>::max();
+        file_s += static_cast<double>(start - tick) / kMidiTicksPerQuarter *
+                  static_cast<double>(t.tempo.back().us_per_quarter) * 1e-6;
+        tick = start;
+        if (c.ramp_beats > 0.0 && c.start_bpm != c.end_bpm) {
+            const long end = std::min(next, start + beat_tick(c.ramp_beats));
+            append_ramp(map, pickup, start, end, file_s, t.tempo);
+            tick = end;
+            if (end < next)
+                t.tempo.push_back({end, midi_us_per_quarter(c.end_bpm)});
+        } else {
+            t.tempo.push_back({start, midi_us_per_quarter(c.start_bpm)});
+        }
+    }
+    return t;
+}
+
 std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
-                               const std::vector<MidiTempo> &tempo, int channel,
-                               const std::vector<int> *drum_notes,
-                               const std::vector<MidiMeter> &meter)
+                               const MidiTimeline &timeline, int channel,
+                               const std::vector<int> *drum_notes)
 {
     auto note_of = [drum_notes](const StrikeEvent &e) {
         if (drum_notes && e.drum >= 0 && e.drum < static_cast<int>(drum_notes->size()))
@@ -187,25 +262,26 @@ std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
     };
     if (channel < 0 || channel > 15)
         throw std::invalid_argument("standard_midi_file: channel must be 0..15");
-    const TempoMap map(tempo);
+    const FileClock map(timeline.tempo);
     std::vector<TrackEvent> events;
     events.push_back({0, 0, -3, meta(0x03, "ictus")});
-    if (meter.empty() || meter.front().time_s > 0.0)
+    if (timeline.meter.empty() || timeline.meter.front().tick > 0)
         events.push_back({0, 0, -2, time_signature_meta(4, 4)});
-    for (const MidiMeter &m : meter)
-        events.push_back({m.time_s > 0.0 ? map.tick_of(m.time_s) : 0, 0, -2,
-                          time_signature_meta(m.numerator, m.denominator)});
+    for (const MidiMeter &m : timeline.meter)
+        events.push_back(
+            {std::max(0L, m.tick), 0, -2, time_signature_meta(m.numerator, m.denominator)});
     for (const TempoSegment &s : map.segments())
-        events.push_back({s.tick, 0, -1, tempo_meta(s.us_per_quarter)});
+        events.push_back({s.tick, 0, -1, tempo_meta(static_cast<uint32_t>(s.us_per_quarter))});
     for (size_t i = 0; i < strikes.size(); ++i) {
         const StrikeEvent &e = strikes[i];
         const int note = note_of(e);
-        const long on = map.tick_of(std::max(0.0, e.time_s));
+        const double at_s = e.time_s - timeline.start_s;
+        const long on = std::max(0L, map.tick_of(at_s));
         // The note ends after kMidiNoteLength_s, or where the same note strikes again.
-        double off_s = e.time_s + kMidiNoteLength_s;
+        double off_s = at_s + kMidiNoteLength_s;
         for (size_t j = i + 1; j < strikes.size(); ++j)
             if (note_of(strikes[j]) == note) {
-                off_s = std::min(off_s, strikes[j].time_s);
+                off_s = std::min(off_s, strikes[j].time_s - timeline.start_s);
                 break;
             }
         const long off = std::max(on + 1, map.tick_of(off_s));

@@ -2,6 +2,7 @@
 // BVH clip is read, how a stick-only CSV is read, the performance options of
 // run and render, the grip and the mode; and the output files of a verb.
 #include "ictus/cli/options.hpp"
+#include "ictus/score/midi_score.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -255,6 +256,9 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.score_name = path;
         if (o.score.score_text.empty())
             throw std::runtime_error("--score: '" + path + "' is empty");
+    } else if (a == "--midi") {
+        o.score.midi_path = value();
+        o.score.score_name = o.score.midi_path;
     } else if (a == "--gestures")
         o.score.gestures = value();
     else if (a == "--mode")
@@ -338,6 +342,39 @@ void OutputFile::close()
     out_.close();
     if (!out_)
         throw std::runtime_error("--out: error writing '" + path_ + "' (disk full?)");
+}
+
+void load_midi_score(PerformanceOptions &o)
+{
+    const std::string &path = o.score.midi_path;
+    if (path.empty())
+        return;
+    if (!o.score.score_text.empty() || !o.mocap.empty())
+        throw UsageError("--midi is a score: give one of --midi, --score, --mocap");
+    std::vector<MidiDrum> drums;
+    for (const KitDrum &d : o.kit.drums)
+        drums.push_back({d.name, d.midi_note});
+    MidiDrumPart part = load_midi_drum_part(path, drums);
+    std::ostringstream line;
+    long skipped = 0;
+    for (const auto &[note, count] : part.skipped) {
+        line << (skipped ? ", " : "") << "note " << note << " x" << count;
+        skipped += count;
+    }
+    if (skipped > 0)
+        std::cerr << "ictusd: warning: --midi " << path << ": " << skipped << " notes the "
+                  << (drums.empty() ? "drum" : "kit") << " cannot play left out (" << line.str()
+                  << ")\n";
+    if (part.too_fast > 0)
+        std::cerr << "ictusd: warning: --midi " << path << ": " << part.too_fast
+                  << " notes left out: no hand free (a third note at once, or under "
+                  << kMidiSameHandMin_s * 1e3 << " ms after both hands' last)\n";
+    if (part.tempo_clamped > 0)
+        std::cerr << "ictusd: warning: --midi " << path << ": " << part.tempo_clamped
+                  << " tempi kept within " << kMinTempoBpm << ".." << kMaxTempoBpm << " bpm\n";
+    std::cerr << "ictusd: --midi " << path << ": " << part.score.notes.size() << " notes from "
+              << (part.channel < 0 ? "every channel" : "channel 10") << "\n";
+    o.score.score = std::make_shared<const Score>(std::move(part.score));
 }
 
 } // namespace cli

@@ -142,7 +142,15 @@ std::vector<std::string> pd_command_line(const PdRenderOptions &o, const std::st
         sends.push_back(to + "radius " + format("%.9g", k.radius_m));
         sends.push_back(to + "tension " + format("%.9g", k.tension_n_per_m));
         sends.push_back(to + "pan " + format("%.6g", k.pan));
+        if (!o.stick_tip.empty()) { // the sticks play every drum with their tip
+            sends.push_back(to + "left tip " + o.stick_tip);
+            sends.push_back(to + "right tip " + o.stick_tip);
+        }
         sends.push_back(to + "dsp 1");
+    }
+    if (o.stretch_n_per_m3 > 0.0) { // the physics' head stretching on both sticks
+        sends.push_back("render-drum left stretch " + format("%.9g", o.stretch_n_per_m3));
+        sends.push_back("render-drum right stretch " + format("%.9g", o.stretch_n_per_m3));
     }
     if (!o.stick_tip.empty()) { // the physics' tip on both sticks (contact~ tip NAME)
         sends.push_back("render-drum left tip " + o.stick_tip);

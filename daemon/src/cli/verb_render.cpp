@@ -77,6 +77,8 @@ void render_usage(std::ostream &out)
            "\n"
            "score mode (run and render):\n"
            "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
+           "  --midi FILE         a Standard MIDI File's drum part as the score: snares and\n"
+           "                      toms of the General MIDI drum map (docs/midi.md, MIDI in)\n"
            "  --gestures DB.json  gesture database (default: the built-in one)\n"
            "  --mode M            cartesian (default, Algorithm 2) | joint (eq. 1, joint\n"
            "                      targets from the IK of the tip targets)\n"
@@ -302,6 +304,7 @@ nlohmann::json drum_json(const Performance &p)
     j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
     j["contact_stretch_n_per_m3"] = d.stretch_n_per_m3(); // the head's k3 (docs/sound.md)
     j["stick_tip"] = d.stick_tip;                         // "": none
+    j["stick_tip_code"] = stick_tip_code(d.stick_tip);    // strikes.csv's stick_tip
     return j;
 }
 
@@ -322,6 +325,7 @@ nlohmann::json kit_json(const Performance &p)
                          {"tension_n_per_m", d.tension_n_per_m},
                          {"shell_depth_m", d.shell_depth_m},
                          {"midi_note", k.midi_note},
+                         {"stick_tip", scene.options().drum.stick_tip}, // the sticks' ("": none)
                          {"shell_passes", scene.shell_passes(i)}});
     }
     return {{"name", kit.name}, {"drums", drums}, {"shell_passes", scene.shell_passes()}};
@@ -479,6 +483,7 @@ bool parse_render_args(Args &args, RenderArgs &r)
         return false;
     if (!r.o.mocap.empty() && !r.o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
+    load_midi_score(r.o);
     if (r.out_dir.empty())
         throw UsageError("--out DIR is required");
     if (!r.wav.empty()) {
@@ -591,30 +596,36 @@ int midi_channel(const RenderArgs &r, const Performance &perf)
     return static_cast<int>(r.midi_channel);
 }
 
-// performance.mid: the strikes as notes at the score's tempo at each note (a
-// clip: --tempo).
+// The clock of performance.mid (docs/midi.md): a score's beats on the
+// file's quarters, its beat 0 on a bar line after a pickup bar (a clip:
+// --tempo from render time 0).
+MidiTimeline midi_timeline_of(const Performance &perf, const RenderArgs &r, bool score_mode,
+                              const StrikeLog &log)
+{
+    if (!score_mode || !perf.plan())
+        return midi_timeline(score_mode ? kDefaultTempoBpm : r.o.tempo_bpm);
+    const ScorePerformOptions &so = perf.options().score;
+    const Score score =
+        so.score ? *so.score
+                 : parse_score(so.score_text.empty() ? default_score_text() : so.score_text,
+                               so.score_name);
+    const double beat0_s = perf.plan_origin_s() + perf.plan()->score_start_s;
+    double earliest_s = beat0_s;
+    for (const StrikeEvent &e : log.strikes())
+        earliest_s = std::min(earliest_s, e.time_s);
+    return midi_timeline(score.tempo, score.meters, beat0_s, earliest_s);
+}
+
+// performance.mid: the strikes as notes on the score's grid.
 std::string render_midi(const Performance &perf, const RenderArgs &r, bool score_mode,
                         const StrikeLog &log)
 {
-    std::vector<MidiTempo> tempo;
-    std::vector<MidiMeter> meter;
-    if (score_mode) {
-        // A grace stroke is not on a beat: the tempo is its note's.
-        for (const PlannedNote &n : perf.plan()->notes)
-            if (n.grace == Grace::none)
-                tempo.push_back({perf.plan_origin_s() + n.time_s, n.tempo_bpm});
-        // The score's meters; one at its beat 0 from the file's start.
-        for (const PlannedMeter &m : perf.plan()->meters)
-            meter.push_back({m.beat <= 0.0 ? 0.0 : perf.plan_origin_s() + m.time_s, m.numerator,
-                             m.denominator});
-    }
-    if (tempo.empty())
-        tempo.push_back({0.0, score_mode ? 120.0 : r.o.tempo_bpm});
     std::vector<int> drum_notes;
     for (const KitDrum &d : perf.options().kit.drums)
         drum_notes.push_back(d.midi_note);
-    return standard_midi_file(log.strikes(), tempo, midi_channel(r, perf) - 1,
-                              drum_notes.empty() ? nullptr : &drum_notes, meter);
+    return standard_midi_file(log.strikes(), midi_timeline_of(perf, r, score_mode, log),
+                              midi_channel(r, perf) - 1,
+                              drum_notes.empty() ? nullptr : &drum_notes);
 }
 
 // render.json but its "performance" (score mode).
@@ -624,7 +635,8 @@ nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool
     const long strikes = static_cast<long>(log.strikes().size());
     nlohmann::json j;
     if (score_mode)
-        j["score"] = r.o.score.score_text.empty() ? "default" : r.o.score.score_name;
+        j["score"] =
+            r.o.score.score_text.empty() && !r.o.score.score ? "default" : r.o.score.score_name;
     else
         j["mocap"] = r.o.mocap;
     j["duration_s"] = perf.time_s();
@@ -639,8 +651,11 @@ nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool
     j["drum"] = drum_json(perf);
     if (!perf.options().kit.empty())
         j["kit"] = kit_json(perf);
+    const MidiTimeline timeline = midi_timeline_of(perf, r, score_mode, log);
     j["midi"] = {{"file", "performance.mid"},
                  {"channel", midi_channel(r, perf)},
+                 {"tick0_time_s", timeline.start_s},
+                 {"first_beat_tick", timeline.first_beat_tick},
                  {"notes", strikes},
                  {"ticks_per_quarter", kMidiTicksPerQuarter}};
     return j;
@@ -726,11 +741,10 @@ int render_wav(RenderArgs &r, const Performance &perf)
     for (int i = 1; i < perf.scene().drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
         const KitDrum &k = kit.drums[static_cast<size_t>(i)];
         const DrumParams &kd = perf.scene().drum(i);
-        // Panned by its place: the performer's left (-x) to the left channel.
-        const double pan = std::clamp(-k.place_m.x() / 0.8, -0.6, 0.6);
-        pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, pan});
+        pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, kit_drum_pan(k)});
     }
     pd.stick_tip = d.stick_tip;
+    pd.stretch_n_per_m3 = d.stretch_n_per_m3();
     std::cout << "render: pd: " << pd.seconds << " s of sound into " << r.wav << " ..."
               << std::endl;
     const PdRenderResult result = run_pd_render(pd, [&](double s) {

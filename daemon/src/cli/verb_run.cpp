@@ -7,6 +7,7 @@
 #include "ictus/cli/verbs.hpp"
 #include "ictus/net/osc_sender.hpp"
 #include "ictus/net/osc_server.hpp"
+#include "ictus/perform/kit.hpp"
 #include "ictus/perform/realtime_loop.hpp"
 #include "ictus/perform/strike_log.hpp"
 #include "ictus/sim/strike_event.hpp"
@@ -36,13 +37,14 @@ namespace
 
 void run_usage(std::ostream &out)
 {
-    out << "usage: ictusd run [--mocap FILE | --score FILE] [options]\n"
+    out << "usage: ictusd run [--mocap FILE | --score FILE | --midi FILE] [options]\n"
            "\n"
            "Plays in real time, sends every strike to Pd as an OSC bundle time-tagged for\n"
            "exact scheduling, streams poses for graphics, and listens for commands (play,\n"
            "stop, score statements, mode, grip, drum ...). See docs/osc.md, docs/perform.md.\n"
            "With --mocap: the clip in joint space (eq. 1). Otherwise score mode: the score\n"
-           "(--score FILE, default: the built-in score) is planned into stick-tip targets and\n"
+           "(--score FILE, or --midi FILE: a Standard MIDI File's drum part, docs/midi.md;\n"
+           "default: the built-in score) is planned into stick-tip targets and\n"
            "performed (Cartesian mode by default); /ictus/score statements replace it at the\n"
            "next /ictus/play.\n"
            "\n"
@@ -208,7 +210,16 @@ class OscIo : public RealtimeIo
         : sender_(sender), server_(server), writer_(writer)
     {
     }
-    bool next_command(Command &out) override { return server_.pop_command(out); }
+    // A play sends the kit first (the sound's drums, docs/osc.md): a patch opened
+    // after the daemon has it before the first strike.
+    bool next_command(Command &out) override
+    {
+        if (!server_.pop_command(out))
+            return false;
+        if (out.kind == CommandKind::play)
+            sender_.send_kit();
+        return true;
+    }
     void refused(const Refusal &refusal) override { server_.post_refusal(refusal); }
     void strike_onset(const StrikeEvent &strike) override { sender_.post_strike(strike); }
     void strike_end(const StrikeEvent &strike) override { sender_.post_strike_end(strike); }
@@ -282,7 +293,22 @@ bool parse_run_args(Args &args, RunOptions &r)
     const PerformanceOptions &o = r.performance;
     if (!o.mocap.empty() && !o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
+    load_midi_score(r.performance);
     return true;
+}
+
+// The kit's drums as the sound plays them (none without a kit): each drum's
+// preset and head as the scene has them, panned by its place.
+std::vector<KitDrumSound> kit_sounds(const Performance &perf)
+{
+    std::vector<KitDrumSound> drums;
+    const Kit &kit = perf.options().kit;
+    for (int i = 0; i < perf.scene().drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
+        const KitDrum &k = kit.drums[static_cast<size_t>(i)];
+        const DrumParams &d = perf.scene().drum(i);
+        drums.push_back({i, k.name, k.preset, d.radius_m, d.tension_n_per_m, kit_drum_pan(k)});
+    }
+    return drums;
 }
 
 // DIR/strikes.csv, DIR created; empty without --out.
@@ -346,6 +372,8 @@ int cmd_run(Args &args)
     } else if (perf.score_mode()) {
         perf.start_score(); // a score that cannot be played ends here, exit 1
     }
+    sender.set_kit(perf.options().kit.name, kit_sounds(perf));
+    sender.send_kit(); // for a patch already listening; again at each play
     LiveStatus status;
     begin_status(perf, status);
     OscServer server(io, &status);

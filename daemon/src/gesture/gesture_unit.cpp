@@ -174,7 +174,7 @@ double GestureUnit::preparation_height_m() const
 
 double dynamics_height_factor(double dynamics)
 {
-    return std::pow(std::clamp(dynamics, 0.04, 1.0), 1.1);
+    return std::pow(std::clamp(dynamics, 0.04, 1.0), 1.3);
 }
 
 GestureDatabase GestureDatabase::builtin()

@@ -187,6 +187,21 @@ bool OscSender::post_strike_end(const StrikeEvent &event)
     return true;
 }
 
+void OscSender::set_kit(const std::string &kit_name, const std::vector<KitDrumSound> &drums)
+{
+    if (kit_set_.load(std::memory_order_acquire))
+        return; // once: the strike thread may be reading it
+    kit_name_ = kit_name;
+    kit_ = drums;
+    kit_set_.store(true, std::memory_order_release);
+}
+
+void OscSender::send_kit()
+{
+    kit_wanted_.store(true, std::memory_order_release);
+    sem_post(&impl_->strike_ready);
+}
+
 bool OscSender::post_pose(const PoseSnapshot &pose)
 {
     if (!poses_.push(pose))
@@ -210,6 +225,7 @@ OscSenderCounters OscSender::counters() const
     c.strike_ends_sent = strike_ends_sent_.load();
     c.poses_sent = poses_sent_.load();
     c.tips_sent = tips_sent_.load();
+    c.kits_sent = kits_sent_.load();
     c.send_errors = send_errors_.load();
     c.strikes_dropped = strikes_.dropped();
     c.poses_dropped = poses_.dropped();
@@ -252,6 +268,31 @@ void count_send(int result, std::atomic<unsigned long> &sent, std::atomic<unsign
 }
 } // namespace
 
+// The kit: /ictus/kit ,si name count, then /ictus/kit/drum ,issfff index name
+// preset radius tension pan per drum, in one bundle to be handled at once.
+void OscSender::send_kit_now()
+{
+    if (!kit_set_.load(std::memory_order_acquire) || kit_.empty())
+        return;
+    lo_bundle b = lo_bundle_new(LO_TT_IMMEDIATE);
+    lo_message head = lo_message_new();
+    lo_message_add_string(head, kit_name_.c_str());
+    lo_message_add_int32(head, static_cast<std::int32_t>(kit_.size()));
+    lo_bundle_add_message(b, "/ictus/kit", head);
+    for (const KitDrumSound &d : kit_) {
+        lo_message m = lo_message_new();
+        lo_message_add_int32(m, d.index);
+        lo_message_add_string(m, d.name.c_str());
+        lo_message_add_string(m, d.preset.c_str());
+        lo_message_add_float(m, static_cast<float>(d.radius_m));
+        lo_message_add_float(m, static_cast<float>(d.tension_n_per_m));
+        lo_message_add_float(m, static_cast<float>(d.pan));
+        lo_bundle_add_message(b, "/ictus/kit/drum", m);
+    }
+    count_send(lo_send_bundle(impl_->strike_target, b), kits_sent_, send_errors_);
+    lo_bundle_free_recursive(b);
+}
+
 void OscSender::strike_loop()
 {
     if (options_.realtime)
@@ -259,6 +300,9 @@ void OscSender::strike_loop()
     StrikeMessage sm;
     for (;;) {
         const bool running = running_.load();
+        // Before the strikes queued after the request: they may play on it.
+        if (kit_wanted_.exchange(false, std::memory_order_acq_rel))
+            send_kit_now();
         while (strikes_.pop(sm)) {
             const StrikeEvent &e = sm.event;
             // The strike sounds at its simulation time plus the lookahead, on

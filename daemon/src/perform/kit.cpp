@@ -2,8 +2,10 @@
 #include "ictus/perform/kit.hpp"
 
 #include "ictus/perform/perform_error.hpp"
+#include "membrane.h"
 #include "membrane_presets.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -30,6 +32,7 @@ KitDrum drum(const char *name, const char *preset, double diameter_in, double de
     d.place_m = place;
     d.radius_m = diameter_in > 0.0 ? 0.5 * diameter_in * kInch_m : p->radius_m;
     d.tension_n_per_m = p->tension_n_per_m;
+    d.density_kg_per_m2 = p->density_kg_per_m2;
     d.shell_depth_m = depth_in * kInch_m;
     d.midi_note = midi_note;
     return d;
@@ -93,6 +96,11 @@ double kit_min_gap_m(const Kit &kit)
     return gap;
 }
 
+double kit_drum_pan(const KitDrum &drum)
+{
+    return std::clamp(-drum.place_m.x() / 0.8, -0.6, 0.6);
+}
+
 int kit_drum_index(const Kit &kit, const std::string &name)
 {
     for (size_t i = 0; i < kit.drums.size(); ++i)
@@ -126,6 +134,8 @@ void validate_kit(const Kit &kit)
             throw PerformError(who + "radius must be 0.05..1 m");
         if (!(d.tension_n_per_m >= 10.0 && d.tension_n_per_m <= 1e5))
             throw PerformError(who + "tension must be 10..1e5 N/m");
+        if (!(d.density_kg_per_m2 >= MEMBRANE_DENSITY_MIN && d.density_kg_per_m2 <= MEMBRANE_DENSITY_MAX))
+            throw PerformError(who + "density must be 0.01..20 kg/m^2");
         if (!(d.shell_depth_m >= 0.01 && d.shell_depth_m <= 1.5))
             throw PerformError(who + "shell depth must be 0.01..1.5 m");
         if (!(d.place_m.allFinite() && d.place_m.cwiseAbs().maxCoeff() <= 2.0))
@@ -154,6 +164,9 @@ std::vector<DrumParams> place_kit(const Kit &kit, const DrumParams &base,
             anchor_m + d.place_m.x() * right + d.place_m.y() * up + d.place_m.z() * forward;
         p.radius_m = d.radius_m;
         p.tension_n_per_m = d.tension_n_per_m;
+        // Mylar, as membrane~'s head: the film as thick as the density says,
+        // for its stretching under the stick (DrumParams::stretch_n_per_m3).
+        p.head_thickness_m = d.density_kg_per_m2 / MEMBRANE_MYLAR_RHO;
         p.shell_depth_m = d.shell_depth_m;
         out.push_back(p);
     }

@@ -4,6 +4,7 @@
 // between steps, the runaway guard, and the background work handed to the
 // planning worker (planning_worker.hpp).
 #include "ictus/perform/performance.hpp"
+#include "membrane.h"
 
 #include "clip_mode.hpp"
 #include "ictus/perform/perform_error.hpp"
@@ -60,9 +61,20 @@ ScorePerformOptions::ScorePerformOptions()
     cartesian.max_joint_speed_rad_s = 35.0;
 }
 
+PlanOptions ScorePerformOptions::plan_for(TrackMode m) const
+{
+    PlanOptions p = plan;
+    if (m == TrackMode::joint && p.contact_lead_m > 0.0)
+        p.contact_lead_m += joint_contact_lead_m;
+    return p;
+}
+
 Performance::Performance(const PerformanceOptions &options)
     : options_(options), detector_(MembraneGeometry{}, options.strikes)
 {
+    // The head's film is as thick as its density says (membrane~'s head: Mylar), for
+    // its stretching under the stick (DrumParams::stretch_n_per_m3).
+    options_.scene.drum.head_thickness_m = options_.drum_density_kg_per_m2 / MEMBRANE_MYLAR_RHO;
     validate(options_.scene);
     if (!(options_.clip_bpm > 0.0 && std::isfinite(options_.clip_bpm)))
         throw PerformError("clip tempo: expected a finite value > 0 bpm");

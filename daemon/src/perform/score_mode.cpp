@@ -65,8 +65,11 @@ ScoreMode::ScoreMode(Performance &performance) : perf_(performance)
     db_ = std::make_unique<GestureDatabase>(
         so.gestures.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(so.gestures));
     builder_ = std::make_unique<ScoreBuilder>("osc");
-    score_ = std::make_shared<const Score>(
-        parse_score(so.score_text.empty() ? default_score_text() : so.score_text, so.score_name));
+    score_ =
+        so.score
+            ? so.score
+            : std::make_shared<const Score>(parse_score(
+                  so.score_text.empty() ? default_score_text() : so.score_text, so.score_name));
     if (!so.grip_given && !score_->notes.empty())
         o.character.grip = score_->notes.front().grip;
     score_first_bpm_ = score_->tempo.tempo_at_beat(0.0);
@@ -151,7 +154,9 @@ void ScoreMode::start_score()
 {
     if (perf_.work_pending())
         throw PerformError("play: background work under way; use apply()");
-    install_plan(make_score_plan(score_, *db_, rig_->frame, perf_.options_.score.plan), true);
+    install_plan(make_score_plan(score_, *db_, rig_->frame,
+                                 perf_.options_.score.plan_for(rig_->tracker->mode())),
+                 true);
 }
 
 // ---- background work -----------------------------------------------------------
@@ -162,7 +167,7 @@ std::unique_ptr<ScoreMode::Job> ScoreMode::plan_job(const Command &origin, Work:
     if (kind == Work::Kind::play && builder_->statements() > 0)
         job->statements = std::make_unique<ScoreBuilder>(*builder_);
     job->frame = rig_->frame;
-    job->options.score.plan = perf_.options_.score.plan;
+    job->options.score.plan = perf_.options_.score.plan_for(rig_->tracker->mode());
     job->tempo_scale = tempo_scale_;
     return job;
 }

@@ -252,7 +252,9 @@ void StrikeDetector::begin_contact(Hand &h, int hand, const TipSample &s, double
                (h.max_gap_since_release < options_.bounce_height_m ||
                 h.max_held_gap_since_release < options_.bounce_height_m || !driven);
     e.stick_mass_kg = s.effective_mass_kg;
-    e.zone = s.on_rim ? kZoneRim : kZoneHead;
+    e.stick_tip = s.stick_tip;
+    h.rim_force_sum = 0.0;
+    h.head_force_sum = 0.0;
     if (!e.bounce)
         ++h.stroke;
     e.stroke = std::max(h.stroke, 0L);
@@ -277,8 +279,8 @@ void StrikeDetector::continue_contact(Hand &h, const TipSample &s, double gap, d
 {
     const double f = normal_force_n(-gap, depth_rate);
     const double dt = s.time_s - h.last_time_s;
-    if (s.on_rim)
-        h.event.zone = kZoneRim;
+    h.rim_force_sum += s.rim_force_n;
+    h.head_force_sum += s.head_force_n;
     h.event.impulse_n_s += 0.5 * (h.last_force_n + f) * dt;
     // Kinetic friction on the membrane along the tip's sliding direction.
     const Eigen::Vector3d vt = s.velocity_mps - s.velocity_mps.dot(kNormal) * kNormal;
@@ -311,8 +313,9 @@ void StrikeDetector::end_contact(Hand &h, const TipSample &s, double gap, double
         frac = -g0 / (gap - g0);
     const double t_rel = h.previous.time_s + frac * (s.time_s - h.previous.time_s);
     const double f_rel = normal_force_n(0.0, depth_rate);
-    if (s.on_rim) // the step that ends the episode: its contacts were during it
-        h.event.zone = kZoneRim;
+    // The step that ends the episode: its contacts were during it.
+    h.rim_force_sum += s.rim_force_n;
+    h.head_force_sum += s.head_force_n;
     const double dt = t_rel - h.last_time_s;
     h.event.impulse_n_s += 0.5 * (h.last_force_n + f_rel) * dt;
     if (!h.peak_has_after && h.peak_t[1] == h.last_time_s) {
@@ -361,6 +364,8 @@ void StrikeDetector::finish(Hand &h, double release_time_s, StrikeEvent &out)
     const Eigen::Vector3d total = -e.impulse_n_s * kNormal + h.friction_sum;
     e.force_dir =
         total.norm() > 0.0 ? Eigen::Vector3d(total.normalized()) : Eigen::Vector3d(-kNormal);
+    // The samples are the physics' equal steps: the sums' ratio is the impulses'.
+    e.zone = h.rim_force_sum > 0.0 && h.rim_force_sum >= h.head_force_sum ? kZoneRim : kZoneHead;
     out = e;
     h.in_contact = false;
     h.released_once = true;
@@ -401,16 +406,16 @@ double distance_to_rim_m(const MembraneGeometry &membrane, const Eigen::Vector3d
     return std::hypot(rho - membrane.radius_m, h);
 }
 
-bool stick_on_rim(const Scene &scene, int hand, const MembraneGeometry &membrane)
+bool stick_on_rim(const Scene &scene, int hand, const MembraneGeometry &membrane, bool *bead_on_rim)
 {
     const Side side = static_cast<Side>(hand & 1);
-    const StickDrumContact &c = scene.drum_contact(side);
-    if (c.bead_points + c.shaft_points == 0)
-        return false;
     const StickParams &sp = scene.model().options().stick;
     const StickInHand &st = scene.model().stick(side);
     const Eigen::Vector3d bead = scene.bead_position(side);
-    if (distance_to_rim_m(membrane, bead) < sp.tip_radius_m)
+    const bool bead_reaches = distance_to_rim_m(membrane, bead) < sp.tip_radius_m;
+    if (bead_on_rim)
+        *bead_on_rim = bead_reaches;
+    if (bead_reaches)
         return true;
     // The shaft's segment (Scene's capsule): from one shaft radius behind the
     // bead's centre to one shaft radius before the butt. The distance to the
@@ -443,6 +448,20 @@ bool stick_on_rim(const Scene &scene, int hand, const MembraneGeometry &membrane
     return std::min(best_d, dist(0.5 * (lo + hi))) < r;
 }
 
+StickDrumForces stick_drum_forces(const Scene &scene, int hand, const MembraneGeometry &membrane)
+{
+    StickDrumForces f;
+    const StickDrumContact &c = scene.drum_contact(static_cast<Side>(hand & 1));
+    if (c.bead_points + c.shaft_points == 0)
+        return f;
+    bool bead_on_rim = false;
+    const bool on_rim = stick_on_rim(scene, hand, membrane, &bead_on_rim);
+    const double bead_n = c.bead_force_n.norm(), shaft_n = c.shaft_force_n.norm();
+    (bead_on_rim ? f.rim_n : f.head_n) += bead_n;
+    (on_rim ? f.rim_n : f.head_n) += shaft_n;
+    return f;
+}
+
 void load_membranes(StrikeDetector &detector, const Scene &scene)
 {
     detector.reset(membrane_of(scene, 0));
@@ -463,9 +482,13 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
         s.held_center_m = scene.held_bead_position(side);
         // Only near the head, where a contact may begin (a 7 x 7 solve).
         const int drum = detector.drum_under(s.center_m);
-        s.on_rim = stick_on_rim(scene, hand, detector.membrane(drum));
-        if (detector.gap_m(s.center_m, drum) < 0.02)
+        const StickDrumForces f = stick_drum_forces(scene, hand, detector.membrane(drum));
+        s.rim_force_n = f.rim_n;
+        s.head_force_n = f.head_n;
+        if (detector.gap_m(s.center_m, drum) < 0.02) {
             s.effective_mass_kg = scene.effective_mass_kg(side, Eigen::Vector3d::UnitY(), drum);
+            s.stick_tip = stick_tip_code(scene.options().drum.stick_tip); // the sticks' tip
+        }
         if (detector.update(hand, s, out[n]))
             ++n;
     }

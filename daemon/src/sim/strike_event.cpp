@@ -2,6 +2,8 @@
 // (strike_event.hpp, docs/osc.md).
 #include "ictus/sim/strike_event.hpp"
 
+#include "stick_tip.h"
+
 #include <cmath>
 #include <cstdio>
 #include <ostream>
@@ -32,6 +34,7 @@ constexpr StrikeFieldInfo kInfo[kStrikeFieldCount] = {
     {"force_dir_y", false, 4, true, true},
     {"force_dir_z", false, 4, true, true},
     {"stick_mass_kg", false, 5, true, false},
+    {"stick_tip", true, 0, true, false},
     // Known at the release only (the stick reaches the rim after the bead's
     // onset): in /ictus/strike/end, not /ictus/strike (docs/osc.md).
     {"zone", true, 0, false, true},
@@ -97,6 +100,8 @@ long strike_field_integer(const StrikeEvent &e, StrikeField field)
         return e.bounce ? 1 : 0;
     case StrikeField::stroke:
         return e.stroke;
+    case StrikeField::stick_tip:
+        return e.stick_tip;
     case StrikeField::zone:
         return e.zone;
     default:
@@ -112,6 +117,7 @@ double strike_field(const StrikeEvent &e, StrikeField field)
     case StrikeField::drum:
     case StrikeField::bounce:
     case StrikeField::stroke:
+    case StrikeField::stick_tip:
     case StrikeField::zone:
         return static_cast<double>(strike_field_integer(e, field));
     case StrikeField::time_s:
@@ -144,6 +150,17 @@ double strike_field(const StrikeEvent &e, StrikeField field)
         return e.stick_mass_kg;
     }
     return 0.0;
+}
+
+int stick_tip_code(const std::string &name)
+{
+    const stick_tip *tip = stick_tip_find(name.c_str());
+    return tip ? static_cast<int>(tip - stick_tips) + 1 : 0;
+}
+
+std::string stick_tip_name(int code)
+{
+    return code >= 1 && code <= STICK_TIP_COUNT ? stick_tips[code - 1].name : "";
 }
 
 void write_strikes_csv_header(std::ostream &out)

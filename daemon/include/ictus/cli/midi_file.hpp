@@ -4,6 +4,7 @@
 // patches/ui/ictus-midi.pd for the live patch.
 #pragma once
 
+#include "ictus/score/score.hpp"
 #include "ictus/sim/strike_event.hpp"
 
 #include <string>
@@ -33,32 +34,54 @@ int midi_zone(double r_over_a);
 int midi_note(int hand, double r_over_a);
 int midi_velocity(double normal_velocity_mps);
 
-// A tempo from time_s on (seconds from the start of the file).
+// The file's clock. tick 0 is at start_s (seconds of the render's clock);
+// a tempo (microseconds per quarter note) from `tick` on, the first at tick 0;
+// a time signature N/D from `tick` on (D a power of two 1..64, N 1..255).
 struct MidiTempo {
-    double time_s = 0.0;
-    double bpm = 120.0;
+    long tick = 0;
+    long us_per_quarter = 500000;
 };
-
-// A time signature N/D from time_s on (D a power of two, 1..64; N 1..255).
 struct MidiMeter {
-    double time_s = 0.0;
+    long tick = 0;
     int numerator = 4;
     int denominator = 4;
 };
+struct MidiTimeline {
+    double start_s = 0.0;
+    std::vector<MidiTempo> tempo;
+    std::vector<MidiMeter> meter; // none: 4/4 at tick 0
+    long first_beat_tick = 0;     // the score's beat 0 (score mode)
+};
 
-// The file: track name, the time signature (the first of `meter` if it is at
-// 0 s, else 4/4; the others at their ticks, FF 58 nn dd 24 8: a metronome
-// click per quarter), the tempo map (at least one entry; the first
-// applies from 0), then for each strike in order a note-on on `channel`
-// (0..15) at its time_s, preceded by a text event "bounce" at the same tick
-// when it is a bounce, and its note-off. Times are rounded to the nearest
-// tick of the tempo map (3840 per quarter: within 0.4 ms at 20 bpm and faster).
-// With a kit, `drum_notes` gives each drum's note (StrikeEvent::drum indexes
-// it: the General MIDI drum map, docs/midi.md); without, midi_note().
+// Microseconds per quarter of a tempo, rounded (4..1000 bpm, else throws
+// std::invalid_argument).
+long midi_us_per_quarter(double bpm);
+// One tempo from render time 0 (a clip).
+MidiTimeline midi_timeline(double bpm);
+// A score's timeline (docs/midi.md): the score's beat b at tick
+// first_beat_tick + b x 3840, first_beat_tick a whole number of pickup bars
+// of the score's first meter (one, or as many as hold `earliest_s`, the
+// render time of the first strike), the pickup at the score's first tempo;
+// beat0_s is the render time of the score's beat 0. Tempo changes at their
+// beats, a ramp as a tempo every kMidiRampStepTicks, each chosen so that the
+// file's time at the step's end is the score's (within half a microsecond);
+// the meters at their beats.
+constexpr long kMidiRampStepTicks = kMidiTicksPerQuarter / 16;
+constexpr int kMidiMaxPickupBars = 64;
+MidiTimeline midi_timeline(const TempoMap &tempo, const std::vector<ScoreMeter> &meters,
+                           double beat0_s, double earliest_s);
+
+// The file: track name, the time signatures and the tempo map of
+// `timeline`, then for each strike in order a note-on on `channel` (0..15)
+// at its time_s on the timeline's clock (a strike before tick 0 at tick 0),
+// preceded by a text event "bounce" at the same tick when it is a bounce,
+// and its note-off. Times are rounded to the nearest tick (3840 per quarter:
+// within 0.4 ms at 20 bpm and faster). With a kit, `drum_notes` gives each
+// drum's note (StrikeEvent::drum indexes it: the General MIDI drum map,
+// docs/midi.md); without, midi_note().
 std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
-                               const std::vector<MidiTempo> &tempo, int channel,
-                               const std::vector<int> *drum_notes = nullptr,
-                               const std::vector<MidiMeter> &meter = {});
+                               const MidiTimeline &timeline, int channel,
+                               const std::vector<int> *drum_notes = nullptr);
 
 } // namespace cli
 } // namespace ictus

@@ -35,6 +35,9 @@ struct PdRenderOptions {
     };
     std::vector<KitDrumSound> kit;
     std::string stick_tip; // render-drum left|right tip NAME, when not empty (contact~)
+    // The head's stretching k3 (N/m^3, DrumParams::stretch_n_per_m3): render-drum
+    // left|right stretch K3, so that contact~ has the physics' head; <= 0: contact~'s own.
+    double stretch_n_per_m3 = 0.0;
     int sample_rate = 48000;
     std::string mix = "stereo"; // render-mix
     int bits = 32;              // render-bits

@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace ictus
 {
@@ -44,8 +45,18 @@ struct OscSenderOptions {
     bool realtime = false;
 };
 
+// One drum of a kit as the sound needs it (/ictus/kit/drum, docs/osc.md): its
+// index (the strikes' `drum`), name, membrane preset, head, and pan (-1..1, + to
+// the left channel).
+struct KitDrumSound {
+    int index = 0;
+    std::string name, preset;
+    double radius_m = 0.0, tension_n_per_m = 0.0, pan = 0.0;
+};
+
 struct OscSenderCounters {
     unsigned long strikes_sent = 0, strike_ends_sent = 0, poses_sent = 0, tips_sent = 0;
+    unsigned long kits_sent = 0;
     unsigned long send_errors = 0;
     unsigned long strikes_dropped = 0, poses_dropped = 0, tips_dropped = 0; // queue full
 };
@@ -73,6 +84,13 @@ class OscSender
     bool post_strike(const StrikeEvent &event);
     bool post_strike_end(const StrikeEvent &event);
     bool post_pose(const PoseSnapshot &pose);
+    // The kit the sound plays (none: empty). Set once, before the first
+    // send_kit(); `kit_name` "" with no drums sends nothing.
+    void set_kit(const std::string &kit_name, const std::vector<KitDrumSound> &drums);
+    // Sends the kit (/ictus/kit and one /ictus/kit/drum per drum, one bundle,
+    // "immediately") from the strike thread before the strikes queued after
+    // this call. Lock-free, never blocks: for the physics thread.
+    void send_kit();
     bool post_tip(const TipState &tip);
 
     // Sends what is queued and joins the threads.
@@ -89,7 +107,11 @@ class OscSender
     std::atomic<NtpTime> epoch_{0};
     std::atomic<bool> running_{true};
     std::atomic<unsigned long> strikes_sent_{0}, strike_ends_sent_{0}, poses_sent_{0},
-        tips_sent_{0}, send_errors_{0};
+        tips_sent_{0}, kits_sent_{0}, send_errors_{0};
+    void send_kit_now();
+    std::string kit_name_;
+    std::vector<KitDrumSound> kit_;
+    std::atomic<bool> kit_set_{false}, kit_wanted_{false};
     struct StrikeMessage {
         StrikeEvent event;
         bool end = false; // /ictus/strike/end

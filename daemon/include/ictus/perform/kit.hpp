@@ -23,6 +23,7 @@ struct KitDrum {
     Eigen::Vector3d place_m = Eigen::Vector3d::Zero();
     double radius_m = 0.1778;
     double tension_n_per_m = 3603.0;
+    double density_kg_per_m2 = 0.345; // the head's areal density (its film's thickness)
     double shell_depth_m = 0.14;
     int midi_note = 38; // General MIDI drum map (docs/midi.md)
 };
@@ -50,6 +51,9 @@ std::string kit_names();
 void validate_kit(const Kit &kit);
 // The smallest plan-view gap between two drums' shells (m; +inf for one drum).
 double kit_min_gap_m(const Kit &kit);
+// The drum's pan in the sound's stereo mix, by its place: -x / 0.8 m within
+// +-0.6 (the performer's left, + here, to the left channel).
+double kit_drum_pan(const KitDrum &drum);
 // The drum named `name` (lower case), or -1.
 int kit_drum_index(const Kit &kit, const std::string &name);
 

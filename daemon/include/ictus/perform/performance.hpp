@@ -35,6 +35,10 @@ namespace ictus
 struct ScorePerformOptions {
     std::string score_text; // the score; empty: default_score_text()
     std::string score_name = "default";
+    // A score already built (ictusd --midi: a MIDI file's drum part); when
+    // set, score_text is not read.
+    std::shared_ptr<const Score> score;
+    std::string midi_path; // --midi FILE, turned into `score` once the kit is known
     std::string gestures; // gesture database JSON; empty: GestureDatabase::builtin()
     TrackMode mode = TrackMode::cartesian;
     bool grip_given = false; // else the character holds the sticks as the score's first note
@@ -58,6 +62,13 @@ struct ScorePerformOptions {
     // motion on every side; the scene's stops and the excursion measured
     // stay at the true limits (docs/perform.md, "Joint limits").
     double ik_limit_margin_deg = 3.0;
+    // Joint mode (eq. 1 alone) holds the tip lower than the Cartesian mode
+    // does: its PD carries the arm's weight on a static error that no
+    // Cartesian feedback corrects. The plan's contact lead adds this much
+    // there (docs/perform.md, "Contact on the beat").
+    double joint_contact_lead_m = 0.0018;
+    // The plan options for a control mode: `plan` with the mode's contact lead.
+    PlanOptions plan_for(TrackMode m) const;
     ScorePerformOptions();
 };
 

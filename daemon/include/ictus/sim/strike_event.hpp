@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <iosfwd>
+#include <string>
 
 namespace ictus
 {
@@ -37,6 +38,9 @@ struct StrikeEvent {
     // onset (the stick on its fulcrum, the grip and the hand: Scene::
     // effective_mass_kg), kg: what a sound model's stick (contact~) weighs.
     double stick_mass_kg = 0.0;
+    // The stick's tip (externals/core/stick_tip.h): 0 none (the head's spring
+    // alone), 1 wood, 2 nylon, 3 felt (the tip table's index + 1).
+    int stick_tip = 0;
     // Where the stick landed: 0 the head, 1 the rim (the stick touched the
     // drum's top edge during the contact, Scene's StickDrumContact::
     // rim_points; docs/osc.md). Known at the release.
@@ -65,9 +69,15 @@ enum class StrikeField {
     force_dir_y,
     force_dir_z,
     stick_mass_kg,
+    stick_tip,
     zone,
 };
 constexpr int kStrikeFieldCount = static_cast<int>(StrikeField::zone) + 1;
+
+// A strike's stick_tip code for a tip name (stick_tip.h: "wood", "nylon", "felt";
+// "" or another name: 0, none), and the name for a code ("" for 0 or out of range).
+int stick_tip_code(const std::string &name);
+std::string stick_tip_name(int code);
 
 struct StrikeFieldInfo {
     const char *name; // column name, with its unit

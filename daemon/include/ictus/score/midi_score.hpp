@@ -1,0 +1,97 @@
+// midi_score.hpp -- a Standard MIDI File's drum part as a Score (docs/midi.md,
+// "MIDI in"): the reader of the file, and the General MIDI drum map, the
+// hands and the dynamics that make its notes the strokes of a score, so
+// everything after the score (the planner, the performance) is unchanged.
+#pragma once
+
+#include "ictus/score/score.hpp"
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ictus
+{
+
+// A malformed file. what() is "SOURCE: byte OFFSET (track T): message"
+// (track 0 is the first MTrk; no track: the header).
+class MidiFileError : public std::runtime_error
+{
+  public:
+    explicit MidiFileError(const std::string &what) : std::runtime_error(what) {}
+};
+
+struct SmfNote {
+    long tick = 0;
+    int track = 0;
+    int channel = 0; // 0..15 (General MIDI's drums: 9, "channel 10")
+    int note = 0;
+    int velocity = 0; // 1..127 (a note-on of velocity 0 is a note-off: not kept)
+};
+struct SmfTempo {
+    long tick = 0;
+    long us_per_quarter = 500000;
+};
+struct SmfMeter {
+    long tick = 0;
+    int numerator = 4;
+    int denominator = 4;
+};
+// The parts of a file a drum part needs, each sorted by tick (ties: in the
+// file's order, track by track).
+struct Smf {
+    int format = 0;
+    int ticks_per_quarter = 480;
+    std::vector<SmfNote> notes;
+    std::vector<SmfTempo> tempo;
+    std::vector<SmfMeter> meters;
+};
+
+// Limits of the reader: ticks beyond kMaxSmfTick, more than kMaxSmfNotes
+// note-ons, or formats other than 0 and 1 and SMPTE time are refused.
+constexpr long kMaxSmfTick = 1L << 40;
+constexpr long kMaxSmfNotes = kMaxScoreNotes;
+
+// Reads a Standard MIDI File (SMF 1.0: MThd, then MTrk chunks; other chunks
+// are skipped). Throws MidiFileError naming `source`, the byte offset and
+// the track.
+Smf read_smf(const std::string &bytes, const std::string &source);
+
+// A kit's drum for the General MIDI drum map: its name and its note.
+struct MidiDrum {
+    std::string name;
+    int midi_note = 38;
+};
+
+// Notes closer than this alternate hands; farther apart, the right hand
+// (the lead) plays.
+constexpr double kMidiAlternateBelow_s = 0.3;
+// A hand strikes again no sooner than this after its previous stroke (the
+// planner refuses a stroke 40 ms after one of the same hand).
+constexpr double kMidiSameHandMin_s = 0.05;
+
+// The score of a file's drum part, and what was left out.
+struct MidiDrumPart {
+    Score score;
+    int channel = 9;             // the channel read (0..15), -1: all
+    std::map<int, long> skipped; // note number -> notes the kit cannot play
+    long too_fast = 0;           // notes no hand could strike in time
+    long tempo_clamped = 0;      // tempi outside kMinTempoBpm..kMaxTempoBpm
+};
+
+// The drum part of `smf` (docs/midi.md): the notes on channel 10 if there
+// are any, else on every channel; snares (38, 40) and toms (41, 43, 45,
+// 47, 48, 50) to `drums` by the General MIDI map (a snare to the drum of
+// note 38, a tom to the drum of its note, else the tom of the nearest
+// note; no drums: the one drum plays them all), the rest skipped; velocity
+// v to dynamics v / 127; hands as docs/midi.md says; the tempo map and the
+// meters of the file, its quarter note the score's beat.
+MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
+                             const std::string &source);
+
+// Reads the file at `path` and converts it. Throws MidiFileError (also when
+// it cannot be read or holds no playable note).
+MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<MidiDrum> &drums);
+
+} // namespace ictus

@@ -1,0 +1,359 @@
+// midi_score.cpp -- a Standard MIDI File's drum part as a Score (docs/midi.md,
+// "MIDI in"). SMF 1.0: "MThd" length 6: format, tracks, division; then "MTrk"
+// chunks of events, each after a variable-length delta time: channel
+// messages (with running status), meta events FF type length data (tempo FF
+// 51, time signature FF 58), system exclusive F0/F7 length data.
+#include "ictus/score/midi_score.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace ictus
+{
+
+namespace
+{
+
+// A cursor over one chunk: every read is bounds-checked and names the byte.
+class Reader
+{
+  public:
+    Reader(const std::string &bytes, size_t begin, size_t end, const std::string &source, int track)
+        : b_(bytes), pos_(begin), end_(end), source_(source), track_(track)
+    {
+    }
+    bool done() const { return pos_ >= end_; }
+    size_t pos() const { return pos_; }
+    [[noreturn]] void fail(const std::string &message, size_t at) const
+    {
+        std::string where = source_ + ": byte " + std::to_string(at);
+        if (track_ >= 0)
+            where += " (track " + std::to_string(track_) + ")";
+        throw MidiFileError(where + ": " + message);
+    }
+    int byte()
+    {
+        if (pos_ >= end_)
+            fail("unexpected end of " + std::string(track_ >= 0 ? "track" : "file"), pos_);
+        return static_cast<unsigned char>(b_[pos_++]);
+    }
+    int peek() const
+    {
+        if (pos_ >= end_)
+            fail("unexpected end of track", pos_);
+        return static_cast<unsigned char>(b_[pos_]);
+    }
+    long vlq()
+    {
+        const size_t at = pos_;
+        long v = 0;
+        for (int i = 0; i < 4; ++i) {
+            const int c = byte();
+            v = (v << 7) | (c & 0x7f);
+            if (!(c & 0x80))
+                return v;
+        }
+        fail("variable-length number longer than 4 bytes", at);
+    }
+    void skip(long n)
+    {
+        if (n < 0 || static_cast<size_t>(n) > end_ - pos_)
+            fail("length " + std::to_string(n) + " runs past the end of the track", pos_);
+        pos_ += static_cast<size_t>(n);
+    }
+    int data_byte()
+    {
+        const size_t at = pos_;
+        const int c = byte();
+        if (c & 0x80)
+            fail("data byte expected, got status byte " + std::to_string(c), at);
+        return c;
+    }
+
+  private:
+    const std::string &b_;
+    size_t pos_, end_;
+    const std::string &source_;
+    int track_;
+};
+
+long u32(const std::string &b, size_t at)
+{
+    long v = 0;
+    for (size_t i = 0; i < 4; ++i)
+        v = (v << 8) | static_cast<unsigned char>(b[at + i]);
+    return v;
+}
+
+// A meta event's data, after FF and its type.
+void read_meta(Reader &r, int type, long tick, Smf &smf)
+{
+    const size_t at = r.pos();
+    const long len = r.vlq();
+    if (type == 0x51 && len == 3) {
+        long us = 0;
+        for (int i = 0; i < 3; ++i)
+            us = (us << 8) | r.byte();
+        if (us == 0)
+            r.fail("tempo of 0 microseconds per quarter", at);
+        smf.tempo.push_back({tick, us});
+    } else if (type == 0x58 && len >= 2) {
+        const int n = r.byte();
+        const int dd = r.byte();
+        r.skip(len - 2);
+        // Kept when the score can say it (N 1..64, D 1..64).
+        if (n >= 1 && n <= kMaxMeterNumerator && dd <= 6)
+            smf.meters.push_back({tick, n, 1 << dd});
+    } else {
+        r.skip(len);
+    }
+}
+
+// One MTrk chunk's events, from `r`.
+void read_track(Reader &r, int track, Smf &smf)
+{
+    long tick = 0;
+    int status = 0;
+    while (!r.done()) {
+        tick += r.vlq();
+        if (tick > kMaxSmfTick)
+            r.fail("time past " + std::to_string(kMaxSmfTick) + " ticks", r.pos());
+        const size_t at = r.pos();
+        int c = r.peek();
+        if (c & 0x80) {
+            r.byte();
+            if (c == 0xff) {
+                const int type = r.byte();
+                if (type == 0x2f)
+                    return; // end of track
+                read_meta(r, type, tick, smf);
+                continue;
+            }
+            if (c == 0xf0 || c == 0xf7) {
+                r.skip(r.vlq());
+                continue;
+            }
+            if (c >= 0xf1)
+                r.fail("system message " + std::to_string(c) + " in a file", at);
+            status = c;
+        } else if (status == 0) {
+            r.fail("data byte with no running status", at);
+        }
+        const int kind = status & 0xf0;
+        const int a = r.data_byte();
+        if (kind == 0xc0 || kind == 0xd0)
+            continue;
+        const int v = r.data_byte();
+        if (kind == 0x90 && v > 0) {
+            if (static_cast<long>(smf.notes.size()) >= kMaxSmfNotes)
+                r.fail("more than " + std::to_string(kMaxSmfNotes) + " notes", at);
+            smf.notes.push_back({tick, track, status & 0x0f, a, v});
+        }
+    }
+}
+
+} // namespace
+
+Smf read_smf(const std::string &b, const std::string &source)
+{
+    Reader head(b, 0, b.size(), source, -1);
+    if (b.size() < 14 || b.compare(0, 4, "MThd") != 0)
+        head.fail("not a Standard MIDI File (no MThd header)", 0);
+    const long head_len = u32(b, 4);
+    if (head_len < 6 || static_cast<size_t>(head_len) > b.size() - 8)
+        head.fail("header length " + std::to_string(head_len), 4);
+    Smf smf;
+    smf.format = (static_cast<unsigned char>(b[8]) << 8) | static_cast<unsigned char>(b[9]);
+    const int division =
+        (static_cast<unsigned char>(b[12]) << 8) | static_cast<unsigned char>(b[13]);
+    if (smf.format > 1)
+        head.fail("format " + std::to_string(smf.format) + " (0 and 1 are read)", 8);
+    if (division & 0x8000)
+        head.fail("SMPTE time division (ticks per quarter note are read)", 12);
+    if (division == 0)
+        head.fail("0 ticks per quarter note", 12);
+    smf.ticks_per_quarter = division;
+    size_t at = 8 + static_cast<size_t>(head_len);
+    int track = 0;
+    while (at < b.size()) {
+        if (b.size() - at < 8)
+            head.fail("truncated chunk header", at);
+        const long len = u32(b, at + 4);
+        if (static_cast<size_t>(len) > b.size() - at - 8)
+            head.fail("chunk length " + std::to_string(len) + " runs past the end of the file",
+                      at + 4);
+        if (b.compare(at, 4, "MTrk") == 0) {
+            Reader r(b, at + 8, at + 8 + static_cast<size_t>(len), source, track);
+            read_track(r, track, smf);
+            ++track;
+        }
+        at += 8 + static_cast<size_t>(len);
+    }
+    if (track == 0)
+        head.fail("no track (MTrk chunk)", at);
+    auto by_tick = [](const auto &x, const auto &y) { return x.tick < y.tick; };
+    std::stable_sort(smf.notes.begin(), smf.notes.end(), by_tick);
+    std::stable_sort(smf.tempo.begin(), smf.tempo.end(), by_tick);
+    std::stable_sort(smf.meters.begin(), smf.meters.end(), by_tick);
+    return smf;
+}
+
+namespace
+{
+
+bool is_snare(int note)
+{
+    return note == 38 || note == 40;
+}
+bool is_tom(int note)
+{
+    return note == 41 || note == 43 || note == 45 || note == 47 || note == 48 || note == 50;
+}
+
+// The drum (index into `drums`) of a General MIDI note, -1: not played;
+// no drums: 0, the one drum, for every snare and tom.
+int drum_of(int note, const std::vector<MidiDrum> &drums)
+{
+    if (!is_snare(note) && !is_tom(note))
+        return -1;
+    if (drums.empty())
+        return 0;
+    const int want = is_snare(note) ? 38 : note;
+    for (size_t i = 0; i < drums.size(); ++i)
+        if (drums[i].midi_note == want)
+            return static_cast<int>(i);
+    if (is_snare(note))
+        return -1;
+    int best = -1;
+    for (size_t i = 0; i < drums.size(); ++i)
+        if (is_tom(drums[i].midi_note) && (best < 0 || std::abs(drums[i].midi_note - note) <
+                                                           std::abs(drums[best].midi_note - note)))
+            best = static_cast<int>(i);
+    return best;
+}
+
+// The file's tempo map and meters on the score's beats (a quarter a beat).
+void add_timing(const Smf &smf, MidiDrumPart &part)
+{
+    const double tpq = smf.ticks_per_quarter;
+    auto bpm_of = [&part](long us) {
+        const double bpm = 60e6 / static_cast<double>(us);
+        const double kept = std::clamp(bpm, kMinTempoBpm, kMaxTempoBpm);
+        if (kept != bpm)
+            ++part.tempo_clamped;
+        return kept;
+    };
+    const bool at0 = !smf.tempo.empty() && smf.tempo.front().tick == 0;
+    part.score.tempo = TempoMap(at0 ? bpm_of(smf.tempo.front().us_per_quarter) : kDefaultTempoBpm);
+    for (const SmfTempo &t : smf.tempo)
+        if (t.tick > 0) {
+            const double bpm = bpm_of(t.us_per_quarter);
+            part.score.tempo.add(static_cast<double>(t.tick) / tpq, bpm, bpm, 0.0);
+        }
+    for (const SmfMeter &m : smf.meters)
+        part.score.meters.push_back(
+            {static_cast<double>(m.tick) / tpq, m.numerator, m.denominator, 0});
+}
+
+// The channel of the drum part: 10 (9) if it has notes, else all (-1).
+int drum_channel(const Smf &smf)
+{
+    for (const SmfNote &n : smf.notes)
+        if (n.channel == 9)
+            return 9;
+    return -1;
+}
+
+} // namespace
+
+MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
+                             const std::string &source)
+{
+    MidiDrumPart part;
+    part.score.source = source;
+    add_timing(smf, part);
+    part.channel = drum_channel(smf);
+    const double tpq = smf.ticks_per_quarter;
+    const TempoMap &map = part.score.tempo;
+    // The hands' last strokes (s; -inf: none yet) and the last note kept.
+    double last_of[2] = {-1e300, -1e300};
+    double last_s = -1e300;
+    long last_tick = -1;
+    int last_hand = 1, at_tick = 0;
+    int line = 0;
+    for (const SmfNote &n : smf.notes) {
+        ++line;
+        if (part.channel >= 0 && n.channel != part.channel)
+            continue;
+        const int drum = drum_of(n.note, drums);
+        if (drum < 0) {
+            ++part.skipped[n.note];
+            continue;
+        }
+        const double beat = static_cast<double>(n.tick) / tpq;
+        if (beat > kMaxScoreBeats)
+            throw MidiFileError(source + ": note " + std::to_string(line) + " at beat " +
+                                std::to_string(beat) + ", past the score's " +
+                                std::to_string(kMaxScoreBeats));
+        const double t = map.time_at_beat(beat);
+        // Hands: at the same tick the other hand (two at once at most);
+        // close to the previous note the other hand; far from it the right.
+        int hand;
+        if (n.tick == last_tick) {
+            if (++at_tick > 1) {
+                ++part.too_fast;
+                continue;
+            }
+            hand = 1 - last_hand;
+        } else {
+            at_tick = 0;
+            hand = t - last_s < kMidiAlternateBelow_s ? 1 - last_hand : 1;
+            if (t - last_of[hand] < kMidiSameHandMin_s)
+                hand = 1 - hand;
+        }
+        if (t - last_of[hand] < kMidiSameHandMin_s) {
+            ++part.too_fast;
+            continue;
+        }
+        ScoreNote s;
+        s.beat = beat;
+        s.beats = kMinNoteBeats;
+        s.hand = hand == 0 ? Side::left : Side::right;
+        s.dynamics = n.velocity / 127.0;
+        s.theta_deg = kDefaultThetaDeg[hand];
+        s.line = line;
+        s.drum_line = line;
+        if (!drums.empty())
+            s.drum = drums[static_cast<size_t>(drum)].name;
+        part.score.notes.push_back(s);
+        last_of[hand] = t;
+        last_s = t;
+        last_tick = n.tick;
+        last_hand = hand;
+    }
+    for (size_t i = 0; i + 1 < part.score.notes.size(); ++i)
+        part.score.notes[i].beats =
+            std::max(kMinNoteBeats, part.score.notes[i + 1].beat - part.score.notes[i].beat);
+    if (!part.score.notes.empty())
+        part.score.length_beats = part.score.notes.back().beat + 1.0;
+    return part;
+}
+
+MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<MidiDrum> &drums)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw MidiFileError(path + ": cannot be read");
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    MidiDrumPart part = drum_part_score(read_smf(bytes.str(), path), drums, path);
+    if (part.score.notes.empty())
+        throw MidiFileError(path + ": no note the " + (drums.empty() ? "drum" : "kit") +
+                            " can play (snares 38, 40 and toms 41..50 of the General MIDI drum "
+                            "map, on channel 10 if it has notes)");
+    return part;
+}
+
+} // namespace ictus

@@ -1,0 +1,152 @@
+// A Standard MIDI File's drum part as a score (score/midi_score.hpp,
+// docs/midi.md "MIDI in"): files written here byte by byte from the SMF 1.0
+// format, read back, and their drum part checked against the General MIDI
+// map, the hand rule and the tempo map computed by hand.
+#include "ictus/score/midi_score.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <initializer_list>
+#include <string>
+
+using namespace ictus;
+
+namespace
+{
+std::string bytes(std::initializer_list<int> v)
+{
+    std::string s;
+    for (int b : v)
+        s += static_cast<char>(b);
+    return s;
+}
+std::string chunk(const std::string &type, const std::string &data)
+{
+    const size_t n = data.size();
+    return type +
+           bytes({static_cast<int>(n >> 24), static_cast<int>((n >> 16) & 0xff),
+                  static_cast<int>((n >> 8) & 0xff), static_cast<int>(n & 0xff)}) +
+           data;
+}
+// MThd: format, tracks, 96 ticks a quarter.
+std::string header(int format, int tracks, int division = 96)
+{
+    return chunk("MThd", bytes({0, format, 0, tracks, division >> 8, division & 0xff}));
+}
+const std::string kEnd = bytes({0x00, 0xff, 0x2f, 0x00});
+
+std::string what_of(const std::string &file)
+{
+    try {
+        read_smf(file, "t.mid");
+    } catch (const MidiFileError &e) {
+        return e.what();
+    }
+    return "";
+}
+} // namespace
+
+TEST_CASE("midi in: a file read event by event", "[score][midi]")
+{
+    // Track 0: tempo 500 000 us (120 bpm) at 0, 3/4 at 0, 750 000 us (80
+    // bpm) at tick 192 (beat 2). Track 1: a sysex, then on channel 10 a
+    // snare at 0 (v 100), with running status a note-on of velocity 0 (a
+    // note-off) at 48 and a tom 45 at 96 (v 64), a program change (one data
+    // byte), and a kick 36 at tick 0x81 0x00 = 128 later (224).
+    const std::string t0 = bytes({0x00, 0xff, 0x51, 0x03, 0x07, 0xa1, 0x20}) +
+                           bytes({0x00, 0xff, 0x58, 0x04, 0x03, 0x02, 0x18, 0x08}) +
+                           bytes({0x81, 0x40, 0xff, 0x51, 0x03, 0x0b, 0x71, 0xb0}) + kEnd;
+    const std::string t1 = bytes({0x00, 0xf0, 0x02, 0x7e, 0xf7}) +
+                           bytes({0x00, 0x99, 38, 100, 0x30, 38, 0, 0x30, 45, 64}) +
+                           bytes({0x00, 0xc9, 5}) + bytes({0x81, 0x00, 0x99, 36, 90}) + kEnd;
+    const Smf smf = read_smf(
+        header(1, 2) + chunk("MTrk", t0) + chunk("XXXX", "ab") + chunk("MTrk", t1), "t.mid");
+    CHECK(smf.format == 1);
+    CHECK(smf.ticks_per_quarter == 96);
+    REQUIRE(smf.notes.size() == 3);
+    CHECK((smf.notes[0].tick == 0 && smf.notes[0].note == 38 && smf.notes[0].velocity == 100 &&
+           smf.notes[0].channel == 9 && smf.notes[0].track == 1));
+    CHECK((smf.notes[1].tick == 96 && smf.notes[1].note == 45 && smf.notes[1].velocity == 64));
+    CHECK((smf.notes[2].tick == 224 && smf.notes[2].note == 36));
+    REQUIRE(smf.tempo.size() == 2);
+    CHECK((smf.tempo[0].tick == 0 && smf.tempo[0].us_per_quarter == 500000));
+    CHECK((smf.tempo[1].tick == 192 && smf.tempo[1].us_per_quarter == 750000));
+    REQUIRE(smf.meters.size() == 1);
+    CHECK((smf.meters[0].numerator == 3 && smf.meters[0].denominator == 4));
+
+    // The drum part on a kit: the snare on the snare, 45 on tom2 (47 and 43
+    // are both 2 away: the kit's first), the kick left out. Times: 120 bpm
+    // to beat 2 (1 s), 80 bpm after: the kick's beat 224/96 would be at
+    // 1 + (1/3) x 0.75 s.
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"tom1", 48}, {"tom2", 47}, {"floor", 43}};
+    const MidiDrumPart part = drum_part_score(smf, kit, "t.mid");
+    CHECK(part.channel == 9);
+    REQUIRE(part.score.notes.size() == 2);
+    CHECK(part.score.notes[0].drum == "snare");
+    CHECK(part.score.notes[1].drum == "tom2");
+    CHECK(part.score.notes[0].dynamics == Approx(100.0 / 127.0));
+    CHECK(part.score.notes[1].beat == Approx(1.0));
+    CHECK(part.skipped.at(36) == 1);
+    CHECK(part.score.tempo.time_at_beat(224.0 / 96.0) == Approx(1.0 + 0.75 / 3.0));
+    REQUIRE(part.score.meters.size() == 1);
+    CHECK(part.score.meters[0].numerator == 3);
+    // 0.5 s apart: both right (the lead hand).
+    CHECK(part.score.notes[0].hand == Side::right);
+    CHECK(part.score.notes[1].hand == Side::right);
+    // The one drum: the snare and the tom both on it.
+    const MidiDrumPart one = drum_part_score(smf, {}, "t.mid");
+    REQUIRE(one.score.notes.size() == 2);
+    CHECK((one.score.notes[0].drum.empty() && one.score.notes[1].drum.empty()));
+}
+
+TEST_CASE("midi in: hands as a drummer's, the drum channel, the GM toms", "[score][midi]")
+{
+    // 120 bpm (the default), 96 ticks a quarter = 0.5 s: 16ths (24 ticks,
+    // 0.125 s) alternate R L R; a note 0.5 s later goes back to R; two at one
+    // tick: R then L; a third at that tick: no hand (too_fast). Channel 1
+    // notes are not read while channel 10 has notes.
+    std::string t = bytes({0x00, 0x99, 38, 10, 0x18, 38, 20, 0x18, 38, 30}) + // R L R
+                    bytes({0x00, 0x90, 38, 40}) +                             // channel 1
+                    bytes({0x60, 0x99, 50, 127, 0x00, 41, 1, 0x00, 48, 9}) + kEnd;
+    const Smf smf = read_smf(header(0, 1) + chunk("MTrk", t), "t.mid");
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"tom1", 48}, {"tom2", 47}, {"floor", 43}};
+    const MidiDrumPart part = drum_part_score(smf, kit, "t.mid");
+    REQUIRE(part.score.notes.size() == 5);
+    const Side R = Side::right, L = Side::left;
+    const Side want[5] = {R, L, R, R, L};
+    for (int i = 0; i < 5; ++i)
+        CHECK(part.score.notes[static_cast<size_t>(i)].hand == want[i]);
+    CHECK(part.score.notes[3].drum == "tom1");  // 50 -> the nearest, 48
+    CHECK(part.score.notes[4].drum == "floor"); // 41 -> 43
+    CHECK(part.too_fast == 1);
+    CHECK(part.score.notes[3].dynamics == Approx(1.0));
+    // No channel 10: every channel is read.
+    const std::string t1 = bytes({0x00, 0x90, 38, 40, 0x18, 0x91, 40, 50}) + kEnd;
+    const MidiDrumPart any =
+        drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t1), "t.mid"), kit, "t.mid");
+    CHECK(any.channel == -1);
+    CHECK(any.score.notes.size() == 2);
+}
+
+TEST_CASE("midi in: a malformed file names its byte and track", "[score][midi]")
+{
+    CHECK(what_of("RIFF....") == "t.mid: byte 0: not a Standard MIDI File (no MThd header)");
+    CHECK(what_of(header(2, 1)) == "t.mid: byte 8: format 2 (0 and 1 are read)");
+    CHECK(what_of(header(0, 1, 0xe728)) ==
+          "t.mid: byte 12: SMPTE time division (ticks per quarter note are read)");
+    CHECK(what_of(header(0, 1)) == "t.mid: byte 14: no track (MTrk chunk)");
+    // Track data starts at byte 22 (14 header + 8 chunk header).
+    CHECK(what_of(header(0, 1) + chunk("MTrk", bytes({0x00, 0x99, 38}))) ==
+          "t.mid: byte 25 (track 0): unexpected end of track");
+    CHECK(what_of(header(0, 1) + chunk("MTrk", bytes({0x00, 38, 10}))) ==
+          "t.mid: byte 23 (track 0): data byte with no running status");
+    CHECK(what_of(header(0, 1) + chunk("MTrk", kEnd) +
+                  chunk("MTrk", bytes({0xff, 0xff, 0xff, 0xff, 0x7f}))) ==
+          "t.mid: byte 34 (track 1): variable-length number longer than 4 bytes");
+    CHECK(what_of(header(0, 1) + chunk("MTrk", bytes({0x00, 0xff, 0x01, 0x10, 'a'}))) ==
+          "t.mid: byte 26 (track 0): length 16 runs past the end of the track");
+    CHECK(what_of(header(0, 1) + chunk("MTrk", bytes({0x00, 0x99, 0x90, 1}))) ==
+          "t.mid: byte 24 (track 0): data byte expected, got status byte 144");
+    CHECK(what_of(header(0, 1) + "MTrk" + bytes({0, 0, 1, 0})) ==
+          "t.mid: byte 18: chunk length 256 runs past the end of the file");
+}
