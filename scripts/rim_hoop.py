@@ -58,7 +58,7 @@ def subpatch(rows):
     """The [pd rim] canvas: a Hertz pulse (wood on steel) into one biquad~ per mode."""
     m = MASS / 2  # modal mass of a ring mode struck at an antinode
     lines = [
-        "#N canvas 100 100 1160 %d 12;" % (200 + 100 * len(rows)),
+        "#N canvas 100 100 1360 %d 12;" % (200 + 100 * len(rows)),
         "#X obj 20 20 inlet;",
         "#X obj 20 50 list append 0 0 0 0 0;",
         "#X obj 20 80 unpack f f f f f;",
@@ -96,9 +96,9 @@ def subpatch(rows):
         lines.append(
             "#X obj 500 %d expr 2*exp(-6.9078/(%s*$f1))*cos(6.28319*%.2f/$f1) \\; "
             "-exp(-13.8155/(%s*$f1)) \\; %.6f/$f1 \\; "
-            "-exp(-6.9078/(%s*$f1))*cos(6.28319*%.2f/$f1)*%.6f/$f1 \\; 0, f 70;"
+            "-exp(-6.9078/(%s*$f1))*cos(6.28319*%.2f/$f1)*%.6f/$f1 \\; 0, f 90;"
             % (y, t, f, t, g, t, f, g))
-        lines.append("#X obj 1020 %d pack f f f f f;" % y)
+        lines.append("#X obj 1220 %d pack f f f f f;" % y)
         lines.append("#X obj %d %d biquad~;" % (20 + 80 * (i % 6), 60 + 100 * len(rows)
                                                - 40 * (i // 6)))
         e, p, b = 13 + 3 * i, 14 + 3 * i, 15 + 3 * i
@@ -122,7 +122,7 @@ def main():
         path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "patches",
                             "ictus-drum.pd")
         text = open(path).read()
-        pat = re.compile(r"#N canvas 100 100 1160 \d+ 12;\n.*?#X restore 480 372 pd rim;\n", re.S)
+        pat = re.compile(r"#N canvas 100 100 1[13]60 \d+ 12;\n.*?#X restore 480 372 pd rim;\n", re.S)
         if not pat.search(text):
             raise SystemExit("rim_hoop.py: no [pd rim] subpatch in %s" % path)
         text = pat.sub(lambda _m: subpatch(rows), text, count=1)
