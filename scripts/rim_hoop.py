@@ -66,7 +66,7 @@ def subpatch(rows):
         "#X obj 20 140 expr 2870*pow(pow(if($f2>0 \\, $f2 \\, 0.05) \\, 2)/(0.007*2.25e+18*"
         "max($f1 \\, 0.01)) \\, 0.2) \\; 4/3*1.5e+09*sqrt(0.007)*pow(15*if($f2>0 \\, $f2 \\, "
         "0.05)*$f1*$f1/(16*1.5e+09*sqrt(0.007)) \\, 0.6), f 60;",
-        "#X msg 20 230 0 \\, 1 \\$1;",
+        "#X msg 20 230 0 \\, 1 \\$1 \\$2;",
         "#X obj 20 260 vline~;",
         "#X obj 20 290 expr~ if($v1 > 0 && $v1 < 1 \\, sin(3.14159265*$v1)*$f2 \\, 0), f 46;",
         "#X obj 500 20 loadbang;",
@@ -87,7 +87,8 @@ def subpatch(rows):
     route, tbf, srcap = top, top + 1, top + 2
     conns = ["0 0 %d 0" % route, "%d 1 1 0" % route, "%d 0 %d 0" % (route, tbf),
              "%d 1 %d 1" % (tbf, srcap), "%d 0 9 0" % tbf, "9 0 %d 0" % srcap,
-             "1 0 2 0", "2 4 3 1", "2 1 3 0", "3 0 4 0", "4 1 7 1", "4 0 5 0",
+             "1 0 2 0", "2 4 3 1", "2 1 3 0", "3 0 4 0", "4 1 7 1", "4 0 %d 0" % (top + 3),
+             "%d 0 5 0" % (top + 3), "9 0 %d 0" % (top + 4), "%d 0 %d 1" % (top + 4, top + 3),
              "5 0 6 0", "6 0 7 0", "8 0 9 0", "10 0 11 0"]
     for i, (n, f, _ka, _s, w, t60) in enumerate(rows):
         y = 90 + 100 * i
@@ -104,7 +105,11 @@ def subpatch(rows):
         e, p, b = 13 + 3 * i, 14 + 3 * i, 15 + 3 * i
         conns += ["%d 0 %d 0" % (srcap, e)] + ["%d %d %d %d" % (e, k, p, k) for k in range(5)]
         conns += ["%d 0 %d 0" % (p, b), "7 0 %d 0" % b, "%d 0 10 0" % b]
-    lines += ["#X obj 160 20 route t60 list;", "#X obj 660 20 t b f;", "#X obj 660 50 pack f 60;"]
+    # [pack f f] and [expr 500/$f1]: the pulse starts half a sample after the hit's logical
+    # time (vline~ sounds from the sample whose span holds its start), on the hit's sample,
+    # round(t sr), as contact~'s stroke.
+    lines += ["#X obj 160 20 route t60 list;", "#X obj 660 20 t b f;", "#X obj 660 50 pack f 60;",
+              "#X obj 200 230 pack f f;", "#X obj 300 230 expr 500/$f1;"]
     lines += ["#X connect %s;" % c for c in conns]
     lines.append("#X restore 480 372 pd rim;")
     return "\n".join(lines) + "\n"

@@ -137,6 +137,43 @@ TEST_CASE("strike: a bead on a linear spring gives the analytic duration, impuls
     }
 }
 
+TEST_CASE("strike: the zone is the rim when the rim takes at least half of the contact's force",
+          "[sim][strike]")
+{
+    // The samples' forces on the rim and the head, as Scene's contact feedback
+    // gives them (stick_drum_forces): the head's the spring's k x, the rim's a
+    // fixed share of it in the contact's samples; a rim force before the onset
+    // (the shaft on the hoop while the bead is still above the head) is no part
+    // of the contact. Equal steps: the sums' ratio is the impulses' ratio.
+    const AnalyticContact a;
+    struct Case {
+        double rim_share, rim_before;
+        int zone;
+    };
+    const Case cases[] = {{0.0, 0.0, ictus::kZoneHead}, {0.9, 0.0, ictus::kZoneHead},
+                          {1.0, 0.0, ictus::kZoneRim},  {1.1, 0.0, ictus::kZoneRim},
+                          {0.0, 1e4, ictus::kZoneHead}, {0.5, 1e4, ictus::kZoneHead}};
+    for (const Case &c : cases) {
+        StrikeDetector det(flat_membrane(a.k, 0.0), continuous_samples());
+        std::vector<TipSample> samples;
+        for (long n = 0; n * 1e-3 <= 0.2; ++n) {
+            TipSample s = a.at(n * 1e-3);
+            const double depth = a.r - s.center_m.y(); // the bead below the plane
+            if (depth > 0.0) {
+                s.head_force_n = a.k * depth;
+                s.rim_force_n = c.rim_share * s.head_force_n;
+            } else if (s.time_s < a.t_c) {
+                s.rim_force_n = c.rim_before;
+            }
+            samples.push_back(s);
+        }
+        const std::vector<StrikeEvent> ev = run_detector(det, 1, samples);
+        REQUIRE(ev.size() == 1);
+        INFO("rim share " << c.rim_share << ", rim force before the onset " << c.rim_before);
+        CHECK(ev[0].zone == c.zone);
+    }
+}
+
 TEST_CASE("strike: the onset is reported in the sample that crosses the head, with the fields "
           "a sound needs, and equals the strike reported at the release",
           "[sim][strike]")
