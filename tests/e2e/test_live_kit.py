@@ -18,7 +18,6 @@ daemon's exit, with a deadline.
 """
 import argparse
 import csv
-import math
 import os
 import signal
 import socket
@@ -29,6 +28,7 @@ import numpy as np
 
 from ictus_tools import uitest
 from ictus_tools.checks import check
+from ictus_tools.drumtone import f01, goertzel_power
 from ictus_tools.pdrun import read_wav_float
 
 SCORE = """tempo 100
@@ -48,22 +48,10 @@ NOTES = 16
 HEADS = [("snare", (0.1778, 3603.0, 0.345)), ("tom1", (0.127, 1231.0, 0.345)),
          ("tom2", (0.1524, 1231.0, 0.345)), ("floor", (0.2032, 878.0, 0.345))]
 TIP, TIP_CODE = "felt", 3  # the sticks' tip and its code in the strike record (docs/osc.md)
-J01 = 2.404825557695773  # first zero of the Bessel function J0
 SR = 48000
 RECORD_S = 40  # the recording's length (s): the score is 11 s after play
 
 
-def f01(radius, tension, density):
-    return J01 / (2.0 * math.pi * radius) * math.sqrt(tension / density)
-
-
-def goertzel_power(x, rate, freq):
-    w = 2.0 * math.pi * freq / rate
-    c = 2.0 * math.cos(w)
-    s1 = s2 = 0.0
-    for v in x:
-        s1, s2 = v + c * s1 - s2, s1
-    return s1 * s1 + s2 * s2 - c * s1 * s2
 
 
 def test_patch(build, pd_port, daemon_port, ctl_port, wav):
