@@ -11,7 +11,7 @@ four drums' (0,1) frequencies, f01 = j01 / (2 pi a) sqrt(T / sigma) from each pr
 (externals/core/membrane_presets.c; the 10-inch tom1 is the tom preset's head on a 10-inch
 shell, docs/kit.md), the one with the most energy (Goertzel) in the 150 ms after its onset.
 The onset is where the patch played it: the strike's logical time, printed by the patch,
-from the start of the recording. Every wait is a handshake on pd's printed lines or the
+from the start of the recording (the play message, however long the daemon took to start). Every wait is a handshake on pd's printed lines or the
 daemon's exit, with a deadline.
 
     PYTHONPATH=python python3 tests/e2e/test_live_kit.py --build build
@@ -57,7 +57,7 @@ RECORD_S = 40  # the recording's length (s): the score is 11 s after play
 def test_patch(build, pd_port, daemon_port, ctl_port, wav):
     """The main patch as built, listening on pd_port, sending to daemon_port, with what the
     test adds at its end: a FUDI port (play; finish;), the recording of the dac~'s two inputs
-    from logical time 0, each strike's logical time since then, and prints of the kit."""
+    from the play message on, each strike's logical time since then, and prints of the kit."""
     main = open(os.path.join(build, "patches", "ictus.pd")).read()
     check("ictus-receive 9000;" in main and "connect 127.0.0.1 9001;" in main,
           "the main patch listens on 9000 and sends to 9001")
@@ -108,14 +108,17 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav):
              "#X obj 20 1250 array define live-l %d" % (RECORD_S * SR),     # 25
              "#X obj 200 1250 array define live-r %d" % (RECORD_S * SR),    # 26
              "#X obj 900 1130 list split 18",                               # 27
-             "#X obj 900 1160 list split 1"]                                # 28
+             "#X obj 900 1160 list split 1",                                # 28
+             "#X obj 300 1090 t b b"]                                       # 29
     base = n
-    # Recording from logical time 0 into two arrays; finish: 1.5 s of ringing on pd's clock,
-    # then the arrays written (soundfiler: done when it returns), "recorded", and pd quits.
-    links = [(0, 0, 1, 0), (0, 0, 2, 0), (3, 0, 4, 0), (4, 0, 5, 0), (4, 1, 6, 0), (6, 0, 7, 0),
+    # Recording from play (however long the daemon took to start) into two arrays; finish:
+    # 1.5 s of ringing on pd's clock, then the arrays written (soundfiler: done when it
+    # returns), "recorded", and pd quits.
+    links = [(29, 1, 1, 0), (29, 1, 2, 0), (3, 0, 4, 0), (4, 0, 29, 0), (29, 0, 5, 0),
+             (4, 1, 6, 0), (6, 0, 7, 0),
              (7, 2, 22, 0), (22, 0, 24, 0), (7, 1, 21, 0), (21, 0, 15, 0), (7, 0, 23, 0),
              (8, 0, 9, 1), (8, 1, 10, 0), (10, 1, 11, 0), (11, 0, 13, 0), (13, 0, 12, 1),
-             (13, 1, 12, 2), (13, 2, 12, 3), (9, 0, 12, 0), (12, 0, 14, 0), (0, 0, 9, 0),
+             (13, 1, 12, 2), (13, 2, 12, 3), (9, 0, 12, 0), (12, 0, 14, 0), (29, 1, 9, 0),
              (0, 0, 16, 0), (16, 0, 15, 0), (17, 0, 18, 0), (19, 0, 20, 0), (8, 1, 27, 0),
              (27, 1, 28, 0), (28, 0, 12, 4)]
     links = [(base + a, o, base + b, i) for a, o, b, i in links]
@@ -218,6 +221,7 @@ def main():
         seq, drum = int(r["seq"]), int(r["drum"])
         i0 = int(round(strikes_pd[seq][0] * rate / 1000.0)) + int(0.005 * rate)
         seg = mono[i0:i0 + int(0.15 * rate)]
+        check(len(seg) == int(0.15 * rate), "strike %d's window lies in the recording" % seq)
         power = {k: goertzel_power(seg, rate, f) for k, f in freq.items()}
         loudest = max(power, key=power.get)
         heard.append((seq, HEADS[drum][0], loudest))
