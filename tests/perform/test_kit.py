@@ -15,7 +15,6 @@ values written here (docs/sound.md, "Presets"), and the timpani's air-loaded (1,
 import argparse
 import csv
 import json
-import math
 import os
 import struct
 import subprocess
@@ -23,6 +22,7 @@ import sys
 
 from ictus_tools import e2e_util
 from ictus_tools.checks import check
+from ictus_tools.drumtone import f01, goertzel_power
 
 SCORE = """tempo 100
 drum snare
@@ -56,9 +56,6 @@ HEADS = {"snare": (0.1778, 3603.0, 0.345), "tom1": (0.127, 1231.0, 0.345),
 F_TIMPANI = 110.0  # (1,1), air-loaded
 
 
-def f01(radius, tension, density):
-    return 2.405 / (2.0 * math.pi * radius) * math.sqrt(tension / density)
-
 
 def read_wav_mono(path):
     """A 32-bit float WAV (ictus-render's default) as the mean of its channels."""
@@ -80,14 +77,6 @@ def read_wav_mono(path):
     values = struct.unpack("<%df" % n, samples[:4 * n])
     return rate, [sum(values[i:i + channels]) / channels for i in range(0, n, channels)]
 
-
-def goertzel_power(x, rate, freq):
-    w = 2.0 * math.pi * freq / rate
-    c = 2.0 * math.cos(w)
-    s1 = s2 = 0.0
-    for v in x:
-        s1, s2 = v + c * s1 - s2, s1
-    return s1 * s1 + s2 * s2 - c * s1 * s2
 
 
 def played_right(out, drums):

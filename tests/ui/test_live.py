@@ -93,9 +93,11 @@ try:
     pd = subprocess.Popen([uitest.PD, "-nogui", "-nosound", "-stderr", "-path", os.path.join(build, "ictus"),
                            "-open", patch], stdout=open(pd_log_path, "w"), stderr=subprocess.STDOUT,
                           env=x.env())
-    # t0: the meter's first report ("poserate 0", at Pd's logical time 0, after its
-    # UDP port is bound); its k-th report counts the frames of (t0 + k - 1, t0 + k]
+    # seen[k]: when the meter's k-th report was read ("poserate 0" first, at Pd's logical
+    # time 0, after its UDP port is bound); the k-th report counts the frames of
+    # (seen[k - 1], seen[k]] as Pd's scheduler lived them, stalls included
     t0 = None
+    seen = []
     deadline = time.time() + 30
     rates = []
     while time.time() < deadline:
@@ -104,9 +106,11 @@ try:
         if t0 is None:
             if "view: poserate 0" in text:
                 t0 = time.time()
+                seen = [t0]
             continue
         rates = [float(v) for v in re.findall(r"view: poserate (\S+)", text)]
-        if len(rates) >= 4 and text.count("daemon: reply /ictus/score") >= len(STATEMENTS) \
+        seen += [time.time()] * (len(rates) - len(seen))
+        if len(rates) >= 5 and text.count("daemon: reply /ictus/score") >= len(STATEMENTS) \
                 and "daemon: pong" in text:
             break
         if pd.poll() is not None:
@@ -131,12 +135,17 @@ check("daemon: error" not in text, "no error replies")
 check("daemon: pong" in text, "ping -> pong")
 # each of the meter's reports against the frames relayed in its second
 check(t0 is not None and len(rates) >= 3, "the rate meter reported (%s)" % rates)
-relayed = [sum(1 for t in pose_times if t0 + k - 1 < t <= t0 + k) for k in range(1, len(rates))]
+# The first second after "poserate 0" is left out: Pd opens the Gem window in it, and
+# the frames queued meanwhile are counted in a second Pd's clock and the log's reading
+# do not share (seen: meter 41 for relayed 30); from the second report on both run.
+n_bins = min(len(rates), len(seen))
+relayed = [sum(1 for t in pose_times if seen[k - 1] < t <= seen[k]) for k in range(2, n_bins)]
+rates = rates[1:n_bins]
 print("rate meter: %s, relayed in the same seconds: %s" % (rates[1:], relayed))
 check(sum(relayed) > 10, "poses were streamed (%d relayed)" % sum(relayed))
-# The meter bins by Pd's logical seconds, the relay by wall-clock ones: when
-# Pd stalls and catches up (a loaded machine, a sanitizer), frames move
-# between neighbouring bins (seen: meter 33 2 15 for relayed 20 15 15), but
+# The meter bins by Pd's logical seconds, the relay by when each report was
+# read: when Pd stalls and catches up (a loaded machine, a sanitizer), reports
+# arrive together and frames move between neighbouring bins (seen: meter 33 2 15 for relayed 20 15 15), but
 # none is lost or counted twice: the totals agree within 2, and each second
 # agrees within 2 whenever Pd kept up (no bin above the relay's rate).
 check(abs(sum(rates[1:]) - sum(relayed)) <= 2,
