@@ -186,7 +186,7 @@ void check_whole_lines(const std::string &text, size_t &rows)
     const std::vector<std::string> all = lines(text);
     REQUIRE(!all.empty());
     const auto columns = std::count(all[0].begin(), all[0].end(), ',');
-    CHECK(columns == 19);
+    CHECK(columns == 20); // ... stick_tip, zone (docs/osc.md)
     for (size_t i = 1; i < all.size(); ++i) {
         INFO("row " << i << ": " << all[i]);
         CHECK(std::count(all[i].begin(), all[i].end(), ',') == columns);
@@ -231,9 +231,10 @@ TEST_CASE("render: two renders give identical bytes, the events add up to the st
         std::vector<std::string> f;
         while (std::getline(c, field, ','))
             f.push_back(field);
-        REQUIRE(f.size() == 20);
+        REQUIRE(f.size() == 21);
         CHECK(std::stol(f[0]) == static_cast<long>(i)); // seq in onset order
         CHECK(f[19] == "0");                            // stick_tip: none without --stick-tip
+        CHECK((f[20] == "0" || f[20] == "1"));          // zone: head or rim
         CHECK(std::stoi(f[1]) == hand);
         CHECK(std::stoi(f[3]) == bounce);
         CHECK(sum_ms == Approx(std::stod(f[5]) * 1e3).margin(1e-6 * (i + 1) + 1e-9));

@@ -100,6 +100,7 @@ ictus::StrikeEvent sample_strike(long seq, double time_s)
     e.force_dir = Eigen::Vector3d(0.6, -0.8, 0.0);
     e.stick_mass_kg = 0.0125;
     e.stick_tip = static_cast<int>(seq % 4); // none, wood, nylon, felt
+    e.zone = seq == 3 ? ictus::kZoneRim : ictus::kZoneHead;
     return e;
 }
 
@@ -222,8 +223,9 @@ TEST_CASE("osc out: /ictus/strike/end carries the field table's end fields, at t
         types += ictus::strike_field_info(f).integer ? 'i' : 'f';
     }
     // ... which docs/osc.md names: seq, hand, peak_force_n, impulse_n_s,
-    // duration_ms, force_dir_x, _y, _z.
-    CHECK(types == "iiffffff");
+    // duration_ms, force_dir_x, _y, _z, zone (last: a reader of the first
+    // eight still parses it).
+    CHECK(types == "iiffffffi");
     CHECK(d.types == types);
     REQUIRE(d.args.size() == fields.size());
     for (std::size_t k = 0; k < fields.size(); ++k) {
@@ -232,6 +234,7 @@ TEST_CASE("osc out: /ictus/strike/end carries the field table's end fields, at t
         CHECK(std::stod(d.args[k]) == Approx(expected).margin(2e-6 * (1 + std::fabs(expected))));
     }
     // Due at the release: onset + duration + lookahead.
+    CHECK(d.args.back() == "1"); // sample_strike(3, ...) landed on the rim
     CHECK(d.timetag ==
           hex_timetag(ictus::ntp_add_seconds(epoch, e.time_s + 1e-3 * e.duration_ms + 0.02)));
     sender.stop();

@@ -137,6 +137,43 @@ TEST_CASE("strike: a bead on a linear spring gives the analytic duration, impuls
     }
 }
 
+TEST_CASE("strike: the zone is the rim when the rim takes at least half of the contact's force",
+          "[sim][strike]")
+{
+    // The samples' forces on the rim and the head, as Scene's contact feedback
+    // gives them (stick_drum_forces): the head's the spring's k x, the rim's a
+    // fixed share of it in the contact's samples; a rim force before the onset
+    // (the shaft on the hoop while the bead is still above the head) is no part
+    // of the contact. Equal steps: the sums' ratio is the impulses' ratio.
+    const AnalyticContact a;
+    struct Case {
+        double rim_share, rim_before;
+        int zone;
+    };
+    const Case cases[] = {{0.0, 0.0, ictus::kZoneHead}, {0.9, 0.0, ictus::kZoneHead},
+                          {1.0, 0.0, ictus::kZoneRim},  {1.1, 0.0, ictus::kZoneRim},
+                          {0.0, 1e4, ictus::kZoneHead}, {0.5, 1e4, ictus::kZoneHead}};
+    for (const Case &c : cases) {
+        StrikeDetector det(flat_membrane(a.k, 0.0), continuous_samples());
+        std::vector<TipSample> samples;
+        for (long n = 0; n * 1e-3 <= 0.2; ++n) {
+            TipSample s = a.at(n * 1e-3);
+            const double depth = a.r - s.center_m.y(); // the bead below the plane
+            if (depth > 0.0) {
+                s.head_force_n = a.k * depth;
+                s.rim_force_n = c.rim_share * s.head_force_n;
+            } else if (s.time_s < a.t_c) {
+                s.rim_force_n = c.rim_before;
+            }
+            samples.push_back(s);
+        }
+        const std::vector<StrikeEvent> ev = run_detector(det, 1, samples);
+        REQUIRE(ev.size() == 1);
+        INFO("rim share " << c.rim_share << ", rim force before the onset " << c.rim_before);
+        CHECK(ev[0].zone == c.zone);
+    }
+}
+
 TEST_CASE("strike: the onset is reported in the sample that crosses the head, with the fields "
           "a sound needs, and equals the strike reported at the release",
           "[sim][strike]")
@@ -350,15 +387,16 @@ TEST_CASE("strike: CSV and events lines have fixed, documented formats", "[sim][
     e.force_dir = Eigen::Vector3d(0.0, -1.0, 0.0);
     e.stick_mass_kg = 0.0123456;
     e.stick_tip = ictus::stick_tip_code("felt");
+    e.zone = ictus::kZoneRim;
     std::ostringstream csv;
     ictus::write_strikes_csv_header(csv);
     ictus::write_strike_csv_row(csv, e);
     CHECK(csv.str() ==
           "seq,hand,drum,bounce,stroke,time_s,x_m,y_m,r_over_a,theta_deg,normal_velocity_mps,"
           "tangential_velocity_mps,peak_force_n,impulse_n_s,duration_ms,force_dir_x,force_dir_y,"
-          "force_dir_z,stick_mass_kg,stick_tip\n"
+          "force_dir_z,stick_mass_kg,stick_tip,zone\n"
           "3,1,0,1,2,1.250000,0.05000,0.00000,0.28090,0.00,1.5000,0.2000,19.123,0.090000,7.130,"
-          "0.0000,-1.0000,0.0000,0.01235,3\n");
+          "0.0000,-1.0000,0.0000,0.01235,3,1\n");
     // The tip codes: stick_tip.h's table order + 1, 0 for none (docs/osc.md).
     CHECK(ictus::stick_tip_code("") == 0);
     CHECK(ictus::stick_tip_code("wood") == 1);
@@ -370,7 +408,7 @@ TEST_CASE("strike: CSV and events lines have fixed, documented formats", "[sim][
     std::ostringstream ev;
     ictus::write_events_line(ev, e, 1.0);
     CHECK(ev.str() == "250.000 hit 1 0 1 1.5000 0.28090 0.00 19.123 0.090000 7.130 0.2000 1.250000 "
-                      "0.01235;\n");
+                      "0.01235 1;\n");
 }
 
 namespace

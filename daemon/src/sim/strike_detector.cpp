@@ -253,6 +253,8 @@ void StrikeDetector::begin_contact(Hand &h, int hand, const TipSample &s, double
                 h.max_held_gap_since_release < options_.bounce_height_m || !driven);
     e.stick_mass_kg = s.effective_mass_kg;
     e.stick_tip = s.stick_tip;
+    h.rim_force_sum = 0.0;
+    h.head_force_sum = 0.0;
     if (!e.bounce)
         ++h.stroke;
     e.stroke = std::max(h.stroke, 0L);
@@ -277,6 +279,8 @@ void StrikeDetector::continue_contact(Hand &h, const TipSample &s, double gap, d
 {
     const double f = normal_force_n(-gap, depth_rate);
     const double dt = s.time_s - h.last_time_s;
+    h.rim_force_sum += s.rim_force_n;
+    h.head_force_sum += s.head_force_n;
     h.event.impulse_n_s += 0.5 * (h.last_force_n + f) * dt;
     // Kinetic friction on the membrane along the tip's sliding direction.
     const Eigen::Vector3d vt = s.velocity_mps - s.velocity_mps.dot(kNormal) * kNormal;
@@ -309,6 +313,9 @@ void StrikeDetector::end_contact(Hand &h, const TipSample &s, double gap, double
         frac = -g0 / (gap - g0);
     const double t_rel = h.previous.time_s + frac * (s.time_s - h.previous.time_s);
     const double f_rel = normal_force_n(0.0, depth_rate);
+    // The step that ends the episode: its contacts were during it.
+    h.rim_force_sum += s.rim_force_n;
+    h.head_force_sum += s.head_force_n;
     const double dt = t_rel - h.last_time_s;
     h.event.impulse_n_s += 0.5 * (h.last_force_n + f_rel) * dt;
     if (!h.peak_has_after && h.peak_t[1] == h.last_time_s) {
@@ -357,6 +364,8 @@ void StrikeDetector::finish(Hand &h, double release_time_s, StrikeEvent &out)
     const Eigen::Vector3d total = -e.impulse_n_s * kNormal + h.friction_sum;
     e.force_dir =
         total.norm() > 0.0 ? Eigen::Vector3d(total.normalized()) : Eigen::Vector3d(-kNormal);
+    // The samples are the physics' equal steps: the sums' ratio is the impulses'.
+    e.zone = h.rim_force_sum > 0.0 && h.rim_force_sum >= h.head_force_sum ? kZoneRim : kZoneHead;
     out = e;
     h.in_contact = false;
     h.released_once = true;
@@ -389,6 +398,70 @@ MembraneGeometry membrane_of(const Scene &scene, int drum_id)
     return m;
 }
 
+double distance_to_rim_m(const MembraneGeometry &membrane, const Eigen::Vector3d &point_m)
+{
+    const Eigen::Vector3d d = point_m - membrane.center_m;
+    const double h = d.dot(kNormal);
+    const double rho = (d - h * kNormal).norm();
+    return std::hypot(rho - membrane.radius_m, h);
+}
+
+bool stick_on_rim(const Scene &scene, int hand, const MembraneGeometry &membrane, bool *bead_on_rim)
+{
+    const Side side = static_cast<Side>(hand & 1);
+    const StickParams &sp = scene.model().options().stick;
+    const StickInHand &st = scene.model().stick(side);
+    const Eigen::Vector3d bead = scene.bead_position(side);
+    const bool bead_reaches = distance_to_rim_m(membrane, bead) < sp.tip_radius_m;
+    if (bead_on_rim)
+        *bead_on_rim = bead_reaches;
+    if (bead_reaches)
+        return true;
+    // The shaft's segment (Scene's capsule): from one shaft radius behind the
+    // bead's centre to one shaft radius before the butt. The distance to the
+    // circle along it: 64 samples, then a golden-section search around the
+    // nearest (the distance is smooth along the segment).
+    const Eigen::Vector3d back = -scene.stick_axis(side);
+    const double r = sp.shaft_radius_m;
+    const double len = (st.tip_m - sp.tip_radius_m * st.axis - st.butt_m).norm() - 2.0 * r;
+    auto dist = [&](double s) { return distance_to_rim_m(membrane, bead + (r + s) * back); };
+    constexpr int kSamples = 64;
+    int best = 0;
+    double best_d = dist(0.0);
+    for (int i = 1; i <= kSamples; ++i) {
+        const double d = dist(len * i / kSamples);
+        if (d < best_d) {
+            best_d = d;
+            best = i;
+        }
+    }
+    double lo = len * std::max(best - 1, 0) / kSamples,
+           hi = len * std::min(best + 1, kSamples) / kSamples;
+    constexpr double kGolden = 0.6180339887498949;
+    for (int it = 0; it < 40; ++it) {
+        const double a = hi - kGolden * (hi - lo), b = lo + kGolden * (hi - lo);
+        if (dist(a) < dist(b))
+            hi = b;
+        else
+            lo = a;
+    }
+    return std::min(best_d, dist(0.5 * (lo + hi))) < r;
+}
+
+StickDrumForces stick_drum_forces(const Scene &scene, int hand, const MembraneGeometry &membrane)
+{
+    StickDrumForces f;
+    const StickDrumContact &c = scene.drum_contact(static_cast<Side>(hand & 1));
+    if (c.bead_points + c.shaft_points == 0)
+        return f;
+    bool bead_on_rim = false;
+    const bool on_rim = stick_on_rim(scene, hand, membrane, &bead_on_rim);
+    const double bead_n = c.bead_force_n.norm(), shaft_n = c.shaft_force_n.norm();
+    (bead_on_rim ? f.rim_n : f.head_n) += bead_n;
+    (on_rim ? f.rim_n : f.head_n) += shaft_n;
+    return f;
+}
+
 void load_membranes(StrikeDetector &detector, const Scene &scene)
 {
     detector.reset(membrane_of(scene, 0));
@@ -409,6 +482,9 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
         s.held_center_m = scene.held_bead_position(side);
         // Only near the head, where a contact may begin (a 7 x 7 solve).
         const int drum = detector.drum_under(s.center_m);
+        const StickDrumForces f = stick_drum_forces(scene, hand, detector.membrane(drum));
+        s.rim_force_n = f.rim_n;
+        s.head_force_n = f.head_n;
         if (detector.gap_m(s.center_m, drum) < 0.02) {
             s.effective_mass_kg = scene.effective_mass_kg(side, Eigen::Vector3d::UnitY(), drum);
             s.stick_tip = stick_tip_code(scene.options().drum.stick_tip); // the sticks' tip

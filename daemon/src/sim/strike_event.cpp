@@ -35,6 +35,9 @@ constexpr StrikeFieldInfo kInfo[kStrikeFieldCount] = {
     {"force_dir_z", false, 4, true, true},
     {"stick_mass_kg", false, 5, true, false},
     {"stick_tip", true, 0, true, false},
+    // Known at the release only (the stick reaches the rim after the bead's
+    // onset): in /ictus/strike/end, not /ictus/strike (docs/osc.md).
+    {"zone", true, 0, false, true},
 };
 
 // Fixed notation with a given number of decimals; -0 printed as 0 so that
@@ -69,13 +72,14 @@ void put_field(std::ostream &out, const StrikeEvent &e, StrikeField f)
 } // namespace
 
 // A hit line: what a drum patch needs first (patches/ictus-render.pd plays them).
-const StrikeField kEventsStrikeFields[12] = {
+const StrikeField kEventsStrikeFields[13] = {
     StrikeField::hand,         StrikeField::drum,
     StrikeField::bounce,       StrikeField::normal_velocity_mps,
     StrikeField::r_over_a,     StrikeField::theta_deg,
     StrikeField::peak_force_n, StrikeField::impulse_n_s,
     StrikeField::duration_ms,  StrikeField::tangential_velocity_mps,
     StrikeField::time_s,       StrikeField::stick_mass_kg,
+    StrikeField::zone,
 };
 
 const StrikeFieldInfo &strike_field_info(StrikeField field)
@@ -98,6 +102,8 @@ long strike_field_integer(const StrikeEvent &e, StrikeField field)
         return e.stroke;
     case StrikeField::stick_tip:
         return e.stick_tip;
+    case StrikeField::zone:
+        return e.zone;
     default:
         return std::lround(strike_field(e, field));
     }
@@ -112,6 +118,7 @@ double strike_field(const StrikeEvent &e, StrikeField field)
     case StrikeField::bounce:
     case StrikeField::stroke:
     case StrikeField::stick_tip:
+    case StrikeField::zone:
         return static_cast<double>(strike_field_integer(e, field));
     case StrikeField::time_s:
         return e.time_s;

@@ -82,6 +82,12 @@ struct TipSample {
     double effective_mass_kg = 0.0;
     // The stick's tip (StrikeEvent::stick_tip's code), copied likewise.
     int stick_tip = 0;
+    // The force (N, magnitude) the stick puts on the drum's rim and on its
+    // head at this sample (stick_drum_forces): a contact episode whose rim
+    // force, summed over its samples, is at least its head force is a strike
+    // on the rim (StrikeEvent::zone).
+    double rim_force_n = 0.0;
+    double head_force_n = 0.0;
 };
 
 class StrikeDetector
@@ -158,6 +164,8 @@ class StrikeDetector
         double peak_t[3] = {0, 0, 0}, peak_f[3] = {0, 0, 0};
         bool peak_has_before = false, peak_has_after = false;
         Eigen::Vector3d friction_sum = Eigen::Vector3d::Zero(); // sum of F dt, tangential
+        // The stick's force on the rim and on the head, summed over the samples.
+        double rim_force_sum = 0.0, head_force_sum = 0.0;
         // Since the last release.
         bool released_once = false;
         double release_time_s = 0.0;
@@ -207,5 +215,27 @@ void load_membranes(StrikeDetector &detector, const Scene &scene);
 // the scene's clock (a run that rebuilt its scene keeps one clock).
 int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out[2],
                    double time_offset_s = 0.0);
+
+// The distance (m) from a point to the rim of `membrane`: the circle of its
+// radius in the membrane plane, where the drum's shell and hoop hold the head.
+double distance_to_rim_m(const MembraneGeometry &membrane, const Eigen::Vector3d &point_m);
+// Whether the stick of `hand` (0 left, 1 right) of `scene` reaches the rim of
+// `membrane` now: its collision geometry (the bead, a sphere of the tip
+// radius, and the shaft, a capsule of the shaft radius from the bead back to
+// the butt) reaches the rim circle. `bead_on_rim` tells which part: the bead
+// (true) or the shaft alone (false).
+bool stick_on_rim(const Scene &scene, int hand, const MembraneGeometry &membrane,
+                  bool *bead_on_rim = nullptr);
+// The forces (N, magnitudes of Scene::drum_contact's) the stick of `hand` puts
+// on the rim of `membrane` and on its head now: the bead's goes to the rim when
+// the bead reaches the rim circle, else to the head; the shaft's to the rim
+// when the shaft reaches it, else to the head (the shaft lying on the head).
+// A strike is on the rim when the rim takes at least half of the blow
+// (StrikeEvent::zone, docs/rim.md).
+struct StickDrumForces {
+    double rim_n = 0.0;
+    double head_n = 0.0;
+};
+StickDrumForces stick_drum_forces(const Scene &scene, int hand, const MembraneGeometry &membrane);
 
 } // namespace ictus

@@ -41,7 +41,12 @@ struct StrikeEvent {
     // The stick's tip (externals/core/stick_tip.h): 0 none (the head's spring
     // alone), 1 wood, 2 nylon, 3 felt (the tip table's index + 1).
     int stick_tip = 0;
+    // Where the stick landed: 0 the head, 1 the rim (the stick touched the
+    // drum's top edge during the contact, Scene's StickDrumContact::
+    // rim_points; docs/osc.md). Known at the release.
+    int zone = 0;
 };
+constexpr int kZoneHead = 0, kZoneRim = 1;
 
 // The fields of a StrikeEvent, in strikes.csv's column order (and the OSC message's).
 enum class StrikeField {
@@ -65,8 +70,9 @@ enum class StrikeField {
     force_dir_z,
     stick_mass_kg,
     stick_tip,
+    zone,
 };
-constexpr int kStrikeFieldCount = static_cast<int>(StrikeField::stick_tip) + 1;
+constexpr int kStrikeFieldCount = static_cast<int>(StrikeField::zone) + 1;
 
 // A strike's stick_tip code for a tip name (stick_tip.h: "wood", "nylon", "felt";
 // "" or another name: 0, none), and the name for a code ("" for 0 or out of range).
@@ -88,7 +94,7 @@ long strike_field_integer(const StrikeEvent &event, StrikeField field);
 // The layouts: strikes.csv has every field in StrikeField's order; the
 // /ictus/strike OSC message those with in_osc and /ictus/strike/end those with
 // in_osc_end, in the same order; the events file's `hit` line these, after "hit":
-extern const StrikeField kEventsStrikeFields[12];
+extern const StrikeField kEventsStrikeFields[13];
 
 // strikes.csv: a header line and one line per event, fixed precision (so that
 // equal runs give equal bytes).
