@@ -161,12 +161,13 @@ void AsyncLog::report(double now_s, bool now)
 
 // One write(2), only when the descriptor takes it without waiting (a pipe with
 // room, a file, a terminal not on hold); else the line is lost, counted. At
-// the end the descriptor is given 0.2 s.
+// the end the descriptor is given 0.2 s, once.
 bool AsyncLog::write_line(const std::string &line)
 {
     pollfd p{fd_, POLLOUT, 0};
-    const int wait_ms = running_.load() ? 0 : 200;
+    const int wait_ms = running_.load() || waited_ ? 0 : 200;
     if (poll(&p, 1, wait_ms) != 1 || !(p.revents & POLLOUT)) {
+        waited_ = waited_ || wait_ms > 0; // 0.2 s once, not once a line
         unwritten_.fetch_add(1, std::memory_order_relaxed);
         return false;
     }

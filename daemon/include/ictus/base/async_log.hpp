@@ -74,6 +74,7 @@ class AsyncLog
     // The writer's state (read by counters() through the atomics below).
     std::string last_;
     bool last_shown_ = false;
+    bool waited_ = false; // stop() has given the descriptor its 0.2 s
     unsigned long pending_repeats_ = 0, pending_suppressed_ = 0;
     double tokens_ = kLinesPerSecond, tokens_at_s_ = 0.0, report_at_s_ = 0.0;
     std::atomic<unsigned long> written_{0}, repeated_{0}, suppressed_{0}, unwritten_{0};
