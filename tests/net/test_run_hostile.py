@@ -99,10 +99,12 @@ class Listener:
         self.thread.start()
 
     def loop(self):
-        while self.running:
+        while True:
             try:
                 packet = self.sock.recv(65536)
             except socket.timeout:
+                if not self.running:
+                    return  # closed, and nothing left in the socket's buffer
                 continue
             now = time.monotonic()
             for address, args in messages(packet):
@@ -112,6 +114,8 @@ class Listener:
                     self.ends.setdefault(args[0], now)
 
     def close(self):
+        """Stops once the datagrams already delivered are read (a loopback send is in the
+        buffer when sendto returns: the daemon's, once it has ended, all are)."""
         self.running = False
         self.thread.join()
         self.sock.close()
@@ -297,7 +301,6 @@ def case_grip(ictusd, workdir):
         list(d.replies(0.0))
         time.sleep(max(0.0, start + 0.05 * k - time.monotonic()))
     code = d.wait(20.0)
-    time.sleep(0.2)  # the last datagrams on loopback
     listener.close()
     rows = {int(r["seq"]) for r in d.strike_rows()}
     onsets, ends = set(listener.onsets), set(listener.ends)
