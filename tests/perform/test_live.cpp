@@ -428,3 +428,66 @@ TEST_CASE("perform: gains are refused past the controller's stability bounds, wi
         CHECK_FALSE(
             (t >= first_runaway_s && t < first_runaway_s + Performance::kRunawayQuiet_s - 0.05));
 }
+
+TEST_CASE("live: a stop cancels a play still being planned, and a later play starts",
+          "[perform][live]")
+{
+    PerformanceOptions o;
+    std::string score = "tempo 200\n";
+    for (int i = 0; i < 500; ++i)
+        score += "R 1/4, L 1/4\n";
+    o.score.score_text = score;
+    Performance perf(o);
+    perf.set_background_work(true);
+    StrikeEvent ev[2];
+    // Steps until the worker has handed back what it was given (deadline 60 s).
+    auto settle = [&] {
+        const auto deadline = Clock::now() + std::chrono::seconds(60);
+        while (perf.work_pending() && Clock::now() < deadline)
+            perf.step(ev);
+        REQUIRE_FALSE(perf.work_pending());
+        perf.step(ev); // installed at the start of a step
+    };
+    Command play, stop;
+    play.kind = CommandKind::play;
+    stop.kind = CommandKind::stop;
+    // The stop right after the play (the plan is being computed): nothing starts.
+    REQUIRE(perf.apply(play));
+    REQUIRE(perf.apply(stop));
+    settle();
+    CHECK_FALSE(perf.playing());
+    CHECK_FALSE(perf.plan_active());
+    // Ten plays and stops in a row, ending in stop: still stopped.
+    for (int i = 0; i < 10; ++i) {
+        REQUIRE(perf.apply(play));
+        perf.step(ev);
+        REQUIRE(perf.apply(stop));
+    }
+    settle();
+    CHECK_FALSE(perf.playing());
+    // A play with no stop after it plays.
+    REQUIRE(perf.apply(play));
+    settle();
+    CHECK(perf.playing());
+    CHECK(perf.plan_active());
+}
+
+TEST_CASE("live: score statements over OSC wait at most kMaxPendingStatements, the rest refused",
+          "[perform][live]")
+{
+    PerformanceOptions o;
+    Performance perf(o);
+    Command c;
+    c.kind = CommandKind::score;
+    std::snprintf(c.text, sizeof c.text, "R, L"); // two statements a line
+    std::string why;
+    for (int i = 0; i < Performance::kMaxPendingStatements / 2; ++i)
+        REQUIRE(perf.apply(c, &why));
+    CHECK_FALSE(perf.apply(c, &why));
+    CHECK(why.find("10000 statements are waiting") != std::string::npos);
+    CHECK(perf.refused_statements() == 1);
+    Command clear;
+    clear.kind = CommandKind::score_clear;
+    REQUIRE(perf.apply(clear));
+    CHECK(perf.apply(c, &why));
+}

@@ -206,8 +206,8 @@ class CsvWriter
 class OscIo : public RealtimeIo
 {
   public:
-    OscIo(OscSender &sender, OscServer &server, CsvWriter &writer)
-        : sender_(sender), server_(server), writer_(writer)
+    OscIo(OscSender &sender, OscServer &server, CsvWriter &writer, AsyncLog &log)
+        : sender_(sender), server_(server), writer_(writer), log_(log)
     {
     }
     // A play sends the kit first (the sound's drums, docs/osc.md): a patch opened
@@ -221,6 +221,7 @@ class OscIo : public RealtimeIo
         return true;
     }
     void refused(const Refusal &refusal) override { server_.post_refusal(refusal); }
+    void log(const char *line) override { log_.post(line); }
     void strike_onset(const StrikeEvent &strike) override { sender_.post_strike(strike); }
     void strike_end(const StrikeEvent &strike) override { sender_.post_strike_end(strike); }
     void strike_logged(const StrikeEvent &strike) override { writer_.post(strike); }
@@ -237,6 +238,7 @@ class OscIo : public RealtimeIo
     OscSender &sender_;
     OscServer &server_;
     CsvWriter &writer_;
+    AsyncLog &log_;
 };
 
 struct RunOptions {
@@ -334,7 +336,9 @@ void print_summary(const Performance &perf, const OscSender &sender, const OscSe
               << " poses, " << sc.send_errors << " send errors; " << rc.packets << " packets in, "
               << rc.accepted << " accepted, " << rc.errors() << " errors (" << rc.errors_unanswered
               << " unanswered: error-reply budget), " << rc.refused_peers << " refused; "
-              << status.overruns.load() << " overruns, " << perf.runaways() << " runaways";
+              << status.overruns.load() << " overruns, " << perf.runaways() << " runaways ("
+              << perf.withheld_strikes() << " strikes held back), " << perf.refused_statements()
+              << " score statements refused";
     if (csv)
         std::cout << "; strikes.csv: " << writer.written() << " rows, " << writer.dropped()
                   << " dropped (queue full), " << loop.out_of_order << " out of order";
@@ -376,6 +380,9 @@ int cmd_run(Args &args)
     sender.send_kit(); // for a patch already listening; again at each play
     LiveStatus status;
     begin_status(perf, status);
+    // The log of the physics and server threads (base/async_log.hpp).
+    AsyncLog log;
+    r.server.log = &log;
     OscServer server(io, &status);
     // Planning and rebuilds from now on run beside the physics loop.
     perf.set_background_work(true);
@@ -384,11 +391,12 @@ int cmd_run(Args &args)
     g_interrupted = 0;
     install_interrupt_handler(true);
 
-    OscIo osc(sender, server, writer);
+    OscIo osc(sender, server, writer, log);
     const RealtimeLoopResult loop = run_realtime(perf, osc, status, r.loop);
     sender.stop();
     server.stop();
     writer.stop();
+    log.stop();
     print_summary(perf, sender, server, status, writer, !csv_path.empty(), loop);
     if (writer.failed())
         throw std::runtime_error(writer.error()); // exit 1

@@ -134,10 +134,12 @@ OscServerCounters snapshot(const Counters &c)
 }
 
 // A rate-limited log: at most one line per second, with the count of the
-// lines suppressed since.
+// lines suppressed since; posted to the daemon's log when there is one (the
+// server's thread then never waits on stderr), else written to stderr.
 class RateLimitedLog
 {
   public:
+    AsyncLog *sink = nullptr;
     void operator()(const char *what, const std::string &detail)
     {
         const auto now = std::chrono::steady_clock::now();
@@ -146,13 +148,20 @@ class RateLimitedLog
             return;
         }
         if (suppressed_)
-            std::fprintf(stderr, "ictusd: osc: (%lu similar lines suppressed)\n", suppressed_);
+            emit("ictusd: osc: (" + std::to_string(suppressed_) + " similar lines suppressed)");
         suppressed_ = 0;
         last_ = now;
-        std::fprintf(stderr, "ictusd: osc: %s: %s\n", what, detail.c_str());
+        emit(std::string("ictusd: osc: ") + what + ": " + detail);
     }
 
   private:
+    void emit(const std::string &line)
+    {
+        if (sink)
+            sink->post(line.c_str());
+        else
+            std::fprintf(stderr, "%s\n", line.c_str());
+    }
     std::chrono::steady_clock::time_point last_{};
     unsigned long suppressed_ = 0;
 };
@@ -179,6 +188,7 @@ struct OscServer::Impl {
 OscServer::OscServer(const OscServerOptions &options, LiveStatus *status)
     : impl_(new Impl), options_(options), status_(status)
 {
+    impl_->log.sink = options.log;
     in_addr bind_addr;
     if (!parse_ipv4(options.bind_address, bind_addr))
         throw OscError("--bind: expected a numeric IPv4 address, got '" + options.bind_address +

@@ -217,7 +217,9 @@ bool ClipMode::install(Work &work, std::string *)
     if (perf_.options_.drum_auto)
         perf_.options_.scene.drum.center_m = job.drum_center_m;
     install_rig(std::move(job.rig));
-    perf_.playing_ = true;
+    // A stop after the play that asked for the rebuild: the clip waits.
+    if (!job.cancelled())
+        perf_.playing_ = true;
     return true;
 }
 

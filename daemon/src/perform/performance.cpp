@@ -139,17 +139,77 @@ int Performance::divergences() const
 int Performance::step(StrikeEvent out[2])
 {
     take_results();
-    const int k = mode_->step(out);
-    return guard_runaway(k);
+    StrikeEvent ended[2];
+    const int k = mode_->step(ended);
+    // Strikes a rebuild ended go first (their onsets came earlier); what
+    // does not fit in this step's two waits for the next.
+    for (int i = 0; i < k; ++i) {
+        if (held_ends_n_ == static_cast<int>(held_ends_.size()))
+            break; // eight strikes waiting: cannot happen (a step ends <= 2, a rebuild <= 2)
+        held_ends_[static_cast<size_t>(held_ends_n_++)] = ended[i];
+    }
+    int n = 0;
+    while (n < 2 && held_ends_n_ > 0) {
+        out[n++] = held_ends_[0];
+        std::copy(held_ends_.begin() + 1, held_ends_.begin() + held_ends_n_, held_ends_.begin());
+        --held_ends_n_;
+    }
+    return guard_runaway(n, out);
 }
 
 int Performance::take_onsets(StrikeEvent out[2])
 {
     int n = 0;
+    StrikeEvent taken[4];
+    for (int i = 0; i < held_onsets_n_; ++i)
+        taken[n++] = held_onsets_[static_cast<size_t>(i)];
+    held_onsets_n_ = 0;
     for (int hand = 0; hand < 2; ++hand)
-        if (detector_.take_onset(hand, out[n]))
+        if (detector_.take_onset(hand, taken[n]))
             ++n;
-    return time_s() < quiet_until_s_ ? 0 : n;
+    int kept = 0;
+    for (int i = 0; i < n; ++i) {
+        if (withheld(taken[i]))
+            continue;
+        if (kept < 2)
+            out[kept++] = taken[i];
+        else if (held_onsets_n_ < 2) // for the next call
+            held_onsets_[static_cast<size_t>(held_onsets_n_++)] = taken[i];
+    }
+    return kept;
+}
+
+bool Performance::flush(StrikeEvent &out)
+{
+    for (;;) {
+        if (held_ends_n_ > 0) {
+            out = held_ends_[0];
+            std::copy(held_ends_.begin() + 1, held_ends_.begin() + held_ends_n_,
+                      held_ends_.begin());
+            --held_ends_n_;
+        } else if (!detector_.flush(out)) {
+            return false;
+        }
+        if (!withheld(out))
+            return true;
+    }
+}
+
+bool Performance::withheld(const StrikeEvent &e) const
+{
+    return e.time_s >= quiet_from_s_ && e.time_s < quiet_until_s_;
+}
+
+void Performance::hold_open_contacts()
+{
+    // The onsets not taken yet, then the contacts themselves, ended at their
+    // last sample: each strike keeps its onset, its end and its row.
+    for (int hand = 0; hand < 2 && held_onsets_n_ < 2; ++hand)
+        if (detector_.take_onset(hand, held_onsets_[static_cast<size_t>(held_onsets_n_)]))
+            ++held_onsets_n_;
+    StrikeEvent e;
+    while (held_ends_n_ < static_cast<int>(held_ends_.size()) && detector_.flush(e))
+        held_ends_[static_cast<size_t>(held_ends_n_++)] = e;
 }
 
 namespace
@@ -216,10 +276,12 @@ void Performance::took_over(double previous_time_s)
     apply_gains();
     set_grips(options_.grip_firmness);
     time_offset_s_ = previous_time_s;
+    // The new scene has no contact history: the contacts under way end now.
+    hold_open_contacts();
     load_membranes(detector_, scene());
 }
 
-int Performance::guard_runaway(int k)
+int Performance::guard_runaway(int k, StrikeEvent out[2])
 {
     double speed = 0.0;
     for (int s = 0; s < 2; ++s)
@@ -239,11 +301,19 @@ int Performance::guard_runaway(int k)
         if (origin.address[0] == '\0')
             std::snprintf(origin.address, sizeof origin.address, "/ictus/gains");
         refuse_later(origin, buf);
+        quiet_from_s_ = time_s();
         quiet_until_s_ = time_s() + kRunawayQuiet_s;
     }
-    if (time_s() < quiet_until_s_)
-        return 0;
-    return k;
+    // A strike whose onset fell in the quiet time is held back whole (its
+    // onset was not sent either); one begun before it ends as it began.
+    int n = 0;
+    for (int i = 0; i < k; ++i) {
+        if (withheld(out[i]))
+            ++withheld_;
+        else
+            out[n++] = out[i];
+    }
+    return n;
 }
 
 bool Performance::apply(const Command &c, std::string *why)
@@ -254,6 +324,7 @@ bool Performance::apply(const Command &c, std::string *why)
             return mode_->play(c, why);
         case CommandKind::stop:
             playing_ = false;
+            stops_.fetch_add(1, std::memory_order_release); // plays not installed yet: cancelled
             mode_->stop();
             return true;
         case CommandKind::tempo:
@@ -447,6 +518,10 @@ bool Performance::submit(std::unique_ptr<Work> job, std::string *why)
     if (!worker_) {
         job->run();
         return install(std::move(job), why);
+    }
+    if (job->kind == Work::Kind::play || job->kind == Work::Kind::clip_rig) {
+        job->stop_count = &stops_;
+        job->stops = stops_.load(std::memory_order_relaxed);
     }
     if (!worker_->submit(std::move(job)))
         return refuse(why, "busy: 64 changes are waiting to be planned; send fewer");

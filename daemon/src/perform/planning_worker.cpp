@@ -10,6 +10,8 @@ namespace ictus
 
 void Work::run()
 {
+    if (kind == Kind::play && cancelled())
+        return; // a stop came first: nothing to plan
     try {
         build();
     } catch (const std::exception &e) {

@@ -33,8 +33,16 @@ class Work
     virtual ~Work() = default;
     Work(const Work &) = delete;
     Work &operator=(const Work &) = delete;
-    // Builds the result; an exception leaves `error` set and no result.
+    // Builds the result; an exception leaves `error` set and no result. A
+    // cancelled play is not built.
     void run();
+    // A play (or a clip's rebuild, which plays when installed) is cancelled
+    // by a stop that came after it was asked for: its plan is not installed,
+    // nothing starts (Performance::apply counts the stops).
+    bool cancelled() const
+    {
+        return stop_count && stop_count->load(std::memory_order_acquire) != stops;
+    }
     // Whether this job, queued after `earlier`, makes it pointless (a drum
     // slider's 20 changes a second plan once).
     bool supersedes(const Work &earlier) const;
@@ -42,6 +50,10 @@ class Work
     const Kind kind;
     Command origin;    // who asked: a refusal found later is answered to them
     std::string error; // not empty: refused, nothing changes
+    // The performance's count of stops when the work was asked for (play,
+    // clip_rig), and that count (null: the work cannot be cancelled).
+    const std::atomic<long> *stop_count = nullptr;
+    long stops = 0;
 
   protected:
     virtual void build() = 0;

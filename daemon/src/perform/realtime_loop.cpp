@@ -20,11 +20,13 @@ namespace ictus
 namespace
 {
 
-// Every refusal goes to stderr and, through `io`, to the client.
+// Every refusal goes to the log and, through `io`, to the client.
 void refuse(RealtimeIo &io, std::uint32_t ipv4, std::uint16_t port, const char *address,
             const char *why)
 {
-    std::fprintf(stderr, "ictusd run: %s%s%s\n", address, address[0] ? ": " : "", why);
+    char line[320];
+    std::snprintf(line, sizeof line, "ictusd run: %s%s%s", address, address[0] ? ": " : "", why);
+    io.log(line);
     Refusal f;
     f.peer_ipv4 = ipv4;
     f.peer_port = port;
@@ -148,10 +150,10 @@ RealtimeLoopResult run_realtime(Performance &performance, RealtimeIo &io, LiveSt
     if (options.realtime) {
         std::string why;
         if (!set_realtime_priority(kPhysicsPriority, &why))
-            std::fprintf(stderr,
-                         "ictusd run: note: no real-time scheduling (%s); on a busy machine "
-                         "strikes may arrive late (raise --lookahead, or allow rtprio)\n",
-                         why.c_str());
+            io.log(("ictusd run: note: no real-time scheduling (" + why +
+                    "); on a busy machine strikes may arrive late (raise --lookahead, or allow "
+                    "rtprio)")
+                       .c_str());
     }
     using clock = std::chrono::steady_clock;
     const double h = performance.step_s();

@@ -244,6 +244,18 @@ bool ScoreMode::install(Work &work, std::string *why)
     Job &job = static_cast<Job &>(work);
     switch (job.kind) {
     case Work::Kind::play:
+        if (job.cancelled()) {
+            // A stop came while it was planned: nothing starts. The score it
+            // finished is the current one (its tempo with it); one never
+            // planned leaves the next play its start tempo.
+            if (job.plan) {
+                tempo_scale_ = job.new_tempo_scale;
+                score_first_bpm_ = job.first_bpm;
+            } else if (start_bpm_ == 0.0) {
+                start_bpm_ = job.start_bpm;
+            }
+            break;
+        }
         install_plan(std::move(job.plan), true);
         tempo_scale_ = job.new_tempo_scale;
         score_first_bpm_ = job.first_bpm;
@@ -469,9 +481,16 @@ void ScoreMode::firmness_changed()
     }
 }
 
-bool ScoreMode::score(const Command &c, std::string *)
+bool ScoreMode::score(const Command &c, std::string *why)
 {
     if (c.kind == CommandKind::score) {
+        // At most kMaxPendingStatements wait (a play copies them).
+        if (builder_->parsed_statements() >= Performance::kMaxPendingStatements) {
+            ++perf_.refused_statements_;
+            return refuse(why, "score: " + std::to_string(Performance::kMaxPendingStatements) +
+                                   " statements are waiting, the limit: send /ictus/score/clear "
+                                   "(a longer score: ictusd run --score FILE)");
+        }
         // Parsed now (an error names the statement and column); played at
         // the next /ictus/play. A score with a faulty statement never plays.
         builder_->add_statement(c.text);

@@ -640,6 +640,10 @@ int ScoreBuilder::statements() const
 {
     return state_->calls;
 }
+std::size_t ScoreBuilder::parsed_statements() const
+{
+    return state_->statements.size();
+}
 bool ScoreBuilder::failed() const
 {
     return state_->first_error.has_value();
@@ -656,21 +660,29 @@ void ScoreBuilder::add_line(const std::string &text, int line)
 {
     LineParser parser(state_->source, line);
     std::vector<Statement> parsed = parser.parse(text); // throws before anything changes
-    // Balance repeat/end on a copy first, so a stray 'end' changes nothing.
-    std::vector<size_t> open = state_->open_repeats;
+    // Balance repeat/end first, so a stray 'end' changes nothing: the line's
+    // own repeats, and how many of those already open its ends close (the
+    // time a line takes does not grow with the depth of the repeats open).
+    std::vector<size_t> opened;
+    size_t closed = 0; // of state_->open_repeats, from its end
     size_t index = state_->statements.size();
     for (const Statement &st : parsed) {
-        if (st.kind == Kind::repeat)
-            open.push_back(index);
-        else if (st.kind == Kind::end) {
-            if (open.empty())
+        if (st.kind == Kind::repeat) {
+            opened.push_back(index);
+        } else if (st.kind == Kind::end) {
+            if (!opened.empty())
+                opened.pop_back();
+            else if (closed < state_->open_repeats.size())
+                ++closed;
+            else
                 throw ScoreError(state_->source, st.line, st.column, "'end' without 'repeat'");
-            open.pop_back();
         }
         ++index;
     }
     state_->statements.insert(state_->statements.end(), parsed.begin(), parsed.end());
-    state_->open_repeats = open;
+    std::vector<size_t> &open = state_->open_repeats;
+    open.resize(open.size() - closed);
+    open.insert(open.end(), opened.begin(), opened.end());
 }
 
 void ScoreBuilder::set_default_nuance(Nuance nuance)

@@ -4,6 +4,7 @@
 // packets are counted and dropped. The namespace is in docs/osc.md.
 #pragma once
 
+#include "ictus/base/async_log.hpp"
 #include "ictus/base/spsc_queue.hpp"
 #include "ictus/net/osc_sender.hpp" // OscError
 #include "ictus/perform/commands.hpp"
@@ -25,6 +26,7 @@ struct OscServerOptions {
     bool allow_any = false;              // every peer (--allow any); `allow` is then ignored
     std::string reply_url;               // default: reply to the sender
     std::size_t max_packet_bytes = 4096; // larger packets are refused
+    AsyncLog *log = nullptr;             // where the server's log lines go; null: stderr
 };
 
 // Error replies (/ictus/error) to one peer address: a bucket of

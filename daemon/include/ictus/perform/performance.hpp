@@ -23,6 +23,8 @@
 #include "ictus/perform/strike_match.hpp"
 #include "ictus/perform/tracker.hpp"
 
+#include <array>
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -128,9 +130,13 @@ class Performance
     // onset: what a sound needs (time, hand, position, velocity), without
     // force, impulse and duration, which step() reports at the release
     // (docs/osc.md: `ictusd run` sends the one at once, the rest after).
+    // Every strike step() or flush() reports had its onset here, and every
+    // onset here has its strike there (a rebuild of the character ends the
+    // contacts under way; a strike held back by the runaway guard is held
+    // back whole).
     int take_onsets(StrikeEvent out[2]);
-    // Ends contacts still open (end of a run).
-    bool flush(StrikeEvent &out) { return detector_.flush(out); }
+    // Ends contacts still open (end of a run), after the strikes still held.
+    bool flush(StrikeEvent &out);
     // Applies a command from the OSC thread. Returns false with a reason when
     // it cannot be applied (the OSC thread has already validated the values;
     // what a command throws is refused with its what()).
@@ -226,6 +232,15 @@ class Performance
     static constexpr double kRunawayTipSpeed_mps = 40.0;
     static constexpr double kRunawayQuiet_s = 1.0;
     long runaways() const { return runaways_; }
+    // Strikes held back whole (onset and release) by the runaway guard.
+    long withheld_strikes() const { return withheld_; }
+    // Score statements over OSC (/ictus/score) refused: kMaxPendingStatements
+    // are waiting already (docs/osc.md).
+    long refused_statements() const { return refused_statements_; }
+    // Statements (parsed; a line may hold several) a score received over OSC
+    // may hold until /ictus/score/clear: what a play copies, and what the
+    // daemon's memory holds of them, stay bounded (docs/osc.md).
+    static constexpr int kMaxPendingStatements = 10000;
     // What /ictus/gains scales may do (refused otherwise, naming the bound):
     // - keep the largest PD rate kp / kd times the step under this: the
     //   stiffness part of eq. 1 is explicit in ODE's motor rows (a velocity
@@ -258,7 +273,11 @@ class Performance
     bool check_gains(const double scale[2], std::string *why) const;
     bool apply_gains_command(const Command &c, std::string *why);
     bool apply_drum_command(const Command &c, std::string *why);
-    int guard_runaway(int k); // the strikes that may leave (0 while quiet)
+    int guard_runaway(int k, StrikeEvent out[2]); // the strikes that may leave
+    bool withheld(const StrikeEvent &e) const;    // an onset while the guard is quiet
+    // Contacts a rebuild (took_over) ended, and onsets it took, given out by
+    // the next step() and take_onsets().
+    void hold_open_contacts();
 
     PerformanceOptions options_;
     Skeleton skeleton_;
@@ -272,7 +291,17 @@ class Performance
     std::vector<Refusal> refusals_; // oldest first
     Command last_gains_;            // the origin a runaway is reported to
     long runaways_ = 0;
-    double quiet_until_s_ = -1.0; // no strike leaves before this time (runaway)
+    double quiet_until_s_ = -1.0; // no strike with an onset before this time (runaway)
+    double quiet_from_s_ = -1.0;  // and from this one on leaves
+    long withheld_ = 0;
+    long refused_statements_ = 0;
+    // Counted by apply(stop), read by the worker: a play asked for before the
+    // last stop is cancelled (Work::cancelled()).
+    std::atomic<long> stops_{0};
+    std::array<StrikeEvent, 8> held_ends_{};
+    int held_ends_n_ = 0;
+    std::array<StrikeEvent, 2> held_onsets_{};
+    int held_onsets_n_ = 0;
     double time_offset_s_ = 0.0;  // simulation time at the last (re)build
     double gain_scale_[2] = {1.0, 1.0};
     int divergences_before_ = 0;

@@ -23,8 +23,12 @@ class RealtimeIo
     // The next command received, false when none waits.
     virtual bool next_command(Command &out) = 0;
     // A refusal of a command (at once, or found later), for its sender
-    // (the loop has printed it to stderr).
+    // (the loop has logged it too).
     virtual void refused(const Refusal &refusal) = 0;
+    // A line for the daemon's log (stderr), without its newline: posted,
+    // never written here (base/async_log.hpp), so that a stderr nobody reads
+    // cannot hold the loop.
+    virtual void log(const char *line) = 0;
     // A strike at its onset (what the sound needs: time, hand, position,
     // velocity), and the same strike at its release (force, impulse,
     // duration).

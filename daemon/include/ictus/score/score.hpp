@@ -196,6 +196,8 @@ class ScoreBuilder
     // /ictus/nuance does in score mode.
     void set_default_nuance(Nuance nuance);
     int statements() const; // how many add_statement() calls so far
+    // How many statements they held (a line may hold several; comments none).
+    std::size_t parsed_statements() const;
     bool failed() const;
     void reset(); // back to an empty score, errors forgotten
 
