@@ -468,6 +468,14 @@ GestureDatabase GestureDatabase::load_json(const std::string &path)
     if (text.size() > kMaxDatabaseBytes)
         throw GestureError(path + ":0: larger than " + std::to_string(kMaxDatabaseBytes >> 20) +
                            " MiB, the bound of a gesture database");
+    return parse_json(text, path);
+}
+
+GestureDatabase GestureDatabase::parse_json(const std::string &text, const std::string &path)
+{
+    if (text.size() > kMaxDatabaseBytes)
+        throw GestureError(path + ":0: larger than " + std::to_string(kMaxDatabaseBytes >> 20) +
+                           " MiB, the bound of a gesture database");
     check_depth(path, text);
     nlohmann::json doc;
     try {
