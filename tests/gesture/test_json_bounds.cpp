@@ -165,3 +165,15 @@ TEST_CASE("gesture JSON: an endless file (/dev/zero) is refused past 16 MiB with
     CHECK(end.exit_status == 0);
     CHECK_THAT(end.message, Catch::StartsWith("/dev/zero:0: larger than 16 MiB"));
 }
+
+TEST_CASE("gesture JSON: a number past a double's range is refused at its line",
+          "[gesture][json][bounds]")
+{
+    // nlohmann reports it as out_of_range, not as a parse error.
+    const std::string text = database_with("").replace(database_with("").find("\"rate_hz\": 250"),
+                                                       14, "\"rate_hz\": 1e999");
+    CHECK_THROWS_MATCHES(
+        GestureDatabase::parse_json(text, "db.json"), GestureError,
+        Catch::Matchers::Message("db.json:5: [json.exception.out_of_range.406] number overflow "
+                                 "parsing '1e999'"));
+}

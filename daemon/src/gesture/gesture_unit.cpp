@@ -485,6 +485,18 @@ GestureDatabase GestureDatabase::parse_json(const std::string &text, const std::
         const int line =
             1 + static_cast<int>(std::count(text.begin(), text.begin() + byte - (byte > 0), '\n'));
         throw GestureError(path + ":" + std::to_string(line) + ": malformed JSON: " + e.what());
+    } catch (const nlohmann::json::exception &e) {
+        // A number past a double's range ("number overflow parsing '1e999'"):
+        // the line of the first such text.
+        const std::string what = e.what();
+        const size_t open = what.find('\''), close = what.rfind('\'');
+        const size_t at =
+            open < close ? text.find(what.substr(open + 1, close - open - 1)) : std::string::npos;
+        const int line =
+            at == std::string::npos
+                ? 0
+                : 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+        throw GestureError(path + ":" + std::to_string(line) + ": " + what);
     }
     const JsonReader r(path, text);
     if (!doc.is_object())
