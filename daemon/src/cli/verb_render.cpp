@@ -511,11 +511,13 @@ bool parse_render_args(Args &args, RenderArgs &r)
     load_midi_score(r.o);
     if (r.out_dir.empty())
         throw UsageError("--out DIR is required");
-    if (r.duration > kMaxRenderSeconds)
-        throw UsageError("--duration: render keeps its outputs in memory (about 0.6 MB a "
-                         "simulated second): at most " +
-                         std::to_string(static_cast<int>(kMaxRenderSeconds)) + " s, got " +
-                         std::to_string(r.duration));
+    if (r.duration > kMaxRenderSeconds) {
+        std::ostringstream m;
+        m << "--duration: render keeps its outputs in memory (about 0.6 MB a simulated second): "
+             "at most "
+          << kMaxRenderSeconds << " s, got " << r.duration;
+        throw UsageError(m.str());
+    }
     if (!r.wav.empty()) {
         find_pd_binary(r.pd.pd);
         r.pd.library = find_pd_library(r.pd.library);
