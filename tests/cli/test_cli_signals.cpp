@@ -207,7 +207,7 @@ TEST_CASE("ictusd render --wav: a signal in Pd's phase stops pd, exit 130, no WA
     // and a library folder with the render patch's name.
     const std::string pid_file = dir / "pd.pid", fake = dir / "pd";
     std::ofstream(fake) << "#!/bin/sh\necho $$ > " << pid_file << ".tmp\nmv " << pid_file << ".tmp "
-                        << pid_file << "\nexec sleep 60\n";
+                        << pid_file << "\necho pd: rendering\nexec sleep 60\n";
     fs::permissions(fake, fs::perms::owner_all);
     fs::create_directories(dir / "lib");
     std::ofstream(dir / "lib/ictus-render.pd") << "#N canvas 0 0 100 100 10;\n";
