@@ -1,11 +1,13 @@
 // The real ictusd as a hostile user drives it: signals in every verb and
 // phase (docs/perform.md, "Signals": SIGINT, SIGTERM and SIGHUP end a verb at
 // its next step with exit 130, files whole, no pd left behind), a file-size
-// limit (exit 1, a message, whole rows), an endless score, and the paths and
-// URLs run and render must refuse before they start.
+// limit (exit 1, a message, whole rows), an endless score, the paths and
+// URLs run and render must refuse before they start, and track's --gains file
+// held to the stability check of /ictus/gains.
 #include "support/cli_test_util.hpp"
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <fcntl.h>
 #include <poll.h>
@@ -383,4 +385,35 @@ TEST_CASE("ictusd render --duration is at most 900 s", "[cli][bounds]")
     CHECK_THAT(p.output(), Catch::Contains("--duration: render keeps its outputs in memory") &&
                                Catch::Contains("at most 900 s, got 1e+07"));
     CHECK_FALSE(fs::exists(dir / "o"));
+}
+
+TEST_CASE("ictusd track --gains FILE passes the stability check of /ictus/gains", "[cli][bounds]")
+{
+    TempDir dir("gains");
+    const std::string base =
+        std::string("track --mode joint --quiet --duration 0.3 --mocap ") + clitest::tiny_bvh();
+    REQUIRE(clitest::ictusd(base + " --out " + (dir / "d")).status == 0);
+    const nlohmann::json defaults =
+        nlohmann::json::parse(slurp(dir / "d/summary.json")).at("gains").at("r_wrist");
+    const double kp0 = defaults.at("kp_nm_per_rad"), kd0 = defaults.at("kd_nm_s_per_rad");
+    REQUIRE(kp0 / kd0 < 500.0); // the default rate kp/kd, well inside 1000/s at 1 ms
+    auto with = [&](double kp, double kd) {
+        const std::string f = dir / "g.json";
+        std::ofstream(f)
+            << nlohmann::json{{"r_wrist", {{"kp_nm_per_rad", kp}, {"kd_nm_s_per_rad", kd}}}}.dump();
+        return clitest::ictusd(base + " --gains " + f);
+    };
+    // The damping ratio scales as kd / sqrt(kp): zeta 1 (the default) x 1/10.
+    clitest::Run r = with(100.0 * kp0, kd0);
+    CHECK(r.status == 1);
+    CHECK_THAT(r.output, Catch::Contains("g.json: joint 'r_wrist'") &&
+                             Catch::Contains("damping ratio of 0.10, under 0.71"));
+    // Stiffness x4 with damping x2 keeps zeta at 1: accepted.
+    r = with(4.0 * kp0, 2.0 * kd0);
+    CHECK(r.status == 0);
+    // Stiffness x10000, damping x100: zeta 1 but kp/kd 100 times the default's,
+    // past 1000/s at the 1 ms step.
+    r = with(1e4 * kp0, 100.0 * kd0);
+    CHECK(r.status == 1);
+    CHECK_THAT(r.output, Catch::Contains("joint 'r_wrist'") && Catch::Contains("PD rate kp/kd"));
 }
