@@ -9,16 +9,20 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -416,4 +420,64 @@ TEST_CASE("ictusd track --gains FILE passes the stability check of /ictus/gains"
     r = with(1e4 * kp0, 100.0 * kd0);
     CHECK(r.status == 1);
     CHECK_THAT(r.output, Catch::Contains("joint 'r_wrist'") && Catch::Contains("PD rate kp/kd"));
+}
+
+TEST_CASE("ictusd run: a command the physics refuses counts among the summary's errors",
+          "[cli][bounds]")
+{
+    // /ictus/gains 4 0.05 (docs/perform.md: a damping ratio of 0.025, refused
+    // by the performance, not by the server's type and range checks).
+    const int sock = ::socket(AF_INET, SOCK_DGRAM, 0);
+    REQUIRE(sock >= 0);
+    sockaddr_in me{};
+    me.sin_family = AF_INET;
+    me.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    REQUIRE(::bind(sock, reinterpret_cast<sockaddr *>(&me), sizeof me) == 0);
+    Proc p({ICTUSD_PATH, "run", "--port", "0", "--pose-rate", "0"});
+    REQUIRE(p.wait_for(", strikes and poses to", 30.0)); // the port whole
+    const std::string &out = p.output();
+    const size_t at = out.find("commands on 127.0.0.1:") + 22;
+    sockaddr_in daemon{};
+    daemon.sin_family = AF_INET;
+    daemon.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    daemon.sin_port = htons(static_cast<uint16_t>(std::stoi(out.substr(at))));
+    std::string packet("/ictus/gains\0\0\0\0,ff\0", 20);
+    for (float v : {4.0f, 0.05f}) {
+        uint32_t bits;
+        std::memcpy(&bits, &v, 4);
+        bits = htonl(bits);
+        packet.append(reinterpret_cast<const char *>(&bits), 4);
+    }
+    // Sent until the refusal comes back (a handshake: the physics loop runs).
+    bool refused = false;
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!refused && since(t0) < 30.0) {
+        ::sendto(sock, packet.data(), packet.size(), 0, reinterpret_cast<sockaddr *>(&daemon),
+                 sizeof daemon);
+        pollfd pf{sock, POLLIN, 0};
+        for (char buf[1024]; ::poll(&pf, 1, 200) > 0;) {
+            const ssize_t n = ::recv(sock, buf, sizeof buf, 0);
+            if (n > 0 && std::string(buf, static_cast<size_t>(n)).find("damping ratio") !=
+                             std::string::npos) {
+                refused = true;
+                break;
+            }
+        }
+    }
+    ::close(sock);
+    CHECK(refused);
+    REQUIRE(::kill(p.pid(), SIGINT) == 0);
+    CHECK(p.wait_exit(30.0) == 130);
+    INFO(p.output());
+    // Every packet was a gains the physics refuses (or had not yet taken at
+    // the stop): errors between 1 and the packets.
+    const std::string &o = p.output();
+    const size_t accepted = o.find(" accepted, ");
+    REQUIRE(accepted != std::string::npos);
+    const long errors = std::stol(o.substr(accepted + 11));
+    const size_t in = o.rfind(" packets in, ", accepted);
+    REQUIRE(in != std::string::npos);
+    const long packets = std::stol(o.substr(o.rfind(' ', in - 1) + 1));
+    CHECK(errors >= 1);
+    CHECK(errors <= packets);
 }
