@@ -166,7 +166,12 @@ bool walk_args(Args &args, void (*usage)(std::ostream &),
 int run_verb(const char *verb, const std::function<int()> &body)
 {
     try {
-        return body();
+        const int status = body();
+        if (status == 0 && g_interrupted) { // a verb of one step (limits, gestures) finished it
+            std::cerr << "ictusd " << verb << ": interrupted\n";
+            return 130;
+        }
+        return status;
     } catch (const UsageError &e) {
         std::cerr << "ictusd " << verb << ": " << e.what() << "\n";
         return 2;
