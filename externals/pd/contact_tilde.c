@@ -93,8 +93,8 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
     if (argc > 3) {
         if (!ictus_getnumber(x, "contact~", "hit", "stick mass (kg)", argc, argv, 3, &mass))
             mass = 0.0;
-        else if (mass < 0.0 ||
-                 (mass > 0.0 && (mass < CONTACT_MASS_MIN || mass > CONTACT_MASS_MAX))) {
+        else if (mass < 0.0 || (mass > 0.0 && (mass < (t_float)CONTACT_MASS_MIN ||
+                                               mass > (t_float)CONTACT_MASS_MAX))) {
             double used = mass < CONTACT_MASS_MIN ? CONTACT_MASS_MIN : CONTACT_MASS_MAX;
             if (mass < 0.0) {
                 pd_error(x,
@@ -107,6 +107,11 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
                          CONTACT_MASS_MIN, CONTACT_MASS_MAX, mass, used);
                 mass = used;
             }
+        } else if (mass > 0.0) {
+            /* Pd's numbers are floats: a bound typed in a message (0.0001) arrives a
+             * rounding away from it, and is the bound. */
+            mass = mass < CONTACT_MASS_MIN ? CONTACT_MASS_MIN
+                                           : (mass > CONTACT_MASS_MAX ? CONTACT_MASS_MAX : mass);
         }
     }
     m = contact_tilde_timing_membrane(x);

@@ -69,6 +69,10 @@ contact_cases = [
                   "unchanged"),
     ("tip felt", None),
     ("hit 2 0.3 0", None),
+    ("hit 2 0.3 0 5e-05", "contact~: hit: stick mass must be in [0.0001, 10] kg, got 5e-05; "
+                          "using 0.0001"),
+    ("hit 2 0.3 0 0.0001", None),  # the bound itself, as a float reads it
+    ("hit 2 0.3 0 10", None),
 ]
 
 sr = 48000
@@ -99,6 +103,9 @@ check(rc == 0, "pd did not crash (exit %d)" % rc)
 for text, expect in membrane_cases + contact_cases:
     if expect:
         check(expect in log, "'%s' -> '%s'" % (text, expect))
+for bound in ["0.0001", "10"]:  # a bound is not out of bounds
+    refused = "stick mass must be in [0.0001, 10] kg, got %s;" % bound
+    check(refused not in log, "no error '%s'" % refused)
 for expect in ["membrane~: radius must be in [0.01, 2] m, got 1e+30; using 2",
                "membrane~: tension must be in [1, 100000] N/m, got -5; using 1",
                "membrane~: creation argument: density must be a number, got 'nan'",

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <sstream>
 
+#include <signal.h>
 #include <unistd.h>
 
 namespace ictus
@@ -18,29 +19,38 @@ namespace cli
 {
 
 volatile std::sig_atomic_t g_interrupted = 0;
+volatile std::sig_atomic_t g_child_pid = 0;
 
 namespace
 {
-// The first SIGINT / SIGTERM asks the verb to stop cleanly at its next step
-// (files closed, summary printed); a second one, if it has not stopped yet,
-// ends the process at once, whatever it is doing (async-signal-safe calls only).
-void on_interrupt(int)
+// The first SIGINT / SIGTERM / SIGHUP asks the verb to stop cleanly at its
+// next step (files closed, summary printed); a second one, if it has not
+// stopped yet, ends the process at once, whatever it is doing, and its child
+// with it (async-signal-safe calls only).
+void on_interrupt(int signal_number)
 {
     if (g_interrupted) {
         static const char msg[] = "ictusd: interrupted again: exiting now\n";
         const ssize_t ignored = write(2, msg, sizeof msg - 1);
         (void)ignored;
+        if (g_child_pid > 0)
+            kill(static_cast<pid_t>(g_child_pid), SIGKILL);
         _exit(130);
     }
-    g_interrupted = 1;
+    g_interrupted = signal_number;
 }
 } // namespace
 
-void install_interrupt_handler(bool also_sigterm)
+void install_signal_handlers()
 {
-    std::signal(SIGINT, on_interrupt);
-    if (also_sigterm)
-        std::signal(SIGTERM, on_interrupt);
+    struct sigaction action {
+    };
+    action.sa_handler = on_interrupt;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESTART;
+    for (int s : {SIGINT, SIGTERM, SIGHUP})
+        sigaction(s, &action, nullptr);
+    std::signal(SIGXFSZ, SIG_IGN);
 }
 
 double parse_number(const std::string &option, const std::string &text)
@@ -156,7 +166,12 @@ bool walk_args(Args &args, void (*usage)(std::ostream &),
 int run_verb(const char *verb, const std::function<int()> &body)
 {
     try {
-        return body();
+        const int status = body();
+        if (status == 0 && g_interrupted) { // a verb of one step (limits, gestures) finished it
+            std::cerr << "ictusd " << verb << ": interrupted\n";
+            return 130;
+        }
+        return status;
     } catch (const UsageError &e) {
         std::cerr << "ictusd " << verb << ": " << e.what() << "\n";
         return 2;

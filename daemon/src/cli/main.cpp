@@ -77,7 +77,7 @@ int main(int argc, char **argv)
         version(std::cout);
         return 0;
     }
-    install_interrupt_handler();
+    install_signal_handlers();
     Args args(argc - 1, argv + 1); // the arguments after the verb
     if (verb == "track")
         return run_verb("track", [&] { return cmd_track(args); });

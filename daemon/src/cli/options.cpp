@@ -187,6 +187,26 @@ MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o
         [&](MocapWarnings *warnings) { return read_marker_csv(path, o, warnings); });
 }
 
+// A --score file: at most kMaxScoreFileBytes, and a byte more read to know
+// it is more (/dev/zero, a FIFO: no size to ask for first).
+std::string read_score_file(const std::string &path)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw std::runtime_error("--score: cannot read '" + path + "'");
+    std::string text;
+    char buf[65536];
+    while (text.size() <= kMaxScoreFileBytes && in.read(buf, sizeof buf).gcount() > 0)
+        text.append(buf, static_cast<size_t>(in.gcount()));
+    if (in.bad())
+        throw std::runtime_error("--score: read error in '" + path + "'");
+    if (text.size() > kMaxScoreFileBytes)
+        throw std::runtime_error("--score: '" + path + "' is larger than " +
+                                 std::to_string(kMaxScoreFileBytes >> 20) +
+                                 " MiB, the bound of a score file");
+    return text;
+}
+
 // The drum's and the kit's options (parse_performance_option's).
 static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptions &o)
 {
@@ -247,12 +267,7 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         std::error_code ec;
         if (std::filesystem::is_directory(path, ec)) // opens, and reads as empty
             throw std::runtime_error("--score: '" + path + "' is a folder, not a score file");
-        std::ifstream in(path, std::ios::binary);
-        if (!in)
-            throw std::runtime_error("--score: cannot read '" + path + "'");
-        std::ostringstream text;
-        text << in.rdbuf();
-        o.score.score_text = text.str();
+        o.score.score_text = read_score_file(path);
         o.score.score_name = path;
         if (o.score.score_text.empty())
             throw std::runtime_error("--score: '" + path + "' is empty");

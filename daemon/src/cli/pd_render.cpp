@@ -6,11 +6,12 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -61,6 +62,20 @@ void check_pd_path(const char *what, const std::string &path)
         throw std::runtime_error(std::string(what) + ": '" + path +
                                  "' has a space or one of , ; $ \\ { } that Pd's messages "
                                  "cannot carry: choose another path");
+}
+
+void check_wav_path(const std::string &path)
+{
+    const std::string suffix = ".wav";
+    const std::string name = fs::path(path).filename().string();
+    if (name.size() <= suffix.size() ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+        throw std::runtime_error("--wav: '" + path +
+                                 "' does not end in .wav: Pd writes a WAV file by that name");
+    std::error_code ec;
+    if (fs::is_directory(path, ec))
+        throw std::runtime_error("--wav: '" + path + "' is a folder: give a file NAME.wav");
+    check_pd_path("--wav", path);
 }
 
 std::string find_pd_library(const std::string &given)
@@ -170,6 +185,10 @@ struct PdProcess {
     int output_fd = -1;
 };
 
+// Pd as a child that ends with ictusd: fork and exec (posix_spawn cannot ask
+// for PR_SET_PDEATHSIG), SIGKILL to it when ictusd's thread that started it
+// ends, however it ends (SIGKILL included). Its signals as a new program's:
+// SIGXFSZ, ignored by ictusd, back to its default.
 PdProcess spawn_pd(const std::string &pd, std::vector<std::string> &argv)
 {
     std::vector<char *> cargv;
@@ -180,19 +199,30 @@ PdProcess spawn_pd(const std::string &pd, std::vector<std::string> &argv)
     int fds[2];
     if (::pipe2(fds, O_CLOEXEC) != 0)
         throw std::runtime_error(std::string("--wav: pipe: ") + std::strerror(errno));
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    const pid_t parent = ::getpid();
     PdProcess p;
-    const int spawned = ::posix_spawn(&p.pid, pd.c_str(), &actions, nullptr, cargv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    ::close(fds[1]);
-    if (spawned != 0) {
-        ::close(fds[0]);
-        throw std::runtime_error("--wav: cannot start '" + pd + "': " + std::strerror(spawned));
+    p.pid = ::fork();
+    if (p.pid == 0) { // the child: async-signal-safe calls only
+        ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (::getppid() != parent) // ictusd ended before prctl
+            ::_exit(127);
+        std::signal(SIGXFSZ, SIG_DFL);
+        const int null_fd = ::open("/dev/null", O_RDONLY);
+        if (null_fd < 0 || ::dup2(null_fd, 0) < 0 || ::dup2(fds[1], 1) < 0 || ::dup2(fds[1], 2) < 0)
+            ::_exit(127);
+        ::execve(pd.c_str(), cargv.data(), environ);
+        static const char msg[] = "ictusd: cannot execute pd\n";
+        const ssize_t ignored = ::write(2, msg, sizeof msg - 1);
+        (void)ignored;
+        ::_exit(127);
     }
+    const int fork_error = errno;
+    ::close(fds[1]);
+    if (p.pid < 0) {
+        ::close(fds[0]);
+        throw std::runtime_error("--wav: cannot start '" + pd + "': " + std::strerror(fork_error));
+    }
+    g_child_pid = p.pid;
     p.output_fd = fds[0];
     return p;
 }
@@ -207,7 +237,8 @@ struct PdEnd {
 
 // Collects Pd's output until it ends. Pd in batch mode renders many times
 // faster than real time; a patch that never quits (the library half loaded)
-// must not hang render: it is killed after `timeout_s`, and stopped on SIGINT.
+// must not hang render: it is killed after `timeout_s`, and stopped on SIGINT,
+// SIGTERM or SIGHUP (g_interrupted).
 PdEnd wait_for_pd(const PdProcess &p, double timeout_s, const std::function<double()> &elapsed,
                   const std::function<void(double)> &progress)
 {
@@ -242,8 +273,13 @@ PdEnd wait_for_pd(const PdProcess &p, double timeout_s, const std::function<doub
         }
     }
     ::close(p.output_fd);
+    if (g_interrupted && end.stop_reason.empty()) {
+        end.stop_reason = "interrupted"; // pd ended by the same Ctrl-C, or first
+        ::kill(p.pid, SIGTERM);
+    }
     while (!reaped && ::waitpid(p.pid, &end.status, 0) < 0 && errno == EINTR) {
     }
+    g_child_pid = 0;
     return end;
 }
 
@@ -278,10 +314,11 @@ PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(
     check_pd_path("--out", o.events);
     check_pd_path("--pd-lib", lib);
     std::vector<std::string> argv = pd_command_line(o, pd, lib);
-    std::error_code ec;
-    fs::remove(o.wav, ec); // so that an earlier file never passes for this one
-    if (ec)
-        throw std::runtime_error("--wav: cannot replace '" + o.wav + "': " + ec.message());
+    check_wav_path(o.wav);
+    // So that an earlier file never passes for this one: unlink(2), which
+    // never removes a folder.
+    if (::unlink(o.wav.c_str()) != 0 && errno != ENOENT)
+        throw std::runtime_error("--wav: cannot replace '" + o.wav + "': " + std::strerror(errno));
     const PdProcess process = spawn_pd(pd, argv);
 
     const double timeout_s = 120.0 + 10.0 * o.seconds;
@@ -301,6 +338,12 @@ PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(
     }
     const std::string log_note = o.log.empty() ? "" : " (log: " + o.log + ")";
     if (!end.stop_reason.empty())
+        ::unlink(o.wav.c_str()); // the cut WAV's header does not say its length
+    if (end.stop_reason == "interrupted") {
+        result.interrupted = true;
+        return result;
+    }
+    if (!end.stop_reason.empty())
         throw std::runtime_error("--wav: pd " + end.stop_reason + log_note);
     const int status = end.status;
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
@@ -310,6 +353,7 @@ PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(
                                       : "signal " + std::to_string(WTERMSIG(status))) +
                                  ")" + log_note);
     const bool reported = read_pd_report(end.output, result);
+    std::error_code ec;
     if (!reported || !fs::is_regular_file(o.wav, ec))
         throw std::runtime_error("--wav: pd wrote no '" + o.wav + "'" + log_note + ":\n" +
                                  end.output);

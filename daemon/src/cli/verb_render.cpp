@@ -183,49 +183,69 @@ void prepare_out_dir(const std::string &dir, bool force)
     }
 }
 
-// An output of render: opened before the run (an unwritable folder shows at
-// once), written whole at the end. A failed or short write, or a failed
-// close, names the file and the system's reason (ENOSPC, EIO, EFBIG): exit 1.
+// An output of render: tried before the run (created and removed again: an
+// unwritable folder shows at once, and a render killed while it simulates
+// leaves no empty file), written whole at the end. A failed or short write,
+// or a failed close, names the file and the system's reason (ENOSPC, EIO,
+// EFBIG under a file-size limit): exit 1, and what was written is cut back to
+// its last whole line (`lines`: a text of lines) or removed.
 class RenderOutput
 {
   public:
-    explicit RenderOutput(const std::string &path) : path_(path)
+    RenderOutput(const std::string &path, bool lines) : path_(path), lines_(lines)
     {
-        fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-        if (fd_ < 0)
-            fail(errno);
-    }
-    ~RenderOutput()
-    {
-        if (fd_ >= 0)
-            ::close(fd_);
+        const int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd < 0)
+            throw std::runtime_error(message(errno));
+        ::close(fd);
+        ::unlink(path_.c_str());
     }
     RenderOutput(const RenderOutput &) = delete;
     RenderOutput &operator=(const RenderOutput &) = delete;
     // The whole content, then the file is closed.
     void write_and_close(const std::string &content)
     {
+        const int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd < 0)
+            throw std::runtime_error(message(errno));
         std::size_t done = 0;
         while (done < content.size()) {
-            const ssize_t n = ::write(fd_, content.data() + done, content.size() - done);
-            if (n > 0)
+            const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+            if (n > 0) {
                 done += static_cast<std::size_t>(n);
-            else if (!(n < 0 && errno == EINTR))
-                fail(n < 0 ? errno : EIO);
+            } else if (!(n < 0 && errno == EINTR)) {
+                const int error = n < 0 ? errno : EIO;
+                ::close(fd);
+                fail(error, content, done);
+            }
         }
-        const int fd = fd_;
-        fd_ = -1;
         if (::close(fd) != 0)
-            fail(errno);
+            fail(errno, content, done);
     }
 
   private:
-    [[noreturn]] void fail(int error) const
+    std::string message(int error) const
     {
-        throw std::runtime_error("--out: cannot write '" + path_ + "': " + std::strerror(error));
+        return "--out: cannot write '" + path_ + "': " + std::strerror(error);
+    }
+    // What was written is cut back to its whole lines, or removed when it
+    // has none or is not lines.
+    [[noreturn]] void fail(int error, const std::string &content, std::size_t done) const
+    {
+        const std::size_t last =
+            lines_ && done > 0 ? content.rfind('\n', done - 1) : std::string::npos;
+        const bool keep = last != std::string::npos &&
+                          ::truncate(path_.c_str(), static_cast<off_t>(last + 1)) == 0;
+        if (!keep) {
+            ::unlink(path_.c_str());
+            throw std::runtime_error(message(error) + " (removed)");
+        }
+        const auto lines = std::count(content.begin(), content.begin() + (last + 1), '\n');
+        throw std::runtime_error(message(error) + " (cut to its first " + std::to_string(lines) +
+                                 " whole lines)");
     }
     std::string path_;
-    int fd_ = -1;
+    bool lines_;
 };
 
 // tips.csv: the stick-tip targets X^T and the simulated tips, both hands.
@@ -409,6 +429,11 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
 }
 
 // The command line of a render.
+// The longest render: its outputs are kept in memory until the end, about
+// 0.6 MB a simulated second (tips.csv and performance.bvh at 250 Hz), some
+// 0.5 GB here; a score's performance is bounded by 900 s too (docs/score.md).
+constexpr double kMaxRenderSeconds = 900.0;
+
 struct RenderArgs {
     PerformanceOptions o;
     double duration = 0.0, tips_rate = 250.0, bvh_rate = 250.0, midi_channel = 1.0;
@@ -486,11 +511,18 @@ bool parse_render_args(Args &args, RenderArgs &r)
     load_midi_score(r.o);
     if (r.out_dir.empty())
         throw UsageError("--out DIR is required");
+    if (r.duration > kMaxRenderSeconds) {
+        std::ostringstream m;
+        m << "--duration: render keeps its outputs in memory (about 0.6 MB a simulated second): "
+             "at most "
+          << kMaxRenderSeconds << " s, got " << r.duration;
+        throw UsageError(m.str());
+    }
     if (!r.wav.empty()) {
         find_pd_binary(r.pd.pd);
         r.pd.library = find_pd_library(r.pd.library);
         r.wav = std::filesystem::absolute(r.wav).lexically_normal().string();
-        check_pd_path("--wav", r.wav);
+        check_wav_path(r.wav);
         check_pd_path("--out", std::filesystem::absolute(r.out_dir).lexically_normal().string());
         check_pd_path("--pd-lib", r.pd.library);
     }
@@ -501,12 +533,12 @@ bool parse_render_args(Args &args, RenderArgs &r)
 // found at once) and written at the end.
 struct RenderFiles {
     RenderFiles(const std::string &dir, bool score_mode)
-        : strikes_csv(dir + "/strikes.csv"), events_txt(dir + "/events.txt"),
-          render_json(dir + "/render.json"), performance_mid(dir + "/performance.mid")
+        : strikes_csv(dir + "/strikes.csv", true), events_txt(dir + "/events.txt", true),
+          render_json(dir + "/render.json", false), performance_mid(dir + "/performance.mid", false)
     {
         if (score_mode) {
-            tips_csv = std::make_unique<RenderOutput>(dir + "/tips.csv");
-            notes_csv = std::make_unique<RenderOutput>(dir + "/notes.csv");
+            tips_csv = std::make_unique<RenderOutput>(dir + "/tips.csv", true);
+            notes_csv = std::make_unique<RenderOutput>(dir + "/notes.csv", true);
         }
     }
     RenderOutput strikes_csv, events_txt, render_json, performance_mid;
@@ -745,12 +777,19 @@ int render_wav(RenderArgs &r, const Performance &perf)
     }
     pd.stick_tip = d.stick_tip;
     pd.stretch_n_per_m3 = d.stretch_n_per_m3();
+    if (g_interrupted)
+        return 130; // the files are written; no sound is started
     std::cout << "render: pd: " << pd.seconds << " s of sound into " << r.wav << " ..."
               << std::endl;
     const PdRenderResult result = run_pd_render(pd, [&](double s) {
         if (r.progress_every > 0.0)
             std::fprintf(stderr, "render: pd still rendering (%.0f s)\n", s);
     });
+    if (result.interrupted) {
+        std::cerr << "ictusd render: interrupted: pd stopped, no " << r.wav << " (log: " << pd.log
+                  << ")\n";
+        return 130;
+    }
     if (!result.errors.empty()) {
         std::cerr << "ictusd render: pd reported errors (log: " << pd.log << "):\n"
                   << result.errors;
@@ -769,6 +808,27 @@ int render_wav(RenderArgs &r, const Performance &perf)
 
 } // namespace
 
+void prepare_run_out_dir(const std::string &dir, bool force)
+{
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec)
+        throw std::runtime_error("--out: cannot create '" + dir + "': " + ec.message());
+    for (const char *name : kRenderOutputs) {
+        const fs::path p = fs::path(dir) / name;
+        if (std::string(name) == "strikes.csv" || !fs::exists(fs::symlink_status(p, ec)))
+            continue;
+        if (!force)
+            throw std::runtime_error("--out: '" + dir + "' holds a render's " + name +
+                                     ": give a new folder, or --force to remove render's own "
+                                     "files in it");
+        fs::remove(p, ec);
+        if (ec)
+            throw std::runtime_error("--out: cannot remove '" + p.string() + "': " + ec.message());
+    }
+}
+
 int cmd_render(Args &args)
 {
     RenderArgs r;
@@ -781,6 +841,11 @@ int cmd_render(Args &args)
         perf.start_score();
     if (r.duration <= 0.0)
         r.duration = perf.clip_duration_s();
+    if (r.duration > kMaxRenderSeconds)
+        throw std::runtime_error("--duration: the clip is " + std::to_string(r.duration) +
+                                 " s long; render takes at most " +
+                                 std::to_string(static_cast<int>(kMaxRenderSeconds)) +
+                                 " s (give --duration to render its start)");
     RenderFiles files(r.out_dir, score_mode);
     RenderRecording rec;
     simulate(perf, r, score_mode, rec);

@@ -72,9 +72,14 @@ void run_usage(std::ostream &out)
            "  --realtime          SCHED_FIFO for the physics loop and the strike sender (when\n"
            "                      the system allows it): no late strike on a busy machine, but\n"
            "                      a physics loop slower than real time then holds a core\n"
-           "  --duration S        stop after S simulated seconds (default: until SIGINT)\n"
+           "  --duration S        stop after S simulated seconds (default: until SIGINT,\n"
+           "                      SIGTERM or SIGHUP: exit 130)\n"
            "  --out DIR           also write DIR/strikes.csv, each row whole as it is\n"
-           "                      released; a write error (disk full) ends the run, exit 1\n"
+           "                      released; a write error (disk full) ends the run, exit 1;\n"
+           "                      a render's folder is refused (its other files would\n"
+           "                      pass for this run's)\n"
+           "  --force             take a render's folder as --out: render's own files\n"
+           "                      there are removed first\n"
            "  common options: see ictusd render --help\n"
            "\n"
            "examples:\n"
@@ -248,6 +253,7 @@ struct RunOptions {
     RealtimeLoopOptions loop;
     bool autoplay = false;
     std::string out_dir;
+    bool force = false; // --out: a render's folder taken, its files removed
     RunOptions() { sender.lookahead_s = 0.02; }
 };
 
@@ -279,6 +285,7 @@ OptionTable run_options(RunOptions &r)
         {"--paused", [&r](const std::string &, Args &) { r.autoplay = false; }},
         {"--autoplay", [&r](const std::string &, Args &) { r.autoplay = true; }},
         {"--out", store_text(r.out_dir)},
+        {"--force", store_flag(r.force)},
     };
 }
 
@@ -296,6 +303,8 @@ bool parse_run_args(Args &args, RunOptions &r)
     if (!o.mocap.empty() && !o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
     load_midi_score(r.performance);
+    if (!r.server.reply_url.empty()) // as --target's, before anything loads
+        check_osc_udp_url("--reply", r.server.reply_url);
     return true;
 }
 
@@ -313,15 +322,13 @@ std::vector<KitDrumSound> kit_sounds(const Performance &perf)
     return drums;
 }
 
-// DIR/strikes.csv, DIR created; empty without --out.
-std::string strikes_csv_path(const std::string &out_dir)
+// DIR/strikes.csv, DIR created (a render's folder refused unless --force);
+// empty without --out.
+std::string strikes_csv_path(const std::string &out_dir, bool force)
 {
     if (out_dir.empty())
         return "";
-    std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
-    if (ec)
-        throw std::runtime_error("--out: cannot create '" + out_dir + "': " + ec.message());
+    prepare_run_out_dir(out_dir, force);
     return out_dir + "/strikes.csv";
 }
 
@@ -362,7 +369,7 @@ int cmd_run(Args &args)
     // at once (exit 2), not a run whose every send fails.
     r.sender.realtime = r.loop.realtime; // the strike thread asks for itself
     OscSender sender(r.sender);
-    const std::string csv_path = strikes_csv_path(r.out_dir);
+    const std::string csv_path = strikes_csv_path(r.out_dir, r.force);
     // Opened (and its header written) before the clip loads: an unwritable
     // folder or a full disk shows at once.
     CsvWriter writer(csv_path);
@@ -388,8 +395,6 @@ int cmd_run(Args &args)
     perf.set_background_work(true);
     std::cerr << "ictusd run: commands on " << io.bind_address << ":" << server.port()
               << ", strikes and poses to " << r.sender.target_url << "\n";
-    g_interrupted = 0;
-    install_interrupt_handler(true);
 
     OscIo osc(sender, server, writer, log);
     const RealtimeLoopResult loop = run_realtime(perf, osc, status, r.loop);

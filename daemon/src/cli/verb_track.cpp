@@ -7,6 +7,7 @@
 #include "ictus/character/stick_capture.hpp"
 #include "ictus/cli/verbs.hpp"
 #include "ictus/mocap/marker_csv.hpp"
+#include "ictus/perform/performance.hpp"
 #include "ictus/perform/strike_log.hpp"
 #include "ictus/perform/track.hpp"
 
@@ -349,6 +350,43 @@ void load_learned_limits(const TrackArgs &t, TrackInput &in)
     in.limit_refs = in.limits->refs();
 }
 
+// --gains FILE passes the stability check /ictus/gains applies
+// (Performance::check_gains, docs/perform.md "Stability of the controller"),
+// joint by joint against its default: the damping ratio zeta0 * (kd/kd0) /
+// sqrt(kp/kp0) at least min(1/sqrt 2, zeta0), and kp/kd times the step at most
+// kMaxPdRateStep. Else std::runtime_error naming the file and the joint.
+void check_gain_overrides(const CharacterModel &model, const std::vector<JointGains> &defaults,
+                          const std::vector<JointGains> &gains, const TrackArgs &t)
+{
+    const double zeta0 = t.options.gains.damping_ratio, h = t.options.scene.step_s;
+    const double zeta_min = std::min(Performance::kMinDampingRatio, zeta0);
+    for (size_t j = 0; j < gains.size() && j < defaults.size(); ++j) {
+        const JointGains &g = gains[j], &d = defaults[j];
+        const double zeta = zeta0 * (g.kd_nm_s_per_rad / d.kd_nm_s_per_rad) /
+                            std::sqrt(g.kp_nm_per_rad / d.kp_nm_per_rad);
+        const double rate = g.kp_nm_per_rad / g.kd_nm_s_per_rad;
+        char why[256] = "";
+        if (zeta < zeta_min * (1.0 - 1e-9))
+            std::snprintf(why, sizeof why,
+                          "leaves a damping ratio of %.2f, under %.2f (the joint would ring): "
+                          "kd_nm_s_per_rad %.4g or more",
+                          zeta, zeta_min,
+                          d.kd_nm_s_per_rad * zeta_min / zeta0 *
+                              std::sqrt(g.kp_nm_per_rad / d.kp_nm_per_rad));
+        else if (rate * h > Performance::kMaxPdRateStep)
+            std::snprintf(why, sizeof why,
+                          "gives a PD rate kp/kd of %.0f/s, unstable at the %g ms step (at most "
+                          "%.0f/s)",
+                          rate, 1e3 * h, Performance::kMaxPdRateStep / h);
+        if (why[0])
+            throw std::runtime_error(t.gains_file + ": joint '" +
+                                     model.joint_name(static_cast<int>(j)) + "': kp_nm_per_rad " +
+                                     std::to_string(g.kp_nm_per_rad) + " with kd_nm_s_per_rad " +
+                                     std::to_string(g.kd_nm_s_per_rad) + " " + why);
+    }
+}
+
+
 void load_track_input(TrackArgs &t, TrackInput &in)
 {
     MarkerCapture capture;
@@ -406,7 +444,9 @@ void load_track_input(TrackArgs &t, TrackInput &in)
         } catch (const nlohmann::json::parse_error &e) {
             throw std::runtime_error(t.gains_file + ": not valid JSON (" + e.what() + ")");
         }
+        const std::vector<JointGains> defaults = in.gains;
         apply_gain_overrides(model, overrides, t.gains_file, in.gains);
+        check_gain_overrides(model, defaults, in.gains, t);
     }
 }
 

@@ -5,10 +5,11 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
-#include <map>
-#include <sstream>
+#include <string>
+#include <vector>
 
 namespace ictus
 {
@@ -244,47 +245,109 @@ std::string vec3(const Eigen::Vector3d &v)
     return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]";
 }
 
-// Line numbers of the values of a JSON text, by JSON pointer ("/units/3/grip"),
-// from a small scan of text nlohmann has already accepted.
-std::map<std::string, int> value_lines(const std::string &text)
+// The deepest nesting of arrays and objects a database may have: a valid one
+// has 5 (the document, "units", a unit, "tip_m", a sample). Deeper text is
+// refused before it is parsed, at the line where it goes past the bound.
+constexpr int kMaxJsonDepth = 16;
+
+// The largest database read: 16 MiB, some 180000 samples (the built-in one
+// is 0.4 MiB; a stroke of a capture at 250 Hz, 0.5 s, about 11 KiB).
+constexpr size_t kMaxDatabaseBytes = size_t{16} << 20;
+
+// Skips the string whose opening quote is at text[i]; i ends on its closing
+// quote (or the end). Newlines in it are counted into `line`.
+void skip_string(const std::string &text, size_t &i, int &line, std::string *out)
 {
-    std::map<std::string, int> lines;
-    struct Frame {
-        bool array;
-        int index;
-        std::string key;
-        std::string path;
-    };
-    std::vector<Frame> stack;
-    int line = 1;
-    std::string pending_key;
-    bool expect_value = true; // at top level
-    auto current_path = [&]() -> std::string {
-        if (stack.empty())
-            return "";
-        const Frame &f = stack.back();
-        return f.path + "/" + (f.array ? std::to_string(f.index) : f.key);
-    };
-    auto mark_value = [&]() {
-        if (expect_value)
-            lines.emplace(current_path(), line);
-        expect_value = false;
-    };
+    for (++i; i < text.size() && text[i] != '"'; ++i) {
+        if (text[i] == '\\' && i + 1 < text.size())
+            ++i;
+        if (text[i] == '\n')
+            ++line;
+        if (out)
+            *out += text[i];
+    }
+}
+
+// One linear scan: a GestureError naming the line where the nesting goes
+// deeper than kMaxJsonDepth.
+void check_depth(const std::string &file, const std::string &text)
+{
+    int depth = 0, line = 1;
     for (size_t i = 0; i < text.size(); ++i) {
         const char c = text[i];
         if (c == '\n') {
             ++line;
         } else if (c == '"') {
+            skip_string(text, i, line, nullptr);
+        } else if (c == '{' || c == '[') {
+            if (++depth > kMaxJsonDepth)
+                throw GestureError(
+                    file + ":" + std::to_string(line) + ": arrays and objects nested deeper than " +
+                    std::to_string(kMaxJsonDepth) + " levels (a gesture database has 5)");
+        } else if (c == '}' || c == ']') {
+            depth = std::max(0, depth - 1);
+        }
+    }
+}
+
+std::vector<std::string> pointer_parts(const std::string &pointer)
+{
+    std::vector<std::string> parts;
+    size_t at = 0;
+    while (at < pointer.size()) {
+        const size_t next = pointer.find('/', at + 1);
+        parts.push_back(
+            pointer.substr(at + 1, next == std::string::npos ? std::string::npos : next - at - 1));
+        at = next == std::string::npos ? pointer.size() : next;
+    }
+    return parts;
+}
+
+// The line of the value at a JSON pointer ("/units/3/grip") in text nlohmann
+// has already accepted, else of its nearest parent: one linear scan that
+// follows only the pointer's path (0 when not even the document is found).
+int pointer_line(const std::string &text, const std::string &pointer)
+{
+    const std::vector<std::string> want = pointer_parts(pointer);
+    struct Frame {
+        bool array;
+        long index;
+        bool on_path;     // this container is the value at want[0 .. depth)
+        bool key_matches; // an object's current key is want[depth]
+    };
+    std::vector<Frame> stack;
+    int line = 1, found = 0, found_depth = -1;
+    bool expect_value = true; // at top level
+    // A value starts here: true when it is on the pointer's path.
+    auto begin_value = [&]() {
+        if (!expect_value)
+            return false;
+        expect_value = false;
+        const size_t d = stack.size();
+        bool on = d == 0;
+        if (d > 0 && stack.back().on_path && d <= want.size())
+            on = stack.back().array ? want[d - 1] == std::to_string(stack.back().index)
+                                    : stack.back().key_matches;
+        if (on && static_cast<int>(d) > found_depth) {
+            found = line;
+            found_depth = static_cast<int>(d);
+        }
+        return on;
+    };
+    for (size_t i = 0; i < text.size() && found_depth < static_cast<int>(want.size()); ++i) {
+        const char c = text[i];
+        if (c == '\n') {
+            ++line;
+        } else if (c == '"') {
+            const bool is_key = !stack.empty() && !stack.back().array && !expect_value;
+            if (!is_key)
+                begin_value(); // on the line of its opening quote
             std::string s;
-            for (++i; i < text.size() && text[i] != '"'; ++i) {
-                if (text[i] == '\\' && i + 1 < text.size())
-                    ++i;
-                s += text[i];
-            }
-            if (!stack.empty() && !stack.back().array && !expect_value) {
-                stack.back().key = s; // a key
-            } else {
-                mark_value();
+            skip_string(text, i, line, is_key ? &s : nullptr);
+            if (is_key) {
+                Frame &f = stack.back();
+                const size_t d = stack.size();
+                f.key_matches = f.on_path && d <= want.size() && s == want[d - 1];
             }
         } else if (c == ':') {
             expect_value = true;
@@ -294,44 +357,28 @@ std::map<std::string, int> value_lines(const std::string &text)
                 expect_value = true;
             }
         } else if (c == '{' || c == '[') {
-            mark_value();
-            const std::string path = current_path();
-            stack.push_back({c == '[', 0, "", path});
+            const bool on = begin_value();
+            stack.push_back({c == '[', 0, on, false});
             expect_value = c == '[';
         } else if (c == '}' || c == ']') {
             if (!stack.empty())
                 stack.pop_back();
             expect_value = false;
         } else if (!std::isspace(static_cast<unsigned char>(c))) {
-            mark_value();
+            begin_value();
         }
     }
-    return lines;
+    return found;
 }
 
 class JsonReader
 {
   public:
-    JsonReader(std::string file, std::map<std::string, int> lines)
-        : file_(std::move(file)), lines_(std::move(lines))
-    {
-    }
+    JsonReader(std::string file, const std::string &text) : file_(std::move(file)), text_(text) {}
     [[noreturn]] void fail(const std::string &pointer, const std::string &what) const
     {
         // The line of the value, else of its nearest parent.
-        std::string p = pointer;
-        int line = 0;
-        for (;;) {
-            auto it = lines_.find(p);
-            if (it != lines_.end()) {
-                line = it->second;
-                break;
-            }
-            const auto slash = p.rfind('/');
-            if (slash == std::string::npos || p.empty())
-                break;
-            p = p.substr(0, slash);
-        }
+        const int line = pointer_line(text_, pointer);
         throw GestureError(file_ + ":" + std::to_string(line) + ": " + pointer + ": " + what);
     }
     const nlohmann::json &member(const nlohmann::json &obj, const std::string &ptr,
@@ -374,7 +421,7 @@ class JsonReader
 
   private:
     std::string file_;
-    std::map<std::string, int> lines_;
+    const std::string &text_;
 };
 
 } // namespace
@@ -410,9 +457,26 @@ GestureDatabase GestureDatabase::load_json(const std::string &path)
     std::ifstream in(path, std::ios::binary);
     if (!in)
         throw GestureError(path + ":0: cannot open");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const std::string text = ss.str();
+    // At most kMaxDatabaseBytes and one byte more, to know it is more
+    // (/dev/zero, a FIFO: no size to ask for first).
+    std::string text;
+    char buf[65536];
+    while (text.size() <= kMaxDatabaseBytes && in.read(buf, sizeof buf).gcount() > 0)
+        text.append(buf, static_cast<size_t>(in.gcount()));
+    if (in.bad())
+        throw GestureError(path + ":0: read error");
+    if (text.size() > kMaxDatabaseBytes)
+        throw GestureError(path + ":0: larger than " + std::to_string(kMaxDatabaseBytes >> 20) +
+                           " MiB, the bound of a gesture database");
+    return parse_json(text, path);
+}
+
+GestureDatabase GestureDatabase::parse_json(const std::string &text, const std::string &path)
+{
+    if (text.size() > kMaxDatabaseBytes)
+        throw GestureError(path + ":0: larger than " + std::to_string(kMaxDatabaseBytes >> 20) +
+                           " MiB, the bound of a gesture database");
+    check_depth(path, text);
     nlohmann::json doc;
     try {
         doc = nlohmann::json::parse(text);
@@ -421,8 +485,20 @@ GestureDatabase GestureDatabase::load_json(const std::string &path)
         const int line =
             1 + static_cast<int>(std::count(text.begin(), text.begin() + byte - (byte > 0), '\n'));
         throw GestureError(path + ":" + std::to_string(line) + ": malformed JSON: " + e.what());
+    } catch (const nlohmann::json::exception &e) {
+        // A number past a double's range ("number overflow parsing '1e999'"):
+        // the line of the first such text.
+        const std::string what = e.what();
+        const size_t open = what.find('\''), close = what.rfind('\'');
+        const size_t at =
+            open < close ? text.find(what.substr(open + 1, close - open - 1)) : std::string::npos;
+        const int line =
+            at == std::string::npos
+                ? 0
+                : 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+        throw GestureError(path + ":" + std::to_string(line) + ": " + what);
     }
-    const JsonReader r(path, value_lines(text));
+    const JsonReader r(path, text);
     if (!doc.is_object())
         r.fail("", "expected an object {\"format\": \"ictus-gestures\", \"units\": [...]}");
     if (!doc.contains("format") || doc["format"] != "ictus-gestures")

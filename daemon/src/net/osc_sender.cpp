@@ -69,18 +69,16 @@ double ntp_diff_seconds(NtpTime a, NtpTime b)
 
 // ---- the target ---------------------------------------------------------------
 
-namespace
-{
-// --target must be osc.udp://HOST:PORT (a trailing '/' aside), checked here
+// --target (and --reply) must be osc.udp://HOST:PORT (a trailing '/' aside), checked here
 // because liblo takes more and fails later, at every send: a port past 65535
 // wraps (99999 -> 34463), "9000x" is port 9000, an IPv6 host needs an IPv6
 // socket (liblo's sending socket is IPv4), and osc.tcp:// is not what Pd
 // listens on ([netreceive -u -b], docs/pd-osc.md) and would block the sending
 // threads on a stalled peer.
-void check_target_url(const std::string &url)
+void check_osc_udp_url(const char *option, const std::string &url)
 {
     auto refuse = [&](const std::string &why) {
-        return OscError("--target '" + url + "': " + why +
+        return OscError(std::string(option) + " '" + url + "': " + why +
                         " (expected osc.udp://HOST:PORT, e.g. osc.udp://127.0.0.1:9000)");
     };
     const std::string udp = "osc.udp://";
@@ -118,7 +116,6 @@ void check_target_url(const std::string &url)
                      gai_strerror(status) + ")");
     freeaddrinfo(found);
 }
-} // namespace
 
 // ---- sender -------------------------------------------------------------------
 
@@ -140,7 +137,7 @@ OscSender::OscSender(const OscSenderOptions &options) : impl_(new Impl), options
     if (!(std::isfinite(options.lookahead_s) && options.lookahead_s >= 0.0 &&
           options.lookahead_s <= 10.0))
         throw OscError("lookahead: expected 0 to 10 s, got " + std::to_string(options.lookahead_s));
-    check_target_url(options.target_url);
+    check_osc_udp_url("--target", options.target_url);
     impl_->strike_target = lo_address_new_from_url(options.target_url.c_str());
     impl_->pose_target = lo_address_new_from_url(options.target_url.c_str());
     if (!impl_->strike_target || !impl_->pose_target)

@@ -53,7 +53,7 @@ const char *lo_arg_string(const lo_arg *a)
 struct Counters {
     std::atomic<unsigned long> packets{0}, accepted{0}, unknown_address{0}, bad_type_tags{0},
         bad_values{0}, malformed{0}, oversized{0}, refused_peers{0}, bundles{0}, queue_full{0},
-        replies{0}, errors_sent{0}, errors_unanswered{0}, score_lines{0};
+        replies{0}, errors_sent{0}, errors_unanswered{0}, score_lines{0}, refused_commands{0};
 };
 
 // The error-reply budget (osc_server.hpp): a token bucket per address the
@@ -130,6 +130,7 @@ OscServerCounters snapshot(const Counters &c)
     o.errors_sent = c.errors_sent;
     o.errors_unanswered = c.errors_unanswered;
     o.score_lines = c.score_lines;
+    o.refused_commands = c.refused_commands;
     return o;
 }
 
@@ -580,6 +581,7 @@ void OscServer::send_refusals()
     Impl &im = *impl_;
     Refusal f;
     while (refusals_.pop(f)) {
+        im.counters.refused_commands++; // an error, answered or not
         sockaddr_in to{};
         to.sin_family = AF_INET;
         to.sin_addr.s_addr = f.peer_ipv4;

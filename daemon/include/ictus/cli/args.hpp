@@ -1,5 +1,5 @@
 // args.hpp -- the one argument module of ictusd's verbs: the usage error, the
-// strict number parsers, the argv walker, the interrupt flag (SIGINT/SIGTERM)
+// strict number parsers, the argv walker, the interrupt flag (SIGINT/SIGTERM/SIGHUP)
 // and the exit-status mapping every verb shares. Exit status: 0 ok, 1 error in
 // a file or the data, 2 usage error, 3 the simulation diverged, 130 interrupted.
 #pragma once
@@ -91,10 +91,18 @@ OptionHandler store_flag(bool &target);
 bool walk_args(Args &args, void (*usage)(std::ostream &),
                const std::function<void(const std::string &item)> &handle);
 
-// Set by SIGINT (and SIGTERM once install_interrupt_handler(true) ran); the
-// loops of track, run and render check it every step.
+// The signal (SIGINT, SIGTERM or SIGHUP) that asked the verb to stop, 0
+// while none did; the loops of track, run and render check it every step and
+// the verb exits 130 (docs/perform.md, "Signals"). Set from the first moment
+// of the process: a signal during loading is not forgotten.
 extern volatile std::sig_atomic_t g_interrupted;
-void install_interrupt_handler(bool also_sigterm = false);
+// A child process (render --wav's pd) ended with ictusd: a second signal,
+// which exits at once, kills it first. 0: none.
+extern volatile std::sig_atomic_t g_child_pid;
+// SIGINT, SIGTERM and SIGHUP set g_interrupted (a second one exits 130 at
+// once); SIGXFSZ is ignored, so that a file-size limit is a write error
+// (EFBIG) each writer reports, not the end of the process.
+void install_signal_handlers();
 
 // Runs a verb: its return value is the exit status; an exception is printed
 // as "ictusd VERB: what" and mapped to 2 (UsageError, a bad network option)

@@ -12,6 +12,7 @@
 #include "ictus/perform/track.hpp"
 #include "ictus/perform/tracker.hpp"
 
+#include <cstddef>
 #include <fstream>
 #include <string>
 
@@ -22,6 +23,13 @@ namespace cli
 
 // The drum may stand this far from the origin at most (--drum-pos), m.
 constexpr double kMaxDrumDistance_m = 100.0;
+
+// The largest --score file read: 16 MiB (a score of the 100000-note bound,
+// one note a line, is about 1 MiB; docs/score.md).
+constexpr std::size_t kMaxScoreFileBytes = std::size_t{16} << 20;
+// A --score file's text; std::runtime_error (exit 1) naming the path when it
+// cannot be read or is larger than kMaxScoreFileBytes.
+std::string read_score_file(const std::string &path);
 
 // --scale M, --skip-frames N. Returns false when `option` is neither (nothing consumed).
 bool parse_bvh_option(const std::string &option, Args &args, double &scale_m_per_unit,

@@ -50,6 +50,7 @@ struct PdRenderResult {
     double peak_out_dbfs = 0.0;
     std::string errors; // Pd's error lines, one a line ("" when none)
     double wall_s = 0.0;
+    bool interrupted = false; // stopped by SIGINT, SIGTERM or SIGHUP: no WAV left
 };
 
 // The Pd library folder: `given` if not empty (checked), else the first of
@@ -63,13 +64,20 @@ std::string find_pd_library(const std::string &given);
 // std::runtime_error "WHAT: 'path' has ...".
 void check_pd_path(const char *what, const std::string &path);
 
+// --wav's path: a file name ending in .wav (what Pd writes; none of render's
+// other outputs ends so), not a folder, and one Pd's messages carry
+// (check_pd_path). std::runtime_error naming the path.
+void check_wav_path(const std::string &path);
+
 // The path of `pd` (a name is looked up on PATH); std::runtime_error when
 // there is none, saying how to get it.
 std::string find_pd_binary(const std::string &pd);
 
 // Runs Pd; `progress` is called about every 2 s of wall time while it runs
 // (elapsed seconds). Throws std::runtime_error when Pd cannot start, exits
-// with an error, is interrupted (SIGINT), times out, or writes no WAV.
+// with an error, times out, or writes no WAV. Interrupted (SIGINT, SIGTERM,
+// SIGHUP: g_interrupted), Pd is stopped, the cut WAV removed, and the result
+// says `interrupted`. Pd is a child that ends with ictusd (PR_SET_PDEATHSIG).
 PdRenderResult run_pd_render(const PdRenderOptions &o, const std::function<void(double)> &progress);
 
 } // namespace cli

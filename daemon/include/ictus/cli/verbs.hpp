@@ -17,5 +17,12 @@ int cmd_run(Args &args);      // verb_run.cpp
 int cmd_render(Args &args);   // verb_render.cpp
 int cmd_gestures(Args &args); // verb_gestures.cpp
 
+// run --out DIR (verb_render.cpp, beside render's rule): DIR is created; a
+// folder holding a file render writes other than strikes.csv (a render's
+// folder) is refused, std::runtime_error naming it, so that no render's
+// events.txt or render.json passes for this run's; with `force` those files
+// are removed first. Another file, an earlier run's strikes.csv, stays.
+void prepare_run_out_dir(const std::string &dir, bool force);
+
 } // namespace cli
 } // namespace ictus

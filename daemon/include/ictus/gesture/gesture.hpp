@@ -101,8 +101,11 @@ class GestureDatabase
     GestureUnit instantiate(Grip g, Nuance n, Side h, double dynamics) const;
     const std::vector<GestureUnit> &units() const { return units_; }
     void save_json(const std::string &path) const; // throws GestureError
-    // Errors name the file, the line and what is wrong.
+    // Errors name the file, the line and what is wrong. At most 16 MiB, nested
+    // at most 16 deep (docs/gestures.md, "File format").
     static GestureDatabase load_json(const std::string &path);
+    // The same from the file's text; `name` stands for the file in errors.
+    static GestureDatabase parse_json(const std::string &text, const std::string &name);
 
   private:
     std::vector<GestureUnit> units_;

@@ -35,6 +35,11 @@ NtpTime ntp_now();
 NtpTime ntp_add_seconds(NtpTime t, double seconds);
 double ntp_diff_seconds(NtpTime a, NtpTime b); // a - b
 
+// `url` is osc.udp://HOST:PORT: UDP, a port 1..65535 in digits, a host that
+// resolves to an IPv4 address; else OscError "OPTION 'url': why" (--target,
+// --reply: docs/osc.md).
+void check_osc_udp_url(const char *option, const std::string &url);
+
 struct OscSenderOptions {
     std::string target_url = "osc.udp://127.0.0.1:9000";
     // Strike bundles carry the timetag epoch + time_s + lookahead_s. A

@@ -46,10 +46,13 @@ struct OscServerCounters {
     // Errors counted but not answered: over the peer's error-reply budget.
     unsigned long errors_unanswered = 0;
     unsigned long score_lines = 0;
+    // Commands accepted here and refused by the physics (a gains past the
+    // stability bounds, a play of a score that cannot be planned ...).
+    unsigned long refused_commands = 0;
     unsigned long errors() const
     {
         return unknown_address + bad_type_tags + bad_values + malformed + oversized + bundles +
-               queue_full;
+               queue_full + refused_commands;
     }
 };
 
