@@ -5,7 +5,9 @@
 on; and `ictusd render --wav` of the same score. Checked on the recording: the peak at most
 -0.3 dBFS (the limiter's ceiling is -0.5), the two channels' RMS within 1.5 dB of each other,
 and the level of the sounding part (the RMS from the first to the last sample above 1e-3) within
-2 dB of the render's, measured the same way. Every wait is a handshake on pd's printed lines or
+2 dB of the render's, measured the same way. The Pd window is quiet by default: no strike
+telemetry (`ictusd: strike end ...`) while the physics panel's verbose is off (the first half of
+the strikes); once it is turned on through its receive name, the strike ends are printed. Every wait is a handshake on pd's printed lines or
 the daemon's output, with a deadline.
 
     PYTHONPATH=python python3 tests/e2e/test_live_output.py --build build
@@ -66,7 +68,7 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav, seconds):
              "#X obj 200 1200 tabwrite~ live-r",                           # 1
              "#X obj 20 1200 tabwrite~ live-l",                            # 2
              "#X obj 300 1000 netreceive -u %d" % ctl_port,                # 3
-             "#X obj 300 1030 route play finish",                          # 4
+             "#X obj 300 1030 route play finish verbose",                  # 4
              "#X msg 300 1060 play",                                       # 5
              "#X obj 400 1060 delay 1500",                                 # 6
              "#X obj 400 1090 t b b b",                                    # 7
@@ -78,12 +80,15 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav, seconds):
              "#X obj 480 1150 soundfiler",                                 # 13
              "#X obj 20 1250 array define live-l %d" % (seconds * SR),     # 14
              "#X obj 200 1250 array define live-r %d" % (seconds * SR),    # 15
-             "#X obj 300 1090 t b b"]                                      # 16
+             "#X obj 300 1090 t b b",                                      # 16
+             "#X obj 600 1000 print strike",                               # 17
+             "#X obj 700 1060 s ictus-physics-verbose"]                    # 18
     links = [(16, 1, 1, 0), (16, 1, 2, 0), (3, 0, 4, 0), (4, 0, 16, 0), (16, 0, 5, 0),
              (4, 1, 6, 0), (6, 0, 7, 0), (7, 2, 11, 0), (11, 0, 13, 0), (7, 1, 10, 0),
-             (10, 0, 8, 0), (7, 0, 12, 0), (0, 0, 9, 0), (9, 0, 8, 0)]
+             (10, 0, 8, 0), (7, 0, 12, 0), (0, 0, 9, 0), (9, 0, 8, 0), (4, 2, 18, 0)]
     links = [(n + a, o, n + b, i) for a, o, b, i in links]
-    links += [(out, 0, n + 2, 0), (out, 1, n + 1, 0), (n + 5, 0, index["ictus-receive"], 0)]
+    links += [(out, 0, n + 2, 0), (out, 1, n + 1, 0), (n + 5, 0, index["ictus-receive"], 0),
+              (index["ictus-receive"], 0, n + 17, 0)]
     return (";\n".join(records) + ";\n" + "".join(e + ";\n" for e in extra)
             + "".join("#X connect %d %d %d %d;\n" % l for l in links))
 
@@ -116,6 +121,9 @@ def main():
     ref, rate = read_wav_float(os.path.join(render_dir, "p.wav"))
     check(rate == SR, "the render at %d Hz" % rate)
     length_s = len(ref) / SR
+    with open(os.path.join(render_dir, "strikes.csv")) as f:
+        n_strikes = len(f.readlines()) - 1
+    check(n_strikes >= 4, "the render has strikes (%d)" % n_strikes)
     seconds = int(length_s + 12)
     pd_port, daemon_port, ctl_port = (uitest.free_udp_port() for _ in range(3))
     lines = uitest.PdLines()
@@ -145,6 +153,11 @@ def main():
         dlines.wait_for(lambda l: "commands on 127.0.0.1:%d" % daemon_port in l,
                         "the daemon listening", 120)
         ctl.sendto(b"play;\n", ("127.0.0.1", ctl_port))
+        for k in range(n_strikes // 2):
+            lines.wait_for(lambda l: l.startswith("strike: "), "strike %d" % k, 60)
+        quiet = [l for l in lines.printed if l.startswith("ictusd: strike")]
+        ctl.sendto(b"verbose 1;\n", ("127.0.0.1", ctl_port))
+        lines.wait_for(lambda l: l.startswith("ictusd: strike end"), "a strike end printed, verbose")
         daemon.wait(length_s * 4 + 120)
         ctl.sendto(b"finish;\n", ("127.0.0.1", ctl_port))
         lines.wait_for(lambda l: l == "test: recorded", "the recording closed")
@@ -154,8 +167,8 @@ def main():
             daemon.kill()
             daemon.wait()
         uitest.stop(pd)
-    summary = [l for l in dlines.printed if l.startswith("run:")]
-    print("daemon: %s" % summary)
+    check(not quiet, "quiet by default: no strike telemetry in the Pd window over %d strikes: %s"
+          % (n_strikes // 2, quiet[:3]))
     x, rate = read_wav_float(wav)
     check(rate == SR and np.all(np.isfinite(x)), "the recording: %d Hz, finite" % rate)
     peak_db = 20.0 * np.log10(max(np.abs(x).max(), 1e-20))
