@@ -38,6 +38,42 @@ install(FILES ${ICTUS_SOURCE_ROOT}/examples/scores/figure5.txt
 install(FILES ${ICTUS_SOURCE_ROOT}/README.md ${ICTUS_SOURCE_ROOT}/LICENSE
         DESTINATION ${ictus_pd_dest} COMPONENT pd_library)
 
+# The references (docs/*.md, their figures, and the same pages as HTML made by
+# scripts/doc_html.py with Debian's python3-markdown) in docs/ beside the help
+# patches: the patches' "docs/NAME.md" resolve there.
+file(GLOB ictus_doc_sources ${ICTUS_SOURCE_ROOT}/docs/*.md)
+file(GLOB ictus_doc_images ${ICTUS_SOURCE_ROOT}/docs/img/*.png)
+install(FILES ${ictus_doc_sources} DESTINATION ${ictus_pd_dest}/docs COMPONENT pd_library)
+install(FILES ${ictus_doc_images} DESTINATION ${ictus_pd_dest}/docs/img COMPONENT pd_library)
+find_program(ICTUS_DOC_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+set(ictus_doc_markdown OFF)
+if(ICTUS_DOC_PYTHON)
+  execute_process(COMMAND ${ICTUS_DOC_PYTHON} -c "import markdown" RESULT_VARIABLE rc
+                  OUTPUT_QUIET ERROR_QUIET)
+  if(rc EQUAL 0)
+    set(ictus_doc_markdown ON)
+  endif()
+endif()
+if(ictus_doc_markdown)
+  set(ictus_doc_html_dir ${CMAKE_BINARY_DIR}/docs-html)
+  set(ictus_doc_html "")
+  foreach(src ${ictus_doc_sources})
+    get_filename_component(name ${src} NAME_WE)
+    list(APPEND ictus_doc_html ${ictus_doc_html_dir}/${name}.html)
+  endforeach()
+  add_custom_command(OUTPUT ${ictus_doc_html}
+    COMMAND ${ICTUS_DOC_PYTHON} ${ICTUS_SOURCE_ROOT}/scripts/doc_html.py ${ictus_doc_html_dir}
+            ${ictus_doc_sources}
+    DEPENDS ${ictus_doc_sources} ${ICTUS_SOURCE_ROOT}/scripts/doc_html.py
+    COMMENT "The references as HTML for the Pd library"
+    VERBATIM)
+  add_custom_target(ictus_docs_html ALL DEPENDS ${ictus_doc_html})
+  install(FILES ${ictus_doc_html} DESTINATION ${ictus_pd_dest}/docs COMPONENT pd_library)
+else()
+  message(WARNING "python3-markdown not found (bash scripts/deps.sh installs it): the Pd "
+                  "library ships the references as Markdown only")
+endif()
+
 # The deken package: LIBRARY[vVERSION](OS-MARCH-FLOATSIZE).dek, a zip of the
 # folder ictus/ (deken's naming; Pd's float is 32-bit in Debian's pd).
 if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
@@ -67,6 +103,9 @@ if(TARGET ictusd)
 endif()
 if(TARGET ictus_sound_clips)
   list(APPEND ictus_deken_depends ictus_sound_clips)
+endif()
+if(TARGET ictus_docs_html)
+  list(APPEND ictus_deken_depends ictus_docs_html)
 endif()
 add_custom_target(deken
   COMMAND ${CMAKE_COMMAND} -DBUILD_DIR=${CMAKE_BINARY_DIR} -DSTAGE_DIR=${CMAKE_BINARY_DIR}/deken

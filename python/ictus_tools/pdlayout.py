@@ -234,12 +234,14 @@ def gop_size(path):
     return None
 
 
-def parse(path, abstraction_dirs=(), gop_areas=None):
+def parse(path, abstraction_dirs=(), gop_areas=None, wiring=None):
     """{canvas name: [Box]} for every canvas of the file (the top one is '').
     An object whose class is an abstraction found in `abstraction_dirs` and
     drawn graph-on-parent takes that abstraction's size. gop_areas (a dict),
     if given, receives each graph-on-parent canvas's area (x, y, w, h): what
-    the parent shows of it."""
+    the parent shows of it. wiring (a dict), if given, receives each canvas's
+    (window (w, h), [(source, outlet, sink, inlet)], {index: (inlets, outlets)})
+    for its objects known to have inlets and outlets (abstractions, subpatches)."""
     records = split_records(open(path, encoding="utf-8").read(), with_offsets=True)
     canvases = {}
     stack = []  # [name, font, boxes, index, coords]
@@ -256,10 +258,15 @@ def parse(path, abstraction_dirs=(), gop_areas=None):
             else:
                 name = stack[-1][0] + "/" + (items[6][1] if len(items) > 6 else "?")
             stack.append([name, font, [], 0, None])
+            if wiring is not None:
+                wiring[name] = ((_num(items, 4), _num(items, 5)), [], {})
             continue
         if head != "#X" or not stack:
             continue
         top = stack[-1]
+        if kind == "connect" and wiring is not None and len(items) >= 6:
+            wiring[top[0]][1].append(tuple(int(_num(items, i)) for i in range(2, 6)))
+            continue
         cw, lh = font_metrics(top[1])
         if kind == "coords":
             # #X coords x1 y1 x2 y2 w h gop [xmargin ymargin]
@@ -283,6 +290,8 @@ def parse(path, abstraction_dirs=(), gop_areas=None):
                 w, h = text_extent(rest, "obj", pcw, plh)
             parent[2].append(Box(parent[0], parent[3], "obj", x, y, w, h, box_text(rest),
                                  offset=offset))
+            if wiring is not None:
+                wiring[parent[0]][2][parent[3]] = iolets([b.text for b in boxes])
             parent[3] += 1
             continue
         if kind in ("obj", "msg", "text", "floatatom", "symbolatom", "listbox"):
@@ -295,8 +304,13 @@ def parse(path, abstraction_dirs=(), gop_areas=None):
                     continue
                 ext = iemgui_extent(cls, rest[1:], cw, lh)
                 for d in abstraction_dirs:
-                    if not ext and os.path.isfile(os.path.join(d, cls + ".pd")):
-                        ext = gop_size(os.path.join(d, cls + ".pd"))
+                    if os.path.isfile(os.path.join(d, cls + ".pd")):
+                        if not ext:
+                            ext = gop_size(os.path.join(d, cls + ".pd"))
+                        if wiring is not None:
+                            wiring[top[0]][2][top[3]] = abstraction_iolets(
+                                os.path.join(d, cls + ".pd"))
+                        break
                 w, h = ext if ext else text_extent(rest, "obj", cw, lh)
             elif kind == "msg":
                 w, h = text_extent(rest, kind, cw, lh)
@@ -333,4 +347,125 @@ def overlaps(path, abstraction_dirs=()):
             for b in boxes[i + 1:]:
                 if a.overlaps(b):
                     found.append((name, a, b))
+    return found
+
+
+# Cables and windows (g_canvas.h, g_text.c: an inlet or outlet is IOWIDTH = 7 px
+# wide, the first at the box's left edge, the last at its right, the others
+# spread evenly; a cable runs from the middle of its outlet on the box's bottom
+# edge to the middle of its inlet on the top edge).
+IOWIDTH = 7
+IOMIDDLE = (IOWIDTH - 1) // 2
+
+
+def iolets(texts):
+    """(inlets, outlets) of a canvas whose objects' texts are given."""
+    ins = sum(1 for t in texts if t.split()[:1] in (["inlet"], ["inlet~"]))
+    outs = sum(1 for t in texts if t.split()[:1] in (["outlet"], ["outlet~"]))
+    return ins, outs
+
+
+def abstraction_iolets(path):
+    """(inlets, outlets) of an abstraction file's top canvas."""
+    depth, texts = 0, []
+    for rec in split_records(open(path, encoding="utf-8").read()):
+        items = atoms(rec)
+        if len(items) < 5:
+            if len(items) >= 2 and items[1][1] == "restore":
+                depth -= 1
+            continue
+        if items[0][1] == "#N" and items[1][1] == "canvas":
+            depth += 1
+        elif items[1][1] == "restore":
+            depth -= 1
+        elif depth == 1 and items[1][1] == "obj":
+            texts.append(items[4][1])
+    return iolets(texts)
+
+
+def _iolet_x(box, n, count):
+    """x of the middle of iolet n of `count` on the box."""
+    if count <= 1:
+        return box.x + IOMIDDLE
+    return box.x + (box.w - IOWIDTH) * n // (count - 1) + IOMIDDLE
+
+
+def segment_hits(x1, y1, x2, y2, rect):
+    """Whether the segment (x1,y1)-(x2,y2) meets the closed rectangle (x, y, w, h)
+    (Liang-Barsky clipping)."""
+    rx, ry, rw, rh = rect
+    t0, t1 = 0.0, 1.0
+    dx, dy = x2 - x1, y2 - y1
+    for p, q in ((-dx, x1 - rx), (dx, rx + rw - x1), (-dy, y1 - ry), (dy, ry + rh - y1)):
+        if p == 0:
+            if q < 0:
+                return False
+            continue
+        t = q / p
+        if p < 0:
+            t0 = max(t0, t)
+        else:
+            t1 = min(t1, t)
+        if t0 > t1:
+            return False
+    return True
+
+
+def cables(path, abstraction_dirs=()):
+    """Every cable of every canvas as (canvas, source box, sink box, (x1, y1, x2, y2)).
+    Iolet counts: an abstraction's or subpatch's inlets and outlets; for other
+    objects at least the highest iolet any cable uses (a cable from the last
+    outlet of a class with more outlets than used is placed at the box's right
+    edge, a few pixels off)."""
+    wiring = {}
+    canvases = parse(path, abstraction_dirs, wiring=wiring)
+    found = []
+    for name, boxes in canvases.items():
+        _, edges, known = wiring.get(name, ((0, 0), [], {}))
+        by_index = {b.index: b for b in boxes if b.kind != "label"}
+        used_out, used_in = {}, {}
+        for s, o, d, i in edges:
+            used_out[s] = max(used_out.get(s, 0), o + 1)
+            used_in[d] = max(used_in.get(d, 0), i + 1)
+        for s, o, d, i in edges:
+            a, b = by_index.get(s), by_index.get(d)
+            if a is None or b is None:
+                continue
+            nout = known[s][1] if s in known else used_out[s]
+            nin = known[d][0] if d in known else used_in[d]
+            found.append((name, a, b, (_iolet_x(a, o, nout), a.y + a.h,
+                                       _iolet_x(b, i, nin), b.y)))
+    return canvases, found
+
+
+def crossings(path, abstraction_dirs=()):
+    """Every cable that meets a box, GUI or label other than its own two boxes
+    (what is seen of it: a comment's glyphs), as (canvas, box, cable's source,
+    sink)."""
+    canvases, wires = cables(path, abstraction_dirs)
+    found = []
+    for name, a, b, seg in wires:
+        for box in canvases[name]:
+            if box is a or box is b or box.owner is a or box.owner is b:
+                continue
+            if segment_hits(*seg, box.visible):
+                found.append((name, box, a, b))
+    return found
+
+
+def outside_window(path, abstraction_dirs=()):
+    """Every box, GUI or label past the right or bottom edge of its canvas's
+    window (#N canvas X Y W H), as (canvas, box, (W, H)). Graph-on-parent
+    canvases are shown in their parent and not checked."""
+    wiring, gops = {}, {}
+    canvases = parse(path, abstraction_dirs, gop_areas=gops, wiring=wiring)
+    found = []
+    for name, boxes in canvases.items():
+        if name in gops:
+            continue
+        (w, h), _, _ = wiring[name]
+        for box in boxes:
+            x, y, bw, bh = box.visible
+            if x + bw > w or y + bh > h:
+                found.append((name, box, (w, h)))
     return found

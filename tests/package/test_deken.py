@@ -4,8 +4,10 @@ top CMakeLists.txt); it is unpacked into an empty folder and used from there
 alone (pd -noprefs -nostdpath -path <that folder>/ictus; Gem's own folder is
 added for the Gem view, which needs Gem): the main patch and every help patch
 open without an error line, the packaged ictus-render.pd renders one strike to
-a WAV that sounds at the strike's sample, and the packaged ictusd starts and
-prints its version. No binary's RUNPATH points outside its own folder, in the
+a WAV that sounds at the strike's sample, the packaged ictusd starts, prints
+its version and renders a score to a WAV from an empty folder with no flag
+naming the library, and the references the patches point at are in docs/
+beside them, as Markdown and HTML. No binary's RUNPATH points outside its own folder, in the
 package or in a `cmake --install` tree, which holds the same files (README.md,
 "Installing")."""
 import argparse
@@ -18,6 +20,8 @@ import shutil
 import stat
 import subprocess
 import zipfile
+
+import numpy as np  # Debian's, as pdrun
 
 from ictus_tools import ROOT as REPO
 from ictus_tools import pdrun
@@ -57,6 +61,12 @@ expected |= {"ictus/examples/scores/" + os.path.basename(p)
 expected |= {"ictus/%s.pd_linux" % n for n in ("membrane~", "contact~", "ictus_timetag", "ictus")}
 expected |= {"ictus/libictus_pd.so", "ictus/clips/ictus-clips.wav", "ictus/README.md",
              "ictus/LICENSE", "ictus/ictusd"}
+# The references beside the help patches: every page of docs/ as Markdown and HTML,
+# and its figures.
+doc_pages = [os.path.basename(p)[:-3] for p in glob.glob(os.path.join(REPO, "docs", "*.md"))]
+expected |= {"ictus/docs/%s.%s" % (n, ext) for n in doc_pages for ext in ("md", "html")}
+expected |= {"ictus/docs/img/" + os.path.basename(p)
+             for p in glob.glob(os.path.join(REPO, "docs", "img", "*.png"))}
 with zipfile.ZipFile(dek) as z:
     infos = z.infolist()
     names = {i.filename for i in infos if not i.is_dir()}
@@ -102,6 +112,53 @@ proc = subprocess.run([os.path.join(lib, "ictusd"), "--version"], capture_output
                       timeout=60)
 check(proc.returncode == 0 and proc.stdout == "ictusd %s\n" % version,
       "the packaged ictusd --version prints 'ictusd %s': %r" % (version, proc.stdout + proc.stderr))
+
+# The references the patches point at ("docs/NAME.md", relative to the patch's
+# folder) are there, as Markdown and as HTML whose links stay in the package.
+pointed = set()
+for p in glob.glob(os.path.join(lib, "*.pd")):
+    pointed |= set(re.findall(r"docs/([a-z0-9_-]+)\.md", open(p).read()))
+check({"score", "osc", "midi", "ui", "pd-osc", "sound"} <= pointed,
+      "the patches point at the score, OSC, MIDI, main patch (ui), pd-osc and sound references: "
+      "%s" % sorted(pointed))
+for n in sorted(pointed):
+    check(all(os.path.isfile(os.path.join(lib, "docs", "%s.%s" % (n, e))) for e in ("md", "html")),
+          "docs/%s.md and docs/%s.html are beside the help patches" % (n, n))
+score_html = open(os.path.join(lib, "docs", "score.html")).read()
+check("<h1" in score_html and "<code>tempo" in score_html and "score.md" in score_html,
+      "docs/score.html is the score language's reference as HTML, naming its Markdown")
+for page in glob.glob(os.path.join(lib, "docs", "*.html")):
+    for target in re.findall(r'(?:href|src)="([^"#:]+)(?:#[^"]*)?"', open(page).read()):
+        check(os.path.isfile(os.path.join(lib, "docs", target)),
+              "%s links to %s, which is in the package" % (os.path.basename(page), target))
+
+# The packaged ictusd renders a WAV from an empty folder with no flag naming the
+# library: it finds the folder it is in (and Pd on PATH).
+def render_wav(ictusd, what):
+    folder = make_workdir("ictus-deken-score-")
+    with open(os.path.join(folder, "s.txt"), "w") as f:
+        f.write("tempo 120\nbeats 1/2\ndynamics mf\nR, L, R, L\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("ICTUS_")}
+    proc = subprocess.run([ictusd, "render", "--score", "s.txt", "--out", "o", "--wav", "o/p.wav"],
+                          cwd=folder, capture_output=True, text=True, timeout=300, env=env)
+    wav = os.path.join(folder, "o", "p.wav")
+    check(proc.returncode == 0 and os.path.isfile(wav),
+          "%s: ictusd render --score S --out O --wav O/p.wav, with no library flag, writes the "
+          "WAV: %s" % (what, (proc.stdout + proc.stderr)[-1500:]))
+    if not os.path.isfile(wav):
+        return
+    first = min(float(row.split(",")[5]) for row in
+                open(os.path.join(folder, "o", "strikes.csv")).read().splitlines()[1:])
+    sound, rate = read_wav_float(wav)
+    level = np.abs(sound).max(axis=1)
+    onset = int(np.argmax(level > 1e-3 * level.max())) / rate
+    check(np.all(np.isfinite(sound)) and level.max() > 1e-3 and abs(onset - first) < 0.002,
+          "%s: the WAV sounds from the first strike (%.4f s): peak %.3g, first sample over "
+          "-60 dB at %.4f s" % (what, first, level.max(), onset))
+    shutil.rmtree(folder, ignore_errors=True)
+
+
+render_wav(os.path.join(lib, "ictusd"), "package")
 
 # Pd with this folder only: no preferences, no standard path; Gem's folder for
 # the Gem view (it needs Gem, a library of its own).
@@ -152,7 +209,6 @@ check(proc.returncode == 0 and not error_lines(log) and os.path.isfile(wav),
 samples, wav_sr = read_wav_float(wav)
 check(wav_sr == sr and samples.shape == (int(0.5 * sr), 2),
       "the WAV is 0.5 s of 2 channels at %d Hz: %s at %d" % (sr, samples.shape, wav_sr))
-import numpy as np  # noqa: E402 (Debian's, as pdrun)
 mono = np.abs(samples).max(axis=1)
 peak = float(mono.max())
 check(np.all(np.isfinite(samples)) and peak > 1e-3, "the WAV has sound (peak %.4g)" % peak)
@@ -176,5 +232,6 @@ check(installed == names - {"ictus/ictusd"},
 check(os.access(os.path.join(prefix, "bin", "ictusd"), os.X_OK), "and ictusd in bin/")
 check_relocatable(installed_lib, "install")
 check(not runpaths(os.path.join(prefix, "bin", "ictusd")), "the installed ictusd has no RUNPATH")
+render_wav(os.path.join(prefix, "bin", "ictusd"), "install")
 shutil.rmtree(prefix, ignore_errors=True)
 print("ok: all")

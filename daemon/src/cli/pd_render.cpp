@@ -88,7 +88,11 @@ std::string find_pd_library(const std::string &given)
     }
     const std::string self = self_dir();
     std::vector<fs::path> tried;
+    // The layouts ictusd ships in: inside the library folder (the deken
+    // package), beside it (the build folder), or in <prefix>/bin with the
+    // library in <prefix>/lib/pd-externals/ictus (cmake --install).
     if (!self.empty()) {
+        tried.push_back(fs::path(self));
         tried.push_back(fs::path(self) / "ictus");
         tried.push_back(fs::path(self) / ".." / "lib" / "pd-externals" / "ictus");
     }
@@ -101,7 +105,8 @@ std::string find_pd_library(const std::string &given)
     throw std::runtime_error(
         "--wav: the Pd library (ictus-render.pd and the externals) is not in " +
         (list.empty() ? std::string("ictusd's folder") : list) +
-        ": build it (cmake --build build) or give --pd-lib DIR");
+        ": unpack the whole deken package, build the library (cmake --build build) or give "
+        "--pd-lib DIR");
 }
 
 std::string find_pd_binary(const std::string &pd)
