@@ -204,7 +204,7 @@ TEST_CASE("ictusd render: SIGINT, SIGTERM or SIGHUP while simulating: exit 130, 
     }
 }
 
-TEST_CASE("ictusd render --wav: a signal in Pd's phase stops pd, exit 130, no WAV; pd dies with "
+TEST_CASE("ictusd render --wav: a signal in the Pd phase stops pd with exit 130 and no WAV and pd dies with "
           "a killed ictusd",
           "[cli][signals]")
 {
