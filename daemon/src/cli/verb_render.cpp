@@ -787,8 +787,15 @@ int render_wav(RenderArgs &r, const Performance &perf)
             std::fprintf(stderr, "render: pd still rendering (%.0f s)\n", s);
     });
     if (result.interrupted) {
-        std::cerr << "ictusd render: interrupted: pd stopped, no " << r.wav << " (log: " << pd.log
-                  << ")\n";
+        // pd stopped before it said anything: an empty log is no output
+        std::error_code ec;
+        if (std::filesystem::exists(pd.log, ec) && std::filesystem::file_size(pd.log, ec) == 0 && !ec) {
+            std::filesystem::remove(pd.log, ec);
+            std::cerr << "ictusd render: interrupted: pd stopped, no " << r.wav << "\n";
+        } else {
+            std::cerr << "ictusd render: interrupted: pd stopped, no " << r.wav << " (log: "
+                      << pd.log << ")\n";
+        }
         return 130;
     }
     if (!result.errors.empty()) {
