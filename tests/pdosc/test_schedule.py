@@ -86,11 +86,21 @@ def main():
                        ("127.0.0.1", pd_port))
             if k % 50 == 49:
                 time.sleep(0.01)
-        time.sleep(0.3)  # let the last packets land before asking (the answer is counted)
-        out.sendto(b"status;\n", ("127.0.0.1", fudi_port))
-        records = wait_records(reports, lambda r: any(a[:2] == ["info", "status"] for _, a in r)
-                               and any(a[:2] == ["info", "refused"] for _, a in r),
-                               "status and refused reports")
+        # Handshake: ask for the status until two answers running report the same packet
+        # count (every packet that reached pd has been through the schedule), with a deadline.
+        asked, last, t_end = 0, None, time.time() + 30.0
+        while time.time() < t_end:
+            out.sendto(b"status;\n", ("127.0.0.1", fudi_port))
+            asked += 1
+            records = wait_records(reports, lambda r: sum(a[:2] == ["info", "status"]
+                                                          for _, a in r) >= asked,
+                                   "status answer %d" % asked)
+            packets = int([a for _, a in records if a[:2] == ["info", "status"]][-1][5])
+            if packets == last:
+                break
+            last = packets
+        records = wait_records(reports, lambda r: any(a[:2] == ["info", "refused"] for _, a in r),
+                               "the refused report")
     finally:
         out.close()
         proc.kill()
