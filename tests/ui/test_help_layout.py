@@ -98,7 +98,6 @@ check(pdlayout.segment_hits(0, 0, 10, 10, (4, 5, 2, 2)) and
 # The main patch's window is being resized on another branch.
 LAYOUT_KNOWN_EXCEPTIONS = {
     "patches/ictus.pd", "help/contact~-help.pd",
-   
     "help/ictus-sound-help.pd",
     "help/ictus-sound-modal-help.pd", "help/ictus-sound-panel-help.pd",
     "help/ictus-sound-synth-help.pd", "help/ictus-view-help.pd",
