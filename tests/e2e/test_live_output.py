@@ -20,7 +20,7 @@ import tempfile
 
 import numpy as np
 
-from ictus_tools import uitest
+from ictus_tools import e2e_util, uitest
 from ictus_tools.checks import check
 from ictus_tools.pdrun import read_wav_float
 
@@ -113,7 +113,8 @@ def main():
     work = tempfile.mkdtemp(prefix="ictus-live-output-")
     render_dir = os.path.join(work, "render")
     render = subprocess.run([ictusd, "render", "--out", render_dir, "--wav",
-                             os.path.join(render_dir, "p.wav")], env=env,
+                             os.path.join(render_dir, "p.wav")],
+                            env=e2e_util.pd_spawning_env(work),
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             timeout=600)
     check(render.returncode == 0, "ictusd render --wav of the default score: %s"

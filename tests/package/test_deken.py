@@ -24,7 +24,7 @@ import zipfile
 import numpy as np  # Debian's, as pdrun
 
 from ictus_tools import ROOT as REPO
-from ictus_tools import pdrun
+from ictus_tools import e2e_util, pdrun
 from ictus_tools.checks import check
 from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float
 
@@ -138,7 +138,10 @@ def render_wav(ictusd, what):
     folder = make_workdir("ictus-deken-score-")
     with open(os.path.join(folder, "s.txt"), "w") as f:
         f.write("tempo 120\nbeats 1/2\ndynamics mf\nR, L, R, L\n")
-    env = {k: v for k, v in os.environ.items() if not k.startswith("ICTUS_")}
+    # pd from PATH (under the sanitizer build a wrapper, outside the folder, preloads its
+    # runtime into pd); no ICTUS_ variable names the library
+    spawn = e2e_util.pd_spawning_env(make_workdir("ictus-deken-pd-"))
+    env = {k: v for k, v in spawn.items() if not k.startswith("ICTUS_")}
     proc = subprocess.run([ictusd, "render", "--score", "s.txt", "--out", "o", "--wav", "o/p.wav"],
                           cwd=folder, capture_output=True, text=True, timeout=300, env=env)
     wav = os.path.join(folder, "o", "p.wav")

@@ -20,7 +20,7 @@ import os
 import numpy as np
 
 from ictus_tools.checks import check
-from ictus_tools.pdrun import (Patch, error_lines, make_workdir, read_wav_float,
+from ictus_tools.pdrun import (PD_ENV, Patch, error_lines, make_workdir, read_wav_float,
                                recorder, run_pd)
 
 ap = argparse.ArgumentParser()
@@ -138,7 +138,7 @@ for zone in (0, 1):
                         str(sr), "-path", lib, "-open", os.path.join(lib, "ictus-render.pd"),
                         "-send", "render-file " + ev, "-send", "render-out " + out,
                         "-send", "render-seconds 1", "-send", "render-mix pickups"],
-                       capture_output=True, text=True, timeout=120)
+                       capture_output=True, text=True, timeout=120, env=PD_ENV)
     check(r.returncode == 0 and "error" not in r.stderr.lower(),
           "ictus-render, zone %d: %s" % (zone, r.stderr.strip()[-200:]))
     render[zone] = read_wav_float(out)[0][:, 0].astype(np.float64)
