@@ -173,3 +173,34 @@ def pose_bundle(time_s, head_quat=IDENTITY):
         msgs.append(oscpacket.message("/ictus/pose/stick", "iffffff", hand, *tip, *butt))
     msgs.append(oscpacket.message("/ictus/pose/drum", "iffff", 0, *DRUM[0], DRUM[1]))
     return oscpacket.bundle(b"\0\0\0\0\0\0\0\1", *msgs)
+
+
+def top_level_boxes(records):
+    """Each box of a patch's top level (its records, split at the unescaped ';\n'), in Pd's
+    numbering, the one '#X connect' uses: (index, kind, words); a subpatch counts as one box
+    (kind 'restore')."""
+    depth, n, boxes = 0, 0, []
+    for r in records:
+        if r.startswith("#N canvas"):
+            depth += 1
+        elif r.startswith("#X restore"):
+            depth -= 1
+            if depth == 1:
+                boxes.append((n, "restore", r.split()))
+                n += 1
+        elif depth == 1 and r.split()[1] in ("obj", "msg", "text", "floatatom", "symbolatom",
+                                             "listbox"):
+            words = r.split()
+            boxes.append((n, words[1], words))
+            n += 1
+    return boxes
+
+
+def top_level_index(records):
+    """The number of top-level boxes, and the index of each object class's first box."""
+    boxes = top_level_boxes(records)
+    index = {}
+    for n, kind, words in boxes:
+        if kind == "obj" and len(words) > 4:
+            index.setdefault(words[4], n)
+    return len(boxes), index

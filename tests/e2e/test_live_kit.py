@@ -65,20 +65,7 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav):
     main = main.replace("ictus-receive 9000;", "ictus-receive %d;" % pd_port)
     main = main.replace("connect 127.0.0.1 9001;", "connect 127.0.0.1 %d;" % daemon_port)
     records = [r for r in main.split(";\n") if r.strip()]
-    depth, n, index = 0, 0, {}
-    for r in records:
-        if r.startswith("#N canvas"):
-            depth += 1
-        elif r.startswith("#X restore"):
-            depth -= 1
-            if depth == 1:
-                n += 1
-        elif depth == 1 and r.split()[1] in ("obj", "msg", "text", "floatatom", "symbolatom",
-                                             "listbox"):
-            words = r.split()
-            if words[1] == "obj" and len(words) > 4:
-                index.setdefault(words[4], n)
-            n += 1
+    n, index = uitest.top_level_index(records)
     for name in ("ictus-receive", "ictus-kit", "ictus-sound"):
         check(name in index, "the main patch has [%s]" % name)
     extra = ["#X obj 20 1000 loadbang",                                     # 0

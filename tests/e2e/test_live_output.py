@@ -29,25 +29,6 @@ PEAK_DBFS, CHANNELS_DB, LEVEL_DB = -0.3, 1.5, 2.0  # the acceptance's bounds
 SOUNDING = 1e-3  # a sample louder than this (-60 dBFS) belongs to the sounding part
 
 
-def top_level_index(records):
-    """The top-level object index of each object's class name (its first occurrence)."""
-    depth, n, index = 0, 0, {}
-    for r in records:
-        if r.startswith("#N canvas"):
-            depth += 1
-        elif r.startswith("#X restore"):
-            depth -= 1
-            if depth == 1:
-                n += 1
-        elif depth == 1 and r.split()[1] in ("obj", "msg", "text", "floatatom", "symbolatom",
-                                             "listbox"):
-            words = r.split()
-            if words[1] == "obj" and len(words) > 4:
-                index.setdefault(words[4], n)
-            n += 1
-    return n, index
-
-
 def test_patch(build, pd_port, daemon_port, ctl_port, wav, seconds):
     """The main patch as built, on the test's ports, with at its end: a FUDI port (play;
     finish;), the recording of ictus-out~'s two outlets (what dac~ plays) from play on."""
@@ -57,7 +38,7 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav, seconds):
     main = main.replace("ictus-receive 9000;", "ictus-receive %d;" % pd_port)
     main = main.replace("connect 127.0.0.1 9001;", "connect 127.0.0.1 %d;" % daemon_port)
     records = [r for r in main.split(";\n") if r.strip()]
-    n, index = top_level_index(records)
+    n, index = uitest.top_level_index(records)
     for name in ("ictus-receive", "ictus-out~", "dac~"):
         check(name in index, "the main patch has [%s]" % name)
     out = index["ictus-out~"]

@@ -124,24 +124,13 @@ check("ictus-receive 9000;" in main and "connect 127.0.0.1 9001;" in main,
 main = main.replace("ictus-receive 9000;", "ictus-receive %d;" % pd_port)
 main = main.replace("connect 127.0.0.1 9001;", "connect 127.0.0.1 %d;" % daemon_port)
 records = [r for r in re.split(r"(?<!\\);\n", main) if r.strip()]
-depth, index = 0, {}
-n = 0
-for r in records:
-    if r.startswith("#N canvas"):
-        depth += 1
-    elif r.startswith("#X restore"):
-        depth -= 1
-        if depth == 1:
-            n += 1
-    elif depth == 1 and re.match(r"#X (obj|msg|text|floatatom|symbolatom|listbox) ", r):
-        words = r.split()
-        if words[1] == "obj" and words[4] in ("ictus-physics", "ictus-status",
-                                              "ictus-sound-panel"):
-            index[words[4]] = n
-        if words[1] == "msg":
-            index.setdefault("boxes", []).append(
-                (n, re.sub(r", f \d+$", "", " ".join(words[4:]))))
-        n += 1
+boxes = uitest.top_level_boxes(records)
+index = {}
+for n, kind, words in boxes:
+    if kind == "obj" and words[4] in ("ictus-physics", "ictus-status", "ictus-sound-panel"):
+        index[words[4]] = n
+    if kind == "msg":
+        index.setdefault("boxes", []).append((n, re.sub(r", f \d+$", "", " ".join(words[4:]))))
 check("ictus-physics" in index and "ictus-status" in index and "ictus-sound-panel" in index
       and len(index["boxes"]) >= 4,
       "the main patch has the physics and daemon panels and score boxes")
@@ -157,7 +146,7 @@ extra = ["#X obj 20 1000 netreceive -u %d" % ctl_port, "#X obj 20 1030 list",
          "#X obj 600 1000 print state", "#X obj 20 1120 list trim"]
 conns = [(0, 0, 1, 0), (1, 0, 2, 0), (2, 1, 3, 0), (3, 0, 4, 0), (4, 0, 6, 1), (2, 0, 5, 0),
          (5, 1, 9, 0), (9, 0, 6, 0)]
-base = n
+base = len(boxes)
 for k, (i, _) in enumerate(score_boxes):
     extra.append("#X obj %d 1200 r test-box-%d" % (20 + 120 * k, i))  # base + 10 + k
 extra.append("#X obj 20 1250 r test-sound")
