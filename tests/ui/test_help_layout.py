@@ -99,8 +99,7 @@ check(pdlayout.segment_hits(0, 0, 10, 10, (4, 5, 2, 2)) and
 LAYOUT_KNOWN_EXCEPTIONS = {
     "patches/ictus.pd", "help/contact~-help.pd", "help/ictus-drum-help.pd",
     "help/ictus-midi-help.pd", "help/ictus-physics-help.pd", "help/ictus-receive-help.pd",
-    "help/ictus-sound-clips-help.pd",
-    "help/ictus-sound-panel-help.pd", "help/ictus-status-help.pd"}
+    "help/ictus-sound-clips-help.pd", "help/ictus-status-help.pd"}
 read = sorted(glob.glob(os.path.join(REPO, "help", "*.pd"))) + [
     os.path.join(REPO, "patches", "ictus.pd")]
 for path in read:
