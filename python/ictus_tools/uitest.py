@@ -204,3 +204,15 @@ def top_level_index(records):
         if kind == "obj" and len(words) > 4:
             index.setdefault(words[4], n)
     return len(boxes), index
+
+
+def main_patch_on_ports(build, pd_port, daemon_port):
+    """The main patch as built (its text and its records), listening on pd_port and sending
+    to daemon_port instead of 9000 / 9001, checked to have those two first."""
+    from ictus_tools.checks import check
+    main = open(os.path.join(build, "patches", "ictus.pd")).read()
+    check("ictus-receive 9000;" in main and "connect 127.0.0.1 9001;" in main,
+          "the main patch listens on 9000 and sends to 9001")
+    main = main.replace("ictus-receive 9000;", "ictus-receive %d;" % pd_port)
+    main = main.replace("connect 127.0.0.1 9001;", "connect 127.0.0.1 %d;" % daemon_port)
+    return main, [r for r in main.split(";\n") if r.strip()]

@@ -59,12 +59,7 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav):
     """The main patch as built, listening on pd_port, sending to daemon_port, with what the
     test adds at its end: a FUDI port (play; finish;), the recording of the dac~'s two inputs
     from the play message on, each strike's logical time since then, and prints of the kit."""
-    main = open(os.path.join(build, "patches", "ictus.pd")).read()
-    check("ictus-receive 9000;" in main and "connect 127.0.0.1 9001;" in main,
-          "the main patch listens on 9000 and sends to 9001")
-    main = main.replace("ictus-receive 9000;", "ictus-receive %d;" % pd_port)
-    main = main.replace("connect 127.0.0.1 9001;", "connect 127.0.0.1 %d;" % daemon_port)
-    records = [r for r in main.split(";\n") if r.strip()]
+    main, records = uitest.main_patch_on_ports(build, pd_port, daemon_port)
     n, index = uitest.top_level_index(records)
     for name in ("ictus-receive", "ictus-kit", "ictus-sound"):
         check(name in index, "the main patch has [%s]" % name)

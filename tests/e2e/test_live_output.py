@@ -32,12 +32,7 @@ SOUNDING = 1e-3  # a sample louder than this (-60 dBFS) belongs to the sounding 
 def test_patch(build, pd_port, daemon_port, ctl_port, wav, seconds):
     """The main patch as built, on the test's ports, with at its end: a FUDI port (play;
     finish;), the recording of ictus-out~'s two outlets (what dac~ plays) from play on."""
-    main = open(os.path.join(build, "patches", "ictus.pd")).read()
-    check("ictus-receive 9000;" in main and "connect 127.0.0.1 9001;" in main,
-          "the main patch listens on 9000 and sends to 9001")
-    main = main.replace("ictus-receive 9000;", "ictus-receive %d;" % pd_port)
-    main = main.replace("connect 127.0.0.1 9001;", "connect 127.0.0.1 %d;" % daemon_port)
-    records = [r for r in main.split(";\n") if r.strip()]
+    main, records = uitest.main_patch_on_ports(build, pd_port, daemon_port)
     n, index = uitest.top_level_index(records)
     for name in ("ictus-receive", "ictus-out~", "dac~"):
         check(name in index, "the main patch has [%s]" % name)
