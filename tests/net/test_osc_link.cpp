@@ -334,10 +334,14 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
         args.insert(args.begin(), {"oscsend", "127.0.0.1", port});
         REQUIRE(osctest::run(args) == 0);
     };
+    // The physics thread's part: take the next command and confirm it (the
+    // server replies once the physics took it).
     auto pop = [&](ictus::Command &c) {
         for (int i = 0; i < 200; ++i) {
-            if (server.pop_command(c))
+            if (server.pop_command(c)) {
+                server.post_accepted(c);
                 return true;
+            }
             std::this_thread::sleep_for(5ms);
         }
         return false;
@@ -435,10 +439,14 @@ TEST_CASE("osc in: score statements, score clear and the cartesian mode pass thr
         args.insert(args.begin(), {"oscsend", "127.0.0.1", port});
         REQUIRE(osctest::run(args) == 0);
     };
+    // The physics thread's part: take the next command and confirm it (the
+    // server replies once the physics took it).
     auto pop = [&](ictus::Command &c) {
         for (int i = 0; i < 200; ++i) {
-            if (server.pop_command(c))
+            if (server.pop_command(c)) {
+                server.post_accepted(c);
                 return true;
+            }
             std::this_thread::sleep_for(5ms);
         }
         return false;

@@ -83,6 +83,24 @@ struct LiveDaemon {
             }
         return false;
     }
+    // The first verdict on `address`: "reply" or "error" (why: the error's
+    // reason), "" at the deadline.
+    std::string verdict_for(const std::string &address, std::string &why, double seconds = 20.0)
+    {
+        const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+        Peer::Message m;
+        while (Clock::now() < deadline) {
+            if (!client.receive(m, 100) || m.strings.empty() || m.strings[0] != address)
+                continue;
+            if (m.path == "/ictus/reply")
+                return "reply";
+            if (m.path == "/ictus/error" && m.strings.size() == 2) {
+                why = m.strings[1];
+                return "error";
+            }
+        }
+        return "";
+    }
     bool pong_within(double seconds) { return ping_until_pong(client, port, seconds); }
     // Polls /ictus/status until it says playing, or false at the deadline.
     bool status_playing(double seconds)
@@ -234,15 +252,28 @@ TEST_CASE("run: refusals of the physics thread and of the planner reach the clie
     lo_message_add_float(g, 4.0f);
     lo_message_add_float(g, 0.05f);
     d.client.send(d.port, "/ictus/gains", g);
-    REQUIRE(d.error_for("/ictus/gains", why));
+    // The verdict is the error alone: no /ictus/reply comes before it.
+    REQUIRE(d.verdict_for("/ictus/gains", why) == "error");
     CHECK(why.find("unstable") != std::string::npos);
-    // A score one hand cannot play (refused by the planner, in the background).
+    // Gains within the bounds: the reply, echoing them.
+    g = lo_message_new();
+    lo_message_add_float(g, 1.5f);
+    lo_message_add_float(g, 1.0f);
+    d.client.send(d.port, "/ictus/gains", g);
+    CHECK(d.verdict_for("/ictus/gains", why) == "reply");
+    // A score one hand cannot play (refused by the planner, in the
+    // background): the play's verdict waits for it, an error and no reply.
     d.client.send(d.port, "/ictus/score/clear", lo_message_new());
     d.client.send(d.port, "/ictus/score", strings({"tempo 400"}));
     d.client.send(d.port, "/ictus/score", strings({"R 1/4, R 1/4, R 1/4"}));
     d.client.send(d.port, "/ictus/play", lo_message_new());
-    REQUIRE(d.error_for("/ictus/play", why));
+    REQUIRE(d.verdict_for("/ictus/play", why) == "error");
     CHECK(why.find("line") != std::string::npos);
+    // A score it can play: the play's reply once its plan is installed.
+    d.client.send(d.port, "/ictus/score/clear", lo_message_new());
+    d.client.send(d.port, "/ictus/score", strings({"tempo 100, R, L"}));
+    d.client.send(d.port, "/ictus/play", lo_message_new());
+    CHECK(d.verdict_for("/ictus/play", why) == "reply");
     // A statement the parser refuses names its column.
     d.client.send(d.port, "/ictus/score", strings({"R lgato"}));
     REQUIRE(d.error_for("/ictus/score", why));

@@ -225,6 +225,7 @@ class OscIo : public RealtimeIo
             sender_.send_kit();
         return true;
     }
+    void accepted(const Command &command) override { server_.post_accepted(command); }
     void refused(const Refusal &refusal) override { server_.post_refusal(refusal); }
     void log(const char *line) override { log_.post(line); }
     void strike_onset(const StrikeEvent &strike) override { sender_.post_strike(strike); }

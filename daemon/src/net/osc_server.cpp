@@ -53,7 +53,8 @@ const char *lo_arg_string(const lo_arg *a)
 struct Counters {
     std::atomic<unsigned long> packets{0}, accepted{0}, unknown_address{0}, bad_type_tags{0},
         bad_values{0}, malformed{0}, oversized{0}, refused_peers{0}, bundles{0}, queue_full{0},
-        replies{0}, errors_sent{0}, errors_unanswered{0}, score_lines{0}, refused_commands{0};
+        replies{0}, errors_sent{0}, errors_unanswered{0}, score_lines{0}, refused_commands{0},
+        replies_dropped{0};
 };
 
 // The error-reply budget (osc_server.hpp): a token bucket per address the
@@ -131,6 +132,7 @@ OscServerCounters snapshot(const Counters &c)
     o.errors_unanswered = c.errors_unanswered;
     o.score_lines = c.score_lines;
     o.refused_commands = c.refused_commands;
+    o.replies_dropped = c.replies_dropped;
     return o;
 }
 
@@ -265,7 +267,7 @@ void OscServer::loop()
     pollfd pfd{impl_->fd, POLLIN, 0};
     while (running_.load()) {
         // A short poll so that stop() is seen within 50 ms.
-        send_refusals();
+        send_verdicts();
         if (poll(&pfd, 1, 20) <= 0)
             continue;
         sockaddr_in peer{};
@@ -486,7 +488,10 @@ std::string read_arguments(const Request &r, const CommandSpec &s, Command &cmd)
     return "";
 }
 
-// A command: checked, queued for the physics thread, echoed in /ictus/reply.
+// A command: checked and queued for the physics thread, which answers with
+// its verdict: /ictus/reply once it took the command (send_verdicts), or
+// /ictus/error. Nothing is replied here, so a command the physics refuses
+// never gets a reply before its error.
 void handle_command(const Request &r, const CommandSpec &s)
 {
     Counters &c = r.counters;
@@ -495,6 +500,7 @@ void handle_command(const Request &r, const CommandSpec &s)
     cmd.peer_ipv4 = r.peer.sin_addr.s_addr;
     cmd.peer_port = r.peer.sin_port;
     std::snprintf(cmd.address, sizeof cmd.address, "%s", r.path);
+    std::snprintf(cmd.types, sizeof cmd.types, "%s", r.types); // the method's: at most "ff"
     const std::string problem = read_arguments(r, s, cmd);
     if (!problem.empty()) {
         c.bad_values++;
@@ -509,14 +515,21 @@ void handle_command(const Request &r, const CommandSpec &s)
     c.accepted++;
     if (s.kind == CommandKind::score)
         c.score_lines++;
+}
+
+// The echo of a command the physics took: its arguments as they came.
+lo_message echo_of(const Command &cmd)
+{
     lo_message echo = lo_message_new();
-    for (int i = 0; r.types[i]; ++i) {
-        if (r.types[i] == 'f')
-            lo_message_add_float(echo, lo_arg_float(r.argv[i]));
-        else if (r.types[i] == 's')
-            lo_message_add_string(echo, lo_arg_string(r.argv[i]));
+    const double floats[2] = {cmd.value, cmd.value2};
+    int f = 0;
+    for (int i = 0; i < static_cast<int>(sizeof cmd.types) && cmd.types[i]; ++i) {
+        if (cmd.types[i] == 'f' && f < 2)
+            lo_message_add_float(echo, static_cast<float>(floats[f++]));
+        else if (cmd.types[i] == 's')
+            lo_message_add_string(echo, cmd.text);
     }
-    r.reply.ok(r.path, echo);
+    return echo;
 }
 
 // One method a line (clang-format would break the rows).
@@ -576,9 +589,28 @@ void dispatch(const Request &r)
 
 } // namespace
 
-void OscServer::send_refusals()
+void OscServer::post_accepted(const Command &command)
+{
+    if (command.peer_port == 0)
+        return; // the daemon's own command: nobody to answer
+    if (!confirmations_.push(command))
+        impl_->counters.replies_dropped++;
+}
+
+void OscServer::send_verdicts()
 {
     Impl &im = *impl_;
+    for (Command cmd; confirmations_.pop(cmd);) {
+        sockaddr_in to{};
+        to.sin_family = AF_INET;
+        to.sin_addr.s_addr = cmd.peer_ipv4;
+        to.sin_port = cmd.peer_port;
+        if (im.reply_fixed)
+            to = im.reply_to;
+        Reply reply{im.fd, &to, &im.counters, &im.error_budget};
+        const std::string address(cmd.address, strnlen(cmd.address, sizeof cmd.address));
+        reply.ok(address.c_str(), echo_of(cmd));
+    }
     Refusal f;
     while (refusals_.pop(f)) {
         im.counters.refused_commands++; // an error, answered or not

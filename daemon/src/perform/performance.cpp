@@ -318,6 +318,7 @@ int Performance::guard_runaway(int k, StrikeEvent out[2])
 
 bool Performance::apply(const Command &c, std::string *why)
 {
+    deferred_ = false;
     try {
         switch (c.kind) {
         case CommandKind::play:
@@ -525,6 +526,7 @@ bool Performance::submit(std::unique_ptr<Work> job, std::string *why)
     }
     if (!worker_->submit(std::move(job)))
         return refuse(why, "busy: 64 changes are waiting to be planned; send fewer");
+    deferred_ = true;
     return true;
 }
 
@@ -551,6 +553,11 @@ void Performance::take_results()
         std::string why;
         if (!install(std::move(r), &why))
             refuse_later(origin, why);
+        else if (origin.peer_port != 0) {
+            if (confirmations_.size() >= 64)
+                confirmations_.erase(confirmations_.begin()); // nobody reads them
+            confirmations_.push_back(origin);
+        }
     }
 }
 
@@ -564,6 +571,15 @@ void Performance::refuse_later(const Command &origin, const std::string &why)
     std::snprintf(f.address, sizeof f.address, "%s", origin.address);
     std::snprintf(f.why, sizeof f.why, "%s", why.c_str());
     refusals_.push_back(f);
+}
+
+bool Performance::pop_confirmation(Command &out)
+{
+    if (confirmations_.empty())
+        return false;
+    out = confirmations_.front();
+    confirmations_.erase(confirmations_.begin());
+    return true;
 }
 
 bool Performance::pop_refusal(Refusal &out)

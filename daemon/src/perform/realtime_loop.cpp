@@ -60,6 +60,8 @@ class LoopStep
         // runaway guard) reach the client too.
         for (Refusal f; perf_.pop_refusal(f);)
             refuse(io_, f.peer_ipv4, f.peer_port, f.address, f.why);
+        for (Command c; perf_.pop_confirmation(c);)
+            io_.accepted(c);
         send_strikes(k);
         if (pose_every_ && n % pose_every_ == 0) {
             PoseSnapshot p;
@@ -103,6 +105,8 @@ class LoopStep
             std::string why;
             if (!perf_.apply(c, &why))
                 refuse(io_, c.peer_ipv4, c.peer_port, c.address, why.c_str());
+            else if (!perf_.deferred()) // else its verdict comes with the work's result
+                io_.accepted(c);
         }
     }
 

@@ -49,6 +49,9 @@ struct OscServerCounters {
     // Commands accepted here and refused by the physics (a gains past the
     // stability bounds, a play of a score that cannot be planned ...).
     unsigned long refused_commands = 0;
+    // Commands taken by the physics whose /ictus/reply was not sent: the
+    // confirmation queue was full (a flood faster than the server drains it).
+    unsigned long replies_dropped = 0;
     unsigned long errors() const
     {
         return unknown_address + bad_type_tags + bad_values + malformed + oversized + bundles +
@@ -74,6 +77,11 @@ class OscServer
     // from), within the error-reply budget. Producer: one thread (the
     // physics thread); lock-free, false when the queue is full.
     bool post_refusal(const Refusal &refusal) { return refusals_.push(refusal); }
+    // A command the physics thread took: the server's thread answers its
+    // peer with /ictus/reply <address> <arguments> (a command with no peer,
+    // the daemon's own, is not answered). Same producer as post_refusal;
+    // lock-free; a full queue drops the reply and counts it.
+    void post_accepted(const Command &command);
     OscServerCounters counters() const;
     void stop();
 
@@ -88,7 +96,8 @@ class OscServer
     std::atomic<bool> running_{true};
     SpscQueue<Command, 256> commands_;
     SpscQueue<Refusal, 64> refusals_;
-    void send_refusals();
+    SpscQueue<Command, 512> confirmations_;
+    void send_verdicts();
     std::thread thread_;
 
   public:

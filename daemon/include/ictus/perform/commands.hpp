@@ -64,6 +64,9 @@ struct Command {
     std::uint32_t peer_ipv4 = 0;
     std::uint16_t peer_port = 0;
     char address[32] = {};
+    // The type tags it came with ("f", "ff", "s" or ""), for the echo in
+    // /ictus/reply once the physics thread has taken it.
+    char types[4] = {};
 };
 
 // A refusal on its way back to the client (see Command's peer fields).

@@ -210,6 +210,12 @@ class Performance
     // the background, the runaway guard), oldest first, each naming the
     // command's peer and address (Command's peer fields).
     bool pop_refusal(Refusal &out);
+    // Whether the last apply() handed its command to the worker: its verdict
+    // comes later, as a refusal or as a confirmation (pop_confirmation).
+    bool deferred() const { return deferred_; }
+    // Commands whose background work was installed (or cancelled by a stop),
+    // oldest first: the sender's /ictus/reply waits for this.
+    bool pop_confirmation(Command &out);
 
     // The runaway guard (docs/perform.md): a stick tip faster than this is
     // no human stroke but a controller gone unstable (the built-in strokes
@@ -289,6 +295,8 @@ class Performance
     bool playing_ = true;
     std::unique_ptr<PlanningWorker> worker_;
     std::vector<Refusal> refusals_; // oldest first
+    std::vector<Command> confirmations_; // oldest first
+    bool deferred_ = false;              // apply() handed its command to the worker
     Command last_gains_;            // the origin a runaway is reported to
     long runaways_ = 0;
     double quiet_until_s_ = -1.0; // no strike with an onset before this time (runaway)

@@ -22,6 +22,9 @@ class RealtimeIo
     virtual ~RealtimeIo() = default;
     // The next command received, false when none waits.
     virtual bool next_command(Command &out) = 0;
+    // A command the performance took, for its sender's /ictus/reply: the
+    // reply comes after the physics thread's verdict, never before a refusal.
+    virtual void accepted(const Command &command) = 0;
     // A refusal of a command (at once, or found later), for its sender
     // (the loop has logged it too).
     virtual void refused(const Refusal &refusal) = 0;
