@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -185,6 +186,38 @@ const char *signal_name(int s)
     return s == SIGINT ? "SIGINT" : s == SIGTERM ? "SIGTERM" : "SIGHUP";
 }
 
+// The write end of the FIFO `path`, opened once a reader (ictusd loading its
+// input) has opened it: the handshake that the process is in its loading
+// phase. -1 past 30 s.
+int open_fifo_writer(const std::string &path)
+{
+    const auto t0 = std::chrono::steady_clock::now();
+    while (since(t0) < 30.0) {
+        const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK);
+        if (fd >= 0) {
+            ::fcntl(fd, F_SETFL, 0); // blocking writes from here on
+            return fd;
+        }
+        pollfd none{-1, 0, 0};
+        ::poll(&none, 0, 20);
+    }
+    return -1;
+}
+
+// Writes all of `text` to `fd` and closes it.
+bool write_all_and_close(int fd, const std::string &text)
+{
+    std::size_t done = 0;
+    while (done < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+        if (n <= 0)
+            break;
+        done += static_cast<std::size_t>(n);
+    }
+    ::close(fd);
+    return done == text.size();
+}
+
 } // namespace
 
 TEST_CASE("ictusd render: SIGINT, SIGTERM or SIGHUP while simulating: exit 130, whole files",
@@ -266,22 +299,63 @@ TEST_CASE("ictusd run: a Ctrl-C while the score is still loading ends the run, e
     const std::string fifo = dir / "score.fifo";
     REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
     Proc p({ICTUSD_PATH, "run", "--score", fifo, "--autoplay", "--port", "0", "--pose-rate", "0"});
-    // Handshake: the write end opens once ictusd has opened the score to read it.
-    int fd = -1;
-    const auto t0 = std::chrono::steady_clock::now();
-    while (fd < 0 && since(t0) < 30.0) {
-        fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
-        if (fd < 0) {
-            pollfd none{-1, 0, 0};
-            ::poll(&none, 0, 20);
-        }
-    }
+    const int fd = open_fifo_writer(fifo);
     REQUIRE(fd >= 0);
     REQUIRE(::kill(p.pid(), SIGINT) == 0); // while it reads the score
     const std::string score = "tempo 120\nR accent\nL accent\n";
     REQUIRE(::write(fd, score.data(), score.size()) == static_cast<ssize_t>(score.size()));
     ::close(fd);
     CHECK(p.wait_exit(20.0) == 130);
+}
+
+TEST_CASE("ictusd limits and gestures: a signal while the input loads finishes the verb, exit 130, "
+          "its output whole",
+          "[cli][signals]")
+{
+    // A capture of 120 frames of the default skeleton, arms swinging: enough
+    // for limits (30 frames at least).
+    const std::string bvh =
+        simtest::default_skeleton_bvh(120, 1.0 / 120.0, [](int f, const std::string &joint) {
+            const double a = 20.0 * std::sin(2.0 * M_PI * f / 60.0);
+            return joint.find("Arm") != std::string::npos ? Eigen::Vector3d(a, 0.5 * a, 0.0)
+                                                           : Eigen::Vector3d::Zero();
+        });
+    TempDir dir("one_step");
+    const std::string db = dir / "db.json";
+    {
+        Proc e({ICTUSD_PATH, "gestures", "--export", db});
+        REQUIRE(e.wait_exit(60.0) == 0);
+    }
+    const std::string db_text = slurp(db);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+        INFO(signal_name(sig));
+        // limits: the signal while the capture is read, the JSON written whole.
+        const std::string fifo = dir / (std::string("clip_") + signal_name(sig) + ".bvh");
+        const std::string out = dir / (std::string("limits_") + signal_name(sig) + ".json");
+        REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+        Proc l({ICTUSD_PATH, "limits", fifo, "--out", out});
+        int fd = open_fifo_writer(fifo);
+        REQUIRE(fd >= 0);
+        REQUIRE(::kill(l.pid(), sig) == 0);
+        CHECK(write_all_and_close(fd, bvh));
+        CHECK(l.wait_exit(60.0) == 130);
+        INFO(l.output());
+        CHECK(l.output().find("interrupted") != std::string::npos);
+        const nlohmann::json limits = nlohmann::json::parse(slurp(out)); // whole: it parses
+        CHECK_FALSE(limits.empty());
+        // gestures: the signal while the database is read, the list printed whole.
+        const std::string db_fifo = dir / (std::string("db_") + signal_name(sig) + ".json");
+        REQUIRE(::mkfifo(db_fifo.c_str(), 0600) == 0);
+        Proc g({ICTUSD_PATH, "gestures", "--list", "--db", db_fifo});
+        fd = open_fifo_writer(db_fifo);
+        REQUIRE(fd >= 0);
+        REQUIRE(::kill(g.pid(), sig) == 0);
+        CHECK(write_all_and_close(fd, db_text));
+        CHECK(g.wait_exit(60.0) == 130);
+        INFO(g.output());
+        CHECK(g.output().find("interrupted") != std::string::npos);
+        CHECK(g.output().find("legato") != std::string::npos); // the units were listed
+    }
 }
 
 TEST_CASE("ictusd run and render under a file-size limit: exit 1, a message, whole rows",
