@@ -318,7 +318,7 @@ TEST_CASE("ictusd limits and gestures: a signal while the input loads finishes t
         simtest::default_skeleton_bvh(120, 1.0 / 120.0, [](int f, const std::string &joint) {
             const double a = 20.0 * std::sin(2.0 * M_PI * f / 60.0);
             return joint.find("Arm") != std::string::npos ? Eigen::Vector3d(a, 0.5 * a, 0.0)
-                                                           : Eigen::Vector3d::Zero();
+                                                          : Eigen::Vector3d::Zero();
         });
     TempDir dir("one_step");
     const std::string db = dir / "db.json";
