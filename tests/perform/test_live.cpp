@@ -4,6 +4,7 @@
 // is the real ictusd; the client is a raw UDP peer; waits are handshakes with
 // deadlines.
 #include "support/osc_test_util.hpp"
+#include "support/sim_test_util.hpp"
 
 #include "ictus/perform/performance.hpp"
 #include "ictus/score/score.hpp"
@@ -501,6 +502,54 @@ TEST_CASE("live: a stop cancels a play still being planned, and a later play sta
     settle();
     CHECK(perf.playing());
     CHECK(perf.plan_active());
+}
+
+TEST_CASE("live: in clip mode a stop cancels the play of a rebuild still being planned",
+          "[perform][live]")
+{
+    // A clip: the default skeleton, arms swinging at 2 Hz, 4 s.
+    const std::string bvh = simtest::write_temp(
+        "live_clip.bvh",
+        simtest::default_skeleton_bvh(480, 1.0 / 120.0, [](int f, const std::string &joint) {
+            const double a = 25.0 * std::sin(2.0 * M_PI * 2.0 * f / 120.0);
+            return joint.find("Arm") != std::string::npos ? Eigen::Vector3d(a, 0.5 * a, 0.0)
+                                                          : Eigen::Vector3d::Zero();
+        }));
+    PerformanceOptions o;
+    o.mocap = bvh;
+    Performance perf(o);
+    perf.set_background_work(true);
+    StrikeEvent ev[2];
+    auto settle = [&] {
+        const auto deadline = Clock::now() + std::chrono::seconds(60);
+        while (perf.work_pending() && Clock::now() < deadline)
+            perf.step(ev);
+        REQUIRE_FALSE(perf.work_pending());
+        perf.step(ev); // installed at the start of a step
+    };
+    Command play, stop, grip;
+    play.kind = CommandKind::play;
+    stop.kind = CommandKind::stop;
+    grip.kind = CommandKind::grip;
+    std::snprintf(grip.text, sizeof grip.text, "german");
+    REQUIRE(perf.apply(stop));
+    perf.step(ev);
+    CHECK_FALSE(perf.playing());
+    // A grip change waits for the next play, which rebuilds the character in
+    // the background; the stop right after it: the rebuilt clip waits.
+    REQUIRE(perf.apply(grip));
+    REQUIRE(perf.apply(play));
+    CHECK(perf.deferred()); // its verdict comes with the rebuild
+    REQUIRE(perf.apply(stop));
+    settle();
+    CHECK_FALSE(perf.playing());
+    Command confirmed;
+    CHECK(perf.pop_confirmation(confirmed) == false); // no peer: nobody to confirm to
+    // A play with no stop after it plays (nothing left to rebuild: at once).
+    REQUIRE(perf.apply(play));
+    CHECK_FALSE(perf.deferred());
+    perf.step(ev);
+    CHECK(perf.playing());
 }
 
 TEST_CASE("live: score statements over OSC wait at most kMaxPendingStatements, the rest refused",
