@@ -136,6 +136,17 @@ int terminate_within(pid_t pid, double seconds)
     return -1;
 }
 
+// Steps until the worker has handed back what it was given (deadline 60 s),
+// then one step more: a result is installed at the start of a step.
+void settle_work(Performance &perf, StrikeEvent ev[2])
+{
+    const auto deadline = Clock::now() + std::chrono::seconds(60);
+    while (perf.work_pending() && Clock::now() < deadline)
+        perf.step(ev);
+    REQUIRE_FALSE(perf.work_pending());
+    perf.step(ev);
+}
+
 } // namespace
 
 TEST_CASE("run: repeats nested around no note are refused to the client, the daemon keeps "
@@ -472,14 +483,7 @@ TEST_CASE("live: a stop cancels a play still being planned, and a later play sta
     Performance perf(o);
     perf.set_background_work(true);
     StrikeEvent ev[2];
-    // Steps until the worker has handed back what it was given (deadline 60 s).
-    auto settle = [&] {
-        const auto deadline = Clock::now() + std::chrono::seconds(60);
-        while (perf.work_pending() && Clock::now() < deadline)
-            perf.step(ev);
-        REQUIRE_FALSE(perf.work_pending());
-        perf.step(ev); // installed at the start of a step
-    };
+    auto settle = [&] { settle_work(perf, ev); };
     Command play, stop;
     play.kind = CommandKind::play;
     stop.kind = CommandKind::stop;
@@ -520,13 +524,7 @@ TEST_CASE("live: in clip mode a stop cancels the play of a rebuild still being p
     Performance perf(o);
     perf.set_background_work(true);
     StrikeEvent ev[2];
-    auto settle = [&] {
-        const auto deadline = Clock::now() + std::chrono::seconds(60);
-        while (perf.work_pending() && Clock::now() < deadline)
-            perf.step(ev);
-        REQUIRE_FALSE(perf.work_pending());
-        perf.step(ev); // installed at the start of a step
-    };
+    auto settle = [&] { settle_work(perf, ev); };
     Command play, stop, grip;
     play.kind = CommandKind::play;
     stop.kind = CommandKind::stop;
