@@ -11,6 +11,7 @@ beside them, as Markdown and HTML. No binary's RUNPATH points outside its own fo
 package or in a `cmake --install` tree, which holds the same files (README.md,
 "Installing")."""
 import argparse
+import atexit
 import glob
 import hashlib
 import os
@@ -19,6 +20,7 @@ import re
 import shutil
 import stat
 import subprocess
+import tempfile
 import zipfile
 
 import numpy as np  # Debian's, as pdrun
@@ -51,7 +53,8 @@ sha = open(dek + ".sha256").read().split()
 check(sha == [hashlib.sha256(data).hexdigest(), os.path.basename(dek)], "the .sha256 beside it matches")
 
 # What the package must hold, listed from the source tree (not from the build rules).
-expected = {"ictus/" + os.path.basename(p) for p in glob.glob(os.path.join(REPO, "help", "*.pd"))}
+expected = {"ictus/" + os.path.basename(p) for p in glob.glob(os.path.join(REPO, "help", "*.pd"))
+            + glob.glob(os.path.join(REPO, "help", "*.mid"))}  # the help patches' examples
 for pattern in ("patches/*.pd", "patches/sound/*.pd", "patches/ui/*.pd"):
     for p in glob.glob(os.path.join(REPO, pattern)):
         if os.path.basename(p) != "ictus-sound-render-clips.pd":  # a build step's patch
@@ -169,6 +172,14 @@ pd_path = ["-noprefs", "-nostdpath", "-path", lib]
 gem = "/usr/lib/pd/extra/Gem"
 if os.path.isdir(gem):
     pd_path += ["-path", gem]
+# and cyclone (Debian's pd-cyclone, a dependency: [ictus-midifile] plays a file with
+# [cyclone/seq]), alone in a folder of its own, reached as cyclone/NAME.
+cyclone = "/usr/lib/pd/extra/cyclone"
+check(os.path.isdir(cyclone), "cyclone is installed (pd-cyclone, scripts/deps.sh)")
+cyclone_parent = tempfile.mkdtemp(prefix="ictus-deken-cyclone-")
+atexit.register(shutil.rmtree, cyclone_parent, True)
+os.symlink(cyclone, os.path.join(cyclone_parent, "cyclone"))
+pd_path += ["-path", cyclone_parent]
 
 
 def open_patch(path, name):
