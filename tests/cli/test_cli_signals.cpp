@@ -327,34 +327,38 @@ TEST_CASE("ictusd limits and gestures: a signal while the input loads finishes t
         REQUIRE(e.wait_exit(60.0) == 0);
     }
     const std::string db_text = slurp(db);
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
-        INFO(signal_name(sig));
-        // limits: the signal while the capture is read, the JSON written whole.
-        const std::string fifo = dir / (std::string("clip_") + signal_name(sig) + ".bvh");
-        const std::string out = dir / (std::string("limits_") + signal_name(sig) + ".json");
+    // ictusd with its input a FIFO (`{fifo}` in args): the signal once it has
+    // opened it, then the input written; its output after it exited 130.
+    auto interrupted = [&](std::vector<std::string> args, const std::string &fifo,
+                           const std::string &input, int sig) {
         REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
-        Proc l({ICTUSD_PATH, "limits", fifo, "--out", out});
-        int fd = open_fifo_writer(fifo);
+        for (std::string &a : args)
+            if (a == "{fifo}")
+                a = fifo;
+        Proc p(args);
+        const int fd = open_fifo_writer(fifo);
         REQUIRE(fd >= 0);
-        REQUIRE(::kill(l.pid(), sig) == 0);
-        CHECK(write_all_and_close(fd, bvh));
-        CHECK(l.wait_exit(60.0) == 130);
-        INFO(l.output());
-        CHECK(l.output().find("interrupted") != std::string::npos);
+        REQUIRE(::kill(p.pid(), sig) == 0);
+        CHECK(write_all_and_close(fd, input));
+        CHECK(p.wait_exit(60.0) == 130);
+        INFO(p.output());
+        CHECK(p.output().find("interrupted") != std::string::npos);
+        return p.output();
+    };
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+        const std::string name = signal_name(sig);
+        INFO(name);
+        // limits: the signal while the capture is read, the JSON written whole.
+        const std::string out = dir / ("limits_" + name + ".json");
+        interrupted({ICTUSD_PATH, "limits", "{fifo}", "--out", out},
+                    dir / ("clip_" + name + ".bvh"), bvh, sig);
         const nlohmann::json limits = nlohmann::json::parse(slurp(out)); // whole: it parses
         CHECK_FALSE(limits.empty());
         // gestures: the signal while the database is read, the list printed whole.
-        const std::string db_fifo = dir / (std::string("db_") + signal_name(sig) + ".json");
-        REQUIRE(::mkfifo(db_fifo.c_str(), 0600) == 0);
-        Proc g({ICTUSD_PATH, "gestures", "--list", "--db", db_fifo});
-        fd = open_fifo_writer(db_fifo);
-        REQUIRE(fd >= 0);
-        REQUIRE(::kill(g.pid(), sig) == 0);
-        CHECK(write_all_and_close(fd, db_text));
-        CHECK(g.wait_exit(60.0) == 130);
-        INFO(g.output());
-        CHECK(g.output().find("interrupted") != std::string::npos);
-        CHECK(g.output().find("legato") != std::string::npos); // the units were listed
+        const std::string listed =
+            interrupted({ICTUSD_PATH, "gestures", "--list", "--db", "{fifo}"},
+                        dir / ("db_" + name + ".json"), db_text, sig);
+        CHECK(listed.find("legato") != std::string::npos); // the units were listed
     }
 }
 

@@ -600,13 +600,21 @@ void OscServer::post_accepted(const Command &command)
 void OscServer::send_verdicts()
 {
     Impl &im = *impl_;
-    for (Command cmd; confirmations_.pop(cmd);) {
+    // Where a verdict goes: --reply's address, else the command's peer, else
+    // (a command of the daemon's own) the last peer heard from.
+    auto reply_to = [&im](std::uint32_t ipv4, std::uint16_t port) {
         sockaddr_in to{};
         to.sin_family = AF_INET;
-        to.sin_addr.s_addr = cmd.peer_ipv4;
-        to.sin_port = cmd.peer_port;
+        to.sin_addr.s_addr = ipv4;
+        to.sin_port = port;
+        if (port == 0)
+            to = im.last_peer;
         if (im.reply_fixed)
             to = im.reply_to;
+        return to;
+    };
+    for (Command cmd; confirmations_.pop(cmd);) {
+        const sockaddr_in to = reply_to(cmd.peer_ipv4, cmd.peer_port);
         Reply reply{im.fd, &to, &im.counters, &im.error_budget};
         const std::string address(cmd.address, strnlen(cmd.address, sizeof cmd.address));
         reply.ok(address.c_str(), echo_of(cmd));
@@ -614,14 +622,7 @@ void OscServer::send_verdicts()
     Refusal f;
     while (refusals_.pop(f)) {
         im.counters.refused_commands++; // an error, answered or not
-        sockaddr_in to{};
-        to.sin_family = AF_INET;
-        to.sin_addr.s_addr = f.peer_ipv4;
-        to.sin_port = f.peer_port;
-        if (f.peer_port == 0)
-            to = im.last_peer;
-        if (im.reply_fixed)
-            to = im.reply_to;
+        const sockaddr_in to = reply_to(f.peer_ipv4, f.peer_port);
         if (to.sin_port == 0)
             continue; // nobody to tell (the daemon's stderr has it)
         Reply reply{im.fd, &to, &im.counters, &im.error_budget};

@@ -19,6 +19,30 @@
 namespace ictus
 {
 
+namespace
+{
+// The lists of verdicts found after apply() (refusals, confirmations): at most
+// kMaxLater, the oldest dropped when nobody reads them; their room is reserved
+// at construction, so the physics thread never allocates for them.
+constexpr std::size_t kMaxLater = 64;
+
+template <typename T> void push_later(std::vector<T> &list, const T &item)
+{
+    if (list.size() >= kMaxLater)
+        list.erase(list.begin()); // nobody reads them: keep the newest
+    list.push_back(item);
+}
+
+template <typename T> bool pop_later(std::vector<T> &list, T &out)
+{
+    if (list.empty())
+        return false;
+    out = list.front();
+    list.erase(list.begin());
+    return true;
+}
+} // namespace
+
 PerformanceOptions::PerformanceOptions()
 {
     scene.sticks = StickMount::fulcrum;
@@ -72,6 +96,8 @@ PlanOptions ScorePerformOptions::plan_for(TrackMode m) const
 Performance::Performance(const PerformanceOptions &options)
     : options_(options), detector_(MembraneGeometry{}, options.strikes)
 {
+    refusals_.reserve(kMaxLater);
+    confirmations_.reserve(kMaxLater);
     // The head's film is as thick as its density says (membrane~'s head: Mylar), for
     // its stretching under the stick (DrumParams::stretch_n_per_m3).
     options_.scene.drum.head_thickness_m = options_.drum_density_kg_per_m2 / MEMBRANE_MYLAR_RHO;
@@ -225,6 +251,7 @@ bool refuse_with(std::string *why, const char *format, Values... values)
     }
     return false;
 }
+
 } // namespace
 
 bool Performance::check_gains(const double scale[2], std::string *why) const
@@ -553,42 +580,29 @@ void Performance::take_results()
         std::string why;
         if (!install(std::move(r), &why))
             refuse_later(origin, why);
-        else if (origin.peer_port != 0) {
-            if (confirmations_.size() >= 64)
-                confirmations_.erase(confirmations_.begin()); // nobody reads them
-            confirmations_.push_back(origin);
-        }
+        else if (origin.peer_port != 0)
+            push_later(confirmations_, origin);
     }
 }
 
 void Performance::refuse_later(const Command &origin, const std::string &why)
 {
-    if (refusals_.size() >= 64)
-        refusals_.erase(refusals_.begin()); // nobody reads them: keep the newest
     Refusal f;
     f.peer_ipv4 = origin.peer_ipv4;
     f.peer_port = origin.peer_port;
     std::snprintf(f.address, sizeof f.address, "%s", origin.address);
     std::snprintf(f.why, sizeof f.why, "%s", why.c_str());
-    refusals_.push_back(f);
+    push_later(refusals_, f);
 }
 
 bool Performance::pop_confirmation(Command &out)
 {
-    if (confirmations_.empty())
-        return false;
-    out = confirmations_.front();
-    confirmations_.erase(confirmations_.begin());
-    return true;
+    return pop_later(confirmations_, out);
 }
 
 bool Performance::pop_refusal(Refusal &out)
 {
-    if (refusals_.empty())
-        return false;
-    out = refusals_.front();
-    refusals_.erase(refusals_.begin());
-    return true;
+    return pop_later(refusals_, out);
 }
 
 void Performance::set_background_work(bool on)
