@@ -27,7 +27,7 @@
 #   --bits N      16 or 24 (integer PCM) or 32 (float, the default)
 #   --gain DB     output gain before the soft limiter (default 0)
 #   --drum-preset NAME  the drum (ictusd render --drum-preset; docs/sound.md): paper,
-#                 snare, tom, floor-tom, timpani, frame (default tom)
+#                 snare, tom, floor-tom, timpani, frame (default snare, wires on)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build
@@ -38,7 +38,7 @@ do_build=1
 mix=stereo
 bits=32
 gain=0
-drum_preset=tom
+drum_preset=snare
 while [[ $# -gt 0 ]]; do
     case $1 in
     --build) build=$2; shift 2 ;;

@@ -11,7 +11,8 @@ How onsets are measured (docs/main-job.md, "Checking the onsets"):
   events file again in a few *passes*: the strikes are dealt into passes so
   that within a pass consecutive strikes are at least MIN_GAP_S apart (greedy,
   in time order), and the drum is given a short decay (render-drum t60 0.01,
-  every other line of the events file untouched: same delays, same hit lists).
+  every other line of the events file untouched: same delays, same hit lists;
+  a snare's snare side, which rings on its own decay, left out).
   Every strike is then played exactly once, onto a drum at rest.
 - The detector sees only the WAV: an onset is the first sample whose magnitude
   (max over the two pickups) exceeds THRESHOLD after at least QUIET_S of
@@ -129,11 +130,15 @@ def write_events(path, header_lines, events, keep=None):
         f.write("\n".join(out) + "\n")
 
 
-def render_pd(build, events_path, wav_path, seconds, sr=48000, timeout=300):
-    """patches/ictus-render.pd in pd batch mode -> (samples [n, 2], sr, log)."""
+def render_pd(build, events_path, wav_path, seconds, sr=48000, timeout=300, sends=()):
+    """patches/ictus-render.pd in pd batch mode -> (samples [n, 2], sr, log).
+    `sends`: messages sent to the patch before the events file (as -send, the way
+    `ictusd render --wav` sends the drum), before DSP starts."""
     cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr), "-path",
-           os.path.join(build, "ictus"), "-open", RENDER_PATCH, "-send",
-           "render-file %s" % os.path.abspath(events_path), "-send",
+           os.path.join(build, "ictus"), "-open", RENDER_PATCH]
+    for message in sends:
+        cmd += ["-send", message]
+    cmd += ["-send", "render-file %s" % os.path.abspath(events_path), "-send",
            "render-out %s" % os.path.abspath(wav_path), "-send", "render-seconds %.3f" % seconds]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=PD_ENV)
     log = proc.stdout + proc.stderr
@@ -176,6 +181,16 @@ def detect_onsets(x, sr, threshold=THRESHOLD, quiet_s=QUIET_S):
     return starts
 
 
+def at_rest_header(header):
+    """The drum of the onset passes: `header` with the batter's decay cut to
+    MEASURE_T60_S. A snare preset is left out (the head keeps render.json's
+    radius, tension and density): its snare head and wires ring on their own
+    decay, which the batter's t60 does not shorten, and would hide the next
+    strike's onset."""
+    kept = [h for h in header if h.split()[:3] != ["render-drum", "preset", "snare"]]
+    return kept + ["render-drum t60 %g" % MEASURE_T60_S]
+
+
 def check_onsets(build, events, strikes, work, sr=48000, header=(), log_errors=None):
     """Renders the strikes in passes (see the module doc) and matches the
     detected onsets to strikes.csv. Returns a dict: errors_ms (per strike, in
@@ -189,8 +204,7 @@ def check_onsets(build, events, strikes, work, sr=48000, header=(), log_errors=N
     for p, members in enumerate(groups):
         ev = os.path.join(work, "pass-%d.txt" % p)
         wav = os.path.join(work, "pass-%d.wav" % p)
-        write_events(ev, list(header) + ["render-drum t60 %g" % MEASURE_T60_S], events,
-                     keep=set(members))
+        write_events(ev, at_rest_header(header), events, keep=set(members))
         seconds = round(max(times[i] for i in members) + 0.2, 3)
         x, file_sr, log = render_pd(build, ev, wav, seconds, sr)
         logs.append(log)
@@ -212,19 +226,24 @@ def check_onsets(build, events, strikes, work, sr=48000, header=(), log_errors=N
 
 
 def departure_onsets(build, events, header, full, seconds_after=0.005, sr=48000, work=None,
-                     indices=None):
+                     indices=None, header_sent=False):
     """Onset of each strike (indices into the hits, default all) in `full` (the
     WAV samples of the whole events file rendered with `header`): the first
     sample where `full` differs from a render of the hits before it. Returns
-    {index: sample or None (no difference)} and the logs."""
+    {index: sample or None (no difference)} and the logs. `header_sent`: `full`
+    was rendered with the header as -send messages before DSP started (as
+    `ictusd render --wav` does), and so are the prefixes. The drum is then set up
+    in the same order on the same state, so the prefixes match `full` to the bit
+    until the strike even on a chaotic drum (the snare's wires turn a difference
+    in the last bit into an audible one within a second)."""
     times = hit_times_us(events)
     result, logs = {}, []
     for k in (range(len(times)) if indices is None else indices):
         ev = os.path.join(work, "prefix-%d.txt" % k)
         wav = os.path.join(work, "prefix-%d.wav" % k)
-        write_events(ev, header, events, keep=set(range(k)))
+        write_events(ev, [] if header_sent else header, events, keep=set(range(k)))
         seconds = round(times[k] / 1e6 + seconds_after, 3)
-        x, _, log = render_pd(build, ev, wav, seconds, sr)
+        x, _, log = render_pd(build, ev, wav, seconds, sr, sends=header if header_sent else ())
         logs.append(log)
         n = min(len(x), len(full))
         diff = np.flatnonzero(np.any(x[:n] != full[:n], axis=1))

@@ -88,8 +88,9 @@ if found:
           % (max(found), float(np.mean(found)), sum(e == 0 for e in found), len(found),
              len(result["passes"])))
 # and in the main job's own WAV (real drum, set by main.sh through -send): where
-# it departs from a render of the strikes before each one (e2e_util).
-departures, _ = u.departure_onsets(build, events, drum, x, work=work)
+# it departs from a render of the strikes before each one, the drum sent as
+# ictusd render sends it (e2e_util).
+departures, _ = u.departure_onsets(build, events, drum, x, work=work, header_sent=True)
 dep, dep_failures, dep_notes = u.judge_departures(departures, strikes, sr)
 known = [abs(v) for v in dep.values() if v is not None]
 print("performance.wav, departure onsets - strike time: max %.4f ms, exact %d of %d"
