@@ -9,6 +9,7 @@ after the previous note, else the right hand); the rest left out and counted; th
 banged. A missing file gives the error line and no note."""
 import argparse
 import os
+import shutil
 import subprocess
 import tempfile
 
@@ -101,11 +102,7 @@ def patch_for(midi_file, channel):
             "#X connect 0 0 11 0;\n#X connect 11 0 10 0;\n" % (midi_file, channel))
 
 
-with tempfile.TemporaryDirectory(prefix="ictus-ui-midifile-") as work:
-    smf = os.path.join(work, "part.mid")
-    write_smf(smf)
-    want = expected(smf)
-    log = run(patch_for(smf, 10), work, "play.pd")
+def check_plays(log, want):
     errors = [l for l in uitest.error_lines(log)]
     check(not errors, "no error lines: %s" % errors)
     got = []
@@ -128,9 +125,25 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-midifile-") as work:
               for l in log.splitlines()), "the %d notes left out are counted at the end" % left_out)
     check(any(l.startswith("end: bang") for l in log.splitlines()), "the end of the file is banged")
 
+
+with tempfile.TemporaryDirectory(prefix="ictus-ui-midifile-") as work:
+    smf = os.path.join(work, "part.mid")
+    write_smf(smf)
+    want = expected(smf)
+    for name, patch_name in ((smf, "play.pd"), ("part.mid", "relative.pd"),
+                             ("songs/part.mid", "relative-sub.pd")):
+        # Absolute, then relative to the patch that holds [ictus-midifile] (not to the
+        # abstraction's own folder, which is the build's).
+        if name == "songs/part.mid":
+            os.makedirs(os.path.join(work, "songs"), exist_ok=True)
+            shutil.copy(smf, os.path.join(work, name))
+        print("open %s from %s" % (name, patch_name))
+        check_plays(run(patch_for(name, 10), work, patch_name), want)
     # A missing file: the error, and nothing plays.
-    log = run(patch_for(os.path.join(work, "missing.mid"), 10), work, "missing.pd")
-    check(any("ictus-midifile: error: no MIDI file" in l and "missing.mid" in l
-              for l in log.splitlines()), "a missing file is named in an error line: %s" % log[-500:])
-    check(not any(l.startswith("got: ") for l in log.splitlines()), "and no note comes out")
+    for name in (os.path.join(work, "missing.mid"), "missing.mid"):
+        log = run(patch_for(name, 10), work, "missing.pd")
+        check(any("ictus-midifile: error: no MIDI file" in l and name in l
+                  for l in log.splitlines()), "a missing file is named in an error line: %s"
+              % log[-500:])
+        check(not any(l.startswith("got: ") for l in log.splitlines()), "and no note comes out")
 print("PASS")
