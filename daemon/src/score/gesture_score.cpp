@@ -462,9 +462,9 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
                   << (n.grace == Grace::none
                           ? std::string()
                           : std::string(" (the ") + to_string(n.grace) + "'s grace stroke)")
-                  << " comes " << written * 1000.0
-                  << " ms after the previous one (line " << prev.line << what(prev)
-                  << "), faster than one hand plays (minimum " << opt.min_stroke_interval_s * 1000.0
+                  << " comes " << written * 1000.0 << " ms after the previous one (line "
+                  << prev.line << what(prev) << "), faster than one hand plays (minimum "
+                  << opt.min_stroke_interval_s * 1000.0
                   << " ms): give it to the other hand or slow down";
                 throw ScoreError(score.source, n.line, n.column, m.str());
             }
