@@ -597,7 +597,11 @@ Eigen::Vector3d pair_position(const Item &a, const Item &b, const Window &w, dou
 // above that head, and kit_clearance_m above it for a drum it does not play
 // here. The lift is applied as kit_bump(), so it is the largest shortfall
 // over kit_bump at 48 points of the move (kit_bump taken as >= 0.05 near the
-// ends, where the tip is over its own drums' heads).
+// ends, where the tip is over its own drums' heads). Over the two drums it
+// plays, only the middle of the move counts (kit_bump >= 0.5): near its ends
+// the tip belongs to the strokes, which may press it into their head (a buzz's
+// press, the strike's aim below the surface), and a lift there would be
+// divided by a vanishing bump into a leap of tens of cm.
 double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFrame &frame,
                 const PlanOptions &opt)
 {
@@ -617,6 +621,8 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
             if ((rel - height * frame.up).norm() > d.membrane_radius_m + opt.kit_margin_m)
                 continue;
             const bool played = static_cast<int>(k) == a.drum || static_cast<int>(k) == b.drum;
+            if (played && kit_bump(x) < 0.5)
+                continue;
             short_m = std::max(short_m, (played ? 0.0 : opt.kit_clearance_m) - height);
         }
         lift = std::max(lift, short_m / std::max(kit_bump(x), 0.05));
