@@ -153,8 +153,7 @@ TEST_CASE("plan: moves between drums never pass through a shell", "[score][kit]"
     }
 }
 
-TEST_CASE("plan: a press on one drum does not throw the move to the next drum high",
-          "[score][kit]")
+TEST_CASE("plan: a press on one drum does not throw the move to the next drum high", "[score][kit]")
 {
     // A buzz presses the tip into its head after the strike. The move to the next drum
     // must rise over the shells as after any stroke, not leap: the highest planned tip
