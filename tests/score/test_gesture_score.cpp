@@ -490,6 +490,49 @@ TEST_CASE("plan: an idle hand waits at its rest tip", "[score][plan]")
     CHECK((f.rest_tip_m[0] - (kCenter + Eigen::Vector3d(0.1, 0.15, -0.05))).norm() < 1e-12);
 }
 
+TEST_CASE("plan: the timing noise never makes a hand play faster than it can",
+          "[score][plan][humanize]")
+{
+    // A drag's two graces are 40 ms apart, the shortest same-hand interval: without the
+    // clip, noise of SD 5 ms (humanize 2) pushed about half of them under it and the
+    // score was refused. Seeded: each seed is another performance of the same score.
+    const Score score = score_of("tempo 100\nrepeat 8\nR drag\nL drag 1/2\nR flam 1/2\nend\n");
+    const double limit = PlanOptions{}.min_stroke_interval_s;
+    int moved = 0;
+    for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+        PlanOptions opt;
+        opt.humanize = 2.0;
+        opt.seed = seed;
+        INFO("seed " << seed);
+        GesturePlan plan;
+        REQUIRE_NOTHROW(plan = plan_performance(score, db(), frame(), opt));
+        const GesturePlan clean = plan_performance(score, db(), frame(), PlanOptions{});
+        REQUIRE(plan.notes.size() == clean.notes.size());
+        double last[2] = {-1.0, -1.0};
+        for (size_t k = 0; k < plan.notes.size(); ++k) {
+            const PlannedNote &n = plan.notes[k];
+            const int h = static_cast<int>(n.hand);
+            if (last[h] >= 0.0)
+                CHECK(n.time_s - last[h] >= limit - 1e-12);
+            last[h] = n.time_s;
+            moved += std::abs(n.time_s - clean.notes[k].time_s) > 1e-6;
+        }
+    }
+    CHECK(moved > 100); // the noise is there: most strokes moved
+    // A score that itself asks too much is still refused with noise, naming the
+    // interval it wrote (37.5 ms), not a noisy one.
+    PlanOptions opt;
+    opt.humanize = 2.0;
+    try {
+        plan_performance(score_of("tempo 400\nR 1/4\nR 1/4\n"), db(), frame(), opt);
+        FAIL("no error");
+    } catch (const ScoreError &e) {
+        INFO(e.what());
+        CHECK(e.line() == 3);
+        CHECK_THAT(e.message(), Catch::Matchers::Contains("comes 37.5 ms after"));
+    }
+}
+
 TEST_CASE("plan: refuses what a hand cannot play and bad options or frames",
           "[score][plan][errors]")
 {

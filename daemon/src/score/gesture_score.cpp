@@ -408,17 +408,21 @@ int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &fra
                      "unknown drum '" + n.drum + "' (the kit: " + names + ")");
 }
 
-// The notes, timed by the tempo map, into plan.notes (score order); a hand
-// asked to play faster than one hand plays is a ScoreError.
+// The notes, timed by the tempo map, into plan.notes (score order); a score that
+// asks a hand to play faster than one hand plays is a ScoreError. The timing noise
+// of `humanize` never does: it is clipped where it would bring a stroke closer
+// than that to the hand's previous one (a hand cannot play faster when it errs).
 HandNotes time_notes(const Score &score, const PerformerFrame &frame, const PlanOptions &opt,
                      GesturePlan &plan)
 {
     HandNotes by_hand;
     const double amount = humanize_amount(score, opt);
+    std::array<double, 2> score_time_prev = {0.0, 0.0}; // each hand's last note, without noise
     for (size_t k = 0; k < score.notes.size(); ++k) {
         const ScoreNote &n = score.notes[k];
         PlannedNote p;
-        p.time_s = opt.lead_in_s + score.note_time_s(n);
+        const double score_time = opt.lead_in_s + score.note_time_s(n);
+        p.time_s = score_time;
         p.hand = n.hand;
         p.nuance = n.nuance;
         p.grip = n.grip;
@@ -444,7 +448,10 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         const std::vector<size_t> &same = by_hand[static_cast<int>(n.hand)];
         if (!same.empty()) {
             const PlannedNote &prev = plan.notes[same.back()];
-            if (p.time_s - prev.time_s < opt.min_stroke_interval_s - 1e-9) {
+            const double written = score_time - score_time_prev[static_cast<int>(n.hand)];
+            if (amount > 0.0 && written >= opt.min_stroke_interval_s - 1e-9)
+                p.time_s = std::max(p.time_s, prev.time_s + opt.min_stroke_interval_s);
+            if (written < opt.min_stroke_interval_s - 1e-9) {
                 auto what = [](const PlannedNote &q) {
                     return q.grace == Grace::none
                                ? std::string()
@@ -455,13 +462,14 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
                   << (n.grace == Grace::none
                           ? std::string()
                           : std::string(" (the ") + to_string(n.grace) + "'s grace stroke)")
-                  << " comes " << (p.time_s - prev.time_s) * 1000.0
-                  << " ms after the previous one (line " << prev.line << what(prev)
-                  << "), faster than one hand plays (minimum " << opt.min_stroke_interval_s * 1000.0
+                  << " comes " << written * 1000.0 << " ms after the previous one (line "
+                  << prev.line << what(prev) << "), faster than one hand plays (minimum "
+                  << opt.min_stroke_interval_s * 1000.0
                   << " ms): give it to the other hand or slow down";
                 throw ScoreError(score.source, n.line, n.column, m.str());
             }
         }
+        score_time_prev[static_cast<int>(n.hand)] = score_time;
         by_hand[static_cast<int>(n.hand)].push_back(plan.notes.size());
         plan.notes.push_back(p);
     }
@@ -589,7 +597,11 @@ Eigen::Vector3d pair_position(const Item &a, const Item &b, const Window &w, dou
 // above that head, and kit_clearance_m above it for a drum it does not play
 // here. The lift is applied as kit_bump(), so it is the largest shortfall
 // over kit_bump at 48 points of the move (kit_bump taken as >= 0.05 near the
-// ends, where the tip is over its own drums' heads).
+// ends, where the tip is over its own drums' heads). Over the two drums it
+// plays, only the middle of the move counts (kit_bump >= 0.5): near its ends
+// the tip belongs to the strokes, which may press it into their head (a buzz's
+// press, the strike's aim below the surface), and a lift there would be
+// divided by a vanishing bump into a leap of tens of cm.
 double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFrame &frame,
                 const PlanOptions &opt)
 {
@@ -609,6 +621,8 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
             if ((rel - height * frame.up).norm() > d.membrane_radius_m + opt.kit_margin_m)
                 continue;
             const bool played = static_cast<int>(k) == a.drum || static_cast<int>(k) == b.drum;
+            if (played && kit_bump(x) < 0.5)
+                continue;
             short_m = std::max(short_m, (played ? 0.0 : opt.kit_clearance_m) - height);
         }
         lift = std::max(lift, short_m / std::max(kit_bump(x), 0.05));
