@@ -442,6 +442,13 @@ static void finish_stroke(contact *c, double dt)
     c->touching = 0;
 }
 
+/* The head's stretching k3 under this stick: a membrane's; a plate (membrane_set_plate)
+ * has none. */
+static double head_k3(const contact *c)
+{
+    return c->point.owner && c->point.owner->plate ? 0.0 : c->stretch;
+}
+
 /* The stretching's force on the stick over a step of its depth s0 -> s1 (m): the
  * discrete gradient of U(s) = k3 s+^4 / 4, so that its work is U's change. */
 static double stretch_step_force(double k3, double s0, double s1)
@@ -468,7 +475,7 @@ static double contact_solve_one(contact *c, double xfree, double K, double T, do
     double s1 = s_coast - h * (c->force + c->stretch_force); /* the last sample's forces */
     double G = 0.0, F = 0.0;
     for (int pass = 0; pass < 4; pass++) {
-        G = stretch_step_force(c->stretch, s0, s1);
+        G = stretch_step_force(head_k3(c), s0, s1);
         double ug = -1.0;
         if (c->force > 0.0 && c->lin_valid && pass == 0) {
             /* The last sample's force law, linearised, in x1 = x_free - C F: the
@@ -493,7 +500,7 @@ static double contact_solve_one(contact *c, double xfree, double K, double T, do
         double s_new = s_coast - h * (F + G);
         double moved = fabs(s_new - s1);
         s1 = s_new;
-        if (!(c->stretch > 0.0) || moved <= 1.0e-13 + 1.0e-10 * fabs(s1))
+        if (!(head_k3(c) > 0.0) || moved <= 1.0e-13 + 1.0e-10 * fabs(s1))
             break;
     }
     *g = G;
@@ -523,7 +530,7 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
             contact *c = point_contact(pts[i]);
             double h = T * T / (2.0 * c->mass_kg);
             double s1 = c->stick_x + T * c->stick_v - h * (c->force + c->stretch_force);
-            G[i] = stretch_step_force(c->stretch, c->stick_x, s1);
+            G[i] = stretch_step_force(head_k3(c), c->stick_x, s1);
             xfree[i] -= h * G[i];
         }
         for (int s = 0; s < 30; s++) {

@@ -45,6 +45,7 @@ membrane *membrane_new(double sample_rate_hz)
     m->radiation = MEMBRANE_DEFAULT_RADIATION;
     m->loss_factor = MEMBRANE_DEFAULT_LOSS_FACTOR;
     m->patch = MEMBRANE_DEFAULT_PATCH;
+    m->bending = MEMBRANE_DEFAULT_BENDING;
     m->tm_g = 1.0;
     m->output_gain = MEMBRANE_DEFAULT_GAIN;
     m->gain_smoothed = MEMBRANE_DEFAULT_GAIN;

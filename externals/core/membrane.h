@@ -53,6 +53,8 @@ extern "C" {
 #define MEMBRANE_LOSS_FACTOR_MAX 0.5
 #define MEMBRANE_PATCH_MIN       0.0 /* m; 0: a point */
 #define MEMBRANE_PATCH_MAX       0.05
+#define MEMBRANE_BENDING_MIN     1.0e-3 /* N m: a plate's bending stiffness (membrane_set_plate) */
+#define MEMBRANE_BENDING_MAX     1.0e4
 #define MEMBRANE_GAIN_MIN       -1.0e6 /* s/m; negative inverts */
 #define MEMBRANE_GAIN_MAX       1.0e6
 #define MEMBRANE_R_OVER_A_MIN   0.0 /* points: pickups, strikes, contacts */
@@ -82,6 +84,9 @@ extern "C" {
  * left out. 0 (the bare head's default): a point, no correction; the drum presets take
  * the stick bead's radius, the physics' tip radius. */
 #define MEMBRANE_DEFAULT_PATCH       0.0
+/* A plate's bending stiffness D = E h^3 / (12 (1 - nu^2)): 1 mm of bronze (E 100 GPa,
+ * nu 0.33); a membrane does not use it. */
+#define MEMBRANE_DEFAULT_BENDING     9.35
 #define MEMBRANE_PATCH_BEAD          0.007
 #define MEMBRANE_AIR_RHO             1.2   /* kg/m^3 */
 #define MEMBRANE_AIR_C               343.0 /* m/s */
@@ -123,6 +128,8 @@ typedef enum membrane_param {
     MEMBRANE_PARAM_LOSS_FACTOR,
     /* m: radius of the disc a strike's or a stick's force is spread over (0: a point) */
     MEMBRANE_PARAM_PATCH,
+    /* N m: the bending stiffness D of a plate (membrane_set_plate); a membrane ignores it */
+    MEMBRANE_PARAM_BENDING,
     MEMBRANE_PARAM_COUNT
 } membrane_param;
 
@@ -135,6 +142,15 @@ typedef struct membrane membrane;
  * Allocates. Returns NULL when memory cannot be had. */
 membrane *membrane_new(double sample_rate_hz);
 void membrane_free(membrane *m);
+
+/* A thin circular plate with a free edge (plate 1: a cymbal, docs/plates.md) or the
+ * membrane fixed at its rim (0, the default) of the same radius and density: the
+ * modes become the plate's, ringing at lambda^2 / (2 pi a^2) sqrt(D / density) with D
+ * the "bending" parameter, and the state is cleared. On a plate the tension, the
+ * tension modulation, the air radiation and the contact patch do nothing (the
+ * t60/hfdamp law sets the decays). Allocates: message time only. */
+ictus_status membrane_set_plate(membrane *m, int plate);
+int membrane_is_plate(const membrane *m);
 
 /* Sample rate of this instance (Hz); recomputes the coefficients, keeps the state. */
 ictus_status membrane_set_sample_rate(membrane *m, double sample_rate_hz);

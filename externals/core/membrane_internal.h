@@ -87,6 +87,13 @@ struct membrane {
     double tension_mod;            /* dimensionless, MEMBRANE_PARAM_TENSION_MOD */
     double radiation, loss_factor; /* MEMBRANE_PARAM_RADIATION, MEMBRANE_PARAM_LOSS_FACTOR */
     double patch;                  /* m, MEMBRANE_PARAM_PATCH */
+    /* A free-edge plate instead of a membrane (membrane_set_plate): its modes are the
+     * plate's (mode_table.h) and ring at j c / (2 pi a) with c = sqrt(bending / density)
+     * / a, bending its bending stiffness D (N m, MEMBRANE_PARAM_BENDING); the tension,
+     * the tension modulation, the air radiation and the contact patch are a membrane's
+     * and do nothing. */
+    int plate;
+    double bending;
     /* The radiation integral of each mode depends on ka = j c / c_air alone: kept for
      * rad_valid modes at the wave speed rad_c (recomputed when either changes). */
     double *rad_int, rad_c;
@@ -137,6 +144,13 @@ struct membrane {
 
 /* Aligned, zeroed floats for the kernels (NULL when memory cannot be had). Allocates. */
 float *membrane_alloc_floats_(int n);
+
+/* The wave speed c of f_k = j_k c / (2 pi a) (mode_table.h): sqrt(T / sigma) for a
+ * membrane, sqrt(D / sigma) / a for a plate (whose j_k is lambda_k^2). */
+static inline double membrane_wave_speed_(const membrane *m)
+{
+    return m->plate ? sqrt(m->bending / m->density) / m->radius : sqrt(m->tension / m->density);
+}
 
 static inline int membrane_padded_(int n)
 {

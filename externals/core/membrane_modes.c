@@ -38,7 +38,9 @@ static double radiation_integral(const membrane *m, int k, double omega)
 static double radiation_rate(const membrane *m, int k, double omega)
 {
     membrane *mm = (membrane *)m; /* the cache only */
-    const double c = sqrt(m->tension / m->density), j = m->table.j[k];
+    if (m->plate)
+        return 0.0; /* the baffled membrane's integral: not a plate's */
+    const double c = membrane_wave_speed_(m), j = m->table.j[k];
     if (c != m->rad_c) {
         mm->rad_c = c;
         mm->rad_valid = 0;
@@ -61,7 +63,7 @@ static double radiation_rate(const membrane *m, int k, double omega)
  * and the internal loss eta w / 2. */
 static double mode_decay_rate(const membrane *m, int k, double omega)
 {
-    double omega1 = m->table.j[0] * sqrt(m->tension / m->density) / m->radius;
+    double omega1 = m->table.j[0] * membrane_wave_speed_(m) / m->radius;
     double w_ref = 2.0 * M_PI * 1000.0;
     double rate1 = log(1000.0) / m->t60;
     double s0 = rate1 / (1.0 + m->hf_damping * (omega1 / w_ref) * (omega1 / w_ref));
@@ -78,7 +80,7 @@ static double mode_decay_rate(const membrane *m, int k, double omega)
 void membrane_update_coefficients_(membrane *m, int rescale)
 {
     const double T = 1.0 / m->sample_rate, h = 0.5 * T;
-    const double c = sqrt(m->tension / m->density);
+    const double c = membrane_wave_speed_(m);
     const double old_scale = m->mass_scale, old_h = m->coef_h;
     m->mass_scale = 1.0 / sqrt(m->density * m->radius * m->radius);
     m->coef_h = h;
@@ -190,7 +192,7 @@ static void mode_arrays_free(mode_arrays *a)
 
 /* Allocates every array at capacity cap (the points' for `points` points); 0, with
  * nothing left allocated, when memory cannot be had. */
-static int mode_arrays_alloc(mode_arrays *a, int cap, int points)
+static int mode_arrays_alloc(mode_arrays *a, int cap, int points, int plate)
 {
     memset(a, 0, sizeof(*a));
     a->omega_model = calloc((size_t)cap, sizeof(double));
@@ -213,7 +215,7 @@ static int mode_arrays_alloc(mode_arrays *a, int cap, int points)
     /* The table last: it computes the Bessel zeros in scratch memory that it
      * frees, and state arrays allocated after that landed at heap offsets
      * that cost ~5 % in bench_membrane_core (contact, 1024 modes). */
-    ok = ok && mode_table_build(&a->table, cap) == ICTUS_OK;
+    ok = ok && mode_table_build(&a->table, cap, plate) == ICTUS_OK;
     if (!ok)
         mode_arrays_free(a);
     return ok;
@@ -320,6 +322,22 @@ void membrane_refresh_shapes_(membrane *m)
     }
 }
 
+ictus_status membrane_set_plate(membrane *m, int plate)
+{
+    plate = plate != 0;
+    if (m->plate == plate)
+        return ICTUS_OK;
+    membrane_clear(m);
+    m->plate = plate;
+    mode_table_free(&m->table); /* the next build lays the other kind's modes */
+    return membrane_build_modes_(m, m->modes);
+}
+
+int membrane_is_plate(const membrane *m)
+{
+    return m->plate;
+}
+
 /* Keeps the state of the modes in both the old and the new table: a mode keeps its
  * index (the order is a prefix property of the sort, mode_table.h). */
 ictus_status membrane_build_modes_(membrane *m, int modes)
@@ -327,7 +345,7 @@ ictus_status membrane_build_modes_(membrane *m, int modes)
     int need = membrane_padded_(modes);
     if (need > m->capacity || !m->table.j) {
         mode_arrays a;
-        if (!mode_arrays_alloc(&a, need, m->point_count))
+        if (!mode_arrays_alloc(&a, need, m->point_count, m->plate))
             return ICTUS_ENOMEM;
         mode_arrays_install(m, &a, need);
     } else {
@@ -356,7 +374,7 @@ int membrane_get_mode(const membrane *m, int k, double *freq_hz, double *t60_s, 
     if (k < 0 || k >= m->modes)
         return 0;
     double omega =
-        mode_table_tuned_j(&m->table, k, &m->tuning) * sqrt(m->tension / m->density) / m->radius;
+        mode_table_tuned_j(&m->table, k, &m->tuning) * membrane_wave_speed_(m) / m->radius;
     if (freq_hz)
         *freq_hz = omega / (2.0 * M_PI);
     if (t60_s)
@@ -382,6 +400,8 @@ double membrane_tension_kappa(const membrane *m)
     /* Biaxial strain eps = (1/4A) int |grad w|^2 dA, dT = Y H eps / (1 - nu); the
      * strain integral is 2 V / T0 (V the potential energy), and V averages E / 2:
      * kappa = Y H / (4 (1 - nu) pi a^2 T0^2), H = density / rho. */
+    if (m->plate)
+        return 0.0; /* a membrane's stretch */
     const double H = m->density / MEMBRANE_MYLAR_RHO;
     const double area = M_PI * m->radius * m->radius;
     return m->tension_mod * MEMBRANE_MYLAR_YOUNG * H /

@@ -130,6 +130,8 @@ static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
     [MEMBRANE_PARAM_LOSS_FACTOR] = {"lossfactor", "", RANGE(LOSS_FACTOR), FIELD(loss_factor),
                                     physics_changed},
     [MEMBRANE_PARAM_PATCH] = {"patch", "m", RANGE(PATCH), FIELD(patch), geometry_changed},
+    [MEMBRANE_PARAM_BENDING] = {"bending", "N m", RANGE(BENDING), FIELD(bending),
+                                physics_changed},
 };
 #undef RANGE
 #undef FIELD

@@ -49,7 +49,7 @@ static double dot_psi(const membrane *m, const float *a, const float *b, const f
 static double residual_compliance(const membrane *m, const membrane_point *pt)
 {
     const double eps = m->patch / m->radius, u = pt->r_over_a;
-    if (!pt->static_correction || !(eps > 0.0) || u * u >= 1.0 - eps)
+    if (m->plate || !pt->static_correction || !(eps > 0.0) || u * u >= 1.0 - eps)
         return 0.0;
     double modal = 0.0;
     for (int k = 0; k < m->modes && k < m->table.size; k++)

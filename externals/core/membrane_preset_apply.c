@@ -33,21 +33,26 @@ ictus_status membrane_apply_preset(membrane *m, const membrane_preset *p)
     mode_tuning u = {0};
     tuning_of(p, &u);
     membrane_flush_points_(m);
+    if ((e = membrane_set_plate(m, p->plate)) > s)
+        s = e;
     m->tuning = u; /* the coefficients follow with the first parameter set below */
+    const int bare = p->linear || p->plate; /* a plate: the four are a membrane's */
     const struct {
         int id;
         double value;
     } sets[] = {
         {MEMBRANE_PARAM_RADIUS, p->radius_m},
-        {MEMBRANE_PARAM_TENSION, p->tension_n_per_m},
+        {p->plate ? MEMBRANE_PARAM_BENDING : MEMBRANE_PARAM_TENSION,
+         p->plate ? p->bending_n_m : p->tension_n_per_m},
         {MEMBRANE_PARAM_DENSITY, p->density_kg_per_m2},
         {MEMBRANE_PARAM_T60, p->t60_s},
         {MEMBRANE_PARAM_HF_DAMPING, p->hf_damping},
         {MEMBRANE_PARAM_MODES, p->modes > 0 ? p->modes : MEMBRANE_DEFAULT_MODES},
-        {MEMBRANE_PARAM_TENSION_MOD, p->linear ? 0.0 : MEMBRANE_DEFAULT_TENSION_MOD},
-        {MEMBRANE_PARAM_RADIATION, p->linear ? 0.0 : MEMBRANE_DEFAULT_RADIATION},
-        {MEMBRANE_PARAM_LOSS_FACTOR, p->linear ? 0.0 : MEMBRANE_DEFAULT_LOSS_FACTOR},
-        {MEMBRANE_PARAM_PATCH, p->linear ? 0.0 : MEMBRANE_PATCH_BEAD},
+        {MEMBRANE_PARAM_TENSION_MOD, bare ? 0.0 : MEMBRANE_DEFAULT_TENSION_MOD},
+        {MEMBRANE_PARAM_RADIATION, bare ? 0.0 : MEMBRANE_DEFAULT_RADIATION},
+        {MEMBRANE_PARAM_LOSS_FACTOR,
+         p->plate ? MEMBRANE_PRESET_BRONZE_LOSS : bare ? 0.0 : MEMBRANE_DEFAULT_LOSS_FACTOR},
+        {MEMBRANE_PARAM_PATCH, bare ? 0.0 : MEMBRANE_PATCH_BEAD},
     };
     for (int i = 0; i < (int)(sizeof(sets) / sizeof(sets[0])); i++)
         if ((e = ictus_param_set(t, m, sets[i].id, sets[i].value)) > s)

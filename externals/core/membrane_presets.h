@@ -15,6 +15,10 @@
 extern "C" {
 #endif
 
+/* The internal loss factor of the cymbal presets' bronze (decay rate eta w / 2): a
+ * choice within the 1e-4 .. 1e-3 that bronze and brass plates show (docs/plates.md). */
+#define MEMBRANE_PRESET_BRONZE_LOSS 3.0e-4
+
 /* The largest m whose (m, 1) ratio a preset may give, plus one. */
 #define MEMBRANE_PRESET_RATIOS 8
 
@@ -37,6 +41,11 @@ typedef struct membrane_preset {
     int wires;       /* snare wires on the head (snare_wires.h; the Pd wrapper lays them) */
     int linear;      /* 1: no tension modulation, radiation or internal loss, forces at a
                       * point (the paper's head); 0: membrane.h's defaults for the four */
+    /* 1: a cymbal, a free-edge plate of bending stiffness bending_n_m (N m) and the
+     * density above (membrane_set_plate; tension unused, the four above off); not a
+     * drum for the daemon's physics. 0: a drum. */
+    int plate;
+    double bending_n_m;
 } membrane_preset;
 
 /* The presets, in the order the docs list them; count via membrane_preset_count(). */
@@ -44,11 +53,13 @@ int membrane_preset_count(void);
 const membrane_preset *membrane_preset_at(int index);
 /* The preset named `name`, or NULL. */
 const membrane_preset *membrane_preset_find(const char *name);
-/* "snare, tom, ...": the names, for error messages. */
+/* "snare, tom, ...": the names, for error messages; the drums' alone (not the
+ * plates), for what takes a drum. */
 const char *membrane_preset_names(void);
+const char *membrane_preset_drum_names(void);
 
-/* Sets m to preset p: radius, tension, density, T60, hfdamp, mode count, strike point,
- * pickups and the tuning of its modes; gain is left as it is (it is the mix, not the
+/* Sets m to preset p: a membrane or a plate, radius, tension (or bending), density,
+ * T60, hfdamp, mode count, strike point, pickups and the tuning of its modes; gain is left as it is (it is the mix, not the
  * head). Allocates when the mode count grows: message time only, never from audio.
  * ICTUS_ENOMEM when the modes could not be had (the other values are set). */
 ictus_status membrane_apply_preset(membrane *m, const membrane_preset *p);

@@ -11,13 +11,66 @@
 
 void mode_table_free(mode_table *t)
 {
-    free(t->j), free(t->norm), free(t->m), free(t->n), free(t->sin);
+    free(t->j), free(t->norm), free(t->m), free(t->n), free(t->sin), free(t->plate);
     t->j = t->norm = NULL;
     t->m = t->n = t->sin = NULL;
+    t->plate = NULL;
     t->size = 0;
 }
 
-ictus_status mode_table_build(mode_table *t, int size)
+static int alloc_entries(mode_table *t, int size)
+{
+    t->j = malloc(sizeof(double) * (size_t)size);
+    t->norm = malloc(sizeof(double) * (size_t)size);
+    t->m = malloc(sizeof(int) * (size_t)size);
+    t->n = malloc(sizeof(int) * (size_t)size);
+    t->sin = malloc(sizeof(int) * (size_t)size);
+    return t->j && t->norm && t->m && t->n && t->sin;
+}
+
+/* A plate's table: the free-edge modes below a lambda that Weyl's law for the plate
+ * (about lambda^2 / 4 modes, cos and sin counted, below lambda) says holds `size`,
+ * grown until it does. Entry k keeps its plate_mode (the radial shape); norm is 1,
+ * the radial shape carries the normalisation. */
+static ictus_status build_plate(mode_table *t, int size)
+{
+    double lambda_max = 2.0 * sqrt((double)size) + 4.0;
+    plate_mode *pm = NULL;
+    int count;
+    for (;;) {
+        count = plate_free_modes_below(lambda_max, MODE_TABLE_PLATE_NU, &pm);
+        if (count < 0)
+            return ICTUS_ENOMEM;
+        int modes = 0;
+        for (int i = 0; i < count; i++)
+            modes += pm[i].m ? 2 : 1;
+        if (modes >= size)
+            break;
+        free(pm);
+        lambda_max *= 1.15;
+    }
+    t->plate = malloc(sizeof(plate_mode) * (size_t)size);
+    if (!t->plate || !alloc_entries(t, size)) {
+        free(pm);
+        mode_table_free(t);
+        return ICTUS_ENOMEM;
+    }
+    int k = 0;
+    for (int i = 0; i < count && k < size; i++)
+        for (int s = 0; s < (pm[i].m ? 2 : 1) && k < size; s++, k++) {
+            t->plate[k] = pm[i];
+            t->j[k] = pm[i].lambda * pm[i].lambda;
+            t->m[k] = pm[i].m;
+            t->n[k] = pm[i].s;
+            t->sin[k] = s;
+            t->norm[k] = 1.0;
+        }
+    free(pm);
+    t->size = size;
+    return ICTUS_OK;
+}
+
+ictus_status mode_table_build(mode_table *t, int size, int plate)
 {
     /* Enough Bessel zeros: Weyl's law gives about x^2/4 modes below j = x. */
     double x_max = 2.0 * sqrt((double)size) + 4.0;
@@ -25,7 +78,10 @@ ictus_status mode_table_build(mode_table *t, int size)
     int count = 0, modes = 0;
     t->j = t->norm = NULL;
     t->m = t->n = t->sin = NULL;
+    t->plate = NULL;
     t->size = 0;
+    if (plate)
+        return build_plate(t, size);
     for (;;) {
         free(zeros);
         count = ictus_bessel_zeros_below(x_max, &zeros);
@@ -38,12 +94,7 @@ ictus_status mode_table_build(mode_table *t, int size)
             break;
         x_max *= 1.15;
     }
-    t->j = malloc(sizeof(double) * (size_t)size);
-    t->norm = malloc(sizeof(double) * (size_t)size);
-    t->m = malloc(sizeof(int) * (size_t)size);
-    t->n = malloc(sizeof(int) * (size_t)size);
-    t->sin = malloc(sizeof(int) * (size_t)size);
-    if (!t->j || !t->norm || !t->m || !t->n || !t->sin) {
+    if (!alloc_entries(t, size)) {
         free(zeros);
         mode_table_free(t);
         return ICTUS_ENOMEM;
@@ -81,7 +132,8 @@ void mode_table_shapes(const mode_table *t, int live, double r_over_a, double th
         }
         /* cos and sin partners are adjacent and share J_m(j r/a). */
         if (!(k > 0 && t->j[k] == t->j[k - 1] && t->m[k] == t->m[k - 1]))
-            radial = ictus_bessel_j(t->m[k], t->j[k] * r_over_a);
+            radial = t->plate ? plate_mode_radial(&t->plate[k], r_over_a)
+                              : ictus_bessel_j(t->m[k], t->j[k] * r_over_a);
         double angular = t->sin[k] ? sin(t->m[k] * theta) : cos(t->m[k] * theta);
         psi[k] = (float)(radial * angular * t->norm[k]);
     }
@@ -89,7 +141,7 @@ void mode_table_shapes(const mode_table *t, int live, double r_over_a, double th
 
 void mode_table_patch_filter(const mode_table *t, int live, double eps, float *psi)
 {
-    if (!(eps > 0.0))
+    if (!(eps > 0.0) || t->plate)
         return;
     double mean = 1.0;
     for (int k = 0; k < live && k < t->size; k++) {
@@ -103,20 +155,22 @@ void mode_table_patch_filter(const mode_table *t, int live, double eps, float *p
 
 double mode_table_shape(const mode_table *t, int k, double r_over_a, double theta_rad)
 {
-    return ictus_bessel_j(t->m[k], t->j[k] * r_over_a) * t->norm[k] *
+    const double radial = t->plate ? plate_mode_radial(&t->plate[k], r_over_a)
+                                   : ictus_bessel_j(t->m[k], t->j[k] * r_over_a);
+    return radial * t->norm[k] *
            (t->sin[k] ? sin(t->m[k] * theta_rad) : cos(t->m[k] * theta_rad));
 }
 
 double mode_table_tuned_j(const mode_table *t, int k, const mode_tuning *u)
 {
-    if (!u || t->n[k] != 1 || t->m[k] >= u->count)
+    if (!u || t->plate || t->n[k] != 1 || t->m[k] >= u->count)
         return t->j[k];
     return t->j[k] * u->factor_m1[t->m[k]];
 }
 
 double mode_table_decay_factor(const mode_table *t, int k, const mode_tuning *u)
 {
-    if (!u || u->count == 0 || t->n[k] != 1 || t->m[k] != 0)
+    if (!u || t->plate || u->count == 0 || t->n[k] != 1 || t->m[k] != 0)
         return 1.0;
     return u->decay_01;
 }

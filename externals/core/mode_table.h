@@ -1,26 +1,34 @@
-/* mode_table.h -- the modes of an ideal circular membrane fixed at its rim, in
- * order of frequency: the Bessel zero each mode rings at, its (m, n) indices, which
- * partner of a degenerate cos/sin pair it is, and its mass-normalised shape
- * (docs/membrane.md, "The membrane"). Internal to the core (the membrane's rooms). */
+/* mode_table.h -- the modes of an ideal circular membrane fixed at its rim, or of a
+ * thin circular plate with a free edge (plate_modes.h), in order of frequency: the
+ * frequency parameter each mode rings at, its (m, n) indices, which partner of a
+ * degenerate cos/sin pair it is, and its mass-normalised shape (docs/membrane.md,
+ * "The membrane"; docs/plates.md). Internal to the core (the membrane's rooms). */
 #ifndef ICTUS_MODE_TABLE_H
 #define ICTUS_MODE_TABLE_H
 
 #include "membrane.h"
+#include "plate_modes.h"
 
-/* Entry k is the k-th mode by frequency; f_k = j[k] c / (2 pi a). The cos and sin
- * partners of an m >= 1 pair are adjacent (cos first). Any prefix of the table is
- * the table of that many modes, so a mode keeps its index when the count changes. */
+/* Entry k is the k-th mode by frequency; f_k = j[k] c / (2 pi a), with c the wave
+ * speed sqrt(T / sigma) of a membrane, and for a plate c = sqrt(D / sigma) / a and
+ * j = lambda^2 (plate_modes.h). The cos and sin partners of an m >= 1 pair are
+ * adjacent (cos first). Any prefix of the table is the table of that many modes, so a
+ * mode keeps its index when the count changes. */
 typedef struct mode_table {
-    double *j;    /* zero of J_m */
+    double *j;    /* membrane: zero of J_m; plate: lambda^2 */
     double *norm; /* sqrt(eps_m / pi) / |J_{m+1}(j)|: makes the shapes mass-normalised */
-    int *m, *n;   /* Bessel order, and which zero of J_m */
+    int *m, *n;   /* order (nodal diameters), and which zero of J_m (plate: nodal circles) */
     int *sin;     /* 0: cos(m theta) partner, 1: sin(m theta) partner */
     int size;
+    plate_mode *plate; /* a plate's modes (their radial shapes, normalised), NULL: a membrane */
 } mode_table;
 
-/* Fills *t with the first `size` modes (size >= 1). Allocates. On ICTUS_ENOMEM *t
- * is left empty (all NULL). */
-ictus_status mode_table_build(mode_table *t, int size);
+/* Fills *t with the first `size` modes (size >= 1) of a membrane (plate 0) or of a
+ * free-edge plate of Poisson's ratio MODE_TABLE_PLATE_NU (plate 1). Allocates. On
+ * ICTUS_ENOMEM *t is left empty (all NULL). */
+ictus_status mode_table_build(mode_table *t, int size, int plate);
+/* Bronze and brass (cymbal alloys): nu = 0.33 (also the value of Leissa's tables). */
+#define MODE_TABLE_PLATE_NU 0.33
 void mode_table_free(mode_table *t);
 
 /* psi[k] = J_m(j r/a) {cos, sin}(m theta) * norm for k < live, 0 for live <= k < size:
@@ -32,7 +40,8 @@ void mode_table_shapes(const mode_table *t, int live, double r_over_a, double th
 /* A force spread evenly over a disc of radius eps (relative to the head's) instead
  * of a point: every shape times its mean over the disc, 2 J1(j eps) / (j eps) (the
  * mean value theorem of the Helmholtz equation, which each mode shape solves), for
- * k < live. eps <= 0: unchanged. O(live) Bessel calls. */
+ * k < live. eps <= 0, or a plate: unchanged (a plate takes forces at a point). O(live)
+ * Bessel calls. */
 void mode_table_patch_filter(const mode_table *t, int live, double eps, float *psi);
 
 /* The same for mode k alone, in double (theta in radians). */

@@ -468,4 +468,12 @@ TEST_CASE("ictusd render --drum-preset: the preset's head, recorded in render.js
     CHECK(r.status == 2);
     CHECK(r.output.find("--drum-preset: unknown preset 'bongo'") != std::string::npos);
     CHECK(r.output.find("floor-tom") != std::string::npos);
+    // a cymbal preset of membrane~ is refused as a drum, naming why and the drums
+    const Run c = ictusd("render --mocap " + bvh + " --duration 0.05 --drum-preset crash --out " +
+                         simtest::temp_path("preset_plate"));
+    INFO(c.output);
+    CHECK(c.status == 2);
+    CHECK(c.output.find("--drum-preset: 'crash' is a cymbal") != std::string::npos);
+    CHECK(c.output.find("the drum presets are paper, snare, tom, floor-tom, timpani, frame") !=
+          std::string::npos);
 }

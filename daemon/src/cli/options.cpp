@@ -38,7 +38,12 @@ void apply_drum_preset(const std::string &option, const std::string &name, Perfo
     const membrane_preset *p = membrane_preset_find(name.c_str());
     if (!p)
         throw UsageError(option + ": unknown preset '" + name + "'; the presets are " +
-                         membrane_preset_names());
+                         membrane_preset_drum_names());
+    if (p->plate)
+        throw UsageError(option + ": '" + name +
+                         "' is a cymbal (a plate, membrane~'s preset for the sound), not a drum "
+                         "the physics can play; the drum presets are " +
+                         membrane_preset_drum_names());
     o.drum_preset = p->name;
     if (!(o.drum_given & kGivenRadius))
         o.scene.drum.radius_m = p->radius_m;

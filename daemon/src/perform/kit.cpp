@@ -127,9 +127,11 @@ void validate_kit(const Kit &kit)
                                "': expected lower-case letters, digits, '_' and '-' (1..32)");
         if (kit_drum_index(kit, d.name) != static_cast<int>(i))
             throw PerformError(who + "the name is given twice");
-        if (!membrane_preset_find(d.preset.c_str()))
-            throw PerformError(who + "unknown preset '" + d.preset +
-                               "' (valid: " + membrane_preset_names() + ")");
+        const membrane_preset *preset = membrane_preset_find(d.preset.c_str());
+        if (!preset || preset->plate)
+            throw PerformError(who + (preset ? "preset '" + d.preset + "' is a cymbal, not a drum"
+                                             : "unknown preset '" + d.preset + "'") +
+                               " (the drum presets: " + membrane_preset_drum_names() + ")");
         if (!(d.radius_m >= 0.05 && d.radius_m <= 1.0))
             throw PerformError(who + "radius must be 0.05..1 m");
         if (!(d.tension_n_per_m >= 10.0 && d.tension_n_per_m <= 1e5))
