@@ -59,6 +59,7 @@ membrane *membrane_new(double sample_rate_hz)
         m->kernel = membrane_kernel_avx2;
         m->kernel_pair = membrane_kernel_pair_avx2;
         m->tension_kernel = membrane_tension_kernel_avx2;
+        m->couplings_kernel = membrane_couplings_kernel_avx2;
         m->energy_kernel = membrane_energy_kernel_avx2;
     }
 #endif
@@ -89,6 +90,7 @@ void membrane_use_generic_kernel_(membrane *m)
     m->kernel = membrane_kernel_generic;
     m->kernel_pair = membrane_kernel_pair_generic;
     m->tension_kernel = membrane_tension_kernel_generic;
+    m->couplings_kernel = membrane_couplings_kernel_generic;
     m->energy_kernel = membrane_energy_kernel_generic;
 }
 
@@ -252,6 +254,8 @@ static inline __attribute__((always_inline)) int gather_points(membrane *m, memb
     for (int c = 0; c < m->point_count; c++) {
         membrane_point *pt = m->points[c];
         if (pt->active || pt->force_pending != 0.0) {
+            if (m->couplings_stale)
+                membrane_refresh_point_couplings_(m);
             act[na] = pt;
             a->point_psi[na] = pt->psi_k;
             a->point_force_pending[na] = (float)pt->force_pending;

@@ -399,9 +399,10 @@ double membrane_frequency_factor(const membrane *m)
 
 /* The coefficients of the sounding modes at factor g (float, as
  * membrane_update_coefficients_ makes them with w' = g wm0), the stored state converted
- * so that each mode's energy (q, p) is kept, and the shapes and couplings in the new sc:
- * one vector pass (membrane_kernel.inc). A point's residual compliance does not depend
- * on g and stays. */
+ * so that each mode's energy (q, p) is kept, and the pickups' shapes in the new sc: one
+ * vector pass (membrane_kernel.inc). The points' couplings follow when a point next
+ * takes part in a sample: no point does while the tension changes, and a head glides
+ * through ~100 updates between two strokes. */
 static void rebuild_coefficients(membrane *m, float g, int live)
 {
     membrane_tension_args a;
@@ -418,23 +419,10 @@ static void rebuild_coefficients(membrane *m, float g, int live)
         a.psi_pick[j] = m->psi_pick[j];
         a.pick_k[j] = m->pick_k[j];
     }
-    membrane_point *pts[MEMBRANE_MAX_POINTS];
-    for (int i = 0; i < m->point_count; i++) {
-        if (!m->points[i]->psi)
-            continue;
-        pts[a.points] = m->points[i];
-        a.psi[a.points] = m->points[i]->psi;
-        a.psi_k[a.points++] = m->points[i]->psi_k;
-    }
     m->tension_kernel(&a);
     for (int k = 0; k < live; k++)
         m->omega_model[k] = m->wm[k]; /* 0 for the silent modes, as wm */
-    const double scale = membrane_displacement_scale_(m);
-    for (int c = 0; c < a.points; c++) {
-        pts[c]->self_compliance = a.self_sum[c] * scale;
-        for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-            pts[c]->pick_coupling[j] = a.pick_coupling[c][j];
-    }
+    m->couplings_stale = m->point_count > 0;
 }
 
 int membrane_tension_update_(membrane *m)

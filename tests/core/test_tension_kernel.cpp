@@ -1,5 +1,6 @@
 // The tension update's vector kernels (membrane_kernel.inc): the rebuild of the
-// coefficients at a new frequency factor and the energy of the stored state, checked
+// coefficients at a new frequency factor, the points' couplings in the new coefficients
+// and the energy of the stored state, checked
 // against the midpoint rule's coefficients and the energy computed here in double, and
 // the AVX2+FMA copy against the portable one (bit for bit in float: the kernels keep
 // the scalar formulas' order and stop FMA contraction).
@@ -99,6 +100,7 @@ TEST_CASE("Tension rebuild: the midpoint rule's coefficients at g w0, each mode'
     fill(after, 11);
     membrane_tension_args a = after.args();
     membrane_tension_kernel_generic(&a);
+    membrane_couplings_kernel_generic(&a);
     double self[2] = {0, 0}, coupling[2][2] = {{0, 0}, {0, 0}};
     for (int k = 0; k < kCount; k++) {
         const bool live = k < kLive && before.wm[k] > 0.0f;
@@ -163,7 +165,9 @@ TEST_CASE("Tension rebuild and energy: the AVX2 kernels agree with the portable 
     CHECK(ey == Approx(ex).epsilon(1e-12));
     membrane_tension_args a = x.args(), b = y.args();
     membrane_tension_kernel_generic(&a);
+    membrane_couplings_kernel_generic(&a);
     membrane_tension_kernel_avx2(&b);
+    membrane_couplings_kernel_avx2(&b);
     size_t differ = 0;
     for (size_t i = 0; i < x.mem.all.size(); i++)
         differ += std::memcmp(x.mem.all[i], y.mem.all[i], sizeof(float) * kCount) != 0;
