@@ -53,22 +53,22 @@ membrane *membrane_new(double sample_rate_hz)
     m->pick_r[0] = 0.5;
     m->pick_r[1] = 0.5;
     m->pick_theta[1] = 90.0;
-    m->kernel = membrane_kernel_generic;
-    m->kernel_pair = membrane_kernel_pair_generic;
+    membrane_use_generic_kernel_(m);
 #if defined(MEMBRANE_X86) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
     __builtin_cpu_init();
     if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
         m->kernel = membrane_kernel_avx2;
         m->kernel_pair = membrane_kernel_pair_avx2;
+        m->tension_kernel = membrane_tension_kernel_avx2;
+        m->couplings_kernel = membrane_couplings_kernel_avx2;
+        m->energy_kernel = membrane_energy_kernel_avx2;
     }
 #endif
     /* ICTUS_MEMBRANE_KERNEL=generic picks the portable kernel on any machine, e.g.
      * to benchmark it inside Pd (bench/peers); read when the object is made. */
     const char *want = getenv("ICTUS_MEMBRANE_KERNEL");
-    if (want && strcmp(want, "generic") == 0) {
-        m->kernel = membrane_kernel_generic;
-        m->kernel_pair = membrane_kernel_pair_generic;
-    }
+    if (want && strcmp(want, "generic") == 0)
+        membrane_use_generic_kernel_(m);
     if (membrane_build_modes_(m, MEMBRANE_DEFAULT_MODES) != ICTUS_OK) {
         membrane_free(m);
         return NULL;
@@ -90,6 +90,9 @@ void membrane_use_generic_kernel_(membrane *m)
 {
     m->kernel = membrane_kernel_generic;
     m->kernel_pair = membrane_kernel_pair_generic;
+    m->tension_kernel = membrane_tension_kernel_generic;
+    m->couplings_kernel = membrane_couplings_kernel_generic;
+    m->energy_kernel = membrane_energy_kernel_generic;
 }
 
 const char *membrane_kernel_name(const membrane *m)
@@ -252,6 +255,8 @@ static inline __attribute__((always_inline)) int gather_points(membrane *m, memb
     for (int c = 0; c < m->point_count; c++) {
         membrane_point *pt = m->points[c];
         if (pt->active || pt->force_pending != 0.0) {
+            if (m->couplings_stale)
+                membrane_refresh_point_couplings_(m);
             act[na] = pt;
             a->point_psi[na] = pt->psi_k;
             a->point_force_pending[na] = (float)pt->force_pending;
@@ -357,6 +362,7 @@ static void block_end(membrane *m, int n)
         m->c1[k] = m->cd[k] = m->c3[k] = m->ep[k] = 0.0f;
         m->sc[k] = m->ep_k[k] = 0.0f;
         m->omega_model[k] = 0.0;
+        m->wm[k] = 0.0f;
     }
     m->fading_modes = m->modes;
     m->count = membrane_padded_(m->modes);

@@ -44,10 +44,39 @@ typedef struct membrane_kernel_args {
     double pick_sum2[MEMBRANE_PICKUPS];
 } membrane_kernel_args;
 
+/* Arguments of the tension update's rebuild (membrane_kernel.inc, membrane_modes.c): the
+ * coefficients of the sounding modes at w' = g wm0, the state converted so that each
+ * mode's energy is kept and the pickups' shapes in the new sc, in one pass; and of the
+ * couplings kernel: the points' shapes in sc and their sums over sc and ep. */
+typedef struct membrane_tension_args {
+    int count;       /* lanes to run, a multiple of MEMBRANE_PAD */
+    int live;        /* modes below this whose wm is > 0 are rebuilt (the sounding ones) */
+    float g, h, ept; /* frequency factor, T / 2, scale T (ep = scale T / D) */
+    const float *wm0, *sm0;
+    float *wm; /* w' now (0: silent), in and out */
+    float *q, *p, *c1, *cd, *c3, *ep, *sc, *ep_k;
+    const float *psi_pick[MEMBRANE_PICKUPS];
+    float *pick_k[MEMBRANE_PICKUPS]; /* out: psi_pick sc */
+    int points;
+    const float *psi[MEMBRANE_MAX_POINTS];
+    float *psi_k[MEMBRANE_MAX_POINTS];                           /* out: psi sc */
+    double self_sum[MEMBRANE_MAX_POINTS];                        /* out: sum psi^2 ep */
+    double pick_coupling[MEMBRANE_MAX_POINTS][MEMBRANE_PICKUPS]; /* out: sum psi_pick psi ep */
+} membrane_tension_args;
+
 void membrane_kernel_generic(membrane_kernel_args *a);
 void membrane_kernel_avx2(membrane_kernel_args *a);
 void membrane_kernel_pair_generic(membrane_kernel_args *a);
 void membrane_kernel_pair_avx2(membrane_kernel_args *a);
+void membrane_tension_kernel_generic(membrane_tension_args *a);
+void membrane_tension_kernel_avx2(membrane_tension_args *a);
+void membrane_couplings_kernel_generic(membrane_tension_args *a);
+void membrane_couplings_kernel_avx2(membrane_tension_args *a);
+/* Energy (J) of modes 0 .. live-1 from the stored state: sum (h wm sc q)^2 + (sc p)^2, / 2. */
+double membrane_energy_kernel_generic(const float *q, const float *p, const float *wm,
+                                      const float *sc, float h, int live);
+double membrane_energy_kernel_avx2(const float *q, const float *p, const float *wm, const float *sc,
+                                   float h, int live);
 
 /* Benchmarks only: run the portable kernel even on an AVX2 machine. */
 void membrane_use_generic_kernel_(membrane *m);
@@ -113,8 +142,9 @@ struct membrane {
     mode_tuning tuning;  /* frequency and decay corrections (count 0: the ideal membrane) */
     double *omega_model; /* model stiffness w' per mode (0: silent) */
     /* w' and the damping s' of each mode at the base tension T0 (float, for the
-     * tension update's vector loop); w' = tm_g wm0 for the sounding modes. */
-    float *wm0, *sm0;
+     * tension update's vector loop); w' = tm_g wm0 for the sounding modes. wm is
+     * omega_model in float (0: silent), what the tension update reads and writes. */
+    float *wm0, *sm0, *wm;
     /* SoA float state and coefficients (see membrane_kernel.inc): q holds the
      * scaled displacement r = q / (h w'), h = T / 2 (the energy coordinate q is
      * h w' r); cd = 2 / D is r's coefficient of p; ep the input gain of both. */
@@ -124,6 +154,10 @@ struct membrane {
      * psi_k = psi sc (membrane_kernel.inc). */
     float *sc, *ep_k, *pick_k[MEMBRANE_PICKUPS];
     double coef_h; /* h of the coefficients (and of r) now in place */
+    /* The tension update changed sc and ep since the points' couplings (psi_k,
+     * self_compliance, pick_coupling) were computed: they are brought up to date before
+     * a point next takes part in a sample (membrane_refresh_point_couplings_). */
+    int couplings_stale;
     float *psi_strike, *psi_pick[MEMBRANE_PICKUPS];
     /* A moved pickup crossfades from its old shapes over a few ms (no click). */
     float *psi_pick_old[MEMBRANE_PICKUPS];
@@ -140,6 +174,9 @@ struct membrane {
     int point_count;
     void (*kernel)(membrane_kernel_args *);
     void (*kernel_pair)(membrane_kernel_args *); /* two samples per pass, same instruction set */
+    void (*tension_kernel)(membrane_tension_args *); /* the same instruction set again */
+    void (*couplings_kernel)(membrane_tension_args *);
+    double (*energy_kernel)(const float *, const float *, const float *, const float *, float, int);
 };
 
 /* Aligned, zeroed floats for the kernels (NULL when memory cannot be had). Allocates. */
@@ -208,6 +245,9 @@ void membrane_flush_points_(membrane *m);
 /* The shapes and couplings in the kernel's coordinates, after the coefficients, the
  * pickups or the shapes changed. */
 void membrane_refresh_couplings_(membrane *m);
+/* The points' couplings after the tension update changed sc and ep (audio thread: no
+ * allocation, O(modes)); a point's residual compliance does not depend on them. */
+void membrane_refresh_point_couplings_(membrane *m);
 /* The cached input shapes at (r, theta), computed into the cache when missing. */
 impulse_shape *membrane_impulse_shape_(membrane *m, double r, double theta);
 /* An impulse of `force` N over one sample along psi, after the kernel's step. */

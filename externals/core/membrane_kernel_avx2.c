@@ -3,4 +3,7 @@
  * when __builtin_cpu_supports says the CPU has both. */
 #define KERNEL_NAME      membrane_kernel_avx2
 #define KERNEL_PAIR_NAME membrane_kernel_pair_avx2
+#define KERNEL_TENSION_NAME membrane_tension_kernel_avx2
+#define KERNEL_COUPLINGS_NAME membrane_couplings_kernel_avx2
+#define KERNEL_ENERGY_NAME  membrane_energy_kernel_avx2
 #include "membrane_kernel.inc"

@@ -97,6 +97,7 @@ void membrane_update_coefficients_(membrane *m, int rescale)
             m->sc[k] = m->ep_k[k] = 0.0f;
             m->q[k] = m->p[k] = 0.0f;
             m->omega_model[k] = 0.0;
+            m->wm[k] = 0.0f;
             continue;
         }
         double omega = 2.0 * M_PI * freq;
@@ -142,6 +143,7 @@ void membrane_update_coefficients_(membrane *m, int rescale)
             m->q[k] = m->p[k] = 0.0f;
         }
         m->omega_model[k] = wm;
+        m->wm[k] = (float)wm;
     }
 }
 
@@ -164,6 +166,7 @@ enum {
     ARR_PICK_K1,
     ARR_WM0,
     ARR_SM0,
+    ARR_WM,
     ARR_COUNT
 };
 
@@ -232,7 +235,7 @@ void membrane_free_mode_arrays_(membrane *m)
     free(m->q), free(m->p), free(m->c1), free(m->cd), free(m->c3);
     free(m->ep), free(m->psi_strike);
     free(m->sc), free(m->ep_k);
-    free(m->wm0), free(m->sm0);
+    free(m->wm0), free(m->sm0), free(m->wm);
     for (int i = 0; i < MEMBRANE_PICKUPS; i++) {
         free(m->psi_pick[i]);
         free(m->psi_pick_old[i]);
@@ -253,6 +256,7 @@ static void mode_arrays_install(membrane *m, mode_arrays *a, int cap)
         memcpy(f[ARR_Q], m->q, sizeof(float) * (size_t)keep);
         memcpy(f[ARR_P], m->p, sizeof(float) * (size_t)keep);
         memcpy(f[ARR_SC], m->sc, sizeof(float) * (size_t)keep); /* the state's scale */
+        memcpy(f[ARR_WM], m->wm, sizeof(float) * (size_t)keep);
         memcpy(a->omega_model, m->omega_model, sizeof(double) * (size_t)keep);
     }
     membrane_free_mode_arrays_(m);
@@ -270,7 +274,7 @@ static void mode_arrays_install(membrane *m, mode_arrays *a, int cap)
     m->sc = f[ARR_SC], m->ep_k = f[ARR_EP_K];
     m->pick_k[0] = f[ARR_PICK_K0];
     m->pick_k[1] = f[ARR_PICK_K1];
-    m->wm0 = f[ARR_WM0], m->sm0 = f[ARR_SM0];
+    m->wm0 = f[ARR_WM0], m->sm0 = f[ARR_SM0], m->wm = f[ARR_WM];
     for (int i = 0; i < MEMBRANE_PICKUPS; i++)
         m->pick_fade_left[i] = 0;
     for (int i = 0; i < IMPULSE_CACHE; i++) {
@@ -413,53 +417,36 @@ double membrane_frequency_factor(const membrane *m)
     return m->tm_g;
 }
 
-/* Energy of the sounding modes (J) from the stored state, without the pending
- * point forces (the caller has flushed them). */
-static double stored_energy(const membrane *m)
+/* The coefficients of the sounding modes at factor g (float, as
+ * membrane_update_coefficients_ makes them with w' = g wm0), the stored state converted
+ * so that each mode's energy (q, p) is kept, and the pickups' shapes in the new sc: one
+ * vector pass (membrane_kernel.inc). The points' couplings follow when a point next
+ * takes part in a sample: no point does while the tension changes, and a head glides
+ * through ~100 updates between two strokes. */
+static void rebuild_coefficients(membrane *m, float g, int live)
 {
-    const float h = (float)m->coef_h;
-    double e = 0.0;
-    for (int k = 0; k < m->modes && k < m->count; k++) {
-        float hw = h * (float)m->omega_model[k] * m->sc[k];
-        float pk = m->sc[k] * m->p[k], qk = hw * m->q[k];
-        e += 0.5 * ((double)qk * qk + (double)pk * pk);
+    membrane_tension_args a;
+    memset(&a, 0, sizeof(a));
+    a.count = m->count;
+    a.live = live;
+    a.g = g;
+    a.h = (float)m->coef_h;
+    a.ept = (float)(m->mass_scale / m->sample_rate); /* ep = scale T / D */
+    a.wm0 = m->wm0, a.sm0 = m->sm0, a.wm = m->wm;
+    a.q = m->q, a.p = m->p, a.c1 = m->c1, a.cd = m->cd, a.c3 = m->c3;
+    a.ep = m->ep, a.sc = m->sc, a.ep_k = m->ep_k;
+    for (int j = 0; j < MEMBRANE_PICKUPS; j++) {
+        a.psi_pick[j] = m->psi_pick[j];
+        a.pick_k[j] = m->pick_k[j];
     }
-    return e;
-}
-
-/* The coefficients of the sounding modes at factor g, the stored state converted so
- * that each mode's energy (q, p) is kept, and the pickups' shapes in the new sc.
- * Float: the coefficients as membrane_update_coefficients_ makes them, with w' = g wm0. */
-static void rebuild_coefficients(membrane *m, float g)
-{
-    const float h = (float)m->coef_h;
-    const float ept = (float)(m->mass_scale / m->sample_rate); /* ep = scale T / D */
-    const int n = m->modes < m->count ? m->modes : m->count;
-    for (int k = 0; k < n; k++) {
-        if (m->omega_model[k] <= 0.0)
-            continue;
-        float wm = g * m->wm0[k], hw = h * wm, hs = h * m->sm0[k];
-        float hw2 = hw * hw, d = 1.0f + 2.0f * hs + hw2, inv = 1.0f / d;
-        float y = sqrtf(2.0f * inv);
-        float old_sc = m->sc[k], old_w = (float)m->omega_model[k];
-        m->c1[k] = 2.0f * hw2 * inv;
-        m->cd[k] = 2.0f * inv;
-        m->c3[k] = (2.0f * hw2 + 4.0f * hs) * inv;
-        m->ep[k] = ept * inv;
-        m->sc[k] = y;
-        m->ep_k[k] = 0.5f * ept * y; /* ep / sc = (scale T / D) sqrt(D / 2) */
-        /* q = h w' sc (stored r) and p = sc (stored p) are kept. */
-        m->q[k] *= (old_w * old_sc) / (wm * y);
-        m->p[k] *= old_sc / y;
-        m->omega_model[k] = wm;
-    }
+    m->tension_kernel(&a);
+    for (int k = 0; k < live; k++)
+        m->omega_model[k] = m->wm[k]; /* 0 for the silent modes, as wm */
+    m->couplings_stale = m->point_count > 0;
 }
 
 int membrane_tension_update_(membrane *m)
 {
-    const double kappa = membrane_tension_kappa(m);
-    if (kappa <= 0.0 && m->tm_g == 1.0)
-        return 1;
     /* Not during a stroke (a stick touching, or flying close above the head): the
      * update keeps each mode's energy, so the displacement under the stick moves by a
      * fraction of the change of g, which a stiff contact would turn into a force step
@@ -468,7 +455,13 @@ int membrane_tension_update_(membrane *m)
     for (int i = 0; i < m->point_count; i++)
         if (m->points[i]->active || m->points[i]->force_pending != 0.0)
             return 0;
-    double g = sqrt(1.0 + kappa * stored_energy(m));
+    const double kappa = membrane_tension_kappa(m);
+    if (kappa <= 0.0 && m->tm_g == 1.0)
+        return 1;
+    /* The sounding modes: the fading ones take no part. */
+    const int live = m->modes < m->count ? m->modes : m->count;
+    double e = m->energy_kernel(m->q, m->p, m->wm, m->sc, (float)m->coef_h, live);
+    double g = sqrt(1.0 + kappa * e);
     if (!(g <= TM_G_MAX))
         g = TM_G_MAX; /* also NaN */
     if (fabs(g - m->tm_g) <= TM_THRESHOLD * m->tm_g && !(g == 1.0 && m->tm_g != 1.0))
@@ -476,7 +469,6 @@ int membrane_tension_update_(membrane *m)
     if (fabs(g - 1.0) <= TM_THRESHOLD)
         g = 1.0;
     m->tm_g = g;
-    rebuild_coefficients(m, (float)g);
-    membrane_refresh_couplings_(m);
+    rebuild_coefficients(m, (float)g, live);
     return 1;
 }

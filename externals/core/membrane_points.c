@@ -73,10 +73,38 @@ static void point_couplings(membrane *m, membrane_point *pt)
         pt->psi_k[k] = pt->psi[k] * m->sc[k];
 }
 
+void membrane_refresh_point_couplings_(membrane *m)
+{
+    membrane_tension_args a;
+    memset(&a, 0, sizeof(a));
+    a.count = m->count;
+    a.sc = m->sc, a.ep = m->ep;
+    for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+        a.psi_pick[j] = m->psi_pick[j];
+    membrane_point *pts[MEMBRANE_MAX_POINTS];
+    for (int i = 0; i < m->point_count; i++) {
+        if (!m->points[i]->psi)
+            continue;
+        pts[a.points] = m->points[i];
+        a.psi[a.points] = m->points[i]->psi;
+        a.psi_k[a.points++] = m->points[i]->psi_k;
+    }
+    if (a.points > 0)
+        m->couplings_kernel(&a);
+    const double scale = membrane_displacement_scale_(m);
+    for (int c = 0; c < a.points; c++) {
+        pts[c]->self_compliance = a.self_sum[c] * scale;
+        for (int j = 0; j < MEMBRANE_PICKUPS; j++)
+            pts[c]->pick_coupling[j] = a.pick_coupling[c][j];
+    }
+    m->couplings_stale = 0;
+}
+
 void membrane_refresh_couplings_(membrane *m)
 {
     if (!m->sc)
         return;
+    m->couplings_stale = 0;
     for (int j = 0; j < MEMBRANE_PICKUPS; j++)
         for (int k = 0; k < m->capacity; k++)
             m->pick_k[j][k] = m->psi_pick[j][k] * m->sc[k];
