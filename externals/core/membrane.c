@@ -83,6 +83,7 @@ void membrane_free(membrane *m)
     while (m->point_count > 0)
         membrane_point_detach_(m, m->points[m->point_count - 1]);
     membrane_free_mode_arrays_(m);
+    membrane_cascade_free_(m);
     free(m);
 }
 
@@ -140,6 +141,7 @@ void membrane_clear(membrane *m)
         pt->force_pending = 0.0;
         pt->ops->cleared(pt);
     }
+    membrane_cascade_cleared_(m);
 }
 
 /* ---------------------------------------------------------------- process */
@@ -211,6 +213,8 @@ static int pair_ok(const membrane *m, const float *force_in, int i, int n, int n
 {
     if (i + 1 >= n || next_landing == i + 1 || m->pick_fade_left[0] > 0 || m->pick_fade_left[1] > 0)
         return 0;
+    if (m->cascade_on)
+        return 0; /* the cascade runs after every sample */
     if (m->tm_countdown == 1 && (m->tension_mod > 0.0 || m->tm_g != 1.0))
         return 0; /* a tension update comes before sample i + 1 */
     if (force_in && (force_in[i] != 0.0f || force_in[i + 1] != 0.0f))
@@ -266,16 +270,19 @@ static inline __attribute__((always_inline)) int gather_points(membrane *m, memb
     return na;
 }
 
-/* The queued strikes landing at sample i, in queue order. */
-static inline void land_strikes(membrane *m, int i, double T, membrane_kernel_args *a)
+/* The queued strikes landing at sample i, in queue order; 1 when one did. */
+static inline int land_strikes(membrane *m, int i, double T, membrane_kernel_args *a)
 {
+    int landed = 0;
     for (int s = 0; s < m->queued; s++) {
         if (m->queue[s].offset != i)
             continue;
         const impulse_shape *shape =
             membrane_impulse_shape_(m, m->queue[s].r_over_a, m->queue[s].theta_deg);
         membrane_add_input_(m, shape->psi, m->queue[s].impulse_ns / T, a);
+        landed = 1;
     }
+    return landed;
 }
 
 /* Solves the forces of the active points among act[0..na) for sample i (their
@@ -425,8 +432,10 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             m->tm_countdown--;
         for (int c = 0; c < na; c++)
             act[c]->force_pending = 0.0;
-        land_strikes(m, i, T, &a);
+        int struck = land_strikes(m, i, T, &a);
         double extra[MEMBRANE_PICKUPS] = {0};
+        if (m->cascade_on)
+            membrane_cascade_step_(m, &a, struck || na > 0 || fin != 0.0f, extra, picks);
         solve_points(m, act, na, &a, wscale, T, i, extra);
         emit_sample(m, a.pick_sum, extra, picks, out, i, gain_coef);
     }

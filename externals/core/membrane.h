@@ -55,6 +55,8 @@ extern "C" {
 #define MEMBRANE_PATCH_MAX       0.05
 #define MEMBRANE_BENDING_MIN     1.0e-3 /* N m: a plate's bending stiffness (membrane_set_plate) */
 #define MEMBRANE_BENDING_MAX     1.0e4
+#define MEMBRANE_CASCADE_MIN     0.0 /* 0: a linear plate */
+#define MEMBRANE_CASCADE_MAX     10.0
 #define MEMBRANE_GAIN_MIN       -1.0e6 /* s/m; negative inverts */
 #define MEMBRANE_GAIN_MAX       1.0e6
 #define MEMBRANE_R_OVER_A_MIN   0.0 /* points: pickups, strikes, contacts */
@@ -87,6 +89,8 @@ extern "C" {
 /* A plate's bending stiffness D = E h^3 / (12 (1 - nu^2)): 1 mm of bronze (E 100 GPa,
  * nu 0.33); a membrane does not use it. */
 #define MEMBRANE_DEFAULT_BENDING     9.35
+/* A plate's von Karman cascade (docs/plates.md, "The cascade"): 0 off, 1 bronze. */
+#define MEMBRANE_DEFAULT_CASCADE     0.0
 #define MEMBRANE_PATCH_BEAD          0.007
 #define MEMBRANE_AIR_RHO             1.2   /* kg/m^3 */
 #define MEMBRANE_AIR_C               343.0 /* m/s */
@@ -130,6 +134,9 @@ typedef enum membrane_param {
     MEMBRANE_PARAM_PATCH,
     /* N m: the bending stiffness D of a plate (membrane_set_plate); a membrane ignores it */
     MEMBRANE_PARAM_BENDING,
+    /* A plate's nonlinear cascade: a factor on the von Karman stretching stiffness E h
+     * (1 = the bronze plate of that D and density; 0 = linear); a membrane ignores it */
+    MEMBRANE_PARAM_CASCADE,
     MEMBRANE_PARAM_COUNT
 } membrane_param;
 
@@ -199,6 +206,9 @@ double membrane_displacement_at(const membrane *m, double r_over_a, double theta
 double membrane_velocity_at(const membrane *m, double r_over_a, double theta_deg);
 /* Total vibrational energy of the modes (J). */
 double membrane_energy(const membrane *m);
+/* A plate's nonlinear potential (J) in its cascade (docs/plates.md, "The cascade"): the
+ * scheme's psi^2 / 2 less its floor; 0 without a cascade. */
+double membrane_cascade_energy(const membrane *m);
 /* Tension modulation: the coefficient kappa (1/J) of T = T0 (1 + kappa E) at the
  * current parameters (tensionmod included), and the frequency factor sqrt(T / T0)
  * the modes ring with now (1 for a linear head). */

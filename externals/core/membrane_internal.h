@@ -123,6 +123,11 @@ struct membrane {
      * and do nothing. */
     int plate;
     double bending;
+    /* A plate's von Karman cascade (membrane_cascade.c): the factor on E h, the coupling
+     * built at message time, and whether the processing loop runs it. */
+    double cascade;
+    struct plate_cascade *pc;
+    int cascade_on;
     /* The radiation integral of each mode depends on ka = j c / c_air alone: kept for
      * rad_valid modes at the wave speed rad_c (recomputed when either changes). */
     double *rad_int, rad_c;
@@ -238,6 +243,18 @@ void membrane_free_mode_arrays_(membrane *m);
  * couplings. Audio thread: no allocation, O(modes). 0 when it has to wait (a point
  * carries a force), 1 when done. */
 int membrane_tension_update_(membrane *m);
+
+/* membrane_cascade.c. Builds the coupling (message time: allocates) and sets it to the
+ * physics and the state now; off unless a plate with cascade > 0 and enough modes. */
+void membrane_cascade_refresh_(membrane *m);
+void membrane_cascade_free_(membrane *m);
+/* The state was cleared or set from outside: the cascade's variables follow it. */
+void membrane_cascade_cleared_(membrane *m);
+/* One sample of the coupling, after the kernel's step and the strikes (audio thread: no
+ * allocation); input: a force acted on the plate this sample. Its force's direct path to
+ * the pickups goes into extra, to the points' displacements into a->point_w. */
+void membrane_cascade_step_(membrane *m, membrane_kernel_args *a, int input, double *extra,
+                            int picks);
 
 /* membrane_points.c. The points' pending forces into the state (message time only:
  * before coefficients or shapes change). */

@@ -145,6 +145,7 @@ void membrane_update_coefficients_(membrane *m, int rescale)
         m->omega_model[k] = wm;
         m->wm[k] = (float)wm;
     }
+    membrane_cascade_refresh_(m); /* a plate's cascade follows the physics and the state */
 }
 
 /* The float arrays of the modal state and coefficients, in their order in memory. */

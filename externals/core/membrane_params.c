@@ -132,6 +132,7 @@ static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
     [MEMBRANE_PARAM_PATCH] = {"patch", "m", RANGE(PATCH), FIELD(patch), geometry_changed},
     [MEMBRANE_PARAM_BENDING] = {"bending", "N m", RANGE(BENDING), FIELD(bending),
                                 physics_changed},
+    [MEMBRANE_PARAM_CASCADE] = {"cascade", "", RANGE(CASCADE), FIELD(cascade), physics_changed},
 };
 #undef RANGE
 #undef FIELD

@@ -1,0 +1,138 @@
+/* membrane_cascade.c -- a plate's von Karman cascade in the modal loop (plate_cascade.h;
+ * docs/plates.md, "The cascade").
+ *
+ * The scheme: the nonlinear force -dV/dY on the coupled modes is written as -g psi with
+ * psi an auxiliary variable, psi^2 / 2 = V + floor, and g = dV/dY / psi taken from the
+ * state at the start of the sample (the scalar auxiliary variable method: X. Yang,
+ * J. Comput. Phys. 327, 2016; for modal plates M. Ducceschi, S. Bilbao, "Simulation of
+ * the geometrically exact nonlinear string via energy quadratisation", JSV 534, 2022).
+ * Over one sample the force is -g (psi + psi+) / 2 and psi+ = psi + g . (Y+ - Y). The
+ * linear step is the kernel's midpoint rule, in which a force f held over the sample
+ * moves Y by b f more (b = h^2 cd) and does the work f . (Y+ - Y); psi^2 / 2 changes by
+ * exactly minus that work. So the linear energy plus psi^2 / 2 is conserved by the
+ * coupling whatever g is, and only the modes' damping and the stick change it: no
+ * energy is created at any amplitude. The force is solved in closed form (one scalar
+ * equation) and folded into the state after the kernel's step, like a stick's force;
+ * its direct path to the pickups and to the sticks' displacements goes with it. */
+#include "membrane_internal.h"
+#include "plate_cascade.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* The reduced model: the lowest CASCADE_MODES transverse modes, the in-plane modes with
+ * zeta below CASCADE_ZETA_MAX, entries of H above CASCADE_TOL of the largest. */
+#define CASCADE_MODES    32
+#define CASCADE_ZETA_MAX 8.0
+#define CASCADE_TOL      1e-2
+/* kg/m^3: cymbal bronze, for the thickness h = density / rho of E h (docs/plates.md) */
+#define CASCADE_BRONZE_RHO 8600.0
+
+void membrane_cascade_free_(membrane *m)
+{
+    if (m->pc) {
+        plate_cascade_free(m->pc);
+        free(m->pc);
+        m->pc = NULL;
+    }
+    m->cascade_on = 0;
+}
+
+/* Y of the coupled modes from the stored state, the auxiliary variable from V there,
+ * and g for the next sample. */
+static void anchor(membrane *m)
+{
+    plate_cascade *c = m->pc;
+    const float h = (float)m->coef_h;
+    for (int k = 0; k < c->modes; k++)
+        c->y[k] = h * m->sc[k] * m->q[k];
+    double v = plate_cascade_potential(c, c->y, c->g);
+    c->psi = sqrt(2.0 * (v + c->floor));
+    for (int k = 0; k < c->modes; k++)
+        c->g[k] = (float)(c->g[k] / c->psi);
+}
+
+void membrane_cascade_refresh_(membrane *m)
+{
+    m->cascade_on = 0;
+    if (!m->plate || !(m->cascade > 0.0) || m->modes < CASCADE_MODES || !m->table.plate)
+        return;
+    if (!m->pc) {
+        plate_cascade *c = calloc(1, sizeof(plate_cascade));
+        if (!c || plate_cascade_build(c, &m->table, CASCADE_MODES, CASCADE_ZETA_MAX, CASCADE_TOL) !=
+                      ICTUS_OK) {
+            free(c);
+            return;
+        }
+        m->pc = c;
+    }
+    /* E h from D = E h^3 / (12 (1 - nu^2)) and h = density / rho */
+    const double nu = MODE_TABLE_PLATE_NU, h = m->density / CASCADE_BRONZE_RHO;
+    const double eh = 12.0 * (1.0 - nu * nu) * m->bending / (h * h);
+    plate_cascade_set_scale(m->pc, m->cascade * eh, m->radius, m->density);
+    anchor(m);
+    m->cascade_on = 1;
+}
+
+void membrane_cascade_cleared_(membrane *m)
+{
+    if (m->cascade_on)
+        anchor(m);
+}
+
+void membrane_cascade_step_(membrane *m, membrane_kernel_args *a, int input, double *extra,
+                            int picks)
+{
+    plate_cascade *c = m->pc;
+    const int n = c->modes;
+    const float h = (float)m->coef_h;
+    const double b0 = m->coef_h * m->coef_h;
+    double num = 0.0, den = 0.0;
+    for (int k = 0; k < n; k++) {
+        c->dy[k] = h * m->sc[k] * m->q[k] - c->y[k];
+        num += (double)c->g[k] * c->dy[k];
+        den += b0 * m->cd[k] * c->g[k] * c->g[k];
+    }
+    const double psibar = (c->psi + 0.5 * num) / (1.0 + 0.5 * den);
+    const float fh = (float)(-psibar * m->coef_h);
+    double ex[MEMBRANE_PICKUPS] = {0}, w[MEMBRANE_MAX_POINTS] = {0};
+    for (int k = 0; k < n; k++) {
+        const float u = fh * c->g[k] * m->sc[k]; /* f coef_h sc, into stored q and p */
+        m->q[k] += u;
+        m->p[k] += u;
+        c->y[k] = h * m->sc[k] * m->q[k];
+        for (int j = 0; j < picks; j++)
+            ex[j] += (double)a->psi_pick[j][k] * u;
+        for (int p = 0; p < a->points; p++)
+            w[p] += (double)a->point_psi[p][k] * u;
+    }
+    for (int j = 0; j < picks; j++)
+        extra[j] += ex[j];
+    for (int p = 0; p < a->points; p++)
+        a->point_w[p] += w[p];
+    c->psi = 2.0 * psibar - c->psi;
+    const double v = plate_cascade_potential(c, c->y, c->g);
+    const double s = sqrt(2.0 * (v + c->floor));
+    /* An input (a stroke) changed the state from outside the scheme: psi follows V. Else
+     * psi may only come down to V (never up: that would add energy). */
+    if (input || c->psi > s)
+        c->psi = s;
+    else if (c->psi < -s)
+        c->psi = -s;
+    if (!isfinite(c->psi) || !isfinite(v)) {
+        c->psi = sqrt(2.0 * c->floor);
+        for (int k = 0; k < n; k++)
+            c->g[k] = 0.0f;
+        return;
+    }
+    const float is = (float)(1.0 / s);
+    for (int k = 0; k < n; k++)
+        c->g[k] *= is;
+}
+
+double membrane_cascade_energy(const membrane *m)
+{
+    if (!m->cascade_on)
+        return 0.0;
+    return 0.5 * m->pc->psi * m->pc->psi - m->pc->floor;
+}
