@@ -166,7 +166,7 @@ double plate_cascade_h(const plate_mode *a, int a_sin, const plate_mode *i, int 
 void plate_cascade_free(plate_cascade *c)
 {
     free(c->ip), free(c->ip_sin), free(c->zeta4), free(c->row), free(c->col), free(c->val);
-    free(c->kappa), free(c->y), free(c->g), free(c->dy), free(c->t), free(c->used_row);
+    free(c->kappa), free(c->y), free(c->g), free(c->dy), free(c->t);
     memset(c, 0, sizeof(*c));
 }
 
@@ -291,56 +291,53 @@ ictus_status plate_cascade_build(plate_cascade *c, const mode_table *t, int mode
         kept += (fabs(l.h[e]) >= rel_tol * big) * (l.i[e] == l.j[e] ? 1 : 2);
     c->zeta4 = malloc(sizeof(double) * (size_t)(na + 1));
     c->kappa = calloc((size_t)(na + 1), sizeof(float));
-    c->row = calloc((size_t)(na * modes + 1), sizeof(int));
-    c->col = malloc(sizeof(int) * (size_t)(kept + 1));
-    c->val = malloc(sizeof(float) * (size_t)(kept + 1));
+    /* per in-plane mode, the columns j of H^a with an entry, each stored whole (modes
+     * floats): t_a = sum over them of Y_j H^a(:, j), a vector loop */
+    unsigned char *has = calloc((size_t)(na * modes + 1), 1);
+    int columns = 0;
+    for (int e = 0; has && e < l.n; e++) {
+        if (fabs(l.h[e]) < rel_tol * big)
+            continue;
+        for (int side = 0; side < 2; side++) {
+            const int r = l.a[e] * modes + (side ? l.i[e] : l.j[e]);
+            columns += !has[r];
+            has[r] = 1;
+        }
+    }
+    c->row = calloc((size_t)(na + 1), sizeof(int));
+    c->col = malloc(sizeof(int) * (size_t)(columns + 1));
+    c->val = calloc((size_t)columns * modes + 1, sizeof(float));
     c->t = calloc((size_t)(na * modes + 1), sizeof(float));
     c->y = calloc((size_t)modes, sizeof(float));
     c->g = calloc((size_t)modes, sizeof(float));
     c->dy = calloc((size_t)modes, sizeof(float));
-    if (big < 0.0 || !c->zeta4 || !c->kappa || !c->row || !c->col || !c->val || !c->t || !c->y ||
-        !c->g || !c->dy) {
-        free(l.a), free(l.i), free(l.j), free(l.h);
+    if (big < 0.0 || !has || !c->zeta4 || !c->kappa || !c->row || !c->col || !c->val || !c->t ||
+        !c->y || !c->g || !c->dy) {
+        free(l.a), free(l.i), free(l.j), free(l.h), free(has);
         plate_cascade_free(c);
         return ICTUS_ENOMEM;
     }
     c->modes = modes;
-    /* rows (a, i): count, then fill (H^a_ij at (a, i) and at (a, j)) */
-    for (int e = 0; e < l.n; e++) {
-        if (fabs(l.h[e]) < rel_tol * big)
-            continue;
-        c->row[l.a[e] * modes + l.i[e] + 1]++;
-        if (l.i[e] != l.j[e])
-            c->row[l.a[e] * modes + l.j[e] + 1]++;
+    int at = 0;
+    for (int a = 0; a < na; a++) {
+        c->row[a] = at;
+        for (int j = 0; j < modes; j++)
+            if (has[a * modes + j])
+                c->col[at++] = j;
     }
-    for (int r = 0; r < na * modes; r++)
-        c->row[r + 1] += c->row[r];
-    int *fill = c->t == NULL ? NULL : calloc((size_t)(na * modes + 1), sizeof(int));
-    if (!fill) {
-        free(l.a), free(l.i), free(l.j), free(l.h);
-        plate_cascade_free(c);
-        return ICTUS_ENOMEM;
-    }
+    c->row[na] = at;
+    free(has);
     for (int e = 0; e < l.n; e++) {
         if (fabs(l.h[e]) < rel_tol * big)
             continue;
         for (int side = 0; side < 1 + (l.i[e] != l.j[e]); side++) {
-            const int r = l.a[e] * modes + (side ? l.j[e] : l.i[e]);
-            const int at = c->row[r] + fill[r]++;
-            c->col[at] = side ? l.i[e] : l.j[e];
-            c->val[at] = (float)l.h[e];
+            const int j = side ? l.i[e] : l.j[e], i = side ? l.j[e] : l.i[e];
+            int k = c->row[l.a[e]];
+            while (c->col[k] != j)
+                k++;
+            c->val[(size_t)k * modes + i] = (float)l.h[e];
         }
     }
-    free(fill);
-    c->used_row = malloc(sizeof(int) * (size_t)(na * modes + 1));
-    if (!c->used_row) {
-        free(l.a), free(l.i), free(l.j), free(l.h);
-        plate_cascade_free(c);
-        return ICTUS_ENOMEM;
-    }
-    for (int r = 0; r < na * modes; r++)
-        if (c->row[r + 1] > c->row[r])
-            c->used_row[c->used++] = r;
     for (int a = 0; a < na; a++) {
         const double z2 = c->ip[a].lambda * c->ip[a].lambda;
         c->zeta4[a] = z2 * z2;
@@ -359,46 +356,65 @@ void plate_cascade_set_scale(plate_cascade *c, double eh, double radius, double 
     c->floor = 1e-12;
 }
 
-/* t_a = H^a Y row by row (each row's sum in a register: the rows are independent), then
- * phi_a = Y . t_a, V = sum kappa_a phi_a^2 and dV/dY = sum 4 kappa_a phi_a t_a; the dense
- * loops run on vectors of 8 (modes is a multiple of 8). */
-typedef float v8f __attribute__((vector_size(32)));
+/* t_a = H^a Y as a sum of H^a's columns with an entry, then phi_a = Y . t_a, V = sum
+ * kappa_a phi_a^2 and dV/dY = sum 4 kappa_a phi_a t_a. Vectors of 4 floats (SSE2: wider
+ * ones would be register pairs spilled to the stack), 32 rows at a time in registers;
+ * modes is a multiple of 8. */
+typedef float v4f __attribute__((vector_size(16)));
+static inline v4f LD4(const float *p)
+{
+    v4f v;
+    memcpy(&v, p, sizeof(v));
+    return v;
+}
+
+static void columns_times(const plate_cascade *c, const float *y)
+{
+    const int n = c->modes;
+    for (int a = 0; a < c->inplane; a++) {
+        for (int k0 = 0; k0 < n; k0 += 32) {
+            v4f acc[8] = {{0}, {0}, {0}, {0}, {0}, {0}, {0}, {0}};
+            const int w = n - k0 >= 32 ? 8 : (n - k0) / 4;
+            for (int e = c->row[a]; e < c->row[a + 1]; e++) {
+                const float yj = y[c->col[e]];
+                const v4f yv = {yj, yj, yj, yj};
+                const float *col = c->val + (size_t)e * n + k0;
+                if (w == 8) {
+                    for (int k = 0; k < 8; k++)
+                        acc[k] += yv * LD4(col + 4 * k);
+                } else {
+                    for (int k = 0; k < w; k++)
+                        acc[k] += yv * LD4(col + 4 * k);
+                }
+            }
+            memcpy(c->t + (size_t)a * n + k0, acc, sizeof(v4f) * (size_t)w);
+        }
+    }
+}
+
 double plate_cascade_potential(const plate_cascade *c, const float *y, float *grad)
 {
     const int n = c->modes;
-    for (int u = 0; u < c->used; u++) { /* the empty rows' t stay 0 */
-        const int r = c->used_row[u];
-        float s = 0.0f;
-        for (int e = c->row[r]; e < c->row[r + 1]; e++)
-            s += c->val[e] * y[c->col[e]];
-        c->t[r] = s;
-    }
+    columns_times(c, y);
     double v = 0.0;
-    v8f gv[PLATE_CASCADE_MAX_MODES / 8];
-    for (int k = 0; k < n / 8; k++)
-        gv[k] = (v8f){0};
+    if (grad)
+        memset(grad, 0, sizeof(float) * (size_t)n);
     for (int a = 0; a < c->inplane; a++) {
         const float *t = c->t + (size_t)a * n;
-        v8f acc = {0};
-        for (int k = 0; k < n; k += 8) {
-            v8f yv, tv;
-            memcpy(&yv, y + k, sizeof(yv));
-            memcpy(&tv, t + k, sizeof(tv));
-            acc += yv * tv;
-        }
-        float phi = 0.0f;
-        for (int k = 0; k < 8; k++)
-            phi += acc[k];
+        v4f acc = {0};
+        for (int k = 0; k < n; k += 4)
+            acc += LD4(y + k) * LD4(t + k);
+        const float phi = (acc[0] + acc[1]) + (acc[2] + acc[3]);
         v += (double)c->kappa[a] * phi * phi;
+        if (!grad)
+            continue;
         const float s = 4.0f * c->kappa[a] * phi;
-        for (int k = 0; k < n; k += 8) {
-            v8f tv;
-            memcpy(&tv, t + k, sizeof(tv));
-            gv[k / 8] += s * tv;
+        const v4f sv = {s, s, s, s};
+        for (int k = 0; k < n; k += 4) {
+            const v4f gk = LD4(grad + k) + sv * LD4(t + k);
+            memcpy(grad + k, &gk, sizeof(gk));
         }
     }
-    if (grad)
-        memcpy(grad, gv, sizeof(float) * (size_t)n);
     return v;
 }
 

@@ -30,9 +30,9 @@ typedef struct plate_cascade {
     plate_mode *ip;
     int *ip_sin;
     double *zeta4;
-    /* H as sparse rows: row a modes + i holds H^a_ij at col[row[.] .. row[. + 1] - 1] */
+    /* H by columns: in-plane mode a has the columns col[row[a] .. row[a + 1] - 1] with an
+     * entry, column e (H^a_ij over i) at val + e modes */
     int *row, *col;
-    int used, *used_row; /* the rows with entries */
     float *val;
     float *kappa;
     /* the scheme's state (membrane_cascade.c) and scratch; t = H^a Y, inplane x modes */

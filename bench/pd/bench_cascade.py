@@ -1,0 +1,51 @@
+"""The crash's cascade in real Pd: what membrane~ "preset crash" costs with its cascade
+(cascade 1, the preset's) and without (cascade 0, the linear plate), each with its own
+contact~ (a 13.8 g stick, wood tip, 6 m/s at r/a 0.9, every 250 ms, so that the plate
+rings throughout), in `pd -batch` at 48 kHz, in one run of the script:
+
+    share of one core = (t_crash - t_empty) / S
+
+with t the CPU time (user + sys) of pd, best of R runs (pdbench.Bench), and the ratio of
+the two. Usage: bench_cascade.py BUILD_DIR [--runs R] [--seconds S]"""
+import argparse
+import os
+import shutil
+import tempfile
+
+from pdbench import Bench
+
+ap = argparse.ArgumentParser()
+ap.add_argument("build")
+ap.add_argument("--runs", type=int, default=3)
+ap.add_argument("--sr", type=int, default=48000)
+ap.add_argument("--seconds", type=float, default=20.0)
+args = ap.parse_args()
+lib = os.path.join(os.path.abspath(args.build), "ictus")
+work = tempfile.mkdtemp(prefix="ictus-bench-cascade-")
+bench = Bench(lib, args.sr, args.runs, work)
+
+
+def crash(cascade):
+    def body(lines, i):
+        lines.append("#X obj 200 10 membrane~ bench-crash;")  # i
+        lines.append("#X msg 200 40 preset crash \\, cascade %d;" % cascade)  # i+1
+        lines.append("#X obj 200 70 contact~ bench-crash;")  # i+2
+        lines.append("#X msg 200 100 tip wood \\, mass 0.0138 \\, hit 6 0.9 0;")  # i+3
+        lines.append("#X obj 10 200 metro 250;")  # i+4
+        lines.append("#X connect 0 0 %d 0;" % (i + 1))
+        lines.append("#X connect %d 0 %d 0;" % (i + 1, i))
+        lines.append("#X connect %d 0 %d 0;" % (i + 3, i + 2))
+        lines.append("#X connect 0 0 %d 0;" % (i + 4))
+        lines.append("#X connect %d 0 %d 0;" % (i + 4, i + 3))
+    return body
+
+
+s = args.seconds
+t_empty = bench.run(bench.patch(s, lambda lines, i: None), "empty")
+t_lin = bench.run(bench.patch(s, crash(0)), "linear")
+t_casc = bench.run(bench.patch(s, crash(1)), "cascade")
+lin, casc = (t_lin - t_empty) / s, (t_casc - t_empty) / s
+print("crash in Pd, %d Hz, %g s of audio, best of %d runs" % (args.sr, s, args.runs))
+print("share of one core: linear plate %.2f %%, with the cascade %.2f %%: %.2fx" % (
+    100.0 * lin, 100.0 * casc, casc / lin))
+shutil.rmtree(work, ignore_errors=True)
