@@ -67,6 +67,8 @@ void membrane_cascade_refresh_(membrane *m)
         }
         m->pc = c;
     }
+    if (m->kernel == membrane_kernel_generic) /* ICTUS_MEMBRANE_KERNEL=generic: portable too */
+        m->pc->potential = plate_cascade_potential_generic;
     /* E h from D = E h^3 / (12 (1 - nu^2)) and h = density / rho */
     const double nu = MODE_TABLE_PLATE_NU, h = m->density / CASCADE_BRONZE_RHO;
     const double eh = 12.0 * (1.0 - nu * nu) * m->bending / (h * h);

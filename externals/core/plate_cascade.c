@@ -279,7 +279,7 @@ ictus_status plate_cascade_build(plate_cascade *c, const mode_table *t, int mode
                                  double rel_tol)
 {
     memset(c, 0, sizeof(*c));
-    if (!t->plate || modes < 8 || modes % 8 || modes > PLATE_CASCADE_MAX_MODES || modes > t->size)
+    if (!t->plate || modes < 32 || modes % 32 || modes > PLATE_CASCADE_MAX_MODES || modes > t->size)
         return ICTUS_CLAMPED;
     entry_list l = {0};
     double big = -1.0;
@@ -318,6 +318,12 @@ ictus_status plate_cascade_build(plate_cascade *c, const mode_table *t, int mode
         return ICTUS_ENOMEM;
     }
     c->modes = modes;
+    c->potential = plate_cascade_potential_generic;
+#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+        c->potential = plate_cascade_potential_avx2;
+#endif
     int at = 0;
     for (int a = 0; a < na; a++) {
         c->row[a] = at;
@@ -356,66 +362,9 @@ void plate_cascade_set_scale(plate_cascade *c, double eh, double radius, double 
     c->floor = 1e-12;
 }
 
-/* t_a = H^a Y as a sum of H^a's columns with an entry, then phi_a = Y . t_a, V = sum
- * kappa_a phi_a^2 and dV/dY = sum 4 kappa_a phi_a t_a. Vectors of 4 floats (SSE2: wider
- * ones would be register pairs spilled to the stack), 32 rows at a time in registers;
- * modes is a multiple of 8. */
-typedef float v4f __attribute__((vector_size(16)));
-static inline v4f LD4(const float *p)
-{
-    v4f v;
-    memcpy(&v, p, sizeof(v));
-    return v;
-}
-
-static void columns_times(const plate_cascade *c, const float *y)
-{
-    const int n = c->modes;
-    for (int a = 0; a < c->inplane; a++) {
-        for (int k0 = 0; k0 < n; k0 += 32) {
-            v4f acc[8] = {{0}, {0}, {0}, {0}, {0}, {0}, {0}, {0}};
-            const int w = n - k0 >= 32 ? 8 : (n - k0) / 4;
-            for (int e = c->row[a]; e < c->row[a + 1]; e++) {
-                const float yj = y[c->col[e]];
-                const v4f yv = {yj, yj, yj, yj};
-                const float *col = c->val + (size_t)e * n + k0;
-                if (w == 8) {
-                    for (int k = 0; k < 8; k++)
-                        acc[k] += yv * LD4(col + 4 * k);
-                } else {
-                    for (int k = 0; k < w; k++)
-                        acc[k] += yv * LD4(col + 4 * k);
-                }
-            }
-            memcpy(c->t + (size_t)a * n + k0, acc, sizeof(v4f) * (size_t)w);
-        }
-    }
-}
-
 double plate_cascade_potential(const plate_cascade *c, const float *y, float *grad)
 {
-    const int n = c->modes;
-    columns_times(c, y);
-    double v = 0.0;
-    if (grad)
-        memset(grad, 0, sizeof(float) * (size_t)n);
-    for (int a = 0; a < c->inplane; a++) {
-        const float *t = c->t + (size_t)a * n;
-        v4f acc = {0};
-        for (int k = 0; k < n; k += 4)
-            acc += LD4(y + k) * LD4(t + k);
-        const float phi = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-        v += (double)c->kappa[a] * phi * phi;
-        if (!grad)
-            continue;
-        const float s = 4.0f * c->kappa[a] * phi;
-        const v4f sv = {s, s, s, s};
-        for (int k = 0; k < n; k += 4) {
-            const v4f gk = LD4(grad + k) + sv * LD4(t + k);
-            memcpy(grad + k, &gk, sizeof(gk));
-        }
-    }
-    return v;
+    return c->potential(c, y, grad);
 }
 
 void plate_cascade_anchor(plate_cascade *c, const float *y)

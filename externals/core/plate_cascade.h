@@ -20,7 +20,7 @@
 extern "C" {
 #endif
 
-/* The most transverse modes a cascade couples (a multiple of 8). */
+/* The most transverse modes a cascade couples (a multiple of 32). */
 #define PLATE_CASCADE_MAX_MODES 256
 
 typedef struct plate_cascade {
@@ -37,7 +37,9 @@ typedef struct plate_cascade {
     float *kappa;
     /* the scheme's state (membrane_cascade.c) and scratch; t = H^a Y, inplane x modes */
     float *y, *g, *dy, *t;
-    double psi;   /* the auxiliary variable, psi^2 / 2 = V + floor */
+    double psi; /* the auxiliary variable, psi^2 / 2 = V + floor */
+    /* plate_cascade_potential's body for this CPU (plate_cascade_kernel.inc) */
+    double (*potential)(const struct plate_cascade *c, const float *y, float *grad);
     double floor; /* J: keeps psi away from 0 */
 } plate_cascade;
 
@@ -52,7 +54,7 @@ int plate_inplane_mode(int m, int s, plate_mode *out);
 double plate_cascade_h(const plate_mode *a, int a_sin, const plate_mode *i, int i_sin,
                        const plate_mode *j, int j_sin);
 
-/* Couples the first `modes` modes (a multiple of 8, at most PLATE_CASCADE_MAX_MODES) of
+/* Couples the first `modes` modes (a multiple of 32, at most PLATE_CASCADE_MAX_MODES) of
  * table t (a plate's) through every in-plane mode with
  * zeta < zeta_max; entries with |H| below rel_tol times the largest are dropped.
  * Allocates; ICTUS_ENOMEM leaves *c empty. */
@@ -66,6 +68,9 @@ void plate_cascade_set_scale(plate_cascade *c, double eh, double radius, double 
 
 /* V (J) at y (c->modes values); grad (may be NULL) receives dV/dY. No allocation. */
 double plate_cascade_potential(const plate_cascade *c, const float *y, float *grad);
+/* Its two builds (the AVX2 one only where the CPU has AVX2 and FMA). */
+double plate_cascade_potential_generic(const plate_cascade *c, const float *y, float *grad);
+double plate_cascade_potential_avx2(const plate_cascade *c, const float *y, float *grad);
 
 /* The auxiliary variable set from the potential at y (with floor): after the state
  * was changed from outside the scheme. */
