@@ -73,7 +73,7 @@ def above(y, t0, t1, hz=5000.0):
 
 
 def figure(on, off, speed, path):
-    fig, axes = plt.subplots(1, 2, figsize=(10, 3.4), dpi=100, sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.2), dpi=72, sharey=True)
     for ax, y, label in ((axes[0], on, "cascade 1"), (axes[1], off, "cascade 0 (linear)")):
         ax.specgram(y, NFFT=1024, Fs=SR, noverlap=896, cmap="magma", vmin=-170, vmax=-50)
         ax.set_ylim(0, 16000)
