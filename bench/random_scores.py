@@ -63,8 +63,12 @@ def main():
     ap.add_argument("--jobs", type=int, default=0)
     ap.add_argument("--json", help="write every note's record here")
     ap.add_argument("--workdir", help="keep the failing renders here")
-    ap.add_argument("render_args", nargs="*", help="extra ictusd render options (after --)")
-    args = ap.parse_args()
+    # The render options after "--" are split off here: argparse gives a trailing
+    # nargs="*" positional nothing once the first positional (ictusd) is taken.
+    argv = sys.argv[1:]
+    cut = argv.index("--") if "--" in argv else len(argv)
+    args = ap.parse_args(argv[:cut])
+    args.render_args = argv[cut + 1:]
 
     nuances = random_score.nuance_list(args.ictusd)
     seeds = list(range(args.first, args.first + args.count))

@@ -3,7 +3,7 @@
 
 Renders membrane~ "preset crash" struck once by contact~ (a 13.8 g stick, wood tip, at
 r/a 0.9, as docs/plates.md's linear measurement) at several speeds, with the cascade on
-(the preset's cascade 1) and off (cascade 0), pickup 1, 1.5 s each, all in one pd run.
+(cascade 1) and off (cascade 0), pickup 1, 1.5 s each, all in one pd run.
 Prints per render the spectral centroid of 0-50 ms and 150-200 ms, the share of energy
 above 5 kHz in 0-50 ms and in 0-1 s, and the share of the render's energy that the
 cascade moved (|on - off|^2 / off^2 over 0-1 s); writes docs/img/plate-cascade.png

@@ -1,5 +1,5 @@
 """The crash's cascade in real Pd: what membrane~ "preset crash" costs with its cascade
-(cascade 1, the preset's) and without (cascade 0, the linear plate), each with its own
+(cascade 1) and without (cascade 0, the linear plate, the preset's), each with its own
 contact~ (a 13.8 g stick, wood tip, 6 m/s at r/a 0.9, every 250 ms, so that the plate
 rings throughout), in `pd -batch` at 48 kHz, in one run of the script:
 

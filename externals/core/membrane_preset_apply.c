@@ -53,7 +53,7 @@ ictus_status membrane_apply_preset(membrane *m, const membrane_preset *p)
         {MEMBRANE_PARAM_LOSS_FACTOR,
          p->plate ? MEMBRANE_PRESET_BRONZE_LOSS : bare ? 0.0 : MEMBRANE_DEFAULT_LOSS_FACTOR},
         {MEMBRANE_PARAM_PATCH, bare ? 0.0 : MEMBRANE_PATCH_BEAD},
-        {MEMBRANE_PARAM_CASCADE, p->plate ? 1.0 : 0.0},
+        {MEMBRANE_PARAM_CASCADE, 0.0}, /* off: it darkens the crash (docs/plates.md) */
     };
     for (int i = 0; i < (int)(sizeof(sets) / sizeof(sets[0])); i++)
         if ((e = ictus_param_set(t, m, sets[i].id, sets[i].value)) > s)

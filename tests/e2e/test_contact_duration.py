@@ -287,8 +287,8 @@ def ladder_part():
             continue
         check(sl <= -0.1, "tom ladder: the contact of %s shortens with speed, slope %.3f <= -0.1"
               % (who, sl))
-    # Reported: the physics' own slope over the free strikes (its 1 ms step and the hand's
-    # pull at the end of loud strokes flatten it; docs/contact.md).
+    # Reported: the physics' own slope over the free strikes (the hand's follow-through,
+    # the strike aim, lengthens the loud contacts; docs/contact.md).
     print("tom ladder %.2f..%.2f m/s, free strikes: log-log slope of the physics %.3f "
           "(target <= -0.1)" % (vf[0], vf[-1], slope(vf, [r[1] for r in free])))
 

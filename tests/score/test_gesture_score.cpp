@@ -162,6 +162,36 @@ TEST_CASE("plan: the strike depth moves the target below the head", "[score][pla
     }
 }
 
+TEST_CASE("plan: the strike aim grows with the impact speed up to its cap", "[score][plan]")
+{
+    // Depth below the head = min(S (v - V), M) for the planned downward impact speed v,
+    // over every nuance at seeded dynamics.
+    PlanOptions opt;
+    opt.strike_aim_s = 0.0025;
+    opt.strike_aim_from_mps = 1.5;
+    opt.strike_aim_max_m = 0.004;
+    const char *nuances[] = {"legato", "tenuto", "accent", "vertical_accent", "staccato"};
+    std::mt19937 rng(20261129);
+    std::uniform_real_distribution<double> dyn(0.0, 1.0);
+    std::string text = "tempo 60\n";
+    for (int k = 0; k < 20; ++k)
+        text += std::string(k % 2 ? "L " : "R ") + nuances[k % 5] + " " +
+                std::to_string(dyn(rng)) + "\n";
+    const GesturePlan plan = plan_performance(score_of(text), db(), frame(), opt);
+    REQUIRE(plan.notes.size() == 20);
+    int capped = 0, free_aim = 0;
+    for (const PlannedNote &n : plan.notes) {
+        const double v = -n.impact_velocity_mps.y();
+        const double want = std::min(0.0025 * std::max(0.0, v - 1.5), 0.004);
+        INFO("line " << n.line << " v " << v);
+        CHECK(n.strike_point_m.y() - n.tip_target_m.y() == Approx(want).margin(1e-12));
+        capped += want == 0.004;
+        free_aim += want > 0.0 && want < 0.004;
+    }
+    CHECK(capped > 0); // the seeds reach both sides of the cap
+    CHECK(free_aim > 0);
+}
+
 TEST_CASE("plan: notes placed on the head where the score says", "[score][plan]")
 {
     const GesturePlan plan =

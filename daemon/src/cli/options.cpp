@@ -296,6 +296,8 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.plan.move_margin_before = parse_number(a, v.substr(comma + 1), 0.0, 0.45);
     } else if (a == "--strike-aim-from")
         o.score.plan.strike_aim_from_mps = parse_number(a, value(), 0.0, 20.0);
+    else if (a == "--strike-aim-max")
+        o.score.plan.strike_aim_max_m = parse_number(a, value(), 0.0, 0.05);
     else if (a == "--advance")
         o.score.time_advance_s = parse_number(a, value(), 0, 0.1);
     else if (a == "--ik-gain")

@@ -292,6 +292,8 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("strike_aim_s must be within 0..0.01 s", o.strike_aim_s);
     if (!(o.strike_aim_from_mps >= 0.0 && o.strike_aim_from_mps <= 20.0))
         bad("strike_aim_from_mps must be within 0..20 m/s", o.strike_aim_from_mps);
+    if (!(o.strike_aim_max_m >= 0.0 && o.strike_aim_max_m <= 0.05))
+        bad("strike_aim_max_m must be within 0..0.05 m", o.strike_aim_max_m);
     if (!(o.contact_lead_m >= 0.0 && o.contact_lead_m <= 0.01))
         bad("contact_lead_m must be within 0..0.01 m", o.contact_lead_m);
     if (!(o.blend_margin > 0.0 && o.blend_margin < 0.5))
@@ -565,8 +567,9 @@ void warp_units(HandStrokes &h, const std::vector<size_t> &idx, const PerformerF
         it.prep_t = std::min(it.curve->prep_s, (1.0 - beta) * before);
         it.lift_t = std::min(it.curve->lift_s, (1.0 - beta) * after);
         const Eigen::Vector3d impact = to_world * it.curve->impact_velocity();
-        it.origin -= opt.strike_aim_s *
-                     std::max(0.0, -impact.dot(frame.up) - opt.strike_aim_from_mps) * frame.up;
+        const double aim =
+            opt.strike_aim_s * std::max(0.0, -impact.dot(frame.up) - opt.strike_aim_from_mps);
+        it.origin -= std::min(aim, opt.strike_aim_max_m) * frame.up;
         plan.notes[idx[k]].tip_target_m = it.origin;
         it.prepare();
         plan.notes[idx[k]].impact_velocity_mps = to_world * it.curve->impact_velocity();

@@ -111,6 +111,9 @@ struct PlanOptions {
     // (deeper, they press on it).
     double strike_aim_s = 0.0;
     double strike_aim_from_mps = 0.0;
+    // The aim's depth goes no deeper than this (m): a deeper aim carries the
+    // hand on into the head during a loud stroke's contact.
+    double strike_aim_max_m = 0.05;
     // The stick meets the head this far (m) before the plan's tip reaches its
     // target: each unit is placed later by this over its planned downward
     // impact speed, so that soft strokes touch on the beat too.
