@@ -175,8 +175,8 @@ TEST_CASE("plan: the strike aim grows with the impact speed up to its cap", "[sc
     std::uniform_real_distribution<double> dyn(0.0, 1.0);
     std::string text = "tempo 60\n";
     for (int k = 0; k < 20; ++k)
-        text += std::string(k % 2 ? "L " : "R ") + nuances[k % 5] + " " +
-                std::to_string(dyn(rng)) + "\n";
+        text += std::string(k % 2 ? "L " : "R ") + nuances[k % 5] + " " + std::to_string(dyn(rng)) +
+                "\n";
     const GesturePlan plan = plan_performance(score_of(text), db(), frame(), opt);
     REQUIRE(plan.notes.size() == 20);
     int capped = 0, free_aim = 0;
