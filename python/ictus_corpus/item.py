@@ -107,6 +107,9 @@ def command(ictusd, params, score_path, tmp, bvh):
            "--humanize", "%g" % params["humanize"], "--seed", str(params["render_seed"]),
            "--tips-rate", "0", "--progress-every", "0"]
     cmd += ["--bvh-rate", "250" if bvh else "0"]
+    # relative to the render's folder (its cwd): render.json names the score, and an item's
+    # bytes must not depend on where it was rendered
+    score_path = os.path.basename(score_path)
     if score_path.lower().endswith((".mid", ".midi")):
         cmd += ["--midi", score_path]
     else:
@@ -144,7 +147,7 @@ def render_item(ictusd, out, params, score_text, source=None, bvh=False, timeout
                 f.write(score_text)
         cmd = command(ictusd, params, score_path, tmp, bvh)
         p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                           timeout=timeout_s)
+                           timeout=timeout_s, cwd=tmp)
         if p.returncode != 0:
             tail = " | ".join(p.stdout.strip().splitlines()[-3:])
             raise RuntimeError("ictusd render exit %d: %s" % (p.returncode, tail))
