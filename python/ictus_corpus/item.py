@@ -95,6 +95,7 @@ def labels(params, folder):
             "r_over_a": float(s["r_over_a"]),
             "theta_deg": float(s["theta_deg"]),
         })
+    onsets.sort(key=lambda o: (o["time_s"], o["seq"]))
     return {"item": params, "sample_rate": SAMPLE_RATE, "wav_bits": WAV_BITS, "onsets": onsets}
 
 
