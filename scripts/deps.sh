@@ -9,7 +9,7 @@ packages=(
     libode-dev libeigen3-dev liblo-dev liblo-tools nlohmann-json3-dev
     catch2
     clang libclang-rt-14-dev  # fuzz/ (libFuzzer: its runtime is only recommended by clang-14)
-    python3 python3-numpy python3-scipy python3-matplotlib python3-mido
+    python3 python3-venv python3-numpy python3-scipy python3-matplotlib python3-mido
     python3-markdown  # the references as HTML in the Pd library (scripts/doc_html.py)
     gem puredata-gui libgl1-mesa-dri xvfb xauth x11-utils imagemagick python3-pil  # Gem view, GUI (tests/ui)
     "$@"

@@ -15,6 +15,9 @@ echo "== release build and tests (build/) =="
 parts=(-DICTUS_BUILD_EXTERNALS=ON -DICTUS_BUILD_DAEMON=ON -DICTUS_BUILD_TESTS=ON)
 bash scripts/build.sh "$root/build" -DCMAKE_BUILD_TYPE=Release -DICTUS_SANITIZE=OFF "${parts[@]}" \
     -DICTUS_BUILD_BENCH=ON
+# the Python environment of the corpus tests (build/venv, PyPI); they skip without it, or
+# fail under CI=true
+bash scripts/venv.sh "$root/build" >/dev/null || echo "test.sh: no build/venv (scripts/venv.sh failed)" >&2
 (cd build && ctest --output-on-failure --no-tests=error -j "$jobs")
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests (build-asan/) =="

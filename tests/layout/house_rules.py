@@ -37,7 +37,7 @@ PATH_EDIT_RE = re.compile(r"\b" + "sys" + r"\.path\s*(\.\s*(insert|append|extend
 SYS_PATH = "sys" + ".path"
 SKIP_DIRS = {".git", "__pycache__"}
 # The folders of tests/ that test no daemon area (docs/architecture.md, "Tests").
-TESTS_APART = {"core", "pd", "pdosc", "sound", "ui", "e2e", "layout", "package", "support"}
+TESTS_APART = {"core", "pd", "pdosc", "sound", "ui", "e2e", "layout", "package", "support", "corpus"}
 
 
 def tree_files(root):

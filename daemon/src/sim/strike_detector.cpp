@@ -114,6 +114,16 @@ long StrikeDetector::first_open_seq() const
     return first;
 }
 
+void StrikeDetector::number_in_onset_order(long first_seq)
+{
+    Hand &a = hands_[0], &b = hands_[1];
+    if (!a.in_contact || !b.in_contact || a.event.seq < first_seq || b.event.seq < first_seq)
+        return;
+    if ((a.event.seq < b.event.seq) != (a.event.time_s < b.event.time_s) &&
+        a.event.time_s != b.event.time_s)
+        std::swap(a.event.seq, b.event.seq);
+}
+
 void StrikeDetector::reset(const MembraneGeometry &membrane)
 {
     membranes_[0] = membrane;
@@ -473,6 +483,7 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
                    double time_offset_s)
 {
     int n = 0;
+    const long first_seq = detector.strikes();
     for (int hand = 0; hand < 2; ++hand) {
         const Side side = static_cast<Side>(hand);
         TipSample s;
@@ -492,6 +503,7 @@ int detect_strikes(StrikeDetector &detector, const Scene &scene, StrikeEvent out
         if (detector.update(hand, s, out[n]))
             ++n;
     }
+    detector.number_in_onset_order(first_seq);
     return n;
 }
 

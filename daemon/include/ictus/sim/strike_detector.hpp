@@ -145,6 +145,10 @@ class StrikeDetector
     // The smallest seq of a contact still under way (strikes() when none): every
     // strike numbered below it has been reported (or was lost to a reset).
     long first_open_seq() const;
+    // Strikes numbered from first_seq on that began in the same step, numbered in
+    // onset order: two hands whose contacts begin in one step get their seq by
+    // their interpolated onset times, not by the order the hands were updated.
+    void number_in_onset_order(long first_seq);
     // Tips that came over the disk from the side below the membrane plane (shell hits, not
     // strikes).
     long side_entries() const { return side_entries_; }

@@ -1,0 +1,5 @@
+import sys
+
+from ictus_corpus.run import main
+
+sys.exit(main())
