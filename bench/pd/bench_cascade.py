@@ -7,22 +7,12 @@ rings throughout), in `pd -batch` at 48 kHz, in one run of the script:
 
 with t the CPU time (user + sys) of pd, best of R runs (pdbench.Bench), and the ratio of
 the two. Usage: bench_cascade.py BUILD_DIR [--runs R] [--seconds S]"""
-import argparse
-import os
 import shutil
-import tempfile
 
-from pdbench import Bench
+import pdbench
 
-ap = argparse.ArgumentParser()
-ap.add_argument("build")
-ap.add_argument("--runs", type=int, default=3)
-ap.add_argument("--sr", type=int, default=48000)
-ap.add_argument("--seconds", type=float, default=20.0)
-args = ap.parse_args()
-lib = os.path.join(os.path.abspath(args.build), "ictus")
-work = tempfile.mkdtemp(prefix="ictus-bench-cascade-")
-bench = Bench(lib, args.sr, args.runs, work)
+args, bench = pdbench.from_args("ictus-bench-cascade-")
+work = bench.work
 
 
 def crash(cascade):

@@ -8,26 +8,18 @@ by a 14 g stick at 3 m/s every 250 ms, staggered), in `pd -batch` at 48 kHz:
 against a bank of N_total vanilla [bp~] in the same run (bench_pd.py's reference), with t
 the CPU time (user + sys) of pd, best of R runs. The mode counts are read from each
 membrane~'s `print` (a snare's: the batter's and the snare head's). Usage: bench_kit.py BUILD_DIR [--runs R] [--seconds S]"""
-import argparse
 import os
 import re
 import shutil
 import subprocess
-import tempfile
 
-from pdbench import Bench, bp_bank
+import pdbench
+from pdbench import bp_bank
 
 KIT = os.environ.get("ICTUS_BENCH_KIT", "snare,tom,floor-tom,timpani").split(",")
 
-ap = argparse.ArgumentParser()
-ap.add_argument("build")
-ap.add_argument("--runs", type=int, default=3)
-ap.add_argument("--sr", type=int, default=48000)
-ap.add_argument("--seconds", type=float, default=20.0)
-args = ap.parse_args()
-lib = os.path.join(os.path.abspath(args.build), "ictus")
-work = tempfile.mkdtemp(prefix="ictus-bench-kit-")
-bench = Bench(lib, args.sr, args.runs, work)
+args, bench = pdbench.from_args("ictus-bench-kit-")
+work = bench.work
 
 
 def kit(lines, i):

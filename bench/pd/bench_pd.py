@@ -18,23 +18,13 @@ Cases, for N = 16, 256, 1024, 4096:
            time too; 200 hits per second, so the per-hit cost shows)
   bp~      N [bp~] fed by one [noise~] (noise~ is in the empty patch too)
 Best (smallest) of R runs each. Usage: bench_pd.py BUILD_DIR [--runs R]"""
-import argparse
-import os
 import shutil
-import tempfile
 
-from pdbench import Bench, bp_bank
+import pdbench
+from pdbench import bp_bank
 
-ap = argparse.ArgumentParser()
-ap.add_argument("build")
-ap.add_argument("--runs", type=int, default=3)
-ap.add_argument("--sr", type=int, default=48000)
-ap.add_argument("--sizes", default="16,256,1024,4096")
-args = ap.parse_args()
-lib = os.path.join(os.path.abspath(args.build), "ictus")
-sr = args.sr
-work = tempfile.mkdtemp(prefix="ictus-bench-")
-bench = Bench(lib, sr, args.runs, work)
+args, bench = pdbench.from_args("ictus-bench-", seconds=False)
+sr, work = args.sr, bench.work
 patch, run = bench.patch, bench.run
 
 

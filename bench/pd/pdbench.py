@@ -1,9 +1,27 @@
 """What the Pd benchmarks share: a generated patch that switches DSP on at load and quits
 after S seconds of audio, and the CPU time (user + sys) pd takes to run it in batch mode,
-best of R runs. Used by bench_pd.py and bench_kit.py."""
+best of R runs. Used by bench_pd.py, bench_kit.py and bench_cascade.py."""
+import argparse
 import os
 import resource
 import subprocess
+import tempfile
+
+
+def from_args(prefix, seconds=True):
+    """The benchmarks' common command line (BUILD_DIR [--runs R] [--sr HZ] [--seconds S]),
+    parsed, and a Bench on BUILD_DIR's Pd library in a new temporary folder."""
+    ap = argparse.ArgumentParser()
+    ap.add_argument("build")
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--sr", type=int, default=48000)
+    if seconds:
+        ap.add_argument("--seconds", type=float, default=20.0)
+    else:
+        ap.add_argument("--sizes", default="16,256,1024,4096")
+    args = ap.parse_args()
+    lib = os.path.join(os.path.abspath(args.build), "ictus")
+    return args, Bench(lib, args.sr, args.runs, tempfile.mkdtemp(prefix=prefix))
 
 
 class Bench:
