@@ -111,8 +111,10 @@ def main():
     ctl = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     pd = daemon = None
     try:
-        pd = subprocess.Popen([uitest.PD, "-nogui", "-nosound", "-nomidi", "-stderr", "-r",
-                               str(SR), "-path", os.path.join(build, "ictus"), "-open", patch,
+        # -nrt: as root pd takes real-time priority, and a sanitizer build's DSP, slower than
+        # real time, then starves the daemon and the other tests on the cores
+        pd = subprocess.Popen([uitest.PD, "-nogui", "-nosound", "-nomidi", "-nrt", "-stderr",
+                               "-r", str(SR), "-path", os.path.join(build, "ictus"), "-open", patch,
                                "-send", "pd dsp 1"], stdout=subprocess.PIPE,
                               stderr=subprocess.STDOUT, text=True, env=uitest.PD_ENV)
         lines.follow(pd.stdout)
