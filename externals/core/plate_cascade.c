@@ -171,6 +171,15 @@ void plate_cascade_free(plate_cascade *c)
 }
 
 /* The in-plane modes with zeta < zeta_max (cos and sin partners), into c. */
+
+/* p resized to cap elements of size bytes, or p itself with *ok cleared when out of memory. */
+static void *grow(void *p, size_t size, int cap, int *ok)
+{
+    void *q = realloc(p, size * (size_t)cap);
+    if (!q)
+        *ok = 0;
+    return q ? q : p;
+}
 static int build_inplane(plate_cascade *c, double zeta_max)
 {
     int cap = 16, n = 0;
@@ -184,13 +193,10 @@ static int build_inplane(plate_cascade *c, double zeta_max)
             for (int part = 0; part <= (m > 0); part++) {
                 if (n == cap) {
                     cap *= 2;
-                    plate_mode *g1 = realloc(c->ip, sizeof(plate_mode) * (size_t)cap);
-                    if (g1)
-                        c->ip = g1;
-                    int *g2 = realloc(c->ip_sin, sizeof(int) * (size_t)cap);
-                    if (g2)
-                        c->ip_sin = g2;
-                    if (!g1 || !g2)
+                    int ok = 1;
+                    c->ip = grow(c->ip, sizeof(plate_mode), cap, &ok);
+                    c->ip_sin = grow(c->ip_sin, sizeof(int), cap, &ok);
+                    if (!ok)
                         return -1;
                 }
                 c->ip[n] = p, c->ip_sin[n] = part, n++;
@@ -213,19 +219,12 @@ static int push_entry(entry_list *l, int a, int i, int j, double h)
 {
     if (l->n == l->cap) {
         int cap = l->cap ? 2 * l->cap : 256;
-        int *na = realloc(l->a, sizeof(int) * (size_t)cap);
-        if (na)
-            l->a = na;
-        int *ni = realloc(l->i, sizeof(int) * (size_t)cap);
-        if (ni)
-            l->i = ni;
-        int *nj = realloc(l->j, sizeof(int) * (size_t)cap);
-        if (nj)
-            l->j = nj;
-        double *nh = realloc(l->h, sizeof(double) * (size_t)cap);
-        if (nh)
-            l->h = nh;
-        if (!na || !ni || !nj || !nh)
+        int ok = 1;
+        l->a = grow(l->a, sizeof(int), cap, &ok);
+        l->i = grow(l->i, sizeof(int), cap, &ok);
+        l->j = grow(l->j, sizeof(int), cap, &ok);
+        l->h = grow(l->h, sizeof(double), cap, &ok);
+        if (!ok)
             return -1;
         l->cap = cap;
     }
