@@ -410,12 +410,15 @@ static contact *point_contact(membrane_point *pt)
 }
 
 /* A hit lands: the stick starts at the surface (compression 0) at the displacement
- * the membrane has there, moving in at the hit's velocity. */
-static void contact_landed(membrane_point *pt, double displacement_m)
+ * the membrane has there, closing in at the hit's velocity relative to the head there.
+ * The hit's velocity is the physics' impact speed, measured against a head at rest; on
+ * a head still moving from an earlier stroke the stick meets it at that speed, on the
+ * sample the strike names, as the physics' stick does (docs/contact.md). */
+static void contact_landed(membrane_point *pt, double displacement_m, double velocity_mps)
 {
     contact *c = point_contact(pt);
     c->stick_x = displacement_m;
-    c->stick_v = c->hit_velocity;
+    c->stick_v = c->hit_velocity + (isfinite(velocity_mps) ? velocity_mps : 0.0);
     if (c->hit_mass_kg > 0.0)
         c->mass_kg = c->hit_mass_kg;
     c->compression = c->compression_before = 0.0;

@@ -283,8 +283,9 @@ void membrane_land_point_(membrane *m, membrane_point *pt);
  * membrane_process(), and never sees its type. */
 typedef struct membrane_point_ops {
     /* A pending move has just landed (membrane_point_move_): the point is at its
-     * new place, displacement_m is the membrane's displacement there. */
-    void (*landed)(membrane_point *pt, double displacement_m);
+     * new place, displacement_m and velocity_mps are the membrane's displacement and
+     * velocity there (positive into the head). */
+    void (*landed)(membrane_point *pt, double displacement_m, double velocity_mps);
     /* Solves the forces of the `count` active points for sample `sample` together:
      * w_free[i] is point i's displacement without this sample's forces, and
      * K[i][j] the change of w_i per newton of F_j over the sample. Sets each

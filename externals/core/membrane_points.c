@@ -296,9 +296,19 @@ static double point_displacement(const membrane *m, const float *psi_k)
     return w * membrane_displacement_scale_(m);
 }
 
+/* The velocity there (m/s, positive into the head): p is stored over sc, psi_k is
+ * psi sc (membrane_kernel.inc), so the product is the pickups' own sum. */
+static double point_velocity(const membrane *m, const float *psi_k)
+{
+    double v = 0.0;
+    for (int k = 0; k < m->count; k++)
+        v += (double)psi_k[k] * m->p[k];
+    return v * m->mass_scale;
+}
+
 /* A pending move lands: the last force at the old place goes into the state, the
- * new shapes take over, and the point's object is told (a stick starts its stroke
- * at the surface there, contact.c). */
+ * new shapes take over, and the point's object is told where the head is there and
+ * how fast it moves (a stick starts its stroke at the surface, contact.c). */
 void membrane_land_point_(membrane *m, membrane_point *pt)
 {
     if (pt->force_pending != 0.0)
@@ -311,5 +321,5 @@ void membrane_land_point_(membrane *m, membrane_point *pt)
     pt->move_pending = 0;
     point_couplings(m, pt);
     pt->force_pending = 0.0;
-    pt->ops->landed(pt, point_displacement(m, pt->psi_k));
+    pt->ops->landed(pt, point_displacement(m, pt->psi_k), point_velocity(m, pt->psi_k));
 }

@@ -385,9 +385,9 @@ static void air_shapes(const membrane *m, const membrane_point *pt, int live, fl
     }
 }
 
-static void air_landed(membrane_point *pt, double displacement_m)
+static void air_landed(membrane_point *pt, double displacement_m, double velocity_mps)
 {
-    (void)pt, (void)displacement_m;
+    (void)pt, (void)displacement_m, (void)velocity_mps;
 }
 
 /* The batter's sample rate changed (DSP restarted at another rate): the snare head's

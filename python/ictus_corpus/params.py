@@ -43,7 +43,7 @@ def split_of(seed, index):
 
 def draw(seed, index, nuances=None):
     """The parameters of item `index` of the corpus of `seed`: a dict of plain values (the
-    manifest's columns) and the score text."""
+    manifest's columns), the score text and the score's length in seconds."""
     rng = item_rng(seed, index)
     score_seed = rng.randrange(1, 2 ** 31)
     score = RandomScore(score_seed, nuances)
@@ -75,11 +75,11 @@ def draw(seed, index, nuances=None):
         "render_seed": rng.randrange(1, 2 ** 31),
         "split": split_of(seed, index),
     }
-    return params, text
+    return params, text, score.length_s
 
 
 def from_file(seed, index, path):
     """An item from a given score file or MIDI drum part: the score as it is, the rest drawn."""
-    params, _ = draw(seed, index)
+    params, _, _ = draw(seed, index)
     params.update(score_source=path, score_seed=0, meter="", hairpin="")
     return params

@@ -22,7 +22,8 @@ def find_ictusd(given):
 
 
 def plan(args):
-    """[(params, score_text, source)] of every item, in index order."""
+    """[(params, score_text, source, length_s)] of every item, in index order (length_s: the
+    score's length, 0 where it is not known before the render)."""
     if args.from_dir:
         files = sorted(f for f in os.listdir(args.from_dir)
                        if f.lower().endswith((".txt", ".score", ".mid", ".midi")))
@@ -33,9 +34,13 @@ def plan(args):
         out = []
         for k in range(count):
             src = os.path.abspath(os.path.join(args.from_dir, files[k % len(files)]))
-            out.append((P.from_file(args.seed, k, src), None, src))
+            out.append((P.from_file(args.seed, k, src), None, src, 0.0))
         return out
-    return [P.draw(args.seed, k) + (None,) for k in range(args.count)]
+    out = []
+    for k in range(args.count):
+        prm, text, length_s = P.draw(args.seed, k)
+        out.append((prm, text, None, length_s))
+    return out
 
 
 def _task(ictusd, out, prm, text, src, bvh):
@@ -66,7 +71,7 @@ def run(args):
     items = plan(args)
     # already finished: checked here, so that they cost no task
     rows, todo = [], []
-    for prm, text, src in items:
+    for prm, text, src, length_s in items:
         folder = os.path.join(out, item.item_name(prm["index"]))
         sums = item.is_done(folder, args.bvh)
         if sums is not None:
@@ -74,7 +79,7 @@ def run(args):
                      sha256=json.dumps(sums, sort_keys=True), render_s=0.0, host="")
             rows.append(r)
         else:
-            todo.append((prm, text, src))
+            todo.append((prm, text, src, length_s))
     print("ictus-corpus: %d items, %d finished already, %d to render into %s"
           % (len(items), len(rows), len(todo), out), flush=True)
     t0 = time.time()
@@ -82,12 +87,18 @@ def run(args):
         from dask.distributed import as_completed
         client, cluster = make_client(args)
         try:
+            if cluster is not None:
+                # the rate counts rendering, not the local workers' start-up
+                client.wait_for_workers(len(cluster.workers), timeout=120)
+                t0 = time.time()
             if client.dashboard_link and args.dashboard:
                 print("ictus-corpus: Dask dashboard at %s" % client.dashboard_link, flush=True)
+            # the longest scores first (Dask runs higher priorities first): the last
+            # items to finish are short ones, so no worker idles long at the end
             futures = [client.submit(_task, ictusd, out, prm, text, src, args.bvh,
                                      key="ictus-item-%d-%d" % (args.seed, prm["index"]),
-                                     retries=1, pure=False)
-                       for prm, text, src in todo]
+                                     retries=1, pure=False, priority=int(length_s * 1000))
+                       for prm, text, src, length_s in todo]
             bar = _bar(len(todo))
             for fut in as_completed(futures):
                 try:
