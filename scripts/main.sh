@@ -27,7 +27,7 @@
 #   --bits N      16 or 24 (integer PCM) or 32 (float, the default)
 #   --gain DB     output gain before the soft limiter (default 0)
 #   --drum-preset NAME  the drum (ictusd render --drum-preset; docs/sound.md): paper,
-#                 snare, tom, floor-tom, timpani, frame (default snare, wires on)
+#                 snare, tom, floor-tom, timpani, frame, kick (default snare, wires on)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build

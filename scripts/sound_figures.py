@@ -36,6 +36,7 @@ RENDERS = [
     ("floor-tom", "", 0.3),
     ("timpani", "", 0.75),
     ("frame", "", 0.5),
+    ("kick", "", 0.15),
 ]
 
 

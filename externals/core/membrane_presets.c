@@ -31,6 +31,11 @@ static const membrane_preset presets[] = {
     /* 18-inch frame drum: no shell, a thin head at low tension, (0,1) at 80 Hz. */
     {"frame", "18-inch frame drum, 0.19 mm Mylar, no shell, (0,1) at 80 Hz",
      0.2286, 599.0, 0.262, 0.4, 2.0, 1024, 0.5, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0},
+    /* 22-inch bass drum (kick), 0.25 mm batter, (0,1) at 55 Hz, muffled (a pad inside
+     * touching the head, as most kit kicks are: T60 0.4 s); the beater strikes near the
+     * centre. Played with the felt tip (stick_tip.h). */
+    {"kick", "22-inch bass drum, 0.25 mm Mylar batter, (0,1) at 55 Hz, muffled",
+     0.2794, 556.1, 0.345, 0.4, 1.0, 1024, 0.15, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0},
     /* Cymbals: flat free-edge plates of cymbal bronze (CuSn20: E 100 GPa, 8600 kg/m^3,
      * nu 0.33), D = E h^3 / (12 (1 - nu^2)), density 8600 h; docs/plates.md. An 18-inch
      * crash 1.0 mm thick, struck at the edge; modes to about 18 kHz. */
@@ -66,10 +71,10 @@ const membrane_preset *membrane_preset_find(const char *name)
 
 const char *membrane_preset_names(void)
 {
-    return "paper, snare, tom, floor-tom, timpani, frame, crash, ride";
+    return "paper, snare, tom, floor-tom, timpani, frame, kick, crash, ride";
 }
 
 const char *membrane_preset_drum_names(void)
 {
-    return "paper, snare, tom, floor-tom, timpani, frame";
+    return "paper, snare, tom, floor-tom, timpani, frame, kick";
 }

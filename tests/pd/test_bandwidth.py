@@ -22,7 +22,7 @@ ap.add_argument("--build", required=True)
 args = ap.parse_args()
 args.build = os.path.abspath(args.build)
 
-PRESETS = ["tom", "floor-tom", "timpani", "frame"]
+PRESETS = ["tom", "floor-tom", "timpani", "frame", "kick"]
 SR = 48000
 SECONDS = 1.0
 LOW_HZ = 1000.0

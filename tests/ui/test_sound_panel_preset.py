@@ -26,10 +26,11 @@ build = os.path.abspath(args.build)
 
 J01 = 2.404825557695773  # first zero of J0
 SR = 48000
-NAMES = ["paper", "snare", "tom", "floor-tom", "timpani", "frame"]  # the selector's order
+NAMES = ["paper", "snare", "tom", "floor-tom", "timpani", "frame", "kick"]  # the selector's order
 # radius m, tension N/m, areal density kg/m^2 (externals/core/membrane_presets.c)
 HEADS = {"paper": (0.178, 3000.0, 0.262), "tom": (0.1524, 1231.0, 0.345),
-         "floor-tom": (0.2032, 878.0, 0.345), "frame": (0.2286, 599.0, 0.262)}
+         "floor-tom": (0.2032, 878.0, 0.345), "frame": (0.2286, 599.0, 0.262),
+         "kick": (0.2794, 556.1, 0.345)}
 
 
 def f01(radius, tension, density):
@@ -120,7 +121,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-preset-") as work:
     # an unknown name: named, nothing sent, the sound keeps its head (paper's f01)
     x, lines = render("preset bongo", work, "unknown")
     check(any("ictus-sound-panel: preset: expected one of paper snare tom floor-tom timpani "
-              "frame - got: bongo" in l for l in lines), "an unknown preset is named: %s"
+              "frame kick - got: bongo" in l for l in lines), "an unknown preset is named: %s"
           % [l for l in lines if "preset" in l])
     check(not any(l.startswith("snd: preset") for l in lines), "an unknown preset sends nothing")
     check(loudest_head(spectrum(x)) == "paper",
