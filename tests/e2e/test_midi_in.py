@@ -9,6 +9,8 @@ the one drum, held against strikes.csv:
   kit's first); 43 and 41 -> floor (43)); without --kit all on the one drum;
 - hands as documented: notes under 0.3 s apart alternate, farther apart the
   right hand; two at one tick: the other hand; computed here from the ticks;
+- side stick 37 is the snare's rim: the snare, aimed at r/a 0.95, and the strike the
+  physics reports is on the rim (zone 1);
 - kick, hi-hat and crash are left out with one warning line counting them per
   note number ("note 36 x2, note 42 x8, note 49 x1");
 - a file cut short or with a bad chunk: exit 1 naming the byte and track,
@@ -62,6 +64,7 @@ notes += [(0, 36, 100), (960, 36, 100)]
 for k, n in enumerate([38, 38, 40, 38, 50, 50, 47, 47, 45, 45, 43, 43, 41, 41, 43, 43]):
     notes.append((1920 + 120 * k, n, 40 + 5 * k))
 notes += [(3840, 38, 127), (3840, 43, 110), (3840, 49, 120)]
+notes += [(4800 + 480 * k, 37, 90) for k in range(4)]  # a bar of side sticks on the beats
 meta = [(0, b"\xff\x51\x03" + US.to_bytes(3, "big")), (0, b"\xff\x58\x04\x04\x02\x18\x08")]
 drum = [(t, bytes([0x99, n, v])) for t, n, v in notes] + [(t + 60, bytes([0x89, n, 0])) for t, n, v in notes]
 smf = b"MThd" + struct.pack(">IHHH", 6, 1, 2, TPQ) + track(meta) + track(drum)
@@ -71,7 +74,7 @@ with open(path, "wb") as f:
 
 # What the test expects, from the file's notes: the playable ones in file order
 # (ties: the order written), their times, hands and drums.
-KIT = {38: "snare", 40: "snare", 50: "tom1", 48: "tom1", 47: "tom2", 45: "tom2", 43: "floor", 41: "floor"}
+KIT = {37: "snare", 38: "snare", 40: "snare", 50: "tom1", 48: "tom1", 47: "tom2", 45: "tom2", 43: "floor", 41: "floor"}
 KIT_INDEX = {"snare": 0, "tom1": 1, "tom2": 2, "floor": 3}
 played = sorted([(t, n, v) for t, n, v in notes if n in KIT], key=lambda e: e[0])
 want = []
@@ -82,7 +85,7 @@ for t, n, v in played:
         hand = 1 - last_hand
     else:
         hand = 1 - last_hand if last_t is not None and sec - last_t < 0.3 else 1
-    want.append((sec, hand, KIT[n]))
+    want.append((sec, hand, KIT[n], n))
     last_t, last_tick, last_hand = sec, t, hand
 
 
@@ -108,19 +111,24 @@ for name, extra in (("kit", ["--kit", "standard"]), ("one", [])):
           % (len(strikes), len(want)))
     # Two at one tick come in either order: compare each tick's strikes as a set.
     worst = 0.0
-    for s, (sec, hand, d) in zip(strikes, want):
+    for s, (sec, hand, d, n) in zip(strikes, want):
         worst = max(worst, abs(s["time_s"] - lead - sec))
     check(worst <= 5e-3, "%s: every note struck within 5 ms of its time (worst %.2f ms)" % (name, worst * 1e3))
     # Strike k is note k; notes at one tick may strike in either order: each
     # tick's (hand, drum) pairs are compared as sets.
     got, exp = {}, {}
-    for s, (sec, hand, d) in zip(strikes, want):
+    for s, (sec, hand, d, n) in zip(strikes, want):
         got.setdefault(sec, []).append((s["hand"], s["drum"]))
         exp.setdefault(sec, []).append((hand, KIT_INDEX[d] if name == "kit" else 0))
     got = {k: sorted(v) for k, v in got.items()}
     exp = {k: sorted(v) for k, v in exp.items()}
     check(got == exp, "%s: hands and drums as documented (%s)" % (
         name, [(k, got[k], exp[k]) for k in sorted(exp) if got.get(k) != exp[k]]))
+    rims = [(s["r_over_a"], s["zone"]) for s, w in zip(strikes, want) if w[3] == 37]
+    check(len(rims) == 4 and all(z == 1 for _, z in rims),
+          "%s: every side stick lands on the snare's rim (r/a, zone: %s)" % (name, rims))
+    heads = [s["zone"] for s, w in zip(strikes, want) if w[3] != 37]
+    check(all(z == 0 for z in heads), "%s: every other note on a head (zones %s)" % (name, heads))
     print("%s: %d notes, worst |strike - file time| %.2f ms" % (name, len(strikes), worst * 1e3))
 
 for cut, what in ((smf[:40], "cut short"), (smf[:14] + b"MTrk\xff\xff\xff\xff", "bad chunk length")):

@@ -203,9 +203,10 @@ Smf read_smf(const std::string &b, const std::string &source)
 namespace
 {
 
+// The snare's notes: 38, 40 on the head, 37 (side stick) on its rim.
 bool is_snare(int note)
 {
-    return note == 38 || note == 40;
+    return note == 38 || note == 40 || note == kMidiSideStick;
 }
 bool is_tom(int note)
 {
@@ -323,6 +324,8 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         s.hand = hand == 0 ? Side::left : Side::right;
         s.dynamics = n.velocity / 127.0;
         s.theta_deg = kDefaultThetaDeg[hand];
+        if (n.note == kMidiSideStick)
+            s.r_over_a = kMidiSideStickRadiusFraction;
         s.line = line;
         s.drum_line = line;
         if (!drums.empty())
@@ -351,8 +354,8 @@ MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<Midi
     MidiDrumPart part = drum_part_score(read_smf(bytes.str(), path), drums, path);
     if (part.score.notes.empty())
         throw MidiFileError(path + ": no note the " + (drums.empty() ? "drum" : "kit") +
-                            " can play (snares 38, 40 and toms 41..50 of the General MIDI drum "
-                            "map, on channel 10 if it has notes)");
+                            " can play (snares 38, 40, side stick 37 and toms 41..50 of the "
+                            "General MIDI drum map, on channel 10 if it has notes)");
     return part;
 }
 

@@ -64,6 +64,11 @@ struct MidiDrum {
     int midi_note = 38;
 };
 
+// General MIDI's side stick (37) is the snare's rim: a stroke aimed this far out, where the
+// stick meets the hoop (docs/rim.md: aimed at 0.93, strikes land at r/a 0.95 on the rim).
+constexpr int kMidiSideStick = 37;
+constexpr double kMidiSideStickRadiusFraction = kMaxRadiusFraction;
+
 // Notes closer than this alternate hands; farther apart, the right hand
 // (the lead) plays.
 constexpr double kMidiAlternateBelow_s = 0.3;
