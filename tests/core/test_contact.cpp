@@ -59,6 +59,28 @@ hit_result hit_membrane(membrane *m, contact *c, double v, double r, double thet
     h.centroid_hz = num / den;
     return h;
 }
+// A membrane with one stick attached, its force outlet and two pickup buffers of 64
+// samples; freed with the rig.
+struct StickRig {
+    membrane *m;
+    contact *c;
+    std::vector<float> force, o0, o1;
+    float *outs[2];
+    explicit StickRig(double fs)
+        : m(membrane_new(fs)), c(contact_new()), force(64), o0(64),
+          o1(64), outs{o0.data(), o1.data()}
+    {
+        membrane_attach_contact(m, c);
+        contact_set_force_output(c, force.data(), 64);
+    }
+    ~StickRig()
+    {
+        membrane_free(m);
+        contact_free(c);
+    }
+    StickRig(const StickRig &) = delete;
+    StickRig &operator=(const StickRig &) = delete;
+};
 } // namespace
 
 TEST_CASE("Rigid target: contact time approaches Hertz within 5 %", "[core][contact]")
@@ -375,12 +397,11 @@ TEST_CASE("Two sticks at once: joint solve stays passive and both report", "[cor
 TEST_CASE("Force buffer carries the stroke and the report is made once", "[core][contact]")
 {
     const double fs = 48000.0;
-    membrane *m = membrane_new(fs);
-    contact *c = contact_new();
-    membrane_attach_contact(m, c);
-    std::vector<float> force(64), o0(64), o1(64);
-    float *outs[2] = {o0.data(), o1.data()};
-    contact_set_force_output(c, force.data(), 64);
+    StickRig rig(fs);
+    membrane *m = rig.m;
+    contact *c = rig.c;
+    std::vector<float> &force = rig.force;
+    float **outs = rig.outs;
     contact_hit(c, 2.0, 0.3, 0.0, 10);
     double integral = 0.0, peak = 0.0;
     int first = -1, reports = 0;
@@ -403,8 +424,6 @@ TEST_CASE("Force buffer carries the stroke and the report is made once", "[core]
     CHECK(rep.impulse_ns == Approx(ictus_param_get(&contact_params, c, CONTACT_PARAM_MASS) *
                                    (2.0 + rep.rebound_velocity_mps))
                                 .epsilon(1e-9));
-    membrane_free(m);
-    contact_free(c);
 }
 
 TEST_CASE("A hit on a moving head meets it on its sample, at the hit's speed relative to it",
@@ -415,12 +434,11 @@ TEST_CASE("A hit on a moving head meets it on its sample, at the hit's speed rel
     // room would chase the head and touch late; it must close in at the hit's speed from
     // the sample it lands on.
     const double fs = 48000.0, r = 0.3, slow = 0.2;
-    membrane *m = membrane_new(fs);
-    contact *c = contact_new();
-    membrane_attach_contact(m, c);
-    std::vector<float> force(64), o0(64), o1(64);
-    float *outs[2] = {o0.data(), o1.data()};
-    contact_set_force_output(c, force.data(), 64);
+    StickRig rig(fs);
+    membrane *m = rig.m;
+    contact *c = rig.c;
+    std::vector<float> &force = rig.force;
+    float **outs = rig.outs;
     contact_hit(c, 6.0, r, 0.0, 0);
     contact_report rep{};
     int reports = 0, steps = 0;
@@ -444,6 +462,4 @@ TEST_CASE("A hit on a moving head meets it on its sample, at the hit's speed rel
     for (int b = 0; b < 100 && !contact_take_report(c, &rep); b++)
         membrane_process(m, nullptr, outs, 64);
     CHECK(rep.duration_ms > 0.0);
-    membrane_free(m);
-    contact_free(c);
 }
