@@ -22,6 +22,7 @@ import subprocess
 
 import numpy as np
 
+from ictus_tools import e2e_util as u
 from ictus_tools.checks import check
 from ictus_tools.pdrun import make_workdir, read_wav_float
 
@@ -42,7 +43,7 @@ wav = os.path.join(out, "kick.wav")
 subprocess.run([os.path.join(args.build, "ictusd"), "render", "--score", path, "--out", out,
                 "--drum-preset", "kick", "--stick-tip", "felt", "--wav", wav, "--wav-mix",
                 "pickups", "--wav-bits", "32"], check=True, timeout=600,
-               stdout=subprocess.DEVNULL)
+               stdout=subprocess.DEVNULL, env=u.pd_spawning_env(work))
 drum = json.load(open(os.path.join(out, "render.json")))["drum"]
 check(drum["preset"] == "kick", "render.json names the preset: %s" % drum["preset"])
 f01 = J01 / (2.0 * math.pi * drum["radius_m"]) * math.sqrt(drum["tension_n_per_m"]
