@@ -287,23 +287,25 @@ void membrane_add_input_(membrane *m, const float *psi, double force, membrane_k
         a->point_w[c] += dw[c];
 }
 
-/* psi_k: a point's shapes times sc (the stored state's coordinates). */
-static double point_displacement(const membrane *m, const float *psi_k)
+/* sum psi_k x over the modes: psi_k is a point's shapes times sc, x a stored state array
+ * (held over sc, membrane_kernel.inc). */
+static double point_sum_k(const membrane *m, const float *psi_k, const float *x)
 {
-    double w = 0.0;
+    double s = 0.0;
     for (int k = 0; k < m->count; k++)
-        w += (double)psi_k[k] * m->q[k];
-    return w * membrane_displacement_scale_(m);
+        s += (double)psi_k[k] * x[k];
+    return s;
 }
 
-/* The velocity there (m/s, positive into the head): p is stored over sc, psi_k is
- * psi sc (membrane_kernel.inc), so the product is the pickups' own sum. */
+static double point_displacement(const membrane *m, const float *psi_k)
+{
+    return point_sum_k(m, psi_k, m->q) * membrane_displacement_scale_(m);
+}
+
+/* The velocity there (m/s, positive into the head): the pickups' own sum. */
 static double point_velocity(const membrane *m, const float *psi_k)
 {
-    double v = 0.0;
-    for (int k = 0; k < m->count; k++)
-        v += (double)psi_k[k] * m->p[k];
-    return v * m->mass_scale;
+    return point_sum_k(m, psi_k, m->p) * m->mass_scale;
 }
 
 /* A pending move lands: the last force at the old place goes into the state, the

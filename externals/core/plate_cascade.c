@@ -170,8 +170,6 @@ void plate_cascade_free(plate_cascade *c)
     memset(c, 0, sizeof(*c));
 }
 
-/* The in-plane modes with zeta < zeta_max (cos and sin partners), into c. */
-
 /* p resized to cap elements of size bytes, or p itself with *ok cleared when out of memory. */
 static void *grow(void *p, size_t size, int cap, int *ok)
 {
@@ -180,6 +178,8 @@ static void *grow(void *p, size_t size, int cap, int *ok)
         *ok = 0;
     return q ? q : p;
 }
+
+/* The in-plane modes with zeta < zeta_max (cos and sin partners), into c. */
 static int build_inplane(plate_cascade *c, double zeta_max)
 {
     int cap = 16, n = 0;

@@ -65,7 +65,7 @@ struct MidiDrum {
 };
 
 // General MIDI's side stick (37) is the snare's rim: a stroke aimed this far out, where the
-// stick meets the hoop (docs/rim.md: aimed at 0.93, strikes land at r/a 0.95 on the rim).
+// stick meets the hoop (docs/rim.md; aimed at 0.95, strikes land at r/a 0.97, zone 1).
 constexpr int kMidiSideStick = 37;
 constexpr double kMidiSideStickRadiusFraction = kMaxRadiusFraction;
 
