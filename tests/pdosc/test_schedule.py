@@ -22,7 +22,8 @@ from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records
 
 CAPACITY = 4096  # the schedule's pending strikes (patches/ictus-receive.pd)
 # OVER: far more than needed, so that the capacity is passed even when a loaded machine
-# drops datagrams on the way (the check counts what reached pd, not what was sent)
+# drops datagrams on the way (the check counts what reached pd, not what was sent); and
+# sent again while pd reports fewer than the capacity
 REAL, JUNK, OVER = 10, 300, 600
 SECONDS = 12.0
 
@@ -82,22 +83,37 @@ def main():
             f = fires[seq]
             check(f[0] == hand and abs(f[1] - vel) < 1e-4 and abs(f[2] - ra) < 1e-5
                   and abs(f[3] - th) < 1e-3, "strike %d fired with its own data: %s" % (seq, f))
-        # past the capacity: paced so that pd's socket buffer keeps up
-        for k in range(CAPACITY - JUNK + OVER):
-            out.sendto(bundle(timetag(now() + 3600.0), strike(20000 + k, 0)),
-                       ("127.0.0.1", pd_port))
-            if k % 25 == 24:
-                time.sleep(0.01)
+        asked = [0]
+
+        def status_packets():
+            """The strike packets pd has taken so far, by asking it (a handshake)."""
+            out.sendto(b"status;\n", ("127.0.0.1", fudi_port))
+            asked[0] += 1
+            got = wait_records(reports, lambda r: sum(a[:2] == ["info", "status"]
+                                                      for _, a in r) >= asked[0],
+                               "status answer %d" % asked[0])
+            return got, int([a for _, a in got if a[:2] == ["info", "status"]][-1][5])
+
+        # past the capacity: paced so that pd's socket buffer keeps up, and sent again in
+        # batches of OVER until pd reports more packets than the schedule holds (a loaded
+        # machine drops datagrams on the way), with a deadline
+        k, batch, t_end = 0, CAPACITY - JUNK + OVER, time.time() + 60.0
+        while True:
+            for _ in range(batch):
+                out.sendto(bundle(timetag(now() + 3600.0), strike(20000 + k, 0)),
+                           ("127.0.0.1", pd_port))
+                k += 1
+                if k % 25 == 0:
+                    time.sleep(0.01)
+            batch = OVER
+            _, packets = status_packets()
+            if packets > REAL + CAPACITY or time.time() > t_end:
+                break
         # Handshake: ask for the status until two answers running report the same packet
         # count (every packet that reached pd has been through the schedule), with a deadline.
-        asked, last, t_end = 0, None, time.time() + 30.0
+        last, t_end = None, time.time() + 30.0
         while time.time() < t_end:
-            out.sendto(b"status;\n", ("127.0.0.1", fudi_port))
-            asked += 1
-            records = wait_records(reports, lambda r: sum(a[:2] == ["info", "status"]
-                                                          for _, a in r) >= asked,
-                                   "status answer %d" % asked)
-            packets = int([a for _, a in records if a[:2] == ["info", "status"]][-1][5])
+            records, packets = status_packets()
             if packets == last:
                 break
             last = packets
