@@ -37,6 +37,7 @@ LOOKAHEAD_S = 0.060
 SPACING_S = 0.045
 SECONDS = 6.0
 LATENCY_MS = 10.0
+LATE_OVERDUE_S = 1.0
 
 reports = Listener()
 ctl = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -89,9 +90,12 @@ try:
         time.sleep(0.005)
         probe()
     time.sleep(0.2)
-    # a bundle 30 ms overdue: fires at once, counted as late
+    # a bundle a second overdue: fires at once, counted as late. Pd's logical
+    # clock may lag the wall clock on a loaded machine (a sanitizer build under
+    # load lagged 40 ms here), and a bundle less overdue than that lag is on
+    # time for pd, not late; a second is well past any lag seen.
     late_seq = 1000
-    t_late = now() - 0.030
+    t_late = now() - LATE_OVERDUE_S
     out.sendto(bundle(timetag(t_late), strike(late_seq, 1)), ("127.0.0.1", pd_port))
     t_late_sent = now()
     # pass-through: pose bundle (immediate), reply, error, pong
@@ -172,8 +176,15 @@ check(not unexplained and len(on_time) >= N_STRIKES - 4,
 t_arr, a = fires.get(late_seq, (None, None))
 check(a is not None, "the late bundle fired")
 late_fire = offset + a[1] / 1000.0
-check(abs(late_fire - t_late_sent) < 0.010,
-      "the late bundle fired on arrival (%.2f ms after sending)" % ((late_fire - t_late_sent) * 1e3))
+# pd handles the packet at its logical "now", which may lag the wall clock: the
+# lag at that moment shows in the fire report's own arrival (t_arr - late_fire,
+# the transit included). Fired at once: no later than 10 ms after sending, and no
+# earlier than the sending minus that lag.
+lag_ms = max(0.0, (t_arr - late_fire) * 1e3 - rtt_ms)
+fired_ms = (late_fire - t_late_sent) * 1e3
+check(-10.0 - lag_ms < fired_ms < 10.0,
+      "the late bundle fired on arrival (%.2f ms after sending; pd's clock %.2f ms behind the "
+      "wall clock then)" % (fired_ms, lag_ms))
 # lateness is counted against the logical time at which pd handled the packet,
 # i.e. (in this test's own mapping) the fire time minus (timetag - latency); the
 # count is the running total, the strikes handled late above included. The
