@@ -5,6 +5,7 @@
 #include "ictus/perform/kit.hpp"
 #include "ictus/perform/performance.hpp"
 #include "ictus/perform/perform_error.hpp"
+#include "ictus/score/score.hpp"
 #include "ictus/sim/strike_detector.hpp"
 
 #include <catch2/catch.hpp>
@@ -33,7 +34,7 @@ void require_refused(const Kit &kit, const std::string &words)
 TEST_CASE("kit: the built-in kits placed in the scene: no shells within 2 cm, all within reach",
           "[perform][kit]")
 {
-    for (const char *name : {"standard", "standard-timpani", "timpani"}) {
+    for (const char *name : {"standard", "standard-cymbals", "standard-timpani", "timpani"}) {
         INFO(name);
         PerformanceOptions o;
         o.kit = kit_named(name);
@@ -52,7 +53,8 @@ TEST_CASE("kit: the built-in kits placed in the scene: no shells within 2 cm, al
         // Reach: the clavicle's root to the shoulder, elbow, wrist and the
         // stick's tip, straightened, from the body at rest (its frames and
         // tips), against the distance from the nearer root to the head's
-        // nearest point at r/a 0.3: at most 95 % of it (the arm a little bent).
+        // nearest point at r/a 0.3 (a cymbal's: at kCymbalRadiusFraction, where
+        // it is played): at most 95 % of it (the arm a little bent).
         const CharacterModel &m = scene.model();
         BodyFrames f;
         scene.body_frames(f);
@@ -73,7 +75,10 @@ TEST_CASE("kit: the built-in kits placed in the scene: no shells within 2 cm, al
             for (int s = 0; s < 2; ++s) {
                 Eigen::Vector3d toward = shoulder[s] - d.center_m;
                 toward.y() = 0.0;
-                const Eigen::Vector3d spot = d.center_m + 0.3 * d.radius_m * toward.normalized();
+                const double r_over_a =
+                    o.kit.drums[static_cast<size_t>(i)].cymbal() ? kCymbalRadiusFraction : 0.3;
+                const Eigen::Vector3d spot =
+                    d.center_m + r_over_a * d.radius_m * toward.normalized();
                 best = std::min(best, (spot - shoulder[s]).norm() / reach[s]);
             }
             INFO("drum " << i);
@@ -94,8 +99,17 @@ TEST_CASE("kit: a bad kit is refused naming the drum and the fault", "[perform][
     k.drums[1].preset = "cowbell";
     require_refused(k, "unknown preset 'cowbell'");
     k = kit_named("standard");
-    k.drums[1].preset = "crash"; // membrane~'s cymbal: a plate, not a drum of the physics
-    require_refused(k, "preset 'crash' is a cymbal, not a drum");
+    k.drums[1].preset = "crash"; // a plate's preset on a drum's head (no bending stiffness)
+    require_refused(k, "preset 'crash' is a cymbal, and the drum has no bending stiffness");
+    k = kit_named("standard-cymbals");
+    k.drums[4].preset = "tom"; // a drum's preset on a cymbal
+    require_refused(k, "preset 'tom' is a drum, and the drum has a bending stiffness");
+    k = kit_named("standard-cymbals");
+    std::swap(k.drums[0], k.drums[4]); // the crash first: the one drum's head
+    require_refused(k, "drum 'crash': the first drum must be a drum, not a cymbal");
+    k = kit_named("standard-cymbals");
+    k.drums[5].tension_n_per_m = 3000.0;
+    require_refused(k, "drum 'ride': a cymbal's bending stiffness must be 0..1e4 N m");
     k = kit_named("standard");
     k.drums[1].name = "Tom 1";
     require_refused(k, "drum name 'Tom 1'");
@@ -157,4 +171,65 @@ TEST_CASE("kit: the detector gives a strike the drum its bead came down on", "[p
     CHECK(e0.drum == 0);
     CHECK(e0.y_m == Approx(0.05).margin(1e-9));
     CHECK(e0.seq == e1.seq + 1);
+}
+
+TEST_CASE("kit: the cymbals are plates of cymbal bronze, their contact a disc's point stiffness",
+          "[perform][kit]")
+{
+    const Kit kit = kit_named("standard-cymbals");
+    REQUIRE(kit.drums.size() == 6);
+    PerformanceOptions o;
+    o.kit = kit;
+    o.score.score_text = "R";
+    Performance perf(o);
+    const Scene &scene = perf.scene();
+    // The bending stiffness from the bronze alone (E 100 GPa, nu 0.33; docs/plates.md):
+    // D = E h^3 / (12 (1 - nu^2)), an 18-inch crash 1.0 mm and a 20-inch ride 1.4 mm thick.
+    const double inch = 0.0254;
+    struct Want {
+        const char *name;
+        double diameter_in, h_m;
+        int note;
+    };
+    for (const Want &w : {Want{"crash", 18.0, 1.0e-3, 49}, Want{"ride", 20.0, 1.4e-3, 51}}) {
+        INFO(w.name);
+        const int i = kit_drum_index(kit, w.name);
+        REQUIRE(i > 0);
+        const KitDrum &k = kit.drums[static_cast<size_t>(i)];
+        const double D = 100e9 * w.h_m * w.h_m * w.h_m / (12.0 * (1.0 - 0.33 * 0.33));
+        CHECK(k.cymbal());
+        CHECK(k.bending_n_m == Approx(D).epsilon(0.005));
+        CHECK(k.tension_n_per_m == 0.0);
+        CHECK(k.radius_m == Approx(0.5 * w.diameter_in * inch).epsilon(1e-3));
+        CHECK(k.midi_note == w.note);
+        // A clamped disc loaded at its centre deflects F R^2 / (16 pi D) (Timoshenko).
+        const double R = 0.5 * w.diameter_in * inch;
+        CHECK(scene.drum_contact_stiffness_n_per_m(i) ==
+              Approx(16.0 * 3.141592653589793 * D / (R * R)).epsilon(0.01));
+        // Higher than every drum's head, and no stretching of a film.
+        for (int j = 0; j < 4; ++j)
+            CHECK(scene.drum(i).center_m.y() > scene.drum(j).center_m.y() + 0.1);
+        CHECK(scene.drum(i).stretch_n_per_m3() == 0.0);
+    }
+    // The drums are as in "standard".
+    const Kit s = kit_named("standard");
+    for (size_t j = 0; j < s.drums.size(); ++j) {
+        CHECK(kit.drums[j].name == s.drums[j].name);
+        CHECK(kit.drums[j].place_m == s.drums[j].place_m);
+        CHECK_FALSE(kit.drums[j].cymbal());
+    }
+}
+
+TEST_CASE("kit: a cymbal's strike is on its plate, never its rim", "[perform][kit]")
+{
+    // A plate's edge is the plate's own (no hoop): a contact at its edge is a
+    // strike on it. The same edge contact on a membrane is its rim.
+    PerformanceOptions o;
+    o.kit = kit_named("standard-cymbals");
+    o.score.score_text = "R";
+    Performance perf(o);
+    const MembraneGeometry crash = membrane_of(perf.scene(), kit_drum_index(o.kit, "crash"));
+    const MembraneGeometry snare = membrane_of(perf.scene(), 0);
+    CHECK(crash.plate);
+    CHECK_FALSE(snare.plate);
 }

@@ -77,6 +77,36 @@ TEST_CASE("score: the kit's statements refuse what they cannot use, at the word"
     require_error("R\nL on tom(1)", 2, 6, "malformed drum name");
 }
 
+TEST_CASE("plan: a cymbal's note without a spot is played on its bow toward the performer",
+          "[score][kit]")
+{
+    // A crash left of the small tom, higher (a kit's cymbal: PerformerFrame::Drum::cymbal).
+    PerformerFrame f = kit_frame();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.push_back({"crash", c + Eigen::Vector3d(0.56, 0.30, 0.30), 0.2286, true});
+    const Score s = parse_score("tempo 80\nR on crash, L on crash, R on crash at 0.5 -30, L", "t");
+    const GesturePlan plan = plan_performance(s, db(), f);
+    REQUIRE(plan.notes.size() == 4);
+    // r/a and theta (membrane frame: theta 90 is toward the performer, world -Z).
+    const double want[4][2] = {{0.7, 110.0}, {0.7, 70.0}, {0.5, -30.0}, {0.3, 0.0}};
+    const int drum[4] = {5, 5, 5, 0};
+    for (size_t i = 0; i < 4; ++i) {
+        INFO(i);
+        const PlannedNote &n = plan.notes[i];
+        REQUIRE(n.drum == drum[i]);
+        CHECK(n.r_over_a == Approx(want[i][0]));
+        CHECK(n.theta_deg == Approx(want[i][1]));
+        const PerformerFrame::Drum &d = f.drums[static_cast<size_t>(drum[i])];
+        const double r = want[i][0] * d.membrane_radius_m, th = want[i][1] * M_PI / 180.0;
+        const Eigen::Vector3d spot =
+            d.membrane_center_m + Eigen::Vector3d(r * std::cos(th), 0.0, -r * std::sin(th));
+        CHECK((n.strike_point_m - spot).norm() < 1e-12);
+    }
+    // Both default spots are on the performer's side of the cymbal's centre.
+    CHECK(plan.notes[0].strike_point_m.z() < c.z() + 0.30);
+    CHECK(plan.notes[1].strike_point_m.z() < c.z() + 0.30);
+}
+
 TEST_CASE(
     "plan: a note on a drum of the kit strikes that drum's spot and unknown drums are refused",
     "[score][kit]")

@@ -128,6 +128,41 @@ TEST_CASE("midi in: hands as a drummer's, the drum channel, the GM toms", "[scor
     CHECK(any.score.notes.size() == 2);
 }
 
+TEST_CASE("midi in: General MIDI's cymbals on a kit's crash and ride", "[score][midi]")
+{
+    // Half a second apart (96 ticks at 96 a quarter, 120 bpm: each the right
+    // hand's): crash 49, crash 2 57, ride 51, ride 2 59, ride bell 53, hi-hat
+    // 42 (no hi-hat in the kit).
+    std::string t;
+    for (int note : {49, 57, 51, 59, 53, 42})
+        t += bytes({0x60, 0x99, note, 100});
+    t += kEnd;
+    const Smf smf = read_smf(header(0, 1) + chunk("MTrk", t), "t.mid");
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"tom1", 48},  {"tom2", 47},
+                                       {"floor", 43}, {"crash", 49}, {"ride", 51}};
+    const MidiDrumPart part = drum_part_score(smf, kit, "t.mid");
+    REQUIRE(part.score.notes.size() == 5);
+    const char *want[5] = {"crash", "crash", "ride", "ride", "ride"};
+    for (size_t i = 0; i < 5; ++i) {
+        INFO(i);
+        CHECK(part.score.notes[i].drum == want[i]);
+        // No spot but the bell's: the planner plays a cymbal's own (kCymbal*).
+        CHECK(part.score.notes[i].spot_given == (i == 4));
+    }
+    CHECK(part.score.notes[4].r_over_a == Approx(kMidiRideBellRadiusFraction));
+    CHECK(part.skipped.at(42) == 1);
+    // Without cymbals in the kit (or without a kit) every cymbal note is left out, counted.
+    const std::vector<MidiDrum> drums = {{"snare", 38}, {"tom1", 48}};
+    t = bytes({0x00, 0x99, 38, 100}) + t;
+    const Smf with_snare = read_smf(header(0, 1) + chunk("MTrk", t), "t.mid");
+    for (const std::vector<MidiDrum> &k : {drums, std::vector<MidiDrum>{}}) {
+        const MidiDrumPart none = drum_part_score(with_snare, k, "t.mid");
+        REQUIRE(none.score.notes.size() == 1);
+        CHECK(none.skipped.at(49) == 1);
+        CHECK(none.skipped.at(53) == 1);
+    }
+}
+
 TEST_CASE("midi in: a malformed file names its byte and track", "[score][midi]")
 {
     CHECK(what_of("RIFF....") == "t.mid: byte 0: not a Standard MIDI File (no MThd header)");

@@ -160,7 +160,8 @@ std::vector<std::string> pd_command_line(const PdRenderOptions &o, const std::st
         if (!k.preset.empty())
             sends.push_back(to + "preset " + k.preset);
         sends.push_back(to + "radius " + format("%.9g", k.radius_m));
-        sends.push_back(to + "tension " + format("%.9g", k.tension_n_per_m));
+        if (k.tension_n_per_m > 0.0) // a cymbal has none (its preset made it a plate)
+            sends.push_back(to + "tension " + format("%.9g", k.tension_n_per_m));
         sends.push_back(to + "pan " + format("%.6g", k.pan));
         if (!o.stick_tip.empty()) { // the sticks play every drum with their tip
             sends.push_back(to + "left tip " + o.stick_tip);

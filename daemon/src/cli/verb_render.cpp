@@ -126,7 +126,8 @@ void render_usage(std::ostream &out)
            "                      sets radius, tension, density (unless given) and, in Pd,\n"
            "                      the head's T60, modes, pickups and tuning (docs/sound.md)\n"
            "  --kit NAME          several drums (score mode): standard (snare, tom1, tom2,\n"
-           "                      floor), standard-timpani (and timpani), timpani (timpani1,\n"
+           "                      floor), standard-cymbals (and crash, ride), standard-\n"
+           "                      timpani (and timpani), timpani (timpani1,\n"
            "                      timpani2); the first where the drum goes, the score's\n"
            "                      'drum NAME' and 'on NAME' choose (docs/perform.md)\n"
            "  --stick-tip NAME    wood, nylon or felt: the tip's law in series with the head\n"
@@ -345,6 +346,7 @@ nlohmann::json kit_json(const Performance &p)
                          {"center_m", {d.center_m.x(), d.center_m.y(), d.center_m.z()}},
                          {"radius_m", d.radius_m},
                          {"tension_n_per_m", d.tension_n_per_m},
+                         {"bending_n_m", k.bending_n_m}, // a cymbal's; 0: a drum
                          {"shell_depth_m", d.shell_depth_m},
                          {"midi_note", k.midi_note},
                          {"stick_tip", scene.options().drum.stick_tip}, // the sticks' ("": none)

@@ -33,6 +33,7 @@ KitDrum drum(const char *name, const char *preset, double diameter_in, double de
     d.radius_m = diameter_in > 0.0 ? 0.5 * diameter_in * kInch_m : p->radius_m;
     d.tension_n_per_m = p->tension_n_per_m;
     d.density_kg_per_m2 = p->density_kg_per_m2;
+    d.bending_n_m = p->plate ? p->bending_n_m : 0.0;
     d.shell_depth_m = depth_in * kInch_m;
     d.midi_note = midi_note;
     return d;
@@ -51,11 +52,23 @@ std::vector<KitDrum> standard_drums()
             drum("floor", "floor-tom", 16.0, 16.0, {0.40, 0.0, -0.05}, 43)};
 }
 
+// The cymbals of "standard-cymbals" (docs/kit.md gives the sources): an
+// 18-inch crash to the left beyond the small tom, and a 20-inch ride to the
+// right beyond the large one, both higher than the toms and clear of every
+// head in plan (kKitMinGap_m); General MIDI's Crash Cymbal 1 (49) and Ride
+// Cymbal 1 (51). Each is a disc 1 cm thick (its stand is not in the scene).
+std::vector<KitDrum> cymbals()
+{
+    constexpr double kDisc_in = 0.4; // 1 cm
+    return {drum("crash", "crash", 0.0, kDisc_in, {-0.56, 0.30, 0.30}, 49),
+            drum("ride", "ride", 0.0, kDisc_in, {0.66, 0.22, 0.38}, 51)};
+}
+
 } // namespace
 
 std::string kit_names()
 {
-    return "standard, standard-timpani, timpani";
+    return "standard, standard-cymbals, standard-timpani, timpani";
 }
 
 Kit kit_named(const std::string &name)
@@ -64,6 +77,10 @@ Kit kit_named(const std::string &name)
     kit.name = name;
     if (name == "standard") {
         kit.drums = standard_drums();
+    } else if (name == "standard-cymbals") {
+        kit.drums = standard_drums();
+        for (const KitDrum &c : cymbals())
+            kit.drums.push_back(c);
     } else if (name == "standard-timpani") {
         // A 26-inch timpani (its kettle 0.6 m deep) where a hi-hat would
         // stand, left of the snare, its head level with the snare's. No
@@ -128,14 +145,25 @@ void validate_kit(const Kit &kit)
         if (kit_drum_index(kit, d.name) != static_cast<int>(i))
             throw PerformError(who + "the name is given twice");
         const membrane_preset *preset = membrane_preset_find(d.preset.c_str());
-        if (!preset || preset->plate)
-            throw PerformError(who + (preset ? "preset '" + d.preset + "' is a cymbal, not a drum"
-                                             : "unknown preset '" + d.preset + "'") +
-                               " (the drum presets: " + membrane_preset_drum_names() + ")");
+        if (!preset)
+            throw PerformError(who + "unknown preset '" + d.preset +
+                               "' (the presets: " + membrane_preset_names() + ")");
+        if (preset->plate != (d.cymbal() ? 1 : 0))
+            throw PerformError(who + "preset '" + d.preset + "' is " +
+                               (preset->plate ? "a cymbal, and the drum has no bending stiffness"
+                                              : "a drum, and the drum has a bending stiffness"));
+        if (i == 0 && d.cymbal())
+            throw PerformError(who +
+                               "the first drum must be a drum, not a cymbal (the drum "
+                               "presets: " +
+                               membrane_preset_drum_names() + ")");
         if (!(d.radius_m >= 0.05 && d.radius_m <= 1.0))
             throw PerformError(who + "radius must be 0.05..1 m");
-        if (!(d.tension_n_per_m >= 10.0 && d.tension_n_per_m <= 1e5))
-            throw PerformError(who + "tension must be 10..1e5 N/m");
+        if (d.cymbal() ? !(d.bending_n_m <= 1e4 && d.tension_n_per_m == 0.0)
+                       : !(d.tension_n_per_m >= 10.0 && d.tension_n_per_m <= 1e5))
+            throw PerformError(who + (d.cymbal() ? "a cymbal's bending stiffness must be "
+                                                   "0..1e4 N m, and it has no tension"
+                                                 : "tension must be 10..1e5 N/m"));
         if (!(d.density_kg_per_m2 >= MEMBRANE_DENSITY_MIN && d.density_kg_per_m2 <= MEMBRANE_DENSITY_MAX))
             throw PerformError(who + "density must be 0.01..20 kg/m^2");
         if (!(d.shell_depth_m >= 0.01 && d.shell_depth_m <= 1.5))
@@ -166,6 +194,7 @@ std::vector<DrumParams> place_kit(const Kit &kit, const DrumParams &base,
             anchor_m + d.place_m.x() * right + d.place_m.y() * up + d.place_m.z() * forward;
         p.radius_m = d.radius_m;
         p.tension_n_per_m = d.tension_n_per_m;
+        p.plate_bending_n_m = d.bending_n_m;
         // Mylar, as membrane~'s head: the film as thick as the density says,
         // for its stretching under the stick (DrumParams::stretch_n_per_m3).
         p.head_thickness_m = d.density_kg_per_m2 / MEMBRANE_MYLAR_RHO;

@@ -442,7 +442,12 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         p.theta_deg = n.theta_deg;
         p.firmness = n.firmness;
         p.drum = drum_index(score, n, frame);
-        p.strike_point_m = membrane_point(frame, n.r_over_a, n.theta_deg, p.drum);
+        if (!n.spot_given && p.drum < static_cast<int>(frame.drums.size()) &&
+            frame.drums[static_cast<size_t>(p.drum)].cymbal) {
+            p.r_over_a = kCymbalRadiusFraction;
+            p.theta_deg = kCymbalThetaDeg[static_cast<int>(n.hand)];
+        }
+        p.strike_point_m = membrane_point(frame, p.r_over_a, p.theta_deg, p.drum);
         p.tip_target_m = p.strike_point_m - opt.strike_depth_m * frame.up;
         p.line = n.line;
         p.column = n.column;

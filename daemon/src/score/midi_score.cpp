@@ -213,10 +213,27 @@ bool is_tom(int note)
     return note == 41 || note == 43 || note == 45 || note == 47 || note == 48 || note == 50;
 }
 
+// A cymbal's note: the kit's cymbal that plays it (crash or ride), 0 for another note.
+int cymbal_of(int note)
+{
+    if (note == kMidiCrash || note == 57)
+        return kMidiCrash;
+    if (note == kMidiRide || note == 59 || note == kMidiRideBell)
+        return kMidiRide;
+    return 0;
+}
+
 // The drum (index into `drums`) of a General MIDI note, -1: not played;
-// no drums: 0, the one drum, for every snare and tom.
+// no drums: 0, the one drum, for every snare and tom. A cymbal's note plays on
+// the kit's drum of its cymbal's note, if the kit has one.
 int drum_of(int note, const std::vector<MidiDrum> &drums)
 {
+    if (const int cymbal = cymbal_of(note)) {
+        for (size_t i = 0; i < drums.size(); ++i)
+            if (drums[i].midi_note == cymbal)
+                return static_cast<int>(i);
+        return -1;
+    }
     if (!is_snare(note) && !is_tom(note))
         return -1;
     if (drums.empty())
@@ -326,6 +343,9 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         s.theta_deg = kDefaultThetaDeg[hand];
         if (n.note == kMidiSideStick)
             s.r_over_a = kMidiSideStickRadiusFraction;
+        else if (n.note == kMidiRideBell)
+            s.r_over_a = kMidiRideBellRadiusFraction;
+        s.spot_given = n.note == kMidiSideStick || n.note == kMidiRideBell;
         s.line = line;
         s.drum_line = line;
         if (!drums.empty())
@@ -354,8 +374,9 @@ MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<Midi
     MidiDrumPart part = drum_part_score(read_smf(bytes.str(), path), drums, path);
     if (part.score.notes.empty())
         throw MidiFileError(path + ": no note the " + (drums.empty() ? "drum" : "kit") +
-                            " can play (snares 38, 40, side stick 37 and toms 41..50 of the "
-                            "General MIDI drum map, on channel 10 if it has notes)");
+                            " can play (snares 38, 40, side stick 37, toms 41..50 and, on a kit "
+                            "with cymbals, crash 49, 57 and ride 51, 53, 59 of the General MIDI "
+                            "drum map, on channel 10 if it has notes)");
     return part;
 }
 

@@ -134,6 +134,7 @@ class Executor
         n.nuance = st.nuance.value_or(default_nuance_);
         n.dynamics = st.dynamics.value_or(n.dynamics);
         n.r_over_a = st.r_over_a.value_or(kDefaultRadiusFraction);
+        n.spot_given = st.r_over_a.has_value() || st.theta_deg.has_value();
         n.firmness = st.firmness.value_or(default_firmness_);
         if (st.drum) {
             n.drum = *st.drum;

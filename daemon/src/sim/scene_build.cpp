@@ -68,11 +68,17 @@ void check_finite_positive(const char *what, double v, double max = 1e300)
 
 double DrumParams::stiffness_n_per_m(double tip_radius_m) const
 {
+    // A plate: a centrally loaded clamped disc's point stiffness, 16 pi D / R^2
+    // (S. Timoshenko, S. Woinowsky-Krieger, Theory of Plates and Shells, 1959, sec. 19).
+    if (plate_bending_n_m > 0.0)
+        return 16.0 * M_PI * plate_bending_n_m / (radius_m * radius_m);
     return 2.0 * M_PI * tension_n_per_m / std::log(radius_m / tip_radius_m);
 }
 
 double DrumParams::stretch_n_per_m3() const
 {
+    if (plate_bending_n_m > 0.0)
+        return 0.0; // a plate bends; it does not stretch as a film does
     return stick_tip_head_k3(head_young_pa, head_poisson, head_thickness_m, radius_m);
 }
 
@@ -87,7 +93,11 @@ void validate_drum(const DrumParams &d, const std::string &which)
 {
     check_finite_positive((which + " radius (m)").c_str(), d.radius_m, 5.0);
     check_finite_positive((which + " shell depth (m)").c_str(), d.shell_depth_m, 5.0);
-    check_finite_positive((which + " tension (N/m)").c_str(), d.tension_n_per_m, 1e7);
+    if (d.plate_bending_n_m > 0.0)
+        check_finite_positive((which + " bending stiffness (N m)").c_str(), d.plate_bending_n_m,
+                              1e4);
+    else
+        check_finite_positive((which + " tension (N/m)").c_str(), d.tension_n_per_m, 1e7);
     if (!(std::isfinite(d.contact_damping_n_s_per_m) && d.contact_damping_n_s_per_m >= 0.0))
         throw SimError(which + " contact damping: expected a finite value >= 0");
     if (!(std::isfinite(d.friction) && d.friction >= 0.0))

@@ -405,6 +405,7 @@ MembraneGeometry membrane_of(const Scene &scene, int drum_id)
     m.damping_n_s_per_m = d.contact_damping_n_s_per_m;
     m.friction = d.friction;
     m.drum_id = drum_id;
+    m.plate = d.plate_bending_n_m > 0.0;
     return m;
 }
 
@@ -465,7 +466,7 @@ StickDrumForces stick_drum_forces(const Scene &scene, int hand, const MembraneGe
     if (c.bead_points + c.shaft_points == 0)
         return f;
     bool bead_on_rim = false;
-    const bool on_rim = stick_on_rim(scene, hand, membrane, &bead_on_rim);
+    const bool on_rim = !membrane.plate && stick_on_rim(scene, hand, membrane, &bead_on_rim);
     const double bead_n = c.bead_force_n.norm(), shaft_n = c.shaft_force_n.norm();
     (bead_on_rim ? f.rim_n : f.head_n) += bead_n;
     (on_rim ? f.rim_n : f.head_n) += shaft_n;

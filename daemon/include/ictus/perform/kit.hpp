@@ -26,6 +26,11 @@ struct KitDrum {
     double density_kg_per_m2 = 0.345; // the head's areal density (its film's thickness)
     double shell_depth_m = 0.14;
     int midi_note = 38; // General MIDI drum map (docs/midi.md)
+    // A cymbal (a plate preset, docs/plates.md): its bending stiffness D (N m),
+    // and no tension (0); 0 for a drum. In the scene it is a disc as thick as
+    // shell_depth_m, its top face the plate (docs/kit.md, "Cymbals").
+    double bending_n_m = 0.0;
+    bool cymbal() const { return bending_n_m > 0.0; }
 };
 
 struct Kit {
@@ -39,14 +44,16 @@ struct Kit {
 constexpr double kKitMinGap_m = 0.02;
 
 // The built-in kits by name: "standard" (snare, two rack toms, floor tom: a
-// right-handed four-piece), "standard-timpani" (the same and a 26-inch
-// timpani to the left of the snare) and "timpani" (two timpani). Throws
-// PerformError naming the kits for another name.
+// right-handed four-piece), "standard-cymbals" (the same with an 18-inch
+// crash and a 20-inch ride), "standard-timpani" (the four drums and a
+// 26-inch timpani to the left of the snare) and "timpani" (two timpani).
+// Throws PerformError naming the kits for another name.
 Kit kit_named(const std::string &name);
-// "standard, standard-timpani, timpani".
+// "standard, standard-cymbals, standard-timpani, timpani".
 std::string kit_names();
 // Throws PerformError naming the drum and the fault: no drums or more than
-// kMaxDrums, a bad or repeated name, an unknown preset, a size out of range,
+// kMaxDrums, a bad or repeated name, an unknown preset, a cymbal first (the
+// first drum is the one drum's head), a size out of range,
 // a MIDI note outside 0..127, two shells closer than kKitMinGap_m in plan.
 void validate_kit(const Kit &kit);
 // The smallest plan-view gap between two drums' shells (m; +inf for one drum).

@@ -45,6 +45,7 @@ struct PerformerFrame {
         std::string name;
         Eigen::Vector3d membrane_center_m = Eigen::Vector3d::Zero(); // raised as membrane_center_m
         double membrane_radius_m = 0.178;
+        bool cymbal = false; // played where a note gives no spot at kCymbal* (score.hpp)
     };
     std::vector<Drum> drums;
 };

@@ -68,6 +68,13 @@ struct MidiDrum {
 // stick meets the hoop (docs/rim.md; aimed at 0.95, strikes land at r/a 0.97, zone 1).
 constexpr int kMidiSideStick = 37;
 constexpr double kMidiSideStickRadiusFraction = kMaxRadiusFraction;
+// General MIDI's cymbals, played on a kit's cymbal of that note (docs/midi.md): crash 49 and
+// 57 on its crash (49), ride 51 and 59 on its ride (51), ride bell 53 on the ride's bell, a
+// stroke aimed this near the centre (a 20-inch ride's bell is about 6 inches across).
+constexpr int kMidiCrash = 49;
+constexpr int kMidiRide = 51;
+constexpr int kMidiRideBell = 53;
+constexpr double kMidiRideBellRadiusFraction = 0.12;
 
 // Notes closer than this alternate hands; farther apart, the right hand
 // (the lead) plays.

@@ -59,6 +59,11 @@ constexpr double kDefaultRadiusFraction = 0.3;
 // left; y_m along world -Z, toward the performer) of each hand's default
 // spot: the right hand plays on the performer's right (x_m < 0).
 constexpr double kDefaultThetaDeg[2] = {0.0, 180.0}; // [Side::left, Side::right]
+// A kit's cymbal (docs/kit.md, "Cymbals") is played, where the note gives no
+// spot, on its bow toward the performer: r/a 0.7, each hand 20 degrees to its
+// own side of the point nearest the performer (theta 90).
+constexpr double kCymbalRadiusFraction = 0.7;
+constexpr double kCymbalThetaDeg[2] = {70.0, 110.0}; // [Side::left, Side::right]
 
 // Grace strokes (docs/score.md, "Flams, drags and rolls"): a flam's one
 // grace stroke of the other hand kFlamGraceLead_s before its note; a drag's
@@ -87,6 +92,7 @@ struct ScoreNote {
     double dynamics = kDefaultDynamics; // 0 (softest) .. 1 (loudest)
     double r_over_a = kDefaultRadiusFraction;
     double theta_deg = 180.0; // membrane frame, in (-180, 180]
+    bool spot_given = false;  // by `at` (else the hand's default spot, or a cymbal's)
     // The grip's firmness for this stroke, 0 (loose) .. 1 (clamped); < 0:
     // the performance's own (its default, or /ictus/grip/firmness).
     double firmness = -1.0;

@@ -51,7 +51,12 @@ struct DrumParams {
     double head_young_pa = 4.5e9;
     double head_poisson = 0.38;
     double head_thickness_m = 0.262 / 1390.0;
-    // k = 2 pi T / ln(R / r_tip), N/m.
+    // A cymbal instead of a membrane (docs/kit.md, "Cymbals"): the plate's
+    // bending stiffness D (N m; 0: a membrane of tension_n_per_m). Its contact
+    // is the point stiffness of a disc of its radius, 16 pi D / R^2, without
+    // the membrane's stretching.
+    double plate_bending_n_m = 0.0;
+    // k = 2 pi T / ln(R / r_tip), N/m (a plate: 16 pi D / R^2).
     double stiffness_n_per_m(double tip_radius_m) const;
     // The stretching's cubic term k3 (N/m^3): F = k y + k3 y^3 under a point load
     // (stick_tip_head_k3 in externals/core/stick_tip.h, Begley & Mackin 2004).

@@ -34,6 +34,7 @@ struct MembraneGeometry {
     double friction = 0.3;             // Coulomb coefficient (force direction only)
     double tip_radius_m = 0.007;       // the bead's radius
     int drum_id = 0;
+    bool plate = false; // a cymbal: its edge is the plate's, no rim (every strike on its head)
 };
 
 struct StrikeDetectorOptions {
