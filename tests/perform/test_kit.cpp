@@ -97,6 +97,9 @@ TEST_CASE("kit: a bad kit is refused naming the drum and the fault", "[perform][
     k.drums[1].preset = "crash"; // membrane~'s cymbal: a plate, not a drum of the physics
     require_refused(k, "preset 'crash' is a cymbal, not a drum");
     k = kit_named("standard");
+    k.drums[1].preset = "hihat"; // the hi-hat too: a plate
+    require_refused(k, "preset 'hihat' is a cymbal, not a drum");
+    k = kit_named("standard");
     k.drums[1].name = "Tom 1";
     require_refused(k, "drum name 'Tom 1'");
     k = kit_named("standard");
