@@ -46,6 +46,8 @@ membrane *membrane_new(double sample_rate_hz)
     m->loss_factor = MEMBRANE_DEFAULT_LOSS_FACTOR;
     m->patch = MEMBRANE_DEFAULT_PATCH;
     m->bending = MEMBRANE_DEFAULT_BENDING;
+    m->openness = MEMBRANE_DEFAULT_OPENNESS;
+    m->edge_damp = MEMBRANE_DEFAULT_EDGE_DAMP;
     m->tm_g = 1.0;
     m->output_gain = MEMBRANE_DEFAULT_GAIN;
     m->gain_smoothed = MEMBRANE_DEFAULT_GAIN;

@@ -57,6 +57,10 @@ extern "C" {
 #define MEMBRANE_BENDING_MAX     1.0e4
 #define MEMBRANE_CASCADE_MIN     0.0 /* 0: a linear plate */
 #define MEMBRANE_CASCADE_MAX     10.0
+#define MEMBRANE_OPENNESS_MIN    0.0 /* a hi-hat's pedal: 0 closed, 1 open */
+#define MEMBRANE_OPENNESS_MAX    1.0
+#define MEMBRANE_EDGE_DAMP_MIN   0.0 /* N s/m^2: 0, no second plate */
+#define MEMBRANE_EDGE_DAMP_MAX   1.0e4
 #define MEMBRANE_GAIN_MIN       -1.0e6 /* s/m; negative inverts */
 #define MEMBRANE_GAIN_MAX       1.0e6
 #define MEMBRANE_R_OVER_A_MIN   0.0 /* points: pickups, strikes, contacts */
@@ -91,6 +95,10 @@ extern "C" {
 #define MEMBRANE_DEFAULT_BENDING     9.35
 /* A plate's von Karman cascade (docs/plates.md, "The cascade"): 0 off, 1 bronze. */
 #define MEMBRANE_DEFAULT_CASCADE     0.0
+/* A hi-hat's pedal (docs/plates.md, "The hi-hat"): the default is the stand at rest, the
+ * spring holding the plates apart; no second plate by default. */
+#define MEMBRANE_DEFAULT_OPENNESS    1.0
+#define MEMBRANE_DEFAULT_EDGE_DAMP   0.0
 #define MEMBRANE_PATCH_BEAD          0.007
 #define MEMBRANE_AIR_RHO             1.2   /* kg/m^3 */
 #define MEMBRANE_AIR_C               343.0 /* m/s */
@@ -137,6 +145,12 @@ typedef enum membrane_param {
     /* A plate's nonlinear cascade: a factor on the von Karman stretching stiffness E h
      * (1 = the bronze plate of that D and density; 0 = linear); a membrane ignores it */
     MEMBRANE_PARAM_CASCADE,
+    /* A hi-hat (docs/plates.md, "The hi-hat"): the bottom plate pressed against a plate's
+     * edge by the pedal acts as a dashpot spread along the edge, edgedamp N s/m^2 (N per
+     * m/s per metre of edge) when closed, times (1 - openness)^2; openness 0 closed, 1
+     * open (the plates apart). A membrane, fixed at its rim, is not moved by it. */
+    MEMBRANE_PARAM_OPENNESS,
+    MEMBRANE_PARAM_EDGE_DAMP,
     MEMBRANE_PARAM_COUNT
 } membrane_param;
 

@@ -126,6 +126,9 @@ struct membrane {
     /* A plate's von Karman cascade (membrane_cascade.c): the factor on E h, the coupling
      * built at message time, and whether the processing loop runs it. */
     double cascade;
+    /* A hi-hat's second plate (MEMBRANE_PARAM_OPENNESS, MEMBRANE_PARAM_EDGE_DAMP): the
+     * loss it puts on the edge, in each mode's decay rate (membrane_modes.c). */
+    double openness, edge_damp;
     struct plate_cascade *pc;
     int cascade_on;
     /* The radiation integral of each mode depends on ka = j c / c_air alone: kept for

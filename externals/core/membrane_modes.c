@@ -69,6 +69,12 @@ static double mode_decay_rate(const membrane *m, int k, double omega)
     double s0 = rate1 / (1.0 + m->hf_damping * (omega1 / w_ref) * (omega1 / w_ref));
     double s1 = m->hf_damping * s0 / (w_ref * w_ref);
     double rate = s0 + s1 * omega * omega + 0.5 * m->loss_factor * omega;
+    /* A dashpot of c N s/m^2 along the edge takes c times the edge integral of the
+     * mass-normalised shape squared, psi^2 / (rho h a^2) over a dtheta, from twice the
+     * rate: c edge_k / (2 rho h a) (docs/plates.md, "The hi-hat"). */
+    const double closed = 1.0 - m->openness;
+    if (m->edge_damp > 0.0 && m->table.edge)
+        rate += closed * closed * m->edge_damp * m->table.edge[k] / (2.0 * m->density * m->radius);
     if (m->radiation > 0.0)
         rate += m->radiation * radiation_rate(m, k, omega);
     return rate;

@@ -130,9 +130,11 @@ static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
     [MEMBRANE_PARAM_LOSS_FACTOR] = {"lossfactor", "", RANGE(LOSS_FACTOR), FIELD(loss_factor),
                                     physics_changed},
     [MEMBRANE_PARAM_PATCH] = {"patch", "m", RANGE(PATCH), FIELD(patch), geometry_changed},
-    [MEMBRANE_PARAM_BENDING] = {"bending", "N m", RANGE(BENDING), FIELD(bending),
-                                physics_changed},
+    [MEMBRANE_PARAM_BENDING] = {"bending", "N m", RANGE(BENDING), FIELD(bending), physics_changed},
     [MEMBRANE_PARAM_CASCADE] = {"cascade", "", RANGE(CASCADE), FIELD(cascade), physics_changed},
+    [MEMBRANE_PARAM_OPENNESS] = {"openness", "", RANGE(OPENNESS), FIELD(openness), physics_changed},
+    [MEMBRANE_PARAM_EDGE_DAMP] = {"edgedamp", "N s/m^2", RANGE(EDGE_DAMP), FIELD(edge_damp),
+                                  physics_changed},
 };
 #undef RANGE
 #undef FIELD

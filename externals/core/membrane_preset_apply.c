@@ -55,6 +55,7 @@ ictus_status membrane_apply_preset(membrane *m, const membrane_preset *p)
                                               : MEMBRANE_DEFAULT_LOSS_FACTOR},
         {MEMBRANE_PARAM_PATCH, bare ? 0.0 : MEMBRANE_PATCH_BEAD},
         {MEMBRANE_PARAM_CASCADE, 0.0}, /* off: it darkens the crash (docs/plates.md) */
+        {MEMBRANE_PARAM_EDGE_DAMP, p->edge_damp_n_s_per_m2},
     };
     for (int i = 0; i < (int)(sizeof(sets) / sizeof(sets[0])); i++)
         if ((e = ictus_param_set(t, m, sets[i].id, sets[i].value)) > s)

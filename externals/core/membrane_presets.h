@@ -46,6 +46,10 @@ typedef struct membrane_preset {
      * drum for the daemon's physics. 0: a drum. */
     int plate;
     double bending_n_m;
+    /* A hi-hat: the closed pair's loss along the top plate's edge (MEMBRANE_PARAM_EDGE_DAMP,
+     * N s/m^2); 0 for every other preset. The pedal (openness) is the player's: a preset
+     * leaves it as it is. */
+    double edge_damp_n_s_per_m2;
 } membrane_preset;
 
 /* The presets, in the order the docs list them; count via membrane_preset_count(). */
@@ -59,8 +63,9 @@ const char *membrane_preset_names(void);
 const char *membrane_preset_drum_names(void);
 
 /* Sets m to preset p: a membrane or a plate, radius, tension (or bending), density,
- * T60, hfdamp, mode count, strike point, pickups and the tuning of its modes; gain is left as it is (it is the mix, not the
- * head). Allocates when the mode count grows: message time only, never from audio.
+ * T60, hfdamp, mode count, a hi-hat's edge loss, strike point, pickups and the tuning of
+ * its modes; gain and openness are left as they are (the mix and the foot, not the
+ * instrument). Allocates when the mode count grows: message time only, never from audio.
  * ICTUS_ENOMEM when the modes could not be had (the other values are set). */
 ictus_status membrane_apply_preset(membrane *m, const membrane_preset *p);
 

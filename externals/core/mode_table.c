@@ -12,7 +12,8 @@
 void mode_table_free(mode_table *t)
 {
     free(t->j), free(t->norm), free(t->m), free(t->n), free(t->sin), free(t->plate);
-    t->j = t->norm = NULL;
+    free(t->edge);
+    t->j = t->norm = t->edge = NULL;
     t->m = t->n = t->sin = NULL;
     t->plate = NULL;
     t->size = 0;
@@ -25,7 +26,8 @@ static int alloc_entries(mode_table *t, int size)
     t->m = malloc(sizeof(int) * (size_t)size);
     t->n = malloc(sizeof(int) * (size_t)size);
     t->sin = malloc(sizeof(int) * (size_t)size);
-    return t->j && t->norm && t->m && t->n && t->sin;
+    t->edge = calloc((size_t)size, sizeof(double));
+    return t->j && t->norm && t->m && t->n && t->sin && t->edge;
 }
 
 /* A plate's table: the free-edge modes below a lambda that Weyl's law for the plate
@@ -64,6 +66,9 @@ static ictus_status build_plate(mode_table *t, int size)
             t->n[k] = pm[i].s;
             t->sin[k] = s;
             t->norm[k] = 1.0;
+            /* cos^2 or sin^2 (m theta) averages 1/2 around the edge, 1 for m = 0 */
+            const double w = plate_mode_radial(&pm[i], 1.0);
+            t->edge[k] = w * w * (pm[i].m ? M_PI : 2.0 * M_PI);
         }
     free(pm);
     t->size = size;
@@ -76,7 +81,7 @@ ictus_status mode_table_build(mode_table *t, int size, int plate)
     double x_max = 2.0 * sqrt((double)size) + 4.0;
     ictus_bessel_zero_entry *zeros = NULL;
     int count = 0, modes = 0;
-    t->j = t->norm = NULL;
+    t->j = t->norm = t->edge = NULL;
     t->m = t->n = t->sin = NULL;
     t->plate = NULL;
     t->size = 0;

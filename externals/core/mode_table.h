@@ -19,6 +19,10 @@ typedef struct mode_table {
     double *norm; /* sqrt(eps_m / pi) / |J_{m+1}(j)|: makes the shapes mass-normalised */
     int *m, *n;   /* order (nodal diameters), and which zero of J_m (plate: nodal circles) */
     int *sin;     /* 0: cos(m theta) partner, 1: sin(m theta) partner */
+    /* The shape squared integrated around the edge, the integral over theta of
+     * psi(1, theta)^2: what a loss spread along the edge takes from the mode (a
+     * hi-hat's second plate, docs/plates.md). 0 for a membrane (fixed at its rim). */
+    double *edge;
     int size;
     plate_mode *plate; /* a plate's modes (their radial shapes, normalised), NULL: a membrane */
 } mode_table;

@@ -477,4 +477,9 @@ TEST_CASE("ictusd render --drum-preset: the preset's head, recorded in render.js
     CHECK(
         c.output.find("the drum presets are paper, snare, tom, floor-tom, timpani, frame, kick") !=
         std::string::npos);
+    const Run h = ictusd("render --mocap " + bvh + " --duration 0.05 --drum-preset hihat --out " +
+                         simtest::temp_path("preset_hihat"));
+    INFO(h.output);
+    CHECK(h.status == 2);
+    CHECK(h.output.find("--drum-preset: 'hihat' is a cymbal") != std::string::npos);
 }

@@ -34,8 +34,8 @@ TEST_CASE("Every preset is found by its name, and the names line lists them all"
 {
     const std::string names = membrane_preset_names();
     const char *expected[] = {"paper", "snare", "tom",   "floor-tom", "timpani",
-                              "frame", "kick",  "crash", "ride"};
-    REQUIRE(membrane_preset_count() == 9);
+                              "frame", "kick",  "crash", "ride",      "hihat"};
+    REQUIRE(membrane_preset_count() == 10);
     for (const char *name : expected) {
         const membrane_preset *p = membrane_preset_find(name);
         REQUIRE(p);
@@ -44,7 +44,7 @@ TEST_CASE("Every preset is found by its name, and the names line lists them all"
     }
     CHECK(membrane_preset_find("bongo") == nullptr);
     CHECK(membrane_preset_find(nullptr) == nullptr);
-    CHECK(membrane_preset_at(9) == nullptr);
+    CHECK(membrane_preset_at(10) == nullptr);
     // the drums' list leaves the plates out
     const std::string drums = membrane_preset_drum_names();
     CHECK(drums.find("frame") != std::string::npos);

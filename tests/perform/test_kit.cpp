@@ -111,6 +111,9 @@ TEST_CASE("kit: a bad kit is refused naming the drum and the fault", "[perform][
     k.drums[5].tension_n_per_m = 3000.0;
     require_refused(k, "drum 'ride': a cymbal's bending stiffness must be 0..1e4 N m");
     k = kit_named("standard");
+    k.drums[1].preset = "hihat"; // the hi-hat too: a plate
+    require_refused(k, "preset 'hihat' is a cymbal, not a drum");
+    k = kit_named("standard");
     k.drums[1].name = "Tom 1";
     require_refused(k, "drum name 'Tom 1'");
     k = kit_named("standard");
