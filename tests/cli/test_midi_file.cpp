@@ -124,6 +124,18 @@ TEST_CASE("midi: with a kit each strike is its drum's General MIDI note", "[cli]
                              "MTrk" + bytes({0, 0, 0, static_cast<int>(track.size())}) + track;
     CHECK(standard_midi_file(s, midi_timeline(60.0), 9, &notes) == want);
     CHECK(standard_midi_file(s, midi_timeline(60.0), 9) != want);
+    // A strike on the snare's rim is the side stick (37), as --midi reads 37; a rim strike
+    // on tom1 stays tom1's note. The same bytes but the first note's two 38s.
+    s[0].zone = kZoneRim;
+    std::string rim = want;
+    for (size_t k = 0; k + 1 < rim.size(); ++k)
+        if ((static_cast<unsigned char>(rim[k]) & 0xef) == 0x89 && rim[k + 1] == 38)
+            rim[k + 1] = 37;
+    REQUIRE(rim != want);
+    CHECK(standard_midi_file(s, midi_timeline(60.0), 9, &notes) == rim);
+    s[0].zone = kZoneHead;
+    s[1].zone = kZoneRim;
+    CHECK(standard_midi_file(s, midi_timeline(60.0), 9, &notes) == want);
 }
 
 TEST_CASE("midi: the score's meters as time signatures, 4/4 without one", "[cli][midi]")

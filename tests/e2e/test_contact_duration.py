@@ -287,10 +287,15 @@ def ladder_part():
             continue
         check(sl <= -0.1, "tom ladder: the contact of %s shortens with speed, slope %.3f <= -0.1"
               % (who, sl))
-    # Reported: the physics' own slope over the free strikes (the hand's follow-through,
-    # the strike aim, lengthens the loud contacts; docs/contact.md).
-    print("tom ladder %.2f..%.2f m/s, free strikes: log-log slope of the physics %.3f "
-          "(target <= -0.1)" % (vf[0], vf[-1], slope(vf, [r[1] for r in free])))
+    # The physics' own slope over the free strikes, held as the law's is (over the whole
+    # ladder): the strike aim's cap keeps the hand from following through into the head,
+    # which lengthened the loud contacts (docs/contact.md).
+    sl = slope(vf, [r[1] for r in free])
+    print("tom ladder %.2f..%.2f m/s, free strikes: log-log slope of the physics %.3f"
+          % (vf[0], vf[-1], sl))
+    if len(ladder) >= 10:
+        check(sl <= -0.1, "tom ladder: the physics' contact shortens with speed, slope %.3f "
+              "<= -0.1" % sl)
 
 
 if args.part == "law":

@@ -3,6 +3,7 @@
 // each after a variable-length delta time; tempo as meta event FF 51
 // (microseconds per quarter note).
 #include "ictus/cli/midi_file.hpp"
+#include "ictus/score/midi_score.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -256,8 +257,11 @@ std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
                                const std::vector<int> *drum_notes)
 {
     auto note_of = [drum_notes](const StrikeEvent &e) {
-        if (drum_notes && e.drum >= 0 && e.drum < static_cast<int>(drum_notes->size()))
-            return (*drum_notes)[static_cast<size_t>(e.drum)];
+        if (drum_notes && e.drum >= 0 && e.drum < static_cast<int>(drum_notes->size())) {
+            const int note = (*drum_notes)[static_cast<size_t>(e.drum)];
+            // A strike on the snare's rim is General MIDI's side stick, as --midi reads it.
+            return note == kMidiSnare && e.zone == kZoneRim ? kMidiSideStick : note;
+        }
         return midi_note(e.hand, e.r_over_a);
     };
     if (channel < 0 || channel > 15)

@@ -86,7 +86,7 @@ void render_usage(std::ostream &out)
            "  --strike-depth M    the target dips this far below the first contact (0)\n"
            "  --strike-aim S      and further by S times the planned impact speed above\n"
            "                      --strike-aim-from V (defaults 0.0025 s, 1.5 m/s)\n"
-           "  --strike-aim-max M  but at most M deeper (default 0.05)\n"
+           "  --strike-aim-max M  but at most M deeper (default 0.004)\n"
            "  --move-margins A,B  a move to another spot spans the gap between the two\n"
            "                      strikes but these fractions after and before (0.05,0.1)\n"
            "  --advance S         tip targets sampled S ahead: the tracking lag (default 0)\n"

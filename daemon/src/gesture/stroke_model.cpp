@@ -38,7 +38,7 @@ constexpr double kMaxPress_s = 0.3;         // buzz: the longest press
 constexpr double kMaxLift_s = 0.4;
 constexpr double kReboundPeriod_s = 0.1;    // shorter periods: rebound strokes
 constexpr double kReboundGainFrom_s = 0.2;
-constexpr double kReboundGainExponent = 0.4;
+constexpr double kReboundGainExponent = 0.35;
 // The lowest stroke: above the 1 cm a stick must rise between two strokes
 // for the second to be a stroke, not a bounce (docs/osc.md).
 constexpr double kMinHeight_m = 0.015;

@@ -65,13 +65,12 @@ ScorePerformOptions::ScorePerformOptions()
     // 200 random scores, docs/perform.md.
     plan.strike_aim_s = 0.0025;
     plan.strike_aim_from_mps = 1.5;
-    // Not capped (strike_aim_max_m: PlanOptions' 5 cm). A cap of 4 mm keeps
-    // the hand from following through into the head during a loud stroke's
-    // contact (the tom ladder's log-log slope of contact against speed: -0.106
-    // against -0.073, the contact law's -0.112), but it slows the first stroke
-    // of a loud double and its second, raised for its short interval, comes
-    // 20.5 % faster (random rudiments seed 245; the rule is 20 %).
-    // docs/contact.md.
+    // At most 4 mm (strokes over 3.1 m/s): deeper, the hand follows through into
+    // the head during a loud stroke's contact, the stick turns in the grip and
+    // its damper presses the bead back into the head, which lengthens loud
+    // contacts (the tom ladder's log-log slope of contact against speed:
+    // -0.073 uncapped, the contact law's -0.112). docs/contact.md.
+    plan.strike_aim_max_m = 0.004;
     // The bead meets the head 2.2 mm before the held tip's target does: a
     // stroke at v landed 2.2 mm / v early (10.9 ms at 0.2 m/s, 4.6 ms at
     // 0.48 m/s, 0.4 ms at 5.9 m/s; docs/gestures.md, "Dynamics rule"), so each

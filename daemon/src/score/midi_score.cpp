@@ -238,7 +238,7 @@ int drum_of(int note, const std::vector<MidiDrum> &drums)
         return -1;
     if (drums.empty())
         return 0;
-    const int want = is_snare(note) ? 38 : note;
+    const int want = is_snare(note) ? kMidiSnare : note;
     for (size_t i = 0; i < drums.size(); ++i)
         if (drums[i].midi_note == want)
             return static_cast<int>(i);

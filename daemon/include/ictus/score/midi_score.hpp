@@ -67,6 +67,8 @@ struct MidiDrum {
 // General MIDI's side stick (37) is the snare's rim: a stroke aimed this far out, where the
 // stick meets the hoop (docs/rim.md; aimed at 0.95, strikes land at r/a 0.97, zone 1).
 constexpr int kMidiSideStick = 37;
+constexpr int kMidiSnare = 38; // Acoustic Snare: a kit's snare's note; MIDI out writes a rim strike
+                               // on it as the side stick
 constexpr double kMidiSideStickRadiusFraction = kMaxRadiusFraction;
 // General MIDI's cymbals, played on a kit's cymbal of that note (docs/midi.md): crash 49 and
 // 57 on its crash (49), ride 51 and 59 on its ride (51), ride bell 53 on the ride's bell, a
