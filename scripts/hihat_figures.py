@@ -13,13 +13,13 @@ Usage: PYTHONPATH=python scripts/hihat_figures.py --build BUILD [--out docs/img]
 Needs python3-matplotlib and numpy (Debian packages)."""
 import argparse
 import os
-import re
 import sys
 
 import numpy as np
 
 from ictus_tools.decay import centroid, schroeder_t60
-from ictus_tools.pdrun import Patch, make_workdir, read_wav_float, recorder, run_pd
+from ictus_tools.pdrun import (Patch, make_workdir, membrane_modes_from_log, read_wav_float,
+                               recorder, run_pd)
 
 import matplotlib
 
@@ -53,20 +53,6 @@ def render(build):
     return x, log
 
 
-def modes_from_log(log):
-    """{name: [(label, f, t60)]} of the cos partners, from membrane~'s print."""
-    out, cur = {}, None
-    for line in log.splitlines():
-        m = re.match(r"membrane~ hihat-(\S+): radius", line)
-        if m:
-            cur = out.setdefault(m.group(1), [])
-            continue
-        m = re.match(r"\s*mode\s+\d+ \((\d+),(\d+)\)\s*(sin|cos)?: +([\d.]+) Hz  T60 ([\d.]+) s", line)
-        if m and cur is not None and m.group(3) != "sin":
-            cur.append(("(%s,%s)" % (m.group(1), m.group(2)), float(m.group(4)), float(m.group(5))))
-    return out
-
-
 def figure(x, t60s, path):
     fig, axes = plt.subplots(1, 3, figsize=(10, 3.2), dpi=72, sharey=True)
     for i, (ax, (name, openness)) in enumerate(zip(axes, PEDAL)):
@@ -95,7 +81,7 @@ def main():
     x, log = render(os.path.abspath(args.build))
     if not np.all(np.isfinite(x)):
         sys.exit("output not finite")
-    modes = modes_from_log(log)
+    modes = membrane_modes_from_log(log, "hihat-")
     t60s = [schroeder_t60(x[:, i], SR) for i in range(len(PEDAL))]
     print("| pedal | openness | T60, measured | centroid 0-50 ms | centroid 150-200 ms "
           "| lowest modes: f, T60 (law) |")

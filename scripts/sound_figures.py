@@ -13,12 +13,12 @@ Usage: PYTHONPATH=python scripts/sound_figures.py --build BUILD [--out docs/img]
 Needs python3-matplotlib and numpy (Debian packages)."""
 import argparse
 import os
-import re
 import sys
 
 import numpy as np
 
-from ictus_tools.pdrun import Patch, make_workdir, read_wav_float, recorder, run_pd
+from ictus_tools.pdrun import (Patch, make_workdir, membrane_modes_from_log, read_wav_float,
+                               recorder, run_pd)
 
 import matplotlib
 
@@ -81,20 +81,6 @@ def t60_broadband(y):
     return -60.0 / slope
 
 
-def modes_from_log(log):
-    """{name: [(label, f, t60)]} from membrane~'s print."""
-    out, cur = {}, None
-    for line in log.splitlines():
-        m = re.match(r"membrane~ (\S+): radius", line)
-        if m:
-            cur = out.setdefault(m.group(1), [])
-            continue
-        m = re.match(r"\s*mode\s+\d+ \((\d+),(\d+)\)\s*(sin|cos)?: +([\d.]+) Hz  T60 ([\d.]+) s", line)
-        if m and cur is not None and m.group(3) != "sin":
-            cur.append(("(%s,%s)" % (m.group(1), m.group(2)), float(m.group(4)), float(m.group(5))))
-    return out
-
-
 def spectrogram(y, name, path):
     fig, ax = plt.subplots(figsize=(7, 3.2), dpi=100)
     ax.specgram(y, NFFT=1024, Fs=SR, noverlap=896, cmap="magma", vmin=-160, vmax=-40)
@@ -115,7 +101,7 @@ def main():
     build = os.path.abspath(args.build)
     os.makedirs(args.out, exist_ok=True)
     x, log = render(build)
-    modes = modes_from_log(log)
+    modes = membrane_modes_from_log(log)
     print("| render | 95 % bandwidth, first 50 ms | broadband T60 (measured) | modes: f, T60 (law) |")
     print("|---|---|---|---|")
     for i, (name, _e, _r) in enumerate(RENDERS):

@@ -211,3 +211,19 @@ def open_patch(path, extra_args=(), timeout=60):
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=PD_ENV)
     log = proc.stdout + proc.stderr
     return proc.returncode, [l for l in error_lines(log) if not any(n in l for n in GEM_NOISE)]
+
+
+def membrane_modes_from_log(log, prefix=""):
+    """{name: [(label, f, t60)]}: the modes (cos partners only) that each `membrane~ PREFIXname`
+    posts on `print`, from pd's log."""
+    out, cur = {}, None
+    for line in log.splitlines():
+        m = re.match(r"membrane~ (\S+): radius", line)
+        if m:
+            name = m.group(1)
+            cur = out.setdefault(name[len(prefix):], []) if name.startswith(prefix) else None
+            continue
+        m = re.match(r"\s*mode\s+\d+ \((\d+),(\d+)\)\s*(sin|cos)?: +([\d.]+) Hz  T60 ([\d.]+) s", line)
+        if m and cur is not None and m.group(3) != "sin":
+            cur.append(("(%s,%s)" % (m.group(1), m.group(2)), float(m.group(4)), float(m.group(5))))
+    return out
