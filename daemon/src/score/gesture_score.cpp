@@ -410,6 +410,26 @@ int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &fra
                      "unknown drum '" + n.drum + "' (the kit: " + names + ")");
 }
 
+// The note's pedal on a hi-hat (closed when it names none), -1 on another
+// drum; a ScoreError at the word when it names one on a drum without a pedal.
+double note_openness(const Score &score, const ScoreNote &n, const PerformerFrame &frame, int drum)
+{
+    const bool kit = drum >= 0 && drum < static_cast<int>(frame.drums.size());
+    if (kit && frame.drums[static_cast<size_t>(drum)].pedal)
+        return n.openness >= 0.0 ? n.openness : kHihatClosed;
+    if (n.openness < 0.0)
+        return -1.0;
+    std::string hihats;
+    for (const PerformerFrame::Drum &d : frame.drums)
+        if (d.pedal)
+            hihats += (hihats.empty() ? "" : ", ") + d.name;
+    throw ScoreError(
+        score.source, n.line, n.openness_column,
+        std::string("'") + hihat_openness_word(n.openness) + "' is a hi-hat's pedal, and drum '" +
+            (kit ? frame.drums[static_cast<size_t>(drum)].name : n.drum) + "' is not a hi-hat (" +
+            (hihats.empty() ? "the kit has none" : "the kit's hi-hat: " + hihats) + ")");
+}
+
 // The notes, timed by the tempo map, into plan.notes (score order); a score that
 // asks a hand to play faster than one hand plays is a ScoreError. The timing noise
 // of `humanize` never does: it is clipped where it would bring a stroke closer
@@ -442,6 +462,7 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         p.theta_deg = n.theta_deg;
         p.firmness = n.firmness;
         p.drum = drum_index(score, n, frame);
+        p.openness = note_openness(score, n, frame, p.drum);
         if (!n.spot_given && p.drum < static_cast<int>(frame.drums.size()) &&
             frame.drums[static_cast<size_t>(p.drum)].cymbal) {
             p.r_over_a = kCymbalRadiusFraction;
