@@ -186,7 +186,7 @@ TEST_CASE("midi in: a malformed file names its byte and track", "[score][midi]")
           "t.mid: byte 18: chunk length 256 runs past the end of the file");
 }
 
-TEST_CASE("midi in: General MIDI's hi-hat on a kit's hi-hat, closed 42 and open 46; pedal 44 "
+TEST_CASE("midi in: General MIDI's hi-hat on a kit's hi-hat, closed 42 and open 46, the pedal 44 "
           "left out",
           "[score][midi][hihat]")
 {

@@ -67,7 +67,7 @@ std::vector<KitDrum> cymbals()
     constexpr double kDisc_in = 0.4; // 1 cm
     return {drum("crash", "crash", 0.0, kDisc_in, {-0.64, 0.30, 0.36}, 49),
             drum("ride", "ride", 0.0, kDisc_in, {0.66, 0.22, 0.38}, 51),
-            drum("hihat", "hihat", 14.0, kDisc_in, {-0.42, 0.12, -0.02}, 42)};
+            drum("hihat", "hihat", 14.0, kDisc_in, {-0.42, 0.26, -0.02}, 42)};
 }
 
 } // namespace
