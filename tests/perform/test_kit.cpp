@@ -12,7 +12,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -374,4 +376,76 @@ TEST_CASE("kit: events.txt has a hi-hat's pedal line before the strike that play
     }
     CHECK(plain_got.str() == plain_want.str());
     CHECK(plain_got.str().find("pedal") == std::string::npos);
+}
+
+TEST_CASE("kit: events.txt's pedal lines on seeded random strikes: one before each change, at "
+          "its strike's time",
+          "[perform][kit][hihat]")
+{
+    // Strikes on drum 0 (no pedal) and on two pedalled drums, each pedal one of
+    // closed, half, open, at seeded random times; the file read back line by line.
+    for (unsigned seed = 1; seed <= 20; ++seed) {
+        INFO("seed " << seed);
+        std::mt19937 rng(seed);
+        std::uniform_int_distribution<int> pick(0, 2);
+        std::uniform_real_distribution<double> gap(0.0, 0.4);
+        const double pedals[3] = {kHihatClosed, kHihatHalf, kHihatOpen};
+        const int drums[3] = {0, 5, 6};
+        std::vector<StrikeEvent> strikes;
+        double t = 0.0;
+        for (int k = 0; k < 60; ++k) {
+            t += gap(rng);
+            const int drum = drums[pick(rng)];
+            strikes.push_back(strike_at(t, pick(rng) % 2, drum, drum ? pedals[pick(rng)] : -1.0));
+            strikes.back().seq = k;
+        }
+        StrikeLog log;
+        log.add(strikes.data(), static_cast<int>(strikes.size()));
+        std::ostringstream text;
+        log.write_events(text);
+        // Expected by the rule: a pedal line when a drum's pedal differs from its last one.
+        double last[kMaxDrums];
+        std::fill(last, last + kMaxDrums, -1.0);
+        std::istringstream in(text.str());
+        std::string line;
+        long long sum_us = 0;
+        size_t k = 0;
+        int pedal_lines = 0, changes = 0;
+        while (std::getline(in, line)) {
+            std::istringstream words(line);
+            double delay_ms = 0.0;
+            std::string kind;
+            words >> delay_ms >> kind;
+            sum_us += std::llround(delay_ms * 1000.0);
+            REQUIRE(k < strikes.size());
+            const StrikeEvent &e = strikes[k];
+            const bool change = e.drum != 0 && e.pedal_openness != last[e.drum];
+            if (kind == "pedal") {
+                int drum = -1;
+                double openness = -1.0;
+                words >> drum >> openness;
+                CHECK(change);
+                CHECK(drum == e.drum);
+                CHECK(openness == e.pedal_openness);
+                CHECK(sum_us == std::llround(e.time_s * 1e6)); // at its strike's time
+                last[e.drum] = openness;
+                ++pedal_lines;
+            } else {
+                REQUIRE(kind == "hit");
+                CHECK_FALSE(change); // its pedal, if any, was written before it
+                CHECK(sum_us == std::llround(e.time_s * 1e6));
+                ++k;
+            }
+        }
+        CHECK(k == strikes.size());
+        // Every change counted independently of the file.
+        double seen[kMaxDrums];
+        std::fill(seen, seen + kMaxDrums, -1.0);
+        for (const StrikeEvent &e : strikes)
+            if (e.drum != 0 && e.pedal_openness != seen[e.drum]) {
+                seen[e.drum] = e.pedal_openness;
+                ++changes;
+            }
+        CHECK(pedal_lines == changes);
+    }
 }
