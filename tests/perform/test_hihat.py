@@ -17,6 +17,7 @@ import csv
 import json
 import math
 import os
+import struct
 import subprocess
 import sys
 
@@ -34,7 +35,6 @@ HIHAT = 6  # its index in standard-cymbals
 
 def read_wav_mono(path):
     """A 32-bit float WAV (ictus-render's default) as the mean of its channels."""
-    import struct
     with open(path, "rb") as f:
         data = f.read()
     pos, fmt, samples = 12, None, None
