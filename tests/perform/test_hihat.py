@@ -3,7 +3,8 @@
 "The hi-hat"): a score of closed and open hi-hat notes (docs/score.md, `open`, `closed`), each
 note's pedal carried from the score through the planner and its strike to the sound.
 
-Checked: every hi-hat note struck once on the hi-hat; events.txt has a `pedal 6 <openness>` line
+Checked: every hi-hat note struck once on the hi-hat, and no other strike (the hand's way
+back to rest passes over the plate); events.txt has a `pedal 6 <openness>` line
 right before (0 ms) the hit that plays a note whose pedal differs from the last one written, and
 no other pedal line; pd.log has no error line; and in the WAV each open note rings longer than
 each closed one: the energy of 20 ms windows from 100 to 400 ms after each onset, in dB, fitted
@@ -101,6 +102,13 @@ def main():
                 "every hi-hat note struck: %s" % [(n["drum"], n["strike_seq"]) for n in notes])
     if not ok:
         return 1
+    # No other strike: the hand's way back to rest passes over the plate (docs/kit.md).
+    with open(os.path.join(out, "render.json")) as f:
+        extra = json.load(f)["performance"]["extra_strikes"]
+    primaries = [s for s in strikes.values() if s["bounce"] == 0]
+    ok &= check(extra == 0 and len(primaries) == len(notes),
+                "one primary strike per note, none extra: %d strikes, %d notes, %d extra"
+                % (len(primaries), len(notes), extra))
     onsets = [strikes[int(n["strike_seq"])]["time_s"] for n in notes]
     print("hihat: timing errors %s ms" % [n["error_ms"] for n in notes])
     # events.txt: a pedal line right before each hit whose pedal changed, and no other.

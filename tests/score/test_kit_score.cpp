@@ -297,3 +297,32 @@ TEST_CASE("plan: a hi-hat note carries its pedal; another drum refuses one at th
         CHECK_THAT(e.message(), Contains("drum 'crash' is not a hi-hat (the kit has none)"));
     }
 }
+
+TEST_CASE("plan: a hand going to or from its rest tip passes over a cymbal above it, never "
+          "through",
+          "[score][kit][hihat]")
+{
+    // The rest tips are 15 cm above the snare (performer_frame_for_drum); a hi-hat's plate
+    // 26 cm above it, to the left: the left hand comes from rest to it, plays, and goes back.
+    PerformerFrame f = kit_frame();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.pop_back();
+    f.drums.push_back({"hihat", c + Eigen::Vector3d(0.42, 0.26, 0.02), 0.1778, true, true});
+    const PerformerFrame::Drum &hat = f.drums.back();
+    // Over its plate and the planner's margin round it (the stick's tip lags the plan:
+    // a tip planned just past the edge below the plate came down on it).
+    const double margin = PlanOptions{}.kit_margin_m;
+    for (const char *score : {"tempo 90\nL on hihat\nrest 8", "tempo 90\nL on hihat ff\nrest 8",
+                              "tempo 60\nR on hihat\nrest 8\nL on hihat\nrest 8"}) {
+        INFO(score);
+        const GesturePlan plan = plan_performance(parse_score(score, "t"), db(), f);
+        double worst = 0.0;
+        for (int s = 0; s < 2; ++s)
+            for (size_t i = 0; i < plan.tips.time_s.size(); ++i) {
+                const Eigen::Vector3d rel = plan.tips.tip_m[s][i] - hat.membrane_center_m;
+                if (std::hypot(rel.x(), rel.z()) <= hat.membrane_radius_m + margin)
+                    worst = std::min(worst, rel.y());
+            }
+        CHECK(worst > -1e-3);
+    }
+}
