@@ -294,6 +294,69 @@ TEST_CASE("osc out: the kit goes out as /ictus/kit and one /ictus/kit/drum per d
     CHECK(sender.counters().kits_sent == 2);
 }
 
+TEST_CASE("osc out: a hi-hat's pedal goes first in its strike's bundle when it changes, and "
+          "again after the kit is sent",
+          "[net][link][hihat]")
+{
+    int port = 0;
+    auto dump = start_oscdump(port);
+    ictus::OscSenderOptions o;
+    o.target_url = "osc.udp://127.0.0.1:" + std::to_string(port);
+    o.lookahead_s = 0.5;
+    ictus::OscSender sender(o);
+    sender.set_kit(
+        "k", {{0, "snare", "snare", 0.1778, 3603.0, 0.0}, {1, "hihat", "hihat", 0.1778, 0.0, 0.5}});
+    sender.set_epoch(ictus::ntp_now());
+    // Strikes: hi-hat closed, closed, snare (no pedal), hi-hat open; then the kit
+    // again and the hi-hat open once more.
+    auto strike = [](long seq, int drum, double pedal) {
+        ictus::StrikeEvent e = sample_strike(seq, 0.1 * static_cast<double>(seq + 1));
+        e.drum = drum;
+        e.pedal_openness = pedal;
+        return e;
+    };
+    struct Seen {
+        std::string path, timetag, arg0, arg1;
+    };
+    std::vector<Seen> seen;
+    auto read_until_strike = [&](long seq) {
+        DumpLine d;
+        for (;;) {
+            std::string line;
+            REQUIRE(dump->line(line, 3000));
+            d = parse_dump(line);
+            seen.push_back({d.path, d.timetag, d.args.empty() ? "" : d.args[0],
+                            d.args.size() < 2 ? "" : d.args[1]});
+            if (d.path == "/ictus/strike" && std::stol(d.args[0]) == seq)
+                return;
+        }
+    };
+    REQUIRE(sender.post_strike(strike(0, 1, 0.0)));
+    REQUIRE(sender.post_strike(strike(1, 1, 0.0)));
+    REQUIRE(sender.post_strike(strike(2, 0, -1.0)));
+    REQUIRE(sender.post_strike(strike(3, 1, 1.0)));
+    read_until_strike(3);
+    sender.send_kit();
+    REQUIRE(sender.post_strike(strike(4, 1, 1.0)));
+    read_until_strike(4);
+    std::vector<std::string> paths;
+    for (const Seen &x : seen)
+        paths.push_back(x.path);
+    const std::vector<std::string> want = {
+        "/ictus/kit/pedal", "/ictus/strike",    "/ictus/strike", "/ictus/strike",
+        "/ictus/kit/pedal", "/ictus/strike",    "/ictus/kit",    "/ictus/kit/drum",
+        "/ictus/kit/drum",  "/ictus/kit/pedal", "/ictus/strike"};
+    REQUIRE(paths == want);
+    // Each pedal: the hi-hat's index and openness, its strike's timetag.
+    for (size_t i : {size_t(0), size_t(4), size_t(9)}) {
+        INFO(i);
+        CHECK(std::stoi(seen[i].arg0) == 1);
+        CHECK(std::stod(seen[i].arg1) == (i == 0 ? 0.0 : 1.0));
+        CHECK(seen[i].timetag == seen[i + 1].timetag);
+    }
+    sender.stop();
+}
+
 TEST_CASE("osc out: a receiver holds a strike bundle until its timetag", "[net][link]")
 {
     // liblo's server (oscdump) dispatches a bundle at its timetag: the

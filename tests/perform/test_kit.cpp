@@ -5,13 +5,19 @@
 #include "ictus/perform/kit.hpp"
 #include "ictus/perform/performance.hpp"
 #include "ictus/perform/perform_error.hpp"
+#include "ictus/perform/strike_log.hpp"
+#include "ictus/perform/strike_match.hpp"
 #include "ictus/score/score.hpp"
 #include "ictus/sim/strike_detector.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
+#include <sstream>
 #include <string>
+#include <vector>
 
 using namespace ictus;
 using Catch::Matchers::Contains;
@@ -180,7 +186,7 @@ TEST_CASE("kit: the cymbals are plates of cymbal bronze, their contact a disc's 
           "[perform][kit]")
 {
     const Kit kit = kit_named("standard-cymbals");
-    REQUIRE(kit.drums.size() == 6);
+    REQUIRE(kit.drums.size() == 7);
     PerformanceOptions o;
     o.kit = kit;
     o.score.score_text = "R";
@@ -235,4 +241,211 @@ TEST_CASE("kit: a cymbal's strike is on its plate, never its rim", "[perform][ki
     const MembraneGeometry snare = membrane_of(perf.scene(), 0);
     CHECK(crash.plate);
     CHECK_FALSE(snare.plate);
+}
+
+TEST_CASE("kit: standard-cymbals' hi-hat: a 14-inch plate with a pedal, left of the snare, a "
+          "little higher",
+          "[perform][kit][hihat]")
+{
+    const Kit kit = kit_named("standard-cymbals");
+    REQUIRE(kit.drums.size() == 7);
+    const int h = kit_drum_index(kit, "hihat");
+    REQUIRE(h > 0);
+    const KitDrum &hh = kit.drums[static_cast<size_t>(h)];
+    const KitDrum &snare = kit.drums[0];
+    CHECK(hh.preset == "hihat");
+    CHECK(hh.cymbal());
+    CHECK(hh.radius_m == Approx(7.0 * 0.0254));
+    CHECK(hh.midi_note == 42); // General MIDI's Closed Hi-Hat
+    CHECK(hh.shell_depth_m == Approx(0.01).epsilon(0.02));
+    // Where a right-handed drummer's stands: to the performer's left of the
+    // snare (x < 0), clear of it, and above it by less than the crash.
+    CHECK(hh.place_m.x() < snare.place_m.x() - snare.radius_m - hh.radius_m);
+    CHECK(hh.place_m.y() > snare.place_m.y() + 0.05);
+    CHECK(hh.place_m.y() <
+          kit.drums[static_cast<size_t>(kit_drum_index(kit, "crash"))].place_m.y());
+    // Only the hi-hat has a pedal.
+    for (const KitDrum &d : kit.drums)
+        CHECK(kit_drum_has_pedal(d) == (d.name == "hihat"));
+    for (const char *name : {"standard", "standard-timpani", "timpani"})
+        for (const KitDrum &d : kit_named(name).drums)
+            CHECK_FALSE(kit_drum_has_pedal(d));
+}
+
+namespace
+{
+PlannedNote note_at(double time_s, Side hand, int drum, double openness)
+{
+    PlannedNote n;
+    n.time_s = time_s;
+    n.hand = hand;
+    n.drum = drum;
+    n.openness = openness;
+    return n;
+}
+StrikeEvent strike_at(double time_s, int hand, int drum, double openness = -1.0)
+{
+    StrikeEvent e;
+    e.time_s = time_s;
+    e.hand = hand;
+    e.drum = drum;
+    e.pedal_openness = openness;
+    return e;
+}
+} // namespace
+
+TEST_CASE("kit: a strike on the hi-hat takes the pedal of the note it plays",
+          "[perform][kit][hihat]")
+{
+    // The plan's notes in time order: the hi-hat is drum 6, the snare 0.
+    const std::vector<PlannedNote> notes = {
+        note_at(1.00, Side::left, 6, 1.0), note_at(1.10, Side::right, 0, -1.0),
+        note_at(1.25, Side::right, 6, 0.0), note_at(1.50, Side::left, 6, 0.5),
+        note_at(2.00, Side::left, 6, 0.0)};
+    const double origin = 10.0; // simulation time of the plan's time 0
+    // Each strike the nearest note of its hand on its drum, a few ms off.
+    CHECK(strike_pedal_openness(notes, strike_at(11.003, 0, 6), origin) == 1.0);
+    CHECK(strike_pedal_openness(notes, strike_at(10.996, 0, 6), origin) == 1.0);
+    CHECK(strike_pedal_openness(notes, strike_at(11.249, 1, 6), origin) == 0.0);
+    // Nearer the right hand's note at 1.25, but the left hand's: its own at 1.50.
+    CHECK(strike_pedal_openness(notes, strike_at(11.26, 0, 6), origin) == 0.5);
+    // The right hand's only note on the hi-hat is at 1.25, however far.
+    CHECK(strike_pedal_openness(notes, strike_at(11.98, 1, 6), origin) == 0.0);
+    // A hand with no note there: the other hand's nearest.
+    const std::vector<PlannedNote> left_only = {note_at(1.0, Side::left, 6, 1.0),
+                                                note_at(2.0, Side::left, 6, 0.0)};
+    CHECK(strike_pedal_openness(left_only, strike_at(11.9, 1, 6), origin) == 0.0);
+    // Another drum, or no notes: none.
+    CHECK(strike_pedal_openness(notes, strike_at(11.1, 1, 0), origin) == -1.0);
+    CHECK(strike_pedal_openness(notes, strike_at(11.1, 1, 5), origin) == -1.0);
+    CHECK(strike_pedal_openness({}, strike_at(11.1, 1, 6), origin) == -1.0);
+}
+
+TEST_CASE("kit: events.txt has a hi-hat's pedal line before the strike that plays it, when it "
+          "changes",
+          "[perform][kit][hihat]")
+{
+    // Strikes (seq order): snare, hi-hat closed, closed, open, snare, open, closed; a
+    // second pedalled drum (5) keeps its own.
+    const std::vector<StrikeEvent> strikes = {
+        strike_at(0.5, 1, 0),      strike_at(1.0, 0, 6, 0.0), strike_at(1.25, 0, 6, 0.0),
+        strike_at(1.5, 1, 6, 1.0), strike_at(1.6, 1, 0),      strike_at(1.75, 0, 6, 1.0),
+        strike_at(2.0, 0, 5, 0.0), strike_at(2.25, 0, 6, 0.0)};
+    StrikeLog log;
+    log.add(strikes.data(), static_cast<int>(strikes.size()));
+    std::ostringstream got;
+    log.write_events(got);
+    // By hand: each line's delay from the previous line, a pedal line at its
+    // strike's time (the strike then 0 ms after it).
+    std::ostringstream want;
+    double prev = 0.0;
+    auto hit = [&](const StrikeEvent &e) {
+        write_events_line(want, e, prev);
+        prev = e.time_s;
+    };
+    hit(strikes[0]);
+    want << "500.000 pedal 6 0.000;\n";
+    prev = 1.0;
+    hit(strikes[1]);
+    hit(strikes[2]);
+    want << "250.000 pedal 6 1.000;\n";
+    prev = 1.5;
+    hit(strikes[3]);
+    hit(strikes[4]);
+    hit(strikes[5]);
+    want << "250.000 pedal 5 0.000;\n";
+    prev = 2.0;
+    hit(strikes[6]);
+    want << "250.000 pedal 6 0.000;\n";
+    prev = 2.25;
+    hit(strikes[7]);
+    CHECK(got.str() == want.str());
+    CHECK(want.str().find("0.000 hit 0 6") != std::string::npos); // a strike 0 ms after its pedal
+    // Without a pedal the file is as it was: hit lines only.
+    StrikeLog plain;
+    std::vector<StrikeEvent> none = strikes;
+    for (StrikeEvent &e : none)
+        e.pedal_openness = -1.0;
+    plain.add(none.data(), static_cast<int>(none.size()));
+    std::ostringstream plain_got, plain_want;
+    plain.write_events(plain_got);
+    prev = 0.0;
+    for (const StrikeEvent &e : none) {
+        write_events_line(plain_want, e, prev);
+        prev = e.time_s;
+    }
+    CHECK(plain_got.str() == plain_want.str());
+    CHECK(plain_got.str().find("pedal") == std::string::npos);
+}
+
+TEST_CASE("kit: events.txt's pedal lines on seeded random strikes: one before each change, at "
+          "its strike's time",
+          "[perform][kit][hihat]")
+{
+    // Strikes on drum 0 (no pedal) and on two pedalled drums, each pedal one of
+    // closed, half, open, at seeded random times; the file read back line by line.
+    for (unsigned seed = 1; seed <= 20; ++seed) {
+        INFO("seed " << seed);
+        std::mt19937 rng(seed);
+        std::uniform_int_distribution<int> pick(0, 2);
+        std::uniform_real_distribution<double> gap(0.0, 0.4);
+        const double pedals[3] = {kHihatClosed, kHihatHalf, kHihatOpen};
+        const int drums[3] = {0, 5, 6};
+        std::vector<StrikeEvent> strikes;
+        double t = 0.0;
+        for (int k = 0; k < 60; ++k) {
+            t += gap(rng);
+            const int drum = drums[pick(rng)];
+            strikes.push_back(strike_at(t, pick(rng) % 2, drum, drum ? pedals[pick(rng)] : -1.0));
+            strikes.back().seq = k;
+        }
+        StrikeLog log;
+        log.add(strikes.data(), static_cast<int>(strikes.size()));
+        std::ostringstream text;
+        log.write_events(text);
+        // Expected by the rule: a pedal line when a drum's pedal differs from its last one.
+        double last[kMaxDrums];
+        std::fill(last, last + kMaxDrums, -1.0);
+        std::istringstream in(text.str());
+        std::string line;
+        long long sum_us = 0;
+        size_t k = 0;
+        int pedal_lines = 0, changes = 0;
+        while (std::getline(in, line)) {
+            std::istringstream words(line);
+            double delay_ms = 0.0;
+            std::string kind;
+            words >> delay_ms >> kind;
+            sum_us += std::llround(delay_ms * 1000.0);
+            REQUIRE(k < strikes.size());
+            const StrikeEvent &e = strikes[k];
+            const bool change = e.drum != 0 && e.pedal_openness != last[e.drum];
+            if (kind == "pedal") {
+                int drum = -1;
+                double openness = -1.0;
+                words >> drum >> openness;
+                CHECK(change);
+                CHECK(drum == e.drum);
+                CHECK(openness == e.pedal_openness);
+                CHECK(sum_us == std::llround(e.time_s * 1e6)); // at its strike's time
+                last[e.drum] = openness;
+                ++pedal_lines;
+            } else {
+                REQUIRE(kind == "hit");
+                CHECK_FALSE(change); // its pedal, if any, was written before it
+                CHECK(sum_us == std::llround(e.time_s * 1e6));
+                ++k;
+            }
+        }
+        CHECK(k == strikes.size());
+        // Every change counted independently of the file.
+        double seen[kMaxDrums];
+        std::fill(seen, seen + kMaxDrums, -1.0);
+        for (const StrikeEvent &e : strikes)
+            if (e.drum != 0 && e.pedal_openness != seen[e.drum]) {
+                seen[e.drum] = e.pedal_openness;
+                ++changes;
+            }
+        CHECK(pedal_lines == changes);
+    }
 }

@@ -218,3 +218,111 @@ TEST_CASE("plan: a press on one drum does not throw the move to the next drum hi
                 CHECK(buzz <= legato + 0.10);
             }
 }
+
+TEST_CASE("score: a hi-hat note's pedal: open, half, closed, none written", "[score][kit][hihat]")
+{
+    const Score s = parse_score("R on hihat open, L on HiHat half\ndrum hihat\nR closed, L, "
+                                "R open flam\nR+L half",
+                                "t");
+    // The flam's grace (the left hand's) comes first, then its note.
+    REQUIRE(s.notes.size() == 8);
+    const double want[8] = {kHihatOpen, kHihatHalf, kHihatClosed, -1.0,
+                            kHihatOpen, kHihatOpen, kHihatHalf,   kHihatHalf};
+    for (size_t i = 0; i < 8; ++i) {
+        INFO(i);
+        CHECK(s.notes[i].openness == want[i]);
+        CHECK(s.notes[i].drum == "hihat");
+    }
+    CHECK(kHihatOpen == 1.0);
+    CHECK(kHihatHalf == 0.5);
+    CHECK(kHihatClosed == 0.0);
+    CHECK(s.notes[0].openness_column == 12);
+    CHECK(s.notes[1].openness_column == 29);
+    CHECK(s.notes[2].line == 3);
+    CHECK(s.notes[2].openness_column == 3);
+    CHECK(s.notes[4].grace == Grace::flam); // one pedal for the note and its grace
+    CHECK(s.notes[4].openness_column == 16);
+    CHECK(s.notes[6].hand != s.notes[7].hand);
+}
+
+TEST_CASE("score: a hi-hat's pedal word where it cannot be, at the word", "[score][kit][hihat]")
+{
+    // The kit's first drum is never a cymbal (validate_kit): a pedal needs a drum named.
+    require_error("R open", 1, 3,
+                  "'open' is a hi-hat's pedal, and this note is on the kit's "
+                  "first drum (write 'on hihat'");
+    require_error("L\nR accent closed", 2, 10, "'closed' is a hi-hat's pedal");
+    require_error("R on hihat open half", 1, 17, "second hi-hat openness 'half' in one note");
+    require_error("R on hihat opened", 1, 12, "unexpected 'opened' in a note");
+}
+
+TEST_CASE("plan: a hi-hat note carries its pedal; another drum refuses one at the word",
+          "[score][kit][hihat]")
+{
+    PerformerFrame f = kit_frame();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.pop_back(); // the timpani, where the hi-hat stands
+    // A 14-inch hi-hat left of the snare, a little higher (PerformerFrame::Drum::pedal).
+    f.drums.push_back({"hihat", c + Eigen::Vector3d(0.42, 0.12, 0.02), 0.1778, true, true});
+    const Score s = parse_score("tempo 90\ndrum hihat\nL open 1/2, L 1/2, L half 1/2, L closed 1/2"
+                                "\nR on snare",
+                                "t");
+    const GesturePlan plan = plan_performance(s, db(), f);
+    REQUIRE(plan.notes.size() == 5);
+    const double want[5] = {1.0, 0.0, 0.5, 0.0, -1.0}; // none written on the hi-hat: closed
+    for (size_t i = 0; i < 5; ++i) {
+        INFO(i);
+        CHECK(plan.notes[i].openness == want[i]);
+        CHECK(plan.notes[i].drum == (i < 4 ? 4 : 0));
+        // A cymbal's spot: the bow toward the performer.
+        CHECK(plan.notes[i].r_over_a == Approx(i < 4 ? kCymbalRadiusFraction : 0.3));
+    }
+    // The pedal on a drum that has none: at the word, naming the drum and the kit's hi-hat.
+    try {
+        plan_performance(parse_score("R on hihat\nL on tom1 half", "t.txt"), db(), f);
+        FAIL("planned");
+    } catch (const ScoreError &e) {
+        CHECK(e.line() == 2);
+        CHECK(e.column() == 11);
+        CHECK_THAT(e.message(), Contains("'half' is a hi-hat's pedal, and drum 'tom1' is not a "
+                                         "hi-hat (the kit's hi-hat: hihat)"));
+    }
+    // A crash is a cymbal without a pedal; a kit without a hi-hat says so.
+    f.drums.back() = {"crash", c + Eigen::Vector3d(0.56, 0.30, 0.30), 0.2286, true, false};
+    try {
+        plan_performance(parse_score("R on crash open", "t.txt"), db(), f);
+        FAIL("planned");
+    } catch (const ScoreError &e) {
+        CHECK(e.column() == 12);
+        CHECK_THAT(e.message(), Contains("drum 'crash' is not a hi-hat (the kit has none)"));
+    }
+}
+
+TEST_CASE("plan: a hand going to or from its rest tip passes over a cymbal above it, never "
+          "through",
+          "[score][kit][hihat]")
+{
+    // The rest tips are 15 cm above the snare (performer_frame_for_drum); a hi-hat's plate
+    // 26 cm above it, to the left: the left hand comes from rest to it, plays, and goes back.
+    PerformerFrame f = kit_frame();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.pop_back();
+    f.drums.push_back({"hihat", c + Eigen::Vector3d(0.42, 0.26, 0.02), 0.1778, true, true});
+    const PerformerFrame::Drum &hat = f.drums.back();
+    // Over its plate and the planner's margin round it (the stick's tip lags the plan:
+    // a tip planned just past the edge below the plate came down on it).
+    const double margin = PlanOptions{}.kit_margin_m;
+    for (const char *score : {"tempo 90\nL on hihat\nrest 8", "tempo 90\nL on hihat ff\nrest 8",
+                              "tempo 60\nR on hihat\nrest 8\nL on hihat\nrest 8"}) {
+        INFO(score);
+        const GesturePlan plan = plan_performance(parse_score(score, "t"), db(), f);
+        double worst = 0.0;
+        for (int s = 0; s < 2; ++s)
+            for (size_t i = 0; i < plan.tips.time_s.size(); ++i) {
+                const Eigen::Vector3d rel = plan.tips.tip_m[s][i] - hat.membrane_center_m;
+                if (std::hypot(rel.x(), rel.z()) <= hat.membrane_radius_m + margin)
+                    worst = std::min(worst, rel.y());
+            }
+        CHECK(worst > -1e-3);
+    }
+}

@@ -185,3 +185,39 @@ TEST_CASE("midi in: a malformed file names its byte and track", "[score][midi]")
     CHECK(what_of(header(0, 1) + "MTrk" + bytes({0, 0, 1, 0})) ==
           "t.mid: byte 18: chunk length 256 runs past the end of the file");
 }
+
+TEST_CASE("midi in: General MIDI's hi-hat on a kit's hi-hat, closed 42 and open 46, the pedal 44 "
+          "left out",
+          "[score][midi][hihat]")
+{
+    // Half a second apart (the right hand's): closed 42, open 46, pedal 44, closed 42.
+    std::string t;
+    for (int note : {42, 46, 44, 42})
+        t += bytes({0x60, 0x99, note, 100});
+    t += kEnd;
+    const Smf smf = read_smf(header(0, 1) + chunk("MTrk", t), "t.mid");
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"tom1", 48}, {"tom2", 47}, {"floor", 43},
+                                       {"crash", 49}, {"ride", 51}, {"hihat", 42}};
+    const MidiDrumPart part = drum_part_score(smf, kit, "t.mid");
+    REQUIRE(part.score.notes.size() == 3);
+    const double want[3] = {kHihatClosed, kHihatOpen, kHihatClosed};
+    const double beat[3] = {1.0, 2.0, 4.0};
+    for (size_t i = 0; i < 3; ++i) {
+        INFO(i);
+        CHECK(part.score.notes[i].drum == "hihat");
+        CHECK(part.score.notes[i].openness == want[i]);
+        CHECK(part.score.notes[i].beat == Approx(beat[i]));
+        CHECK_FALSE(part.score.notes[i].spot_given); // the cymbal's own spot
+    }
+    CHECK(part.skipped.size() == 1);
+    CHECK(part.skipped.at(44) == 1); // a foot's note: the performer has none
+    // A kit without a hi-hat, and no kit: 42 and 46 left out too, counted.
+    const std::vector<MidiDrum> cymbals(kit.begin(), kit.end() - 1);
+    for (const std::vector<MidiDrum> &k : {cymbals, std::vector<MidiDrum>{}}) {
+        const MidiDrumPart none = drum_part_score(smf, k, "t.mid");
+        CHECK(none.score.notes.empty());
+        CHECK(none.skipped.at(42) == 2);
+        CHECK(none.skipped.at(46) == 1);
+        CHECK(none.skipped.at(44) == 1);
+    }
+}

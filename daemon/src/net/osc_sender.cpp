@@ -145,6 +145,7 @@ OscSender::OscSender(const OscSenderOptions &options) : impl_(new Impl), options
     sem_init(&impl_->strike_ready, 0, 0);
     sem_init(&impl_->pose_ready, 0, 0);
     epoch_.store(ntp_now());
+    pedal_sent_.fill(-1.0);
     strike_thread_ = std::thread(&OscSender::strike_loop, this);
     pose_thread_ = std::thread(&OscSender::pose_loop, this);
 }
@@ -288,6 +289,7 @@ void OscSender::send_kit_now()
     }
     count_send(lo_send_bundle(impl_->strike_target, b), kits_sent_, send_errors_);
     lo_bundle_free_recursive(b);
+    pedal_sent_.fill(-1.0); // the kit's drums are set anew: the next pedal goes out
 }
 
 void OscSender::strike_loop()
@@ -310,6 +312,16 @@ void OscSender::strike_loop()
             if (options_.lookahead_s > 0.0)
                 tt = to_lo(ntp_add_seconds(epoch(), due_s + options_.lookahead_s));
             lo_bundle b = lo_bundle_new(tt);
+            // A hi-hat's pedal, when it changes, before the strike that plays
+            // it, in its bundle: Pd schedules both at the strike's time.
+            if (!sm.end && e.pedal_openness >= 0.0 && e.drum >= 0 && e.drum < kMaxDrums &&
+                e.pedal_openness != pedal_sent_[static_cast<size_t>(e.drum)]) {
+                lo_message p = lo_message_new();
+                lo_message_add_int32(p, e.drum);
+                lo_message_add_float(p, static_cast<float>(e.pedal_openness));
+                lo_bundle_add_message(b, "/ictus/kit/pedal", p);
+                pedal_sent_[static_cast<size_t>(e.drum)] = e.pedal_openness;
+            }
             lo_message m = lo_message_new();
             add_strike_fields(m, e,
                               sm.end ? &StrikeFieldInfo::in_osc_end : &StrikeFieldInfo::in_osc);

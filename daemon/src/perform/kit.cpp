@@ -53,15 +53,21 @@ std::vector<KitDrum> standard_drums()
 }
 
 // The cymbals of "standard-cymbals" (docs/kit.md gives the sources): an
-// 18-inch crash to the left beyond the small tom, and a 20-inch ride to the
-// right beyond the large one, both higher than the toms and clear of every
-// head in plan (kKitMinGap_m); General MIDI's Crash Cymbal 1 (49) and Ride
-// Cymbal 1 (51). Each is a disc 1 cm thick (its stand is not in the scene).
+// 18-inch crash to the left beyond the small tom, a 20-inch ride to the
+// right beyond the large one, both higher than the toms, and a 14-inch
+// hi-hat where a right-handed drummer's stands: left of the snare, a little
+// higher, for the left hand and the right hand crossing over. Each is clear
+// of every head in plan (kKitMinGap_m); the crash stands a little further
+// left and forward than it would without the hi-hat, to clear it. General
+// MIDI's Crash Cymbal 1 (49), Ride Cymbal 1 (51) and Closed Hi-Hat (42).
+// Each is a disc 1 cm thick (its stand and the hi-hat's bottom plate are
+// not in the scene).
 std::vector<KitDrum> cymbals()
 {
     constexpr double kDisc_in = 0.4; // 1 cm
-    return {drum("crash", "crash", 0.0, kDisc_in, {-0.56, 0.30, 0.30}, 49),
-            drum("ride", "ride", 0.0, kDisc_in, {0.66, 0.22, 0.38}, 51)};
+    return {drum("crash", "crash", 0.0, kDisc_in, {-0.64, 0.30, 0.36}, 49),
+            drum("ride", "ride", 0.0, kDisc_in, {0.66, 0.22, 0.38}, 51),
+            drum("hihat", "hihat", 14.0, kDisc_in, {-0.42, 0.26, -0.02}, 42)};
 }
 
 } // namespace
@@ -116,6 +122,12 @@ double kit_min_gap_m(const Kit &kit)
 double kit_drum_pan(const KitDrum &drum)
 {
     return std::clamp(-drum.place_m.x() / 0.8, -0.6, 0.6);
+}
+
+bool kit_drum_has_pedal(const KitDrum &drum)
+{
+    const membrane_preset *p = membrane_preset_find(drum.preset.c_str());
+    return p && p->plate && p->edge_damp_n_s_per_m2 > 0.0;
 }
 
 int kit_drum_index(const Kit &kit, const std::string &name)

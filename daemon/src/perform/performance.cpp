@@ -186,7 +186,10 @@ int Performance::step(StrikeEvent out[2])
         std::copy(held_ends_.begin() + 1, held_ends_.begin() + held_ends_n_, held_ends_.begin());
         --held_ends_n_;
     }
-    return guard_runaway(n, out);
+    n = guard_runaway(n, out);
+    for (int i = 0; i < n; ++i)
+        mark_pedal(out[i]);
+    return n;
 }
 
 int Performance::take_onsets(StrikeEvent out[2])
@@ -203,9 +206,10 @@ int Performance::take_onsets(StrikeEvent out[2])
     for (int i = 0; i < n; ++i) {
         if (withheld(taken[i]))
             continue;
-        if (kept < 2)
-            out[kept++] = taken[i];
-        else if (held_onsets_n_ < 2) // for the next call
+        if (kept < 2) {
+            out[kept] = taken[i];
+            mark_pedal(out[kept++]);
+        } else if (held_onsets_n_ < 2) // for the next call
             held_onsets_[static_cast<size_t>(held_onsets_n_++)] = taken[i];
     }
     return kept;
@@ -222,9 +226,21 @@ bool Performance::flush(StrikeEvent &out)
         } else if (!detector_.flush(out)) {
             return false;
         }
-        if (!withheld(out))
+        if (!withheld(out)) {
+            mark_pedal(out);
             return true;
+        }
     }
+}
+
+void Performance::mark_pedal(StrikeEvent &e) const
+{
+    const GesturePlan *p = plan();
+    const PerformerFrame &f = performer_frame();
+    if (!p || e.drum <= 0 || e.drum >= static_cast<int>(f.drums.size()) ||
+        !f.drums[static_cast<size_t>(e.drum)].pedal)
+        return;
+    e.pedal_openness = strike_pedal_openness(p->notes, e, plan_origin_s());
 }
 
 bool Performance::withheld(const StrikeEvent &e) const

@@ -42,8 +42,8 @@ PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eige
         for (size_t i = 0; i < kit->drums.size(); ++i) {
             const DrumParams &d =
                 i == 0 || !kit_drums || i - 1 >= kit_drums->size() ? drum : (*kit_drums)[i - 1];
-            f.drums.push_back(
-                {kit->drums[i].name, d.center_m + raise, d.radius_m, kit->drums[i].cymbal()});
+            f.drums.push_back({kit->drums[i].name, d.center_m + raise, d.radius_m,
+                               kit->drums[i].cymbal(), kit_drum_has_pedal(kit->drums[i])});
         }
     }
     return f;

@@ -3,6 +3,7 @@
 #include "ictus/perform/strike_log.hpp"
 
 #include <algorithm>
+#include <array>
 #include <ostream>
 
 namespace ictus
@@ -35,7 +36,17 @@ void StrikeLog::write_csv(std::ostream &out) const
 void StrikeLog::write_events(std::ostream &out) const
 {
     double previous_s = 0.0;
+    // Each drum's pedal as last written: a hi-hat's pedal line goes before
+    // the strike that plays it, when it changes (the first one always).
+    std::array<double, kMaxDrums> pedal;
+    pedal.fill(-1.0);
     for (const StrikeEvent &e : strikes_) {
+        if (e.pedal_openness >= 0.0 && e.drum >= 0 && e.drum < kMaxDrums &&
+            e.pedal_openness != pedal[static_cast<size_t>(e.drum)]) {
+            write_pedal_line(out, e.drum, e.pedal_openness, e.time_s, previous_s);
+            pedal[static_cast<size_t>(e.drum)] = e.pedal_openness;
+            previous_s = e.time_s;
+        }
         write_events_line(out, e, previous_s);
         previous_s = e.time_s;
     }

@@ -1,6 +1,7 @@
 // How the strikes of a performance met its planned notes (strike_match.hpp).
 #include "ictus/perform/strike_match.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -57,6 +58,39 @@ MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
     }
     m.mean_abs_error_ms = m.matched_notes > 0 ? sum / m.matched_notes : 0.0;
     return m;
+}
+
+double strike_pedal_openness(const std::vector<PlannedNote> &notes, const StrikeEvent &strike,
+                             double origin_s)
+{
+    const double t = strike.time_s - origin_s; // the plan's clock
+    // Outward from the strike's time: the first note of the strike's hand
+    // on its drum each way, and of either hand for want of one.
+    const auto at = std::lower_bound(notes.begin(), notes.end(), t,
+                                     [](const PlannedNote &n, double s) { return n.time_s < s; });
+    const PlannedNote *best[2] = {nullptr, nullptr}; // [0] its hand, [1] either
+    double best_d[2] = {std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity()};
+    auto consider = [&](const PlannedNote &n) {
+        if (n.drum != strike.drum || n.openness < 0.0)
+            return false;
+        const double d = std::abs(n.time_s - t);
+        const int k = static_cast<int>(n.hand) == strike.hand ? 0 : 1;
+        for (int j = k; j < 2; ++j)
+            if (d < best_d[j]) {
+                best_d[j] = d;
+                best[j] = &n;
+            }
+        return k == 0; // found its hand's nearest this way
+    };
+    for (auto it = at; it != notes.end(); ++it)
+        if (consider(*it))
+            break;
+    for (auto it = at; it != notes.begin();)
+        if (consider(*--it))
+            break;
+    const PlannedNote *n = best[0] ? best[0] : best[1];
+    return n ? n->openness : -1.0;
 }
 
 } // namespace ictus

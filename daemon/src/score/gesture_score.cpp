@@ -410,6 +410,26 @@ int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &fra
                      "unknown drum '" + n.drum + "' (the kit: " + names + ")");
 }
 
+// The note's pedal on a hi-hat (closed when it names none), -1 on another
+// drum; a ScoreError at the word when it names one on a drum without a pedal.
+double note_openness(const Score &score, const ScoreNote &n, const PerformerFrame &frame, int drum)
+{
+    const bool kit = drum >= 0 && drum < static_cast<int>(frame.drums.size());
+    if (kit && frame.drums[static_cast<size_t>(drum)].pedal)
+        return n.openness >= 0.0 ? n.openness : kHihatClosed;
+    if (n.openness < 0.0)
+        return -1.0;
+    std::string hihats;
+    for (const PerformerFrame::Drum &d : frame.drums)
+        if (d.pedal)
+            hihats += (hihats.empty() ? "" : ", ") + d.name;
+    throw ScoreError(
+        score.source, n.line, n.openness_column,
+        std::string("'") + hihat_openness_word(n.openness) + "' is a hi-hat's pedal, and drum '" +
+            (kit ? frame.drums[static_cast<size_t>(drum)].name : n.drum) + "' is not a hi-hat (" +
+            (hihats.empty() ? "the kit has none" : "the kit's hi-hat: " + hihats) + ")");
+}
+
 // The notes, timed by the tempo map, into plan.notes (score order); a score that
 // asks a hand to play faster than one hand plays is a ScoreError. The timing noise
 // of `humanize` never does: it is clipped where it would bring a stroke closer
@@ -442,6 +462,7 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         p.theta_deg = n.theta_deg;
         p.firmness = n.firmness;
         p.drum = drum_index(score, n, frame);
+        p.openness = note_openness(score, n, frame, p.drum);
         if (!n.spot_given && p.drum < static_cast<int>(frame.drums.size()) &&
             frame.drums[static_cast<size_t>(p.drum)].cymbal) {
             p.r_over_a = kCymbalRadiusFraction;
@@ -611,7 +632,7 @@ Eigen::Vector3d pair_position(const Item &a, const Item &b, const Window &w, dou
 // press, the strike's aim below the surface), and a lift there would be
 // divided by a vanishing bump into a leap of tens of cm.
 double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFrame &frame,
-                const PlanOptions &opt)
+                const PlanOptions &opt, bool cymbals_only = false)
 {
     if (!(w.move_end > w.move_begin) || frame.drums.size() < 2)
         return 0.0;
@@ -624,6 +645,8 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
         double short_m = 0.0;
         for (size_t k = 0; k < frame.drums.size(); ++k) {
             const PerformerFrame::Drum &d = frame.drums[k];
+            if (cymbals_only && !d.cymbal)
+                continue;
             const Eigen::Vector3d rel = p - d.membrane_center_m;
             const double height = rel.dot(frame.up);
             if ((rel - height * frame.up).norm() > d.membrane_radius_m + opt.kit_margin_m)
@@ -636,6 +659,24 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
         lift = std::max(lift, short_m / std::max(kit_bump(x), 0.05));
     }
     return lift;
+}
+
+// A move between a stroke and the hand's rest tip (window w, from a to b),
+// lifted as a move between drums is over the kit's cymbals on its way: the
+// rest tips stand above every head and below the cymbals, so that a hand
+// going back to rest from a hi-hat would come down on its plate. Unchanged
+// (no move window) when nothing is in the way.
+void lift_rest_move(const Item &a, const Item &b, Window &w, const PerformerFrame &frame,
+                    const PlanOptions &opt)
+{
+    Window m = w;
+    m.move_begin = w.begin;
+    m.move_end = w.end;
+    const double lift = kit_lift(a, b, m, frame, opt, true);
+    if (lift > 0.0) {
+        m.lift = lift * frame.up;
+        w = m;
+    }
 }
 
 // A hand's timeline: rest, unit, [rest,] unit, ..., rest, and the
@@ -656,9 +697,11 @@ double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
     Item rest;
     rest.rest_pos = frame.rest_tip_m[s];
     rest.rest_dir = rest_stick_direction(frame, s);
+    rest.drum = -1; // no drum: the rest tip
     line.items.push_back(rest);
     const double first_start = placed[0].strike_t - placed[0].prep_t;
     line.windows.push_back({std::max(0.0, first_start - tr), first_start});
+    lift_rest_move(rest, placed[0], line.windows.back(), frame, opt);
     for (size_t k = 0; k < n; ++k) {
         line.items.push_back(placed[k]);
         const Item &it = placed[k];
@@ -666,13 +709,16 @@ double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
             Item back;
             back.rest_pos = frame.rest_tip_m[s];
             back.rest_dir = rest_stick_direction(frame, s);
+            back.drum = -1;
             const double lift_end = it.strike_t + it.lift_t;
             line.windows.push_back({lift_end, lift_end + tr});
+            lift_rest_move(it, back, line.windows.back(), frame, opt);
             last_motion_end = std::max(last_motion_end, lift_end + tr);
             line.items.push_back(back);
             if (k + 1 < n) {
                 const double next_start = placed[k + 1].strike_t - placed[k + 1].prep_t;
                 line.windows.push_back({next_start - tr, next_start});
+                lift_rest_move(back, placed[k + 1], line.windows.back(), frame, opt);
             }
         } else {
             const double gap = placed[k + 1].strike_t - it.strike_t;

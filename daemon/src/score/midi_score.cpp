@@ -213,9 +213,11 @@ bool is_tom(int note)
     return note == 41 || note == 43 || note == 45 || note == 47 || note == 48 || note == 50;
 }
 
-// A cymbal's note: the kit's cymbal that plays it (crash or ride), 0 for another note.
+// A cymbal's note: the kit's cymbal that plays it (crash, ride or hi-hat), 0 for another note.
 int cymbal_of(int note)
 {
+    if (note == kMidiClosedHihat || note == kMidiOpenHihat)
+        return kMidiClosedHihat;
     if (note == kMidiCrash || note == 57)
         return kMidiCrash;
     if (note == kMidiRide || note == 59 || note == kMidiRideBell)
@@ -346,6 +348,8 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         else if (n.note == kMidiRideBell)
             s.r_over_a = kMidiRideBellRadiusFraction;
         s.spot_given = n.note == kMidiSideStick || n.note == kMidiRideBell;
+        if (n.note == kMidiClosedHihat || n.note == kMidiOpenHihat)
+            s.openness = n.note == kMidiOpenHihat ? kHihatOpen : kHihatClosed;
         s.line = line;
         s.drum_line = line;
         if (!drums.empty())
@@ -375,8 +379,8 @@ MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<Midi
     if (part.score.notes.empty())
         throw MidiFileError(path + ": no note the " + (drums.empty() ? "drum" : "kit") +
                             " can play (snares 38, 40, side stick 37, toms 41..50 and, on a kit "
-                            "with cymbals, crash 49, 57 and ride 51, 53, 59 of the General MIDI "
-                            "drum map, on channel 10 if it has notes)");
+                            "with cymbals, crash 49, 57, ride 51, 53, 59 and hi-hat 42, 46 of "
+                            "the General MIDI drum map, on channel 10 if it has notes)");
     return part;
 }
 

@@ -62,6 +62,17 @@ const char *to_string(Grace grace)
     return "none";
 }
 
+const char *hihat_openness_word(double openness)
+{
+    if (openness == kHihatOpen)
+        return "open";
+    if (openness == kHihatHalf)
+        return "half";
+    if (openness == kHihatClosed)
+        return "closed";
+    return "";
+}
+
 const std::vector<DynamicsWord> &dynamics_words()
 {
     // Evenly spread over the range, mf = the default 0.6 and ff = the loudest.
@@ -119,6 +130,15 @@ std::optional<double> dynamics_word(const std::string &lower)
     for (const auto &w : dynamics_words())
         if (lower == w.word)
             return w.value;
+    return std::nullopt;
+}
+
+// A hi-hat note's pedal word (`open`, `half`, `closed`) as membrane~'s openness.
+std::optional<double> openness_word(const std::string &lower)
+{
+    for (double o : {kHihatOpen, kHihatHalf, kHihatClosed})
+        if (lower == hihat_openness_word(o))
+            return o;
     return std::nullopt;
 }
 
@@ -571,6 +591,12 @@ class LineParser
                     fail(t.column, "second drum in one note");
                 drum_name(need(tk, i + 1, "'on' needs a drum's name, e.g. 'on tom1'"), st);
                 ++i;
+            } else if (auto o = openness_word(t.lower)) {
+                if (st.openness)
+                    fail(t.column, "second hi-hat openness '" + t.text +
+                                       "' in one note (one of open, half, closed)");
+                st.openness = *o;
+                st.openness_column = t.column;
             } else if (t.lower == "at") {
                 if (st.r_over_a)
                     fail(t.column, "second position in one note");
@@ -606,7 +632,8 @@ class LineParser
                 fail(t.column, "unexpected '" + t.text + "' in a note: expected a nuance (" +
                                    nuance_list() + "), dynamics (0..1 or " + dynamics_list() +
                                    "), a duration (N/D or 'beats X'), 'at R/A THETA', "
-                                   "'firmness F', 'on DRUM', 'flam' or 'drag'");
+                                   "'firmness F', 'on DRUM', 'flam', 'drag' or a hi-hat's "
+                                   "'open', 'half', 'closed'");
             }
         }
     }

@@ -141,12 +141,26 @@ class Executor
             n.drum_line = st.line;
             n.drum_column = st.drum_column;
         }
+        if (st.openness) {
+            // The kit's first drum is never a cymbal (validate_kit): the
+            // pedal needs a note on a named drum, a hi-hat (the planner,
+            // which knows the kit, checks that it is one).
+            if (n.drum.empty())
+                throw ScoreError(score_.source, st.line, st.openness_column,
+                                 std::string("'") + hihat_openness_word(*st.openness) +
+                                     "' is a hi-hat's pedal, and this note is on the kit's "
+                                     "first drum (write 'on hihat', or 'drum hihat' before it)");
+            n.openness = *st.openness;
+            n.openness_column = st.openness_column;
+        }
         if (st.ornament != Grace::none) {
             // The grace strokes: the other hand's, soft, before the beat, on the note's drum.
             ScoreNote g = stroke(st, st.hand == Side::right ? Side::left : Side::right);
             g.drum = n.drum;
             g.drum_line = n.drum_line;
             g.drum_column = n.drum_column;
+            g.openness = n.openness; // one pedal for the note and its graces
+            g.openness_column = n.openness_column;
             g.beats = 0.0;
             g.nuance = Nuance::legato;
             g.dynamics = std::min(kGraceDynamics, 0.5 * n.dynamics);

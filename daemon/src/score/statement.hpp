@@ -64,6 +64,9 @@ struct Statement {
     // and its column
     std::optional<std::string> drum;
     int drum_column = 0;
+    // note: the hi-hat's pedal (`open`, `half`, `closed`) and its word's column
+    std::optional<double> openness;
+    int openness_column = 0;
     double humanize = 0.0; // humanize
 };
 

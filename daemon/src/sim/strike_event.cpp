@@ -194,4 +194,15 @@ void write_events_line(std::ostream &out, const StrikeEvent &e, double previous_
     out << ";\n";
 }
 
+void write_pedal_line(std::ostream &out, int drum, double openness, double time_s,
+                      double previous_time_s)
+{
+    const long long t_us = std::llround(time_s * 1e6);
+    const long long prev_us = std::llround(previous_time_s * 1e6);
+    put(out, static_cast<double>(t_us - prev_us) * 1e-3, 3);
+    out << " pedal " << drum << ' ';
+    put(out, openness, 3);
+    out << ";\n";
+}
+
 } // namespace ictus

@@ -10,6 +10,7 @@
 #include "ictus/perform/commands.hpp"
 #include "ictus/sim/strike_detector.hpp"
 
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -117,6 +118,9 @@ class OscSender
     std::string kit_name_;
     std::vector<KitDrumSound> kit_;
     std::atomic<bool> kit_set_{false}, kit_wanted_{false};
+    // Each drum's pedal as last sent (/ictus/kit/pedal; -1: not yet since the
+    // kit was sent), the strike thread's own.
+    std::array<double, kMaxDrums> pedal_sent_{}; // filled with -1 by the constructor
     struct StrikeMessage {
         StrikeEvent event;
         bool end = false; // /ictus/strike/end

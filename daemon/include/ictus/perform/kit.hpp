@@ -45,7 +45,7 @@ constexpr double kKitMinGap_m = 0.02;
 
 // The built-in kits by name: "standard" (snare, two rack toms, floor tom: a
 // right-handed four-piece), "standard-cymbals" (the same with an 18-inch
-// crash and a 20-inch ride), "standard-timpani" (the four drums and a
+// crash, a 20-inch ride and a 14-inch hi-hat), "standard-timpani" (the four drums and a
 // 26-inch timpani to the left of the snare) and "timpani" (two timpani).
 // Throws PerformError naming the kits for another name.
 Kit kit_named(const std::string &name);
@@ -61,6 +61,10 @@ double kit_min_gap_m(const Kit &kit);
 // The drum's pan in the sound's stereo mix, by its place: -x / 0.8 m within
 // +-0.6 (the performer's left, + here, to the left channel).
 double kit_drum_pan(const KitDrum &drum);
+// Whether the drum is a hi-hat: a cymbal whose preset has a pedal (the
+// closed pair's edge loss, docs/plates.md "The hi-hat"), so that its notes
+// carry the pedal's openness (docs/kit.md, "The hi-hat").
+bool kit_drum_has_pedal(const KitDrum &drum);
 // The drum named `name` (lower case), or -1.
 int kit_drum_index(const Kit &kit, const std::string &name);
 

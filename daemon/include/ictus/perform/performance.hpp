@@ -281,6 +281,8 @@ class Performance
     bool apply_drum_command(const Command &c, std::string *why);
     int guard_runaway(int k, StrikeEvent out[2]); // the strikes that may leave
     bool withheld(const StrikeEvent &e) const;    // an onset while the guard is quiet
+    // A strike on a hi-hat gets the pedal of the note it plays (score mode).
+    void mark_pedal(StrikeEvent &e) const;
     // Contacts a rebuild (took_over) ended, and onsets it took, given out by
     // the next step() and take_onsets().
     void hold_open_contacts();

@@ -31,4 +31,12 @@ struct MatchSummary {
 MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
                            const std::vector<StrikeEvent> &strikes, double origin_s);
 
+// The hi-hat's pedal for a strike (StrikeEvent::pedal_openness): the
+// openness of the note it plays, the nearest note in time on its drum that
+// carries one (PlannedNote::openness), of its hand if it has any there, else
+// of the other's; -1 when its drum has none (not a hi-hat). `notes` in time
+// order; no allocation (the physics thread asks it at each onset).
+double strike_pedal_openness(const std::vector<PlannedNote> &notes, const StrikeEvent &strike,
+                             double origin_s);
+
 } // namespace ictus

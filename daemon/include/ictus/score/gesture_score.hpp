@@ -46,6 +46,7 @@ struct PerformerFrame {
         Eigen::Vector3d membrane_center_m = Eigen::Vector3d::Zero(); // raised as membrane_center_m
         double membrane_radius_m = 0.178;
         bool cymbal = false; // played where a note gives no spot at kCymbal* (score.hpp)
+        bool pedal = false;  // a hi-hat: its notes carry the pedal's openness
     };
     std::vector<Drum> drums;
 };
@@ -85,6 +86,10 @@ struct PlannedNote {
     double theta_deg = 0.0;
     double firmness = -1.0; // ScoreNote::firmness
     int drum = 0;           // the kit's drum (PerformerFrame::drums), 0: the first or only
+    // The hi-hat's pedal for a note on a hi-hat (PerformerFrame::Drum::pedal):
+    // ScoreNote::openness, closed (0) when the note names none; -1 on any
+    // other drum.
+    double openness = -1.0;
     int line = 0;           // where the note is written
     int column = 0;
     Grace grace = Grace::none; // a flam's or a drag's grace stroke (ScoreNote::grace)
@@ -176,7 +181,8 @@ struct GesturePlan {
 
 // Plans the whole performance before anything plays. Throws ScoreError (at
 // the note's line and column) for a note its hand cannot play in time or a
-// performance too long, std::invalid_argument for bad options or frame, and
+// performance too long, (at the word's column) for a hi-hat's openness on a
+// drum that is not a hi-hat, std::invalid_argument for bad options or frame, and
 // lets GestureError from the database through.
 GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
                              const PerformerFrame &frame, const PlanOptions &options = {});

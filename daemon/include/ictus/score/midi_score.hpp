@@ -77,6 +77,12 @@ constexpr int kMidiCrash = 49;
 constexpr int kMidiRide = 51;
 constexpr int kMidiRideBell = 53;
 constexpr double kMidiRideBellRadiusFraction = 0.12;
+// General MIDI's hi-hat played by a hand on a kit's hi-hat (its note 42): closed 42 with the
+// pedal down, open 46 with it up (ScoreNote::openness). The pedal hi-hat 44 is played by a
+// foot, which the performer does not have: left out (MidiDrumPart::skipped).
+constexpr int kMidiClosedHihat = 42;
+constexpr int kMidiOpenHihat = 46;
+constexpr int kMidiPedalHihat = 44;
 
 // Notes closer than this alternate hands; farther apart, the right hand
 // (the lead) plays.
@@ -98,7 +104,8 @@ struct MidiDrumPart {
 // are any, else on every channel; snares (38, 40) and toms (41, 43, 45,
 // 47, 48, 50) to `drums` by the General MIDI map (a snare to the drum of
 // note 38, a tom to the drum of its note, else the tom of the nearest
-// note; no drums: the one drum plays them all), the rest skipped; velocity
+// note; no drums: the one drum plays them all), cymbals to the kit's crash,
+// ride and hi-hat (42 closed, 46 open) when it has them, the rest skipped; velocity
 // v to dynamics v / 127; hands as docs/midi.md says; the tempo map and the
 // meters of the file, its quarter note the score's beat.
 MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,

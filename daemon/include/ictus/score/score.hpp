@@ -65,6 +65,16 @@ constexpr double kDefaultThetaDeg[2] = {0.0, 180.0}; // [Side::left, Side::right
 constexpr double kCymbalRadiusFraction = 0.7;
 constexpr double kCymbalThetaDeg[2] = {70.0, 110.0}; // [Side::left, Side::right]
 
+// The hi-hat's pedal as a note writes it (docs/score.md, `open`, `half`,
+// `closed`): membrane~'s `openness` (docs/plates.md, "The hi-hat"), 0 the
+// plates pressed together, 1 held apart by the stand's spring. A hi-hat
+// note that names none is closed.
+constexpr double kHihatClosed = 0.0;
+constexpr double kHihatHalf = 0.5;
+constexpr double kHihatOpen = 1.0;
+// The word for an openness ("open", "half", "closed"; "" for another value).
+const char *hihat_openness_word(double openness);
+
 // Grace strokes (docs/score.md, "Flams, drags and rolls"): a flam's one
 // grace stroke of the other hand kFlamGraceLead_s before its note; a drag's
 // two, the second kFlamGraceLead_s before the note and the first
@@ -104,6 +114,11 @@ struct ScoreNote {
     // planner's error when the kit has no such drum.
     std::string drum;
     int drum_line = 0, drum_column = 0;
+    // The hi-hat's pedal for this note (`open` 1, `half` 0.5, `closed` 0:
+    // kHihatOpen ...), < 0 when the note names none (closed on a hi-hat);
+    // the word's column, for the planner's error when the drum is not a hi-hat.
+    double openness = -1.0;
+    int openness_column = 0;
     // A grace stroke (its ornament; none: a written note) is played
     // grace_lead_s before `beat`, the beat of the note it ornaments.
     Grace grace = Grace::none;

@@ -45,6 +45,12 @@ struct StrikeEvent {
     // drum's top edge during the contact, Scene's StickDrumContact::
     // rim_points; docs/osc.md). Known at the release.
     int zone = 0;
+    // The hi-hat's pedal for this strike, 0 closed .. 1 open (the note it
+    // plays: PlannedNote::openness, given by the performance); < 0: none (not
+    // a hi-hat). Not one of the fields below: strikes.csv and /ictus/strike
+    // stay as they are; it goes to the sound as its own line and message
+    // before the strike when it changes (write_pedal_line, /ictus/kit/pedal).
+    double pedal_openness = -1.0;
 };
 constexpr int kZoneHead = 0, kZoneRim = 1;
 
@@ -105,5 +111,10 @@ void write_strike_csv_row(std::ostream &out, const StrikeEvent &event);
 //   <delay_ms since previous line> hit <kEventsStrikeFields>;
 // The first delay is from time 0. Fixed precision, see docs/osc.md.
 void write_events_line(std::ostream &out, const StrikeEvent &event, double previous_time_s);
+// A hi-hat's pedal in the events file, before the strike that plays it:
+//   <delay_ms since previous line> pedal <drum> <openness>;
+// (ictus-render.pd gives it to that drum's membrane~ as `openness`).
+void write_pedal_line(std::ostream &out, int drum, double openness, double time_s,
+                      double previous_time_s);
 
 } // namespace ictus
