@@ -125,6 +125,39 @@ TEST_CASE("score: R+L strikes both hands on one beat", "[score][parser]")
     require_error("R+L at 0.3 90", 1, 1, "'at' places one stick");
 }
 
+TEST_CASE("score: '+' joins a note of each hand on one beat, each with its options",
+          "[score][parser]")
+{
+    // Beats: 0 (1/2 and 1: the chord lasts 1), 1 (1/2 and 1 again), 2.
+    const Score s = parse_score("R accent 1/2 at 0.2 170 + L ff\nL 1/2 + R\nR", "chord");
+    REQUIRE(s.notes.size() == 5);
+    CHECK((s.notes[0].hand == Side::right && s.notes[1].hand == Side::left));
+    for (int i : {0, 1})
+        CHECK(s.notes[i].beat == 0.0);
+    CHECK(s.notes[0].beats == 0.5);
+    CHECK(s.notes[1].beats == 1.0);
+    CHECK(s.notes[0].nuance == Nuance::accent);
+    CHECK(s.notes[1].nuance == Nuance::legato);
+    CHECK(s.notes[0].dynamics == 0.6);
+    CHECK(s.notes[1].dynamics == 1.0);
+    CHECK((s.notes[0].r_over_a == 0.2 && s.notes[0].theta_deg == 170.0));
+    CHECK((s.notes[1].r_over_a == 0.3 && s.notes[1].theta_deg == 0.0));
+    CHECK((s.notes[2].beat == 1.0 && s.notes[3].beat == 1.0));
+    CHECK(s.notes[4].beat == 2.0);
+    CHECK(s.length_beats == 3.0);
+    // The same in a Pd message box (statements between commas).
+    const Score m = parse_score("R accent 1/2 at 0.2 170 + L ff, L 1/2 + R, R", "box");
+    REQUIRE(m.notes.size() == s.notes.size());
+    for (size_t i = 0; i < m.notes.size(); ++i)
+        CHECK((m.notes[i].beat == s.notes[i].beat && m.notes[i].hand == s.notes[i].hand));
+    require_error("R + R", 1, 5, "both notes joined by '+' are the right hand's");
+    require_error("R +", 1, 3, "'+' joins two notes played on one beat");
+    require_error("+ L", 1, 1, "'+' joins two notes played on one beat");
+    require_error("R + tempo 90", 1, 5, "'+' joins two notes of one hand each");
+    require_error("R+L + L", 1, 1, "'+' joins two notes of one hand each");
+    require_error("R + L + R", 1, 7, "a second '+': two hands play two notes on one beat");
+}
+
 TEST_CASE("score: the dynamics words rise from pp to ff and mf is the default", "[score][parser]")
 {
     const auto &words = dynamics_words();

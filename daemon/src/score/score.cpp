@@ -204,7 +204,7 @@ class LineParser
         std::vector<Token> tokens;
         auto flush = [&]() {
             if (!tokens.empty())
-                out.push_back(statement(tokens));
+                chord(tokens, out);
             tokens.clear();
         };
         size_t i = 0;
@@ -238,6 +238,39 @@ class LineParser
   private:
     const std::string &source_;
     int line_;
+
+    // One statement, or a chord: `R on hihat + L on snare`, two notes of the two hands
+    // on one beat, each with its own options (a '+' between spaces).
+    void chord(const std::vector<Token> &tk, std::vector<Statement> &out) const
+    {
+        size_t plus = 0;
+        while (plus < tk.size() && tk[plus].text != "+")
+            ++plus;
+        if (plus == tk.size()) {
+            out.push_back(statement(tk));
+            return;
+        }
+        const std::vector<Token> a(tk.begin(), tk.begin() + static_cast<long>(plus)),
+            b(tk.begin() + static_cast<long>(plus) + 1, tk.end());
+        if (a.empty() || b.empty())
+            fail(tk[plus].column, "'+' joins two notes played on one beat, one of each hand: "
+                                  "'R on hihat + L on snare'");
+        for (const Token &t : b)
+            if (t.text == "+")
+                fail(t.column, "a second '+': two hands play two notes on one beat at most");
+        for (const std::vector<Token> *part : {&a, &b})
+            if (!hand_word((*part)[0].lower))
+                fail((*part)[0].column, "'+' joins two notes of one hand each ('R ...' or "
+                                        "'L ...'), got '" + (*part)[0].text + "'");
+        Statement first = statement(a), second = statement(b);
+        if (first.hand == second.hand)
+            fail(b[0].column, "both notes joined by '+' are the " +
+                                  std::string(first.hand == Side::right ? "right" : "left") +
+                                  " hand's: one hand plays one note at a time");
+        first.with_next = true;
+        out.push_back(first);
+        out.push_back(second);
+    }
 
     [[noreturn]] void fail(int column, const std::string &message) const
     {

@@ -70,6 +70,7 @@ class Executor
   private:
     Score score_;
     double beat_ = 0.0;
+    double chord_beats_ = 0.0; // the longest note of a chord so far (`R ... + L ...`)
     Grip grip_ = Grip::french;
     double default_beats_ = kDefaultNoteBeats;
     double default_firmness_ = -1.0; // the performance's
@@ -180,7 +181,12 @@ class Executor
             n.theta_deg = st.theta_deg.value_or(kDefaultThetaDeg[static_cast<int>(hand)]);
             add(st, n);
         }
-        advance(st, n.beats);
+        // A chord's first note (`R ... + L ...`): the second starts on the same beat.
+        chord_beats_ = std::max(chord_beats_, n.beats);
+        if (st.with_next)
+            return;
+        advance(st, chord_beats_);
+        chord_beats_ = 0.0;
     }
 
     // A roll: strokes at the `beats` default for its length, alternating

@@ -41,6 +41,9 @@ struct Statement {
     // note
     Side hand = Side::right;
     bool both_hands = false;        // R+L: one stroke of each hand on the same beat
+    // `R ... + L ...`: the next statement is this one's other hand, on the same beat
+    // (the beat advances after it, by the longer of the two durations)
+    bool with_next = false;
     std::optional<Nuance> nuance;   // note, default_nuance
     std::optional<double> beats;    // note, rest, default_beats
     std::optional<double> dynamics; // note, default_dynamics
