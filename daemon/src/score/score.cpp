@@ -261,7 +261,8 @@ class LineParser
         for (const std::vector<Token> *part : {&a, &b})
             if (!hand_word((*part)[0].lower))
                 fail((*part)[0].column, "'+' joins two notes of one hand each ('R ...' or "
-                                        "'L ...'), got '" + (*part)[0].text + "'");
+                                        "'L ...'), got '" +
+                                            (*part)[0].text + "'");
         Statement first = statement(a), second = statement(b);
         if (first.hand == second.hand)
             fail(b[0].column, "both notes joined by '+' are the " +
