@@ -256,7 +256,7 @@ TEST_CASE("score: a hi-hat's pedal word where it cannot be, at the word", "[scor
     require_error("R on hihat opened", 1, 12, "unexpected 'opened' in a note");
 }
 
-TEST_CASE("plan: a hi-hat note carries its pedal; another drum refuses one at the word",
+TEST_CASE("plan: a hi-hat note carries its pedal, and another drum refuses one at the word",
           "[score][kit][hihat]")
 {
     PerformerFrame f = kit_frame();
