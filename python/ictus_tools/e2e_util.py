@@ -29,6 +29,7 @@ How onsets are measured (docs/main-job.md, "Checking the onsets"):
 """
 import json
 import os
+import struct
 import subprocess
 
 import numpy as np
@@ -304,3 +305,24 @@ def pd_spawning_env(work):
     elif os.path.dirname(PD):
         env["PATH"] = os.path.dirname(PD) + os.pathsep + env["PATH"]
     return env
+
+
+def read_wav_mono(path):
+    """A 32-bit float WAV (ictus-render's default) as the mean of its channels."""
+    with open(path, "rb") as f:
+        data = f.read()
+    pos, fmt, samples = 12, None, None
+    while pos + 8 <= len(data):
+        cid, size = data[pos:pos + 4], struct.unpack("<I", data[pos + 4:pos + 8])[0]
+        body = data[pos + 8:pos + 8 + size]
+        if cid == b"fmt ":
+            fmt = struct.unpack("<HHIIHH", body[:16])
+        elif cid == b"data":
+            samples = body
+        pos += 8 + size + (size & 1)
+    tag, channels, rate, _, _, bits = fmt
+    if not (bits == 32 and tag in (3, 0xFFFE)):
+        raise SystemExit("expected a 32-bit float WAV, got format %d, %d bits" % (tag, bits))
+    n = len(samples) // 4
+    values = struct.unpack("<%df" % n, samples[:4 * n])
+    return rate, [sum(values[i:i + channels]) / channels for i in range(0, n, channels)]

@@ -18,7 +18,6 @@ import csv
 import json
 import math
 import os
-import struct
 import subprocess
 import sys
 
@@ -32,27 +31,6 @@ L closed 2/1, L open 2/1, L closed 2/1, L open 2/1, L 2/1
 """
 WANT = [0.0, 1.0, 0.0, 1.0, 0.0]  # the notes' pedals (none written: closed)
 HIHAT = 6  # its index in standard-cymbals
-
-
-def read_wav_mono(path):
-    """A 32-bit float WAV (ictus-render's default) as the mean of its channels."""
-    with open(path, "rb") as f:
-        data = f.read()
-    pos, fmt, samples = 12, None, None
-    while pos + 8 <= len(data):
-        cid, size = data[pos:pos + 4], struct.unpack("<I", data[pos + 4:pos + 8])[0]
-        body = data[pos + 8:pos + 8 + size]
-        if cid == b"fmt ":
-            fmt = struct.unpack("<HHIIHH", body[:16])
-        elif cid == b"data":
-            samples = body
-        pos += 8 + size + (size & 1)
-    tag, channels, rate, _, _, bits = fmt
-    if not (bits == 32 and tag in (3, 0xFFFE)):
-        raise SystemExit("expected a 32-bit float WAV, got format %d, %d bits" % (tag, bits))
-    n = len(samples) // 4
-    values = struct.unpack("<%df" % n, samples[:4 * n])
-    return rate, [sum(values[i:i + channels]) / channels for i in range(0, n, channels)]
 
 
 def decay_t60(x, rate, onset_s, t0=0.100, t1=0.400, window=0.020):
@@ -133,7 +111,7 @@ def main():
     with open(os.path.join(out, "pd.log")) as f:
         errors = [l for l in f if "error" in l.lower()]
     ok &= check(not errors, "pd.log has no error line: %s" % errors[:3])
-    rate, x = read_wav_mono(wav)
+    rate, x = e2e_util.read_wav_mono(wav)
     t60 = [decay_t60(x, rate, s) for s in onsets]
     closed = [t for t, p in zip(t60, WANT) if p == 0.0]
     opened = [t for t, p in zip(t60, WANT) if p == 1.0]

@@ -16,7 +16,6 @@ import argparse
 import csv
 import json
 import os
-import struct
 import subprocess
 import sys
 
@@ -54,28 +53,6 @@ L on timpani1 at 0.5 70, R on timpani2 at 0.5 110
 HEADS = {"snare": (0.1778, 3603.0, 0.345), "tom1": (0.127, 1231.0, 0.345),
          "tom2": (0.1524, 1231.0, 0.345)}
 F_TIMPANI = 110.0  # (1,1), air-loaded
-
-
-
-def read_wav_mono(path):
-    """A 32-bit float WAV (ictus-render's default) as the mean of its channels."""
-    with open(path, "rb") as f:
-        data = f.read()
-    pos, fmt, samples = 12, None, None
-    while pos + 8 <= len(data):
-        cid, size = data[pos:pos + 4], struct.unpack("<I", data[pos + 4:pos + 8])[0]
-        body = data[pos + 8:pos + 8 + size]
-        if cid == b"fmt ":
-            fmt = struct.unpack("<HHIIHH", body[:16])
-        elif cid == b"data":
-            samples = body
-        pos += 8 + size + (size & 1)
-    tag, channels, rate, _, _, bits = fmt
-    if not (bits == 32 and tag in (3, 0xFFFE)):
-        raise SystemExit("expected a 32-bit float WAV, got format %d, %d bits" % (tag, bits))
-    n = len(samples) // 4
-    values = struct.unpack("<%df" % n, samples[:4 * n])
-    return rate, [sum(values[i:i + channels]) / channels for i in range(0, n, channels)]
 
 
 
@@ -135,7 +112,7 @@ def main():
     # Each strike's sound: its drum's lowest mode has the most energy of the drums' modes.
     freq = {k: f01(*v) for k, v in HEADS.items()}
     freq["timpani"] = F_TIMPANI
-    rate, x = read_wav_mono(wav)
+    rate, x = e2e_util.read_wav_mono(wav)
     right = 0
     for s in primaries:
         i0 = int(round(float(s["time_s"]) * rate)) + int(0.005 * rate)
