@@ -150,12 +150,44 @@ TEST_CASE("score: '+' joins a note of each hand on one beat, each with its optio
     REQUIRE(m.notes.size() == s.notes.size());
     for (size_t i = 0; i < m.notes.size(); ++i)
         CHECK((m.notes[i].beat == s.notes[i].beat && m.notes[i].hand == s.notes[i].hand));
-    require_error("R + R", 1, 5, "both notes joined by '+' are the right hand's");
-    require_error("R +", 1, 3, "'+' joins two notes played on one beat");
-    require_error("+ L", 1, 1, "'+' joins two notes played on one beat");
-    require_error("R + tempo 90", 1, 5, "'+' joins two notes of one hand each");
-    require_error("R+L + L", 1, 1, "'+' joins two notes of one hand each");
-    require_error("R + L + R", 1, 7, "a second '+': two hands play two notes on one beat");
+    require_error("R + R", 1, 5, "two notes joined by '+' are the right hand's");
+    require_error("R +", 1, 3, "'+' joins notes played on one beat");
+    require_error("+ L", 1, 1, "'+' joins notes played on one beat");
+    require_error("R + tempo 90", 1, 5, "'+' joins notes of one limb each");
+    require_error("R+L + L", 1, 1, "'+' joins notes of one limb each");
+    require_error("R + L + R", 1, 9, "two notes joined by '+' are the right hand's");
+    require_error("R + L + RF + L", 1, 12, "a third '+'");
+    require_error("RF + R + RF", 1, 10, "two notes joined by '+' are the right foot's");
+}
+
+TEST_CASE("score: RF is the right foot's note on the kick, alone or in a chord", "[score][parser]")
+{
+    const Score s = parse_score("drum snare\nRF ff 1/2\nR on hihat + L + RF p\nRF on kick\nR\n",
+                                "feet");
+    REQUIRE(s.notes.size() == 6);
+    // A foot's note: the right side, the foot, and no drum but its own `on`
+    // (the hands' current drum is not the kick's).
+    CHECK((s.notes[0].foot && s.notes[0].hand == Side::right && s.notes[0].drum.empty()));
+    CHECK((s.notes[0].beat == 0.0 && s.notes[0].dynamics == 1.0 && s.notes[0].beats == 0.5));
+    // The chord: three notes on beat 0.5, the next note one beat later.
+    for (int i = 1; i <= 3; ++i)
+        CHECK(s.notes[static_cast<size_t>(i)].beat == 0.5);
+    int feet = 0;
+    for (int i = 1; i <= 3; ++i)
+        feet += s.notes[static_cast<size_t>(i)].foot ? 1 : 0;
+    CHECK(feet == 1);
+    CHECK((s.notes[4].foot && s.notes[4].drum == "kick" && s.notes[4].beat == 1.5));
+    CHECK((!s.notes[5].foot && s.notes[5].drum == "snare" && s.notes[5].beat == 2.5));
+    // The same chord in a Pd message box.
+    const Score m = parse_score("RF + R on hihat", "box");
+    REQUIRE(m.notes.size() == 2);
+    CHECK((m.notes[0].beat == 0.0 && m.notes[1].beat == 0.0));
+    require_error("RF flam", 1, 4, "'RF' is the right foot's note on the kick's pedal");
+    require_error("RF at 0.2", 1, 4, "'at' is a stick's");
+    require_error("RF firmness 0.5", 1, 4, "'firmness' is a stick's");
+    require_error("RF on hihat open", 1, 12, "'open' is the hi-hat's");
+    require_error("LF", 1, 1, "the left foot (the hi-hat's pedal) is not built");
+    require_error("R + LF", 1, 5, "the left foot (the hi-hat's pedal) is not built");
 }
 
 TEST_CASE("score: the dynamics words rise from pp to ff and mf is the default", "[score][parser]")

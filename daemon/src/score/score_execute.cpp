@@ -119,6 +119,7 @@ class Executor
         n.dynamics = dynamics_at(beat_);
         n.firmness = default_firmness_;
         n.hand = hand;
+        n.foot = st.foot;
         n.theta_deg = kDefaultThetaDeg[static_cast<int>(hand)];
         n.line = st.line;
         n.column = st.column;
@@ -137,6 +138,13 @@ class Executor
         n.r_over_a = st.r_over_a.value_or(kDefaultRadiusFraction);
         n.spot_given = st.r_over_a.has_value() || st.theta_deg.has_value();
         n.firmness = st.firmness.value_or(default_firmness_);
+        if (n.foot) {
+            // The foot plays its pedal's drum (the planner finds the kit's
+            // kick), not the hands' current drum.
+            n.drum.clear();
+            n.drum_line = st.line;
+            n.drum_column = st.column;
+        }
         if (st.drum) {
             n.drum = *st.drum;
             n.drum_line = st.line;
@@ -181,7 +189,7 @@ class Executor
             n.theta_deg = st.theta_deg.value_or(kDefaultThetaDeg[static_cast<int>(hand)]);
             add(st, n);
         }
-        // A chord's first note (`R ... + L ...`): the second starts on the same beat.
+        // A chord's notes but its last (`R ... + L ... + RF`): the next starts on the same beat.
         chord_beats_ = std::max(chord_beats_, n.beats);
         if (st.with_next)
             return;
