@@ -183,9 +183,9 @@ TEST_CASE("score: RF is the right foot's note on the kick, alone or in a chord",
     REQUIRE(m.notes.size() == 2);
     CHECK((m.notes[0].beat == 0.0 && m.notes[1].beat == 0.0));
     require_error("RF flam", 1, 4, "'RF' is the right foot's note on the kick's pedal");
-    require_error("RF at 0.2", 1, 4, "'at' is a stick's");
+    require_error("RF at 0.2 90", 1, 4, "'at' is a stick's");
     require_error("RF firmness 0.5", 1, 4, "'firmness' is a stick's");
-    require_error("RF on hihat open", 1, 12, "'open' is the hi-hat's");
+    require_error("RF on hihat open", 1, 13, "'open' is the hi-hat's");
     require_error("LF", 1, 1, "the left foot (the hi-hat's pedal) is not built");
     require_error("R + LF", 1, 5, "the left foot (the hi-hat's pedal) is not built");
 }

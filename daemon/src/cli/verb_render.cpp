@@ -311,6 +311,25 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
             out << ',' << kit.drums[static_cast<size_t>(n.drum)].name;
         out << '\n';
     }
+    // The right foot's notes (a kit's kick) after the hands': hand
+    // "right-foot", no nuance or grip.
+    for (size_t i = 0; i < plan.foot_notes.size(); ++i) {
+        const PlannedFootNote &n = plan.foot_notes[i];
+        const NoteMatch &k = m.foot_notes[i];
+        std::snprintf(buf, sizeof buf, "%zu,%.6f,right-foot,,,%.3f,,,%d,%ld,",
+                      plan.notes.size() + i, origin_s + n.time_s, n.dynamics, n.line,
+                      k.strike_seq);
+        out << buf;
+        if (k.strike_seq >= 0)
+            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f,", k.strike_time_s, k.error_ms,
+                          k.normal_velocity_mps, k.duration_ms);
+        else
+            std::snprintf(buf, sizeof buf, ",,,,");
+        out << buf << 0;
+        if (n.drum >= 0 && n.drum < static_cast<int>(kit.drums.size()))
+            out << ',' << kit.drums[static_cast<size_t>(n.drum)].name;
+        out << '\n';
+    }
 }
 
 nlohmann::json drum_json(const Performance &p)
@@ -331,6 +350,31 @@ nlohmann::json drum_json(const Performance &p)
     return j;
 }
 
+// A kit's foot piece (the kick) as render.json has it: where its upright
+// head stands, its head, and the pedal that plays it (docs/pedal.md).
+nlohmann::json foot_piece_json(const Performance &p, const KitDrum &k)
+{
+    const Eigen::Vector3d c = p.foot_piece_center_m();
+    const KickPedal *pedal = p.kick_pedal();
+    nlohmann::json j = {{"name", k.name},
+                        {"preset", k.preset},
+                        {"center_m", {c.x(), c.y(), c.z()}},
+                        {"radius_m", k.radius_m},
+                        {"tension_n_per_m", k.tension_n_per_m},
+                        {"bending_n_m", 0.0},
+                        {"shell_depth_m", k.shell_depth_m},
+                        {"midi_note", k.midi_note},
+                        {"stick_tip", "felt"}, // the beater's
+                        {"played_by", "right foot"},
+                        {"shell_passes", 0}};
+    if (pedal)
+        j["pedal"] = {{"beater_length_m", pedal->params().beater_length_m},
+                      {"effective_mass_kg", pedal->effective_mass_kg()},
+                      {"min_speed_mps", pedal->min_speed_mps()},
+                      {"max_speed_mps", pedal->max_speed_mps()}};
+    return j;
+}
+
 // A kit's drums as placed, and the stick parts that met a shell from the
 // side (Scene::shell_passes: none when every stroke reached its head from above).
 nlohmann::json kit_json(const Performance &p)
@@ -338,9 +382,14 @@ nlohmann::json kit_json(const Performance &p)
     const Scene &scene = p.scene();
     const Kit &kit = p.options().kit;
     nlohmann::json drums = nlohmann::json::array();
-    for (int i = 0; i < scene.drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
-        const DrumParams &d = scene.drum(i);
+    for (int i = 0; i < static_cast<int>(kit.drums.size()); ++i) {
         const KitDrum &k = kit.drums[static_cast<size_t>(i)];
+        if (i >= scene.drum_count()) {
+            if (k.foot) // the kick: its pedal's, not in the sticks' scene
+                drums.push_back(foot_piece_json(p, k));
+            continue;
+        }
+        const DrumParams &d = scene.drum(i);
         drums.push_back({{"name", k.name},
                          {"preset", k.preset},
                          {"center_m", {d.center_m.x(), d.center_m.y(), d.center_m.z()}},
@@ -362,11 +411,13 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
     const GesturePlan &plan = *perf.plan();
     nlohmann::json j;
     j["mode"] = to_string(perf.mode());
-    j["notes"] = plan.notes.size();
+    const long all_notes = static_cast<long>(plan.notes.size() + plan.foot_notes.size());
+    j["notes"] = all_notes; // the hands' and the foot's
+    j["foot_notes"] = plan.foot_notes.size();
     j["primary_strikes"] = m.primary_strikes;
     j["bounces"] = m.bounces;
     j["matched_notes"] = m.matched_notes;
-    j["missed_notes"] = static_cast<long>(plan.notes.size()) - m.matched_notes;
+    j["missed_notes"] = all_notes - m.matched_notes;
     j["extra_strikes"] = m.extra_strikes;
     j["timing_error_ms"] = {{"mean_abs", m.mean_abs_error_ms}, {"max_abs", m.max_abs_error_ms}};
     double v_lo = 0.0, v_hi = 0.0, d_lo = 0.0, d_hi = 0.0, v_sum = 0.0, d_sum = 0.0;
@@ -595,7 +646,7 @@ void simulate(Performance &perf, const RenderArgs &r, bool score_mode, RenderRec
             std::make_unique<BvhRecorder>(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h));
         record_bvh_frame(perf, frames, *rec.bvh);
     }
-    StrikeEvent ev[2];
+    StrikeEvent ev[kStepStrikes];
     double next_progress = r.progress_every;
     for (long n = 0; n < steps; ++n) {
         if (g_interrupted) {
@@ -721,8 +772,9 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
     NoteCount count;
     if (score_mode) {
         const GesturePlan &plan = *perf.plan();
-        const MatchSummary m = match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s());
-        count.notes = static_cast<long>(plan.notes.size());
+        const MatchSummary m =
+            match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s(), plan.foot_notes);
+        count.notes = static_cast<long>(plan.notes.size() + plan.foot_notes.size());
         count.missed = count.notes - m.matched_notes;
         text.str("");
         write_notes_csv(text, plan, m, perf.plan_origin_s(), perf.options().kit);
@@ -775,10 +827,14 @@ int render_wav(RenderArgs &r, const Performance &perf)
     pd.preset = perf.options().drum_preset;
     const Kit &kit = perf.options().kit;
     pd.kit.clear();
-    for (int i = 1; i < perf.scene().drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
+    for (int i = 1; i < static_cast<int>(kit.drums.size()); ++i) {
         const KitDrum &k = kit.drums[static_cast<size_t>(i)];
-        const DrumParams &kd = perf.scene().drum(i);
-        pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, kit_drum_pan(k)});
+        if (i < perf.scene().drum_count()) {
+            const DrumParams &kd = perf.scene().drum(i);
+            pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, kit_drum_pan(k)});
+        } else if (k.foot) { // the kick: not in the sticks' scene
+            pd.kit.push_back({k.preset, k.radius_m, k.tension_n_per_m, kit_drum_pan(k), "felt"});
+        }
     }
     pd.stick_tip = d.stick_tip;
     pd.stretch_n_per_m3 = d.stretch_n_per_m3();

@@ -40,10 +40,17 @@ PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eige
         const Eigen::Vector3d anchor = drum.center_m - p0.x() * right - p0.y() * up - p0.z() * forward;
         f.rest_tip_m = performer_frame_for_drum(anchor + raise, drum.radius_m).rest_tip_m;
         for (size_t i = 0; i < kit->drums.size(); ++i) {
+            const KitDrum &k = kit->drums[i];
+            if (k.foot) { // not in the scene: its upright head's centre from the anchor
+                const Eigen::Vector3d c = anchor + k.place_m.x() * right + k.place_m.y() * up +
+                                          k.place_m.z() * forward;
+                f.drums.push_back({k.name, c, k.radius_m, false, false, true});
+                continue;
+            }
             const DrumParams &d =
                 i == 0 || !kit_drums || i - 1 >= kit_drums->size() ? drum : (*kit_drums)[i - 1];
-            f.drums.push_back({kit->drums[i].name, d.center_m + raise, d.radius_m,
-                               kit->drums[i].cymbal(), kit_drum_has_pedal(kit->drums[i])});
+            f.drums.push_back(
+                {k.name, d.center_m + raise, d.radius_m, k.cymbal(), kit_drum_has_pedal(k)});
         }
     }
     return f;

@@ -308,6 +308,8 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("return_time_s must be in (0, 10] s", o.return_time_s);
     if (!(o.min_stroke_interval_s > 0.0 && o.min_stroke_interval_s <= 10.0))
         bad("min_stroke_interval_s must be in (0, 10] s", o.min_stroke_interval_s);
+    if (!(o.min_foot_interval_s > 0.0 && o.min_foot_interval_s <= 10.0))
+        bad("min_foot_interval_s must be in (0, 10] s", o.min_foot_interval_s);
     if (!(o.max_duration_s > 0.0) || !std::isfinite(o.max_duration_s))
         bad("max_duration_s must be > 0", o.max_duration_s);
 }
@@ -430,6 +432,49 @@ double note_openness(const Score &score, const ScoreNote &n, const PerformerFram
             (hihats.empty() ? "the kit has none" : "the kit's hi-hat: " + hihats) + ")");
 }
 
+// A foot's note: its time (with the motor noise of `humanize`, as a hand's)
+// and its drum, the kit's foot piece (the first, or the one it names); a
+// ScoreError where the kit has none or it names a piece of the hands.
+PlannedFootNote foot_note(const Score &score, const ScoreNote &n, size_t k,
+                          const PerformerFrame &frame, const PlanOptions &opt)
+{
+    PlannedFootNote f;
+    f.time_s = opt.lead_in_s + score.note_time_s(n);
+    f.dynamics = n.dynamics;
+    f.line = n.line;
+    f.column = n.column;
+    const double amount = humanize_amount(score, opt);
+    if (amount > 0.0) {
+        MotorNoise noise(opt.seed, k + 1);
+        f.time_s += amount * kHumanizeTimingSd_s * noise.normal();
+        f.dynamics =
+            std::clamp(n.dynamics * (1.0 + amount * kHumanizeForceCv * noise.normal()), 0.0, 1.0);
+    }
+    std::string feet;
+    for (size_t i = 0; i < frame.drums.size(); ++i)
+        if (frame.drums[i].foot)
+            feet += (feet.empty() ? "" : ", ") + frame.drums[i].name;
+    if (n.drum.empty()) {
+        for (size_t i = 0; i < frame.drums.size(); ++i)
+            if (frame.drums[i].foot) {
+                f.drum = static_cast<int>(i);
+                return f;
+            }
+        throw ScoreError(score.source, n.line, n.column,
+                         "the right foot plays a kick's pedal, and " +
+                             std::string(frame.drums.empty() ? "there is no kit"
+                                                             : "this kit has no kick") +
+                             " (--kit full has one: docs/kit.md)");
+    }
+    f.drum = drum_index(score, n, frame);
+    if (!frame.drums[static_cast<size_t>(f.drum)].foot)
+        throw ScoreError(score.source, n.drum_line, n.drum_column,
+                         "drum '" + n.drum + "' is the hands'; the right foot plays " +
+                             (feet.empty() ? std::string("a kick's pedal, and this kit has none")
+                                           : feet));
+    return f;
+}
+
 // The notes, timed by the tempo map, into plan.notes (score order); a score that
 // asks a hand to play faster than one hand plays is a ScoreError. The timing noise
 // of `humanize` never does: it is clipped where it would bring a stroke closer
@@ -440,8 +485,30 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
     HandNotes by_hand;
     const double amount = humanize_amount(score, opt);
     std::array<double, 2> score_time_prev = {0.0, 0.0}; // each hand's last note, without noise
+    double foot_written_prev = 0.0;                     // the foot's, likewise
     for (size_t k = 0; k < score.notes.size(); ++k) {
         const ScoreNote &n = score.notes[k];
+        if (n.foot) {
+            // As a hand's: a kick closer to the last than the pedal plays is
+            // refused; the noise of `humanize` never brings it closer.
+            PlannedFootNote f = foot_note(score, n, k, frame, opt);
+            const double written = opt.lead_in_s + score.note_time_s(n);
+            if (!plan.foot_notes.empty()) {
+                const PlannedFootNote &prev = plan.foot_notes.back();
+                if (written - foot_written_prev < opt.min_foot_interval_s - 1e-9) {
+                    std::ostringstream m;
+                    m << "this kick comes " << (written - foot_written_prev) * 1000.0
+                      << " ms after the previous one (line " << prev.line
+                      << "), faster than the right foot plays its pedal (minimum "
+                      << opt.min_foot_interval_s * 1000.0 << " ms)";
+                    throw ScoreError(score.source, n.line, n.column, m.str());
+                }
+                f.time_s = std::max(f.time_s, prev.time_s + opt.min_foot_interval_s);
+            }
+            foot_written_prev = written;
+            plan.foot_notes.push_back(f);
+            continue;
+        }
         PlannedNote p;
         const double score_time = opt.lead_in_s + score.note_time_s(n);
         p.time_s = score_time;
@@ -462,6 +529,11 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         p.theta_deg = n.theta_deg;
         p.firmness = n.firmness;
         p.drum = drum_index(score, n, frame);
+        if (p.drum < static_cast<int>(frame.drums.size()) &&
+            frame.drums[static_cast<size_t>(p.drum)].foot)
+            throw ScoreError(score.source, n.drum_line, n.drum_column,
+                             "drum '" + frame.drums[static_cast<size_t>(p.drum)].name +
+                                 "' is played by the right foot on its pedal: write 'RF'");
         p.openness = note_openness(score, n, frame, p.drum);
         if (!n.spot_given && p.drum < static_cast<int>(frame.drums.size()) &&
             frame.drums[static_cast<size_t>(p.drum)].cymbal) {
@@ -645,7 +717,7 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
         double short_m = 0.0;
         for (size_t k = 0; k < frame.drums.size(); ++k) {
             const PerformerFrame::Drum &d = frame.drums[k];
-            if (cymbals_only && !d.cymbal)
+            if ((cymbals_only && !d.cymbal) || d.foot)
                 continue;
             const Eigen::Vector3d rel = p - d.membrane_center_m;
             const double height = rel.dot(frame.up);
@@ -869,6 +941,9 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
     std::stable_sort(
         plan.notes.begin(), plan.notes.end(),
         [](const PlannedNote &a, const PlannedNote &b) { return a.time_s < b.time_s; });
+    std::stable_sort(
+        plan.foot_notes.begin(), plan.foot_notes.end(),
+        [](const PlannedFootNote &a, const PlannedFootNote &b) { return a.time_s < b.time_s; });
     return plan;
 }
 
