@@ -195,8 +195,14 @@ TEST_CASE("kick pedal: the contact against RK4 of the felt law in series with a 
     for (double v : speeds) {
         const PedalStrike s = throw_at_head(pedal, v);
         REQUIRE(s.speed_mps > 0.0);
-        // The speed at onset: v less the spring's deceleration over 1 mrad of flight.
-        CHECK(s.speed_mps == Approx(v).epsilon(0.01));
+        // The speed at onset: v less the spring's work over the last 1 mrad of flight,
+        // (1/2) I (w0^2 - w^2) = preload dphi + k (phi_h^2 - (phi_h - dphi)^2) / 2; the axle's
+        // damping changes it by c dphi / (2 I w0) < 1e-4.
+        const double ph = p.phi_head_rad, dphi = 1e-3, w0 = v / p.beater_length_m;
+        const double work = p.spring_preload_n_m * dphi + 0.5 * p.spring_stiffness_n_m_per_rad *
+                                                              (ph * ph - (ph - dphi) * (ph - dphi));
+        const double w_on = std::sqrt(w0 * w0 - 2.0 * work / inertia_of(p));
+        CHECK(s.speed_mps == Approx(w_on * p.beater_length_m).epsilon(1e-4));
         CHECK(s.bounce); // no push: a contact without a push is no note
         const Contact ref = reference_contact(p, s.speed_mps);
         INFO("v " << v << " m/s: duration " << s.duration_ms << " ms (RK4 " << ref.duration_ms

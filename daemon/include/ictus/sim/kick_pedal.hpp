@@ -87,7 +87,8 @@ class KickPedal
     /// The beater's inertia about the axle (kg m^2).
     double inertia_kg_m2() const { return inertia_; }
     /// Puts the beater at phi (in [0, phi_head]) with angular velocity omega; pending
-    /// pushes are kept. SimError for values out of range or non-finite.
+    /// pushes are kept but were planned for the old state (notes may miss their marks).
+    /// SimError for values out of range or non-finite.
     void set_beater(double phi_rad, double omega_rad_s);
     /// The contact force (N) at the felt's depth d (m, > 0 into the head) and its rate (m/s).
     double contact_force_n(double depth_m, double depth_rate_mps) const;
@@ -105,9 +106,7 @@ class KickPedal
         long long n = 0; // substeps taken from t = 0
         double phi = 0.0, omega = 0.0;
         bool in_contact = false;
-        PedalStrike cur;           // the contact episode being measured
-        std::size_t next_push = 0; // pushes_[0, next_push) have t0 <= the current substep
-        bool push_since_strike = true;
+        PedalStrike cur; // the contact episode being measured
     };
     struct FootState {
         double pos, vel, acc;
@@ -142,7 +141,6 @@ class KickPedal
     // cannot change what happens before it), so planning starts there, not at time_s().
     bool anchor_valid_ = false;
     State anchor_;
-    double anchor_t_ = 0.0;
 };
 
 } // namespace ictus
