@@ -12,10 +12,10 @@ real `ictusd render --wav`:
    higher velocity at least as fast as every kick of a lower one, the pedal's speed law);
    performance.mid has a note 36 per kick strike; render.json lists the kick, played by the
    right foot; pd.log has no error line. The hands' notes are reported.
-2. A score of kicks alone (`RF`, seeded dynamics): every strike's fundamental, the lowest
-   spectral peak 5..65 ms after it, is the kick head's (0,1) mode j01 / (2 pi a) sqrt(T / sigma)
-   from render.json's head (-3 % .. +8 %: above only by the tension modulation's glide) and
-   below 100 Hz.
+2. A score of kicks alone (`RF` pp .. ff, seeded order): every strike's fundamental, the
+   lowest spectral peak 5..65 ms after it, is below 100 Hz; the softest one's is the kick
+   head's (0,1) mode j01 / (2 pi a) sqrt(T / sigma) from render.json's head (3 %); it never
+   falls as the kicks get faster (the tension modulation raises it, docs/sound.md).
 
     PYTHONPATH=python python3 tests/perform/test_kick_pedal.py --ictusd build/ictusd
 """
@@ -137,7 +137,7 @@ def main():
           "kicks" % (len(foot_primary), len(kicks)))
     check(all(s["drum"] == KICK for s in strikes if s["hand"] == FOOT),
           "the foot strikes the kick only")
-    check(all(s["hand"] != FOOT for s in strikes if s["drum"] == KICK),
+    check(all(s["hand"] == FOOT for s in strikes if s["drum"] == KICK),
           "no hand strikes the kick")
     times = [s["time_s"] for s in strikes]
     check(all(b >= a for a, b in zip(times, times[1:])),
@@ -160,11 +160,12 @@ def main():
     print("hands: %d notes, %d missed, worst timing error %.2f ms"
           % (len(hands), len(missed), max(herr) if herr else float("nan")))
 
-    # 2. Kicks alone: the kick's fundamental.
+    # 2. Kicks alone, pp to ff (seeded order): the kick's fundamental.
     dyn = ["pp", "p", "mp", "mf", "f", "ff"]
+    rng.shuffle(dyn)
     score = os.path.join(args.workdir, "kicks.txt")
     with open(score, "w") as f:
-        f.write("tempo 60\n" + "\n".join("RF %s" % rng.choice(dyn) for _ in range(5)) + "\n")
+        f.write("tempo 60\n" + "\n".join("RF %s" % d for d in dyn) + "\n")
     out, wav = render(args.ictusd, args.workdir, "kicks", ["--score", score])
     with open(os.path.join(out, "render.json")) as f:
         head = json.load(f)["kit"]["drums"][KICK]
@@ -173,12 +174,19 @@ def main():
     rate, x = e2e_util.read_wav_mono(wav)
     strikes = [s for s in e2e_util.read_strikes(os.path.join(out, "strikes.csv"))
                if s["bounce"] == 0]
-    check(len(strikes) == 5, "five kicks struck: %d" % len(strikes))
-    for s in strikes:
-        f0 = lowest_peak_hz(x, rate, int(round(s["time_s"] * rate)))
-        check(f0 < 100.0 and 0.97 * want <= f0 <= 1.08 * want,
-              "kick at %.3f s, %.2f m/s: fundamental %.1f Hz, the head's (0,1) %.1f Hz, below "
-              "100 Hz" % (s["time_s"], s["normal_velocity_mps"], f0, want))
+    check(len(strikes) == len(dyn), "every kick struck: %d of %d" % (len(strikes), len(dyn)))
+    found = sorted((s["normal_velocity_mps"], lowest_peak_hz(x, rate, int(round(s["time_s"] * rate))))
+                   for s in strikes)
+    print("kicks: speed m/s -> fundamental Hz: %s (the head's (0,1): %.2f Hz)"
+          % (["%.2f: %.1f" % p for p in found], want))
+    check(all(f0 < 100.0 for _, f0 in found), "every kick's fundamental below 100 Hz")
+    # The softest is the linear head's (0,1) (the 60 ms window resolves it to about 3 %); the
+    # tension modulation only raises it with the strike (docs/sound.md): never lower as the
+    # kicks get faster (1 %: the window's peak estimate).
+    check(abs(found[0][1] / want - 1.0) <= 0.03,
+          "the softest kick's fundamental %.1f Hz is the (0,1) %.1f Hz (3 %%)" % (found[0][1], want))
+    check(all(b[1] >= a[1] * 0.99 for a, b in zip(found, found[1:])),
+          "the fundamental rises (or holds) with the kick's speed: %s" % found)
     return 0
 
 

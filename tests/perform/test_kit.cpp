@@ -112,8 +112,10 @@ TEST_CASE("kit: full is standard-cymbals and a 22-inch kick for the right foot, 
     CHECK(kit_hand_pieces(full) == static_cast<int>(cymbals.drums.size()));
     CHECK(kit_foot_piece(full) == static_cast<int>(full.drums.size()) - 1);
     CHECK(kit_foot_piece(cymbals) == -1);
-    // Its centre half its diameter above a floor 0.65 m under the snare's head.
-    CHECK(kick.place_m.y() + 0.65 == Approx(kick.radius_m).margin(0.01));
+    // Its centre half its diameter above the floor, before the right foot.
+    CHECK(kick.place_m.y() == Approx(kick.radius_m));
+    CHECK(kick.place_m.x() == 0.0);
+    CHECK((kick.place_m.z() > 0.2 && kick.place_m.z() < 0.35)); // a pedal's footboard ahead
     // Placed: the scene has the hands' pieces only, at the same places as
     // standard-cymbals'.
     const std::vector<DrumParams> placed = place_kit(full, DrumParams(), Eigen::Vector3d::Zero(),

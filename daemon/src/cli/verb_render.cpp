@@ -11,6 +11,7 @@
 #include "ictus/cli/pd_render.hpp"
 #include "ictus/cli/verbs.hpp"
 #include "ictus/perform/strike_log.hpp"
+#include "ictus/sim/kick_pedal.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -831,7 +832,7 @@ int render_wav(RenderArgs &r, const Performance &perf)
         const KitDrum &k = kit.drums[static_cast<size_t>(i)];
         if (i < perf.scene().drum_count()) {
             const DrumParams &kd = perf.scene().drum(i);
-            pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, kit_drum_pan(k)});
+            pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, kit_drum_pan(k), ""});
         } else if (k.foot) { // the kick: not in the sticks' scene
             pd.kit.push_back({k.preset, k.radius_m, k.tension_n_per_m, kit_drum_pan(k), "felt"});
         }

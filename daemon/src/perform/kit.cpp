@@ -70,14 +70,15 @@ std::vector<KitDrum> cymbals()
             drum("hihat", "hihat", 14.0, kDisc_in, {-0.42, 0.26, -0.02}, 42)};
 }
 
-// The kick of "full": a 22x18 bass drum on the floor, right of the snare
-// (the right foot's pedal before it), its batter upright facing the
-// performer, its centre half its diameter (0.28 m) above the floor: 0.37 m
-// below the snare's head, which stands 0.65 m above the floor (docs/kit.md),
-// and 0.10 m forward of the snare's centre. General MIDI's Bass Drum 1 (36).
+// The kick of "full": a 22x18 bass drum on the floor before the right foot,
+// its batter upright facing the performer, its centre half its diameter
+// (0.28 m) above the floor, the batter 0.27 m ahead of the right ankle: the
+// pedal's footboard (about 0.28 m, heel plate to axle) under the foot, its
+// heel behind the ankle. A foot piece's place is from the right ankle over
+// the floor (docs/kit.md, "The kick"). General MIDI's Bass Drum 1 (36).
 KitDrum kick()
 {
-    KitDrum d = drum("kick", "kick", 22.0, 18.0, {0.18, -0.37, 0.10}, 36);
+    KitDrum d = drum("kick", "kick", 22.0, 18.0, {0.0, 11.0 * kInch_m, 0.27}, 36);
     d.foot = true;
     return d;
 }

@@ -111,7 +111,7 @@ void ScoreMode::install_rig(std::unique_ptr<ScoreRig> rig, bool keep_pose)
     // The live drum and gains win over those the rig was built with.
     o.scene.drum.center_m = r.drum_center_m;
     r.frame = frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right,
-                        r.frame.forward, &o.kit, &r.kit_drums);
+                        r.frame.forward, &o.kit, &r.kit_drums, r.right_sole_m);
     r.tracker->set_mode(mode);
     if (!keep_pose)
         rest_from_m_ = r.frame.rest_tip_m;
@@ -393,6 +393,8 @@ int ScoreMode::step(StrikeEvent out[kStepStrikes])
     else
         follow_rest(r.tips);
     r.trunk_synergy();
+    if (foot_)
+        r.foot_on_pedal(foot_->pedal().footboard_angle_rad());
     r.tracker->step(r.step_body, &r.tips, true);
     const long first_seq = perf_.detector_.strikes();
     int n = detect_strikes(perf_.detector_, r.tracker->scene(), out, perf_.time_offset_s_);
@@ -486,7 +488,7 @@ bool ScoreMode::drum_changed(const Command &c, std::string *why)
     const PerformanceOptions &o = perf_.options_;
     ScoreRig &r = *rig_;
     r.frame = frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right,
-                        r.frame.forward, &o.kit, &r.kit_drums);
+                        r.frame.forward, &o.kit, &r.kit_drums, r.right_sole_m);
     if (plan_active_ || perf_.work_pending())
         return perf_.submit(plan_job(c, Work::Kind::replan), why);
     return true;

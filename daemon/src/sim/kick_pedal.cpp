@@ -166,6 +166,23 @@ void KickPedal::record(const PedalStrike &s)
     ring_[slot] = s;
 }
 
+bool KickPedal::take_onset(PedalStrike &out)
+{
+    if (onset_count_ == 0)
+        return false;
+    out = onsets_[onset_head_];
+    onset_head_ = (onset_head_ + 1) % onsets_.size();
+    --onset_count_;
+    return true;
+}
+
+void KickPedal::cancel_pending(double t_s)
+{
+    while (!pushes_.empty() && pushes_.back().t0 > t_s)
+        pushes_.pop_back();
+    anchor_valid_ = false;
+}
+
 bool KickPedal::take_strike(PedalStrike &out)
 {
     if (ring_count_ == 0)
@@ -226,6 +243,14 @@ void KickPedal::step()
             }
         }
         s_.in_contact = true;
+        PedalStrike on = cur;
+        on.peak_force_n = on.impulse_n_s = on.duration_ms = 0.0;
+        const std::size_t slot = (onset_head_ + onset_count_) % onsets_.size();
+        if (onset_count_ == onsets_.size())
+            onset_head_ = (onset_head_ + 1) % onsets_.size(); // full: the oldest is dropped
+        else
+            ++onset_count_;
+        onsets_[slot] = on;
     } else if (s_.in_contact) {
         if (phi_free <= ph) {
             const double frac = std::clamp((phi - ph) / (phi - phi_free), 0.0, 1.0);
@@ -421,6 +446,14 @@ double KickPedal::schedule(double t_imp, double v)
         throw SimError("kick pedal: schedule impact_time_s (" + std::to_string(t_imp) +
                        " s) must be after the pending note at " + std::to_string(last) + " s");
     const double vc = std::clamp(v, p_.min_speed_mps, p_.max_speed_mps);
+    // The pushes the foot finished over a second ago go (all but the latest): the list
+    // stays short over a long performance, within its reserve.
+    std::size_t done = 0;
+    while (done + 1 < pushes_.size() &&
+           pushes_[done].t0 + 2.0 * pushes_[done].rise_s + pushes_[done].stop_s < t_ - 1.0 &&
+           pushes_[done + 1].t0 < t_ - 1.0)
+        ++done;
+    pushes_.erase(pushes_.begin(), pushes_.begin() + static_cast<long>(done));
 
     // Where planning starts: the state at the last planned first contact, or now if later.
     KickPedal base = *this;

@@ -32,9 +32,10 @@ struct KitDrum {
     double bending_n_m = 0.0;
     bool cymbal() const { return bending_n_m > 0.0; }
     // Played by the right foot on a pedal (the kick, docs/pedal.md): its head
-    // stands upright facing the performer, place_m is the head's centre, and
-    // it is not in the sticks' scene (the sticks play above it). A kit's foot
-    // pieces come after every piece the hands play.
+    // stands upright facing the performer, place_m is the head's centre from
+    // the right ankle over the floor (not from the anchor), and it is not in
+    // the sticks' scene (the sticks play above it). A kit's foot pieces come
+    // after every piece the hands play.
     bool foot = false;
 };
 

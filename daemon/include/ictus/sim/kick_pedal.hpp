@@ -74,6 +74,13 @@ class KickPedal
     void advance_to(double t_s);
     /// The oldest strike whose contact ended; false when there is none.
     bool take_strike(PedalStrike &out);
+    /// The oldest contact begun (its onset fields: time, speed, effective mass, bounce; the
+    /// rest 0), each once, before take_strike() has it; false when there is none.
+    bool take_onset(PedalStrike &out);
+    /// Drops the pushes not begun by t_s (a performance that stops): the foot stays up.
+    void cancel_pending(double t_s);
+    /// The beater's effective mass at the felt, I / L^2 (kg).
+    double effective_mass_kg() const { return inertia_ / (p_.beater_length_m * p_.beater_length_m); }
 
     double time_s() const { return t_; }
     double beater_angle_rad() const { return s_.phi; }
@@ -137,6 +144,9 @@ class KickPedal
     static constexpr std::size_t kRing = 256;
     std::array<PedalStrike, kRing> ring_{};
     std::size_t ring_head_ = 0, ring_count_ = 0;
+    // The onsets not yet taken (a ring of the same kind).
+    std::array<PedalStrike, 8> onsets_{};
+    std::size_t onset_head_ = 0, onset_count_ = 0;
     // The planner's anchor: the state at the last planned first contact (pushes after it
     // cannot change what happens before it), so planning starts there, not at time_s().
     bool anchor_valid_ = false;
