@@ -338,9 +338,9 @@ TEST_CASE("plan: the right foot's notes are the kick's, timed as the hands', nev
                                 "R + L + RF 1/4\nRF pp",
                                 "t");
     const GesturePlan plan = plan_performance(s, db(), f);
-    // Beats 0, 0.5, 2.5, 3.5 and 4.5 at 100 bpm after the lead-in.
+    // Beats 0, 0.5, 2, 3 and 3.25 at 100 bpm after the lead-in.
     REQUIRE(plan.foot_notes.size() == 5);
-    const double beats[5] = {0.0, 0.5, 2.5, 3.5, 4.5}; // a chord lasts its longest note
+    const double beats[5] = {0.0, 0.5, 2.0, 3.0, 3.25}; // a chord: its longest written note
     const double dyn[5] = {1.0, 0.3, 0.6, 0.6, 0.2}; // ff, p, the default mf, mf, pp
     for (size_t i = 0; i < 5; ++i) {
         INFO(i);

@@ -128,25 +128,32 @@ TEST_CASE("score: R+L strikes both hands on one beat", "[score][parser]")
 TEST_CASE("score: '+' joins a note of each hand on one beat, each with its options",
           "[score][parser]")
 {
-    // Beats: 0 (1/2 and 1: the chord lasts 1), 1 (1/2 and 1 again), 2.
-    const Score s = parse_score("R accent 1/2 at 0.2 170 + L ff\nL 1/2 + R\nR", "chord");
-    REQUIRE(s.notes.size() == 5);
+    // Beats: 0 (1/2 written, the other none: the chord lasts 1/2), 0.5 (the same), 1
+    // (1/4 and 3/4 written: the longest, 3/4), 1.75 (none written: the default, 1), 2.75.
+    const Score s = parse_score("R accent 1/2 at 0.2 170 + L ff\nL 1/2 + R\nR 1/4 + L 3/4\n"
+                                "R + L\nR",
+                                "chord");
+    REQUIRE(s.notes.size() == 9);
     CHECK((s.notes[0].hand == Side::right && s.notes[1].hand == Side::left));
     for (int i : {0, 1})
         CHECK(s.notes[i].beat == 0.0);
     CHECK(s.notes[0].beats == 0.5);
-    CHECK(s.notes[1].beats == 1.0);
+    CHECK(s.notes[1].beats == 0.5); // none written: the chord's
+    CHECK((s.notes[4].beat == 1.0 && s.notes[5].beat == 1.0));
+    CHECK((s.notes[4].beats == 0.25 && s.notes[5].beats == 0.75));
+    CHECK((s.notes[6].beat == 1.75 && s.notes[7].beat == 1.75 && s.notes[6].beats == 1.0));
     CHECK(s.notes[0].nuance == Nuance::accent);
     CHECK(s.notes[1].nuance == Nuance::legato);
     CHECK(s.notes[0].dynamics == 0.6);
     CHECK(s.notes[1].dynamics == 1.0);
     CHECK((s.notes[0].r_over_a == 0.2 && s.notes[0].theta_deg == 170.0));
     CHECK((s.notes[1].r_over_a == 0.3 && s.notes[1].theta_deg == 0.0));
-    CHECK((s.notes[2].beat == 1.0 && s.notes[3].beat == 1.0));
-    CHECK(s.notes[4].beat == 2.0);
-    CHECK(s.length_beats == 3.0);
+    CHECK((s.notes[2].beat == 0.5 && s.notes[3].beat == 0.5));
+    CHECK(s.notes[8].beat == 2.75);
+    CHECK(s.length_beats == 3.75);
     // The same in a Pd message box (statements between commas).
-    const Score m = parse_score("R accent 1/2 at 0.2 170 + L ff, L 1/2 + R, R", "box");
+    const Score m =
+        parse_score("R accent 1/2 at 0.2 170 + L ff, L 1/2 + R, R 1/4 + L 3/4, R + L, R", "box");
     REQUIRE(m.notes.size() == s.notes.size());
     for (size_t i = 0; i < m.notes.size(); ++i)
         CHECK((m.notes[i].beat == s.notes[i].beat && m.notes[i].hand == s.notes[i].hand));

@@ -410,6 +410,64 @@ TEST_CASE("kick pedal: bad input is refused by name", "[kick_pedal]")
 
 // The numbers docs/pedal.md quotes: contact durations and peaks on the `kick` head, and the
 // tightest gap at which a second note lands (0.5 ms, 2 %) after a first of the same speed.
+TEST_CASE("kick pedal: onsets once each, before their strikes, and pushes dropped by "
+          "cancel_pending",
+          "[kick_pedal]")
+{
+    // Notes of one speed 0.5 s apart (the beater back on its stop between them: the push found
+    // for the first is reused, shifted), seeded speeds per run.
+    std::mt19937 rng(7);
+    for (int run = 0; run < 3; ++run) {
+        KickPedal pedal;
+        const double v = std::uniform_real_distribution<double>(1.0, 6.0)(rng);
+        std::vector<double> times;
+        for (int k = 0; k < 6; ++k)
+            times.push_back(0.3 + 0.5 * k);
+        std::vector<PedalStrike> onsets, strikes;
+        size_t next = 0;
+        for (double t = 0.0; t < 3.6; t += 0.001) {
+            while (next < times.size() && times[next] <= t + 0.5)
+                pedal.schedule(times[next++], v);
+            pedal.advance_to(t);
+            PedalStrike s;
+            while (pedal.take_onset(s)) {
+                // Its onset is taken before its strike ends.
+                CHECK(s.duration_ms == 0.0);
+                onsets.push_back(s);
+            }
+            while (pedal.take_strike(s))
+                strikes.push_back(s);
+        }
+        std::vector<PedalStrike> primary;
+        for (const PedalStrike &s : strikes)
+            if (!s.bounce)
+                primary.push_back(s);
+        REQUIRE(primary.size() == times.size());
+        REQUIRE(onsets.size() == strikes.size());
+        for (size_t k = 0; k < times.size(); ++k) {
+            INFO("run " << run << " note " << k << " speed " << v);
+            CHECK(std::fabs(primary[k].time_s - times[k]) <= 0.5e-3);
+            CHECK(std::fabs(primary[k].speed_mps - v) <= 0.02 * v);
+        }
+        for (size_t k = 0; k < strikes.size(); ++k) {
+            CHECK(onsets[k].time_s == strikes[k].time_s);
+            CHECK(onsets[k].speed_mps == strikes[k].speed_mps);
+            CHECK(onsets[k].bounce == strikes[k].bounce);
+        }
+    }
+    // A note scheduled, then dropped before its push begins: no strike, the foot stays up.
+    KickPedal pedal;
+    pedal.schedule(1.0, 3.0);
+    pedal.advance_to(0.5);
+    pedal.cancel_pending(0.5);
+    pedal.advance_to(2.0);
+    PedalStrike s;
+    CHECK_FALSE(pedal.take_onset(s));
+    CHECK_FALSE(pedal.take_strike(s));
+    CHECK(pedal.footboard_angle_rad() == 0.0);
+    CHECK(pedal.beater_angle_rad() == 0.0);
+}
+
 TEST_CASE("kick pedal: numbers for the doc", "[.kick_pedal_numbers]")
 {
     KickPedal pedal;

@@ -432,6 +432,49 @@ KickPedal::Plan KickPedal::plan_rise(const KickPedal &base, double t_lo, double 
     return best;
 }
 
+bool KickPedal::at_rest(double t) const
+{
+    const FootState f = foot_at(t, pushes_.size());
+    return s_.phi == 0.0 && s_.omega == 0.0 && !s_.in_contact && f.pos == 0.0 && f.vel == 0.0 &&
+           f.acc == 0.0;
+}
+
+bool KickPedal::plan_from_rest(const KickPedal &base, double t_lo, double t_imp, double v,
+                               Plan &out)
+{
+    const RestPlan *c = nullptr;
+    for (const RestPlan &r : rest_plans_)
+        if (r.valid && r.speed == v)
+            c = &r;
+    if (!c)
+        return false;
+    const double h = p_.substep_s;
+    double t0 = t_imp - c->lead_s;
+    for (int it = 0; it < 2 && t0 >= t_lo; ++it) {
+        KickPedal pre = base;
+        while (static_cast<double>(pre.s_.n + 1) * h <= t0)
+            pre.step();
+        if (!pre.at_rest(t0))
+            return false;
+        Push q = c->push;
+        q.t0 = t0;
+        q.impact_time_s = t_imp;
+        pre.pushes_.push_back(q);
+        Plan e;
+        e.onset = pre.onset_first_contact(t0 + 2.0 * q.rise_s + q.stop_s + 0.3, e.speed, nullptr);
+        if (e.onset < 0.0)
+            return false;
+        if (std::fabs(e.onset - t_imp) <= 2e-5 && std::fabs(e.speed - v) <= 2e-3 * v) {
+            e.found = true;
+            e.push = q;
+            out = e;
+            return true;
+        }
+        t0 += t_imp - e.onset; // the substep grid's phase: once more, shifted
+    }
+    return false;
+}
+
 double KickPedal::schedule(double t_imp, double v)
 {
     if (!std::isfinite(t_imp))
@@ -476,7 +519,8 @@ double KickPedal::schedule(double t_imp, double v)
     rises.push_back(p_.stroke_max_s);
     Plan best;
     double best_cost = 1e300;
-    for (double rise : rises) {
+    const bool cached = plan_from_rest(base, t_lo, t_imp, vc, best);
+    for (double rise : cached ? std::vector<double>{} : rises) {
         Plan pl = plan_rise(base, t_lo, t_imp, vc, rise);
         if (!pl.found)
             continue;
@@ -503,6 +547,15 @@ double KickPedal::schedule(double t_imp, double v)
     KickPedal pre = base;
     while (static_cast<double>(pre.s_.n + 1) * p_.substep_s <= best.push.t0)
         pre.step();
+    if (!cached && pre.at_rest(best.push.t0) &&
+        std::fabs(best.onset - t_imp) <= 2e-5 && std::fabs(best.speed - vc) <= 2e-3 * vc) {
+        RestPlan &r = rest_plans_[rest_next_];
+        rest_next_ = (rest_next_ + 1) % rest_plans_.size();
+        r.valid = true;
+        r.speed = vc;
+        r.lead_s = t_imp - best.push.t0;
+        r.push = best.push;
+    }
     pre.pushes_.push_back(best.push);
     double speed = 0.0;
     State at;

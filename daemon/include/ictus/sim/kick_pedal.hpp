@@ -125,6 +125,18 @@ class KickPedal
         double speed = 0.0, onset = -1.0;
     };
 
+    // A push found from rest (the beater on its stop, the foot up, no contact): the same
+    // push, shifted in time, plays the same speed from rest at any time (up to the substep
+    // grid), so schedule() tries it first for that speed.
+    struct RestPlan {
+        bool valid = false;
+        double speed = 0.0;     // the speed asked (clamped)
+        double lead_s = 0.0;    // impact time - the push's start
+        Push push;              // its shape (t0 and impact time are set when used)
+    };
+    bool at_rest(double t) const;
+    bool plan_from_rest(const KickPedal &base, double t_lo, double t_imp, double v, Plan &out);
+
     FootState foot_at(double t, std::size_t upto) const;
     void step();
     void record(const PedalStrike &s);
@@ -144,6 +156,8 @@ class KickPedal
     static constexpr std::size_t kRing = 256;
     std::array<PedalStrike, kRing> ring_{};
     std::size_t ring_head_ = 0, ring_count_ = 0;
+    std::array<RestPlan, 16> rest_plans_{};
+    std::size_t rest_next_ = 0; // the slot the next one takes (round robin)
     // The onsets not yet taken (a ring of the same kind).
     std::array<PedalStrike, 8> onsets_{};
     std::size_t onset_head_ = 0, onset_count_ = 0;
