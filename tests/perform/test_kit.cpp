@@ -118,13 +118,12 @@ TEST_CASE("kit: full is standard-cymbals and a 22-inch kick for the right foot, 
     CHECK((kick.place_m.z() > 0.2 && kick.place_m.z() < 0.35)); // a pedal's footboard ahead
     // Placed: the scene has the hands' pieces only, at the same places as
     // standard-cymbals'.
-    const std::vector<DrumParams> placed = place_kit(full, DrumParams(), Eigen::Vector3d::Zero(),
-                                                     -Eigen::Vector3d::UnitX(),
-                                                     Eigen::Vector3d::UnitY(),
-                                                     Eigen::Vector3d::UnitZ());
-    const std::vector<DrumParams> placed_c = place_kit(
-        cymbals, DrumParams(), Eigen::Vector3d::Zero(), -Eigen::Vector3d::UnitX(),
-        Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ());
+    const std::vector<DrumParams> placed =
+        place_kit(full, DrumParams(), Eigen::Vector3d::Zero(), -Eigen::Vector3d::UnitX(),
+                  Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ());
+    const std::vector<DrumParams> placed_c =
+        place_kit(cymbals, DrumParams(), Eigen::Vector3d::Zero(), -Eigen::Vector3d::UnitX(),
+                  Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ());
     REQUIRE(placed.size() == placed_c.size());
     for (size_t i = 0; i < placed.size(); ++i)
         CHECK((placed[i].center_m - placed_c[i].center_m).norm() == 0.0);

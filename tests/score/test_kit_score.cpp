@@ -333,7 +333,8 @@ TEST_CASE("plan: the right foot's notes are the kick's, timed as the hands', nev
     PerformerFrame f = kit_frame();
     const Eigen::Vector3d c = f.drums[0].membrane_center_m;
     // A 22-inch kick right of the snare, its upright head below the toms (a foot's piece).
-    f.drums.push_back({"kick", c + Eigen::Vector3d(-0.18, -0.37, 0.10), 0.2794, false, false, true});
+    f.drums.push_back(
+        {"kick", c + Eigen::Vector3d(-0.18, -0.37, 0.10), 0.2794, false, false, true});
     const Score s = parse_score("tempo 100\nRF ff 1/2\nR + RF p 1/2\nL on tom1\nRF on kick mf\n"
                                 "R + L + RF 1/4\nRF pp",
                                 "t");
@@ -341,7 +342,7 @@ TEST_CASE("plan: the right foot's notes are the kick's, timed as the hands', nev
     // Beats 0, 0.5, 2, 3 and 3.25 at 100 bpm after the lead-in.
     REQUIRE(plan.foot_notes.size() == 5);
     const double beats[5] = {0.0, 0.5, 2.0, 3.0, 3.25}; // a chord: its longest written note
-    const double dyn[5] = {1.0, 0.3, 0.6, 0.6, 0.2}; // ff, p, the default mf, mf, pp
+    const double dyn[5] = {1.0, 0.3, 0.6, 0.6, 0.2};    // ff, p, the default mf, mf, pp
     for (size_t i = 0; i < 5; ++i) {
         INFO(i);
         CHECK(plan.foot_notes[i].time_s ==

@@ -231,12 +231,11 @@ TEST_CASE("midi in: General MIDI's bass drums 35 and 36 on a kit's kick, the rig
     // (faster than the pedal: left out, counted), one 12 ticks after that
     // (115 ms after the last one played), then a snare.
     std::string t = bytes({0x00, 0x99, 36, 127, 0x00, 0x99, 38, 100, 0x60, 0x99, 35, 64,
-                           0x0a, 0x99, 36, 90, 0x0c, 0x99, 36, 90, 0x60, 0x99, 38, 100});
+                           0x0a, 0x99, 36, 90,  0x0c, 0x99, 36, 90,  0x60, 0x99, 38, 100});
     t += kEnd;
     const Smf smf = read_smf(header(0, 1) + chunk("MTrk", t), "t.mid");
-    const std::vector<MidiDrum> kit = {{"snare", 38}, {"tom1", 48}, {"tom2", 47},
-                                       {"floor", 43}, {"crash", 49}, {"ride", 51},
-                                       {"hihat", 42}, {"kick", 36}};
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"tom1", 48}, {"tom2", 47},  {"floor", 43},
+                                       {"crash", 49}, {"ride", 51}, {"hihat", 42}, {"kick", 36}};
     const MidiDrumPart part = drum_part_score(smf, kit, "t.mid");
     REQUIRE(part.score.notes.size() == 5);
     std::vector<const ScoreNote *> feet, hands;

@@ -169,8 +169,8 @@ TEST_CASE("score: '+' joins a note of each hand on one beat, each with its optio
 
 TEST_CASE("score: RF is the right foot's note on the kick, alone or in a chord", "[score][parser]")
 {
-    const Score s = parse_score("drum snare\nRF ff 1/2\nR on hihat + L + RF p\nRF on kick\nR\n",
-                                "feet");
+    const Score s =
+        parse_score("drum snare\nRF ff 1/2\nR on hihat + L + RF p\nRF on kick\nR\n", "feet");
     REQUIRE(s.notes.size() == 6);
     // A foot's note: the right side, the foot, and no drum but its own `on`
     // (the hands' current drum is not the kick's).

@@ -66,7 +66,7 @@ class FootPlayer
     std::vector<PlannedFootNote> notes_; // the plan's, in time order
     size_t next_ = 0;                    // the first not scheduled
     double origin_s_ = 0.0;
-    double last_scheduled_s_ = -1e9;     // the latest impact scheduled (performance clock)
+    double last_scheduled_s_ = -1e9; // the latest impact scheduled (performance clock)
     long stroke_ = -1;
     bool onset_new_ = false, end_new_ = false;
     StrikeEvent onset_, end_;

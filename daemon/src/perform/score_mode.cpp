@@ -80,8 +80,8 @@ void ScoreMode::begin()
     install_rig(make_score_rig(perf_.options_, nullptr), false);
     const Kit &kit = perf_.options_.kit;
     if (const int k = kit_foot_piece(kit); k >= 0)
-        foot_ = std::make_unique<FootPlayer>(kit.drums[static_cast<size_t>(k)], k,
-                                             rig_->frame.forward);
+        foot_ =
+            std::make_unique<FootPlayer>(kit.drums[static_cast<size_t>(k)], k, rig_->frame.forward);
     perf_.playing_ = false;
 }
 

@@ -117,8 +117,7 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
     // performer's left) in the shank's frame.
     r.right_sole_m = frames.origin_m[model.body_index("r_foot")];
     r.right_sole_m.y() = 0.0;
-    r.r_ankle_axis =
-        (frames.rotation[model.body_index("r_shank")].conjugate() * left).normalized();
+    r.r_ankle_axis = (frames.rotation[model.body_index("r_shank")].conjugate() * left).normalized();
     r.frame = frame_for(scene.drum, options.character.stick.tip_radius_m, -left, forward,
                         &options.kit, &r.kit_drums, r.right_sole_m);
 

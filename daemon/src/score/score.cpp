@@ -410,8 +410,10 @@ class LineParser
             note_options(tk, st);
             foot_options(tk, st);
         } else if (left_foot_word(key)) {
-            fail(tk[0].column, "'" + tk[0].text + "': the left foot (the hi-hat's pedal) is not "
-                               "built; a hi-hat note's 'open', 'half' or 'closed' sets the pedal");
+            fail(tk[0].column,
+                 "'" + tk[0].text +
+                     "': the left foot (the hi-hat's pedal) is not "
+                     "built; a hi-hat note's 'open', 'half' or 'closed' sets the pedal");
         } else if (key == "r+l" || key == "l+r" || key == "both") {
             st.kind = Kind::note;
             st.both_hands = true;
@@ -516,10 +518,12 @@ class LineParser
             st.kind = Kind::end;
             no_more(tk, 1, "'end'");
         } else {
-            fail(tk[0].column,
-                 "unknown statement '" + tk[0].text +
-                     "' (expected a hand R, L, right, left, R+L, the right foot RF, or tempo, grip, rest, "
-                     "beats, dynamics, firmness, nuance, roll, meter, drum, humanize, repeat, end)");
+            fail(
+                tk[0].column,
+                "unknown statement '" + tk[0].text +
+                    "' (expected a hand R, L, right, left, R+L, the right foot RF, or tempo, grip, "
+                    "rest, "
+                    "beats, dynamics, firmness, nuance, roll, meter, drum, humanize, repeat, end)");
         }
         return st;
     }
@@ -634,17 +638,19 @@ class LineParser
     // the head where the pedal stands), a grip's firmness, a hi-hat's openness.
     void foot_options(const std::vector<Token> &tk, Statement &st) const
     {
-        const std::string what = "'" + tk[0].text + "' is the right foot's note on the kick's pedal";
+        const std::string what =
+            "'" + tk[0].text + "' is the right foot's note on the kick's pedal";
         if (st.ornament != Grace::none)
             fail(st.ornament_column, what + ": a " + std::string(to_string(st.ornament)) +
                                          "'s grace strokes are the hands'");
         if (st.openness)
-            fail(st.openness_column, what + ": '" + hihat_openness_word(*st.openness) +
-                                         "' is the hi-hat's");
+            fail(st.openness_column,
+                 what + ": '" + hihat_openness_word(*st.openness) + "' is the hi-hat's");
         for (const Token &t : tk)
             if (t.lower == "at" || t.lower == "firmness")
-                fail(t.column, what + ": '" + t.text + "' is a stick's (the beater meets the "
-                                      "head where the pedal stands)");
+                fail(t.column, what + ": '" + t.text +
+                                   "' is a stick's (the beater meets the "
+                                   "head where the pedal stands)");
     }
 
     void note_options(const std::vector<Token> &tk, Statement &st) const

@@ -70,8 +70,8 @@ class Executor
   private:
     Score score_;
     double beat_ = 0.0;
-    double chord_beats_ = 0.0;   // the longest note of a chord so far (`R ... + L ...`)
-    double chord_written_ = 0.0; // its longest written duration (0: none written)
+    double chord_beats_ = 0.0;            // the longest note of a chord so far (`R ... + L ...`)
+    double chord_written_ = 0.0;          // its longest written duration (0: none written)
     std::vector<size_t> chord_unwritten_; // its notes without one (indices into the score's)
     Grip grip_ = Grip::french;
     double default_beats_ = kDefaultNoteBeats;

@@ -547,8 +547,8 @@ double KickPedal::schedule(double t_imp, double v)
     KickPedal pre = base;
     while (static_cast<double>(pre.s_.n + 1) * p_.substep_s <= best.push.t0)
         pre.step();
-    if (!cached && pre.at_rest(best.push.t0) &&
-        std::fabs(best.onset - t_imp) <= 2e-5 && std::fabs(best.speed - vc) <= 2e-3 * vc) {
+    if (!cached && pre.at_rest(best.push.t0) && std::fabs(best.onset - t_imp) <= 2e-5 &&
+        std::fabs(best.speed - vc) <= 2e-3 * vc) {
         RestPlan &r = rest_plans_[rest_next_];
         rest_next_ = (rest_next_ + 1) % rest_plans_.size();
         r.valid = true;

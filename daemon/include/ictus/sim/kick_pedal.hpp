@@ -80,7 +80,10 @@ class KickPedal
     /// Drops the pushes not begun by t_s (a performance that stops): the foot stays up.
     void cancel_pending(double t_s);
     /// The beater's effective mass at the felt, I / L^2 (kg).
-    double effective_mass_kg() const { return inertia_ / (p_.beater_length_m * p_.beater_length_m); }
+    double effective_mass_kg() const
+    {
+        return inertia_ / (p_.beater_length_m * p_.beater_length_m);
+    }
 
     double time_s() const { return t_; }
     double beater_angle_rad() const { return s_.phi; }
@@ -130,9 +133,9 @@ class KickPedal
     // grid), so schedule() tries it first for that speed.
     struct RestPlan {
         bool valid = false;
-        double speed = 0.0;     // the speed asked (clamped)
-        double lead_s = 0.0;    // impact time - the push's start
-        Push push;              // its shape (t0 and impact time are set when used)
+        double speed = 0.0;  // the speed asked (clamped)
+        double lead_s = 0.0; // impact time - the push's start
+        Push push;           // its shape (t0 and impact time are set when used)
     };
     bool at_rest(double t) const;
     bool plan_from_rest(const KickPedal &base, double t_lo, double t_imp, double v, Plan &out);
