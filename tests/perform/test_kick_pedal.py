@@ -11,7 +11,8 @@ real `ictusd render --wav`:
    order and events.txt's delays are never negative; louder kicks hit faster (every kick of a
    higher velocity at least as fast as every kick of a lower one, the pedal's speed law);
    performance.mid has a note 36 per kick strike; render.json lists the kick, played by the
-   right foot; pd.log has no error line. The hands' notes are reported.
+   right foot; pd.log has no error line. The hands' notes are reported. The example
+   examples/scores/groove.txt: every note struck, its kicks within 0.5 ms.
 2. A score of kicks alone (`RF` pp .. ff, seeded order): every strike's fundamental, the
    lowest spectral peak 5..65 ms after it, is below 100 Hz; the softest one's is the kick
    head's (0,1) mode j01 / (2 pi a) sqrt(T / sigma) from render.json's head (3 %); it never
@@ -159,6 +160,21 @@ def main():
     herr = [abs(float(n["error_ms"])) for n in hands if n["strike_seq"] != "-1"]
     print("hands: %d notes, %d missed, worst timing error %.2f ms"
           % (len(hands), len(missed), max(herr) if herr else float("nan")))
+
+    # The example of the full kit: every note struck, the kicks on time.
+    example = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "examples",
+                           "scores", "groove.txt")
+    out_ex = os.path.join(args.workdir, "example")
+    env = e2e_util.pd_spawning_env(os.path.abspath(args.workdir))
+    run = subprocess.run([args.ictusd, "render", "--kit", "full", "--score", example, "--out",
+                          out_ex, "--force"], capture_output=True, text=True, timeout=600, env=env)
+    check(run.returncode == 0, "examples/scores/groove.txt renders: %s" % run.stderr[-500:])
+    with open(os.path.join(out_ex, "notes.csv")) as f:
+        ex = list(csv.DictReader(f))
+    check(all(n["strike_seq"] != "-1" for n in ex), "examples/scores/groove.txt: all %d notes "
+          "struck" % len(ex))
+    check(all(abs(float(n["error_ms"])) <= 0.5 for n in ex if n["hand"] == "right-foot"),
+          "examples/scores/groove.txt: its kicks within 0.5 ms")
 
     # 2. Kicks alone, pp to ff (seeded order): the kick's fundamental.
     dyn = ["pp", "p", "mp", "mf", "f", "ff"]

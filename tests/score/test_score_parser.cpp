@@ -614,7 +614,7 @@ TEST_CASE("score: nothing is produced from a faulty score", "[score][parser][err
 
 TEST_CASE("score: example files parse", "[score][parser]")
 {
-    for (const char *name : {"figure5.txt", "nuances.txt", "tempo_ramp.txt"}) {
+    for (const char *name : {"figure5.txt", "nuances.txt", "tempo_ramp.txt", "groove.txt"}) {
         const std::string path = std::string(ICTUS_SOURCE_DIR) + "/examples/scores/" + name;
         INFO(path);
         const Score s = load_score(path);

@@ -40,6 +40,18 @@ nlohmann::json foot_piece_json(const Performance &p, const KitDrum &k)
     return j;
 }
 
+// notes.csv's columns of a note's strike: time, error, speed, contact (empty: none).
+void write_match(std::ostream &out, const NoteMatch &k)
+{
+    char buf[128];
+    if (k.strike_seq >= 0)
+        std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f,", k.strike_time_s, k.error_ms,
+                      k.normal_velocity_mps, k.duration_ms);
+    else
+        std::snprintf(buf, sizeof buf, ",,,,");
+    out << buf;
+}
+
 } // namespace
 
 // notes.csv: the planned notes and the strike each one got; with a kit, each
@@ -58,12 +70,8 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
                       origin_s + n.time_s, to_string(n.hand), to_string(n.nuance),
                       to_string(n.grip), n.dynamics, n.beats, n.tempo_bpm, n.line, k.strike_seq);
         out << buf;
-        if (k.strike_seq >= 0)
-            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f,", k.strike_time_s, k.error_ms,
-                          k.normal_velocity_mps, k.duration_ms);
-        else
-            std::snprintf(buf, sizeof buf, ",,,,");
-        out << buf << (n.grace == Grace::none ? 0 : 1);
+        write_match(out, k);
+        out << (n.grace == Grace::none ? 0 : 1);
         if (!kit.empty() && n.drum >= 0 && n.drum < static_cast<int>(kit.drums.size()))
             out << ',' << kit.drums[static_cast<size_t>(n.drum)].name;
         out << '\n';
@@ -76,12 +84,8 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
         std::snprintf(buf, sizeof buf, "%zu,%.6f,right-foot,,,%.3f,,,%d,%ld,",
                       plan.notes.size() + i, origin_s + n.time_s, n.dynamics, n.line, k.strike_seq);
         out << buf;
-        if (k.strike_seq >= 0)
-            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f,", k.strike_time_s, k.error_ms,
-                          k.normal_velocity_mps, k.duration_ms);
-        else
-            std::snprintf(buf, sizeof buf, ",,,,");
-        out << buf << 0;
+        write_match(out, k);
+        out << 0;
         if (n.drum >= 0 && n.drum < static_cast<int>(kit.drums.size()))
             out << ',' << kit.drums[static_cast<size_t>(n.drum)].name;
         out << '\n';

@@ -129,6 +129,7 @@ void render_usage(std::ostream &out)
            "                      the head's T60, modes, pickups and tuning (docs/sound.md)\n"
            "  --kit NAME          several drums (score mode): standard (snare, tom1, tom2,\n"
            "                      floor), standard-cymbals (and crash, ride, hihat),\n"
+           "                      full (and kick: the right foot's RF, docs/pedal.md),\n"
            "                      standard-timpani (and timpani), timpani (timpani1,\n"
            "                      timpani2); the first where the drum goes, the score's\n"
            "                      'drum NAME' and 'on NAME' choose (docs/perform.md)\n"

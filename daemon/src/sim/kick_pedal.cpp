@@ -290,15 +290,22 @@ double KickPedal::onset_first_contact(double horizon_s, double &speed, State *pr
     speed = 0.0;
     if (pushes_.empty())
         return -1.0;
+    // Once the foot has stopped pushing (the throw and the stop are over), a beater at rest
+    // or on its way back never reaches the head: the spring only pulls it back, and the
+    // release only lowers the chain.
+    const Push &q = pushes_.back();
+    const double pushed_until = q.t0 + q.rise_s + q.stop_s;
     while (static_cast<double>(s_.n) * h < horizon_s) {
         State before = s_;
         step();
-        if (pushes_.back().credited) {
+        if (q.credited) {
             if (pre)
                 *pre = before;
             speed = s_.cur.speed_mps;
             return s_.cur.time_s;
         }
+        if (s_.omega <= 0.0 && !s_.in_contact && static_cast<double>(s_.n) * h > pushed_until)
+            return -1.0;
     }
     return -1.0;
 }
@@ -356,7 +363,7 @@ KickPedal::Plan KickPedal::plan_at(const KickPedal &base, KickPedal &pre, double
                     x = 0.5 * (x_lo + x_hi);
                 e = eval(x);
                 const double g = e.speed - v;
-                if (std::fabs(g) <= 2e-4 * v || x_hi - x_lo <= 1e-12)
+                if (std::fabs(g) <= 1e-3 * v || x_hi - x_lo <= 1e-12)
                     break;
                 if (g > 0.0) {
                     x_hi = x;
@@ -383,7 +390,17 @@ KickPedal::Plan KickPedal::plan_at(const KickPedal &base, KickPedal &pre, double
 KickPedal::Plan KickPedal::plan_rise(const KickPedal &base, double t_lo, double t_imp, double v,
                                      double rise) const
 {
-    KickPedal pre = base;
+    // A checkpoint of the pedal without the new push, shortly before the push's likely start:
+    // the searches below restart from it, not from base (which may lie before the last
+    // note's contact, whose substeps cost the most), unless they try an earlier start.
+    KickPedal ck = base;
+    const double t_ck = std::max(t_lo, t_imp - rise - 0.05);
+    while (static_cast<double>(ck.s_.n + 1) * p_.substep_s <= t_ck)
+        ck.step();
+    auto from = [&](double t0) -> const KickPedal & {
+        return static_cast<double>(ck.s_.n) * p_.substep_s <= t0 ? ck : base;
+    };
+    KickPedal pre = ck;
     Plan best;
     double best_err = 1e300;
     double early = -1.0, late = -1.0; // starts whose onsets were before / after t_imp
@@ -402,19 +419,19 @@ KickPedal::Plan KickPedal::plan_rise(const KickPedal &base, double t_lo, double 
     };
     double t0 = std::max(t_lo, t_imp - rise - 0.010);
     for (int it = 0; it < 8; ++it) {
-        const Plan pl = plan_at(base, pre, t0, t_imp, v, rise);
+        const Plan pl = plan_at(from(t0), pre, t0, t_imp, v, rise);
         keep(pl);
         if (!pl.found)
             break;
         const double err = t_imp - pl.onset;
-        if (std::fabs(err) < 1e-6)
+        if (std::fabs(err) < 5e-6)
             return best;
         if (t0 <= t_lo && err < 0.0)
             return best; // late even from the earliest start
         t0 = std::max(t_lo, t0 + err);
     }
     if (early < 0.0) {
-        const Plan pl = plan_at(base, pre, t_lo, t_imp, v, rise);
+        const Plan pl = plan_at(from(t_lo), pre, t_lo, t_imp, v, rise);
         keep(pl);
         if (!pl.found || pl.onset >= t_imp)
             return best;
@@ -422,11 +439,12 @@ KickPedal::Plan KickPedal::plan_rise(const KickPedal &base, double t_lo, double 
     if (late < 0.0)
         return best;
     for (int it = 0; it < 30 && late - early > 1e-7; ++it) {
-        const Plan pl = plan_at(base, pre, 0.5 * (early + late), t_imp, v, rise);
+        const double mid = 0.5 * (early + late);
+        const Plan pl = plan_at(from(mid), pre, mid, t_imp, v, rise);
         if (!pl.found)
             break;
         keep(pl);
-        if (std::fabs(pl.onset - t_imp) < 1e-6)
+        if (std::fabs(pl.onset - t_imp) < 5e-6)
             break;
     }
     return best;
