@@ -30,6 +30,7 @@ install(FILES ${ICTUS_SOURCE_ROOT}/patches/ictus.pd
               ${ICTUS_SOURCE_ROOT}/patches/sound/ictus-sound-render.pd
         DESTINATION ${ictus_pd_dest} COMPONENT pd_library)
 install(FILES ${ICTUS_SOURCE_ROOT}/examples/scores/figure5.txt
+              ${ICTUS_SOURCE_ROOT}/examples/scores/groove.txt
               ${ICTUS_SOURCE_ROOT}/examples/scores/kit.txt
               ${ICTUS_SOURCE_ROOT}/examples/scores/nuances.txt
               ${ICTUS_SOURCE_ROOT}/examples/scores/rudiments.txt

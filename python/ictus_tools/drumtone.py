@@ -19,3 +19,21 @@ def goertzel_power(x, rate, freq):
     for v in x:
         s1, s2 = v + c * s1 - s2, s1
     return s1 * s1 + s2 * s2 - c * s1 * s2
+
+
+def lowest_peak_hz(y, rate, onset, t0=0.005, t1=0.065, lo=20.0, hi=400.0, within_db=20.0):
+    """A struck drum's fundamental: the lowest spectral peak of y[onset + t0 .. onset + t1]
+    (s after the onset sample `onset`) in lo..hi Hz within `within_db` of the strongest there,
+    refined by a parabola through the log magnitudes (numpy; Hann window, zero-padded FFT)."""
+    import numpy as np
+    seg = np.asarray(y[onset + int(t0 * rate):onset + int(t1 * rate)], dtype=np.float64)
+    nfft = 1 << 18
+    mag = np.abs(np.fft.rfft(seg * np.hanning(len(seg)), nfft))
+    f = np.arange(len(mag)) * rate / nfft
+    band = (f > lo) & (f < hi)
+    floor = np.max(mag[band]) * 10.0 ** (-within_db / 20.0)
+    peaks = [j for j in np.nonzero(band)[0][1:-1]
+             if mag[j] >= floor and mag[j] > mag[j - 1] and mag[j] >= mag[j + 1]]
+    k = int(peaks[0])
+    a, b, c = np.log(mag[k - 1:k + 2] + 1e-300)
+    return (k + 0.5 * (a - c) / (a - 2 * b + c)) * rate / nfft

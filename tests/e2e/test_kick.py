@@ -24,6 +24,7 @@ import numpy as np
 
 from ictus_tools import e2e_util as u
 from ictus_tools.checks import check
+from ictus_tools.drumtone import lowest_peak_hz
 from ictus_tools.pdrun import make_workdir, read_wav_float
 
 J01 = 2.404825557695773  # first zero of J0
@@ -55,19 +56,8 @@ y = x[:, 0].astype(np.float64)
 check(np.all(np.isfinite(y)) and np.max(np.abs(y)) > 1e-4, "the WAV is finite and sounds")
 rows = [r for r in csv.DictReader(open(os.path.join(out, "strikes.csv"))) if r["bounce"] == "0"]
 check(len(rows) == len(notes), "one primary strike per note: %d of %d" % (len(rows), len(notes)))
-nfft = 1 << 18
 for r in rows:
-    i = int(round(float(r["time_s"]) * sr))
-    seg = y[i + int(0.005 * sr):i + int(0.065 * sr)]
-    mag = np.abs(np.fft.rfft(seg * np.hanning(len(seg)), nfft))
-    f = np.arange(len(mag)) * sr / nfft
-    band = (f > 20.0) & (f < 400.0)
-    floor = np.max(mag[band]) * 10.0 ** (-20.0 / 20.0)
-    peaks = [j for j in np.nonzero(band)[0][1:-1]
-             if mag[j] >= floor and mag[j] > mag[j - 1] and mag[j] >= mag[j + 1]]
-    k = int(peaks[0])
-    a, b, c = np.log(mag[k - 1:k + 2] + 1e-300)
-    fundamental = (k + 0.5 * (a - c) / (a - 2 * b + c)) * sr / nfft
+    fundamental = lowest_peak_hz(y, sr, int(round(float(r["time_s"]) * sr)))
     what = "strike at %s s, r/a %s, %s m/s" % (r["time_s"], r["r_over_a"],
                                                r["normal_velocity_mps"])
     check(fundamental < 100.0, "%s: fundamental %.1f Hz, below 100 Hz" % (what, fundamental))

@@ -40,14 +40,16 @@ void require_refused(const Kit &kit, const std::string &words)
 TEST_CASE("kit: the built-in kits placed in the scene: no shells within 2 cm, all within reach",
           "[perform][kit]")
 {
-    for (const char *name : {"standard", "standard-cymbals", "standard-timpani", "timpani"}) {
+    for (const char *name :
+         {"standard", "standard-cymbals", "full", "standard-timpani", "timpani"}) {
         INFO(name);
         PerformanceOptions o;
         o.kit = kit_named(name);
         o.score.score_text = "R";
         Performance perf(o);
         const Scene &scene = perf.scene();
-        REQUIRE(scene.drum_count() == static_cast<int>(o.kit.drums.size()));
+        // The sticks' scene has the hands' pieces (the kick is the foot's).
+        REQUIRE(scene.drum_count() == kit_hand_pieces(o.kit));
         // Shells in plan view: centre distance less the two radii, from the
         // placed scene (world frame, y up).
         for (int i = 0; i < scene.drum_count(); ++i)
@@ -91,6 +93,47 @@ TEST_CASE("kit: the built-in kits placed in the scene: no shells within 2 cm, al
             CHECK(best < 0.95);
         }
     }
+}
+
+TEST_CASE("kit: full is standard-cymbals and a 22-inch kick for the right foot, last, off the "
+          "sticks' scene",
+          "[perform][kit]")
+{
+    const Kit full = kit_named("full"), cymbals = kit_named("standard-cymbals");
+    REQUIRE(full.drums.size() == cymbals.drums.size() + 1);
+    for (size_t i = 0; i < cymbals.drums.size(); ++i) {
+        CHECK(full.drums[i].name == cymbals.drums[i].name);
+        CHECK(!full.drums[i].foot);
+    }
+    const KitDrum &kick = full.drums.back();
+    CHECK((kick.name == "kick" && kick.preset == "kick" && kick.foot && !kick.cymbal()));
+    CHECK(kick.radius_m == Approx(11.0 * 0.0254)); // 22 inches across
+    CHECK(kick.midi_note == 36);                   // General MIDI's Bass Drum 1
+    CHECK(kit_hand_pieces(full) == static_cast<int>(cymbals.drums.size()));
+    CHECK(kit_foot_piece(full) == static_cast<int>(full.drums.size()) - 1);
+    CHECK(kit_foot_piece(cymbals) == -1);
+    // Its centre half its diameter above the floor, before the right foot.
+    CHECK(kick.place_m.y() == Approx(kick.radius_m));
+    CHECK(kick.place_m.x() == 0.0);
+    CHECK((kick.place_m.z() > 0.2 && kick.place_m.z() < 0.35)); // a pedal's footboard ahead
+    // Placed: the scene has the hands' pieces only, at the same places as
+    // standard-cymbals'.
+    const std::vector<DrumParams> placed =
+        place_kit(full, DrumParams(), Eigen::Vector3d::Zero(), -Eigen::Vector3d::UnitX(),
+                  Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ());
+    const std::vector<DrumParams> placed_c =
+        place_kit(cymbals, DrumParams(), Eigen::Vector3d::Zero(), -Eigen::Vector3d::UnitX(),
+                  Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ());
+    REQUIRE(placed.size() == placed_c.size());
+    for (size_t i = 0; i < placed.size(); ++i)
+        CHECK((placed[i].center_m - placed_c[i].center_m).norm() == 0.0);
+    // A foot's piece first, or a hand's after it, is refused.
+    Kit k = full;
+    std::swap(k.drums.front(), k.drums.back());
+    require_refused(k, "a foot's piece is a drum and not the kit's first");
+    k = full;
+    std::swap(k.drums[6], k.drums[7]);
+    require_refused(k, "drum 'hihat': the hands' pieces come before the foot's");
 }
 
 TEST_CASE("kit: a bad kit is refused naming the drum and the fault", "[perform][kit]")

@@ -326,3 +326,51 @@ TEST_CASE("plan: a hand going to or from its rest tip passes over a cymbal above
         CHECK(worst > -1e-3);
     }
 }
+
+TEST_CASE("plan: the right foot's notes are the kick's, timed as the hands', never a hand's",
+          "[score][kit][kick]")
+{
+    PerformerFrame f = kit_frame();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    // A 22-inch kick right of the snare, its upright head below the toms (a foot's piece).
+    f.drums.push_back(
+        {"kick", c + Eigen::Vector3d(-0.18, -0.37, 0.10), 0.2794, false, false, true});
+    const Score s = parse_score("tempo 100\nRF ff 1/2\nR + RF p 1/2\nL on tom1\nRF on kick mf\n"
+                                "R + L + RF 1/4\nRF pp",
+                                "t");
+    const GesturePlan plan = plan_performance(s, db(), f);
+    // Beats 0, 0.5, 2, 3 and 3.25 at 100 bpm after the lead-in.
+    REQUIRE(plan.foot_notes.size() == 5);
+    const double beats[5] = {0.0, 0.5, 2.0, 3.0, 3.25}; // a chord: its longest written note
+    const double dyn[5] = {1.0, 0.3, 0.6, 0.6, 0.2};    // ff, p, the default mf, mf, pp
+    for (size_t i = 0; i < 5; ++i) {
+        INFO(i);
+        CHECK(plan.foot_notes[i].time_s ==
+              Approx(PlanOptions().lead_in_s + beats[i] * 60.0 / 100.0).margin(1e-12));
+        CHECK(plan.foot_notes[i].drum == 5);
+        CHECK(plan.foot_notes[i].dynamics == dyn[i]);
+    }
+    // The hands' notes are the hands' only: none is on the kick.
+    REQUIRE(plan.notes.size() == 4);
+    for (const PlannedNote &n : plan.notes)
+        CHECK(n.drum != 5);
+    auto refused = [&](const std::string &text, const PerformerFrame &frame, int line, int column,
+                       const std::string &words) {
+        INFO(text);
+        try {
+            plan_performance(parse_score(text, "t.txt"), db(), frame);
+            FAIL("planned");
+        } catch (const ScoreError &e) {
+            CHECK(e.line() == line);
+            CHECK(e.column() == column);
+            CHECK_THAT(e.message(), Contains(words));
+        }
+    };
+    refused("R\nR on kick", f, 2, 6, "drum 'kick' is played by the right foot on its pedal");
+    refused("RF on snare", f, 1, 7, "drum 'snare' is the hands'; the right foot plays kick");
+    // 16ths at 300 bpm are 50 ms apart: faster than the pedal (60 ms).
+    refused("tempo 300\nRF 1/4\nRF", f, 3, 1, "faster than the right foot plays its pedal");
+    f.drums.pop_back();
+    refused("R\nRF", f, 2, 1, "this kit has no kick");
+    refused("RF", performer_frame_for_drum(c, 0.178), 1, 1, "there is no kit");
+}

@@ -8,6 +8,7 @@
 
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 using namespace ictus;
 
@@ -219,5 +220,48 @@ TEST_CASE("midi in: General MIDI's hi-hat on a kit's hi-hat, closed 42 and open 
         CHECK(none.skipped.at(42) == 2);
         CHECK(none.skipped.at(46) == 1);
         CHECK(none.skipped.at(44) == 1);
+    }
+}
+
+TEST_CASE("midi in: General MIDI's bass drums 35 and 36 on a kit's kick, the right foot's",
+          "[score][midi][kick]")
+{
+    // 96 ticks a quarter at 120 bpm: a kick 36 with a snare on the same
+    // tick, a kick 35 half a second later, one 10 ticks (52 ms) after it
+    // (faster than the pedal: left out, counted), one 12 ticks after that
+    // (115 ms after the last one played), then a snare.
+    std::string t = bytes({0x00, 0x99, 36, 127, 0x00, 0x99, 38, 100, 0x60, 0x99, 35, 64,
+                           0x0a, 0x99, 36, 90,  0x0c, 0x99, 36, 90,  0x60, 0x99, 38, 100});
+    t += kEnd;
+    const Smf smf = read_smf(header(0, 1) + chunk("MTrk", t), "t.mid");
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"tom1", 48}, {"tom2", 47},  {"floor", 43},
+                                       {"crash", 49}, {"ride", 51}, {"hihat", 42}, {"kick", 36}};
+    const MidiDrumPart part = drum_part_score(smf, kit, "t.mid");
+    REQUIRE(part.score.notes.size() == 5);
+    std::vector<const ScoreNote *> feet, hands;
+    for (const ScoreNote &n : part.score.notes)
+        (n.foot ? feet : hands).push_back(&n);
+    REQUIRE(feet.size() == 3);
+    REQUIRE(hands.size() == 2);
+    const double beat[3] = {0.0, 1.0, (96.0 + 22.0) / 96.0};
+    const double vel[3] = {127.0, 64.0, 90.0};
+    for (size_t i = 0; i < 3; ++i) {
+        INFO(i);
+        CHECK(feet[i]->drum == "kick");
+        CHECK(feet[i]->hand == Side::right);
+        CHECK(feet[i]->beat == Approx(beat[i]));
+        CHECK(feet[i]->dynamics == Approx(vel[i] / 127.0));
+    }
+    // The snare on the kick's tick is the right hand's: the foot takes no hand.
+    CHECK((hands[0]->drum == "snare" && hands[0]->hand == Side::right && hands[0]->beat == 0.0));
+    CHECK(part.too_fast == 1);
+    CHECK(part.skipped.empty());
+    // Without a kick in the kit, and without a kit, 35 and 36 are left out, counted.
+    const std::vector<MidiDrum> no_kick(kit.begin(), kit.end() - 1);
+    for (const std::vector<MidiDrum> &k : {no_kick, std::vector<MidiDrum>{}}) {
+        const MidiDrumPart none = drum_part_score(smf, k, "t.mid");
+        CHECK(none.score.notes.size() == 2);
+        CHECK(none.skipped.at(36) == 3);
+        CHECK(none.skipped.at(35) == 1);
     }
 }

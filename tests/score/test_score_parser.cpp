@@ -128,34 +128,73 @@ TEST_CASE("score: R+L strikes both hands on one beat", "[score][parser]")
 TEST_CASE("score: '+' joins a note of each hand on one beat, each with its options",
           "[score][parser]")
 {
-    // Beats: 0 (1/2 and 1: the chord lasts 1), 1 (1/2 and 1 again), 2.
-    const Score s = parse_score("R accent 1/2 at 0.2 170 + L ff\nL 1/2 + R\nR", "chord");
-    REQUIRE(s.notes.size() == 5);
+    // Beats: 0 (1/2 written, the other none: the chord lasts 1/2), 0.5 (the same), 1
+    // (1/4 and 3/4 written: the longest, 3/4), 1.75 (none written: the default, 1), 2.75.
+    const Score s = parse_score("R accent 1/2 at 0.2 170 + L ff\nL 1/2 + R\nR 1/4 + L 3/4\n"
+                                "R + L\nR",
+                                "chord");
+    REQUIRE(s.notes.size() == 9);
     CHECK((s.notes[0].hand == Side::right && s.notes[1].hand == Side::left));
     for (int i : {0, 1})
         CHECK(s.notes[i].beat == 0.0);
     CHECK(s.notes[0].beats == 0.5);
-    CHECK(s.notes[1].beats == 1.0);
+    CHECK(s.notes[1].beats == 0.5); // none written: the chord's
+    CHECK((s.notes[4].beat == 1.0 && s.notes[5].beat == 1.0));
+    CHECK((s.notes[4].beats == 0.25 && s.notes[5].beats == 0.75));
+    CHECK((s.notes[6].beat == 1.75 && s.notes[7].beat == 1.75 && s.notes[6].beats == 1.0));
     CHECK(s.notes[0].nuance == Nuance::accent);
     CHECK(s.notes[1].nuance == Nuance::legato);
     CHECK(s.notes[0].dynamics == 0.6);
     CHECK(s.notes[1].dynamics == 1.0);
     CHECK((s.notes[0].r_over_a == 0.2 && s.notes[0].theta_deg == 170.0));
     CHECK((s.notes[1].r_over_a == 0.3 && s.notes[1].theta_deg == 0.0));
-    CHECK((s.notes[2].beat == 1.0 && s.notes[3].beat == 1.0));
-    CHECK(s.notes[4].beat == 2.0);
-    CHECK(s.length_beats == 3.0);
+    CHECK((s.notes[2].beat == 0.5 && s.notes[3].beat == 0.5));
+    CHECK(s.notes[8].beat == 2.75);
+    CHECK(s.length_beats == 3.75);
     // The same in a Pd message box (statements between commas).
-    const Score m = parse_score("R accent 1/2 at 0.2 170 + L ff, L 1/2 + R, R", "box");
+    const Score m =
+        parse_score("R accent 1/2 at 0.2 170 + L ff, L 1/2 + R, R 1/4 + L 3/4, R + L, R", "box");
     REQUIRE(m.notes.size() == s.notes.size());
     for (size_t i = 0; i < m.notes.size(); ++i)
         CHECK((m.notes[i].beat == s.notes[i].beat && m.notes[i].hand == s.notes[i].hand));
-    require_error("R + R", 1, 5, "both notes joined by '+' are the right hand's");
-    require_error("R +", 1, 3, "'+' joins two notes played on one beat");
-    require_error("+ L", 1, 1, "'+' joins two notes played on one beat");
-    require_error("R + tempo 90", 1, 5, "'+' joins two notes of one hand each");
-    require_error("R+L + L", 1, 1, "'+' joins two notes of one hand each");
-    require_error("R + L + R", 1, 7, "a second '+': two hands play two notes on one beat");
+    require_error("R + R", 1, 5, "two notes joined by '+' are the right hand's");
+    require_error("R +", 1, 3, "'+' joins notes played on one beat");
+    require_error("+ L", 1, 1, "'+' joins notes played on one beat");
+    require_error("R + tempo 90", 1, 5, "'+' joins notes of one limb each");
+    require_error("R+L + L", 1, 1, "'+' joins notes of one limb each");
+    require_error("R + L + R", 1, 9, "two notes joined by '+' are the right hand's");
+    require_error("R + L + RF + L", 1, 12, "a third '+'");
+    require_error("RF + R + RF", 1, 10, "two notes joined by '+' are the right foot's");
+}
+
+TEST_CASE("score: RF is the right foot's note on the kick, alone or in a chord", "[score][parser]")
+{
+    const Score s =
+        parse_score("drum snare\nRF ff 1/2\nR on hihat + L + RF p\nRF on kick\nR\n", "feet");
+    REQUIRE(s.notes.size() == 6);
+    // A foot's note: the right side, the foot, and no drum but its own `on`
+    // (the hands' current drum is not the kick's).
+    CHECK((s.notes[0].foot && s.notes[0].hand == Side::right && s.notes[0].drum.empty()));
+    CHECK((s.notes[0].beat == 0.0 && s.notes[0].dynamics == 1.0 && s.notes[0].beats == 0.5));
+    // The chord: three notes on beat 0.5, the next note one beat later.
+    for (int i = 1; i <= 3; ++i)
+        CHECK(s.notes[static_cast<size_t>(i)].beat == 0.5);
+    int feet = 0;
+    for (int i = 1; i <= 3; ++i)
+        feet += s.notes[static_cast<size_t>(i)].foot ? 1 : 0;
+    CHECK(feet == 1);
+    CHECK((s.notes[4].foot && s.notes[4].drum == "kick" && s.notes[4].beat == 1.5));
+    CHECK((!s.notes[5].foot && s.notes[5].drum == "snare" && s.notes[5].beat == 2.5));
+    // The same chord in a Pd message box.
+    const Score m = parse_score("RF + R on hihat", "box");
+    REQUIRE(m.notes.size() == 2);
+    CHECK((m.notes[0].beat == 0.0 && m.notes[1].beat == 0.0));
+    require_error("RF flam", 1, 4, "'RF' is the right foot's note on the kick's pedal");
+    require_error("RF at 0.2 90", 1, 4, "'at' is a stick's");
+    require_error("RF firmness 0.5", 1, 4, "'firmness' is a stick's");
+    require_error("RF on hihat open", 1, 13, "'open' is the hi-hat's");
+    require_error("LF", 1, 1, "the left foot (the hi-hat's pedal) is not built");
+    require_error("R + LF", 1, 5, "the left foot (the hi-hat's pedal) is not built");
 }
 
 TEST_CASE("score: the dynamics words rise from pp to ff and mf is the default", "[score][parser]")
@@ -575,7 +614,7 @@ TEST_CASE("score: nothing is produced from a faulty score", "[score][parser][err
 
 TEST_CASE("score: example files parse", "[score][parser]")
 {
-    for (const char *name : {"figure5.txt", "nuances.txt", "tempo_ramp.txt"}) {
+    for (const char *name : {"figure5.txt", "nuances.txt", "tempo_ramp.txt", "groove.txt"}) {
         const std::string path = std::string(ICTUS_SOURCE_DIR) + "/examples/scores/" + name;
         INFO(path);
         const Score s = load_score(path);

@@ -691,3 +691,38 @@ TEST_CASE("strike: a stick bouncing on its fulcrum while the hand stays down is 
         CHECK(events[0].stick_mass_kg == 0.015);
     }
 }
+
+TEST_CASE("strike: a seq claimed for the foot's strike keeps onset order with the hands'",
+          "[sim][strike]")
+{
+    // The left hand down at 1 m/s through the head at t = 20.5 ms (its
+    // onset found in the step that ends at 21 ms), the foot's onset claimed
+    // in that step before and after it.
+    for (double foot_t : {0.0202, 0.0208}) {
+        INFO(foot_t);
+        StrikeDetector det(flat_membrane(5000.0, 0.0));
+        StrikeEvent e;
+        long foot_seq = -1;
+        for (int n = 0; n <= 23; ++n) {
+            TipSample t;
+            t.time_s = n * 1e-3;
+            t.center_m = Eigen::Vector3d(0.0, 0.0075 + 0.001 * (20 - n), 0.0);
+            t.velocity_mps = Eigen::Vector3d(0.0, -1.0, 0.0);
+            const long first = det.strikes();
+            det.update(0, t, e);
+            if (n == 21)
+                foot_seq = det.claim_seq(foot_t, first);
+        }
+        REQUIRE(det.take_onset(0, e));
+        CHECK(e.time_s == Approx(0.0205).margin(1e-9));
+        // Two strikes numbered 0 and 1 in onset order, whichever came first.
+        CHECK(foot_seq == (foot_t < 0.0205 ? 0 : 1));
+        CHECK(e.seq == (foot_t < 0.0205 ? 1 : 0));
+        // The foot's strike is open until it ends: nothing after it is released.
+        CHECK(det.first_open_seq() == 0);
+        det.end_claimed();
+        CHECK(det.first_open_seq() == e.seq); // the hand still presses
+        // A later claim, in a later step, takes the next seq.
+        CHECK(det.claim_seq(0.030, det.strikes()) == 2);
+    }
+}

@@ -163,7 +163,9 @@ std::vector<std::string> pd_command_line(const PdRenderOptions &o, const std::st
         if (k.tension_n_per_m > 0.0) // a cymbal has none (its preset made it a plate)
             sends.push_back(to + "tension " + format("%.9g", k.tension_n_per_m));
         sends.push_back(to + "pan " + format("%.6g", k.pan));
-        if (!o.stick_tip.empty()) { // the sticks play every drum with their tip
+        if (!k.foot_tip.empty()) { // the kick's beater
+            sends.push_back(to + "right tip " + k.foot_tip);
+        } else if (!o.stick_tip.empty()) { // the sticks play every drum with their tip
             sends.push_back(to + "left tip " + o.stick_tip);
             sends.push_back(to + "right tip " + o.stick_tip);
         }

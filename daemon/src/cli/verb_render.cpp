@@ -12,6 +12,8 @@
 #include "ictus/cli/verbs.hpp"
 #include "ictus/perform/strike_log.hpp"
 
+#include "render_report.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <fcntl.h>
@@ -127,6 +129,7 @@ void render_usage(std::ostream &out)
            "                      the head's T60, modes, pickups and tuning (docs/sound.md)\n"
            "  --kit NAME          several drums (score mode): standard (snare, tom1, tom2,\n"
            "                      floor), standard-cymbals (and crash, ride, hihat),\n"
+           "                      full (and kick: the right foot's RF, docs/pedal.md),\n"
            "                      standard-timpani (and timpani), timpani (timpani1,\n"
            "                      timpani2); the first where the drum goes, the score's\n"
            "                      'drum NAME' and 'on NAME' choose (docs/perform.md)\n"
@@ -283,154 +286,6 @@ void write_tips_row(std::ostream &out, const Performance &perf)
         out << buf;
     }
     out << '\n';
-}
-
-// notes.csv: the planned notes and the strike each one got; with a kit, each
-// note's drum last (the strike matched is on it).
-void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSummary &m,
-                     double origin_s, const Kit &kit)
-{
-    out << "index,time_s,hand,nuance,grip,dynamics,beats,tempo_bpm,line,strike_seq,strike_time_s,"
-           "error_ms,normal_velocity_mps,duration_ms,grace"
-        << (kit.empty() ? "\n" : ",drum\n");
-    char buf[256];
-    for (size_t i = 0; i < plan.notes.size(); ++i) {
-        const PlannedNote &n = plan.notes[i];
-        const NoteMatch &k = m.notes[i];
-        std::snprintf(buf, sizeof buf, "%zu,%.6f,%s,%s,%s,%.3f,%.4f,%.3f,%d,%ld,", i,
-                      origin_s + n.time_s, to_string(n.hand), to_string(n.nuance),
-                      to_string(n.grip), n.dynamics, n.beats, n.tempo_bpm, n.line, k.strike_seq);
-        out << buf;
-        if (k.strike_seq >= 0)
-            std::snprintf(buf, sizeof buf, "%.6f,%.3f,%.4f,%.3f,", k.strike_time_s, k.error_ms,
-                          k.normal_velocity_mps, k.duration_ms);
-        else
-            std::snprintf(buf, sizeof buf, ",,,,");
-        out << buf << (n.grace == Grace::none ? 0 : 1);
-        if (!kit.empty() && n.drum >= 0 && n.drum < static_cast<int>(kit.drums.size()))
-            out << ',' << kit.drums[static_cast<size_t>(n.drum)].name;
-        out << '\n';
-    }
-}
-
-nlohmann::json drum_json(const Performance &p)
-{
-    const DrumParams &d = p.scene().options().drum;
-    nlohmann::json j;
-    j["center_m"] = {d.center_m.x(), d.center_m.y(), d.center_m.z()};
-    j["radius_m"] = d.radius_m;
-    j["tension_n_per_m"] = d.tension_n_per_m;
-    j["density_kg_per_m2"] = p.options().drum_density_kg_per_m2;
-    j["preset"] = p.options().drum_preset.empty() ? nlohmann::json(nullptr)
-                                                  : nlohmann::json(p.options().drum_preset);
-    j["contact_stiffness_n_per_m"] = p.detector().membrane().stiffness_n_per_m;
-    j["contact_damping_n_s_per_m"] = d.contact_damping_n_s_per_m;
-    j["contact_stretch_n_per_m3"] = d.stretch_n_per_m3(); // the head's k3 (docs/sound.md)
-    j["stick_tip"] = d.stick_tip;                         // "": none
-    j["stick_tip_code"] = stick_tip_code(d.stick_tip);    // strikes.csv's stick_tip
-    return j;
-}
-
-// A kit's drums as placed, and the stick parts that met a shell from the
-// side (Scene::shell_passes: none when every stroke reached its head from above).
-nlohmann::json kit_json(const Performance &p)
-{
-    const Scene &scene = p.scene();
-    const Kit &kit = p.options().kit;
-    nlohmann::json drums = nlohmann::json::array();
-    for (int i = 0; i < scene.drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
-        const DrumParams &d = scene.drum(i);
-        const KitDrum &k = kit.drums[static_cast<size_t>(i)];
-        drums.push_back({{"name", k.name},
-                         {"preset", k.preset},
-                         {"center_m", {d.center_m.x(), d.center_m.y(), d.center_m.z()}},
-                         {"radius_m", d.radius_m},
-                         {"tension_n_per_m", d.tension_n_per_m},
-                         {"bending_n_m", k.bending_n_m}, // a cymbal's; 0: a drum
-                         {"shell_depth_m", d.shell_depth_m},
-                         {"midi_note", k.midi_note},
-                         {"stick_tip", scene.options().drum.stick_tip}, // the sticks' ("": none)
-                         {"shell_passes", scene.shell_passes(i)}});
-    }
-    return {{"name", kit.name}, {"drums", drums}, {"shell_passes", scene.shell_passes()}};
-}
-
-// render.json's "performance": how the strikes met the notes (docs/perform.md).
-nlohmann::json performance_json(const PerformanceOptions &o, const Performance &perf,
-                                const MatchSummary &m)
-{
-    const GesturePlan &plan = *perf.plan();
-    nlohmann::json j;
-    j["mode"] = to_string(perf.mode());
-    j["notes"] = plan.notes.size();
-    j["primary_strikes"] = m.primary_strikes;
-    j["bounces"] = m.bounces;
-    j["matched_notes"] = m.matched_notes;
-    j["missed_notes"] = static_cast<long>(plan.notes.size()) - m.matched_notes;
-    j["extra_strikes"] = m.extra_strikes;
-    j["timing_error_ms"] = {{"mean_abs", m.mean_abs_error_ms}, {"max_abs", m.max_abs_error_ms}};
-    double v_lo = 0.0, v_hi = 0.0, d_lo = 0.0, d_hi = 0.0, v_sum = 0.0, d_sum = 0.0;
-    long n = 0;
-    for (const NoteMatch &k : m.notes) {
-        if (k.strike_seq < 0)
-            continue;
-        if (n == 0) {
-            v_lo = v_hi = k.normal_velocity_mps;
-            d_lo = d_hi = k.duration_ms;
-        }
-        v_lo = std::min(v_lo, k.normal_velocity_mps);
-        v_hi = std::max(v_hi, k.normal_velocity_mps);
-        d_lo = std::min(d_lo, k.duration_ms);
-        d_hi = std::max(d_hi, k.duration_ms);
-        v_sum += k.normal_velocity_mps;
-        d_sum += k.duration_ms;
-        ++n;
-    }
-    j["impact_speed_mps"] = {{"min", v_lo}, {"mean", n ? v_sum / n : 0.0}, {"max", v_hi}};
-    j["contact_ms"] = {{"min", d_lo}, {"mean", n ? d_sum / n : 0.0}, {"max", d_hi}};
-    j["plan"] = {{"duration_s", plan.duration_s},
-                 {"origin_s", perf.plan_origin_s()},
-                 {"strike_depth_m", o.score.plan.strike_depth_m},
-                 {"strike_aim_s", o.score.plan.strike_aim_s},
-                 {"strike_aim_from_mps", o.score.plan.strike_aim_from_mps},
-                 {"strike_aim_max_m", o.score.plan.strike_aim_max_m},
-                 {"time_advance_s", o.score.time_advance_s},
-                 {"lead_in_s", o.score.plan.lead_in_s}};
-    const Performance::BodyStats &b = perf.body_stats();
-    j["joint_limits"] = {{"kind", "range_of_motion"},
-                         {"max_excursion_deg", b.max_limit_excursion_deg},
-                         {"joint", b.max_limit_joint}};
-    j["trunk"] = {{"max_deg", b.trunk_max_deg}, {"rms_deg", b.trunk_rms_deg()}};
-    j["sticks"] = {{"mount", o.scene.sticks == StickMount::fulcrum ? "fulcrum" : "rigid"},
-                   {"grip_firmness", o.grip_firmness},
-                   {"grip_damping_ratio", o.scene.grip_damping_ratio},
-                   {"rebound_s", o.score.rebound_s}};
-    const PerformerFrame &f = perf.performer_frame();
-    j["performer"] = {{"right", {f.right.x(), f.right.y(), f.right.z()}},
-                      {"forward", {f.forward.x(), f.forward.y(), f.forward.z()}}};
-    nlohmann::json per_note = nlohmann::json::array();
-    for (size_t i = 0; i < plan.notes.size(); ++i) {
-        const PlannedNote &p = plan.notes[i];
-        const NoteMatch &k = m.notes[i];
-        nlohmann::json e = {{"time_s", perf.plan_origin_s() + p.time_s},
-                            {"hand", to_string(p.hand)},
-                            {"nuance", to_string(p.nuance)},
-                            {"dynamics", p.dynamics},
-                            {"line", p.line},
-                            {"grace", to_string(p.grace)},
-                            {"planned_impact_speed_mps", perf.planned_impact_speed_mps(i)}};
-        if (k.strike_seq >= 0) {
-            e["strike_seq"] = k.strike_seq;
-            e["error_ms"] = k.error_ms;
-            e["impact_speed_mps"] = k.normal_velocity_mps;
-            e["contact_ms"] = k.duration_ms;
-        } else {
-            e["strike_seq"] = nullptr;
-        }
-        per_note.push_back(e);
-    }
-    j["per_note"] = per_note;
-    return j;
 }
 
 // The command line of a render.
@@ -595,7 +450,7 @@ void simulate(Performance &perf, const RenderArgs &r, bool score_mode, RenderRec
             std::make_unique<BvhRecorder>(perf.model(), perf.skeleton(), 1.0 / (bvh_every * h));
         record_bvh_frame(perf, frames, *rec.bvh);
     }
-    StrikeEvent ev[2];
+    StrikeEvent ev[kStepStrikes];
     double next_progress = r.progress_every;
     for (long n = 0; n < steps; ++n) {
         if (g_interrupted) {
@@ -721,8 +576,9 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
     NoteCount count;
     if (score_mode) {
         const GesturePlan &plan = *perf.plan();
-        const MatchSummary m = match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s());
-        count.notes = static_cast<long>(plan.notes.size());
+        const MatchSummary m =
+            match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s(), plan.foot_notes);
+        count.notes = static_cast<long>(plan.notes.size() + plan.foot_notes.size());
         count.missed = count.notes - m.matched_notes;
         text.str("");
         write_notes_csv(text, plan, m, perf.plan_origin_s(), perf.options().kit);
@@ -775,10 +631,14 @@ int render_wav(RenderArgs &r, const Performance &perf)
     pd.preset = perf.options().drum_preset;
     const Kit &kit = perf.options().kit;
     pd.kit.clear();
-    for (int i = 1; i < perf.scene().drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
+    for (int i = 1; i < static_cast<int>(kit.drums.size()); ++i) {
         const KitDrum &k = kit.drums[static_cast<size_t>(i)];
-        const DrumParams &kd = perf.scene().drum(i);
-        pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, kit_drum_pan(k)});
+        if (i < perf.scene().drum_count()) {
+            const DrumParams &kd = perf.scene().drum(i);
+            pd.kit.push_back({k.preset, kd.radius_m, kd.tension_n_per_m, kit_drum_pan(k), ""});
+        } else if (k.foot) { // the kick: not in the sticks' scene
+            pd.kit.push_back({k.preset, k.radius_m, k.tension_n_per_m, kit_drum_pan(k), "felt"});
+        }
     }
     pd.stick_tip = d.stick_tip;
     pd.stretch_n_per_m3 = d.stretch_n_per_m3();

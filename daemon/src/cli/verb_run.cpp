@@ -315,10 +315,14 @@ std::vector<KitDrumSound> kit_sounds(const Performance &perf)
 {
     std::vector<KitDrumSound> drums;
     const Kit &kit = perf.options().kit;
-    for (int i = 0; i < perf.scene().drum_count() && i < static_cast<int>(kit.drums.size()); ++i) {
+    for (int i = 0; i < static_cast<int>(kit.drums.size()); ++i) {
         const KitDrum &k = kit.drums[static_cast<size_t>(i)];
-        const DrumParams &d = perf.scene().drum(i);
-        drums.push_back({i, k.name, k.preset, d.radius_m, d.tension_n_per_m, kit_drum_pan(k)});
+        if (i < perf.scene().drum_count()) {
+            const DrumParams &d = perf.scene().drum(i);
+            drums.push_back({i, k.name, k.preset, d.radius_m, d.tension_n_per_m, kit_drum_pan(k)});
+        } else if (k.foot) { // the kick: not in the sticks' scene
+            drums.push_back({i, k.name, k.preset, k.radius_m, k.tension_n_per_m, kit_drum_pan(k)});
+        }
     }
     return drums;
 }

@@ -164,7 +164,7 @@ double ClipMode::duration_s() const
     return rig_->reference.duration_s() * o.clip_bpm / o.tempo_bpm;
 }
 
-int ClipMode::step(StrikeEvent out[2])
+int ClipMode::step(StrikeEvent out[kStepStrikes])
 {
     Rig &r = *rig_;
     const PerformanceOptions &o = perf_.options_;

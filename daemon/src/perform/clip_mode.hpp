@@ -20,7 +20,7 @@ class ClipMode final : public PerformMode
     ~ClipMode() override;
     void begin() override;
 
-    int step(StrikeEvent out[2]) override;
+    int step(StrikeEvent out[kStepStrikes]) override;
 
     // The grip is rebuilt at the next play; the other commands act at once.
     bool play(const Command &c, std::string *why) override;

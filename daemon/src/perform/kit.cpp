@@ -70,11 +70,40 @@ std::vector<KitDrum> cymbals()
             drum("hihat", "hihat", 14.0, kDisc_in, {-0.42, 0.26, -0.02}, 42)};
 }
 
+// The kick of "full": a 22x18 bass drum on the floor before the right foot,
+// its batter upright facing the performer, its centre half its diameter
+// (0.28 m) above the floor, the batter 0.27 m ahead of the right ankle: the
+// pedal's footboard (about 0.28 m, heel plate to axle) under the foot, its
+// heel behind the ankle. A foot piece's place is from the right ankle over
+// the floor (docs/kit.md, "The kick"). General MIDI's Bass Drum 1 (36).
+KitDrum kick()
+{
+    KitDrum d = drum("kick", "kick", 22.0, 18.0, {0.0, 11.0 * kInch_m, 0.27}, 36);
+    d.foot = true;
+    return d;
+}
+
 } // namespace
 
 std::string kit_names()
 {
-    return "standard, standard-cymbals, standard-timpani, timpani";
+    return "standard, standard-cymbals, full, standard-timpani, timpani";
+}
+
+int kit_hand_pieces(const Kit &kit)
+{
+    int n = 0;
+    for (const KitDrum &d : kit.drums)
+        n += d.foot ? 0 : 1;
+    return n;
+}
+
+int kit_foot_piece(const Kit &kit)
+{
+    for (size_t i = 0; i < kit.drums.size(); ++i)
+        if (kit.drums[i].foot)
+            return static_cast<int>(i);
+    return -1;
 }
 
 Kit kit_named(const std::string &name)
@@ -87,6 +116,11 @@ Kit kit_named(const std::string &name)
         kit.drums = standard_drums();
         for (const KitDrum &c : cymbals())
             kit.drums.push_back(c);
+    } else if (name == "full") {
+        kit.drums = standard_drums();
+        for (const KitDrum &c : cymbals())
+            kit.drums.push_back(c);
+        kit.drums.push_back(kick());
     } else if (name == "standard-timpani") {
         // A 26-inch timpani (its kettle 0.6 m deep) where a hi-hat would
         // stand, left of the snare, its head level with the snare's. No
@@ -112,6 +146,8 @@ double kit_min_gap_m(const Kit &kit)
     for (size_t i = 0; i < kit.drums.size(); ++i)
         for (size_t j = i + 1; j < kit.drums.size(); ++j) {
             const KitDrum &a = kit.drums[i], &b = kit.drums[j];
+            if (a.foot || b.foot) // on the floor, under the others: not in the sticks' way
+                continue;
             const double d =
                 std::hypot(a.place_m.x() - b.place_m.x(), a.place_m.z() - b.place_m.z());
             gap = std::min(gap, d - a.radius_m - b.radius_m);
@@ -164,6 +200,10 @@ void validate_kit(const Kit &kit)
             throw PerformError(who + "preset '" + d.preset + "' is " +
                                (preset->plate ? "a cymbal, and the drum has no bending stiffness"
                                               : "a drum, and the drum has a bending stiffness"));
+        if (d.foot && (d.cymbal() || i == 0))
+            throw PerformError(who + "a foot's piece is a drum and not the kit's first");
+        if (!d.foot && i > 0 && kit.drums[i - 1].foot)
+            throw PerformError(who + "the hands' pieces come before the foot's");
         if (i == 0 && d.cymbal())
             throw PerformError(who +
                                "the first drum must be a drum, not a cymbal (the drum "
@@ -201,6 +241,8 @@ std::vector<DrumParams> place_kit(const Kit &kit, const DrumParams &base,
 {
     std::vector<DrumParams> out;
     for (const KitDrum &d : kit.drums) {
+        if (d.foot)
+            continue;
         DrumParams p = base;
         p.center_m =
             anchor_m + d.place_m.x() * right + d.place_m.y() * up + d.place_m.z() * forward;

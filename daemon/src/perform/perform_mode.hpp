@@ -28,8 +28,11 @@ class PerformMode
     const CharacterModel &model() const { return *model_; }
     const std::vector<JointGains> &base_gains() const { return *base_gains_; }
     std::vector<JointGains> &gains() { return *gains_; }
-    // One physics step; the strikes ended in it (<= 2) in out[0..n).
-    virtual int step(StrikeEvent out[2]) = 0;
+    // One physics step; the strikes ended in it (<= kStepStrikes: the two
+    // hands' and the foot's) in out[0..n).
+    virtual int step(StrikeEvent out[kStepStrikes]) = 0;
+    // The foot's contact begun in the last step, at its onset (score mode).
+    virtual bool take_foot_onset(StrikeEvent &) { return false; }
 
     // The commands' parts that differ. False with a reason when refused;
     // they may throw (Performance::apply answers with what()).

@@ -168,10 +168,10 @@ int Performance::divergences() const
     return divergences_before_ + scene().divergences();
 }
 
-int Performance::step(StrikeEvent out[2])
+int Performance::step(StrikeEvent out[kStepStrikes])
 {
     take_results();
-    StrikeEvent ended[2];
+    StrikeEvent ended[kStepStrikes];
     const int k = mode_->step(ended);
     // Strikes a rebuild ended go first (their onsets came earlier); what
     // does not fit in this step's two waits for the next.
@@ -181,7 +181,7 @@ int Performance::step(StrikeEvent out[2])
         held_ends_[static_cast<size_t>(held_ends_n_++)] = ended[i];
     }
     int n = 0;
-    while (n < 2 && held_ends_n_ > 0) {
+    while (n < kStepStrikes && held_ends_n_ > 0) {
         out[n++] = held_ends_[0];
         std::copy(held_ends_.begin() + 1, held_ends_.begin() + held_ends_n_, held_ends_.begin());
         --held_ends_n_;
@@ -192,24 +192,26 @@ int Performance::step(StrikeEvent out[2])
     return n;
 }
 
-int Performance::take_onsets(StrikeEvent out[2])
+int Performance::take_onsets(StrikeEvent out[kStepStrikes])
 {
     int n = 0;
-    StrikeEvent taken[4];
+    StrikeEvent taken[2 * kStepStrikes];
     for (int i = 0; i < held_onsets_n_; ++i)
         taken[n++] = held_onsets_[static_cast<size_t>(i)];
     held_onsets_n_ = 0;
     for (int hand = 0; hand < 2; ++hand)
         if (detector_.take_onset(hand, taken[n]))
             ++n;
+    if (mode_->take_foot_onset(taken[n]))
+        ++n;
     int kept = 0;
     for (int i = 0; i < n; ++i) {
         if (withheld(taken[i]))
             continue;
-        if (kept < 2) {
+        if (kept < kStepStrikes) {
             out[kept] = taken[i];
             mark_pedal(out[kept++]);
-        } else if (held_onsets_n_ < 2) // for the next call
+        } else if (held_onsets_n_ < kStepStrikes) // for the next call
             held_onsets_[static_cast<size_t>(held_onsets_n_++)] = taken[i];
     }
     return kept;
@@ -330,7 +332,7 @@ void Performance::took_over(double previous_time_s)
     load_membranes(detector_, scene());
 }
 
-int Performance::guard_runaway(int k, StrikeEvent out[2])
+int Performance::guard_runaway(int k, StrikeEvent out[kStepStrikes])
 {
     double speed = 0.0;
     for (int s = 0; s < 2; ++s)
@@ -526,6 +528,19 @@ double Performance::plan_origin_s() const
 double Performance::plan_time_s() const
 {
     return score_ ? score_->plan_time_s() : 0.0;
+}
+
+const KickPedal *Performance::kick_pedal() const
+{
+    return score_ ? score_->kick_pedal() : nullptr;
+}
+
+Eigen::Vector3d Performance::foot_piece_center_m() const
+{
+    for (const PerformerFrame::Drum &d : performer_frame().drums)
+        if (d.foot)
+            return d.membrane_center_m;
+    return Eigen::Vector3d::Zero();
 }
 
 const PerformerFrame &Performance::performer_frame() const

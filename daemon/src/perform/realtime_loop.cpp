@@ -116,7 +116,7 @@ class LoopStep
     void send_strikes(int k)
     {
         auto to_log = [this](const StrikeEvent &e) { io_.strike_logged(e); };
-        StrikeEvent onset[2];
+        StrikeEvent onset[kStepStrikes];
         const int ons = perf_.take_onsets(onset);
         for (int i = 0; i < ons; ++i)
             io_.strike_onset(onset[i]);
@@ -131,7 +131,7 @@ class LoopStep
     RealtimeIo &io_;
     LiveStatus &status_;
     long pose_every_ = 0, tip_every_ = 0;
-    StrikeEvent ev_[2];
+    StrikeEvent ev_[kStepStrikes];
     StrikeOrder order_;
 };
 

@@ -78,6 +78,10 @@ ScoreMode::ScoreMode(Performance &performance) : perf_(performance)
 void ScoreMode::begin()
 {
     install_rig(make_score_rig(perf_.options_, nullptr), false);
+    const Kit &kit = perf_.options_.kit;
+    if (const int k = kit_foot_piece(kit); k >= 0)
+        foot_ =
+            std::make_unique<FootPlayer>(kit.drums[static_cast<size_t>(k)], k, rig_->frame.forward);
     perf_.playing_ = false;
 }
 
@@ -107,7 +111,7 @@ void ScoreMode::install_rig(std::unique_ptr<ScoreRig> rig, bool keep_pose)
     // The live drum and gains win over those the rig was built with.
     o.scene.drum.center_m = r.drum_center_m;
     r.frame = frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right,
-                        r.frame.forward, &o.kit, &r.kit_drums);
+                        r.frame.forward, &o.kit, &r.kit_drums, r.right_sole_m);
     r.tracker->set_mode(mode);
     if (!keep_pose)
         rest_from_m_ = r.frame.rest_tip_m;
@@ -128,6 +132,10 @@ void ScoreMode::install_plan(std::unique_ptr<ScorePlan> plan, bool start_now)
         const PlanOptions &po = perf_.options_.score.plan;
         if (plan_ && plan_->score)
             rig_->tracker->scene().set_motor_noise(humanize_amount(*plan_->score, po), po.seed);
+        if (foot_ && plan_)
+            foot_->start(plan_->plan, plan_origin_s_, perf_.time_s());
+    } else if (foot_ && plan_) {
+        foot_->replace(plan_->plan);
     }
     // else: a plan under way goes on from where it was (the notes keep their times)
     if (plan && perf_.worker_)
@@ -377,7 +385,7 @@ void ScoreMode::follow_rest(TipTargets &tips)
     tips.has_direction = true;
 }
 
-int ScoreMode::step(StrikeEvent out[2])
+int ScoreMode::step(StrikeEvent out[kStepStrikes])
 {
     ScoreRig &r = *rig_;
     if (plan_active_)
@@ -385,11 +393,24 @@ int ScoreMode::step(StrikeEvent out[2])
     else
         follow_rest(r.tips);
     r.trunk_synergy();
+    if (foot_)
+        r.foot_on_pedal(foot_->pedal().footboard_angle_rad());
     r.tracker->step(r.step_body, &r.tips, true);
-    const int n = detect_strikes(perf_.detector_, r.tracker->scene(), out, perf_.time_offset_s_);
+    const long first_seq = perf_.detector_.strikes();
+    int n = detect_strikes(perf_.detector_, r.tracker->scene(), out, perf_.time_offset_s_);
+    if (foot_) {
+        foot_->step(perf_.time_s(), perf_.detector_, first_seq);
+        if (foot_->take_end(out[n]))
+            ++n;
+    }
     r.tracker->scene().local_rotations(pose_scratch_);
     body_stats_.add_step(r.model, r.range_of_motion, r.lumbar, r.thorax, pose_scratch_);
     return n;
+}
+
+bool ScoreMode::take_foot_onset(StrikeEvent &out)
+{
+    return foot_ && foot_->take_onset(out);
 }
 
 // ---- the commands' score-mode parts ------------------------------------------------
@@ -407,10 +428,13 @@ bool ScoreMode::play(const Command &c, std::string *why)
 
 void ScoreMode::stop()
 {
-    // The performance ends; the sticks go back to their rest.
+    // The performance ends; the sticks go back to their rest, the foot plays
+    // no further kick.
     if (plan_active_)
         start_rest_move();
     plan_active_ = false;
+    if (foot_)
+        foot_->stop(perf_.time_s());
 }
 
 bool ScoreMode::tempo(const Command &c, std::string *why)
@@ -464,7 +488,7 @@ bool ScoreMode::drum_changed(const Command &c, std::string *why)
     const PerformanceOptions &o = perf_.options_;
     ScoreRig &r = *rig_;
     r.frame = frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right,
-                        r.frame.forward, &o.kit, &r.kit_drums);
+                        r.frame.forward, &o.kit, &r.kit_drums, r.right_sole_m);
     if (plan_active_ || perf_.work_pending())
         return perf_.submit(plan_job(c, Work::Kind::replan), why);
     return true;

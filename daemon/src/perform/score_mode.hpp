@@ -4,6 +4,7 @@
 // tempo, grip and drum changes live (docs/perform.md, docs/osc.md).
 #pragma once
 
+#include "foot_player.hpp"
 #include "perform_mode.hpp"
 #include "score_plan.hpp"
 #include "score_rig.hpp"
@@ -36,7 +37,8 @@ class ScoreMode final : public PerformMode
     void returned(const Work &work) override;
     bool install(Work &work, std::string *why) override;
     // The tips follow the plan under way, else move to their rest and hold.
-    int step(StrikeEvent out[2]) override;
+    int step(StrikeEvent out[kStepStrikes]) override;
+    bool take_foot_onset(StrikeEvent &out) override;
 
     // Performance's score-mode queries (performance.hpp).
     const GesturePlan *plan() const { return plan_ ? &plan_->plan : nullptr; }
@@ -50,6 +52,7 @@ class ScoreMode final : public PerformMode
     TrackMode track_mode() const { return rig_->tracker->mode(); }
     const Eigen::Vector3d &tip_target(int hand) const { return rig_->tips.position_m[hand & 1]; }
     const BodyStats &body_stats() const { return body_stats_; }
+    const KickPedal *kick_pedal() const { return foot_ ? &foot_->pedal() : nullptr; }
     // Plans the current score and starts it now.
     void start_score();
 
@@ -89,6 +92,8 @@ class ScoreMode final : public PerformMode
     std::array<Eigen::Vector3d, 2> rest_from_m_;
     double rest_move_start_s_ = -1e9;
     BodyStats body_stats_;
+    // The right foot on the kit's kick (none without one).
+    std::unique_ptr<FootPlayer> foot_;
     std::vector<Eigen::Quaterniond> pose_scratch_;
 };
 

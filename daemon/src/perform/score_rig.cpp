@@ -26,7 +26,8 @@ double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_wo
 
 PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
                          const Eigen::Vector3d &forward, const Kit *kit,
-                         const std::vector<DrumParams> *kit_drums)
+                         const std::vector<DrumParams> *kit_drums,
+                         const Eigen::Vector3d &right_sole_m)
 {
     const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
     const Eigen::Vector3d raise = contact_height_m(tip_radius_m, kDefaultStickDirection) * up;
@@ -40,10 +41,17 @@ PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eige
         const Eigen::Vector3d anchor = drum.center_m - p0.x() * right - p0.y() * up - p0.z() * forward;
         f.rest_tip_m = performer_frame_for_drum(anchor + raise, drum.radius_m).rest_tip_m;
         for (size_t i = 0; i < kit->drums.size(); ++i) {
+            const KitDrum &k = kit->drums[i];
+            if (k.foot) { // not in the scene: its upright head's centre from the right foot
+                const Eigen::Vector3d c = right_sole_m + k.place_m.x() * right +
+                                          k.place_m.y() * up + k.place_m.z() * forward;
+                f.drums.push_back({k.name, c, k.radius_m, false, false, true});
+                continue;
+            }
             const DrumParams &d =
                 i == 0 || !kit_drums || i - 1 >= kit_drums->size() ? drum : (*kit_drums)[i - 1];
-            f.drums.push_back({kit->drums[i].name, d.center_m + raise, d.radius_m,
-                               kit->drums[i].cymbal(), kit_drum_has_pedal(kit->drums[i])});
+            f.drums.push_back(
+                {k.name, d.center_m + raise, d.radius_m, k.cymbal(), kit_drum_has_pedal(k)});
         }
     }
     return f;
@@ -105,8 +113,13 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
         r.kit_drums = scene.extra_drums;
     }
     r.drum_center_m = scene.drum.center_m;
+    // The right ankle over the floor, and its axis of plantar flexion (the
+    // performer's left) in the shank's frame.
+    r.right_sole_m = frames.origin_m[model.body_index("r_foot")];
+    r.right_sole_m.y() = 0.0;
+    r.r_ankle_axis = (frames.rotation[model.body_index("r_shank")].conjugate() * left).normalized();
     r.frame = frame_for(scene.drum, options.character.stick.tip_radius_m, -left, forward,
-                        &options.kit, &r.kit_drums);
+                        &options.kit, &r.kit_drums, r.right_sole_m);
 
     // Start: the arms solved to hold the sticks at the rest tips (or the
     // pose the old rig was in, when a grip change rebuilds it).
@@ -147,6 +160,12 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
 // tips) and turns the shoulder of the higher stick back (kTrunkTwist_rad_per_m
 // of the difference of the tips' heights), 40 % at the lumbar joint and 60 %
 // at the thorax; eq. 1 then follows it with the trunk's compliant gains.
+void ScoreRig::foot_on_pedal(double footboard_rad)
+{
+    step_body.local[r_ankle] =
+        body.local[r_ankle] * Eigen::Quaterniond(Eigen::AngleAxisd(footboard_rad, r_ankle_axis));
+}
+
 void ScoreRig::trunk_synergy()
 {
     ScoreRig &r = *this;

@@ -26,6 +26,12 @@ struct ScoreRig {
     PerformerFrame frame;
     Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero(); // where the drum goes
     std::vector<DrumParams> kit_drums; // a kit's drums after the first, placed
+    // The right foot: its ankle over the floor (world, y 0), where a kit's
+    // foot piece is placed from (KitDrum::foot), and the ankle's axis of
+    // plantar flexion in the shank's frame (the performer's left).
+    Eigen::Vector3d right_sole_m = Eigen::Vector3d::Zero();
+    int r_ankle = model.joint_index("r_ankle");
+    Eigen::Vector3d r_ankle_axis = Eigen::Vector3d::UnitX();
     TipTargets tips;
     ScoreRig(const CharacterModel &m, double ik_limit_margin_rad)
         : model(m), range_of_motion(model), ik_range_of_motion(model, ik_limit_margin_rad)
@@ -34,6 +40,9 @@ struct ScoreRig {
     // The trunk takes part in the strokes: step_body is body with the lean
     // and twist that the tip targets of this step call for.
     void trunk_synergy();
+    // The right foot on its pedal: step_body's right ankle turned toe down by
+    // the footboard's angle (rad; docs/pedal.md).
+    void foot_on_pedal(double footboard_rad);
 
     // The trunk: eq. 1's natural frequency of the lumbar and thorax joints,
     // and how they follow the sticks.
@@ -52,9 +61,11 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
 // `forward` with `right` to the performer's right, the membrane raised by the
 // tip's contact height.
 // With a kit, the frame's drums (PerformerFrame::drums): `drum` first, then
-// `kit_drums`, named as the kit's, each raised so.
+// `kit_drums`, named as the kit's, each raised so; a foot piece (the kick)
+// at its place from `right_sole_m` (ScoreRig::right_sole_m).
 PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
                          const Eigen::Vector3d &forward, const Kit *kit = nullptr,
-                         const std::vector<DrumParams> *kit_drums = nullptr);
+                         const std::vector<DrumParams> *kit_drums = nullptr,
+                         const Eigen::Vector3d &right_sole_m = Eigen::Vector3d::Zero());
 
 } // namespace ictus

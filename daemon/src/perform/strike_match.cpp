@@ -9,24 +9,36 @@ namespace ictus
 {
 
 MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
-                           const std::vector<StrikeEvent> &strikes, double origin_s)
+                           const std::vector<StrikeEvent> &strikes, double origin_s,
+                           const std::vector<PlannedFootNote> &foot_notes)
 {
+    // Every note as (time, limb, drum): the hands' first, then the foot's.
+    struct Target {
+        double time_s;
+        int limb, drum;
+    };
+    std::vector<Target> all;
+    all.reserve(notes.size() + foot_notes.size());
+    for (const PlannedNote &n : notes)
+        all.push_back({n.time_s, static_cast<int>(n.hand), n.drum});
+    for (const PlannedFootNote &n : foot_notes)
+        all.push_back({n.time_s, kFootRight, n.drum});
     MatchSummary m;
-    m.notes.assign(notes.size(), NoteMatch{});
-    std::vector<double> best(notes.size(), std::numeric_limits<double>::infinity());
+    std::vector<NoteMatch> matched(all.size(), NoteMatch{});
+    std::vector<double> best(all.size(), std::numeric_limits<double>::infinity());
     for (const StrikeEvent &e : strikes) {
         if (e.bounce) {
             ++m.bounces;
             continue;
         }
         ++m.primary_strikes;
-        // The nearest note of the strike's hand on the strike's drum.
+        // The nearest note of the strike's limb on the strike's drum.
         long nearest = -1;
         double nearest_d = std::numeric_limits<double>::infinity();
-        for (size_t i = 0; i < notes.size(); ++i) {
-            if (static_cast<int>(notes[i].hand) != e.hand || notes[i].drum != e.drum)
+        for (size_t i = 0; i < all.size(); ++i) {
+            if (all[i].limb != e.hand || all[i].drum != e.drum)
                 continue;
-            const double d = std::abs(e.time_s - (origin_s + notes[i].time_s));
+            const double d = std::abs(e.time_s - (origin_s + all[i].time_s));
             if (d < nearest_d) {
                 nearest_d = d;
                 nearest = static_cast<long>(i);
@@ -37,19 +49,19 @@ MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
             continue;
         }
         const size_t i = static_cast<size_t>(nearest);
-        if (m.notes[i].strike_seq >= 0)
+        if (matched[i].strike_seq >= 0)
             ++m.extra_strikes; // the note already has one: one of the two is extra
         if (nearest_d < best[i]) {
             best[i] = nearest_d;
-            m.notes[i].strike_seq = e.seq;
-            m.notes[i].strike_time_s = e.time_s;
-            m.notes[i].error_ms = 1e3 * (e.time_s - (origin_s + notes[i].time_s));
-            m.notes[i].normal_velocity_mps = e.normal_velocity_mps;
-            m.notes[i].duration_ms = e.duration_ms;
+            matched[i].strike_seq = e.seq;
+            matched[i].strike_time_s = e.time_s;
+            matched[i].error_ms = 1e3 * (e.time_s - (origin_s + all[i].time_s));
+            matched[i].normal_velocity_mps = e.normal_velocity_mps;
+            matched[i].duration_ms = e.duration_ms;
         }
     }
     double sum = 0.0;
-    for (const NoteMatch &n : m.notes) {
+    for (const NoteMatch &n : matched) {
         if (n.strike_seq < 0)
             continue;
         ++m.matched_notes;
@@ -57,6 +69,8 @@ MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
         m.max_abs_error_ms = std::max(m.max_abs_error_ms, std::abs(n.error_ms));
     }
     m.mean_abs_error_ms = m.matched_notes > 0 ? sum / m.matched_notes : 0.0;
+    m.notes.assign(matched.begin(), matched.begin() + static_cast<long>(notes.size()));
+    m.foot_notes.assign(matched.begin() + static_cast<long>(notes.size()), matched.end());
     return m;
 }
 

@@ -21,6 +21,7 @@
 #include "ictus/score/gesture_score.hpp"
 
 #include "ictus/base/motor_noise.hpp"
+#include "kit_notes.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -308,6 +309,8 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("return_time_s must be in (0, 10] s", o.return_time_s);
     if (!(o.min_stroke_interval_s > 0.0 && o.min_stroke_interval_s <= 10.0))
         bad("min_stroke_interval_s must be in (0, 10] s", o.min_stroke_interval_s);
+    if (!(o.min_foot_interval_s > 0.0 && o.min_foot_interval_s <= 10.0))
+        bad("min_foot_interval_s must be in (0, 10] s", o.min_foot_interval_s);
     if (!(o.max_duration_s > 0.0) || !std::isfinite(o.max_duration_s))
         bad("max_duration_s must be > 0", o.max_duration_s);
 }
@@ -387,48 +390,11 @@ class UnitCache
     std::map<std::tuple<int, int, int, double, long, long>, std::unique_ptr<UnitCurve>> units_;
 };
 
+using score_detail::drum_index;
+using score_detail::foot_note;
+using score_detail::note_openness;
+
 using HandNotes = std::array<std::vector<size_t>, 2>; // each hand's notes, indices into plan.notes
-
-// The index of the note's drum in the frame's kit; a ScoreError where the
-// drum was named when the kit has none of that name.
-int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &frame)
-{
-    if (n.drum.empty())
-        return 0;
-    std::string names;
-    for (size_t i = 0; i < frame.drums.size(); ++i) {
-        if (frame.drums[i].name == n.drum)
-            return static_cast<int>(i);
-        names += (i ? ", " : "") + frame.drums[i].name;
-    }
-    if (frame.drums.empty())
-        throw ScoreError(score.source, n.drum_line, n.drum_column,
-                         "drum '" + n.drum +
-                             "': there is one drum and no kit (give the performance a kit, "
-                             "e.g. --kit standard: docs/perform.md)");
-    throw ScoreError(score.source, n.drum_line, n.drum_column,
-                     "unknown drum '" + n.drum + "' (the kit: " + names + ")");
-}
-
-// The note's pedal on a hi-hat (closed when it names none), -1 on another
-// drum; a ScoreError at the word when it names one on a drum without a pedal.
-double note_openness(const Score &score, const ScoreNote &n, const PerformerFrame &frame, int drum)
-{
-    const bool kit = drum >= 0 && drum < static_cast<int>(frame.drums.size());
-    if (kit && frame.drums[static_cast<size_t>(drum)].pedal)
-        return n.openness >= 0.0 ? n.openness : kHihatClosed;
-    if (n.openness < 0.0)
-        return -1.0;
-    std::string hihats;
-    for (const PerformerFrame::Drum &d : frame.drums)
-        if (d.pedal)
-            hihats += (hihats.empty() ? "" : ", ") + d.name;
-    throw ScoreError(
-        score.source, n.line, n.openness_column,
-        std::string("'") + hihat_openness_word(n.openness) + "' is a hi-hat's pedal, and drum '" +
-            (kit ? frame.drums[static_cast<size_t>(drum)].name : n.drum) + "' is not a hi-hat (" +
-            (hihats.empty() ? "the kit has none" : "the kit's hi-hat: " + hihats) + ")");
-}
 
 // The notes, timed by the tempo map, into plan.notes (score order); a score that
 // asks a hand to play faster than one hand plays is a ScoreError. The timing noise
@@ -440,8 +406,30 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
     HandNotes by_hand;
     const double amount = humanize_amount(score, opt);
     std::array<double, 2> score_time_prev = {0.0, 0.0}; // each hand's last note, without noise
+    double foot_written_prev = 0.0;                     // the foot's, likewise
     for (size_t k = 0; k < score.notes.size(); ++k) {
         const ScoreNote &n = score.notes[k];
+        if (n.foot) {
+            // As a hand's: a kick closer to the last than the pedal plays is
+            // refused; the noise of `humanize` never brings it closer.
+            PlannedFootNote f = foot_note(score, n, k, frame, opt);
+            const double written = opt.lead_in_s + score.note_time_s(n);
+            if (!plan.foot_notes.empty()) {
+                const PlannedFootNote &prev = plan.foot_notes.back();
+                if (written - foot_written_prev < opt.min_foot_interval_s - 1e-9) {
+                    std::ostringstream m;
+                    m << "this kick comes " << (written - foot_written_prev) * 1000.0
+                      << " ms after the previous one (line " << prev.line
+                      << "), faster than the right foot plays its pedal (minimum "
+                      << opt.min_foot_interval_s * 1000.0 << " ms)";
+                    throw ScoreError(score.source, n.line, n.column, m.str());
+                }
+                f.time_s = std::max(f.time_s, prev.time_s + opt.min_foot_interval_s);
+            }
+            foot_written_prev = written;
+            plan.foot_notes.push_back(f);
+            continue;
+        }
         PlannedNote p;
         const double score_time = opt.lead_in_s + score.note_time_s(n);
         p.time_s = score_time;
@@ -462,6 +450,11 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         p.theta_deg = n.theta_deg;
         p.firmness = n.firmness;
         p.drum = drum_index(score, n, frame);
+        if (p.drum < static_cast<int>(frame.drums.size()) &&
+            frame.drums[static_cast<size_t>(p.drum)].foot)
+            throw ScoreError(score.source, n.drum_line, n.drum_column,
+                             "drum '" + frame.drums[static_cast<size_t>(p.drum)].name +
+                                 "' is played by the right foot on its pedal: write 'RF'");
         p.openness = note_openness(score, n, frame, p.drum);
         if (!n.spot_given && p.drum < static_cast<int>(frame.drums.size()) &&
             frame.drums[static_cast<size_t>(p.drum)].cymbal) {
@@ -645,7 +638,7 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
         double short_m = 0.0;
         for (size_t k = 0; k < frame.drums.size(); ++k) {
             const PerformerFrame::Drum &d = frame.drums[k];
-            if (cymbals_only && !d.cymbal)
+            if ((cymbals_only && !d.cymbal) || d.foot)
                 continue;
             const Eigen::Vector3d rel = p - d.membrane_center_m;
             const double height = rel.dot(frame.up);
@@ -869,6 +862,9 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
     std::stable_sort(
         plan.notes.begin(), plan.notes.end(),
         [](const PlannedNote &a, const PlannedNote &b) { return a.time_s < b.time_s; });
+    std::stable_sort(
+        plan.foot_notes.begin(), plan.foot_notes.end(),
+        [](const PlannedFootNote &a, const PlannedFootNote &b) { return a.time_s < b.time_s; });
     return plan;
 }
 

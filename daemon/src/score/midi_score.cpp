@@ -230,6 +230,12 @@ int cymbal_of(int note)
 // the kit's drum of its cymbal's note, if the kit has one.
 int drum_of(int note, const std::vector<MidiDrum> &drums)
 {
+    if (note == kMidiAcousticBass || note == kMidiKick) {
+        for (size_t i = 0; i < drums.size(); ++i)
+            if (drums[i].midi_note == kMidiKick)
+                return static_cast<int>(i);
+        return -1;
+    }
     if (const int cymbal = cymbal_of(note)) {
         for (size_t i = 0; i < drums.size(); ++i)
             if (drums[i].midi_note == cymbal)
@@ -299,6 +305,7 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
     const TempoMap &map = part.score.tempo;
     // The hands' last strokes (s; -inf: none yet) and the last note kept.
     double last_of[2] = {-1e300, -1e300};
+    double last_foot_s = -1e300;
     double last_s = -1e300;
     long last_tick = -1;
     int last_hand = 1, at_tick = 0;
@@ -318,6 +325,25 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
                                 std::to_string(beat) + ", past the score's " +
                                 std::to_string(kMaxScoreBeats));
         const double t = map.time_at_beat(beat);
+        if (n.note == kMidiAcousticBass || n.note == kMidiKick) {
+            // The right foot's, beside the hands.
+            if (t - last_foot_s < kMidiFootMin_s - 1e-9) {
+                ++part.too_fast;
+                continue;
+            }
+            ScoreNote s;
+            s.beat = beat;
+            s.beats = kMinNoteBeats;
+            s.hand = Side::right;
+            s.foot = true;
+            s.dynamics = n.velocity / 127.0;
+            s.line = line;
+            s.drum_line = line;
+            s.drum = drums[static_cast<size_t>(drum)].name;
+            part.score.notes.push_back(s);
+            last_foot_s = t;
+            continue;
+        }
         // Hands: at the same tick the other hand (two at once at most);
         // close to the previous note the other hand; far from it the right.
         int hand;
@@ -379,8 +405,9 @@ MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<Midi
     if (part.score.notes.empty())
         throw MidiFileError(path + ": no note the " + (drums.empty() ? "drum" : "kit") +
                             " can play (snares 38, 40, side stick 37, toms 41..50 and, on a kit "
-                            "with cymbals, crash 49, 57, ride 51, 53, 59 and hi-hat 42, 46 of "
-                            "the General MIDI drum map, on channel 10 if it has notes)");
+                            "with cymbals, crash 49, 57, ride 51, 53, 59 and hi-hat 42, 46, on a "
+                            "kit with a kick, 35, 36 of the General MIDI drum map, on channel 10 "
+                            "if it has notes)");
     return part;
 }
 

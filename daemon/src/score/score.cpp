@@ -142,6 +142,18 @@ std::optional<double> openness_word(const std::string &lower)
     return std::nullopt;
 }
 
+// A foot's note: `RF` (the right foot, on the kick's pedal; docs/pedal.md).
+bool foot_word(const std::string &lower)
+{
+    return lower == "rf" || lower == "right-foot";
+}
+
+// The left foot's (the hi-hat's pedal): not built, refused by name.
+bool left_foot_word(const std::string &lower)
+{
+    return lower == "lf" || lower == "left-foot";
+}
+
 std::optional<Side> hand_word(const std::string &lower)
 {
     if (lower == "r" || lower == "right")
@@ -239,38 +251,58 @@ class LineParser
     const std::string &source_;
     int line_;
 
-    // One statement, or a chord: `R on hihat + L on snare`, two notes of the two hands
-    // on one beat, each with its own options (a '+' between spaces).
+    // One statement, or a chord: `R on hihat + L on snare + RF`, notes of up to three
+    // limbs (the two hands and the right foot) on one beat, each with its own options
+    // (a '+' between spaces).
     void chord(const std::vector<Token> &tk, std::vector<Statement> &out) const
     {
-        size_t plus = 0;
-        while (plus < tk.size() && tk[plus].text != "+")
-            ++plus;
-        if (plus == tk.size()) {
+        std::vector<std::vector<Token>> parts(1);
+        std::vector<int> plus_columns;
+        for (const Token &t : tk) {
+            if (t.text != "+") {
+                parts.back().push_back(t);
+                continue;
+            }
+            if (parts.back().empty())
+                fail(t.column, "'+' joins notes played on one beat, one of each limb: "
+                               "'R on hihat + L on snare + RF'");
+            if (parts.size() == 3)
+                fail(t.column, "a third '+': two hands and a foot play three notes on one "
+                               "beat at most");
+            plus_columns.push_back(t.column);
+            parts.emplace_back();
+        }
+        if (parts.size() == 1) {
             out.push_back(statement(tk));
             return;
         }
-        const std::vector<Token> a(tk.begin(), tk.begin() + static_cast<long>(plus)),
-            b(tk.begin() + static_cast<long>(plus) + 1, tk.end());
-        if (a.empty() || b.empty())
-            fail(tk[plus].column, "'+' joins two notes played on one beat, one of each hand: "
-                                  "'R on hihat + L on snare'");
-        for (const Token &t : b)
-            if (t.text == "+")
-                fail(t.column, "a second '+': two hands play two notes on one beat at most");
-        for (const std::vector<Token> *part : {&a, &b})
-            if (!hand_word((*part)[0].lower))
-                fail((*part)[0].column, "'+' joins two notes of one hand each ('R ...' or "
-                                        "'L ...'), got '" +
-                                            (*part)[0].text + "'");
-        Statement first = statement(a), second = statement(b);
-        if (first.hand == second.hand)
-            fail(b[0].column, "both notes joined by '+' are the " +
-                                  std::string(first.hand == Side::right ? "right" : "left") +
-                                  " hand's: one hand plays one note at a time");
-        first.with_next = true;
-        out.push_back(first);
-        out.push_back(second);
+        if (parts.back().empty())
+            fail(plus_columns.back(), "'+' joins notes played on one beat, one of each limb: "
+                                      "'R on hihat + L on snare + RF'");
+        std::vector<Statement> notes;
+        for (const std::vector<Token> &part : parts) {
+            const std::string &w = part[0].lower;
+            if (!hand_word(w) && !foot_word(w) && !left_foot_word(w))
+                fail(part[0].column, "'+' joins notes of one limb each ('R ...', 'L ...' or "
+                                     "'RF ...'), got '" +
+                                         part[0].text + "'");
+            Statement st = statement(part);
+            for (const Statement &other : notes)
+                if (other.hand == st.hand && other.foot == st.foot)
+                    fail(part[0].column, "two notes joined by '+' are the " + limb_name(st) +
+                                             "'s: one limb plays one note at a time");
+            notes.push_back(st);
+        }
+        for (size_t i = 0; i + 1 < notes.size(); ++i)
+            notes[i].with_next = true;
+        out.insert(out.end(), notes.begin(), notes.end());
+    }
+
+    static std::string limb_name(const Statement &st)
+    {
+        if (st.foot)
+            return "right foot";
+        return st.hand == Side::right ? "right hand" : "left hand";
     }
 
     [[noreturn]] void fail(int column, const std::string &message) const
@@ -371,6 +403,17 @@ class LineParser
             st.kind = Kind::note;
             st.hand = *hand;
             note_options(tk, st);
+        } else if (foot_word(key)) {
+            st.kind = Kind::note;
+            st.hand = Side::right;
+            st.foot = true;
+            note_options(tk, st);
+            foot_options(tk, st);
+        } else if (left_foot_word(key)) {
+            fail(tk[0].column,
+                 "'" + tk[0].text +
+                     "': the left foot (the hi-hat's pedal) is not "
+                     "built; a hi-hat note's 'open', 'half' or 'closed' sets the pedal");
         } else if (key == "r+l" || key == "l+r" || key == "both") {
             st.kind = Kind::note;
             st.both_hands = true;
@@ -475,10 +518,12 @@ class LineParser
             st.kind = Kind::end;
             no_more(tk, 1, "'end'");
         } else {
-            fail(tk[0].column,
-                 "unknown statement '" + tk[0].text +
-                     "' (expected a hand R, L, right, left, R+L, or tempo, grip, rest, "
-                     "beats, dynamics, firmness, nuance, roll, meter, drum, humanize, repeat, end)");
+            fail(
+                tk[0].column,
+                "unknown statement '" + tk[0].text +
+                    "' (expected a hand R, L, right, left, R+L, the right foot RF, or tempo, grip, "
+                    "rest, "
+                    "beats, dynamics, firmness, nuance, roll, meter, drum, humanize, repeat, end)");
         }
         return st;
     }
@@ -587,6 +632,25 @@ class LineParser
         if (!(f >= 0.0 && f <= 1.0))
             fail(t.column, "firmness " + t.text + " is out of range (0..1: 0 loose, 1 firm)");
         return f;
+    }
+
+    // What a foot's note cannot have: grace strokes, a spot (the beater meets
+    // the head where the pedal stands), a grip's firmness, a hi-hat's openness.
+    void foot_options(const std::vector<Token> &tk, Statement &st) const
+    {
+        const std::string what =
+            "'" + tk[0].text + "' is the right foot's note on the kick's pedal";
+        if (st.ornament != Grace::none)
+            fail(st.ornament_column, what + ": a " + std::string(to_string(st.ornament)) +
+                                         "'s grace strokes are the hands'");
+        if (st.openness)
+            fail(st.openness_column,
+                 what + ": '" + hihat_openness_word(*st.openness) + "' is the hi-hat's");
+        for (const Token &t : tk)
+            if (t.lower == "at" || t.lower == "firmness")
+                fail(t.column, what + ": '" + t.text +
+                                   "' is a stick's (the beater meets the "
+                                   "head where the pedal stands)");
     }
 
     void note_options(const std::vector<Token> &tk, Statement &st) const

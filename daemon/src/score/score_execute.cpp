@@ -70,7 +70,9 @@ class Executor
   private:
     Score score_;
     double beat_ = 0.0;
-    double chord_beats_ = 0.0; // the longest note of a chord so far (`R ... + L ...`)
+    double chord_beats_ = 0.0;            // the longest note of a chord so far (`R ... + L ...`)
+    double chord_written_ = 0.0;          // its longest written duration (0: none written)
+    std::vector<size_t> chord_unwritten_; // its notes without one (indices into the score's)
     Grip grip_ = Grip::french;
     double default_beats_ = kDefaultNoteBeats;
     double default_firmness_ = -1.0; // the performance's
@@ -119,6 +121,7 @@ class Executor
         n.dynamics = dynamics_at(beat_);
         n.firmness = default_firmness_;
         n.hand = hand;
+        n.foot = st.foot;
         n.theta_deg = kDefaultThetaDeg[static_cast<int>(hand)];
         n.line = st.line;
         n.column = st.column;
@@ -137,6 +140,13 @@ class Executor
         n.r_over_a = st.r_over_a.value_or(kDefaultRadiusFraction);
         n.spot_given = st.r_over_a.has_value() || st.theta_deg.has_value();
         n.firmness = st.firmness.value_or(default_firmness_);
+        if (n.foot) {
+            // The foot plays its pedal's drum (the planner finds the kit's
+            // kick), not the hands' current drum.
+            n.drum.clear();
+            n.drum_line = st.line;
+            n.drum_column = st.column;
+        }
         if (st.drum) {
             n.drum = *st.drum;
             n.drum_line = st.line;
@@ -179,14 +189,25 @@ class Executor
                 continue;
             n.hand = hand;
             n.theta_deg = st.theta_deg.value_or(kDefaultThetaDeg[static_cast<int>(hand)]);
+            if (!st.beats)
+                chord_unwritten_.push_back(score_.notes.size());
             add(st, n);
         }
-        // A chord's first note (`R ... + L ...`): the second starts on the same beat.
+        // A chord's notes but its last (`R ... + L ... + RF`): the next starts on the same
+        // beat. The chord lasts its longest written duration (`R on hihat 1/2 + RF` lasts
+        // half a beat), the default when none is written.
         chord_beats_ = std::max(chord_beats_, n.beats);
+        if (st.beats)
+            chord_written_ = std::max(chord_written_, *st.beats);
         if (st.with_next)
             return;
-        advance(st, chord_beats_);
+        const double beats = chord_written_ > 0.0 ? chord_written_ : chord_beats_;
+        for (size_t i : chord_unwritten_) // its notes without a written duration last as long
+            score_.notes[i].beats = beats;
+        chord_unwritten_.clear();
+        advance(st, beats);
         chord_beats_ = 0.0;
+        chord_written_ = 0.0;
     }
 
     // A roll: strokes at the `beats` default for its length, alternating

@@ -40,9 +40,10 @@ struct Statement {
     int column = 0;
     // note
     Side hand = Side::right;
+    bool foot = false;              // RF: the right foot's (the kick's pedal), not a hand's
     bool both_hands = false;        // R+L: one stroke of each hand on the same beat
-    // `R ... + L ...`: the next statement is this one's other hand, on the same beat
-    // (the beat advances after it, by the longer of the two durations)
+    // `R ... + L ... + RF`: the next statement is another limb's note on the same beat
+    // (the beat advances after the chord's last, by the longest of its durations)
     bool with_next = false;
     std::optional<Nuance> nuance;   // note, default_nuance
     std::optional<double> beats;    // note, rest, default_beats

@@ -4,6 +4,7 @@
 #include "ictus/sim/scene.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <ostream>
@@ -111,6 +112,8 @@ long StrikeDetector::first_open_seq() const
     for (const Hand &h : hands_)
         if (h.in_contact)
             first = std::min(first, h.event.seq);
+    if (claimed_open_seq_ >= 0)
+        first = std::min(first, claimed_open_seq_);
     return first;
 }
 
@@ -122,6 +125,30 @@ void StrikeDetector::number_in_onset_order(long first_seq)
     if ((a.event.seq < b.event.seq) != (a.event.time_s < b.event.time_s) &&
         a.event.time_s != b.event.time_s)
         std::swap(a.event.seq, b.event.seq);
+}
+
+long StrikeDetector::claim_seq(double onset_time_s, long first_seq)
+{
+    long seq = next_seq_++;
+    // The hands' onsets of this step after this one move one seq later: the
+    // new strike takes the earliest of their seqs (onset order).
+    std::array<Hand *, 2> later{};
+    int n = 0;
+    for (Hand &h : hands_)
+        if (h.in_contact && h.event.seq >= first_seq && h.event.time_s > onset_time_s)
+            later[static_cast<size_t>(n++)] = &h;
+    if (n == 2 && later[1]->event.seq < later[0]->event.seq)
+        std::swap(later[0], later[1]);
+    if (n == 1) {
+        std::swap(seq, later[0]->event.seq);
+    } else if (n == 2) {
+        const long first = later[0]->event.seq;
+        later[0]->event.seq = later[1]->event.seq;
+        later[1]->event.seq = seq;
+        seq = first;
+    }
+    claimed_open_seq_ = seq;
+    return seq;
 }
 
 void StrikeDetector::reset(const MembraneGeometry &membrane)

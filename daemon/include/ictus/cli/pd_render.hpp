@@ -32,6 +32,9 @@ struct PdRenderOptions {
         double radius_m = 0.178;
         double tension_n_per_m = 3000.0;
         double pan = 0.0;
+        // A foot's piece (the kick): its beater's tip on the contact~ the
+        // foot plays (ictus-drum plays hand 2 on the right one); "": none.
+        std::string foot_tip;
     };
     std::vector<KitDrumSound> kit;
     std::string stick_tip; // render-drum left|right tip NAME, when not empty (contact~)

@@ -31,6 +31,12 @@ struct KitDrum {
     // shell_depth_m, its top face the plate (docs/kit.md, "Cymbals").
     double bending_n_m = 0.0;
     bool cymbal() const { return bending_n_m > 0.0; }
+    // Played by the right foot on a pedal (the kick, docs/pedal.md): its head
+    // stands upright facing the performer, place_m is the head's centre from
+    // the right ankle over the floor (not from the anchor), and it is not in
+    // the sticks' scene (the sticks play above it). A kit's foot pieces come
+    // after every piece the hands play.
+    bool foot = false;
 };
 
 struct Kit {
@@ -45,11 +51,12 @@ constexpr double kKitMinGap_m = 0.02;
 
 // The built-in kits by name: "standard" (snare, two rack toms, floor tom: a
 // right-handed four-piece), "standard-cymbals" (the same with an 18-inch
-// crash, a 20-inch ride and a 14-inch hi-hat), "standard-timpani" (the four drums and a
+// crash, a 20-inch ride and a 14-inch hi-hat), "full" (standard-cymbals and a 22-inch
+// kick played by the right foot), "standard-timpani" (the four drums and a
 // 26-inch timpani to the left of the snare) and "timpani" (two timpani).
 // Throws PerformError naming the kits for another name.
 Kit kit_named(const std::string &name);
-// "standard, standard-cymbals, standard-timpani, timpani".
+// "standard, standard-cymbals, full, standard-timpani, timpani".
 std::string kit_names();
 // Throws PerformError naming the drum and the fault: no drums or more than
 // kMaxDrums, a bad or repeated name, an unknown preset, a cymbal first (the
@@ -65,12 +72,18 @@ double kit_drum_pan(const KitDrum &drum);
 // closed pair's edge loss, docs/plates.md "The hi-hat"), so that its notes
 // carry the pedal's openness (docs/kit.md, "The hi-hat").
 bool kit_drum_has_pedal(const KitDrum &drum);
+// The number of pieces the hands play (the scene's drums): the kit's size
+// less its foot pieces, which come last.
+int kit_hand_pieces(const Kit &kit);
+// The kit's first foot piece, or -1.
+int kit_foot_piece(const Kit &kit);
 // The drum named `name` (lower case), or -1.
 int kit_drum_index(const Kit &kit, const std::string &name);
 
 // The kit in the world: drum i's scene parameters (`base`'s damping and
 // friction, the kit's radius, tension and shell), each at
-// anchor_m + place_m in the frame (right, up, forward).
+// anchor_m + place_m in the frame (right, up, forward). The foot pieces
+// (KitDrum::foot) are not in the scene: the result has the hands' pieces only.
 std::vector<DrumParams> place_kit(const Kit &kit, const DrumParams &base,
                                   const Eigen::Vector3d &anchor_m,
                                   const Eigen::Vector3d &right, const Eigen::Vector3d &up,

@@ -109,6 +109,11 @@ class ClipMode;
 class ScoreMode;
 class Work;
 class PlanningWorker;
+class KickPedal;
+
+// The most strikes one physics step ends or begins: one per hand and the
+// right foot's (the kick's pedal, docs/pedal.md).
+constexpr int kStepStrikes = 3;
 
 // The physics side of run and render: the character tracking the clip or
 // performing a score, the drum, the strike detector, and the commands Pd may
@@ -123,9 +128,9 @@ class Performance
     explicit Performance(const PerformanceOptions &options);
     ~Performance();
 
-    // One physics step; returns the number of strikes ended in it (<= 2),
-    // written to out[0..n).
-    int step(StrikeEvent out[2]);
+    // One physics step; returns the number of strikes ended in it (<=
+    // kStepStrikes), written to out[0..n).
+    int step(StrikeEvent out[kStepStrikes]);
     // The strikes whose contact began in the last step (<= 2), at their
     // onset: what a sound needs (time, hand, position, velocity), without
     // force, impulse and duration, which step() reports at the release
@@ -134,7 +139,7 @@ class Performance
     // onset here has its strike there (a rebuild of the character ends the
     // contacts under way; a strike held back by the runaway guard is held
     // back whole).
-    int take_onsets(StrikeEvent out[2]);
+    int take_onsets(StrikeEvent out[kStepStrikes]);
     // Ends contacts still open (end of a run), after the strikes still held.
     bool flush(StrikeEvent &out);
     // Applies a command from the OSC thread. Returns false with a reason when
@@ -185,6 +190,10 @@ class Performance
     Eigen::Vector3d tip_target(int hand) const;
     Eigen::Vector3d tip_position(int hand) const;
     const PerformerFrame &performer_frame() const;
+    // The kick's pedal (the kit's foot piece, docs/pedal.md), nullptr without
+    // one; where its head's centre stands (world; zero without one).
+    const KickPedal *kick_pedal() const;
+    Eigen::Vector3d foot_piece_center_m() const;
     TrackMode mode() const;
     // The planned target's speed toward the head as it reaches the contact,
     // per note of plan() (m/s).
@@ -279,7 +288,7 @@ class Performance
     bool check_gains(const double scale[2], std::string *why) const;
     bool apply_gains_command(const Command &c, std::string *why);
     bool apply_drum_command(const Command &c, std::string *why);
-    int guard_runaway(int k, StrikeEvent out[2]); // the strikes that may leave
+    int guard_runaway(int k, StrikeEvent out[kStepStrikes]); // the strikes that may leave
     bool withheld(const StrikeEvent &e) const;    // an onset while the guard is quiet
     // A strike on a hi-hat gets the pedal of the note it plays (score mode).
     void mark_pedal(StrikeEvent &e) const;
@@ -310,7 +319,7 @@ class Performance
     std::atomic<long> stops_{0};
     std::array<StrikeEvent, 8> held_ends_{};
     int held_ends_n_ = 0;
-    std::array<StrikeEvent, 2> held_onsets_{};
+    std::array<StrikeEvent, kStepStrikes> held_onsets_{};
     int held_onsets_n_ = 0;
     double time_offset_s_ = 0.0;  // simulation time at the last (re)build
     double gain_scale_[2] = {1.0, 1.0};

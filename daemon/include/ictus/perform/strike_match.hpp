@@ -21,15 +21,19 @@ struct NoteMatch {
     double duration_ms = 0.0;
 };
 struct MatchSummary {
-    std::vector<NoteMatch> notes; // [note], as the plan's notes
+    std::vector<NoteMatch> notes;      // [note], as the plan's notes
+    std::vector<NoteMatch> foot_notes; // [note], as the plan's foot notes
     long primary_strikes = 0, bounces = 0;
     long matched_notes = 0;
     long extra_strikes = 0; // primary strikes not matched to a note
     double mean_abs_error_ms = 0.0, max_abs_error_ms = 0.0;
 };
-// `origin_s`: simulation time of the plan's time 0.
+// `origin_s`: simulation time of the plan's time 0. The right foot's strikes
+// (StrikeEvent::hand kFootRight) meet the foot's notes likewise; the counts
+// and errors are over both.
 MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
-                           const std::vector<StrikeEvent> &strikes, double origin_s);
+                           const std::vector<StrikeEvent> &strikes, double origin_s,
+                           const std::vector<PlannedFootNote> &foot_notes = {});
 
 // The hi-hat's pedal for a strike (StrikeEvent::pedal_openness): the
 // openness of the note it plays, the nearest note in time on its drum that

@@ -47,6 +47,10 @@ struct PerformerFrame {
         double membrane_radius_m = 0.178;
         bool cymbal = false; // played where a note gives no spot at kCymbal* (score.hpp)
         bool pedal = false;  // a hi-hat: its notes carry the pedal's openness
+        // Played by the right foot (the kick, docs/pedal.md): its notes are
+        // GesturePlan::foot_notes, never a hand's; membrane_center_m is its
+        // upright head's centre, out of the sticks' way.
+        bool foot = false;
     };
     std::vector<Drum> drums;
 };
@@ -93,6 +97,15 @@ struct PlannedNote {
     int line = 0;           // where the note is written
     int column = 0;
     Grace grace = Grace::none; // a flam's or a drag's grace stroke (ScoreNote::grace)
+};
+
+// A note of the right foot (`RF`, docs/pedal.md): the kick's pedal strikes
+// its drum at time_s (plan clock) at `dynamics`.
+struct PlannedFootNote {
+    double time_s = 0.0;
+    double dynamics = 0.0;
+    int drum = 0; // the kit's foot piece (PerformerFrame::Drum::foot)
+    int line = 0, column = 0;
 };
 
 // A meter of the score (ScoreMeter) from plan time time_s on.
@@ -148,6 +161,9 @@ struct PlanOptions {
     // interval the simulated body plays as two strokes (docs/score.md,
     // "Rebound strokes", measured).
     double min_stroke_interval_s = 0.04;
+    // Two kicks closer than this are refused: the shortest interval the
+    // pedal plays as two strokes (docs/pedal.md).
+    double min_foot_interval_s = 0.06;
     double max_duration_s = 900.0; // longer performances are refused
     // Motor noise (docs/humanize.md): the amount, 0 for none;
     // < 0: the score's `humanize` statement (0 when it has none). The seed
@@ -174,6 +190,7 @@ struct GesturePlan {
     TipTrajectory tips;
     std::array<std::vector<Eigen::Vector3d>, 2> stick_dir; // [side][frame], unit, butt -> tip
     std::vector<PlannedNote> notes;                        // in time order
+    std::vector<PlannedFootNote> foot_notes;               // the right foot's, in time order
     std::vector<PlannedMeter> meters;                      // the score's, in order
     double duration_s = 0.0;
     double score_start_s = 0.0; // plan time of the score's beat 0 (= lead_in_s)

@@ -80,6 +80,12 @@ constexpr double kMidiRideBellRadiusFraction = 0.12;
 // General MIDI's hi-hat played by a hand on a kit's hi-hat (its note 42): closed 42 with the
 // pedal down, open 46 with it up (ScoreNote::openness). The pedal hi-hat 44 is played by a
 // foot, which the performer does not have: left out (MidiDrumPart::skipped).
+// General MIDI's bass drums, Acoustic (35) and Bass Drum 1 (36), played by the right foot
+// on a kit's kick (its note 36; docs/pedal.md), no sooner than kMidiFootMin_s after the
+// last: a foot note (ScoreNote::foot), whatever the hands do.
+constexpr int kMidiAcousticBass = 35;
+constexpr int kMidiKick = 36;
+constexpr double kMidiFootMin_s = 0.06;
 constexpr int kMidiClosedHihat = 42;
 constexpr int kMidiOpenHihat = 46;
 constexpr int kMidiPedalHihat = 44;

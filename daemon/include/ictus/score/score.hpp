@@ -97,6 +97,9 @@ struct ScoreNote {
     double beat = 0.0;  // onset (the strike), beats from the start of the score
     double beats = 1.0; // duration: the next statement starts this much later
     Side hand = Side::right;
+    // Played by the foot of `hand`'s side (`RF`: the right foot on the kick's
+    // pedal, docs/pedal.md), not by the hand.
+    bool foot = false;
     Nuance nuance = Nuance::legato;
     Grip grip = Grip::french;
     double dynamics = kDefaultDynamics; // 0 (softest) .. 1 (loudest)

@@ -1,0 +1,76 @@
+// foot_player.hpp -- the right foot of a score's performance (private to
+// src/perform): the plan's foot notes (GesturePlan::foot_notes) played on the
+// kit's kick by its pedal (ictus/sim/kick_pedal.hpp, docs/pedal.md), each
+// scheduled a little ahead of its time, the pedal advanced with the physics
+// and its contacts reported as strikes of the right foot (StrikeEvent::hand
+// kFootRight).
+#pragma once
+
+#include "ictus/perform/kit.hpp"
+#include "ictus/score/gesture_score.hpp"
+#include "ictus/sim/kick_pedal.hpp"
+#include "ictus/sim/strike_detector.hpp"
+
+#include <array>
+#include <vector>
+
+namespace ictus
+{
+
+class FootPlayer
+{
+  public:
+    // The pedal of the kit's piece `drum` (a foot's, KitDrum::foot) before
+    // the performer (forward: the performer's facing, world).
+    FootPlayer(const KitDrum &drum, int drum_index, const Eigen::Vector3d &forward);
+
+    // A plan starts at origin_s (the performance's clock): its foot notes
+    // from now on; the pushes not yet begun are dropped.
+    void start(const GesturePlan &plan, double origin_s, double now_s);
+    // A plan under way is replaced (a tempo change, a replan): the notes
+    // already scheduled stay, the new plan's later ones follow.
+    void replace(const GesturePlan &plan);
+    // The performance stops: the pushes not yet begun are dropped.
+    void stop(double now_s);
+
+    // The pedal to now_s (the end of a physics step): the notes due within
+    // the look-ahead scheduled, the contacts begun and ended in the step
+    // taken. Seqs come from the detector, in onset order with the hands'
+    // (first_seq: the detector's first seq of the step).
+    void step(double now_s, StrikeDetector &detector, long first_seq);
+    // The foot's contact begun in the last step (at most one), at its onset.
+    bool take_onset(StrikeEvent &out);
+    // The foot's contact ended in the last step (at most one).
+    bool take_end(StrikeEvent &out);
+
+    // The beater's speed (m/s) for a note's dynamics 0..1.
+    double speed_for(double dynamics) const;
+    const KickPedal &pedal() const { return pedal_; }
+    int drum_index() const { return drum_; }
+
+    // How far ahead a note is scheduled (s): more than the foot's longest
+    // push (docs/pedal.md).
+    static constexpr double kLookAhead_s = 0.5;
+    // Where the felt meets the head: above its centre at this fraction of
+    // its radius (a 22-inch kick's beater, ~4 cm up; the `kick` preset's
+    // strike, docs/sound.md).
+    static constexpr double kBeaterRadiusFraction = 0.15;
+
+  private:
+    StrikeEvent event_for(const PedalStrike &s) const;
+
+    KickPedal pedal_;
+    int drum_ = 0;
+    Eigen::Vector3d forward_;
+    double radius_m_ = 0.2794;
+    std::vector<PlannedFootNote> notes_; // the plan's, in time order
+    size_t next_ = 0;                    // the first not scheduled
+    double origin_s_ = 0.0;
+    double last_scheduled_s_ = -1e9; // the latest impact scheduled (performance clock)
+    long stroke_ = -1;
+    bool onset_new_ = false, end_new_ = false;
+    StrikeEvent onset_, end_;
+    long open_seq_ = -1; // the contact under way's seq
+};
+
+} // namespace ictus
