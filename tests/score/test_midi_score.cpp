@@ -265,3 +265,46 @@ TEST_CASE("midi in: General MIDI's bass drums 35 and 36 on a kit's kick, the rig
         CHECK(none.skipped.at(35) == 1);
     }
 }
+
+TEST_CASE("midi in: the right hand keeps time on the hi-hat and the ride, the left plays under it",
+          "[score][midi][hihat]")
+{
+    // Two bars at 120 bpm (96 ticks a quarter): 8th-note closed hi-hats, the snare on 2 and 4
+    // written before the hi-hat of its tick, then a bar of 8th-note ride with a tom on each
+    // beat. A drummer: every hi-hat and ride note the right hand's, the snare and the toms
+    // the left's (crossed over the hi-hat).
+    std::string t;
+    int delta = 0;
+    for (int eighth = 0; eighth < 16; ++eighth) {
+        if (eighth % 4 == 2) {
+            t += bytes({delta, 0x99, 38, 100});
+            delta = 0;
+        }
+        t += bytes({delta, 0x99, 42, 90});
+        delta = 48;
+    }
+    for (int eighth = 0; eighth < 8; ++eighth) {
+        if (eighth % 2 == 0) {
+            t += bytes({delta, 0x99, 45, 100});
+            delta = 0;
+        }
+        t += bytes({delta, 0x99, 51, 90});
+        delta = 48;
+    }
+    t += kEnd;
+    const Smf smf = read_smf(header(0, 1) + chunk("MTrk", t), "t.mid");
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"tom1", 48}, {"tom2", 47}, {"floor", 43},
+                                       {"crash", 49}, {"ride", 51}, {"hihat", 42}};
+    const MidiDrumPart part = drum_part_score(smf, kit, "t.mid");
+    REQUIRE(part.score.notes.size() == 16 + 4 + 8 + 4);
+    CHECK(part.too_fast == 0);
+    for (const ScoreNote &n : part.score.notes) {
+        INFO(n.drum << " at beat " << n.beat << ", note line " << n.line);
+        const bool keeps_time = n.drum == "hihat" || n.drum == "ride";
+        CHECK(n.hand == (keeps_time ? Side::right : Side::left));
+    }
+    // Each note keeps its line in the file (the snare before the hi-hat of its tick).
+    CHECK(part.score.notes[2].drum == "hihat");
+    CHECK(part.score.notes[3].drum == "snare");
+    CHECK(part.score.notes[3].line + 1 == part.score.notes[2].line);
+}

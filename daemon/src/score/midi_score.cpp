@@ -213,6 +213,13 @@ bool is_tom(int note)
     return note == 41 || note == 43 || note == 45 || note == 47 || note == 48 || note == 50;
 }
 
+// A note the right hand keeps time on: the hi-hat's (42, 46) and the ride's (51, 59, 53).
+bool keeps_time(int note)
+{
+    return note == kMidiClosedHihat || note == kMidiOpenHihat || note == kMidiRide ||
+           note == 59 || note == kMidiRideBell;
+}
+
 // A cymbal's note: the kit's cymbal that plays it (crash, ride or hi-hat), 0 for another note.
 int cymbal_of(int note)
 {
@@ -309,9 +316,19 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
     double last_s = -1e300;
     long last_tick = -1;
     int last_hand = 1, at_tick = 0;
-    int line = 0;
-    for (const SmfNote &n : smf.notes) {
-        ++line;
+    // The notes in file order, but at one tick the hi-hat's and the ride's first: the right
+    // hand keeps time on them and the other hand plays what falls with them (crossed over
+    // the hi-hat, as a right-handed drummer plays a groove).
+    std::vector<size_t> order(smf.notes.size());
+    for (size_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+        const SmfNote &x = smf.notes[a], &y = smf.notes[b];
+        return x.tick != y.tick ? x.tick < y.tick : keeps_time(x.note) && !keeps_time(y.note);
+    });
+    for (size_t index : order) {
+        const SmfNote &n = smf.notes[index];
+        const int line = static_cast<int>(index) + 1;
         if (part.channel >= 0 && n.channel != part.channel)
             continue;
         const int drum = drum_of(n.note, drums);
@@ -355,7 +372,7 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
             hand = 1 - last_hand;
         } else {
             at_tick = 0;
-            hand = t - last_s < kMidiAlternateBelow_s ? 1 - last_hand : 1;
+            hand = keeps_time(n.note) || t - last_s >= kMidiAlternateBelow_s ? 1 : 1 - last_hand;
             if (t - last_of[hand] < kMidiSameHandMin_s)
                 hand = 1 - hand;
         }
