@@ -216,8 +216,8 @@ bool is_tom(int note)
 // A note the right hand keeps time on: the hi-hat's (42, 46) and the ride's (51, 59, 53).
 bool keeps_time(int note)
 {
-    return note == kMidiClosedHihat || note == kMidiOpenHihat || note == kMidiRide ||
-           note == 59 || note == kMidiRideBell;
+    return note == kMidiClosedHihat || note == kMidiOpenHihat || note == kMidiRide || note == 59 ||
+           note == kMidiRideBell;
 }
 
 // A cymbal's note: the kit's cymbal that plays it (crash, ride or hi-hat), 0 for another note.
