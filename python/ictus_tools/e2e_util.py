@@ -326,3 +326,18 @@ def read_wav_mono(path):
     n = len(samples) // 4
     values = struct.unpack("<%df" % n, samples[:4 * n])
     return rate, [sum(values[i:i + channels]) / channels for i in range(0, n, channels)]
+
+
+def require_mido():
+    """Debian's python3-mido (an independent MIDI reader and writer for the tests): the module;
+    without it the test fails under CI=true, else it is skipped (exit 77)."""
+    try:
+        import mido
+    except ImportError:
+        import sys
+        from ictus_tools.checks import fail
+        if os.environ.get("CI") == "true":
+            fail("python3-mido is missing (scripts/deps.sh installs it)")
+        print("SKIPPED: python3-mido is missing (scripts/deps.sh installs it)")
+        sys.exit(77)
+    return mido

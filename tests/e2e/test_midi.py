@@ -21,19 +21,12 @@ import json
 import math
 import os
 import subprocess
-import sys
 
 from ictus_tools import e2e_util as u
-from ictus_tools.checks import check, fail
+from ictus_tools.checks import check
 from ictus_tools.pdrun import make_workdir
 
-try:
-    import mido
-except ImportError:
-    if os.environ.get("CI") == "true":
-        fail("python3-mido is missing (scripts/deps.sh installs it)")
-    print("SKIPPED: python3-mido is missing (scripts/deps.sh installs it)")
-    sys.exit(77)
+mido = u.require_mido()
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)

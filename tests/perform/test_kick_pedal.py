@@ -29,16 +29,10 @@ import subprocess
 import sys
 
 from ictus_tools import e2e_util
-from ictus_tools.checks import check, fail
+from ictus_tools.checks import check
 from ictus_tools.drumtone import f01, lowest_peak_hz
 
-try:
-    import mido
-except ImportError:
-    if os.environ.get("CI") == "true":
-        fail("python3-mido is missing (scripts/deps.sh installs it)")
-    print("SKIPPED: python3-mido is missing (scripts/deps.sh installs it)")
-    sys.exit(77)
+mido = e2e_util.require_mido()
 
 KICK = 7  # its index in `full`
 FOOT = 2  # strikes.csv's hand of the right foot

@@ -32,7 +32,7 @@ FootPlayer::FootPlayer(const KitDrum &drum, int drum_index, const Eigen::Vector3
 void FootPlayer::start(const GesturePlan &plan, double origin_s, double now_s)
 {
     pedal_.cancel_pending(now_s);
-    notes_ = plan.foot_notes;
+    notes_ = &plan.foot_notes;
     origin_s_ = origin_s;
     next_ = 0;
     last_scheduled_s_ = -1e9;
@@ -41,16 +41,17 @@ void FootPlayer::start(const GesturePlan &plan, double origin_s, double now_s)
 void FootPlayer::replace(const GesturePlan &plan)
 {
     // The notes at or before the last one scheduled are played already.
-    notes_ = plan.foot_notes;
+    notes_ = &plan.foot_notes;
     next_ = 0;
-    while (next_ < notes_.size() && origin_s_ + notes_[next_].time_s <= last_scheduled_s_ + 1e-9)
+    while (next_ < notes_->size() &&
+           origin_s_ + (*notes_)[next_].time_s <= last_scheduled_s_ + 1e-9)
         ++next_;
 }
 
 void FootPlayer::stop(double now_s)
 {
     pedal_.cancel_pending(now_s);
-    next_ = notes_.size();
+    next_ = notes_ ? notes_->size() : 0;
 }
 
 double FootPlayer::speed_for(double dynamics) const
@@ -64,8 +65,8 @@ double FootPlayer::speed_for(double dynamics) const
 
 void FootPlayer::step(double now_s, StrikeDetector &detector, long first_seq)
 {
-    while (next_ < notes_.size()) {
-        const PlannedFootNote &n = notes_[next_];
+    while (notes_ && next_ < notes_->size()) {
+        const PlannedFootNote &n = (*notes_)[next_];
         const double t = origin_s_ + n.time_s;
         if (t > now_s + kLookAhead_s)
             break;

@@ -63,7 +63,9 @@ class FootPlayer
     int drum_ = 0;
     Eigen::Vector3d forward_;
     double radius_m_ = 0.2794;
-    std::vector<PlannedFootNote> notes_; // the plan's, in time order
+    // The plan's, in time order: the plan performed (ScoreMode holds it while it is
+    // this one's; start() and replace() come with every new one), not a copy.
+    const std::vector<PlannedFootNote> *notes_ = nullptr;
     size_t next_ = 0;                    // the first not scheduled
     double origin_s_ = 0.0;
     double last_scheduled_s_ = -1e9; // the latest impact scheduled (performance clock)
