@@ -17,6 +17,10 @@ namespace
 {
 
 constexpr double kInch_m = 0.0254;
+// The full kit's rack toms stand this much higher than the standard's, and
+// its floor tom this far right of the snare and behind it, clear of the ride (m).
+constexpr double kFullRackRaise_m = 0.13;
+constexpr double kFullFloorRight_m = 0.54, kFullFloorForward_m = -0.10;
 
 // A drum of the preset `preset`, its diameter in inches (the preset's radius
 // when 0) and shell depth in inches, at `place` (right, up, forward; m).
@@ -117,7 +121,15 @@ Kit kit_named(const std::string &name)
         for (const KitDrum &c : cymbals())
             kit.drums.push_back(c);
     } else if (name == "full") {
+        // Seated, the thighs run where the standing kit's floor tom stands
+        // and the kick lies under the rack toms: the floor tom right of the
+        // right knee, the rack toms above the kick (docs/kit.md, "The
+        // throne").
         kit.drums = standard_drums();
+        kit.drums[1].place_m.y() += kFullRackRaise_m;
+        kit.drums[2].place_m.y() += kFullRackRaise_m;
+        kit.drums[3].place_m.x() = kFullFloorRight_m;
+        kit.drums[3].place_m.z() = kFullFloorForward_m;
         for (const KitDrum &c : cymbals())
             kit.drums.push_back(c);
         kit.drums.push_back(kick());
