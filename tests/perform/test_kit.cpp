@@ -151,8 +151,8 @@ namespace
 // The distance from a point to a solid cylinder (m, < 0 inside): its top
 // face's centre, its axis (unit, from the top face into the shell), depth
 // and radius.
-double to_cylinder(const Eigen::Vector3d &p, const Eigen::Vector3d &top, const Eigen::Vector3d &axis,
-                   double depth, double radius)
+double to_cylinder(const Eigen::Vector3d &p, const Eigen::Vector3d &top,
+                   const Eigen::Vector3d &axis, double depth, double radius)
 {
     const Eigen::Vector3d v = p - top;
     const double t = v.dot(axis);
@@ -208,7 +208,8 @@ TEST_CASE("kit: seated at the full kit, no leg through a drum, a stand or the ki
     for (size_t i = 0; i < o.kit.drums.size(); ++i) {
         const KitDrum &k = o.kit.drums[i];
         const bool foot = k.foot;
-        const Eigen::Vector3d top = foot ? kick.membrane_center_m : scene.drum(static_cast<int>(i)).center_m;
+        const Eigen::Vector3d top =
+            foot ? kick.membrane_center_m : scene.drum(static_cast<int>(i)).center_m;
         const double radius = foot ? kick_k.radius_m : scene.drum(static_cast<int>(i)).radius_m;
         const Eigen::Vector3d axis = foot ? forward : down;
         INFO(k.name);
@@ -216,7 +217,8 @@ TEST_CASE("kit: seated at the full kit, no leg through a drum, a stand or the ki
         for (const auto &l : legs)
             for (int n = 0; n <= 100; ++n) {
                 const Eigen::Vector3d p = at(l.from) + (at(l.to) - at(l.from)) * (n / 100.0);
-                leg = std::min(leg, to_cylinder(p, top, axis, k.shell_depth_m, radius) - l.radius_m);
+                leg =
+                    std::min(leg, to_cylinder(p, top, axis, k.shell_depth_m, radius) - l.radius_m);
                 if (k.cymbal() && p.y() < top.y())
                     stand = std::min(stand, std::hypot(p.x() - top.x(), p.z() - top.z()) -
                                                 l.radius_m - 0.0125);

@@ -47,23 +47,24 @@ void sit_on_throne(const CharacterModel &model, CharacterPose &pose)
     for (const char *s : {"l_", "r_"}) {
         const std::string side(s);
         const double out = side == "l_" ? 1.0 : -1.0; // the performer's left is +X (world)
-        const int thigh = model.body_index(side + "thigh"), shank = model.body_index(side + "shank"),
-                  foot = model.body_index(side + "foot");
+        const int thigh = model.body_index(side + "thigh"),
+                  shank = model.body_index(side + "shank"), foot = model.body_index(side + "foot");
         const Eigen::Vector3d h = frames.origin_m[thigh], k0 = frames.origin_m[shank],
                               a0 = frames.origin_m[foot];
         // The ankle's place (right, up, forward from the pelvis over the
         // floor) in the world: facing +Z, the performer's right is -X.
-        const Eigen::Vector3d &seat = side == "l_" ? ScoreRig::kLeftAnkleSeated_m
-                                                   : ScoreRig::kRightAnkleSeated_m;
+        const Eigen::Vector3d &seat =
+            side == "l_" ? ScoreRig::kLeftAnkleSeated_m : ScoreRig::kRightAnkleSeated_m;
         const Eigen::Vector3d a(pose.pelvis_position_m.x() - seat.x(), seat.y(),
                                 pose.pelvis_position_m.z() + seat.z());
-        const Eigen::Vector3d k = knee_between(h, a, (k0 - h).norm(), (a0 - k0).norm(),
-                                               forward + 0.6 * out * Eigen::Vector3d::UnitX() +
-                                                   0.5 * up);
+        const Eigen::Vector3d k =
+            knee_between(h, a, (k0 - h).norm(), (a0 - k0).norm(),
+                         forward + 0.6 * out * Eigen::Vector3d::UnitX() + 0.5 * up);
         // World rotations of the thigh and shank that carry the standing
         // segments onto the seated ones; the foot stays level.
         const Eigen::Quaterniond rt = Eigen::Quaterniond::FromTwoVectors(k0 - h, k - h);
-        const Eigen::Quaterniond rs = Eigen::Quaterniond::FromTwoVectors(rt * (a0 - k0), a - k) * rt;
+        const Eigen::Quaterniond rs =
+            Eigen::Quaterniond::FromTwoVectors(rt * (a0 - k0), a - k) * rt;
         const Eigen::Quaterniond p = pose.pelvis_rotation;
         pose.local[model.joint_index(side + "hip")] = p.conjugate() * rt * p;
         pose.local[model.joint_index(side + "knee")] = p.conjugate() * rt.conjugate() * rs * p;

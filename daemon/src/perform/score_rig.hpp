@@ -66,8 +66,8 @@ struct ScoreRig {
 void sit_on_throne(const CharacterModel &model, CharacterPose &pose);
 
 // The default body (stick_capture.hpp), standing with the hips 0.9 m up
-// (seated on a throne with a kit that has a foot piece), pelvis welded, facing +Z, in `pose` (joint rotations) or with the arms
-// solved to hold the sticks at the rest tips. Reads only `options`.
+// (seated on a throne with a kit that has a foot piece), pelvis welded, facing +Z, in `pose` (joint
+// rotations) or with the arms solved to hold the sticks at the rest tips. Reads only `options`.
 std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
                                          const std::vector<Eigen::Quaterniond> *pose);
 
