@@ -22,14 +22,13 @@
 import argparse
 import csv
 import json
-import math
 import os
 import random
-import subprocess
 import sys
 
 from ictus_tools import e2e_util
 from ictus_tools.checks import check
+from ictus_tools.drumtone import decay_t60, level_db
 
 mido = e2e_util.require_mido()
 
@@ -56,54 +55,8 @@ def groove(path, rng):
                 v = rng.randint(20, 127)
                 events.append((tick, 44, v))
                 chicks.append((tick, v))
-    mid = mido.MidiFile(type=0, ticks_per_beat=tpq)
-    track = mido.MidiTrack()
-    mid.tracks.append(track)
-    track.append(mido.MetaMessage("set_tempo", tempo=int(round(60e6 / bpm)), time=0))
-    now = 0
-    for tick, note, vel in sorted(events):
-        track.append(mido.Message("note_on", channel=9, note=note, velocity=vel, time=tick - now))
-        now = tick
-    track.append(mido.Message("note_off", channel=9, note=42, velocity=0, time=tpq))
-    mid.save(path)
+    e2e_util.write_drum_midi(mido, path, events, bpm, tpq)
     return bpm, chicks
-
-
-def render(ictusd, workdir, name, source_args):
-    out = os.path.join(workdir, name)
-    wav = os.path.join(out, name + ".wav")
-    env = e2e_util.pd_spawning_env(os.path.abspath(workdir))
-    run = subprocess.run([ictusd, "render", "--kit", "full"] + source_args +
-                         ["--out", out, "--force", "--wav", wav, "--wav-mix", "pickups",
-                          "--wav-bits", "32"],
-                         capture_output=True, text=True, timeout=900, env=env)
-    if not check(run.returncode == 0, "ictusd render --kit full %s: exit %d %s"
-                 % (" ".join(source_args), run.returncode, run.stderr[-2000:])):
-        sys.exit(1)
-    with open(os.path.join(out, "pd.log")) as f:
-        errors = [l for l in f if "error" in l.lower()]
-    check(not errors, "%s: pd.log has no error line: %s" % (name, errors[:3]))
-    return out, wav
-
-
-def level_db(x, rate, t0_s, t1_s):
-    seg = x[int(round(t0_s * rate)):int(round(t1_s * rate))]
-    return 10.0 * math.log10(sum(v * v for v in seg) / max(len(seg), 1) + 1e-30)
-
-
-def decay_t60(x, rate, onset_s, t0=0.100, t1=0.400, window=0.020):
-    """T60 (s): the least-squares line through the levels of 20 ms windows t0..t1 after onset
-    (as tests/perform/test_hihat.py)."""
-    ts, levels = [], []
-    t = t0
-    while t + window <= t1 + 1e-9:
-        ts.append(t + window / 2)
-        levels.append(level_db(x, rate, onset_s + t, onset_s + t + window))
-        t += window
-    n = len(ts)
-    mt, ml = sum(ts) / n, sum(levels) / n
-    slope = sum((a - mt) * (b - ml) for a, b in zip(ts, levels)) / sum((a - mt) ** 2 for a in ts)
-    return -60.0 / slope if slope < 0 else float("inf")
 
 
 def main():
@@ -120,7 +73,8 @@ def main():
     part = os.path.join(args.workdir, "groove.mid")
     bpm, chicks = groove(part, rng)
     print("groove: %.1f bpm, %d chicks" % (bpm, len(chicks)))
-    out, _ = render(args.ictusd, args.workdir, "groove", ["--midi", part])
+    out, _ = e2e_util.render_kit(args.ictusd, args.workdir, "groove", "full",
+                                 ["--midi", part])
     with open(os.path.join(out, "render.json")) as f:
         rj = json.load(f)
     ok &= check(rj["kit"]["drums"][HIHAT]["name"] == "hihat", "the hi-hat is drum %d" % HIHAT)
@@ -190,7 +144,8 @@ def main():
     with open(score, "w") as f:
         f.write("tempo 60\n" + "\n".join("LF %s" % d for d in dyn) +
                 "\nL on hihat mf\nL on hihat mf\nL on hihat mf\n")
-    out, wav = render(args.ictusd, args.workdir, "chicks", ["--score", score])
+    out, wav = e2e_util.render_kit(args.ictusd, args.workdir, "chicks", "full",
+                                   ["--score", score])
     rate, x = e2e_util.read_wav_mono(wav)
     strikes = [s for s in e2e_util.read_strikes(os.path.join(out, "strikes.csv"))
                if s["bounce"] == 0]

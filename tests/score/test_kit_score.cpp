@@ -42,6 +42,21 @@ PerformerFrame kit_frame()
     return f;
 }
 
+// The plan of `text` on `frame` is refused at line:column with `words` in its message.
+void refused(const std::string &text, const PerformerFrame &frame, int line, int column,
+             const std::string &words)
+{
+    INFO(text);
+    try {
+        plan_performance(parse_score(text, "t.txt"), db(), frame);
+        FAIL("planned");
+    } catch (const ScoreError &e) {
+        CHECK(e.line() == line);
+        CHECK(e.column() == column);
+        CHECK_THAT(e.message(), Contains(words));
+    }
+}
+
 } // namespace
 
 TEST_CASE("score: 'drum NAME' sets the drum of the notes after it, 'on NAME' one note's",
@@ -354,18 +369,6 @@ TEST_CASE("plan: the right foot's notes are the kick's, timed as the hands', nev
     REQUIRE(plan.notes.size() == 4);
     for (const PlannedNote &n : plan.notes)
         CHECK(n.drum != 5);
-    auto refused = [&](const std::string &text, const PerformerFrame &frame, int line, int column,
-                       const std::string &words) {
-        INFO(text);
-        try {
-            plan_performance(parse_score(text, "t.txt"), db(), frame);
-            FAIL("planned");
-        } catch (const ScoreError &e) {
-            CHECK(e.line() == line);
-            CHECK(e.column() == column);
-            CHECK_THAT(e.message(), Contains(words));
-        }
-    };
     refused("R\nR on kick", f, 2, 6, "drum 'kick' is played by the right foot on its pedal");
     refused("RF on snare", f, 1, 7,
             "drum 'snare' is not the right foot's; the right foot plays kick");
@@ -408,18 +411,6 @@ TEST_CASE("plan: the left foot's chicks are the hi-hat's, timed as the hands', a
     REQUIRE(plan.notes.size() == 3);
     CHECK(plan.notes[0].openness == kHihatClosed);
     CHECK(plan.notes[1].openness == kHihatOpen);
-    auto refused = [&](const std::string &text, const PerformerFrame &frame, int line, int column,
-                       const std::string &words) {
-        INFO(text);
-        try {
-            plan_performance(parse_score(text, "t.txt"), db(), frame);
-            FAIL("planned");
-        } catch (const ScoreError &e) {
-            CHECK(e.line() == line);
-            CHECK(e.column() == column);
-            CHECK_THAT(e.message(), Contains(words));
-        }
-    };
     refused("LF on snare", f, 1, 7,
             "drum 'snare' is not the left foot's; the left foot plays hihat");
     refused("LF on kick", f, 1, 7, "the left foot plays hihat");
