@@ -94,7 +94,7 @@ extern "C" {
  * nu 0.33); a membrane does not use it. */
 #define MEMBRANE_DEFAULT_BENDING     9.35
 /* A plate's von Karman cascade (docs/plates.md, "The cascade"): 0 off, 1 bronze. */
-#define MEMBRANE_DEFAULT_CASCADE 0.0
+#define MEMBRANE_DEFAULT_CASCADE     0.0
 /* A hi-hat's pedal (docs/plates.md, "The hi-hat"): the default is the stand at rest, the
  * spring holding the plates apart; no second plate by default. */
 #define MEMBRANE_DEFAULT_OPENNESS    1.0
