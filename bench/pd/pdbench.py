@@ -8,9 +8,10 @@ import subprocess
 import tempfile
 
 
-def from_args(prefix, seconds=True):
+def from_args(prefix, seconds=True, extra=None):
     """The benchmarks' common command line (BUILD_DIR [--runs R] [--sr HZ] [--seconds S]),
-    parsed, and a Bench on BUILD_DIR's Pd library in a new temporary folder."""
+    plus what extra(parser) adds, parsed, and a Bench on BUILD_DIR's Pd library in a new
+    temporary folder."""
     ap = argparse.ArgumentParser()
     ap.add_argument("build")
     ap.add_argument("--runs", type=int, default=3)
@@ -19,6 +20,8 @@ def from_args(prefix, seconds=True):
         ap.add_argument("--seconds", type=float, default=20.0)
     else:
         ap.add_argument("--sizes", default="16,256,1024,4096")
+    if extra:
+        extra(ap)
     args = ap.parse_args()
     lib = os.path.join(os.path.abspath(args.build), "ictus")
     return args, Bench(lib, args.sr, args.runs, tempfile.mkdtemp(prefix=prefix))
@@ -51,6 +54,8 @@ class Bench:
             f.write(text)
         best = None
         for _ in range(self.runs):
+            usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+            self.cpu_so_far = usage.ru_utime + usage.ru_stime  # not other children run before
             proc = subprocess.Popen(["pd", "-nogui", "-nosound", "-batch", "-stderr", "-r",
                                      str(self.sr), "-open", path], stdout=subprocess.PIPE,
                                     stderr=subprocess.PIPE, text=True)
@@ -62,6 +67,13 @@ class Bench:
                 raise SystemExit("%s failed:\n%s" % (name, err))
             best = cpu if best is None else min(best, cpu)
         return best
+
+    def dsp_time(self, body, name, seconds):
+        """CPU time (s) of seconds of audio of body's patch alone: the best run of it less
+        the best run of the same patch quitting before its first DSP tick, so pd's start-up
+        and the patch's set-up (loading, presets: a plate's modes take ~0.8 s) are out."""
+        return (self.run(self.patch(seconds, body), name)
+                - self.run(self.patch(0.0, body), name + "-setup"))
 
 
 def bp_bank(n):

@@ -33,6 +33,8 @@ Performer, real-time factor (simulated s / CPU s):
   render   `ictusd render` of the default score, --bvh-rate 0 --tips-rate 0
            (start-up included)
   kit      the same with `--kit standard --score examples/scores/kit.txt`
+  groove   the same with `--kit full --score examples/scores/groove.txt` (hands and
+           the kick's foot on the pedal)
   before   with --before-ictusd FILE, another ictusd's track and render in the
            same rounds (before / after a change, alternating)
 
@@ -216,6 +218,7 @@ def track_run(r, results, binary, key, case):
 
 
 KIT_SCORE = os.path.join(ROOT, "examples", "scores", "kit.txt")
+GROOVE_SCORE = os.path.join(ROOT, "examples", "scores", "groove.txt")
 
 
 def render_run(r, results, binary, key, case, extra=()):
@@ -252,6 +255,8 @@ def track_round(r, results):
     render_run(r, results, ictusd, "render", "ictusd render")
     render_run(r, results, ictusd, "render_kit", "ictusd render --kit standard, kit.txt",
                ["--kit", "standard", "--score", KIT_SCORE])
+    render_run(r, results, ictusd, "render_groove", "ictusd render --kit full, groove.txt",
+               ["--kit", "full", "--score", GROOVE_SCORE])
 
 
 # ---------------------------------------------------------------- main
@@ -355,6 +360,10 @@ if "performer" not in skip:
     print("  ictusd render --kit standard, examples/scores/kit.txt: %.1fx  [%s]; "
           "ratio to MuJoCo, median of rounds %.2f (target >= 1.0)" % (
               max(rk), ", ".join("%.1f" % v for v in rk), per_round_ratio(rk, mj)))
+    rg = results["render_groove"]
+    print("  ictusd render --kit full, examples/scores/groove.txt: %.1fx  [%s]; "
+          "ratio to MuJoCo, median of rounds %.2f (target >= 0.8)" % (
+              max(rg), ", ".join("%.1f" % v for v in rg), per_round_ratio(rg, mj)))
     if args.before_ictusd:
         tb, rb = results["track_before"], results["render_before"]
         print("  before (%s): track %.1fx [%s], ratio track / MuJoCo median %.2f; "

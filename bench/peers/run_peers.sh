@@ -2,8 +2,9 @@
 # ictus against its peers, side by side in one run (docs/benchmarks.md):
 # the drum in Pd against vanilla [bp~] banks and the Sound Design Toolkit, and
 # `ictusd track --mode joint` against MuJoCo's CMU humanoid, plus `ictusd render`.
-# Installs the peers it needs into BUILD_DIR/peers/venv (PyPI: mujoco and
-# dm_control, pysdt), never into the source tree; nothing of theirs is committed.
+# Installs the peers it needs into BUILD_DIR/peers/venv, or into $ICTUS_PEERS_VENV
+# if set (PyPI: mujoco and dm_control, pysdt), never into the source tree;
+# nothing of theirs is committed.
 # Usage: bench/peers/run_peers.sh [BUILD_DIR] [bench_peers.py options: --rounds R,
 #        --sizes 64,256,1024,4096, --before OLD_BUILD/ictus, --json FILE, --skip ...]
 # The build needs the Pd library and ictusd (scripts/build.sh BUILD_DIR).
@@ -17,7 +18,7 @@ for need in "$build/ictus/membrane~.pd_linux" "$build/ictusd"; do
         exit 1
     fi
 done
-venv="$build/peers/venv"
+venv=${ICTUS_PEERS_VENV:-$build/peers/venv}
 # The peers' versions: the figures in docs/benchmarks.md were taken with these.
 peers=(mujoco==4.0.0 dm_control==1.0.50 pysdt==0.1.2)
 have='import importlib.util as u, sys; sys.exit(not all(u.find_spec(m) for m in ("mujoco", "dm_control", "pysdt")))'

@@ -215,10 +215,12 @@ static int pair_ok(const membrane *m, const float *force_in, int i, int n, int n
 {
     if (i + 1 >= n || next_landing == i + 1 || m->pick_fade_left[0] > 0 || m->pick_fade_left[1] > 0)
         return 0;
-    if (m->cascade_on)
-        return 0; /* the cascade runs after every sample */
+    if (m->vk_on)
+        return 0; /* the von Karman coupling runs after every sample */
     if (m->tm_countdown == 1 && (m->tension_mod > 0.0 || m->tm_g != 1.0))
         return 0; /* a tension update comes before sample i + 1 */
+    if (m->bc_on && m->bc_countdown == 1)
+        return 0; /* an energy cascade update comes before sample i + 1 */
     if (force_in && (force_in[i] != 0.0f || force_in[i + 1] != 0.0f))
         return 0; /* NaN and inf (read as 0) take the one-sample path too */
     for (int s = 0; s < m->queued; s++)
@@ -412,6 +414,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             if (m->tm_countdown <= 0 && membrane_tension_update_(m))
                 m->tm_countdown = TM_INTERVAL;
         }
+        if (m->bc_on && m->bc_countdown <= 0 && membrane_band_cascade_update_(m))
+            m->bc_countdown = BC_INTERVAL; /* absolute time, as the tension update */
         membrane_point *act[MEMBRANE_MAX_POINTS];
         int na = gather_points(m, &a, act);
         a.points = na;
@@ -421,6 +425,8 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
             m->kernel_pair(&a);
             if (m->tm_countdown > 0)
                 m->tm_countdown -= 2;
+            if (m->bc_countdown > 0)
+                m->bc_countdown -= 2;
             const double none[MEMBRANE_PICKUPS] = {0};
             if (emit_sample(m, a.pick_sum, none, picks, out, i, gain_coef)) {
                 i++;
@@ -432,11 +438,13 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
         m->kernel(&a);
         if (m->tm_countdown > 0)
             m->tm_countdown--;
+        if (m->bc_countdown > 0)
+            m->bc_countdown--;
         for (int c = 0; c < na; c++)
             act[c]->force_pending = 0.0;
         int struck = land_strikes(m, i, T, &a);
         double extra[MEMBRANE_PICKUPS] = {0};
-        if (m->cascade_on)
+        if (m->vk_on)
             membrane_cascade_step_(m, &a, struck || na > 0 || fin != 0.0f, extra, picks);
         solve_points(m, act, na, &a, wscale, T, i, extra);
         emit_sample(m, a.pick_sum, extra, picks, out, i, gain_coef);

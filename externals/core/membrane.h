@@ -56,7 +56,9 @@ extern "C" {
 #define MEMBRANE_BENDING_MIN     1.0e-3 /* N m: a plate's bending stiffness (membrane_set_plate) */
 #define MEMBRANE_BENDING_MAX     1.0e4
 #define MEMBRANE_CASCADE_MIN     0.0 /* 0: a linear plate */
-#define MEMBRANE_CASCADE_MAX     10.0
+#define MEMBRANE_CASCADE_MAX     100.0
+#define MEMBRANE_VON_KARMAN_MIN  0.0 /* 0: off */
+#define MEMBRANE_VON_KARMAN_MAX  10.0
 #define MEMBRANE_OPENNESS_MIN    0.0 /* a hi-hat's pedal: 0 closed, 1 open */
 #define MEMBRANE_OPENNESS_MAX    1.0
 #define MEMBRANE_EDGE_DAMP_MIN   0.0 /* N s/m^2: 0, no second plate */
@@ -93,8 +95,11 @@ extern "C" {
 /* A plate's bending stiffness D = E h^3 / (12 (1 - nu^2)): 1 mm of bronze (E 100 GPa,
  * nu 0.33); a membrane does not use it. */
 #define MEMBRANE_DEFAULT_BENDING     9.35
-/* A plate's von Karman cascade (docs/plates.md, "The cascade"): 0 off, 1 bronze. */
+/* A plate's energy cascade (docs/plates.md, "The cascade"): 0 off (a bare plate; the
+ * cymbal presets turn it on); and the von Karman coupling of its lowest modes: 0 off,
+ * 1 bronze. */
 #define MEMBRANE_DEFAULT_CASCADE     0.0
+#define MEMBRANE_DEFAULT_VON_KARMAN  0.0
 /* A hi-hat's pedal (docs/plates.md, "The hi-hat"): the default is the stand at rest, the
  * spring holding the plates apart; no second plate by default. */
 #define MEMBRANE_DEFAULT_OPENNESS    1.0
@@ -142,8 +147,10 @@ typedef enum membrane_param {
     MEMBRANE_PARAM_PATCH,
     /* N m: the bending stiffness D of a plate (membrane_set_plate); a membrane ignores it */
     MEMBRANE_PARAM_BENDING,
-    /* A plate's nonlinear cascade: a factor on the von Karman stretching stiffness E h
-     * (1 = the bronze plate of that D and density; 0 = linear); a membrane ignores it */
+    /* A plate's energy cascade (docs/plates.md, "The cascade"): energy moves between
+     * neighbouring third-octave bands of modes toward equal energy per mode, at a rate
+     * cascade x Gamma, Gamma the frequency shift the in-plane stress of the vibration puts
+     * on every mode (1 = that rate; 0 = linear); a membrane ignores it */
     MEMBRANE_PARAM_CASCADE,
     /* A hi-hat (docs/plates.md, "The hi-hat"): the bottom plate pressed against a plate's
      * edge by the pedal acts as a dashpot spread along the edge, edgedamp N s/m^2 (N per
@@ -151,6 +158,10 @@ typedef enum membrane_param {
      * open (the plates apart). A membrane, fixed at its rim, is not moved by it. */
     MEMBRANE_PARAM_OPENNESS,
     MEMBRANE_PARAM_EDGE_DAMP,
+    /* A plate's von Karman coupling of its lowest 32 modes (docs/plates.md): a factor on
+     * the stretching stiffness E h (1 = the bronze plate of that D and density; 0 = off);
+     * a membrane ignores it */
+    MEMBRANE_PARAM_VON_KARMAN,
     MEMBRANE_PARAM_COUNT
 } membrane_param;
 
@@ -220,8 +231,8 @@ double membrane_displacement_at(const membrane *m, double r_over_a, double theta
 double membrane_velocity_at(const membrane *m, double r_over_a, double theta_deg);
 /* Total vibrational energy of the modes (J). */
 double membrane_energy(const membrane *m);
-/* A plate's nonlinear potential (J) in its cascade (docs/plates.md, "The cascade"): the
- * scheme's psi^2 / 2 less its floor; 0 without a cascade. */
+/* A plate's nonlinear potential (J) in its von Karman coupling (docs/plates.md): the
+ * scheme's psi^2 / 2 less its floor; 0 without it (the energy cascade has none). */
 double membrane_cascade_energy(const membrane *m);
 /* Tension modulation: the coefficient kappa (1/J) of T = T0 (1 + kappa E) at the
  * current parameters (tensionmod included), and the frequency factor sqrt(T / T0)

@@ -36,7 +36,7 @@ void membrane_cascade_free_(membrane *m)
         free(m->pc);
         m->pc = NULL;
     }
-    m->cascade_on = 0;
+    m->vk_on = 0;
 }
 
 /* Y of the coupled modes from the stored state, the auxiliary variable from V there,
@@ -55,8 +55,8 @@ static void anchor(membrane *m)
 
 void membrane_cascade_refresh_(membrane *m)
 {
-    m->cascade_on = 0;
-    if (!m->plate || !(m->cascade > 0.0) || m->modes < CASCADE_MODES || !m->table.plate)
+    m->vk_on = 0;
+    if (!m->plate || !(m->von_karman > 0.0) || m->modes < CASCADE_MODES || !m->table.plate)
         return;
     if (!m->pc) {
         plate_cascade *c = calloc(1, sizeof(plate_cascade));
@@ -72,14 +72,14 @@ void membrane_cascade_refresh_(membrane *m)
     /* E h from D = E h^3 / (12 (1 - nu^2)) and h = density / rho */
     const double nu = MODE_TABLE_PLATE_NU, h = m->density / CASCADE_BRONZE_RHO;
     const double eh = 12.0 * (1.0 - nu * nu) * m->bending / (h * h);
-    plate_cascade_set_scale(m->pc, m->cascade * eh, m->radius, m->density);
+    plate_cascade_set_scale(m->pc, m->von_karman * eh, m->radius, m->density);
     anchor(m);
-    m->cascade_on = 1;
+    m->vk_on = 1;
 }
 
 void membrane_cascade_cleared_(membrane *m)
 {
-    if (m->cascade_on)
+    if (m->vk_on)
         anchor(m);
 }
 
@@ -135,7 +135,7 @@ void membrane_cascade_step_(membrane *m, membrane_kernel_args *a, int input, dou
 
 double membrane_cascade_energy(const membrane *m)
 {
-    if (!m->cascade_on)
+    if (!m->vk_on)
         return 0.0;
     return 0.5 * m->pc->psi * m->pc->psi - m->pc->floor;
 }

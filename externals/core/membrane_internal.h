@@ -111,6 +111,11 @@ typedef struct membrane_point membrane_point;
 #define TM_THRESHOLD 2.0e-5
 #define TM_G_MAX     2.0 /* frequency factor cap: tension at most 4 T0 */
 
+/* The energy cascade (membrane_band_cascade.c): updated every BC_INTERVAL samples of
+ * absolute time (block-size independent), over bands a third of an octave wide. */
+#define BC_INTERVAL  32
+#define BC_MAX_BANDS 64
+
 struct membrane {
     double sample_rate, radius, tension, density, t60, hf_damping, output_gain;
     double tension_mod;            /* dimensionless, MEMBRANE_PARAM_TENSION_MOD */
@@ -123,14 +128,23 @@ struct membrane {
      * and do nothing. */
     int plate;
     double bending;
-    /* A plate's von Karman cascade (membrane_cascade.c): the factor on E h, the coupling
-     * built at message time, and whether the processing loop runs it. */
+    /* A plate's energy cascade (membrane_band_cascade.c, MEMBRANE_PARAM_CASCADE): its
+     * amount, whether the loop runs it, the samples to its next update (absolute time),
+     * its bands of modes (set at message time: band b holds modes bc_start[b] ..
+     * bc_start[b + 1] - 1) and Gamma per unit of sum e_k / w_k (1/(J s^2)). */
     double cascade;
+    int bc_on, bc_countdown, bc_bands;
+    int bc_start[BC_MAX_BANDS + 1];
+    double bc_e[BC_MAX_BANDS], bc_gamma_per_ew, bc_dt;
+    /* A plate's von Karman coupling of its lowest modes (membrane_cascade.c,
+     * MEMBRANE_PARAM_VON_KARMAN): the factor on E h, the coupling built at message time,
+     * and whether the processing loop runs it. */
+    double von_karman;
     /* A hi-hat's second plate (MEMBRANE_PARAM_OPENNESS, MEMBRANE_PARAM_EDGE_DAMP): the
      * loss it puts on the edge, in each mode's decay rate (membrane_modes.c). */
     double openness, edge_damp;
     struct plate_cascade *pc;
-    int cascade_on;
+    int vk_on;
     /* The radiation integral of each mode depends on ka = j c / c_air alone: kept for
      * rad_valid modes at the wave speed rad_c (recomputed when either changes). */
     double *rad_int, rad_c;
@@ -258,6 +272,13 @@ void membrane_cascade_cleared_(membrane *m);
  * the pickups goes into extra, to the points' displacements into a->point_w. */
 void membrane_cascade_step_(membrane *m, membrane_kernel_args *a, int input, double *extra,
                             int picks);
+
+/* membrane_band_cascade.c. The bands and the rate for the modes and physics now
+ * (message time, no allocation; off unless a plate with cascade > 0). */
+void membrane_band_cascade_refresh_(membrane *m);
+/* One update: energy moved between neighbouring bands (audio thread: no allocation,
+ * O(modes)). 0 when it has to wait (a point carries a force), 1 when done. */
+int membrane_band_cascade_update_(membrane *m);
 
 /* membrane_points.c. The points' pending forces into the state (message time only:
  * before coefficients or shapes change). */

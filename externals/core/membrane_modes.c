@@ -151,7 +151,8 @@ void membrane_update_coefficients_(membrane *m, int rescale)
         m->omega_model[k] = wm;
         m->wm[k] = (float)wm;
     }
-    membrane_cascade_refresh_(m); /* a plate's cascade follows the physics and the state */
+    membrane_cascade_refresh_(m);      /* a plate's von Karman coupling follows the physics */
+    membrane_band_cascade_refresh_(m); /* and its energy cascade */
 }
 
 /* The float arrays of the modal state and coefficients, in their order in memory. */

@@ -135,6 +135,8 @@ static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
     [MEMBRANE_PARAM_OPENNESS] = {"openness", "", RANGE(OPENNESS), FIELD(openness), physics_changed},
     [MEMBRANE_PARAM_EDGE_DAMP] = {"edgedamp", "N s/m^2", RANGE(EDGE_DAMP), FIELD(edge_damp),
                                   physics_changed},
+    [MEMBRANE_PARAM_VON_KARMAN] = {"vonkarman", "", RANGE(VON_KARMAN), FIELD(von_karman),
+                                   physics_changed},
 };
 #undef RANGE
 #undef FIELD

@@ -54,7 +54,8 @@ ictus_status membrane_apply_preset(membrane *m, const membrane_preset *p)
                                      : bare   ? 0.0
                                               : MEMBRANE_DEFAULT_LOSS_FACTOR},
         {MEMBRANE_PARAM_PATCH, bare ? 0.0 : MEMBRANE_PATCH_BEAD},
-        {MEMBRANE_PARAM_CASCADE, 0.0}, /* off: it darkens the crash (docs/plates.md) */
+        {MEMBRANE_PARAM_CASCADE, p->cascade},
+        {MEMBRANE_PARAM_VON_KARMAN, 0.0}, /* off: it darkens the crash (docs/plates.md) */
         {MEMBRANE_PARAM_EDGE_DAMP, p->edge_damp_n_s_per_m2},
     };
     for (int i = 0; i < (int)(sizeof(sets) / sizeof(sets[0])); i++)

@@ -226,11 +226,12 @@ static void membrane_tilde_print(t_membrane_tilde *x)
          ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_TENSION_MOD),
          membrane_get_sample_rate(core));
     if (membrane_is_plate(core))
-        post("membrane~ %s: a free-edge plate, bending %g N m, cascade %g, openness %g, "
-             "edgedamp %g N s/m^2",
+        post("membrane~ %s: a free-edge plate, bending %g N m, cascade %g, vonkarman %g, "
+             "openness %g, edgedamp %g N s/m^2",
              x->x_name != &s_ ? x->x_name->s_name : "(no name)",
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_BENDING),
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_CASCADE),
+             ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_VON_KARMAN),
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_OPENNESS),
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_EDGE_DAMP));
     if (x->x_wires)

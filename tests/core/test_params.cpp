@@ -21,7 +21,8 @@ const expected_range membrane_expected[] = {
     {MEMBRANE_PARAM_DENSITY, 0.01, 20.0, 0.262}, {MEMBRANE_PARAM_MODES, 1.0, 4096.0, 128.0},
     {MEMBRANE_PARAM_T60, 0.005, 60.0, 1.0},      {MEMBRANE_PARAM_HF_DAMPING, 0.0, 1000.0, 1.0},
     {MEMBRANE_PARAM_GAIN, -1e6, 1e6, 0.16},      {MEMBRANE_PARAM_OPENNESS, 0.0, 1.0, 1.0},
-    {MEMBRANE_PARAM_EDGE_DAMP, 0.0, 1e4, 0.0},
+    {MEMBRANE_PARAM_EDGE_DAMP, 0.0, 1e4, 0.0},   {MEMBRANE_PARAM_CASCADE, 0.0, 100.0, 0.0},
+    {MEMBRANE_PARAM_VON_KARMAN, 0.0, 10.0, 0.0},
 };
 const expected_range contact_expected[] = {
     {CONTACT_PARAM_MASS, 1e-4, 10.0, 0.05},

@@ -53,7 +53,9 @@ membrane *crash(double cascade)
     membrane *m = membrane_new(48000.0);
     REQUIRE(m);
     REQUIRE(membrane_apply_preset(m, membrane_preset_find("crash")) == ICTUS_OK);
-    REQUIRE(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_CASCADE, cascade) == ICTUS_OK);
+    // the von Karman coupling alone: the preset's energy cascade off
+    REQUIRE(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_CASCADE, 0.0) == ICTUS_OK);
+    REQUIRE(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_VON_KARMAN, cascade) == ICTUS_OK);
     return m;
 }
 

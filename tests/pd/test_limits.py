@@ -22,7 +22,8 @@ args.build = os.path.abspath(args.build)
 # docs/externals.md: (message, min, max)
 membrane_limits = [("radius", 0.01, 2.0), ("tension", 1.0, 1e5), ("density", 0.01, 20.0),
                    ("modes", 1, 4096), ("t60", 0.005, 60.0), ("hfdamp", 0.0, 1000.0),
-                   ("gain", -1e6, 1e6), ("openness", 0.0, 1.0), ("edgedamp", 0.0, 1e4)]
+                   ("gain", -1e6, 1e6), ("openness", 0.0, 1.0), ("edgedamp", 0.0, 1e4),
+                   ("cascade", 0.0, 100.0), ("vonkarman", 0.0, 10.0)]
 contact_limits = [("mass", 1e-4, 10.0), ("stiffness", 1.0, 1e12), ("alpha", 1.0, 4.0),
                   ("damping", 0.0, 1e13)]
 

@@ -152,6 +152,25 @@ TEST_CASE("midi in: General MIDI's cymbals on a kit's crash and ride", "[score][
     }
     CHECK(part.score.notes[4].r_over_a == Approx(kMidiRideBellRadiusFraction));
     CHECK(part.skipped.at(42) == 1);
+    // The crash's notes are the left hand's (on its side of the kit), the
+    // ride's the right's.
+    for (size_t i = 0; i < 5; ++i)
+        CHECK(part.score.notes[i].hand == (i < 2 ? Side::left : Side::right));
+    // After a fill of 16ths ending on the left hand (125 ms apart), the crash
+    // is still the left's; a snare on the crash's tick, written before it,
+    // is the right's.
+    std::string fill;
+    for (int k = 0; k < 4; ++k)
+        fill += bytes({k == 0 ? 0 : 24, 0x99, 48, 100});
+    fill += bytes({24, 0x99, 38, 100}) + bytes({0, 0x99, 49, 120}) + kEnd;
+    const MidiDrumPart f =
+        drum_part_score(read_smf(header(0, 1) + chunk("MTrk", fill), "f.mid"), kit, "f.mid");
+    REQUIRE(f.score.notes.size() == 6);
+    CHECK(f.score.notes[3].hand == Side::left); // the fill: R L R L
+    CHECK(f.score.notes[4].drum == "crash");
+    CHECK(f.score.notes[4].hand == Side::left);
+    CHECK(f.score.notes[5].drum == "snare");
+    CHECK(f.score.notes[5].hand == Side::right);
     // Without cymbals in the kit (or without a kit) every cymbal note is left out, counted.
     const std::vector<MidiDrum> drums = {{"snare", 38}, {"tom1", 48}};
     t = bytes({0x00, 0x99, 38, 100}) + t;

@@ -17,6 +17,13 @@ namespace
 {
 
 constexpr double kInch_m = 0.0254;
+// The full kit's rack toms stand this much higher than the standard's, and
+// its floor tom this far right of the snare and behind it, beside the right knee (m).
+constexpr double kFullRackRaise_m = 0.13;
+constexpr double kFullFloorRight_m = 0.56, kFullFloorForward_m = -0.20;
+// Its ride nearer the right shoulder, where the floor tom's move leaves room
+// (2 cm clear of tom2 and of the floor tom in plan; m, the anchor's frame).
+const Eigen::Vector3d kFullRide_m{0.62, 0.22, 0.28};
 
 // A drum of the preset `preset`, its diameter in inches (the preset's radius
 // when 0) and shell depth in inches, at `place` (right, up, forward; m).
@@ -117,9 +124,19 @@ Kit kit_named(const std::string &name)
         for (const KitDrum &c : cymbals())
             kit.drums.push_back(c);
     } else if (name == "full") {
+        // Seated, the thighs run where the standing kit's floor tom stands
+        // and the kick lies under the rack toms: the floor tom beside the
+        // right knee, the rack toms above the kick, and the ride where the
+        // floor tom leaves room, nearer the right hand (docs/kit.md, "The
+        // throne").
         kit.drums = standard_drums();
+        kit.drums[1].place_m.y() += kFullRackRaise_m;
+        kit.drums[2].place_m.y() += kFullRackRaise_m;
+        kit.drums[3].place_m.x() = kFullFloorRight_m;
+        kit.drums[3].place_m.z() = kFullFloorForward_m;
         for (const KitDrum &c : cymbals())
             kit.drums.push_back(c);
+        kit.drums[5].place_m = kFullRide_m;
         kit.drums.push_back(kick());
     } else if (name == "standard-timpani") {
         // A 26-inch timpani (its kettle 0.6 m deep) where a hi-hat would

@@ -22,7 +22,55 @@ double contact_height_m(double tip_radius_m, const Eigen::Vector3d &stick_dir_wo
 {
     return tip_radius_m * (1.0 + stick_dir_world.normalized().y());
 }
+
+// The knee of a leg from its hip H to its ankle A (thigh l1, shank l2): on
+// the circle where the two segments meet, toward `pole` (the knee's side).
+Eigen::Vector3d knee_between(const Eigen::Vector3d &h, const Eigen::Vector3d &a, double l1,
+                             double l2, const Eigen::Vector3d &pole)
+{
+    const Eigen::Vector3d ha = a - h;
+    const double d = std::clamp(ha.norm(), std::abs(l1 - l2) + 1e-6, l1 + l2 - 1e-6);
+    const Eigen::Vector3d u = ha.normalized();
+    const double along = (l1 * l1 - l2 * l2 + d * d) / (2.0 * d);
+    const double off = std::sqrt(std::max(0.0, l1 * l1 - along * along));
+    const Eigen::Vector3d side = (pole - pole.dot(u) * u).normalized();
+    return h + along * u + off * side;
+}
 } // namespace
+
+void sit_on_throne(const CharacterModel &model, CharacterPose &pose)
+{
+    pose.pelvis_position_m.y() -= ScoreRig::kThroneDrop_m;
+    BodyFrames frames;
+    model.forward(pose, frames);
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitY(), forward = Eigen::Vector3d::UnitZ();
+    for (const char *s : {"l_", "r_"}) {
+        const std::string side(s);
+        const double out = side == "l_" ? 1.0 : -1.0; // the performer's left is +X (world)
+        const int thigh = model.body_index(side + "thigh"),
+                  shank = model.body_index(side + "shank"), foot = model.body_index(side + "foot");
+        const Eigen::Vector3d h = frames.origin_m[thigh], k0 = frames.origin_m[shank],
+                              a0 = frames.origin_m[foot];
+        // The ankle's place (right, up, forward from the pelvis over the
+        // floor) in the world: facing +Z, the performer's right is -X.
+        const Eigen::Vector3d &seat =
+            side == "l_" ? ScoreRig::kLeftAnkleSeated_m : ScoreRig::kRightAnkleSeated_m;
+        const Eigen::Vector3d a(pose.pelvis_position_m.x() - seat.x(), seat.y(),
+                                pose.pelvis_position_m.z() + seat.z());
+        const Eigen::Vector3d k =
+            knee_between(h, a, (k0 - h).norm(), (a0 - k0).norm(),
+                         forward + 0.6 * out * Eigen::Vector3d::UnitX() + 0.5 * up);
+        // World rotations of the thigh and shank that carry the standing
+        // segments onto the seated ones; the foot stays level.
+        const Eigen::Quaterniond rt = Eigen::Quaterniond::FromTwoVectors(k0 - h, k - h);
+        const Eigen::Quaterniond rs =
+            Eigen::Quaterniond::FromTwoVectors(rt * (a0 - k0), a - k) * rt;
+        const Eigen::Quaterniond p = pose.pelvis_rotation;
+        pose.local[model.joint_index(side + "hip")] = p.conjugate() * rt * p;
+        pose.local[model.joint_index(side + "knee")] = p.conjugate() * rt.conjugate() * rs * p;
+        pose.local[model.joint_index(side + "ankle")] = p.conjugate() * rs.conjugate() * p;
+    }
+}
 
 PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
                          const Eigen::Vector3d &forward, const Kit *kit,
@@ -69,6 +117,8 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
     auto rig = std::make_unique<ScoreRig>(model, options.score.ik_limit_margin_deg * M_PI / 180.0);
     ScoreRig &r = *rig;
     r.body = model.pose_from_motion(motion, 0);
+    if (kit_foot_piece(options.kit) >= 0)
+        sit_on_throne(model, r.body);
 
     // The drum in front of the performer: from the midpoint of the shoulders,
     // drum_forward_m along the facing direction and drum_below_m down, unless

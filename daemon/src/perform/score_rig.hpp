@@ -49,11 +49,25 @@ struct ScoreRig {
     static constexpr double kTrunkHz = 8.0;
     static constexpr double kTrunkLean_rad_per_m = 0.15;
     static constexpr double kTrunkTwist_rad_per_m = 0.2;
+
+    // On a throne (a kit with a foot piece, docs/kit.md "The throne"): the
+    // hips this much lower than standing, and the ankles' places (right, up,
+    // forward from the pelvis over the floor, m): the right foot on the
+    // kick's pedal, the left on the hi-hat's, the feet level.
+    static constexpr double kThroneDrop_m = 0.15;
+    static inline const Eigen::Vector3d kRightAnkleSeated_m{0.26, 0.08, 0.445};
+    static inline const Eigen::Vector3d kLeftAnkleSeated_m{-0.36, 0.08, 0.17};
 };
 
-// The default body (stick_capture.hpp), standing with the hips 0.9 m up,
-// pelvis welded, facing +Z, in `pose` (joint rotations) or with the arms
-// solved to hold the sticks at the rest tips. Reads only `options`.
+// The standing default body (its legs straight, the identity pose) seated on
+// a throne: the pelvis lowered by ScoreRig::kThroneDrop_m, each knee placed
+// between its hip and its seated ankle (bent forward and a little out), the
+// feet level.
+void sit_on_throne(const CharacterModel &model, CharacterPose &pose);
+
+// The default body (stick_capture.hpp), standing with the hips 0.9 m up
+// (seated on a throne with a kit that has a foot piece), pelvis welded, facing +Z, in `pose` (joint
+// rotations) or with the arms solved to hold the sticks at the rest tips. Reads only `options`.
 std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
                                          const std::vector<Eigen::Quaterniond> *pose);
 

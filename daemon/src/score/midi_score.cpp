@@ -220,6 +220,13 @@ bool keeps_time(int note)
            note == kMidiRideBell;
 }
 
+// A crash's note (49, 57): the left hand's, on whose side the built-in kits'
+// crash stands (docs/kit.md: the right hand does not reach it).
+bool left_hands(int note)
+{
+    return note == kMidiCrash || note == 57;
+}
+
 // A cymbal's note: the kit's cymbal that plays it (crash, ride or hi-hat), 0 for another note.
 int cymbal_of(int note)
 {
@@ -324,7 +331,12 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
         const SmfNote &x = smf.notes[a], &y = smf.notes[b];
-        return x.tick != y.tick ? x.tick < y.tick : keeps_time(x.note) && !keeps_time(y.note);
+        if (x.tick != y.tick)
+            return x.tick < y.tick;
+        // At one tick: the right hand's time first, then the left's crash.
+        const int rx = keeps_time(x.note) ? 0 : left_hands(x.note) ? 1 : 2;
+        const int ry = keeps_time(y.note) ? 0 : left_hands(y.note) ? 1 : 2;
+        return rx < ry;
     });
     for (size_t index : order) {
         const SmfNote &n = smf.notes[index];
@@ -375,7 +387,9 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
             hand = 1 - last_hand;
         } else {
             at_tick = 0;
-            hand = keeps_time(n.note) || t - last_s >= kMidiAlternateBelow_s ? 1 : 1 - last_hand;
+            hand = left_hands(n.note)                                          ? 0
+                   : keeps_time(n.note) || t - last_s >= kMidiAlternateBelow_s ? 1
+                                                                               : 1 - last_hand;
             if (t - last_of[hand] < kMidiSameHandMin_s)
                 hand = 1 - hand;
         }
