@@ -37,3 +37,27 @@ def lowest_peak_hz(y, rate, onset, t0=0.005, t1=0.065, lo=20.0, hi=400.0, within
     k = int(peaks[0])
     a, b, c = np.log(mag[k - 1:k + 2] + 1e-300)
     return (k + 0.5 * (a - c) / (a - 2 * b + c)) * rate / nfft
+
+
+def level_db(x, rate, t0_s, t1_s):
+    """The mean power of x from t0_s to t1_s (s), in dB."""
+    seg = x[int(round(t0_s * rate)):int(round(t1_s * rate))]
+    return 10.0 * math.log10(sum(v * v for v in seg) / max(len(seg), 1) + 1e-30)
+
+
+def decay_t60(x, rate, onset_s, t0=0.100, t1=0.400, window=0.020):
+    """T60 (s) from the energy of `window`-long stretches t0..t1 after the onset: the least-
+    squares line through their levels (dB) against their centres' times."""
+    ts, levels = [], []
+    t = t0
+    while t + window <= t1 + 1e-9:
+        i0 = int(round((onset_s + t) * rate))
+        seg = x[i0:i0 + int(round(window * rate))]
+        energy = sum(v * v for v in seg) / len(seg)
+        ts.append(t + window / 2)
+        levels.append(10.0 * math.log10(energy + 1e-30))
+        t += window
+    n = len(ts)
+    mt, ml = sum(ts) / n, sum(levels) / n
+    slope = sum((a - mt) * (b - ml) for a, b in zip(ts, levels)) / sum((a - mt) ** 2 for a in ts)
+    return -60.0 / slope if slope < 0 else float("inf")

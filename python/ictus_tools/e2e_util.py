@@ -341,3 +341,40 @@ def require_mido():
         print("SKIPPED: python3-mido is missing (scripts/deps.sh installs it)")
         sys.exit(77)
     return mido
+
+
+def render_kit(ictusd, workdir, name, kit, source_args, timeout=900):
+    """`ictusd render --kit KIT` of source_args (["--midi", F] or ["--score", F]) into
+    workdir/name, with a WAV of the two pickups in 32-bit float there: (out dir, wav path).
+    A failed render fails the test (exit 1); pd.log is checked for error lines."""
+    import sys
+    from ictus_tools.checks import check
+    out = os.path.join(workdir, name)
+    wav = os.path.join(out, name + ".wav")
+    env = pd_spawning_env(os.path.abspath(workdir))
+    run = subprocess.run([ictusd, "render", "--kit", kit] + source_args +
+                         ["--out", out, "--force", "--wav", wav, "--wav-mix", "pickups",
+                          "--wav-bits", "32"],
+                         capture_output=True, text=True, timeout=timeout, env=env)
+    if not check(run.returncode == 0, "ictusd render --kit %s %s: exit %d %s"
+                 % (kit, " ".join(source_args), run.returncode, run.stderr[-2000:])):
+        sys.exit(1)
+    with open(os.path.join(out, "pd.log")) as f:
+        errors = [line for line in f if "error" in line.lower()]
+    check(not errors, "%s: pd.log has no error line: %s" % (name, errors[:3]))
+    return out, wav
+
+
+def write_drum_midi(mido, path, events, bpm, tpq):
+    """A type-0 Standard MIDI File at `bpm` (ticks_per_beat tpq) of the note-ons `events`
+    ((tick, note, velocity), any order) on channel 10, ended by a note-off a beat later."""
+    mid = mido.MidiFile(type=0, ticks_per_beat=tpq)
+    track = mido.MidiTrack()
+    mid.tracks.append(track)
+    track.append(mido.MetaMessage("set_tempo", tempo=int(round(60e6 / bpm)), time=0))
+    now = 0
+    for tick, note, vel in sorted(events):
+        track.append(mido.Message("note_on", channel=9, note=note, velocity=vel, time=tick - now))
+        now = tick
+    track.append(mido.Message("note_off", channel=9, note=42, velocity=0, time=tpq))
+    mid.save(path)

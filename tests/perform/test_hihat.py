@@ -16,13 +16,13 @@ by a line, gives a decay time T60 = -60 dB / slope; the physics of the plate (do
 import argparse
 import csv
 import json
-import math
 import os
 import subprocess
 import sys
 
 from ictus_tools import e2e_util
 from ictus_tools.checks import check
+from ictus_tools.drumtone import decay_t60
 
 # Two seconds between notes (60 bpm, 2 beats): an open note rings on to the window's end.
 SCORE = """tempo 60
@@ -31,24 +31,6 @@ L closed 2/1, L open 2/1, L closed 2/1, L open 2/1, L 2/1
 """
 WANT = [0.0, 1.0, 0.0, 1.0, 0.0]  # the notes' pedals (none written: closed)
 HIHAT = 6  # its index in standard-cymbals
-
-
-def decay_t60(x, rate, onset_s, t0=0.100, t1=0.400, window=0.020):
-    """T60 (s) from the energy of `window`-long stretches t0..t1 after the onset: the least-
-    squares line through their levels (dB) against their centres' times."""
-    ts, levels = [], []
-    t = t0
-    while t + window <= t1 + 1e-9:
-        i0 = int(round((onset_s + t) * rate))
-        seg = x[i0:i0 + int(round(window * rate))]
-        energy = sum(v * v for v in seg) / len(seg)
-        ts.append(t + window / 2)
-        levels.append(10.0 * math.log10(energy + 1e-30))
-        t += window
-    n = len(ts)
-    mt, ml = sum(ts) / n, sum(levels) / n
-    slope = sum((a - mt) * (b - ml) for a, b in zip(ts, levels)) / sum((a - mt) ** 2 for a in ts)
-    return -60.0 / slope if slope < 0 else float("inf")
 
 
 def main():

@@ -55,34 +55,8 @@ def groove(path, rng):
                 v = rng.randint(20, 127)
                 events.append((tick, rng.choice((35, 36, 36)), v))
                 kicks.append((tick, v))
-    mid = mido.MidiFile(type=0, ticks_per_beat=tpq)
-    track = mido.MidiTrack()
-    mid.tracks.append(track)
-    track.append(mido.MetaMessage("set_tempo", tempo=int(round(60e6 / bpm)), time=0))
-    now = 0
-    for tick, note, vel in sorted(events):
-        track.append(mido.Message("note_on", channel=9, note=note, velocity=vel, time=tick - now))
-        now = tick
-    track.append(mido.Message("note_off", channel=9, note=42, velocity=0, time=tpq))
-    mid.save(path)
+    e2e_util.write_drum_midi(mido, path, events, bpm, tpq)
     return bpm, tpq, kicks
-
-
-def render(ictusd, workdir, name, source_args):
-    out = os.path.join(workdir, name)
-    wav = os.path.join(out, name + ".wav")
-    env = e2e_util.pd_spawning_env(os.path.abspath(workdir))
-    run = subprocess.run([ictusd, "render", "--kit", "full"] + source_args +
-                         ["--out", out, "--force", "--wav", wav, "--wav-mix", "pickups",
-                          "--wav-bits", "32"],
-                         capture_output=True, text=True, timeout=900, env=env)
-    if not check(run.returncode == 0, "ictusd render --kit full %s: exit %d %s"
-                 % (" ".join(source_args), run.returncode, run.stderr[-2000:])):
-        sys.exit(1)
-    with open(os.path.join(out, "pd.log")) as f:
-        errors = [l for l in f if "error" in l.lower()]
-    check(not errors, "%s: pd.log has no error line: %s" % (name, errors[:3]))
-    return out, wav
 
 
 def main():
@@ -98,7 +72,8 @@ def main():
     part = os.path.join(args.workdir, "groove.mid")
     bpm, tpq, kicks = groove(part, rng)
     print("groove: %.1f bpm, %d kicks" % (bpm, len(kicks)))
-    out, _ = render(args.ictusd, args.workdir, "groove", ["--midi", part])
+    out, _ = e2e_util.render_kit(args.ictusd, args.workdir, "groove", "full",
+                                 ["--midi", part])
     with open(os.path.join(out, "render.json")) as f:
         rj = json.load(f)
     drums = rj["kit"]["drums"]
@@ -176,7 +151,8 @@ def main():
     score = os.path.join(args.workdir, "kicks.txt")
     with open(score, "w") as f:
         f.write("tempo 60\n" + "\n".join("RF %s" % d for d in dyn) + "\n")
-    out, wav = render(args.ictusd, args.workdir, "kicks", ["--score", score])
+    out, wav = e2e_util.render_kit(args.ictusd, args.workdir, "kicks", "full",
+                                   ["--score", score])
     with open(os.path.join(out, "render.json")) as f:
         head = json.load(f)["kit"]["drums"][KICK]
     # The head's (0,1) mode: the kick preset's density (docs/sound.md, its table).

@@ -42,6 +42,21 @@ PerformerFrame kit_frame()
     return f;
 }
 
+// The plan of `text` on `frame` is refused at line:column with `words` in its message.
+void refused(const std::string &text, const PerformerFrame &frame, int line, int column,
+             const std::string &words)
+{
+    INFO(text);
+    try {
+        plan_performance(parse_score(text, "t.txt"), db(), frame);
+        FAIL("planned");
+    } catch (const ScoreError &e) {
+        CHECK(e.line() == line);
+        CHECK(e.column() == column);
+        CHECK_THAT(e.message(), Contains(words));
+    }
+}
+
 } // namespace
 
 TEST_CASE("score: 'drum NAME' sets the drum of the notes after it, 'on NAME' one note's",
@@ -354,23 +369,54 @@ TEST_CASE("plan: the right foot's notes are the kick's, timed as the hands', nev
     REQUIRE(plan.notes.size() == 4);
     for (const PlannedNote &n : plan.notes)
         CHECK(n.drum != 5);
-    auto refused = [&](const std::string &text, const PerformerFrame &frame, int line, int column,
-                       const std::string &words) {
-        INFO(text);
-        try {
-            plan_performance(parse_score(text, "t.txt"), db(), frame);
-            FAIL("planned");
-        } catch (const ScoreError &e) {
-            CHECK(e.line() == line);
-            CHECK(e.column() == column);
-            CHECK_THAT(e.message(), Contains(words));
-        }
-    };
     refused("R\nR on kick", f, 2, 6, "drum 'kick' is played by the right foot on its pedal");
-    refused("RF on snare", f, 1, 7, "drum 'snare' is the hands'; the right foot plays kick");
+    refused("RF on snare", f, 1, 7,
+            "drum 'snare' is not the right foot's; the right foot plays kick");
     // 16ths at 300 bpm are 50 ms apart: faster than the pedal (60 ms).
     refused("tempo 300\nRF 1/4\nRF", f, 3, 1, "faster than the right foot plays its pedal");
     f.drums.pop_back();
     refused("R\nRF", f, 2, 1, "this kit has no kick");
     refused("RF", performer_frame_for_drum(c, 0.178), 1, 1, "there is no kit");
+}
+
+TEST_CASE("plan: the left foot's chicks are the hi-hat's, timed as the hands', a hand's note "
+          "unchanged",
+          "[score][kit][chick]")
+{
+    PerformerFrame f = kit_frame();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.push_back({"hihat", c + Eigen::Vector3d(0.42, 0.26, -0.02), 0.1778, true, true});
+    f.drums.push_back(
+        {"kick", c + Eigen::Vector3d(-0.18, -0.37, 0.10), 0.2794, false, false, true});
+    const Score s = parse_score("tempo 100\nLF ff 1/2\nR on hihat + LF p 1/2\nRF + LF\n"
+                                "R on hihat open + L on snare\nLF on hihat pp",
+                                "t");
+    const GesturePlan plan = plan_performance(s, db(), f);
+    REQUIRE(plan.foot_notes.size() == 5);
+    const double beats[5] = {0.0, 0.5, 1.0, 1.0, 3.0};
+    int chicks = 0;
+    for (const PlannedFootNote &n : plan.foot_notes) {
+        INFO(n.line);
+        const bool left = n.side == Side::left;
+        chicks += left ? 1 : 0;
+        CHECK(n.drum == (left ? 5 : 6));
+    }
+    CHECK(chicks == 4);
+    for (size_t i = 0; i < 5; ++i)
+        CHECK(plan.foot_notes[i].time_s ==
+              Approx(PlanOptions().lead_in_s + beats[i] * 60.0 / 100.0).margin(1e-12));
+    CHECK(plan.foot_notes.front().dynamics == 1.0);
+    CHECK(plan.foot_notes.back().dynamics == 0.2);
+    // The hands' hi-hat notes keep their pedal: closed when none is written, open when it is.
+    REQUIRE(plan.notes.size() == 3);
+    CHECK(plan.notes[0].openness == kHihatClosed);
+    CHECK(plan.notes[1].openness == kHihatOpen);
+    refused("LF on snare", f, 1, 7,
+            "drum 'snare' is not the left foot's; the left foot plays hihat");
+    refused("LF on kick", f, 1, 7, "the left foot plays hihat");
+    // 16ths at 200 bpm are 75 ms apart: faster than the hi-hat's pedal (100 ms).
+    refused("tempo 200\nLF 1/4\nLF", f, 3, 1, "faster than the left foot plays the hi-hat's");
+    PerformerFrame no_hat = kit_frame();
+    refused("R\nLF", no_hat, 2, 1, "this kit has no hi-hat");
+    refused("LF", performer_frame_for_drum(c, 0.178), 1, 1, "there is no kit");
 }

@@ -207,38 +207,49 @@ TEST_CASE("midi in: a malformed file names its byte and track", "[score][midi]")
 }
 
 TEST_CASE("midi in: General MIDI's hi-hat on a kit's hi-hat, closed 42 and open 46, the pedal 44 "
-          "left out",
+          "the left foot's chick",
           "[score][midi][hihat]")
 {
-    // Half a second apart (the right hand's): closed 42, open 46, pedal 44, closed 42.
+    // Half a second apart (the right hand's): closed 42, open 46, pedal 44, closed 42; then
+    // two pedals 10 ticks (52 ms) apart: the second left out (faster than the left foot).
     std::string t;
-    for (int note : {42, 46, 44, 42})
+    for (int note : {42, 46, 44, 42, 44})
         t += bytes({0x60, 0x99, note, 100});
+    t += bytes({0x0a, 0x99, 44, 100});
     t += kEnd;
     const Smf smf = read_smf(header(0, 1) + chunk("MTrk", t), "t.mid");
     const std::vector<MidiDrum> kit = {{"snare", 38}, {"tom1", 48}, {"tom2", 47}, {"floor", 43},
                                        {"crash", 49}, {"ride", 51}, {"hihat", 42}};
     const MidiDrumPart part = drum_part_score(smf, kit, "t.mid");
-    REQUIRE(part.score.notes.size() == 3);
-    const double want[3] = {kHihatClosed, kHihatOpen, kHihatClosed};
-    const double beat[3] = {1.0, 2.0, 4.0};
-    for (size_t i = 0; i < 3; ++i) {
+    REQUIRE(part.score.notes.size() == 5);
+    const double want[5] = {kHihatClosed, kHihatOpen, -1.0, kHihatClosed, -1.0};
+    const double beat[5] = {1.0, 2.0, 3.0, 4.0, 5.0};
+    for (size_t i = 0; i < 5; ++i) {
         INFO(i);
-        CHECK(part.score.notes[i].drum == "hihat");
-        CHECK(part.score.notes[i].openness == want[i]);
-        CHECK(part.score.notes[i].beat == Approx(beat[i]));
-        CHECK_FALSE(part.score.notes[i].spot_given); // the cymbal's own spot
+        const ScoreNote &n = part.score.notes[i];
+        CHECK(n.drum == "hihat");
+        CHECK(n.beat == Approx(beat[i]));
+        const bool chick = i == 2 || i == 4;
+        CHECK(n.foot == chick); // 44: the left foot's
+        if (chick) {
+            CHECK(n.hand == Side::left);
+            CHECK(n.openness < 0.0); // the chick closes the pedal; the note carries none
+        } else {
+            CHECK(n.hand == Side::right);
+            CHECK(n.openness == want[i]);
+            CHECK_FALSE(n.spot_given); // the cymbal's own spot
+        }
     }
-    CHECK(part.skipped.size() == 1);
-    CHECK(part.skipped.at(44) == 1); // a foot's note: the performer has none
-    // A kit without a hi-hat, and no kit: 42 and 46 left out too, counted.
+    CHECK(part.skipped.empty());
+    CHECK(part.too_fast == 1);
+    // A kit without a hi-hat, and no kit: 42, 46 and 44 left out, counted.
     const std::vector<MidiDrum> cymbals(kit.begin(), kit.end() - 1);
     for (const std::vector<MidiDrum> &k : {cymbals, std::vector<MidiDrum>{}}) {
         const MidiDrumPart none = drum_part_score(smf, k, "t.mid");
         CHECK(none.score.notes.empty());
         CHECK(none.skipped.at(42) == 2);
         CHECK(none.skipped.at(46) == 1);
-        CHECK(none.skipped.at(44) == 1);
+        CHECK(none.skipped.at(44) == 3);
     }
 }
 

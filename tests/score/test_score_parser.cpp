@@ -163,7 +163,9 @@ TEST_CASE("score: '+' joins a note of each hand on one beat, each with its optio
     require_error("R + tempo 90", 1, 5, "'+' joins notes of one limb each");
     require_error("R+L + L", 1, 1, "'+' joins notes of one limb each");
     require_error("R + L + R", 1, 9, "two notes joined by '+' are the right hand's");
-    require_error("R + L + RF + L", 1, 12, "a third '+'");
+    require_error("R + L + RF + LF + L", 1, 17, "a fourth '+'");
+    require_error("R + L + RF + L", 1, 14, "two notes joined by '+' are the left hand's");
+    require_error("LF + R + left-foot", 1, 10, "two notes joined by '+' are the left foot's");
     require_error("RF + R + RF", 1, 10, "two notes joined by '+' are the right foot's");
 }
 
@@ -193,8 +195,38 @@ TEST_CASE("score: RF is the right foot's note on the kick, alone or in a chord",
     require_error("RF at 0.2 90", 1, 4, "'at' is a stick's");
     require_error("RF firmness 0.5", 1, 4, "'firmness' is a stick's");
     require_error("RF on hihat open", 1, 13, "'open' is the hi-hat's");
-    require_error("LF", 1, 1, "the left foot (the hi-hat's pedal) is not built");
-    require_error("R + LF", 1, 5, "the left foot (the hi-hat's pedal) is not built");
+}
+
+TEST_CASE("score: LF is the left foot's chick on the hi-hat's pedal, alone or in a chord",
+          "[score][parser][chick]")
+{
+    const Score s = parse_score("drum snare\nLF ff 1/2\nR on ride + L + RF + LF p\nleft-foot on "
+                                "hihat pp\nR\n",
+                                "feet");
+    REQUIRE(s.notes.size() == 7);
+    // The left side, the foot, no drum but its own `on` (the planner finds the hi-hat).
+    CHECK((s.notes[0].foot && s.notes[0].hand == Side::left && s.notes[0].drum.empty()));
+    CHECK((s.notes[0].beat == 0.0 && s.notes[0].dynamics == 1.0 && s.notes[0].beats == 0.5));
+    // The chord: four limbs on beat 0.5, each foot once.
+    int left = 0, right = 0;
+    for (int i = 1; i <= 4; ++i) {
+        const ScoreNote &n = s.notes[static_cast<size_t>(i)];
+        CHECK(n.beat == 0.5);
+        left += n.foot && n.hand == Side::left ? 1 : 0;
+        right += n.foot && n.hand == Side::right ? 1 : 0;
+    }
+    CHECK((left == 1 && right == 1));
+    CHECK(s.notes[4].dynamics == Approx(0.3));
+    CHECK((s.notes[5].foot && s.notes[5].hand == Side::left && s.notes[5].drum == "hihat"));
+    CHECK((!s.notes[6].foot && s.notes[6].drum == "snare"));
+    const Score m = parse_score("R on ride + LF", "box");
+    REQUIRE(m.notes.size() == 2);
+    CHECK((m.notes[1].foot && m.notes[1].hand == Side::left && m.notes[1].beat == 0.0));
+    require_error("LF flam", 1, 4, "'LF' is the left foot's chick on the hi-hat's pedal");
+    require_error("LF at 0.9 90", 1, 4, "'at' is a stick's (the plates meet");
+    require_error("LF firmness 0.5", 1, 4, "'firmness' is a stick's");
+    require_error("LF open", 1, 4, "'open' is a hand's note's (the chick closes it)");
+    require_error("R + LF closed", 1, 8, "'closed' is a hand's note's");
 }
 
 TEST_CASE("score: the dynamics words rise from pp to ff and mf is the default", "[score][parser]")

@@ -256,12 +256,13 @@ struct Note {
 // beyond it on either side), all ahead or each 0.4 s before its time, and checks every
 // note's first contact: one non-bounce strike each, within 0.5 ms of its time and 2 % of its
 // clamped speed.
-void check_sequence(unsigned seed, int n, bool interleaved, double *worst_dt, double *worst_dv)
+void check_sequence(unsigned seed, int n, bool interleaved, double *worst_dt, double *worst_dv,
+                    const KickPedalParams &p = KickPedalParams(), double min_gap_s = 0.06)
 {
-    KickPedal pedal;
+    KickPedal pedal(p);
     const double lo = pedal.min_speed_mps(), hi = pedal.max_speed_mps();
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> lgap(std::log(0.06), std::log(1.0));
+    std::uniform_real_distribution<double> lgap(std::log(min_gap_s), std::log(1.0));
     std::uniform_real_distribution<double> uv(lo - 0.1 * (hi - lo), hi + 0.1 * (hi - lo));
     std::vector<Note> notes;
     std::vector<PedalStrike> firsts;
@@ -318,6 +319,64 @@ TEST_CASE("kick pedal: scheduled notes land on time at their speed", "[kick_peda
     check_sequence(13u, 40, true, &worst_dt, &worst_dv);
     WARN("scheduling: worst onset error " << worst_dt * 1e3 << " ms, worst speed error "
                                           << worst_dv * 100.0 << " %");
+}
+
+// The hi-hat's pedal (hihat_pedal_params: the `hihat` preset's plate, D 12.45 N m, R 0.1778 m):
+// the same planner and the same law, a plate closing on a plate.
+TEST_CASE("hi-hat pedal: chicks land on time at their speed", "[kick_pedal][hihat_pedal]")
+{
+    const KickPedalParams p = hihat_pedal_params(12.45, 0.1778);
+    double worst_dt = 0.0, worst_dv = 0.0;
+    check_sequence(21u, 40, false, &worst_dt, &worst_dv, p, 0.1);
+    check_sequence(22u, 30, true, &worst_dt, &worst_dv, p, 0.1);
+    WARN("hi-hat scheduling: worst onset error " << worst_dt * 1e3 << " ms, worst speed error "
+                                                 << worst_dv * 100.0 << " %");
+}
+
+TEST_CASE("hi-hat pedal: the gap, the plates' stiffness, passivity, no NaN",
+          "[kick_pedal][hihat_pedal]")
+{
+    const KickPedalParams p = hihat_pedal_params(12.45, 0.1778);
+    CHECK(p.beater_length_m * p.phi_head_rad == Approx(0.015)); // the gap open, 1.5 cm
+    CHECK(p.surface_stiffness_n_per_m == Approx(0.5 * 16.0 * kPi * 12.45 / (0.1778 * 0.1778)));
+    KickPedal pedal(p);
+    CHECK(pedal.effective_mass_kg() == Approx(1.19));
+    for (double v : seeded(8u, 10, 0.1, 2.0 * pedal.max_speed_mps())) {
+        double e0 = 0.0, e1 = 0.0;
+        const PedalStrike s = throw_at_head(pedal, v, &e0, &e1);
+        INFO("v " << v << " m/s: energy " << e0 << " J before, " << e1 << " J after");
+        REQUIRE(s.duration_ms > 0.0);
+        CHECK(std::isfinite(s.peak_force_n));
+        CHECK(std::isfinite(pedal.beater_angle_rad()));
+        CHECK(e1 <= e0 + 1e-12);
+        // A linear contact lasts at most about half the period of the mass on the plates,
+        // pi sqrt(m / k) (the return spring pushes the plates apart sooner, the more so the
+        // slower they meet).
+        const double half =
+            1e3 * kPi * std::sqrt(s.effective_mass_kg / p.surface_stiffness_n_per_m);
+        CHECK(s.duration_ms <= 1.1 * half);
+    }
+    CHECK_THROWS_AS(hihat_pedal_params(0.0, 0.1778), SimError);
+}
+
+TEST_CASE("hi-hat pedal: the closing speed grows with the dynamics asked",
+          "[kick_pedal][hihat_pedal]")
+{
+    const KickPedalParams p = hihat_pedal_params(12.45, 0.1778);
+    double last = 0.0;
+    for (double v : {0.2, 0.4, 0.6, 0.8, 1.0, 1.2}) {
+        KickPedal pedal(p);
+        const double got = pedal.schedule(0.3, v);
+        pedal.advance_to(0.6);
+        PedalStrike s;
+        REQUIRE(pedal.take_strike(s));
+        INFO("asked " << v << " m/s, planned " << got << ", struck " << s.speed_mps << " at "
+                      << s.time_s);
+        CHECK(std::fabs(s.time_s - 0.3) <= 0.5e-3);
+        CHECK(s.speed_mps == Approx(v).epsilon(0.02));
+        CHECK(s.speed_mps > last);
+        last = s.speed_mps;
+    }
 }
 
 TEST_CASE("kick pedal: sixteenths at 120 bpm and heel-toe doubles", "[kick_pedal]")

@@ -259,7 +259,10 @@ std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
     auto note_of = [drum_notes](const StrikeEvent &e) {
         if (drum_notes && e.drum >= 0 && e.drum < static_cast<int>(drum_notes->size())) {
             const int note = (*drum_notes)[static_cast<size_t>(e.drum)];
-            // A strike on the snare's rim is General MIDI's side stick, as --midi reads it.
+            // A strike on the snare's rim is General MIDI's side stick, as --midi reads it;
+            // the left foot's chick on the hi-hat its pedal hi-hat.
+            if (note == kMidiClosedHihat && e.hand == kFootLeft)
+                return kMidiPedalHihat;
             return note == kMidiSnare && e.zone == kZoneRim ? kMidiSideStick : note;
         }
         return midi_note(e.hand, e.r_over_a);

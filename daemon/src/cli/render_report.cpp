@@ -76,13 +76,14 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
             out << ',' << kit.drums[static_cast<size_t>(n.drum)].name;
         out << '\n';
     }
-    // The right foot's notes (a kit's kick) after the hands': hand
-    // "right-foot", no nuance or grip.
+    // The feet's notes after the hands': hand "right-foot" (a kit's kick) or
+    // "left-foot" (its hi-hat's chick), no nuance or grip.
     for (size_t i = 0; i < plan.foot_notes.size(); ++i) {
         const PlannedFootNote &n = plan.foot_notes[i];
         const NoteMatch &k = m.foot_notes[i];
-        std::snprintf(buf, sizeof buf, "%zu,%.6f,right-foot,,,%.3f,,,%d,%ld,",
-                      plan.notes.size() + i, origin_s + n.time_s, n.dynamics, n.line, k.strike_seq);
+        std::snprintf(buf, sizeof buf, "%zu,%.6f,%s,,,%.3f,,,%d,%ld,", plan.notes.size() + i,
+                      origin_s + n.time_s, n.side == Side::right ? "right-foot" : "left-foot",
+                      n.dynamics, n.line, k.strike_seq);
         out << buf;
         write_match(out, k);
         out << 0;
@@ -147,8 +148,11 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
     nlohmann::json j;
     j["mode"] = to_string(perf.mode());
     const long all_notes = static_cast<long>(plan.notes.size() + plan.foot_notes.size());
-    j["notes"] = all_notes; // the hands' and the foot's
-    j["foot_notes"] = plan.foot_notes.size();
+    j["notes"] = all_notes;                   // the hands' and the feet's
+    j["foot_notes"] = plan.foot_notes.size(); // both feet's
+    j["left_foot_notes"] =
+        std::count_if(plan.foot_notes.begin(), plan.foot_notes.end(),
+                      [](const PlannedFootNote &n) { return n.side == Side::left; });
     j["primary_strikes"] = m.primary_strikes;
     j["bounces"] = m.bounces;
     j["matched_notes"] = m.matched_notes;

@@ -1,4 +1,4 @@
-// The right foot of a score's performance (foot_player.hpp).
+// A foot of a score's performance (foot_player.hpp).
 #include "foot_player.hpp"
 
 #include <algorithm>
@@ -11,9 +11,12 @@ namespace
 {
 
 // The kick's pedal for a kit piece: its head's radius, tension and film
-// (KitDrum's; the film as thick as its density says, as membrane~'s head).
-KickPedalParams pedal_params(const KitDrum &d)
+// (KitDrum's; the film as thick as its density says, as membrane~'s head);
+// the hi-hat's for the left foot (its plate's bending stiffness and radius).
+KickPedalParams pedal_params(const KitDrum &d, Side side)
 {
+    if (side == Side::left)
+        return hihat_pedal_params(d.bending_n_m, d.radius_m);
     KickPedalParams p;
     p.head_radius_m = d.radius_m;
     p.head_tension_n_per_m = d.tension_n_per_m;
@@ -23,9 +26,10 @@ KickPedalParams pedal_params(const KitDrum &d)
 
 } // namespace
 
-FootPlayer::FootPlayer(const KitDrum &drum, int drum_index, const Eigen::Vector3d &forward)
-    : pedal_(pedal_params(drum)), drum_(drum_index), forward_(forward.normalized()),
-      radius_m_(drum.radius_m)
+FootPlayer::FootPlayer(const KitDrum &drum, int drum_index, const Eigen::Vector3d &force_dir,
+                       Side side)
+    : pedal_(pedal_params(drum, side)), drum_(drum_index), side_(side),
+      force_dir_(force_dir.normalized()), radius_m_(drum.radius_m)
 {
 }
 
@@ -71,6 +75,8 @@ void FootPlayer::step(double now_s, StrikeDetector &detector, long first_seq)
         if (t > now_s + kLookAhead_s)
             break;
         ++next_;
+        if (n.side != side_)
+            continue; // the other foot's
         // A note whose push would have had to begin already is left out
         // (a plan that starts with a kick at once: the lead-in is longer).
         if (t <= pedal_.time_s() + pedal_.params().stroke_max_s || t <= last_scheduled_s_)
@@ -84,7 +90,7 @@ void FootPlayer::step(double now_s, StrikeDetector &detector, long first_seq)
         if (!s.bounce)
             ++stroke_;
         onset_ = event_for(s);
-        onset_.seq = detector.claim_seq(s.time_s, first_seq);
+        onset_.seq = detector.claim_seq(s.time_s, first_seq, side_ == Side::right ? 0 : 1);
         open_seq_ = onset_.seq;
         onset_new_ = true;
     }
@@ -92,7 +98,7 @@ void FootPlayer::step(double now_s, StrikeDetector &detector, long first_seq)
         end_ = event_for(s);
         end_.seq = open_seq_;
         end_new_ = true;
-        detector.end_claimed();
+        detector.end_claimed(side_ == Side::right ? 0 : 1);
     }
 }
 
@@ -120,7 +126,7 @@ bool FootPlayer::take_end(StrikeEvent &out)
 StrikeEvent FootPlayer::event_for(const PedalStrike &s) const
 {
     StrikeEvent e;
-    e.hand = kFootRight;
+    e.hand = side_ == Side::right ? kFootRight : kFootLeft;
     e.drum = drum_;
     e.bounce = s.bounce;
     e.stroke = std::max(stroke_, 0L);
@@ -136,10 +142,19 @@ StrikeEvent FootPlayer::event_for(const PedalStrike &s) const
     e.peak_force_n = s.peak_force_n;
     e.impulse_n_s = s.impulse_n_s;
     e.duration_ms = s.duration_ms;
-    e.force_dir = forward_; // the felt pushes the head away from the performer
+    e.force_dir = force_dir_; // the felt pushes the head away from the performer
     e.stick_mass_kg = s.effective_mass_kg;
     e.stick_tip = stick_tip_code("felt");
     e.zone = kZoneHead;
+    if (side_ == Side::left) {
+        // The chick: the top plate's edge, toward the performer (the plate's
+        // frame as a hand's strike on it), pushed down onto the bottom plate;
+        // no tip (metal on metal), the sound's mass (kChickSoundMass_kg).
+        e.r_over_a = kChickRadiusFraction;
+        e.y_m = kChickRadiusFraction * radius_m_;
+        e.stick_mass_kg = kChickSoundMass_kg;
+        e.stick_tip = 0;
+    }
     return e;
 }
 

@@ -1,9 +1,10 @@
-// foot_player.hpp -- the right foot of a score's performance (private to
-// src/perform): the plan's foot notes (GesturePlan::foot_notes) played on the
-// kit's kick by its pedal (ictus/sim/kick_pedal.hpp, docs/pedal.md), each
+// foot_player.hpp -- a foot of a score's performance (private to
+// src/perform): the plan's notes of that foot (GesturePlan::foot_notes)
+// played by its pedal (ictus/sim/kick_pedal.hpp, docs/pedal.md): the right
+// foot's on the kit's kick, the left foot's on its hi-hat (the chick), each
 // scheduled a little ahead of its time, the pedal advanced with the physics
-// and its contacts reported as strikes of the right foot (StrikeEvent::hand
-// kFootRight).
+// and its contacts reported as strikes of that foot (StrikeEvent::hand
+// kFootRight, kFootLeft).
 #pragma once
 
 #include "ictus/perform/kit.hpp"
@@ -20,9 +21,12 @@ namespace ictus
 class FootPlayer
 {
   public:
-    // The pedal of the kit's piece `drum` (a foot's, KitDrum::foot) before
-    // the performer (forward: the performer's facing, world).
-    FootPlayer(const KitDrum &drum, int drum_index, const Eigen::Vector3d &forward);
+    // The pedal of the kit's piece `drum` before the performer: the right
+    // foot's on a kick (KitDrum::foot; force_dir: the performer's facing,
+    // world), the left foot's on a hi-hat (kit_drum_has_pedal; force_dir:
+    // down, the top plate onto the bottom one).
+    FootPlayer(const KitDrum &drum, int drum_index, const Eigen::Vector3d &force_dir,
+               Side side = Side::right);
 
     // A plan starts at origin_s (the performance's clock): its foot notes
     // from now on; the pushes not yet begun are dropped.
@@ -43,10 +47,11 @@ class FootPlayer
     // The foot's contact ended in the last step (at most one).
     bool take_end(StrikeEvent &out);
 
-    // The beater's speed (m/s) for a note's dynamics 0..1.
+    // The beater's (the top plate's) speed (m/s) for a note's dynamics 0..1.
     double speed_for(double dynamics) const;
     const KickPedal &pedal() const { return pedal_; }
     int drum_index() const { return drum_; }
+    Side side() const { return side_; }
 
     // How far ahead a note is scheduled (s): more than the foot's longest
     // push (docs/pedal.md).
@@ -55,13 +60,20 @@ class FootPlayer
     // its radius (a 22-inch kick's beater, ~4 cm up; the `kick` preset's
     // strike, docs/sound.md).
     static constexpr double kBeaterRadiusFraction = 0.15;
+    // The chick on the hi-hat's plate: at its edge (r/a), toward the
+    // performer; its sound excited by this mass at the plates' closing speed
+    // (a choice, docs/pedal.md: the plates meet all round their rims, damped
+    // at once, and a chick sounds below a hand's hit).
+    static constexpr double kChickRadiusFraction = 0.95;
+    static constexpr double kChickSoundMass_kg = 0.02;
 
   private:
     StrikeEvent event_for(const PedalStrike &s) const;
 
     KickPedal pedal_;
     int drum_ = 0;
-    Eigen::Vector3d forward_;
+    Side side_ = Side::right;
+    Eigen::Vector3d force_dir_;
     double radius_m_ = 0.2794;
     // The plan's, in time order: the plan performed (ScoreMode holds it while it is
     // this one's; start() and replace() come with every new one), not a copy.

@@ -31,7 +31,8 @@ class PerformMode
     // One physics step; the strikes ended in it (<= kStepStrikes: the two
     // hands' and the foot's) in out[0..n).
     virtual int step(StrikeEvent out[kStepStrikes]) = 0;
-    // The foot's contact begun in the last step, at its onset (score mode).
+    // A foot's contact begun in the last step, at its onset (score mode); each
+    // once, true while there is one.
     virtual bool take_foot_onset(StrikeEvent &) { return false; }
 
     // The commands' parts that differ. False with a reason when refused;

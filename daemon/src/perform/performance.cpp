@@ -202,7 +202,7 @@ int Performance::take_onsets(StrikeEvent out[kStepStrikes])
     for (int hand = 0; hand < 2; ++hand)
         if (detector_.take_onset(hand, taken[n]))
             ++n;
-    if (mode_->take_foot_onset(taken[n]))
+    for (int foot = 0; foot < 2 && mode_->take_foot_onset(taken[n]); ++foot)
         ++n;
     int kept = 0;
     for (int i = 0; i < n; ++i) {
@@ -242,7 +242,9 @@ void Performance::mark_pedal(StrikeEvent &e) const
     if (!p || e.drum <= 0 || e.drum >= static_cast<int>(f.drums.size()) ||
         !f.drums[static_cast<size_t>(e.drum)].pedal)
         return;
-    e.pedal_openness = strike_pedal_openness(p->notes, e, plan_origin_s());
+    // The left foot's chick closes the hi-hat (docs/pedal.md).
+    e.pedal_openness =
+        e.hand == kFootLeft ? kHihatClosed : strike_pedal_openness(p->notes, e, plan_origin_s());
 }
 
 bool Performance::withheld(const StrikeEvent &e) const

@@ -80,8 +80,14 @@ void ScoreMode::begin()
     install_rig(make_score_rig(perf_.options_, nullptr), false);
     const Kit &kit = perf_.options_.kit;
     if (const int k = kit_foot_piece(kit); k >= 0)
-        foot_ =
+        feet_[0] =
             std::make_unique<FootPlayer>(kit.drums[static_cast<size_t>(k)], k, rig_->frame.forward);
+    for (size_t k = 0; k < kit.drums.size(); ++k)
+        if (kit_drum_has_pedal(kit.drums[k])) {
+            feet_[1] = std::make_unique<FootPlayer>(kit.drums[k], static_cast<int>(k),
+                                                    -rig_->frame.up, Side::left);
+            break; // the first hi-hat (the left foot's: docs/pedal.md)
+        }
     perf_.playing_ = false;
 }
 
@@ -132,10 +138,13 @@ void ScoreMode::install_plan(std::unique_ptr<ScorePlan> plan, bool start_now)
         const PlanOptions &po = perf_.options_.score.plan;
         if (plan_ && plan_->score)
             rig_->tracker->scene().set_motor_noise(humanize_amount(*plan_->score, po), po.seed);
-        if (foot_ && plan_)
-            foot_->start(plan_->plan, plan_origin_s_, perf_.time_s());
-    } else if (foot_ && plan_) {
-        foot_->replace(plan_->plan);
+        for (auto &foot : feet_)
+            if (foot && plan_)
+                foot->start(plan_->plan, plan_origin_s_, perf_.time_s());
+    } else if (plan_) {
+        for (auto &foot : feet_)
+            if (foot)
+                foot->replace(plan_->plan);
     }
     // else: a plan under way goes on from where it was (the notes keep their times)
     if (plan && perf_.worker_)
@@ -393,16 +402,17 @@ int ScoreMode::step(StrikeEvent out[kStepStrikes])
     else
         follow_rest(r.tips);
     r.trunk_synergy();
-    if (foot_)
-        r.foot_on_pedal(foot_->pedal().footboard_angle_rad());
+    if (feet_[0])
+        r.foot_on_pedal(feet_[0]->pedal().footboard_angle_rad());
     r.tracker->step(r.step_body, &r.tips, true);
     const long first_seq = perf_.detector_.strikes();
     int n = detect_strikes(perf_.detector_, r.tracker->scene(), out, perf_.time_offset_s_);
-    if (foot_) {
-        foot_->step(perf_.time_s(), perf_.detector_, first_seq);
-        if (foot_->take_end(out[n]))
-            ++n;
-    }
+    for (auto &foot : feet_)
+        if (foot) {
+            foot->step(perf_.time_s(), perf_.detector_, first_seq);
+            if (foot->take_end(out[n]))
+                ++n;
+        }
     r.tracker->scene().local_rotations(pose_scratch_);
     body_stats_.add_step(r.model, r.range_of_motion, r.lumbar, r.thorax, pose_scratch_);
     return n;
@@ -410,7 +420,10 @@ int ScoreMode::step(StrikeEvent out[kStepStrikes])
 
 bool ScoreMode::take_foot_onset(StrikeEvent &out)
 {
-    return foot_ && foot_->take_onset(out);
+    for (auto &foot : feet_)
+        if (foot && foot->take_onset(out))
+            return true; // the other's, if any, at the next call
+    return false;
 }
 
 // ---- the commands' score-mode parts ------------------------------------------------
@@ -433,8 +446,9 @@ void ScoreMode::stop()
     if (plan_active_)
         start_rest_move();
     plan_active_ = false;
-    if (foot_)
-        foot_->stop(perf_.time_s());
+    for (auto &foot : feet_)
+        if (foot)
+            foot->stop(perf_.time_s());
 }
 
 bool ScoreMode::tempo(const Command &c, std::string *why)

@@ -52,7 +52,7 @@ class ScoreMode final : public PerformMode
     TrackMode track_mode() const { return rig_->tracker->mode(); }
     const Eigen::Vector3d &tip_target(int hand) const { return rig_->tips.position_m[hand & 1]; }
     const BodyStats &body_stats() const { return body_stats_; }
-    const KickPedal *kick_pedal() const { return foot_ ? &foot_->pedal() : nullptr; }
+    const KickPedal *kick_pedal() const { return feet_[0] ? &feet_[0]->pedal() : nullptr; }
     // Plans the current score and starts it now.
     void start_score();
 
@@ -92,8 +92,9 @@ class ScoreMode final : public PerformMode
     std::array<Eigen::Vector3d, 2> rest_from_m_;
     double rest_move_start_s_ = -1e9;
     BodyStats body_stats_;
-    // The right foot on the kit's kick (none without one).
-    std::unique_ptr<FootPlayer> foot_;
+    // The feet: [0] the right on the kit's kick, [1] the left on its hi-hat's
+    // pedal (none without one).
+    std::array<std::unique_ptr<FootPlayer>, 2> feet_;
     std::vector<Eigen::Quaterniond> pose_scratch_;
 };
 

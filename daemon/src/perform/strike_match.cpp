@@ -12,7 +12,7 @@ MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
                            const std::vector<StrikeEvent> &strikes, double origin_s,
                            const std::vector<PlannedFootNote> &foot_notes)
 {
-    // Every note as (time, limb, drum): the hands' first, then the foot's.
+    // Every note as (time, limb, drum): the hands' first, then the feet's.
     struct Target {
         double time_s;
         int limb, drum;
@@ -22,7 +22,7 @@ MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
     for (const PlannedNote &n : notes)
         all.push_back({n.time_s, static_cast<int>(n.hand), n.drum});
     for (const PlannedFootNote &n : foot_notes)
-        all.push_back({n.time_s, kFootRight, n.drum});
+        all.push_back({n.time_s, n.side == Side::right ? kFootRight : kFootLeft, n.drum});
     MatchSummary m;
     std::vector<NoteMatch> matched(all.size(), NoteMatch{});
     std::vector<double> best(all.size(), std::numeric_limits<double>::infinity());

@@ -311,6 +311,8 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("min_stroke_interval_s must be in (0, 10] s", o.min_stroke_interval_s);
     if (!(o.min_foot_interval_s > 0.0 && o.min_foot_interval_s <= 10.0))
         bad("min_foot_interval_s must be in (0, 10] s", o.min_foot_interval_s);
+    if (!(o.min_chick_interval_s > 0.0 && o.min_chick_interval_s <= 10.0))
+        bad("min_chick_interval_s must be in (0, 10] s", o.min_chick_interval_s);
     if (!(o.max_duration_s > 0.0) || !std::isfinite(o.max_duration_s))
         bad("max_duration_s must be > 0", o.max_duration_s);
 }
@@ -406,27 +408,32 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
     HandNotes by_hand;
     const double amount = humanize_amount(score, opt);
     std::array<double, 2> score_time_prev = {0.0, 0.0}; // each hand's last note, without noise
-    double foot_written_prev = 0.0;                     // the foot's, likewise
+    std::array<double, 2> foot_written_prev = {0.0, 0.0}; // each foot's, likewise
+    std::array<long, 2> foot_prev = {-1, -1};             // each foot's last, in plan.foot_notes
     for (size_t k = 0; k < score.notes.size(); ++k) {
         const ScoreNote &n = score.notes[k];
         if (n.foot) {
-            // As a hand's: a kick closer to the last than the pedal plays is
-            // refused; the noise of `humanize` never brings it closer.
+            // As a hand's: a kick (a chick) closer to the foot's last than its
+            // pedal plays is refused; the noise of `humanize` never brings it closer.
             PlannedFootNote f = foot_note(score, n, k, frame, opt);
             const double written = opt.lead_in_s + score.note_time_s(n);
-            if (!plan.foot_notes.empty()) {
-                const PlannedFootNote &prev = plan.foot_notes.back();
-                if (written - foot_written_prev < opt.min_foot_interval_s - 1e-9) {
+            const size_t s = f.side == Side::right ? 0 : 1;
+            const double min_s = s == 0 ? opt.min_foot_interval_s : opt.min_chick_interval_s;
+            if (foot_prev[s] >= 0) {
+                const PlannedFootNote &prev = plan.foot_notes[static_cast<size_t>(foot_prev[s])];
+                if (written - foot_written_prev[s] < min_s - 1e-9) {
                     std::ostringstream m;
-                    m << "this kick comes " << (written - foot_written_prev) * 1000.0
-                      << " ms after the previous one (line " << prev.line
-                      << "), faster than the right foot plays its pedal (minimum "
-                      << opt.min_foot_interval_s * 1000.0 << " ms)";
+                    m << "this " << (s == 0 ? "kick" : "chick") << " comes "
+                      << (written - foot_written_prev[s]) * 1000.0
+                      << " ms after the previous one (line " << prev.line << "), faster than the "
+                      << (s == 0 ? "right foot plays its pedal" : "left foot plays the hi-hat's")
+                      << " (minimum " << min_s * 1000.0 << " ms)";
                     throw ScoreError(score.source, n.line, n.column, m.str());
                 }
-                f.time_s = std::max(f.time_s, prev.time_s + opt.min_foot_interval_s);
+                f.time_s = std::max(f.time_s, prev.time_s + min_s);
             }
-            foot_written_prev = written;
+            foot_written_prev[s] = written;
+            foot_prev[s] = static_cast<long>(plan.foot_notes.size());
             plan.foot_notes.push_back(f);
             continue;
         }

@@ -53,14 +53,16 @@ double note_openness(const Score &score, const ScoreNote &n, const PerformerFram
 }
 
 // A foot's note: its time (with the motor noise of `humanize`, as a hand's)
-// and its drum, the kit's foot piece (the first, or the one it names); a
-// ScoreError where the kit has none or it names a piece of the hands.
+// and its drum: the right foot's the kit's foot piece, the left foot's its
+// hi-hat (the first, or the one it names); a ScoreError where the kit has none
+// or it names another piece.
 PlannedFootNote foot_note(const Score &score, const ScoreNote &n, size_t k,
                           const PerformerFrame &frame, const PlanOptions &opt)
 {
     PlannedFootNote f;
     f.time_s = opt.lead_in_s + score.note_time_s(n);
     f.dynamics = n.dynamics;
+    f.side = n.hand;
     f.line = n.line;
     f.column = n.column;
     const double amount = humanize_amount(score, opt);
@@ -70,28 +72,35 @@ PlannedFootNote foot_note(const Score &score, const ScoreNote &n, size_t k,
         f.dynamics =
             std::clamp(n.dynamics * (1.0 + amount * kHumanizeForceCv * noise.normal()), 0.0, 1.0);
     }
+    // The right foot's piece is the kick (Drum::foot), the left foot's the
+    // hi-hat (Drum::pedal).
+    const bool right = n.hand == Side::right;
+    auto plays = [&](const PerformerFrame::Drum &d) { return right ? d.foot : d.pedal; };
+    const std::string foot = right ? "the right foot" : "the left foot";
+    const std::string pedal = right ? "a kick's pedal" : "a hi-hat's pedal";
     std::string feet;
     for (size_t i = 0; i < frame.drums.size(); ++i)
-        if (frame.drums[i].foot)
+        if (plays(frame.drums[i]))
             feet += (feet.empty() ? "" : ", ") + frame.drums[i].name;
     if (n.drum.empty()) {
         for (size_t i = 0; i < frame.drums.size(); ++i)
-            if (frame.drums[i].foot) {
+            if (plays(frame.drums[i])) {
                 f.drum = static_cast<int>(i);
                 return f;
             }
-        throw ScoreError(
-            score.source, n.line, n.column,
-            "the right foot plays a kick's pedal, and " +
-                std::string(frame.drums.empty() ? "there is no kit" : "this kit has no kick") +
-                " (--kit full has one: docs/kit.md)");
+        throw ScoreError(score.source, n.line, n.column,
+                         foot + " plays " + pedal + ", and " +
+                             std::string(frame.drums.empty() ? "there is no kit"
+                                                             : (right ? "this kit has no kick"
+                                                                      : "this kit has no hi-hat")) +
+                             (right ? " (--kit full has one: docs/kit.md)"
+                                    : " (--kit standard-cymbals and full have one: docs/kit.md)"));
     }
     f.drum = drum_index(score, n, frame);
-    if (!frame.drums[static_cast<size_t>(f.drum)].foot)
-        throw ScoreError(
-            score.source, n.drum_line, n.drum_column,
-            "drum '" + n.drum + "' is the hands'; the right foot plays " +
-                (feet.empty() ? std::string("a kick's pedal, and this kit has none") : feet));
+    if (!plays(frame.drums[static_cast<size_t>(f.drum)]))
+        throw ScoreError(score.source, n.drum_line, n.drum_column,
+                         "drum '" + n.drum + "' is not " + foot + "'s; " + foot + " plays " +
+                             (feet.empty() ? pedal + ", and this kit has none" : feet));
     return f;
 }
 

@@ -230,7 +230,7 @@ bool left_hands(int note)
 // A cymbal's note: the kit's cymbal that plays it (crash, ride or hi-hat), 0 for another note.
 int cymbal_of(int note)
 {
-    if (note == kMidiClosedHihat || note == kMidiOpenHihat)
+    if (note == kMidiClosedHihat || note == kMidiOpenHihat || note == kMidiPedalHihat)
         return kMidiClosedHihat;
     if (note == kMidiCrash || note == 57)
         return kMidiCrash;
@@ -319,7 +319,7 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
     const TempoMap &map = part.score.tempo;
     // The hands' last strokes (s; -inf: none yet) and the last note kept.
     double last_of[2] = {-1e300, -1e300};
-    double last_foot_s = -1e300;
+    double last_foot_s[2] = {-1e300, -1e300}; // the right foot's, the left's
     double last_s = -1e300;
     long last_tick = -1;
     int last_hand = 1, at_tick = 0;
@@ -354,23 +354,26 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
                                 std::to_string(beat) + ", past the score's " +
                                 std::to_string(kMaxScoreBeats));
         const double t = map.time_at_beat(beat);
-        if (n.note == kMidiAcousticBass || n.note == kMidiKick) {
-            // The right foot's, beside the hands.
-            if (t - last_foot_s < kMidiFootMin_s - 1e-9) {
+        const bool kick = n.note == kMidiAcousticBass || n.note == kMidiKick;
+        if (kick || n.note == kMidiPedalHihat) {
+            // A foot's, beside the hands: the right on the kick, the left's
+            // chick on the hi-hat.
+            double &last_foot = last_foot_s[kick ? 0 : 1];
+            if (t - last_foot < (kick ? kMidiFootMin_s : kMidiChickMin_s) - 1e-9) {
                 ++part.too_fast;
                 continue;
             }
             ScoreNote s;
             s.beat = beat;
             s.beats = kMinNoteBeats;
-            s.hand = Side::right;
+            s.hand = kick ? Side::right : Side::left;
             s.foot = true;
             s.dynamics = n.velocity / 127.0;
             s.line = line;
             s.drum_line = line;
             s.drum = drums[static_cast<size_t>(drum)].name;
             part.score.notes.push_back(s);
-            last_foot_s = t;
+            last_foot = t;
             continue;
         }
         // Hands: at the same tick the other hand (two at once at most);
@@ -436,8 +439,9 @@ MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<Midi
     if (part.score.notes.empty())
         throw MidiFileError(path + ": no note the " + (drums.empty() ? "drum" : "kit") +
                             " can play (snares 38, 40, side stick 37, toms 41..50 and, on a kit "
-                            "with cymbals, crash 49, 57, ride 51, 53, 59 and hi-hat 42, 46, on a "
-                            "kit with a kick, 35, 36 of the General MIDI drum map, on channel 10 "
+                            "with cymbals, crash 49, 57, ride 51, 53, 59 and hi-hat 42, 46, 44, "
+                            "on a kit with a kick, 35, 36 of the General MIDI drum map, on channel "
+                            "10 "
                             "if it has notes)");
     return part;
 }

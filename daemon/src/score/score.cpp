@@ -148,7 +148,7 @@ bool foot_word(const std::string &lower)
     return lower == "rf" || lower == "right-foot";
 }
 
-// The left foot's (the hi-hat's pedal): not built, refused by name.
+// The left foot's: `LF`, on the hi-hat's pedal (the chick; docs/pedal.md).
 bool left_foot_word(const std::string &lower)
 {
     return lower == "lf" || lower == "left-foot";
@@ -251,8 +251,8 @@ class LineParser
     const std::string &source_;
     int line_;
 
-    // One statement, or a chord: `R on hihat + L on snare + RF`, notes of up to three
-    // limbs (the two hands and the right foot) on one beat, each with its own options
+    // One statement, or a chord: `R on hihat + L on snare + RF`, notes of up to four
+    // limbs (the two hands and the two feet) on one beat, each with its own options
     // (a '+' between spaces).
     void chord(const std::vector<Token> &tk, std::vector<Statement> &out) const
     {
@@ -266,8 +266,8 @@ class LineParser
             if (parts.back().empty())
                 fail(t.column, "'+' joins notes played on one beat, one of each limb: "
                                "'R on hihat + L on snare + RF'");
-            if (parts.size() == 3)
-                fail(t.column, "a third '+': two hands and a foot play three notes on one "
+            if (parts.size() == 4)
+                fail(t.column, "a fourth '+': two hands and two feet play four notes on one "
                                "beat at most");
             plus_columns.push_back(t.column);
             parts.emplace_back();
@@ -283,8 +283,8 @@ class LineParser
         for (const std::vector<Token> &part : parts) {
             const std::string &w = part[0].lower;
             if (!hand_word(w) && !foot_word(w) && !left_foot_word(w))
-                fail(part[0].column, "'+' joins notes of one limb each ('R ...', 'L ...' or "
-                                     "'RF ...'), got '" +
+                fail(part[0].column, "'+' joins notes of one limb each ('R ...', 'L ...', "
+                                     "'RF ...' or 'LF ...'), got '" +
                                          part[0].text + "'");
             Statement st = statement(part);
             for (const Statement &other : notes)
@@ -301,7 +301,7 @@ class LineParser
     static std::string limb_name(const Statement &st)
     {
         if (st.foot)
-            return "right foot";
+            return st.hand == Side::right ? "right foot" : "left foot";
         return st.hand == Side::right ? "right hand" : "left hand";
     }
 
@@ -403,17 +403,12 @@ class LineParser
             st.kind = Kind::note;
             st.hand = *hand;
             note_options(tk, st);
-        } else if (foot_word(key)) {
+        } else if (foot_word(key) || left_foot_word(key)) {
             st.kind = Kind::note;
-            st.hand = Side::right;
+            st.hand = foot_word(key) ? Side::right : Side::left;
             st.foot = true;
             note_options(tk, st);
             foot_options(tk, st);
-        } else if (left_foot_word(key)) {
-            fail(tk[0].column,
-                 "'" + tk[0].text +
-                     "': the left foot (the hi-hat's pedal) is not "
-                     "built; a hi-hat note's 'open', 'half' or 'closed' sets the pedal");
         } else if (key == "r+l" || key == "l+r" || key == "both") {
             st.kind = Kind::note;
             st.both_hands = true;
@@ -521,7 +516,7 @@ class LineParser
             fail(
                 tk[0].column,
                 "unknown statement '" + tk[0].text +
-                    "' (expected a hand R, L, right, left, R+L, the right foot RF, or tempo, grip, "
+                    "' (expected a hand R, L, right, left, R+L, a foot RF or LF, or tempo, grip, "
                     "rest, "
                     "beats, dynamics, firmness, nuance, roll, meter, drum, humanize, repeat, end)");
         }
@@ -635,22 +630,26 @@ class LineParser
     }
 
     // What a foot's note cannot have: grace strokes, a spot (the beater meets
-    // the head where the pedal stands), a grip's firmness, a hi-hat's openness.
+    // the head, the plates meet, where the pedal stands), a grip's firmness, a
+    // hi-hat's openness (the left foot's chick closes it).
     void foot_options(const std::vector<Token> &tk, Statement &st) const
     {
-        const std::string what =
-            "'" + tk[0].text + "' is the right foot's note on the kick's pedal";
+        const bool right = st.hand == Side::right;
+        const std::string what = "'" + tk[0].text +
+                                 (right ? "' is the right foot's note on the kick's pedal"
+                                        : "' is the left foot's chick on the hi-hat's pedal");
         if (st.ornament != Grace::none)
             fail(st.ornament_column, what + ": a " + std::string(to_string(st.ornament)) +
                                          "'s grace strokes are the hands'");
         if (st.openness)
             fail(st.openness_column,
-                 what + ": '" + hihat_openness_word(*st.openness) + "' is the hi-hat's");
+                 what + ": '" + hihat_openness_word(*st.openness) +
+                     (right ? "' is the hi-hat's" : "' is a hand's note's (the chick closes it)"));
         for (const Token &t : tk)
             if (t.lower == "at" || t.lower == "firmness")
-                fail(t.column, what + ": '" + t.text +
-                                   "' is a stick's (the beater meets the "
-                                   "head where the pedal stands)");
+                fail(t.column, what + ": '" + t.text + "' is a stick's (the " +
+                                   (right ? "beater meets the head" : "plates meet") +
+                                   " where the pedal stands)");
     }
 
     void note_options(const std::vector<Token> &tk, Statement &st) const

@@ -38,7 +38,7 @@ void check(const char *name, double v, double lo, double hi, bool lo_open, bool 
 KickPedal::KickPedal(const KickPedalParams &p) : p_(p)
 {
     check("beater_length_m", p.beater_length_m, 0.05, 0.5, false, false, "m");
-    check("felt_mass_kg", p.felt_mass_kg, 0.0, 1.0, true, false, "kg");
+    check("felt_mass_kg", p.felt_mass_kg, 0.0, 5.0, true, false, "kg");
     check("shaft_mass_kg", p.shaft_mass_kg, 0.0, 1.0, false, false, "kg");
     check("felt_radius_m", p.felt_radius_m, 0.0, 0.1, true, false, "m");
     check("axle_inertia_kg_m2", p.axle_inertia_kg_m2, 0.0, 0.1, false, false, "kg m^2");
@@ -53,6 +53,9 @@ KickPedal::KickPedal(const KickPedalParams &p) : p_(p)
     check("head_thickness_m", p.head_thickness_m, 0.0, 0.01, true, false, "m");
     check("head_modulus_pa", p.head_modulus_pa, 0.0, 1.0e12, false, false, "Pa");
     check("head_poisson", p.head_poisson, 0.0, 0.5, false, true, "");
+    check("surface_stiffness_n_per_m", p.surface_stiffness_n_per_m, 0.0, 1.0e8, false, false,
+          "N/m");
+    check("surface_mu_s_per_m", p.surface_mu_s_per_m, 0.0, 10.0, false, false, "s/m");
     check("substep_s", p.substep_s, 0.0, 1.0e-3, true, false, "s");
     check("max_speed_mps", p.max_speed_mps, 0.0, 50.0, true, false, "m/s");
     check("min_speed_mps", p.min_speed_mps, 0.0, p.max_speed_mps, true, true, "m/s");
@@ -65,16 +68,54 @@ KickPedal::KickPedal(const KickPedalParams &p) : p_(p)
     const stick_tip *felt = stick_tip_find("felt");
     if (!felt)
         throw SimError("kick pedal: the stick tip table has no felt");
-    tip_k_ = felt->stiffness;
+    tip_k_ = p.felt_tip ? felt->stiffness : 0.0; // 0: the surface alone
     tip_alpha_ = felt->alpha;
-    tip_mu_ = felt->mu;
+    tip_mu_ = p.felt_tip ? felt->mu : p.surface_mu_s_per_m;
     const double l = p.beater_length_m;
     inertia_ = p.felt_mass_kg * l * l + p.shaft_mass_kg * l * l / 3.0 + p.axle_inertia_kg_m2;
     k1_ = 2.0 * kPi * p.head_tension_n_per_m / std::log(p.head_radius_m / p.felt_radius_m);
     k3_ = p.head_modulus_pa > 0.0 ? stick_tip_head_k3(p.head_modulus_pa, p.head_poisson,
                                                       p.head_thickness_m, p.head_radius_m)
                                   : 0.0;
+    if (p.surface_stiffness_n_per_m > 0.0) {
+        k1_ = p.surface_stiffness_n_per_m; // a plate: linear, no stretching
+        k3_ = 0.0;
+    }
+    if (!p.felt_tip && !(k1_ > 0.0))
+        throw SimError("kick pedal: without the felt the surface needs a stiffness");
     pushes_.reserve(64);
+}
+
+KickPedalParams hihat_pedal_params(double bending_n_m, double radius_m)
+{
+    check("hi-hat bending_n_m", bending_n_m, 0.0, 1.0e4, true, false, "N m");
+    check("hi-hat radius_m", radius_m, 0.05, 1.0, false, false, "m");
+    KickPedalParams p;
+    const double lever_m = 0.1;           // L: a plate's travel x = L phi
+    const double gap_m = 0.015;           // the plates apart when the pedal is up
+    const double mass_kg = 0.94 + 0.25;   // 14-inch top plate, clutch and rod
+    const double net_force_n = 20.0;      // spring 31.7 N less the weight 11.7 N, open
+    const double spring_n_per_m = 500.0;  // +7.5 N at the gap closed
+    const double damping_n_s_per_m = 0.5; // the rod in its tube, viscous
+    const double plate_k = 16.0 * kPi * bending_n_m / (radius_m * radius_m);
+    p.beater_length_m = lever_m;
+    p.felt_mass_kg = mass_kg;
+    p.shaft_mass_kg = 0.0;
+    p.spring_preload_n_m = net_force_n * lever_m;
+    p.spring_stiffness_n_m_per_rad = spring_n_per_m * lever_m * lever_m;
+    p.axle_damping_n_m_s = damping_n_s_per_m * lever_m * lever_m;
+    p.phi_head_rad = gap_m / lever_m;
+    p.chain_ratio = 3.0;        // rod travel per footboard (0.3 m) angle, in L's
+    p.head_radius_m = radius_m; // the membrane's fields are unused with a surface stiffness
+    p.surface_stiffness_n_per_m = 0.5 * plate_k; // two plates in series
+    p.felt_tip = false;
+    p.surface_mu_s_per_m = 0.4; // a choice: bronze on bronze, restitution ~0.6-0.8 (tested)
+    p.min_speed_mps = 0.2;
+    p.max_speed_mps = 1.2;
+    p.stroke_min_s = 0.025;
+    p.stroke_max_s = 0.120;
+    p.throw_fraction = 0.95; // the foot carries the plate to within 0.75 mm
+    return p;
 }
 
 double KickPedal::contact_force_n(double d, double ddot) const

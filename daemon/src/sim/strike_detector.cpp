@@ -112,8 +112,9 @@ long StrikeDetector::first_open_seq() const
     for (const Hand &h : hands_)
         if (h.in_contact)
             first = std::min(first, h.event.seq);
-    if (claimed_open_seq_ >= 0)
-        first = std::min(first, claimed_open_seq_);
+    for (long c : claimed_open_seq_)
+        if (c >= 0)
+            first = std::min(first, c);
     return first;
 }
 
@@ -127,7 +128,7 @@ void StrikeDetector::number_in_onset_order(long first_seq)
         std::swap(a.event.seq, b.event.seq);
 }
 
-long StrikeDetector::claim_seq(double onset_time_s, long first_seq)
+long StrikeDetector::claim_seq(double onset_time_s, long first_seq, int slot)
 {
     long seq = next_seq_++;
     // The hands' onsets of this step after this one move one seq later: the
@@ -147,7 +148,7 @@ long StrikeDetector::claim_seq(double onset_time_s, long first_seq)
         later[1]->event.seq = seq;
         seq = first;
     }
-    claimed_open_seq_ = seq;
+    claimed_open_seq_[static_cast<size_t>(slot & 1)] = seq;
     return seq;
 }
 

@@ -111,9 +111,9 @@ class Work;
 class PlanningWorker;
 class KickPedal;
 
-// The most strikes one physics step ends or begins: one per hand and the
-// right foot's (the kick's pedal, docs/pedal.md).
-constexpr int kStepStrikes = 3;
+// The most strikes one physics step ends or begins: one per hand and one per
+// foot (the kick's pedal, the hi-hat's: docs/pedal.md).
+constexpr int kStepStrikes = 4;
 
 // The physics side of run and render: the character tracking the clip or
 // performing a score, the drum, the strike detector, and the commands Pd may

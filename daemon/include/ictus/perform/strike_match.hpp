@@ -28,9 +28,9 @@ struct MatchSummary {
     long extra_strikes = 0; // primary strikes not matched to a note
     double mean_abs_error_ms = 0.0, max_abs_error_ms = 0.0;
 };
-// `origin_s`: simulation time of the plan's time 0. The right foot's strikes
-// (StrikeEvent::hand kFootRight) meet the foot's notes likewise; the counts
-// and errors are over both.
+// `origin_s`: simulation time of the plan's time 0. The feet's strikes
+// (StrikeEvent::hand kFootRight, kFootLeft) meet their foot's notes likewise;
+// the counts and errors are over all.
 MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
                            const std::vector<StrikeEvent> &strikes, double origin_s,
                            const std::vector<PlannedFootNote> &foot_notes = {});

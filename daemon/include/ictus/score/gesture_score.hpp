@@ -99,12 +99,16 @@ struct PlannedNote {
     Grace grace = Grace::none; // a flam's or a drag's grace stroke (ScoreNote::grace)
 };
 
-// A note of the right foot (`RF`, docs/pedal.md): the kick's pedal strikes
-// its drum at time_s (plan clock) at `dynamics`.
+// A note of a foot (docs/pedal.md): the right foot's (`RF`) on the kick's
+// pedal strikes its drum, the left foot's (`LF`) on the hi-hat's pedal closes
+// the hi-hat (the chick), at time_s (plan clock) at `dynamics`.
 struct PlannedFootNote {
     double time_s = 0.0;
     double dynamics = 0.0;
-    int drum = 0; // the kit's foot piece (PerformerFrame::Drum::foot)
+    // The kit's foot piece (PerformerFrame::Drum::foot) for the right foot,
+    // its hi-hat (Drum::pedal) for the left.
+    int drum = 0;
+    Side side = Side::right; // the foot
     int line = 0, column = 0;
 };
 
@@ -164,6 +168,9 @@ struct PlanOptions {
     // Two kicks closer than this are refused: the shortest interval the
     // pedal plays as two strokes (docs/pedal.md).
     double min_foot_interval_s = 0.06;
+    // Two chicks of the left foot closer than this are refused: the hi-hat's
+    // pedal opens again between them (docs/pedal.md).
+    double min_chick_interval_s = 0.1;
     double max_duration_s = 900.0; // longer performances are refused
     // Motor noise (docs/humanize.md): the amount, 0 for none;
     // < 0: the score's `humanize` statement (0 when it has none). The seed
@@ -190,7 +197,7 @@ struct GesturePlan {
     TipTrajectory tips;
     std::array<std::vector<Eigen::Vector3d>, 2> stick_dir; // [side][frame], unit, butt -> tip
     std::vector<PlannedNote> notes;                        // in time order
-    std::vector<PlannedFootNote> foot_notes;               // the right foot's, in time order
+    std::vector<PlannedFootNote> foot_notes;               // the feet's, in time order
     std::vector<PlannedMeter> meters;                      // the score's, in order
     double duration_s = 0.0;
     double score_start_s = 0.0; // plan time of the score's beat 0 (= lead_in_s)

@@ -78,8 +78,9 @@ constexpr int kMidiRide = 51;
 constexpr int kMidiRideBell = 53;
 constexpr double kMidiRideBellRadiusFraction = 0.12;
 // General MIDI's hi-hat played by a hand on a kit's hi-hat (its note 42): closed 42 with the
-// pedal down, open 46 with it up (ScoreNote::openness). The pedal hi-hat 44 is played by a
-// foot, which the performer does not have: left out (MidiDrumPart::skipped).
+// pedal down, open 46 with it up (ScoreNote::openness). The pedal hi-hat 44 is the left
+// foot's chick on that hi-hat's pedal (`LF`, docs/pedal.md), no sooner than
+// kMidiChickMin_s after the last (sooner: left out, MidiDrumPart::too_fast).
 // General MIDI's bass drums, Acoustic (35) and Bass Drum 1 (36), played by the right foot
 // on a kit's kick (its note 36; docs/pedal.md), no sooner than kMidiFootMin_s after the
 // last: a foot note (ScoreNote::foot), whatever the hands do.
@@ -89,6 +90,7 @@ constexpr double kMidiFootMin_s = 0.06;
 constexpr int kMidiClosedHihat = 42;
 constexpr int kMidiOpenHihat = 46;
 constexpr int kMidiPedalHihat = 44;
+constexpr double kMidiChickMin_s = 0.1;
 
 // Notes closer than this alternate hands; farther apart, the right hand
 // (the lead) plays.

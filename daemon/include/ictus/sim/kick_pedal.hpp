@@ -3,6 +3,8 @@
 // the head by a footboard through a one-sided chain, thrown into the bass drum's head and
 // met there by the project's contact law (externals/core/stick_tip.h: the felt tip in
 // series with the head's point stiffness and stretching). Standalone: no ODE, no scene.
+// The same model plays the hi-hat's pedal (hihat_pedal_params(), docs/pedal.md "The
+// hi-hat's pedal"): the top plate on its rod, the travel L phi, closed on the bottom plate.
 #pragma once
 
 #include <algorithm>
@@ -36,6 +38,13 @@ struct KickPedalParams {
     double head_thickness_m = 0.345 / 1390.0;
     double head_modulus_pa = 4.5e9;
     double head_poisson = 0.38;
+    // A plate instead of a head (the hi-hat's pedal): > 0 is the struck surface's linear
+    // point stiffness (N/m), used instead of the membrane's (no stretching).
+    double surface_stiffness_n_per_m = 0.0;
+    // The tip between beater and surface: true the felt's law in series with the surface;
+    // false the surface alone, linear, with Hunt-Crossley's mu (s/m) (metal on metal).
+    bool felt_tip = true;
+    double surface_mu_s_per_m = 0.0;
     // Integration and the foot.
     double substep_s = 1.0 / 48000.0;
     double min_speed_mps = 1.0;   // the softest note schedule() plans
@@ -44,6 +53,13 @@ struct KickPedalParams {
     double stroke_max_s = 0.120;  // the longest (the softest notes with room to spare)
     double throw_fraction = 0.85; // the foot takes the beater at most this far of phi_head
 };
+
+/// The hi-hat's pedal as a KickPedal (docs/pedal.md, "The hi-hat's pedal"): the top plate,
+/// its clutch and rod as a point mass on a lever of length L (its travel L phi, closed at
+/// L phi_head = the gap), the return spring's net force (spring less the weight) and
+/// stiffness as torques, the plates meeting by the plate's point stiffness 16 pi D / R^2 of
+/// each plate in series (bending_n_m D, radius_m R: the kit's hi-hat), no felt.
+KickPedalParams hihat_pedal_params(double bending_n_m, double radius_m);
 
 /// A strike of the beater on the head: one contact episode.
 struct PedalStrike {

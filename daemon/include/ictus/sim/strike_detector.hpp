@@ -150,12 +150,12 @@ class StrikeDetector
     // onset order: two hands whose contacts begin in one step get their seq by
     // their interpolated onset times, not by the order the hands were updated.
     void number_in_onset_order(long first_seq);
-    // A seq for a strike found elsewhere (the kick's pedal) with its onset
-    // at onset_time_s in this step: the onsets of the step (seq >=
-    // first_seq) keep onset order with it.
-    // It is open (first_open_seq() counts it) until end_claimed().
-    long claim_seq(double onset_time_s, long first_seq);
-    void end_claimed() { claimed_open_seq_ = -1; }
+    // A seq for a strike found elsewhere (a foot's pedal: slot 0 the right
+    // foot's, 1 the left's) with its onset at onset_time_s in this step: the
+    // hands' onsets of the step (seq >= first_seq) keep onset order with it.
+    // It is open (first_open_seq() counts it) until end_claimed(slot).
+    long claim_seq(double onset_time_s, long first_seq, int slot = 0);
+    void end_claimed(int slot = 0) { claimed_open_seq_[static_cast<size_t>(slot & 1)] = -1; }
     // Tips that came over the disk from the side below the membrane plane (shell hits, not
     // strikes).
     long side_entries() const { return side_entries_; }
@@ -209,7 +209,7 @@ class StrikeDetector
     std::array<Hand, 2> hands_;
     long next_seq_ = 0;
     long side_entries_ = 0;
-    long claimed_open_seq_ = -1; // claim_seq()'s strike under way, -1: none
+    std::array<long, 2> claimed_open_seq_{-1, -1}; // claim_seq()'s strikes under way, -1: none
 };
 
 class Scene;

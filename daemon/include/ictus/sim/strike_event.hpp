@@ -19,7 +19,8 @@ constexpr int kMaxDrums = 8;
 // One contact episode of a stick tip with the membrane (one row of strikes.csv).
 struct StrikeEvent {
     long seq = 0;        // 0, 1, 2 ... in order of onset within a run
-    int hand = 0;        // the limb: 0 left hand, 1 right hand, 2 right foot (kFootRight)
+    int hand = 0; // the limb: 0 left hand, 1 right hand, 2 right foot (kFootRight), 3 left foot
+                  // (kFootLeft)
     int drum = 0;        // the drum's index in the scene (0: the one drum, a kit's first)
     bool bounce = false; // a re-contact of the same stroke
     long stroke = 0;     // per hand: increments on every non-bounce strike
@@ -55,7 +56,7 @@ struct StrikeEvent {
 constexpr int kZoneHead = 0, kZoneRim = 1;
 // StrikeEvent::hand: the limb that struck. The right foot plays the kick's
 // pedal (docs/pedal.md); its strikes are the felt beater's.
-constexpr int kHandLeft = 0, kHandRight = 1, kFootRight = 2;
+constexpr int kHandLeft = 0, kHandRight = 1, kFootRight = 2, kFootLeft = 3;
 
 // The fields of a StrikeEvent, in strikes.csv's column order (and the OSC message's).
 enum class StrikeField {
