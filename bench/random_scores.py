@@ -14,8 +14,12 @@ For the statistics each note gets its nearest primary strike within 50 ms (close
 the hand's neighbouring notes): *off-time* when that strike is beyond 5 ms, *missed* when there
 is none; primary strikes given to no note are *extra*.
 
+With `--kit full`: random scores over that kit (random_score's kit mode, rendered with
+`--kit full`; tests/perform/test_random_kit_scores.py), the notes also by limb and drum; a kick
+is right within 0.5 ms.
+
 usage: bench/random_scores.py ICTUSD [--count 1000] [--first 1] [--jobs N] [--json FILE]
-                              [--workdir DIR] [-- extra ictusd render options]
+                              [--workdir DIR] [--kit full] [-- extra ictusd render options]
 """
 import argparse
 import json
@@ -63,6 +67,7 @@ def main():
     ap.add_argument("--jobs", type=int, default=0)
     ap.add_argument("--json", help="write every note's record here")
     ap.add_argument("--workdir", help="keep the failing renders here")
+    ap.add_argument("--kit", help="random scores over this kit (full)")
     # The render options after "--" are split off here: argparse gives a trailing
     # nargs="*" positional nothing once the first positional (ictusd) is taken.
     argv = sys.argv[1:]
@@ -82,7 +87,7 @@ def main():
 
     results, workdir = render_check.run_many(args.ictusd, seeds, workdir=args.workdir, jobs=jobs,
                                              nuances=nuances, extra_args=args.render_args,
-                                             progress=progress)
+                                             progress=progress, kit=args.kit)
     wall = time.monotonic() - t0
     sys.stderr.write("\n")
 
@@ -111,9 +116,10 @@ def main():
     limits = [r.joint_limits_deg for r in results if r.joint_limits_deg is not None]
     trunk = [(r.seed, p, v) for r in results for p, v in r.trunk if isinstance(v, (int, float))]
 
+    render_args = (["--kit", args.kit] if args.kit else []) + args.render_args
     print("## Random scores: %d seeds (%d..%d), `%s`%s\n"
           % (len(results), seeds[0], seeds[-1], os.path.basename(args.ictusd),
-             (" " + " ".join(args.render_args)) if args.render_args else ""))
+             (" " + " ".join(render_args)) if render_args else ""))
     print("Rendered in %.0f s wall (%d jobs; %.0f s simulated, %.0f s of renders, %.1fx real time "
           "per render). Nuances: %s.\n" % (wall, jobs, simulated, cpu, simulated / max(cpu, 1e-9),
                                             ", ".join(nuances)))
@@ -160,7 +166,7 @@ def main():
           "their hand's nearest note.\n")
     print("| feature | value | notes | not right | % | missed | off-time | extra |")
     print("|---|---|---|---|---|---|---|---|")
-    for f in FEATURES:
+    for f in FEATURES + (["hand", "drum"] if args.kit else []):
         table = {}
         for n in notes:
             v = n["features"][f]

@@ -5,10 +5,13 @@
     python3 -m ictus_tools.random_score --seed N --notes  # and the notes it must give
     python3 -m ictus_tools.random_score --seed N --ictusd build/ictusd   # nuances from that parser
     python3 -m ictus_tools.random_score --coverage 100    # how many of seeds 1..100 hold each form
+    python3 -m ictus_tools.random_score --seed N --kit full   # over the kit full (its drums,
+                                                   # chords, kicks, cymbals: random_kit_score)
 
 (with python/ on PYTHONPATH, as everywhere for this package: docs/python.md).
 
-Used by tests/perform/test_random_scores.py (CTest) and bench/random_scores.py. The same seed
+Used by tests/perform/test_random_scores.py and test_random_kit_scores.py (CTest) and
+bench/random_scores.py. The same seed
 and the same nuance list give the same bytes (Python's own `random.Random(seed)`, no hashing
 of sets, no clock).
 
@@ -496,7 +499,7 @@ class Generator:
             else:
                 body.append(self.note(hand))
         rep = {"kind": "repeat", "count": count, "body": body}
-        if count_notes(rep) > notes_left:
+        if self.count_notes(rep) > notes_left:
             return None
         for attempt in range(6):
             trial = state.copy()
@@ -508,9 +511,12 @@ class Generator:
                 body.append(self.rest())
         return None
 
+    count_notes = staticmethod(count_notes)
+    new_state = State
+
     def generate(self):
         rng = self.rng
-        state = State()
+        state = self.new_state()
         out = []   # top-level statements
         first_tempo = rng.randint(int(TEMPO_RANGE[0]), int(TEMPO_RANGE[1]))  # whole bpm
         if rng.random() < 0.3:
@@ -548,17 +554,17 @@ class Generator:
                 rep = self.make_repeat(state, target - notes)
                 if rep is not None:
                     out.append(rep)
-                    notes += count_notes(rep)
+                    notes += self.count_notes(rep)
                     hand = None
                     continue
             hand = self.pick_hand(hand)
             st = self.note(hand)
-            if notes + count_notes(st) > NOTES_RANGE[1]:
+            if notes + self.count_notes(st) > NOTES_RANGE[1]:
                 hand = rng.choice(["right", "left"])
                 st = self.note(hand)
             emitted = self.place_note(state, st)
             out.extend(emitted)
-            notes += count_notes(emitted[-1])
+            notes += self.count_notes(emitted[-1])
             hand = emitted[-1]["hand"]
         self.state = state
         self.statements = out
@@ -602,19 +608,29 @@ class Generator:
         return "\n".join(lines) + "\n"
 
 
-class RandomScore:
-    """A generated score: `text`, the `notes` it must give (time_s from beat 0, hand, nuance,
-    grip, dynamics, beats, tempo_bpm, r_over_a, theta_deg, features), `length_s`."""
+LIMB_ORDER = {"right": 0, "left": 1, "right-foot": 2}  # notes on one beat: notes.csv's order
 
-    def __init__(self, seed, nuances=None):
+
+class RandomScore:
+    """A generated score: `text`, the `notes` it must give (time_s from beat 0, hand -- a limb
+    on a kit, `right-foot` too --, nuance, grip, dynamics, beats, tempo_bpm, r_over_a,
+    theta_deg, features; on a kit its `drum`), `length_s`. `kit` ("full"): a score over that
+    kit (ictus_tools.random_kit_score), rendered with `--kit KIT`; None: on the one drum."""
+
+    def __init__(self, seed, nuances=None, kit=None):
         self.seed = seed
+        self.kit = kit
         self.nuances = list(nuances) if nuances else nuance_list()
-        gen = Generator(seed, self.nuances)
+        if kit:
+            from ictus_tools.random_kit_score import KitGenerator
+            gen = KitGenerator(seed, self.nuances, kit)
+        else:
+            gen = Generator(seed, self.nuances)
         statements = gen.generate()
         self.text = gen.render_text(statements)
-        self.notes = sorted(gen.state.notes, key=lambda n: (n["time_s"], n["hand"] != "right"))
+        self.notes = sorted(gen.state.notes, key=lambda n: (n["time_s"], LIMB_ORDER[n["hand"]]))
         self.length_s = gen.state.time_s()
-        self.physical_grip = self.notes[0]["grip"] if self.notes else "french"
+        self.physical_grip = next((n["grip"] for n in self.notes if n["grip"]), "french")
         for n in self.notes:
             n["line"] = n.pop("stmt")["line"]
             n["features"] = note_features(n, self.notes)
@@ -653,7 +669,8 @@ def note_features(n, notes):
     gap_next = min(nxt) - n["time_s"] if nxt else None
     other_gap = n["time_s"] - max(other) if other else None
     d = n["dynamics"]
-    return {
+    kit = {"drum": n["drum"]} if "drum" in n else {}
+    return kit | {
         "tempo": tempo_band(n["tempo_bpm"]),
         "ramp": "in ramp" if n["ramp"] else "steady",
         "fraction": n["label"],
@@ -746,19 +763,21 @@ def main(argv=None):
                     help="instead: how many of seeds 1..N hold each form of the language")
     ap.add_argument("--ictusd", help="read the nuance list from this ictusd's parser")
     ap.add_argument("--notes", action="store_true", help="also print the expected notes (as comments)")
+    ap.add_argument("--kit", help="a score over this kit (full), rendered with --kit KIT")
     args = ap.parse_args(argv)
     if args.coverage:
         sys.stdout.write(coverage(args.coverage, nuance_list(args.ictusd)))
         return 0
     if args.seed is None:
         ap.error("--seed N is required (or --coverage N)")
-    score = RandomScore(args.seed, nuance_list(args.ictusd))
+    score = RandomScore(args.seed, nuance_list(args.ictusd), kit=args.kit)
     sys.stdout.write(score.text)
     if args.notes:
         for n in score.notes:
-            sys.stdout.write("# note t=%.6f s (plan %.6f) %-5s %s %s dyn %.2f beats %.4f tempo %.1f\n"
+            sys.stdout.write("# note t=%.6f s (plan %.6f) %-5s %s %s dyn %.2f beats %.4f tempo %.1f%s\n"
                              % (n["time_s"], n["time_s"] + LEAD_IN_S, n["hand"], n["nuance"],
-                                n["grip"], n["dynamics"], n["beats"], n["tempo_bpm"]))
+                                n["grip"], n["dynamics"], n["beats"], n["tempo_bpm"],
+                                " on " + n["drum"] if "drum" in n else ""))
     return 0
 
 

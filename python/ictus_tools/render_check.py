@@ -27,9 +27,11 @@ import shutil
 import subprocess
 import tempfile
 
-from ictus_tools.random_score import LEAD_IN_S, RandomScore
+from ictus_tools.random_score import LEAD_IN_S, LIMB_ORDER, RandomScore
 
 TOLERANCE_MS = 5.0            # the acceptance bound, never loosened
+FOOT_TOLERANCE_MS = 0.5       # a kick's: the pedal's planning tolerance (docs/pedal.md)
+LIMB_OF_HAND = {0: "left", 1: "right", 2: "right-foot"}  # strikes.csv's hand column
 ASSIGN_MS = 50.0              # a strike further than this from a note is not its strike
 PLAN_TIME_TOL_S = 1e-5        # notes.csv has 6 decimals
 MAX_LIMIT_EXCURSION_DEG = 2.0
@@ -116,14 +118,16 @@ class Result:
         """Everything needed to reproduce and see a failure."""
         out = ["seed %d: %s" % (self.seed, "; ".join(self.problems[:6]) +
                                 (" ..." if len(self.problems) > 6 else ""))]
-        out.append("  reproduce: PYTHONPATH=python python3 -m ictus_tools.random_score --seed %d --ictusd %s "
-                   "> s.txt && "
-                   "%s render --score s.txt --out out-%d" % (self.seed, ictusd, ictusd, self.seed))
+        kit = " --kit " + self.score.kit if self.score.kit else ""
+        out.append("  reproduce: PYTHONPATH=python python3 -m ictus_tools.random_score --seed %d --ictusd %s%s "
+                   "> s.txt && %s render%s --score s.txt --out out-%d"
+                   % (self.seed, ictusd, kit, ictusd, kit, self.seed))
         out.append("  score:")
         out.extend("    | " + line for line in self.score.text.rstrip("\n").split("\n"))
         for n in self.failing_notes():
-            out.append("  note %d (line %d) %s %s %s dyn %.2f beats %.4f tempo %.1f at plan t=%.6f s:"
-                       " %s" % (n["index"], n["line"], n["hand"], n["nuance"], n["grip"],
+            out.append("  note %d (line %d) %s%s %s %s dyn %.2f beats %.4f tempo %.1f at plan t=%.6f s:"
+                       " %s" % (n["index"], n["line"], n["hand"],
+                                " on " + n["drum"] if "drum" in n else "", n["nuance"], n["grip"],
                                 n["dynamics"], n["beats"], n["tempo_bpm"], n["plan_time_s"],
                                 n["why"]))
         for s in self.extra:
@@ -146,6 +150,8 @@ def render(ictusd, score, workdir, timeout_s=600, extra_args=()):
     if os.path.exists(out):
         shutil.rmtree(out)
     cmd = [ictusd, "render", "--score", path, "--out", out, "--bvh-rate", "0"] + list(extra_args)
+    if score.kit:
+        cmd += ["--kit", score.kit]
     t0 = time.monotonic()
     try:
         proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -186,7 +192,12 @@ def judge(res, out):
     lead_in = perf.get("plan", {}).get("lead_in_s", LEAD_IN_S)
     origin = perf.get("plan", {}).get("origin_s", 0.0)
     per_note_json = perf.get("per_note", [])
-    plane_y = j["drum"]["center_m"][1]
+    # Each piece's striking plane (its head; a cymbal's top face): tip heights are taken
+    # over the plane of the strike's piece.
+    drums = j.get("kit", {}).get("drums") or [j["drum"]]
+    names = [d.get("name", "drum") for d in drums]
+    planes = [d["center_m"][1] + (d.get("shell_depth_m", 0.0) / 2 if d.get("bending_n_m") else 0.0)
+              for d in drums]
 
     for p, v in _find_keys(j, lambda k: k == "max_excursion_deg"):
         res.joint_limits_deg = v if res.joint_limits_deg is None else max(res.joint_limits_deg, v)
@@ -214,27 +225,29 @@ def judge(res, out):
         res.problems.extend(bad)
         if tip_rows:
             tips = {"t": [float(r["time_s"]) for r in tip_rows],
-                    "left": [float(r["left_sim_y_m"]) - plane_y for r in tip_rows],
-                    "right": [float(r["right_sim_y_m"]) - plane_y for r in tip_rows]}
+                    "left": [float(r["left_sim_y_m"]) for r in tip_rows],
+                    "right": [float(r["right_sim_y_m"]) for r in tip_rows]}
             # Where the hand held the stick (the sticks on their fulcrum): the bounce rule
             # also counts a re-contact the hand did not lift the stick 1 cm for (docs/osc.md).
             if "left_held_y_m" in tip_rows[0]:
-                tips["held"] = {h: [float(r[h + "_held_y_m"]) - plane_y for r in tip_rows]
+                tips["held"] = {h: [float(r[h + "_held_y_m"]) for r in tip_rows]
                                 for h in ("left", "right")}
 
     # The plan holds the generator's notes.
     expected = score.notes
-    rows = sorted(note_rows, key=lambda r: (float(r["time_s"]), r["hand"] != "right"))
+    rows = sorted(note_rows, key=lambda r: (float(r["time_s"]), LIMB_ORDER.get(r["hand"], 3)))
     if len(rows) != len(expected):
         res.problems.append("notes.csv has %d notes, the score %d" % (len(rows), len(expected)))
     for e, r in zip(expected, rows):
         t = origin + lead_in + e["time_s"]
         if (r["hand"] != e["hand"] or r["nuance"] != e["nuance"] or r["grip"] != e["grip"]
+                or r.get("drum") != e.get("drum", r.get("drum"))
                 or abs(float(r["time_s"]) - t) > PLAN_TIME_TOL_S):
-            res.problems.append("notes.csv row %s (%s %s %s at %s s) is not the score's note "
-                                "(%s %s %s at %.6f s)" % (r["index"], r["hand"], r["nuance"],
-                                                          r["grip"], r["time_s"], e["hand"],
-                                                          e["nuance"], e["grip"], t))
+            res.problems.append("notes.csv row %s (%s %s %s %s at %s s) is not the score's note "
+                                "(%s %s %s %s at %.6f s)" % (
+                                    r["index"], r["hand"], r["nuance"], r["grip"],
+                                    r.get("drum", ""), r["time_s"], e["hand"], e["nuance"],
+                                    e["grip"], e.get("drum", ""), t))
             break
     per_note_by_index = {i: pn for i, pn in enumerate(per_note_json)}
     rows_by_hand = {}
@@ -248,7 +261,8 @@ def judge(res, out):
     # Strikes.
     strikes = []
     for r in strike_rows:
-        s = {"seq": int(r["seq"]), "hand": "left" if int(r["hand"]) == 0 else "right",
+        s = {"seq": int(r["seq"]), "hand": LIMB_OF_HAND[int(r["hand"])],
+             "drum": names[int(r.get("drum") or 0)], "plane_y": planes[int(r.get("drum") or 0)],
              "bounce": int(r["bounce"]), "stroke": int(r["stroke"]), "time_s": float(r["time_s"]),
              "duration_ms": float(r["duration_ms"]),
              "normal_velocity_mps": float(r["normal_velocity_mps"]),
@@ -257,10 +271,17 @@ def judge(res, out):
     res.strikes = strikes
     res.bounces = sum(s["bounce"] for s in strikes)
     check_bounce_tags(res, strikes, tips)
+    if score.kit:
+        late = [(a, b) for a, b in zip(strikes, strikes[1:]) if b["time_s"] < a["time_s"]]
+        if late:
+            res.problems.append("strikes.csv is not in onset order: seq %d at %.6f s after seq "
+                                "%d at %.6f s" % (late[0][1]["seq"], late[0][1]["time_s"],
+                                                  late[0][0]["seq"], late[0][0]["time_s"]))
 
-    # Notes and their strikes, per hand.
-    for hand in ("right", "left"):
+    # Notes and their strikes, per limb (on a kit, the strikes on the note's piece).
+    for hand in ("right", "left", "right-foot"):
         notes = [n for n in expected if n["hand"] == hand]
+        tolerance_ms = FOOT_TOLERANCE_MS if hand == "right-foot" else TOLERANCE_MS
         prim = [s for s in strikes if s["hand"] == hand and s["bounce"] == 0]
         taken = set()
         for k, n in enumerate(notes):
@@ -271,8 +292,9 @@ def judge(res, out):
                 lo = max(lo, (t + origin + lead_in + notes[k - 1]["time_s"]) / 2)
             if k + 1 < len(notes):
                 hi = min(hi, (t + origin + lead_in + notes[k + 1]["time_s"]) / 2)
-            near = [s for s in prim if lo <= s["time_s"] < hi]
-            within = [s for s in prim if abs(s["time_s"] - t) <= TOLERANCE_MS / 1000.0]
+            mine = [s for s in prim if s["drum"] == n.get("drum", s["drum"])]
+            near = [s for s in mine if lo <= s["time_s"] < hi]
+            within = [s for s in mine if abs(s["time_s"] - t) <= tolerance_ms / 1000.0]
             rec = dict(n)
             rec["plan_time_s"] = t
             rec["index"] = row_index(hand, t)
@@ -288,15 +310,16 @@ def judge(res, out):
             elif len(within) > 1:
                 rec["status"] = "double"
                 rec["why"] = "%d primary strikes within %g ms (%s ms)" % (
-                    len(within), TOLERANCE_MS,
+                    len(within), tolerance_ms,
                     ", ".join("%+.2f" % ((s["time_s"] - t) * 1000) for s in within))
             elif best:
                 rec["status"] = "off-time"
-                rec["why"] = "nearest primary strike %+.2f ms from the beat (%.2f m/s, contact %.1f ms)" % (
+                rec["why"] = "nearest primary strike on it %+.2f ms from the beat (%.2f m/s, contact %.1f ms)" % (
                     rec["error_ms"], best["normal_velocity_mps"], best["duration_ms"])
             else:
                 rec["status"] = "missed"
-                rec["why"] = "no primary strike of its hand within %g ms" % ASSIGN_MS
+                rec["why"] = "no primary strike of its limb%s within %g ms" % (
+                    " on " + n["drum"] if "drum" in n else "", ASSIGN_MS)
             res.notes.append(rec)
         for s in prim:
             if s["seq"] in taken:
@@ -346,10 +369,21 @@ def _tip_max(tips, hand, t0, t1):
     return max(vals) if vals else None
 
 
-def check_bounce_tags(res, strikes, tips):
+def _over_plane(tips, hand, plane_y):
+    """A hand's tips (and held tips) as heights over a piece's plane; None for a foot's."""
+    if not tips or hand not in tips:
+        return None
+    out = {"t": tips["t"], hand: [y - plane_y for y in tips[hand]]}
+    if "held" in tips:
+        out["held"] = {hand: [y - plane_y for y in tips["held"][hand]]}
+    return out
+
+
+def check_bounce_tags(res, strikes, all_tips):
     last = {}   # hand -> previous strike of that hand
     for s in strikes:
         prev = last.get(s["hand"])
+        tips = _over_plane(all_tips, s["hand"], s["plane_y"])
         if s["bounce"]:
             if prev is None:
                 res.problems.append("strike seq %d is tagged a bounce but is its hand's first" % s["seq"])
@@ -405,15 +439,53 @@ def check_bounce_tags(res, strikes, tips):
         last[s["hand"]] = s
 
 
+def seed_arguments(ap, count, seeds_note):
+    """The random-score tests' common options: --ictusd, the seeds (--first, --count or
+    --seeds; `seeds_note` says what --seeds skips), --jobs, --workdir, --keep."""
+    ap.add_argument("--ictusd", required=True)
+    ap.add_argument("--first", type=int, default=1, help="first seed (default 1)")
+    ap.add_argument("--count", type=int, default=count, help="number of seeds (default %d)" % count)
+    ap.add_argument("--seeds", help="these seeds (comma-separated) instead of --first/--count; "
+                    + seeds_note)
+    ap.add_argument("--jobs", type=int, default=0, help="parallel renders (default: the cores)")
+    ap.add_argument("--workdir", help="folder for the renders (emptied first)")
+    ap.add_argument("--keep", action="store_true", help="keep every render, not only failures")
+
+
+def seeds_of(args):
+    if args.seeds:
+        return [int(x) for x in args.seeds.split(",") if x.strip()]
+    return list(range(args.first, args.first + args.count))
+
+
+def empty_workdir(path, prefix):
+    """`path` (else a new temporary folder) emptied and made."""
+    workdir = path or tempfile.mkdtemp(prefix=prefix)
+    if os.path.isdir(workdir):
+        shutil.rmtree(workdir)
+    os.makedirs(workdir)
+    return workdir
+
+
+def progress_printer(t0):
+    """One line per score as it comes (a timeout still shows the rest): run_many's progress."""
+    import time
+
+    def progress(i, n, r):
+        print("[%d/%d %.0f s] seed %d: %s" % (i, n, time.monotonic() - t0, r.seed,
+                                                "ok" if r.ok else "; ".join(r.problems)), flush=True)
+    return progress
+
+
 def run_many(ictusd, seeds, workdir=None, jobs=None, nuances=None, keep=False, extra_args=(),
-             progress=None):
+             progress=None, kit=None):
     """Render every seed in parallel (threads, each waiting on its own ictusd); results in
-    seed order."""
+    seed order. `kit`: scores over that kit (random_score's kit mode)."""
     from concurrent.futures import ThreadPoolExecutor
     jobs = jobs or os.cpu_count() or 2
     own = workdir is None
     workdir = workdir or tempfile.mkdtemp(prefix="ictus-random-scores-")
-    scores = [RandomScore(s, nuances) for s in seeds]
+    scores = [RandomScore(s, nuances, kit=kit) for s in seeds]
     results = []
     try:
         with ThreadPoolExecutor(max_workers=jobs) as pool:

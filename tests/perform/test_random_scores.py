@@ -27,7 +27,6 @@ import argparse
 import os
 import shutil
 import sys
-import tempfile
 import time
 
 from ictus_tools import checks, random_score, render_check
@@ -36,15 +35,8 @@ from ictus_tools.checks import check, fail
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--ictusd", required=True)
-    ap.add_argument("--first", type=int, default=1, help="first seed (default 1)")
-    ap.add_argument("--count", type=int, default=100, help="number of seeds (default 100)")
-    ap.add_argument("--seeds", help="these seeds (comma-separated) instead of --first/--count; "
-                    "the coverage check is then skipped (a handful of seeds need not hold every "
-                    "nuance)")
-    ap.add_argument("--jobs", type=int, default=0, help="parallel renders (default: the cores)")
-    ap.add_argument("--workdir", help="folder for the renders (emptied first)")
-    ap.add_argument("--keep", action="store_true", help="keep every render, not only failures")
+    render_check.seed_arguments(ap, 100, "the coverage check is then skipped (a handful of "
+                                "seeds need not hold every nuance)")
     args = ap.parse_args()
 
     if not os.access(args.ictusd, os.X_OK):
@@ -54,10 +46,7 @@ def main():
 
     # The generator is deterministic and draws what it claims to (checked on the test's own
     # seeds: every nuance and both grips must appear, or the test would miss them silently).
-    if args.seeds:
-        seeds = [int(x) for x in args.seeds.split(",") if x.strip()]
-    else:
-        seeds = list(range(args.first, args.first + args.count))
+    seeds = render_check.seeds_of(args)
     scores = [random_score.RandomScore(s, nuances) for s in seeds]
     again = random_score.RandomScore(seeds[0], nuances)
     problems = []
@@ -79,16 +68,10 @@ def main():
     # strike removed, moved, made NaN, re-tagged, or added (render_check.planted_faults).
     jobs = args.jobs or os.cpu_count() or 2
     t0 = time.monotonic()
-    workdir = args.workdir or tempfile.mkdtemp(prefix="ictus-random-scores-")
-    if os.path.isdir(workdir):
-        shutil.rmtree(workdir)
-    os.makedirs(workdir)
-    def progress(i, n, r):  # one line per score as it comes: a timeout still shows the rest
-        print("[%d/%d %.0f s] seed %d: %s" % (i, n, time.monotonic() - t0, r.seed,
-                                                "ok" if r.ok else "; ".join(r.problems)), flush=True)
-
+    workdir = render_check.empty_workdir(args.workdir, "ictus-random-scores-")
     results, _ = render_check.run_many(args.ictusd, seeds, workdir=workdir, jobs=jobs,
-                                       nuances=nuances, keep=args.keep, progress=progress)
+                                       nuances=nuances, keep=args.keep,
+                                       progress=render_check.progress_printer(t0))
     wall = time.monotonic() - t0
     notes = sum(len(r.notes) for r in results)
     failed = [r for r in results if not r.ok]
