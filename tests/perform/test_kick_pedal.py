@@ -145,6 +145,33 @@ def main():
     check(all(abs(float(n["error_ms"])) <= 0.5 for n in ex if n["hand"] == "right-foot"),
           "examples/scores/groove.txt: its kicks within 0.5 ms")
 
+    # The sticks' runaway guard never holds a kick back: a score (from the random kit scores)
+    # whose left stick flies off the crash's edge after three bounces, which fires the guard on
+    # this build; every kick is struck either way, and a guard that fired is said.
+    runaway = os.path.join(args.workdir, "runaway.txt")
+    with open(runaway, "w") as f:
+        f.write("tempo 214\nr on tom2 legato\nrest 3/4, L 2/2 on tom2 staccato, tempo -> 95 over 1\n"
+                "RF pp + L tenuto on tom2 1/16\nrest 2/1, l accent f 6/32 on crash\nrest 7/8\n"
+                "L on hihat + right accent + rf ff beats 1/32\nrest 3/2\nL f on tom2, rest 1/2\n"
+                "L staccato 0.79 on crash beats 1/3\n"
+                "rest 3/2, left 1/1 accent pp on snare + right-foot f\n")
+    out_r = os.path.join(args.workdir, "runaway")
+    run = subprocess.run([args.ictusd, "render", "--kit", "full", "--score", runaway, "--out",
+                          out_r, "--force"], capture_output=True, text=True, timeout=600, env=env)
+    check(run.returncode == 0, "the runaway score renders: %s" % run.stderr[-500:])
+    with open(os.path.join(out_r, "notes.csv")) as f:
+        kicks_r = [n for n in csv.DictReader(f) if n["hand"] == "right-foot"]
+    with open(os.path.join(out_r, "render.json")) as f:
+        perf_r = json.load(f)["performance"]
+    print("runaway score: guard fired %d time(s), %d strikes held back; kicks %s"
+          % (perf_r["runaways"], perf_r["withheld_strikes"], [n["error_ms"] for n in kicks_r]))
+    check(len(kicks_r) == 3 and all(n["strike_seq"] != "-1" and abs(float(n["error_ms"])) <= 0.5
+                                    for n in kicks_r),
+          "every kick of the runaway score struck within 0.5 ms: %s"
+          % [(n["time_s"], n["strike_seq"], n["error_ms"]) for n in kicks_r])
+    check((perf_r["runaways"] > 0) == ("runaway guard fired" in run.stderr),
+          "a guard that fired is said on stderr (and only then): %s" % run.stderr[-300:])
+
     # 2. Kicks alone, pp to ff (seeded order): the kick's fundamental.
     dyn = ["pp", "p", "mp", "mf", "f", "ff"]
     rng.shuffle(dyn)

@@ -191,6 +191,9 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
                          {"max_excursion_deg", b.max_limit_excursion_deg},
                          {"joint", b.max_limit_joint}};
     j["trunk"] = {{"max_deg", b.trunk_max_deg}, {"rms_deg", b.trunk_rms_deg()}};
+    // The runaway guard (docs/perform.md): times it fired, strikes it held back.
+    j["runaways"] = perf.runaways();
+    j["withheld_strikes"] = perf.withheld_strikes();
     j["sticks"] = {{"mount", o.scene.sticks == StickMount::fulcrum ? "fulcrum" : "rigid"},
                    {"grip_firmness", o.grip_firmness},
                    {"grip_damping_ratio", o.scene.grip_damping_ratio},

@@ -249,7 +249,9 @@ void Performance::mark_pedal(StrikeEvent &e) const
 
 bool Performance::withheld(const StrikeEvent &e) const
 {
-    return e.time_s >= quiet_from_s_ && e.time_s < quiet_until_s_;
+    // The guard watches the sticks: a foot's strike (its pedal's own model)
+    // is never held back by it.
+    return e.hand < 2 && e.time_s >= quiet_from_s_ && e.time_s < quiet_until_s_;
 }
 
 void Performance::hold_open_contacts()

@@ -237,8 +237,10 @@ bool StrikeDetector::update_hand(Hand &h, int hand, const TipSample &s, StrikeEv
 
 // A tip that comes in over the disk already below the membrane plane entered
 // from the side: that is the shell (or rim), not a strike on the membrane. It
-// is ignored until the tip is above the plane again. So is a tip first seen
-// below the plane (no approach was observed), uncounted. True while ignored.
+// is ignored until the tip is above the plane again, or out of the disk in
+// plan (gone out the way it came: a stick that passed under a cymbal's edge
+// on its way down to a drum plays that drum). So is a tip first seen below
+// the plane (no approach was observed), uncounted. True while ignored.
 bool StrikeDetector::entered_from_side(Hand &h, const TipSample &s, double gap, bool touching)
 {
     if (!h.in_contact && touching && !h.side_entry) {
@@ -251,7 +253,7 @@ bool StrikeDetector::entered_from_side(Hand &h, const TipSample &s, double gap, 
     }
     if (!h.side_entry)
         return false;
-    if (gap >= 0.0)
+    if (gap >= 0.0 || !over_membrane(s.center_m))
         h.side_entry = false;
     h.previous = s;
     h.previous_gap = gap;
