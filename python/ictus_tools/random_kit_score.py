@@ -40,14 +40,16 @@ import math
 
 from ictus_tools import random_score as rs
 
-# The limbs a kit score writes. The left foot (`LF` / `left-foot`, the hi-hat's chick) is added
-# here: "left-foot" in LIMBS, its words in LIMB_HEADS, its piece in FOOT_LIMBS (each foot keeps
-# KICK_MIN_INTERVAL_S), and the chords of KitGenerator.note and pick_hand that may hold it.
-LIMBS = ["right", "left", "right-foot"]
+# The limbs a kit score writes: the hands, the right foot on the kick and the left foot's chick
+# on the hi-hat (`LF`); each foot's notes at least its interval apart (the planner's 60 ms for
+# the kick, 100 ms for the chick, docs/pedal.md, with a margin).
+LIMBS = ["right", "left", "right-foot", "left-foot"]
 LIMB_HEADS = {"right": ["R", "R", "right", "r"], "left": ["L", "L", "left", "l"],
-              "right-foot": ["RF", "RF", "right-foot", "rf"]}
-FOOT_LIMBS = {"right-foot": "kick"}          # a foot and the piece it plays
+              "right-foot": ["RF", "RF", "right-foot", "rf"],
+              "left-foot": ["LF", "LF", "left-foot", "lf"]}
+FOOT_LIMBS = {"right-foot": "kick", "left-foot": "hihat"}  # a foot and the piece it plays
 KICK_MIN_INTERVAL_S = 0.07
+FOOT_MIN_INTERVAL_S = {"right-foot": KICK_MIN_INTERVAL_S, "left-foot": 0.11}
 
 # The kits: each hand piece's place (x right, y up, z forward, m; docs/kit.md's table).
 KITS = {
@@ -112,7 +114,7 @@ class KitState(rs.State):
         if last is None:
             return True
         if limb in FOOT_LIMBS:
-            need = KICK_MIN_INTERVAL_S
+            need = FOOT_MIN_INTERVAL_S[limb]
         else:
             need = move_interval_s(self.kit, self.last_piece[limb], piece)
         return t - last >= need + rs.INTERVAL_MARGIN_S
@@ -202,8 +204,10 @@ class KitGenerator(rs.Generator):
         r = self.rng.random()
         if r < 0.3:
             return "chord"
-        if r < 0.45:
+        if r < 0.4:
             return "right-foot"
+        if r < 0.45:
+            return "left-foot"
         if r < 0.52:
             return "both"
         if prev_hand in ("right", "left") and self.rng.random() < 0.5:
@@ -215,7 +219,9 @@ class KitGenerator(rs.Generator):
         rng = self.rng
         if hand == "chord":
             limbs = rng.choice([["right", "left"], ["right", "right-foot"], ["left", "right-foot"],
-                                ["right", "left", "right-foot"], ["right", "left", "right-foot"]])
+                                ["right", "left", "right-foot"], ["right", "left", "right-foot"],
+                                ["right", "left-foot"], ["right", "right-foot", "left-foot"],
+                                ["right", "left", "right-foot", "left-foot"]])
             parts, taken = [], set()
             self.chord_left = self.chord_right = None
             for limb in limbs:

@@ -608,7 +608,7 @@ class Generator:
         return "\n".join(lines) + "\n"
 
 
-LIMB_ORDER = {"right": 0, "left": 1, "right-foot": 2}  # notes on one beat: notes.csv's order
+LIMB_ORDER = {"right": 0, "left": 1, "right-foot": 2, "left-foot": 3}  # notes.csv's order on a beat
 
 
 class RandomScore:

@@ -31,7 +31,8 @@ from ictus_tools.random_score import LEAD_IN_S, LIMB_ORDER, RandomScore
 
 TOLERANCE_MS = 5.0            # the acceptance bound, never loosened
 FOOT_TOLERANCE_MS = 0.5       # a kick's: the pedal's planning tolerance (docs/pedal.md)
-LIMB_OF_HAND = {0: "left", 1: "right", 2: "right-foot"}  # strikes.csv's hand column
+LIMB_OF_HAND = {0: "left", 1: "right", 2: "right-foot", 3: "left-foot"}  # strikes.csv's hand
+FEET = ("right-foot", "left-foot")
 ASSIGN_MS = 50.0              # a strike further than this from a note is not its strike
 PLAN_TIME_TOL_S = 1e-5        # notes.csv has 6 decimals
 MAX_LIMIT_EXCURSION_DEG = 2.0
@@ -235,7 +236,7 @@ def judge(res, out):
 
     # The plan holds the generator's notes.
     expected = score.notes
-    rows = sorted(note_rows, key=lambda r: (float(r["time_s"]), LIMB_ORDER.get(r["hand"], 3)))
+    rows = sorted(note_rows, key=lambda r: (float(r["time_s"]), LIMB_ORDER.get(r["hand"], 4)))
     if len(rows) != len(expected):
         res.problems.append("notes.csv has %d notes, the score %d" % (len(rows), len(expected)))
     for e, r in zip(expected, rows):
@@ -279,9 +280,9 @@ def judge(res, out):
                                                   late[0][0]["seq"], late[0][0]["time_s"]))
 
     # Notes and their strikes, per limb (on a kit, the strikes on the note's piece).
-    for hand in ("right", "left", "right-foot"):
+    for hand in ("right", "left") + FEET:
         notes = [n for n in expected if n["hand"] == hand]
-        tolerance_ms = FOOT_TOLERANCE_MS if hand == "right-foot" else TOLERANCE_MS
+        tolerance_ms = FOOT_TOLERANCE_MS if hand in FEET else TOLERANCE_MS
         prim = [s for s in strikes if s["hand"] == hand and s["bounce"] == 0]
         taken = set()
         for k, n in enumerate(notes):
