@@ -80,16 +80,7 @@ def song(path, rng):
     groove(15, range(8), 42)
     notes.append((16 * bar, 49, 120))
     notes.append((16 * bar, 36, 110))
-    mid = mido.MidiFile(type=0, ticks_per_beat=tpq)
-    track = mido.MidiTrack()
-    mid.tracks.append(track)
-    track.append(mido.MetaMessage("set_tempo", tempo=500000, time=0))
-    now = 0
-    for tick, note, vel in sorted(notes):
-        track.append(mido.Message("note_on", channel=9, note=note, velocity=vel, time=tick - now))
-        now = tick
-    track.append(mido.Message("note_off", channel=9, note=49, velocity=0, time=tpq))
-    mid.save(path)
+    e2e_util.write_drum_midi(mido, path, notes, 120.0, tpq)
     return notes
 
 
