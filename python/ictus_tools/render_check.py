@@ -119,7 +119,7 @@ class Result:
         """Everything needed to reproduce and see a failure."""
         out = ["seed %d: %s" % (self.seed, "; ".join(self.problems[:6]) +
                                 (" ..." if len(self.problems) > 6 else ""))]
-        kit = " --kit " + self.score.kit if self.score.kit else ""
+        kit = " --kit " + self.score.kit if getattr(self.score, "kit", None) else ""
         out.append("  reproduce: PYTHONPATH=python python3 -m ictus_tools.random_score --seed %d --ictusd %s%s "
                    "> s.txt && %s render%s --score s.txt --out out-%d"
                    % (self.seed, ictusd, kit, ictusd, kit, self.seed))
@@ -151,7 +151,7 @@ def render(ictusd, score, workdir, timeout_s=600, extra_args=()):
     if os.path.exists(out):
         shutil.rmtree(out)
     cmd = [ictusd, "render", "--score", path, "--out", out, "--bvh-rate", "0"] + list(extra_args)
-    if score.kit:
+    if getattr(score, "kit", None):
         cmd += ["--kit", score.kit]
     t0 = time.monotonic()
     try:
@@ -272,7 +272,7 @@ def judge(res, out):
     res.strikes = strikes
     res.bounces = sum(s["bounce"] for s in strikes)
     check_bounce_tags(res, strikes, tips)
-    if score.kit:
+    if getattr(score, "kit", None):
         late = [(a, b) for a, b in zip(strikes, strikes[1:]) if b["time_s"] < a["time_s"]]
         if late:
             res.problems.append("strikes.csv is not in onset order: seq %d at %.6f s after seq "
