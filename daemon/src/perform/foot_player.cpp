@@ -67,7 +67,7 @@ double FootPlayer::speed_for(double dynamics) const
     return lo + (hi - lo) * std::pow(d, 1.3);
 }
 
-void FootPlayer::step(double now_s, StrikeDetector &detector, long first_seq)
+void FootPlayer::advance(double now_s)
 {
     while (notes_ && next_ < notes_->size()) {
         const PlannedFootNote &n = (*notes_)[next_];
@@ -85,6 +85,10 @@ void FootPlayer::step(double now_s, StrikeDetector &detector, long first_seq)
         last_scheduled_s_ = t;
     }
     pedal_.advance_to(now_s);
+}
+
+void FootPlayer::take_contacts(StrikeDetector &detector, long first_seq)
+{
     PedalStrike s;
     while (pedal_.take_onset(s)) {
         if (!s.bounce)

@@ -38,10 +38,16 @@ class FootPlayer
     void stop(double now_s);
 
     // The pedal to now_s (the end of a physics step): the notes due within
-    // the look-ahead scheduled, the contacts begun and ended in the step
-    // taken. Seqs come from the detector, in onset order with the hands'
-    // (first_seq: the detector's first seq of the step).
-    void step(double now_s, StrikeDetector &detector, long first_seq);
+    // the look-ahead scheduled, the pedal advanced.
+    void advance(double now_s);
+    // The contacts begun and ended in the step taken. Seqs come from the
+    // detector, in onset order with the hands' (first_seq: the detector's
+    // first seq of the step); of two feet, the one whose contact began first
+    // takes them first (ScoreMode).
+    void take_contacts(StrikeDetector &detector, long first_seq);
+    // The onset time (s) of the contact begun in the step and not taken yet;
+    // +inf for none.
+    double next_onset_s() const { return pedal_.next_onset_s(); }
     // The foot's contact begun in the last step (at most one), at its onset.
     bool take_onset(StrikeEvent &out);
     // The foot's contact ended in the last step (at most one).

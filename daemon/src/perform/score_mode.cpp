@@ -408,8 +408,14 @@ int ScoreMode::step(StrikeEvent out[kStepStrikes])
     const long first_seq = perf_.detector_.strikes();
     int n = detect_strikes(perf_.detector_, r.tracker->scene(), out, perf_.time_offset_s_);
     for (auto &foot : feet_)
-        if (foot) {
-            foot->step(perf_.time_s(), perf_.detector_, first_seq);
+        if (foot)
+            foot->advance(perf_.time_s());
+    // The feet's contacts of this step, the earlier onset's first (its seq).
+    const bool left_first =
+        feet_[0] && feet_[1] && feet_[1]->next_onset_s() < feet_[0]->next_onset_s();
+    for (int i = 0; i < 2; ++i)
+        if (FootPlayer *foot = feet_[static_cast<size_t>(left_first ? 1 - i : i)].get()) {
+            foot->take_contacts(perf_.detector_, first_seq);
             if (foot->take_end(out[n]))
                 ++n;
         }

@@ -636,6 +636,10 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
 {
     if (!(w.move_end > w.move_begin) || frame.drums.size() < 2)
         return 0.0;
+    // A move to or from rest passes over the cymbals and over any head that
+    // stands within kit_clearance_m of the lower rest tip, or above it (the
+    // full kit's rack toms, raised over its kick).
+    const double rest_y = std::min(frame.rest_tip_m[0].dot(frame.up), frame.rest_tip_m[1].dot(frame.up));
     double lift = 0.0;
     constexpr int kPoints = 48;
     for (int i = 1; i < kPoints; ++i) {
@@ -645,7 +649,8 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
         double short_m = 0.0;
         for (size_t k = 0; k < frame.drums.size(); ++k) {
             const PerformerFrame::Drum &d = frame.drums[k];
-            if ((cymbals_only && !d.cymbal) || d.foot)
+            if (d.foot || (cymbals_only && !d.cymbal &&
+                           d.membrane_center_m.dot(frame.up) < rest_y - opt.kit_clearance_m))
                 continue;
             const Eigen::Vector3d rel = p - d.membrane_center_m;
             const double height = rel.dot(frame.up);
@@ -662,10 +667,11 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
 }
 
 // A move between a stroke and the hand's rest tip (window w, from a to b),
-// lifted as a move between drums is over the kit's cymbals on its way: the
-// rest tips stand above every head and below the cymbals, so that a hand
-// going back to rest from a hi-hat would come down on its plate. Unchanged
-// (no move window) when nothing is in the way.
+// lifted as a move between drums is over the kit's cymbals on its way, and
+// over any head near or above the rest tips: the rest tips stand above most
+// heads and below the cymbals, so that a hand going back to rest from a
+// hi-hat would come down on its plate, and one from a raised rack tom through
+// its neighbour. Unchanged (no move window) when nothing is in the way.
 void lift_rest_move(const Item &a, const Item &b, Window &w, const PerformerFrame &frame,
                     const PlanOptions &opt)
 {

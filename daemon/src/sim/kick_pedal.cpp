@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -205,6 +206,12 @@ void KickPedal::record(const PedalStrike &s)
         ++ring_count_;
     }
     ring_[slot] = s;
+}
+
+double KickPedal::next_onset_s() const
+{
+    return onset_count_ == 0 ? std::numeric_limits<double>::infinity()
+                             : onsets_[onset_head_].time_s;
 }
 
 bool KickPedal::take_onset(PedalStrike &out)

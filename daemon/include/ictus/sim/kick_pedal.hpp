@@ -93,6 +93,9 @@ class KickPedal
     /// The oldest contact begun (its onset fields: time, speed, effective mass, bounce; the
     /// rest 0), each once, before take_strike() has it; false when there is none.
     bool take_onset(PedalStrike &out);
+    /// The time (s) of the oldest contact begun and not taken yet by take_onset(); +inf when
+    /// there is none.
+    double next_onset_s() const;
     /// Drops the pushes not begun by t_s (a performance that stops): the foot stays up.
     void cancel_pending(double t_s);
     /// The beater's effective mass at the felt, I / L^2 (kg).
