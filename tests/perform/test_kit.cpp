@@ -350,6 +350,59 @@ TEST_CASE("kit: the detector gives a strike the drum its bead came down on", "[p
     CHECK(e0.seq == e1.seq + 1);
 }
 
+TEST_CASE("kit: a stick that passed under a cymbal's edge plays the drum it then comes down on",
+          "[perform][kit]")
+{
+    // A cymbal (drum 1) whose plate lies 0.2 m above a drum's head (drum 0),
+    // beside it in plan. The bead slides along +X at 0.16 m below the plate,
+    // enters the plate's disk from the side (no strike: side_entries 1), leaves
+    // it over the drum and comes down on the drum at 2 m/s: one strike of
+    // drum 0 with that speed, at the time the bead's bottom reaches the head.
+    MembraneGeometry drum, plate;
+    drum.center_m = Eigen::Vector3d(0.15, 0.7, 0.45);
+    drum.radius_m = 0.178;
+    plate.center_m = Eigen::Vector3d(-0.3, 0.9, 0.45);
+    plate.radius_m = 0.2;
+    plate.drum_id = 1;
+    StrikeDetectorOptions so;
+    so.semi_implicit_samples = false;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> speed(0.5, 4.0), depth(0.01, 0.15);
+    for (int trial = 0; trial < 20; ++trial) {
+        StrikeDetector det(drum, so);
+        det.set_membrane(plate);
+        const double u = speed(rng), v = speed(rng), h = 0.9 - depth(rng);
+        const double dt = 0.001, x_turn = 0.1, r = drum.tip_radius_m;
+        const double t_turn = (x_turn - -0.6) / u, t_hit = t_turn + (h - r - 0.7) / v;
+        std::vector<StrikeEvent> got;
+        StrikeEvent out;
+        for (int k = 0; k * dt < t_hit + 0.05; ++k) {
+            const double t = k * dt;
+            TipSample s;
+            s.time_s = t;
+            // Across under the plate at height h, then down onto the drum,
+            // then back up after 10 ms in the head.
+            const bool across = t < t_turn, down = !across && t < t_hit + 0.01;
+            const double x = across ? -0.6 + u * t : x_turn;
+            const double y = across ? h : down ? h - v * (t - t_turn) : 0.7 + r;
+            s.center_m = Eigen::Vector3d(x, y, 0.45);
+            s.velocity_mps = Eigen::Vector3d(across ? u : 0.0, down ? -v : 0.0, 0.0);
+            if (det.update(1, s, out))
+                got.push_back(out);
+        }
+        while (det.flush(out))
+            got.push_back(out);
+        INFO("trial " << trial << ": across at " << u << " m/s, " << 0.9 - h
+                      << " m under the plate, down at " << v << " m/s");
+        CHECK(det.side_entries() == 1);
+        REQUIRE(got.size() == 1);
+        CHECK(got[0].drum == 0);
+        CHECK(got[0].normal_velocity_mps == Approx(v).epsilon(1e-9));
+        CHECK(got[0].time_s == Approx(t_hit).margin(1e-9));
+        CHECK(got[0].x_m == Approx(x_turn - drum.center_m.x()).margin(1e-12));
+    }
+}
+
 TEST_CASE("kit: the cymbals are plates of cymbal bronze, their contact a disc's point stiffness",
           "[perform][kit]")
 {
