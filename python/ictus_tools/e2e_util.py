@@ -343,22 +343,26 @@ def require_mido():
     return mido
 
 
-def render_kit(ictusd, workdir, name, kit, source_args, timeout=900):
+def render_kit(ictusd, workdir, name, kit, source_args, timeout=900, wav=True):
     """`ictusd render --kit KIT` of source_args (["--midi", F] or ["--score", F]) into
     workdir/name, with a WAV of the two pickups in 32-bit float there: (out dir, wav path).
-    A failed render fails the test (exit 1); pd.log is checked for error lines."""
+    A failed render fails the test (exit 1); pd.log is checked for error lines. wav=False:
+    the physics alone (no pd), (out dir, None)."""
     import sys
     from ictus_tools.checks import check
     out = os.path.join(workdir, name)
-    wav = os.path.join(out, name + ".wav")
+    wav_path = os.path.join(out, name + ".wav") if wav else None
     env = pd_spawning_env(os.path.abspath(workdir))
+    sound = ["--wav", wav_path, "--wav-mix", "pickups", "--wav-bits", "32"] if wav else []
     run = subprocess.run([ictusd, "render", "--kit", kit] + source_args +
-                         ["--out", out, "--force", "--wav", wav, "--wav-mix", "pickups",
-                          "--wav-bits", "32"],
+                         ["--out", out, "--force"] + sound,
                          capture_output=True, text=True, timeout=timeout, env=env)
     if not check(run.returncode == 0, "ictusd render --kit %s %s: exit %d %s"
                  % (kit, " ".join(source_args), run.returncode, run.stderr[-2000:])):
         sys.exit(1)
+    if not wav:
+        return out, None
+    wav = wav_path
     with open(os.path.join(out, "pd.log")) as f:
         errors = [line for line in f if "error" in line.lower()]
     check(not errors, "%s: pd.log has no error line: %s" % (name, errors[:3]))

@@ -117,7 +117,7 @@ void ScoreMode::install_rig(std::unique_ptr<ScoreRig> rig, bool keep_pose)
     // The live drum and gains win over those the rig was built with.
     o.scene.drum.center_m = r.drum_center_m;
     r.frame = frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right,
-                        r.frame.forward, &o.kit, &r.kit_drums, r.right_sole_m);
+                        r.frame.forward, &o.kit, &r.kit_drums, r.right_sole_m, &r.shoulder_m);
     r.tracker->set_mode(mode);
     if (!keep_pose)
         rest_from_m_ = r.frame.rest_tip_m;
@@ -508,7 +508,7 @@ bool ScoreMode::drum_changed(const Command &c, std::string *why)
     const PerformanceOptions &o = perf_.options_;
     ScoreRig &r = *rig_;
     r.frame = frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right,
-                        r.frame.forward, &o.kit, &r.kit_drums, r.right_sole_m);
+                        r.frame.forward, &o.kit, &r.kit_drums, r.right_sole_m, &r.shoulder_m);
     if (plan_active_ || perf_.work_pending())
         return perf_.submit(plan_job(c, Work::Kind::replan), why);
     return true;

@@ -75,13 +75,16 @@ void sit_on_throne(const CharacterModel &model, CharacterPose &pose)
 PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
                          const Eigen::Vector3d &forward, const Kit *kit,
                          const std::vector<DrumParams> *kit_drums,
-                         const Eigen::Vector3d &right_sole_m)
+                         const Eigen::Vector3d &right_sole_m,
+                         const std::array<Eigen::Vector3d, 2> *shoulder_m)
 {
     const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
     const Eigen::Vector3d raise = contact_height_m(tip_radius_m, kDefaultStickDirection) * up;
     PerformerFrame f = performer_frame_for_drum(drum.center_m + raise, drum.radius_m);
     f.right = right;
     f.forward = forward;
+    if (shoulder_m)
+        f.shoulder_m = *shoulder_m;
     if (kit && !kit->empty()) {
         // The rest tips before the kit's anchor (where the one drum goes),
         // not its first drum, which may stand to a side (two timpani).
@@ -168,8 +171,9 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
     r.right_sole_m = frames.origin_m[model.body_index("r_foot")];
     r.right_sole_m.y() = 0.0;
     r.r_ankle_axis = (frames.rotation[model.body_index("r_shank")].conjugate() * left).normalized();
+    r.shoulder_m = {shoulder[0], shoulder[1]};
     r.frame = frame_for(scene.drum, options.character.stick.tip_radius_m, -left, forward,
-                        &options.kit, &r.kit_drums, r.right_sole_m);
+                        &options.kit, &r.kit_drums, r.right_sole_m, &r.shoulder_m);
 
     // Start: the arms solved to hold the sticks at the rest tips (or the
     // pose the old rig was in, when a grip change rebuilds it).

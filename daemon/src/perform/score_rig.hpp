@@ -30,6 +30,7 @@ struct ScoreRig {
     // foot piece is placed from (KitDrum::foot), and the ankle's axis of
     // plantar flexion in the shank's frame (the performer's left).
     Eigen::Vector3d right_sole_m = Eigen::Vector3d::Zero();
+    std::array<Eigen::Vector3d, 2> shoulder_m{}; // [Side], world (PerformerFrame::shoulder_m)
     int r_ankle = model.joint_index("r_ankle");
     Eigen::Vector3d r_ankle_axis = Eigen::Vector3d::UnitX();
     TipTargets tips;
@@ -76,10 +77,12 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
 // tip's contact height.
 // With a kit, the frame's drums (PerformerFrame::drums): `drum` first, then
 // `kit_drums`, named as the kit's, each raised so; a foot piece (the kick)
-// at its place from `right_sole_m` (ScoreRig::right_sole_m).
+// at its place from `right_sole_m` (ScoreRig::right_sole_m); the shoulders
+// (ScoreRig::shoulder_m) when given.
 PerformerFrame frame_for(const DrumParams &drum, double tip_radius_m, const Eigen::Vector3d &right,
                          const Eigen::Vector3d &forward, const Kit *kit = nullptr,
                          const std::vector<DrumParams> *kit_drums = nullptr,
-                         const Eigen::Vector3d &right_sole_m = Eigen::Vector3d::Zero());
+                         const Eigen::Vector3d &right_sole_m = Eigen::Vector3d::Zero(),
+                         const std::array<Eigen::Vector3d, 2> *shoulder_m = nullptr);
 
 } // namespace ictus

@@ -319,42 +319,6 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
 
 } // namespace
 
-PerformerFrame performer_frame_for_drum(const Eigen::Vector3d &membrane_center_m, double radius_m,
-                                        double rest_height_m)
-{
-    PerformerFrame f;
-    f.membrane_center_m = membrane_center_m;
-    f.membrane_radius_m = radius_m;
-    for (int s = 0; s < 2; ++s) {
-        const double side = s == static_cast<int>(Side::right) ? 1.0 : -1.0;
-        f.rest_tip_m[s] =
-            membrane_center_m + side * 0.1 * f.right + rest_height_m * f.up - 0.05 * f.forward;
-    }
-    return f;
-}
-
-Eigen::Vector3d rest_stick_direction(const PerformerFrame &frame, int side)
-{
-    const double yaw = 40.0 * kPi / 180.0;
-    const Eigen::Vector3d inward =
-        side == static_cast<int>(Side::right) ? -frame.right : frame.right;
-    const Eigen::Vector3d level = std::cos(yaw) * frame.forward + std::sin(yaw) * inward;
-    return (kDefaultStickDirection.y() * frame.up + kDefaultStickDirection.z() * level)
-        .normalized();
-}
-
-Eigen::Vector3d membrane_point(const PerformerFrame &frame, double r_over_a, double theta_deg,
-                               int drum)
-{
-    // docs/osc.md: x_m along world +X, y_m along world -Z.
-    const bool kit = drum > 0 && drum < static_cast<int>(frame.drums.size());
-    const PerformerFrame::Drum *d = kit ? &frame.drums[static_cast<size_t>(drum)] : nullptr;
-    const double radius = d ? d->membrane_radius_m : frame.membrane_radius_m;
-    const Eigen::Vector3d &centre = d ? d->membrane_center_m : frame.membrane_center_m;
-    const double r = r_over_a * radius, th = theta_deg * kPi / 180.0;
-    return centre + Eigen::Vector3d(r * std::cos(th), 0.0, -r * std::sin(th));
-}
-
 namespace
 {
 
@@ -515,7 +479,8 @@ struct HandStrokes {
 // rest tip: when it is longer than idle_return_s and leaves room for a
 // nominal lift, two moves and a nominal preparation.
 HandStrokes place_strokes(const std::vector<size_t> &idx, const GesturePlan &plan,
-                          const PlanOptions &opt, const Eigen::Matrix3d &to_world)
+                          const PerformerFrame &frame, const PlanOptions &opt,
+                          const Eigen::Matrix3d &to_world)
 {
     const size_t n = idx.size();
     HandStrokes h{std::vector<Item>(n), std::vector<bool>(n, false)};
@@ -523,7 +488,11 @@ HandStrokes place_strokes(const std::vector<size_t> &idx, const GesturePlan &pla
         const PlannedNote &p = plan.notes[idx[k]];
         Item &it = h.placed[k];
         it.rest = false;
-        it.to_world = to_world;
+        it.to_world =
+            Eigen::AngleAxisd(
+                piece_yaw_rad(frame, static_cast<int>(p.hand), p.strike_point_m, p.drum), frame.up)
+                .toRotationMatrix() *
+            to_world;
         it.origin = p.tip_target_m;
         it.strike_t = p.time_s;
         it.drum = p.drum;
@@ -860,7 +829,7 @@ GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
             timelines[s].items.push_back(rest);
             continue;
         }
-        HandStrokes strokes = place_strokes(idx, plan, opt, to_world);
+        HandStrokes strokes = place_strokes(idx, plan, frame, opt, to_world);
         choose_units(strokes, idx, plan, units);
         delay_for_contact(strokes, opt, frame, to_world);
         warp_units(strokes, idx, frame, opt, to_world, plan);

@@ -38,6 +38,12 @@ struct PerformerFrame {
     // Where each stick tip waits when its hand has nothing to play [Side].
     std::array<Eigen::Vector3d, 2> rest_tip_m = {Eigen::Vector3d(0.1, 0.85, 0.4),
                                                  Eigen::Vector3d(-0.1, 0.85, 0.4)};
+    // The shoulders [Side] (performer_frame_for_drum: 0.18 m to each side, 0.45 m
+    // behind the membrane's centre): a stroke on a kit's other pieces turns about
+    // the vertical as the direction from its hand's shoulder to the strike turns
+    // from that to the first drum's centre (piece_yaw_rad).
+    std::array<Eigen::Vector3d, 2> shoulder_m = {Eigen::Vector3d(0.18, 1.2, 0.0),
+                                                 Eigen::Vector3d(-0.18, 1.2, 0.0)};
     // A kit (docs/perform.md, "A kit"): its drums by name, the first the
     // membrane above (its centre and radius equal membrane_center_m and
     // membrane_radius_m). Empty: the one drum, whose notes name none.
@@ -67,6 +73,15 @@ PerformerFrame performer_frame_for_drum(const Eigen::Vector3d &membrane_center_m
 // midline. The performer starts and ends every plan in it, and the plan's
 // rests (before the first note, between far-apart notes, after the last) ask for it.
 Eigen::Vector3d rest_stick_direction(const PerformerFrame &frame, int side);
+
+// The turn about frame.up (rad, > 0 toward the performer's left) that a stroke of hand
+// `side` at `strike_m` on kit piece `drum` is given: the horizontal direction from the
+// hand's shoulder to the strike, less that to the first drum's centre; 0 on the first
+// drum and without a kit. A hand reaching across the kit then holds its stick along its
+// forearm, as a drummer does, where a stroke of the first drum's shape would ask the
+// wrist for a stick turned back toward the front (and the arm would leave it pitched up).
+double piece_yaw_rad(const PerformerFrame &frame, int side, const Eigen::Vector3d &strike_m,
+                     int drum);
 
 // A point of the head from the membrane frame of docs/osc.md (x_m = world
 // +X, y_m = world -Z, around the centre); of a kit's drum `drum` (0: the first).
