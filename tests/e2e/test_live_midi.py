@@ -10,7 +10,9 @@ here (not read from ictus): snare 38, tom1 48, tom2 47, floor 43, crash 49, ride
 velocity the documented curve of the strike's speed in strikes.csv. The kit message's notes are
 that table's too. Then MIDI in with the kit ('in' ticked, `note G V`): each General MIDI note
 plays the kit's drum of that note (the strike list to ictus-kit, and a kit drum's hit line on
-render-kit-hit), 46 with the pedal open before it, 36 as the right foot, 44 the left foot.
+render-kit-hit), 46 with the pedal open before it, 36 as the right foot, 44 the left foot;
+`note N V G` as [ictus-midifile] sends it: G on the kit's drum, the hand from N; a note the kit
+has no drum of (60; 45, a tom `full` lacks) plays nothing.
 
     PYTHONPATH=python python3 tests/e2e/test_live_midi.py --build build
 """
@@ -51,6 +53,8 @@ HIHAT_OPEN = [False, True, False]
 MIDI_IN = [(38, 100, "snare", 1, None), (36, 90, "kick", 2, None), (46, 80, "hihat", 1, 1),
            (42, 70, "hihat", 1, 0), (44, 60, "hihat", 3, None), (49, 100, "crash", 1, None),
            (51, 64, "ride", 1, None), (43, 100, "floor", 1, None), (60, 100, None, 0, None)]
+# as [ictus-midifile] sends them (note N V G): G on the kit, the hand from N (48 left, 52 right)
+MIDI_IN_FILE = [(47, 90, "tom2", 0, 48), (43, 70, "floor", 1, 52), (45, 70, None, 0, 48)]
 
 
 def velocity(v):
@@ -65,7 +69,8 @@ def test_patch(build, pd_port, daemon_port, ctl_port):
     n, index = uitest.top_level_index(records)
     for name in ("ictus-receive", "ictus-midi", "ictus-kit"):
         check(name in index, "the main patch has [%s]" % name)
-    in_msgs = " \\, ".join(["in 1"] + ["note %d %d" % m[:2] for m in MIDI_IN] + ["in 0"])
+    in_msgs = " \\, ".join(["in 1"] + ["note %d %d" % m[:2] for m in MIDI_IN] +
+                            ["note %d %d %d" % (m[4], m[1], m[0]) for m in MIDI_IN_FILE] + ["in 0"])
     extra = ["#X obj 20 1000 loadbang",                                     # 0
              "#X msg 20 1030 on 1 \\, channel 10",                          # 1
              "#X obj 300 1000 netreceive -u %d" % ctl_port,                 # 2
@@ -210,7 +215,7 @@ def main():
     # MIDI in with the kit: each note on the kit's drum of that note
     drum_of = {name: i for i, name in names.items()}
     heard = [[float(x) for x in l.split()[1:]] for l in lines.printed if l.startswith("midiin: ")]
-    want_in = [m for m in MIDI_IN if m[2] is not None]
+    want_in = [m for m in MIDI_IN + MIDI_IN_FILE if m[2] is not None]
     check(len(heard) == len(want_in), "MIDI in: one strike per note the kit has (%d, want %d)"
           % (len(heard), len(want_in)))
     for (note, vel, name, hand, _), h in zip(want_in, heard):
