@@ -8,7 +8,8 @@ panel must give each strike, in order, its drum's note of the General MIDI drum 
 here (not read from ictus): snare 38, tom1 48, tom2 47, floor 43, crash 49, ride 51, hi-hat 42
 (46 while the score's note has the pedal open, 44 for the left foot's chick), kick 36; its
 velocity the documented curve of the strike's speed in strikes.csv. The kit message's notes are
-that table's too. Then MIDI in with the kit ('in' ticked, `note G V`): each General MIDI note
+that table's too, and so are performance.mid's of `ictusd render` of the same score. Then MIDI
+in with the kit ('in' ticked, `note G V`): each General MIDI note
 plays the kit's drum of that note (the strike list to ictus-kit, and a kit drum's hit line on
 render-kit-hit), 46 with the pedal open before it, 36 as the right foot, 44 the left foot;
 `note N V G` as [ictus-midifile] sends it: G on the kit's drum, the hand from N; a note the kit
@@ -27,7 +28,7 @@ import tempfile
 import time
 import queue
 
-from ictus_tools import uitest
+from ictus_tools import e2e_util, uitest
 from ictus_tools.checks import check
 
 # The General MIDI drum map (GM Level 1, percussion key map), by the kit's piece names
@@ -60,6 +61,27 @@ MIDI_IN_FILE = [(47, 90, "tom2", 0, 48), (43, 70, "floor", 1, 52), (45, 70, None
 def velocity(v):
     return 1 if not v > 0.1 else int(min(127, max(1, math.floor(
         1 + 126 * math.log(v / 0.1) / math.log(100) + 0.5))))
+
+
+def wanted_notes(rows, names):
+    """Each strike's note by the GM map above: {seq: note}. The hi-hat's hand strikes in seq
+    order are the score's hi-hat notes (a bounce its stroke's), each with its note's pedal."""
+    hihat_hand = [s for s in sorted(rows) if names[int(rows[s]["drum"])] == "hihat"
+                  and int(rows[s]["hand"]) in (0, 1)]
+    primaries = [s for s in hihat_hand if rows[s]["bounce"] == "0"]
+    check(len(primaries) == len(HIHAT_OPEN), "the three hi-hat notes struck: %d" % len(primaries))
+    opened, k = {}, -1
+    for s in hihat_hand:
+        k += rows[s]["bounce"] == "0"
+        opened[s] = HIHAT_OPEN[max(0, k)]
+    want = {}
+    for seq, r in rows.items():
+        name, hand = names[int(r["drum"])], int(r["hand"])
+        want[seq] = GM[name]
+        if name == "hihat":
+            open_note = GM_OPEN_HIHAT if opened[seq] else GM[name]
+            want[seq] = GM_PEDAL_HIHAT if hand == 3 else open_note
+    return want
 
 
 def test_patch(build, pd_port, daemon_port, ctl_port):
@@ -145,16 +167,16 @@ def main():
             w = lines.wait_for(lambda l: l.startswith("kit: drum "), "the kit's drums").split()
             kit[int(float(w[2]))] = (w[3], int(float(w[-1])))
         ctl.sendto(b"play;\n", ("127.0.0.1", ctl_port))
-        # the strikes and notes as they come, until 4 s without one after the first (the
-        # score lasts 6 s), within 180 s
+        # the strikes and notes as they come, until 6 s without one after the first (the
+        # score lasts 6 s, its longest gap 1.2 s), within 180 s
         start, last = time.time(), None
-        while time.time() - start < 180 and (last is None or time.time() - last < 4.0):
+        while time.time() - start < 180 and (last is None or time.time() - last < 6.0):
             try:
                 line = lines.queue.get(timeout=0.2)
             except queue.Empty:
                 continue
             lines.printed.append(line)
-            w = line.split()
+            w = line.split() or [""]
             if w[0] == "strike:":
                 strikes.append(int(float(w[9])))
                 last = time.time()
@@ -187,22 +209,11 @@ def main():
           % (len(strikes), len(rows)))
     check(len(notes) == len(strikes), "one note per strike (%d notes, %d strikes)"
           % (len(notes), len(strikes)))
-    # the hi-hat's hand strikes in order, each its score note's pedal
-    hihat_hand = [s for s in sorted(rows) if names[int(rows[s]["drum"])] == "hihat"
-                  and int(rows[s]["hand"]) in (0, 1)]
-    primaries = [s for s in hihat_hand if rows[s]["bounce"] == "0"]
-    check(len(primaries) == len(HIHAT_OPEN), "the three hi-hat notes struck: %d" % len(primaries))
-    opened, k = {}, -1
-    for s in hihat_hand:
-        k += rows[s]["bounce"] == "0"
-        opened[s] = HIHAT_OPEN[max(0, k)]
     seen = set()
+    wanted = wanted_notes(rows, names)
     for seq, (note, vel, channel, bounce) in zip(strikes, notes):
         r = rows[seq]
-        name, hand = names[int(r["drum"])], int(r["hand"])
-        want = GM[name]
-        if name == "hihat":
-            want = GM_PEDAL_HIHAT if hand == 3 else (GM_OPEN_HIHAT if opened[seq] else want)
+        name, hand, want = names[int(r["drum"])], int(r["hand"]), wanted[seq]
         seen.add(want)
         check((note, vel, channel, bounce) ==
               (want, velocity(float(r["normal_velocity_mps"])), 10, int(r["bounce"])),
@@ -212,6 +223,23 @@ def main():
     check({36, 42, 44, 46, 38, 49, 48, 47, 43} <= seen,
           "kick, hi-hat closed and open, chick, snare, crash and toms among them: %s"
           % sorted(seen))
+    # the render of the same score: performance.mid (read by mido) by the same map
+    mido = e2e_util.require_mido()
+    out = os.path.join(work, "render")
+    env = dict(os.environ)
+    env.pop("LD_PRELOAD", None)
+    proc = subprocess.run([ictusd, "render", "--kit", "full", "--score", score, "--out", out,
+                           "--bvh-rate", "0", "--tips-rate", "0"], capture_output=True, text=True,
+                          timeout=300, env=env)
+    check(proc.returncode == 0, "ictusd render ran: %s" % proc.stderr[-500:])
+    with open(os.path.join(out, "strikes.csv")) as f:
+        rendered = {int(r["seq"]): r for r in csv.DictReader(f)}
+    file_notes = [m.note for m in mido.MidiFile(os.path.join(out, "performance.mid"))
+                  if m.type == "note_on" and m.velocity > 0]
+    want_file = wanted_notes(rendered, names)
+    check(file_notes == [want_file[s] for s in sorted(rendered)],
+          "performance.mid of the same score: each strike its drum's note by the same map "
+          "(46 open, 44 the chick): %s" % file_notes)
     # MIDI in with the kit: each note on the kit's drum of that note
     drum_of = {name: i for i, name in names.items()}
     heard = [[float(x) for x in l.split()[1:]] for l in lines.printed if l.startswith("midiin: ")]
@@ -225,7 +253,8 @@ def main():
               "MIDI in note %d -> %s (drum %d), hand %d, %.4f m/s: %s"
               % (note, name, drum_of[name], hand, speed, h[:8]))
     pedals = [l for l in lines.printed if l.startswith("kit: pedal ")]
-    check(pedals[-2:] == ["kit: pedal %d 1" % drum_of["hihat"], "kit: pedal %d 0" % drum_of["hihat"]],
+    hihat = drum_of["hihat"]
+    check(pedals[-2:] == ["kit: pedal %d 1" % hihat, "kit: pedal %d 0" % hihat],
           "MIDI in's 46 opens the hi-hat's pedal, its 42 closes it: %s" % pedals[-2:])
     kithits = [l for l in lines.printed if l.startswith("kithit: ")]
     check(len(kithits) >= 1 and any(int(float(l.split()[2])) == drum_of["crash"]
