@@ -79,8 +79,10 @@ def wanted_notes(rows, names):
         name, hand = names[int(r["drum"])], int(r["hand"])
         want[seq] = GM[name]
         if name == "hihat":
-            open_note = GM_OPEN_HIHAT if opened[seq] else GM[name]
-            want[seq] = GM_PEDAL_HIHAT if hand == 3 else open_note
+            if hand == 3:
+                want[seq] = GM_PEDAL_HIHAT
+            elif opened[seq]:
+                want[seq] = GM_OPEN_HIHAT
     return want
 
 
