@@ -138,6 +138,26 @@ TEST_CASE("midi: with a kit each strike is its drum's General MIDI note", "[cli]
     CHECK(standard_midi_file(s, midi_timeline(60.0), 9, &notes) == want);
 }
 
+TEST_CASE("midi: a hi-hat strike is 42 closed, 46 half or open, 44 the left foot's chick",
+          "[cli][midi]")
+{
+    // Drum 0 a hi-hat (42): the right hand with the pedal closed, half, open, then the
+    // left foot (the chick), each 0.2 s apart; the note-ons read back from the bytes.
+    std::vector<StrikeEvent> s;
+    const double openness[] = {0.0, 0.5, 1.0, 0.0};
+    for (int i = 0; i < 4; ++i) {
+        s.push_back(strike(i == 3 ? kFootLeft : 1, 0.5 + 0.2 * i, 0.1, 1.0, false));
+        s.back().pedal_openness = openness[i];
+    }
+    const std::vector<int> notes = {42};
+    const std::string f = standard_midi_file(s, midi_timeline(60.0), 9, &notes);
+    std::vector<int> on;
+    for (size_t k = 0; k + 2 < f.size(); ++k)
+        if (static_cast<unsigned char>(f[k]) == 0x99 && f[k + 2] != 0)
+            on.push_back(f[k + 1]);
+    CHECK(on == std::vector<int>{42, 46, 46, 44});
+}
+
 TEST_CASE("midi: the score's meters as time signatures, 4/4 without one", "[cli][midi]")
 {
     // 60 bpm, 3840 ticks a second. 6/8 from 0 s replaces the 4/4 (FF 58 04

@@ -262,8 +262,8 @@ TEST_CASE("osc out: the kit goes out as /ictus/kit and one /ictus/kit/drum per d
         CHECK(bare.counters().kits_sent == 0);
     }
     ictus::OscSender sender(o);
-    sender.set_kit("standard", {{0, "snare", "snare", 0.1778, 3603.0, 0.0},
-                                {1, "tom1", "tom", 0.127, 1231.0, 0.1875}});
+    sender.set_kit("standard", {{0, "snare", "snare", 0.1778, 3603.0, 0.0, 38},
+                                {1, "tom1", "tom", 0.127, 1231.0, 0.1875, 48}});
     // Set once: a second kit is ignored (the strike thread may be reading the first).
     sender.set_kit("other", {{0, "x", "paper", 0.2, 3000.0, 0.0}});
     for (int round = 0; round < 2; ++round) {
@@ -277,10 +277,11 @@ TEST_CASE("osc out: the kit goes out as /ictus/kit and one /ictus/kit/drum per d
         const char *names[] = {"tom1", "tom"};
         const double radius[] = {0.1778, 0.127}, tension[] = {3603.0, 1231.0},
                      pan[] = {0.0, 0.1875};
+        const int note[] = {38, 48};
         for (int i = 0; i < 2; ++i) {
             REQUIRE(next_dump(*dump, "/ictus/kit/drum", d));
-            CHECK(d.types == "issfff");
-            REQUIRE(d.args.size() == 6);
+            CHECK(d.types == "issfffi");
+            REQUIRE(d.args.size() == 7);
             CHECK(std::stoi(d.args[0]) == i);
             CHECK(d.args[2].find(i ? names[1] : "snare") != std::string::npos);
             if (i == 1)
@@ -288,6 +289,7 @@ TEST_CASE("osc out: the kit goes out as /ictus/kit and one /ictus/kit/drum per d
             CHECK(std::stod(d.args[3]) == Approx(radius[i]).epsilon(1e-6));
             CHECK(std::stod(d.args[4]) == Approx(tension[i]).epsilon(1e-6));
             CHECK(std::stod(d.args[5]) == Approx(pan[i]).margin(1e-6));
+            CHECK(std::stoi(d.args[6]) == note[i]);
         }
     }
     sender.stop();

@@ -260,9 +260,12 @@ std::string standard_midi_file(const std::vector<StrikeEvent> &strikes,
         if (drum_notes && e.drum >= 0 && e.drum < static_cast<int>(drum_notes->size())) {
             const int note = (*drum_notes)[static_cast<size_t>(e.drum)];
             // A strike on the snare's rim is General MIDI's side stick, as --midi reads it;
-            // the left foot's chick on the hi-hat its pedal hi-hat.
+            // the left foot's chick on the hi-hat its pedal hi-hat; a stick on the hi-hat
+            // with its pedal not closed (half or open) its open hi-hat.
             if (note == kMidiClosedHihat && e.hand == kFootLeft)
                 return kMidiPedalHihat;
+            if (note == kMidiClosedHihat && e.pedal_openness > 0.0)
+                return kMidiOpenHihat;
             return note == kMidiSnare && e.zone == kZoneRim ? kMidiSideStick : note;
         }
         return midi_note(e.hand, e.r_over_a);

@@ -319,9 +319,11 @@ std::vector<KitDrumSound> kit_sounds(const Performance &perf)
         const KitDrum &k = kit.drums[static_cast<size_t>(i)];
         if (i < perf.scene().drum_count()) {
             const DrumParams &d = perf.scene().drum(i);
-            drums.push_back({i, k.name, k.preset, d.radius_m, d.tension_n_per_m, kit_drum_pan(k)});
+            drums.push_back(
+                {i, k.name, k.preset, d.radius_m, d.tension_n_per_m, kit_drum_pan(k), k.midi_note});
         } else if (k.foot) { // the kick: not in the sticks' scene
-            drums.push_back({i, k.name, k.preset, k.radius_m, k.tension_n_per_m, kit_drum_pan(k)});
+            drums.push_back(
+                {i, k.name, k.preset, k.radius_m, k.tension_n_per_m, kit_drum_pan(k), k.midi_note});
         }
     }
     return drums;

@@ -266,8 +266,8 @@ void count_send(int result, std::atomic<unsigned long> &sent, std::atomic<unsign
 }
 } // namespace
 
-// The kit: /ictus/kit ,si name count, then /ictus/kit/drum ,issfff index name
-// preset radius tension pan per drum, in one bundle to be handled at once.
+// The kit: /ictus/kit ,si name count, then /ictus/kit/drum ,issfffi index name
+// preset radius tension pan midi_note per drum, in one bundle to be handled at once.
 void OscSender::send_kit_now()
 {
     if (!kit_set_.load(std::memory_order_acquire) || kit_.empty())
@@ -285,6 +285,7 @@ void OscSender::send_kit_now()
         lo_message_add_float(m, static_cast<float>(d.radius_m));
         lo_message_add_float(m, static_cast<float>(d.tension_n_per_m));
         lo_message_add_float(m, static_cast<float>(d.pan));
+        lo_message_add_int32(m, d.midi_note);
         lo_bundle_add_message(b, "/ictus/kit/drum", m);
     }
     count_send(lo_send_bundle(impl_->strike_target, b), kits_sent_, send_errors_);

@@ -52,12 +52,14 @@ struct OscSenderOptions {
 };
 
 // One drum of a kit as the sound needs it (/ictus/kit/drum, docs/osc.md): its
-// index (the strikes' `drum`), name, membrane preset, head, and pan (-1..1, + to
-// the left channel).
+// index (the strikes' `drum`), name, membrane preset, head, pan (-1..1, + to
+// the left channel), and its General MIDI note (the kit's, as performance.mid
+// writes its strikes: docs/midi.md).
 struct KitDrumSound {
     int index = 0;
     std::string name, preset;
     double radius_m = 0.0, tension_n_per_m = 0.0, pan = 0.0;
+    int midi_note = 38;
 };
 
 struct OscSenderCounters {
