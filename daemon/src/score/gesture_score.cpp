@@ -25,6 +25,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <memory>
@@ -590,6 +591,28 @@ Eigen::Vector3d pair_position(const Item &a, const Item &b, const Window &w, dou
     return p0 + (smoothstep5(x) - made) * w.across;
 }
 
+// The stick's direction between two units of one hand at t in the move
+// window: the units' cross-fade, as sample_hand makes it.
+Eigen::Vector3d pair_direction(const Item &a, const Item &b, const Window &w, double t)
+{
+    Eigen::Vector3d p0, d0;
+    a.eval(t, p0, d0);
+    if (t < w.begin || !(w.end > w.begin))
+        return d0;
+    Eigen::Vector3d p1, d1;
+    b.eval(t, p1, d1);
+    const double wt = t > w.end ? 1.0 : smoothstep5((t - w.begin) / (w.end - w.begin));
+    const Eigen::Vector3d blended = (1.0 - wt) * d0 + wt * d1;
+    return blended.norm() > 1e-9 ? blended.normalized() : (wt < 0.5 ? d0 : d1);
+}
+
+// Points of the stick behind its tip that a move keeps above the heads as it
+// keeps the tip (m along the stick, to the butt of the default 0.406 m stick:
+// character.hpp's StickParams). A hand moving from the snare to the crash
+// carries its stick's shaft through the hi-hat's edge when only the tip is
+// lifted over it.
+constexpr double kShaftPoints_m[] = {0.1, 0.2, 0.3, 0.4};
+
 // How far a move from drum a.drum to b.drum must rise (m): wherever the tip
 // is over a drum's disk (its radius plus kit_margin_m, in plan), it must be
 // above that head, and kit_clearance_m above it for a drum it does not play
@@ -613,22 +636,26 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
     constexpr int kPoints = 48;
     for (int i = 1; i < kPoints; ++i) {
         const double x = static_cast<double>(i) / kPoints;
-        const Eigen::Vector3d p =
-            pair_position(a, b, w, w.move_begin + x * (w.move_end - w.move_begin));
+        const double t = w.move_begin + x * (w.move_end - w.move_begin);
+        const Eigen::Vector3d tip = pair_position(a, b, w, t);
+        const Eigen::Vector3d dir = pair_direction(a, b, w, t);
         double short_m = 0.0;
-        for (size_t k = 0; k < frame.drums.size(); ++k) {
-            const PerformerFrame::Drum &d = frame.drums[k];
-            if (d.foot || (cymbals_only && !d.cymbal &&
-                           d.membrane_center_m.dot(frame.up) < rest_y - opt.kit_clearance_m))
-                continue;
-            const Eigen::Vector3d rel = p - d.membrane_center_m;
-            const double height = rel.dot(frame.up);
-            if ((rel - height * frame.up).norm() > d.membrane_radius_m + opt.kit_margin_m)
-                continue;
-            const bool played = static_cast<int>(k) == a.drum || static_cast<int>(k) == b.drum;
-            if (played && kit_bump(x) < 0.5)
-                continue;
-            short_m = std::max(short_m, (played ? 0.0 : opt.kit_clearance_m) - height);
+        for (int j = -1; j < static_cast<int>(std::size(kShaftPoints_m)); ++j) {
+            const Eigen::Vector3d p = j < 0 ? tip : Eigen::Vector3d(tip - kShaftPoints_m[j] * dir);
+            for (size_t k = 0; k < frame.drums.size(); ++k) {
+                const PerformerFrame::Drum &d = frame.drums[k];
+                if (d.foot || (cymbals_only && !d.cymbal &&
+                               d.membrane_center_m.dot(frame.up) < rest_y - opt.kit_clearance_m))
+                    continue;
+                const Eigen::Vector3d rel = p - d.membrane_center_m;
+                const double height = rel.dot(frame.up);
+                if ((rel - height * frame.up).norm() > d.membrane_radius_m + opt.kit_margin_m)
+                    continue;
+                const bool played = static_cast<int>(k) == a.drum || static_cast<int>(k) == b.drum;
+                if (played && kit_bump(x) < 0.5)
+                    continue;
+                short_m = std::max(short_m, (played ? 0.0 : opt.kit_clearance_m) - height);
+            }
         }
         lift = std::max(lift, short_m / std::max(kit_bump(x), 0.05));
     }
