@@ -591,6 +591,14 @@ Eigen::Vector3d pair_position(const Item &a, const Item &b, const Window &w, dou
     return p0 + (smoothstep5(x) - made) * w.across;
 }
 
+// Two units' stick directions cross-faded by weight w (0: d0, 1: d1), unit;
+// of two opposite ones, the nearer.
+Eigen::Vector3d blend_directions(const Eigen::Vector3d &d0, const Eigen::Vector3d &d1, double w)
+{
+    const Eigen::Vector3d blended = (1.0 - w) * d0 + w * d1;
+    return blended.norm() > 1e-9 ? blended.normalized() : (w < 0.5 ? d0 : d1);
+}
+
 // The stick's direction between two units of one hand at t in the move
 // window: the units' cross-fade, as sample_hand makes it.
 Eigen::Vector3d pair_direction(const Item &a, const Item &b, const Window &w, double t)
@@ -601,9 +609,8 @@ Eigen::Vector3d pair_direction(const Item &a, const Item &b, const Window &w, do
         return d0;
     Eigen::Vector3d p1, d1;
     b.eval(t, p1, d1);
-    const double wt = t > w.end ? 1.0 : smoothstep5((t - w.begin) / (w.end - w.begin));
-    const Eigen::Vector3d blended = (1.0 - wt) * d0 + wt * d1;
-    return blended.norm() > 1e-9 ? blended.normalized() : (wt < 0.5 ? d0 : d1);
+    return blend_directions(d0, d1,
+                            t > w.end ? 1.0 : smoothstep5((t - w.begin) / (w.end - w.begin)));
 }
 
 // Points of the stick behind its tip that a move keeps above the heads as it
@@ -801,8 +808,7 @@ void sample_hand(const std::vector<double> &times, const HandTimeline &line,
             its[j + 1].eval(t, p1, d1);
             const double w = smoothstep5((t - win[j].begin) / (win[j].end - win[j].begin));
             p0 = (1.0 - w) * p0 + w * p1;
-            const Eigen::Vector3d blended = (1.0 - w) * d0 + w * d1;
-            d0 = blended.norm() > 1e-9 ? blended.normalized() : (w < 0.5 ? d0 : d1);
+            d0 = blend_directions(d0, d1, w);
         }
         // The move across the head: the units' blend makes it over
         // [begin, end]; it is made over [move_begin, move_end] instead
