@@ -28,6 +28,7 @@ How onsets are measured (docs/main-job.md, "Checking the onsets"):
   apart, because whatever sounded before strike k is in both signals.
 """
 import json
+import math
 import os
 import struct
 import subprocess
@@ -326,6 +327,20 @@ def read_wav_mono(path):
     n = len(samples) // 4
     values = struct.unpack("<%df" % n, samples[:4 * n])
     return rate, [sum(values[i:i + channels]) / channels for i in range(0, n, channels)]
+
+
+def midi_velocities(v, resolution=1e-4):
+    """The MIDI velocities, 1 + 126 ln(v / 0.1) / ln(100) rounded and held to 1..127, that a
+    strike of strikes.csv's speed v may be given: the file writes v to `resolution` (m/s), and
+    Pd's [expr] works in float32 (a few 1e-5 on the curve near 100). One velocity, or two when v
+    lies on a rounding boundary within that precision."""
+    def curve(s):
+        return 1.0 if not s > 0.1 else 1 + 126 * math.log(s / 0.1) / math.log(100)
+
+    def held(x):
+        return int(min(127, max(1, math.floor(x + 0.5))))
+    return set(range(held(curve(v - resolution / 2) - 1e-4),
+                     held(curve(v + resolution / 2) + 1e-4) + 1))
 
 
 def require_mido():
