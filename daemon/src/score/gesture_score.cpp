@@ -22,6 +22,7 @@
 
 #include "ictus/base/motor_noise.hpp"
 #include "kit_notes.hpp"
+#include "plan_timing.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -162,6 +163,8 @@ struct Item {
     Eigen::Vector3d end_pos = Eigen::Vector3d::Zero(), end_vel = Eigen::Vector3d::Zero();
     Eigen::Vector3d start_dir = Eigen::Vector3d::UnitZ(), end_dir = Eigen::Vector3d::UnitZ();
     int drum = 0; // the note's drum of a kit
+    // The turn of the unit about the vertical toward its piece (piece_yaw_rad).
+    double yaw_rad = 0.0;
 
     // The warped unit inside its own time span [strike - prep_t, strike + lift_t].
     void warped(double tau, Eigen::Vector3d &pos, Eigen::Vector3d &vel) const
@@ -223,6 +226,12 @@ struct Window {
     // A move between two drums of a kit: lifted by lift times kit_bump()
     // over [move_begin, move_end] (kit_lift()).
     Eigen::Vector3d lift = Eigen::Vector3d::Zero();
+    // A turn of the stick's heading made apart from the units' cross-fade:
+    // the second unit's heading less the first's (rad, within +-pi) about
+    // `up`, over [turn_begin, turn_end] (within the move window); 0 where the
+    // cross-fade makes it (turn_for_window()).
+    double turn_rad = 0.0, turn_begin = 0.0, turn_end = 0.0;
+    Eigen::Vector3d up = Eigen::Vector3d::UnitY();
 };
 
 // Quintic smoothstep: 0 -> 1 with zero slope and curvature at both ends.
@@ -300,6 +309,8 @@ void validate(const PerformerFrame &f, const PlanOptions &o)
         bad("contact_lead_m must be within 0..0.01 m", o.contact_lead_m);
     if (!(o.blend_margin > 0.0 && o.blend_margin < 0.5))
         bad("blend_margin must be in (0, 0.5)", o.blend_margin);
+    if (!(o.max_turn_rate_rad_s > 0.0 && o.max_turn_rate_rad_s <= 1000.0))
+        bad("max_turn_rate_rad_s must be in (0, 1000]", o.max_turn_rate_rad_s);
     if (!(o.move_margin_after >= 0.0 && o.move_margin_before >= 0.0 &&
           o.move_margin_after + o.move_margin_before < 0.9))
         bad("move margins must be >= 0 and leave > 10 % of the gap",
@@ -360,6 +371,8 @@ class UnitCache
 using score_detail::drum_index;
 using score_detail::foot_note;
 using score_detail::note_openness;
+using score_detail::plan_duration;
+using score_detail::sample_times;
 
 using HandNotes = std::array<std::vector<size_t>, 2>; // each hand's notes, indices into plan.notes
 
@@ -489,11 +502,8 @@ HandStrokes place_strokes(const std::vector<size_t> &idx, const GesturePlan &pla
         const PlannedNote &p = plan.notes[idx[k]];
         Item &it = h.placed[k];
         it.rest = false;
-        it.to_world =
-            Eigen::AngleAxisd(
-                piece_yaw_rad(frame, static_cast<int>(p.hand), p.strike_point_m, p.drum), frame.up)
-                .toRotationMatrix() *
-            to_world;
+        it.yaw_rad = piece_yaw_rad(frame, static_cast<int>(p.hand), p.strike_point_m, p.drum);
+        it.to_world = Eigen::AngleAxisd(it.yaw_rad, frame.up).toRotationMatrix() * to_world;
         it.origin = p.tip_target_m;
         it.strike_t = p.time_s;
         it.drum = p.drum;
@@ -599,18 +609,32 @@ Eigen::Vector3d blend_directions(const Eigen::Vector3d &d0, const Eigen::Vector3
     return blended.norm() > 1e-9 ? blended.normalized() : (w < 0.5 ? d0 : d1);
 }
 
+// The stick's direction at t in window w between two units of one hand, d0 and
+// d1 theirs at t: the units' cross-fade over [begin, end]; with a turn, the
+// second's shape taken into the first's heading for the fade and the heading
+// turned over the move window.
+Eigen::Vector3d window_direction(const Window &w, double t, const Eigen::Vector3d &d0,
+                                 const Eigen::Vector3d &d1)
+{
+    const double fade = t < w.begin || !(w.end > w.begin) ? 0.0
+                        : t > w.end                       ? 1.0
+                                    : smoothstep5((t - w.begin) / (w.end - w.begin));
+    if (w.turn_rad == 0.0 || !(w.turn_end > w.turn_begin))
+        return fade == 0.0 ? d0 : blend_directions(d0, d1, fade);
+    const Eigen::Vector3d shape =
+        blend_directions(d0, Eigen::AngleAxisd(-w.turn_rad, w.up) * d1, fade);
+    const double turned = smoothstep5((t - w.turn_begin) / (w.turn_end - w.turn_begin));
+    return Eigen::AngleAxisd(turned * w.turn_rad, w.up) * shape;
+}
+
 // The stick's direction between two units of one hand at t in the move
-// window: the units' cross-fade, as sample_hand makes it.
+// window, as sample_hand makes it.
 Eigen::Vector3d pair_direction(const Item &a, const Item &b, const Window &w, double t)
 {
-    Eigen::Vector3d p0, d0;
+    Eigen::Vector3d p0, d0, p1, d1;
     a.eval(t, p0, d0);
-    if (t < w.begin || !(w.end > w.begin))
-        return d0;
-    Eigen::Vector3d p1, d1;
     b.eval(t, p1, d1);
-    return blend_directions(d0, d1,
-                            t > w.end ? 1.0 : smoothstep5((t - w.begin) / (w.end - w.begin)));
+    return window_direction(w, t, d0, d1);
 }
 
 // Points of the stick behind its tip that a move keeps above the heads as it
@@ -695,6 +719,26 @@ struct HandTimeline {
     std::vector<Window> windows;
 };
 
+// The heading's turn between two strokes (turn rad) in window w: over the
+// cross-fade, as the units' blend makes it, while its peak rate there
+// (smoothstep5's, 15/8 of the mean) is within max_turn_rate_rad_s; else over
+// a span widened from the cross-fade toward the move window as far as brings
+// the peak down to it (the whole move window at most). A hand crossing from
+// the ride to the hi-hat turns its stick 100 degrees: over the cross-fade
+// (the middle half of the gap) the shoulder could not follow at 120 bpm.
+void turn_for_window(double turn, const PerformerFrame &frame, const PlanOptions &opt, Window &w)
+{
+    const double fade_s = w.end - w.begin, move_s = w.move_end - w.move_begin;
+    const double needed_s = 1.875 * std::abs(turn) / opt.max_turn_rate_rad_s;
+    if (!(needed_s > fade_s) || !(move_s > fade_s))
+        return;
+    const double widen = std::min(1.0, (needed_s - fade_s) / (move_s - fade_s));
+    w.turn_rad = turn;
+    w.turn_begin = w.begin + widen * (w.move_begin - w.begin);
+    w.turn_end = w.end + widen * (w.move_end - w.end);
+    w.up = frame.up;
+}
+
 // The timeline of a hand with strokes; returns the end of its last motion.
 double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
                       const PlanOptions &opt, HandTimeline &line)
@@ -737,52 +781,14 @@ double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
             w.across = move - move.dot(frame.up) * frame.up;
             w.move_begin = it.strike_t + opt.move_margin_after * gap;
             w.move_end = placed[k + 1].strike_t - opt.move_margin_before * gap;
+            turn_for_window(std::remainder(placed[k + 1].yaw_rad - it.yaw_rad, 2.0 * M_PI), frame,
+                            opt, w);
             if (it.drum != placed[k + 1].drum)
                 w.lift = kit_lift(it, placed[k + 1], w, frame, opt) * frame.up;
             line.windows.push_back(w);
         }
     }
     return last_motion_end;
-}
-
-// The plan's length: the score's and the tail, or the last motion's end; a
-// ScoreError beyond the planner's limit.
-double plan_duration(const Score &score, const PlanOptions &opt, double last_motion_end)
-{
-    const double duration_s =
-        std::max(opt.lead_in_s + score.duration_s() + opt.tail_s, last_motion_end + 0.1);
-    if (duration_s > opt.max_duration_s) {
-        const int line = score.notes.empty() ? 0 : score.notes.back().line;
-        const int column = score.notes.empty() ? 0 : score.notes.back().column;
-        std::ostringstream m;
-        m << "the performance lasts " << duration_s << " s, longer than the planner's limit ("
-          << opt.max_duration_s << " s)";
-        throw ScoreError(score.source, line, column, m.str());
-    }
-    return duration_s;
-}
-
-// Sample times: the grid plus each strike exactly.
-void sample_times(const PlanOptions &opt, GesturePlan &plan)
-{
-    std::vector<double> strikes;
-    for (const PlannedNote &p : plan.notes)
-        strikes.push_back(p.time_s);
-    std::sort(strikes.begin(), strikes.end());
-    const long grid = static_cast<long>(std::ceil(plan.duration_s * opt.rate_hz));
-    std::vector<double> &times = plan.tips.time_s;
-    times.reserve(static_cast<size_t>(grid) + 1 + strikes.size());
-    size_t next_strike = 0;
-    for (long i = 0; i <= grid; ++i) {
-        const double t = static_cast<double>(i) / opt.rate_hz;
-        while (next_strike < strikes.size() && strikes[next_strike] <= t + 1e-6) {
-            if (times.empty() || strikes[next_strike] > times.back() + 1e-9)
-                times.push_back(strikes[next_strike]);
-            ++next_strike;
-        }
-        if (times.empty() || t > times.back() + 1e-6)
-            times.push_back(t);
-    }
 }
 
 // A hand's tip and stick direction at every sample time: the ruling item,
@@ -820,6 +826,12 @@ void sample_hand(const std::vector<double> &times, const HandTimeline &line,
                                              : smoothstep5((t - mv.begin) / (mv.end - mv.begin));
             const double x = (t - mv.move_begin) / (mv.move_end - mv.move_begin);
             p0 += (smoothstep5(x) - made) * mv.across + kit_bump(x) * mv.lift;
+            if (mv.turn_rad != 0.0) {
+                Eigen::Vector3d pa, da, pb, db;
+                its[m].eval(t, pa, da);
+                its[m + 1].eval(t, pb, db);
+                d0 = window_direction(mv, t, da, db);
+            }
         }
         tip[i] = p0;
         dir[i] = d0;

@@ -167,6 +167,11 @@ struct PlanOptions {
     // which the arm tracks closely (docs/score.md, "From score to motion").
     double move_margin_after = 0.05;
     double move_margin_before = 0.1;
+    // A stroke's stick turns about the vertical toward its piece (the reach);
+    // between two strokes the turn is made over their blend, or, where that
+    // asks the stick to turn faster than this at its peak (rad/s), over as
+    // much more of the move as brings it down to this (docs/kit.md, "Reach").
+    double max_turn_rate_rad_s = 15.0;
     // A move between two drums of a kit lifts the tip so that, wherever it
     // is over a drum's head (that head's radius and this margin), it stays
     // above it, and this clearance above any drum but the two it plays

@@ -18,11 +18,12 @@ recall found notes over notes, F1 their harmonic mean, reported with the worst e
 asserted 1.0. The hi-hat's and the ride's notes are the right hand's, the snare's under them
 the left's (crossed over the hi-hat); the crash's are the left's; the kicks the right foot's,
 the chicks the left foot's.
-render.json's `shell_passes` (stick parts that went through a shell) is reported. Each
-check prints ok or FAIL; the exit status is 1 when any fails (docs/kit.md, "The song", has
-the last figures: the acceptance is not met yet, so this is a report, not a CTest test).
+Stick parts that went through a drum or cymbal (render.json's `shell_passes`) are
+reported. Each check prints ok or FAIL, every one of them for every seed; the exit status is 1 when any
+fails. CTest `perform_song` plays seeds 1, 2, 3 and 16 (docs/kit.md, "The song").
 
-    PYTHONPATH=python python3 bench/perform/song_report.py --ictusd build/ictusd
+    PYTHONPATH=python python3 tests/perform/test_song.py --ictusd build/ictusd --workdir /tmp/song \
+        --seed 1 2 3 16
 """
 import argparse
 import csv
@@ -30,6 +31,7 @@ import json
 import os
 import random
 import subprocess
+import tempfile
 import sys
 
 from ictus_tools import e2e_util
@@ -87,18 +89,35 @@ def song(path, rng):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--ictusd", required=True)
-    ap.add_argument("--workdir", default="song-report")
-    ap.add_argument("--seed", type=int, default=16)
+    ap.add_argument("--workdir", default=None, help="where the renders go (default: a new "
+                    "temporary folder)")
+    ap.add_argument("--seed", type=int, nargs="+", default=[16],
+                    help="the songs' seeds, one render each (default 16)")
+    ap.add_argument("--render-arg", action="append", default=[],
+                    help="an argument more for `ictusd render` (repeat it), e.g. --render-arg=--grip "
+                    "--render-arg=german")
     args = ap.parse_args()
-    checks.keep_going()  # a report: every check is printed
-    os.makedirs(args.workdir, exist_ok=True)
-    rng = random.Random(args.seed)
-    part = os.path.join(args.workdir, "song.mid")
+    checks.keep_going()  # every check is printed, for every seed
+    workdir = args.workdir or tempfile.mkdtemp(prefix="ictus-song-")
+    status = 0
+    for seed in args.seed:
+        print("seed %d:" % seed)
+        status |= play(args.ictusd, os.path.join(workdir, "seed-%d" % seed), seed,
+                       args.render_arg)
+    return status
+
+
+def play(ictusd, workdir, seed, render_args):
+    """The song of `seed` rendered in workdir and checked; 1 when the render failed."""
+    os.makedirs(workdir, exist_ok=True)
+    rng = random.Random(seed)
+    part = os.path.join(workdir, "song.mid")
     written = song(part, rng)
-    out = os.path.join(args.workdir, "song")
-    env = e2e_util.pd_spawning_env(os.path.abspath(args.workdir))
-    run = subprocess.run([args.ictusd, "render", "--kit", "full", "--midi", part, "--out", out,
-                          "--force"], capture_output=True, text=True, timeout=900, env=env)
+    out = os.path.join(workdir, "song")
+    env = e2e_util.pd_spawning_env(os.path.abspath(workdir))
+    run = subprocess.run([ictusd, "render", "--kit", "full", "--midi", part, "--out", out,
+                          "--force"] + render_args, capture_output=True, text=True, timeout=900,
+                         env=env)
     if not check(run.returncode == 0, "ictusd render --kit full --midi: exit %d %s"
                  % (run.returncode, run.stderr[-2000:])):
         return 1
@@ -136,7 +155,10 @@ def main():
     for d in sorted(by_drum):
         e = by_drum[d]
         print("  %-6s %3d notes, error %+.2f .. %+.2f ms" % (d, len(e), min(e), max(e)))
-    print("render.json shell_passes: %s" % rj["kit"].get("shell_passes"))
+    # Reported, not asserted: seeds 4 and 7 have one each (a shaft meeting a cymbal's near edge
+    # side-on).
+    print("stick parts through a drum or cymbal (render.json shell_passes): %s"
+          % rj["kit"].get("shell_passes"))
     check(not wrong, "every note one primary strike of its instrument and limb within %.0f ms: "
           "%d not: %s" % (TOL_MS, len(wrong), wrong[:6]))
     check(f1 == 1.0, "F1 at +-%.0f ms is 1.0: %.3f" % (TOL_MS, f1))
