@@ -109,7 +109,19 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
                 deepest = i;
         // The normal points into the stick: up (the drum's axis, +y) on the
         // head, outward and up on the rim's edge, level on the shell's side.
-        const bool from_above = geoms[deepest].normal[1] > kHeadNormalMin;
+        bool from_above = geoms[deepest].normal[1] > kHeadNormalMin;
+        // A plate is soft in its contact (its bending) and 1 cm thick: an ff
+        // bead sinks deeper than the disc, the shaft behind it follows, and
+        // the capsule-cylinder collision (libccd) gives a nearly flat capsule
+        // deeper than the disc a sideways normal. On a plate, a shaft coming
+        // down at its first touch comes from above; one rising meets it from
+        // below.
+        if (!from_above && !bead && self->drum(drum).plate_bending_n_m > 0.0) {
+            dVector3 v;
+            dBodyGetPointVel(self->stick_body_[side], geoms[deepest].pos[0], geoms[deepest].pos[1],
+                             geoms[deepest].pos[2], v);
+            from_above = v[1] < 0.0;
+        }
         self->part_through_[static_cast<size_t>(part)] = !from_above;
         if (!from_above) {
             ++self->shell_passes_;
