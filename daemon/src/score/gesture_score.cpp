@@ -612,7 +612,7 @@ Eigen::Vector3d blend_directions(const Eigen::Vector3d &d0, const Eigen::Vector3
 // The stick's direction at t in window w between two units of one hand, d0 and
 // d1 theirs at t: the units' cross-fade over [begin, end]; with a turn, the
 // second's shape taken into the first's heading for the fade and the heading
-// turned over the move window.
+// turned over [turn_begin, turn_end] (turn_for_window()).
 Eigen::Vector3d window_direction(const Window &w, double t, const Eigen::Vector3d &d0,
                                  const Eigen::Vector3d &d1)
 {
