@@ -10,10 +10,11 @@ the right hand's note on some bars' downbeats; a last crash. Tempo 70-140 bpm, e
 dynamics drawn from pp..ff. French sticks, then the same scores with German sticks.
 
 Asserted, French sticks (the kit's acceptance): every note of the hands one primary strike of
-its piece within +-5 ms and no extra primary strike. Printed, not asserted: the stick parts
-that went through a piece (render.json's shell_passes: the left stick's shaft grazing the
-hi-hat's edge as it rises from the snare, docs/kit.md, "Not done"), and the same scores with
-German sticks, where the arm crossed over to the hi-hat meets the wrist's limits.
+its piece within +-5 ms and no extra primary strike, no stick part through a piece
+(render.json's shell_passes) and no limb through a piece or a stand (performance.bvh read by
+ictus_tools.limb_clearance: no limb's core inside one; its volume's clearance printed).
+Printed, not asserted: the same scores with German sticks, where the arm crossed over to the
+hi-hat meets the wrist's limits.
 
     PYTHONPATH=python python3 tests/perform/test_reach.py --ictusd build/ictusd
 """
@@ -25,6 +26,7 @@ import random
 import sys
 
 from ictus_tools import e2e_util
+from ictus_tools import limb_clearance
 from ictus_tools.checks import check, keep_going, finish
 
 DYNAMICS = ["pp", "p", "mp", "mf", "f", "ff"]
@@ -65,7 +67,16 @@ def judge(out):
     if extra:
         wrong.append("%d extra primary strike(s)" % extra)
     passes = {d["name"]: d["shell_passes"] for d in report["kit"]["drums"] if d["shell_passes"]}
-    return len(hands), len(hands) - sum(1 for w in wrong if w.startswith("note")), wrong, passes
+    if passes:
+        wrong.append("stick parts through a piece: %s" % passes)
+    c = limb_clearance.clearances(out)
+    (limb, piece), least = min(c.items(), key=lambda kv: kv[1].core_m)
+    if least.core_m <= 0.0:
+        wrong.append("the %s through the %s at %.3f s (its core %.1f mm in)"
+                     % (limb, piece, least.time_s, -1e3 * least.core_m))
+    volume = min(v.volume_m for v in c.values())
+    return (len(hands), len(hands) - sum(1 for w in wrong if w.startswith("note")), wrong, passes,
+            (least.core_m, volume))
 
 
 def main():
@@ -87,13 +98,14 @@ def main():
                 f.write(groove(seed, grip))
             out, _ = e2e_util.render_kit(args.ictusd, args.workdir, name, "full",
                                          ["--score", path], wav=False)
-            n, ok, wrong, passes = judge(out)
+            n, ok, wrong, passes, (core, volume) = judge(out)
             n_all += n
             ok_all += ok
             passes_all += sum(passes.values())
             message = "%s: %d of %d notes of the hands within %g ms%s (stick parts through a " \
-                "piece: %s)" % (name, ok, n, WINDOW_MS, "" if not wrong else ": " +
-                                "; ".join(wrong), passes or "none")
+                "piece: %s; limbs: least clearance of a core %.1f mm, of a volume %.1f mm)" % (
+                    name, ok, n, WINDOW_MS, "" if not wrong else ": " + "; ".join(wrong),
+                    passes or "none", 1e3 * core, 1e3 * volume)
             if grip == "french":
                 check(not wrong, message)
             else:

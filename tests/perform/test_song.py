@@ -18,7 +18,10 @@ recall found notes over notes, F1 their harmonic mean, reported with the worst e
 asserted 1.0. The hi-hat's and the ride's notes are the right hand's, the snare's under them
 the left's (crossed over the hi-hat); the crash's are the left's; the kicks the right foot's,
 the chicks the left foot's.
-No stick part may go through a drum or cymbal (render.json's `shell_passes` 0). Each
+No stick part may go through a drum or cymbal (render.json's `shell_passes` 0), nor a limb
+through a drum, a cymbal or a stand (performance.bvh read by ictus_tools.limb_clearance: no
+limb's core, its bones, palm or grip, inside a piece; the clearance of its volume printed);
+the left foot presses the hi-hat's footboard for each chick. Each
 check prints ok or FAIL, every one of them for every seed; the exit status is 1 when any
 fails. CTest `perform_song` plays seeds 1–7 and 16 (docs/kit.md, "The song").
 
@@ -28,14 +31,18 @@ fails. CTest `perform_song` plays seeds 1–7 and 16 (docs/kit.md, "The song").
 import argparse
 import csv
 import json
+import math
 import os
 import random
 import subprocess
 import tempfile
 import sys
 
+import numpy as np
+
 from ictus_tools import e2e_util
 from ictus_tools import checks
+from ictus_tools import limb_clearance
 from ictus_tools.checks import check
 
 mido = e2e_util.require_mido()
@@ -176,7 +183,71 @@ def play(ictusd, workdir, seed, render_args):
     check(len(chicks) == sum(1 for _, note, _ in written if note == 44)
           and all(n["drum"] == "hihat" for n in chicks),
           "every pedal hi-hat (44) the left foot's chick on the hi-hat: %d" % len(chicks))
+    check_body(out, strikes)
     return 0
+
+
+def foot_pitch(pos, index, side, rest_frame):
+    """The foot's toe-down turn from its pose at rest_frame (rad), each frame: the angle of
+    the ankle-to-toe vector from its rest direction."""
+    v = pos[:, index[side + "ToeBase"]] - pos[:, index[side + "Foot"]]
+    v0 = v[rest_frame]
+    c = (v @ v0) / (np.linalg.norm(v, axis=1) * np.linalg.norm(v0))
+    return np.arccos(np.clip(c, -1.0, 1.0))
+
+
+def check_body(out, strikes):
+    """The performer's body from performance.bvh (its own forward kinematics,
+    ictus_tools.limb_clearance): no limb through a piece, and the left foot on the hi-hat's
+    pedal."""
+    bvh = limb_clearance.Bvh(os.path.join(out, "performance.bvh"))
+    pos = bvh.positions()
+    index = {n: i for i, n in enumerate(bvh.names)}
+    # The reading checked against the physics' strikes: at each primary strike of a hand, the
+    # stick's end (the BVH's end site) on its head at the struck radius, within the bead's
+    # size (15 mm) and the 2 ms a 250 Hz frame may be off the strike.
+    with open(os.path.join(out, "render.json")) as f:
+        drums = json.load(f)["kit"]["drums"]
+    off = []
+    for s in strikes:
+        if s["hand"] in (HANDS["left"], HANDS["right"]) and s["bounce"] == 0:
+            f = int(round(s["time_s"] / bvh.frame_time_s))
+            end = pos[f, index[("Left" if s["hand"] == 0 else "Right") + "HandStick_End"]]
+            d = drums[s["drum"]]
+            rel = end - np.array(d["center_m"])
+            reach = 0.015 + 0.002 * math.hypot(s["normal_velocity_mps"],
+                                               s["tangential_velocity_mps"])
+            if abs(rel[1]) > reach or abs(math.hypot(rel[0], rel[2]) - s["r_over_a"] *
+                                          d["radius_m"]) > reach:
+                off.append((s["seq"], d["name"], rel.round(4).tolist()))
+    check(not off, "performance.bvh's sticks on their heads at the strikes: %d off %s"
+          % (len(off), off[:4]))
+    c = limb_clearance.clearances(out)
+    core = min(c.items(), key=lambda kv: kv[1].core_m)
+    volume = min(c.items(), key=lambda kv: kv[1].volume_m)
+    print("  limbs: least clearance of a limb's core (bones, palm, grip) %.1f mm (%s to %s at "
+          "%.3f s); of its volume %.1f mm (%s to %s at %.3f s)"
+          % (1e3 * core[1].core_m, core[0][0], core[0][1], core[1].time_s,
+             1e3 * volume[1].volume_m, volume[0][0], volume[0][1], volume[1].time_s))
+    check(core[1].core_m > 0.0, "no limb through a drum, a cymbal or a stand (its core "
+          "outside every piece): %.1f mm" % (1e3 * core[1].core_m))
+    # The left foot presses the hi-hat's footboard for each chick: the plates meet when the
+    # rod has come down the 15 mm gap, 3 x 0.1 m of lever per footboard radian (docs/pedal.md:
+    # a footboard angle of 0.05 rad); before the stroke (0.2 s, longer than its 0.12 s) the
+    # foot rests.
+    first = min(s["time_s"] for s in strikes)
+    pitch = foot_pitch(pos, index, "Left", int(0.5 * first / bvh.frame_time_s))
+    closed = 0.015 / (3.0 * 0.1)
+    at, before = [], []
+    for s in strikes:
+        if s["hand"] == HANDS["left-foot"] and s["bounce"] == 0:
+            f = int(round(s["time_s"] / bvh.frame_time_s))
+            at.append(pitch[f])
+            before.append(pitch[f - int(round(0.2 / bvh.frame_time_s))])
+    print("  left foot at the chicks: toe down %.4f .. %.4f rad (the plates meet at %.4f), "
+          "0.2 s before %.4f .. %.4f" % (min(at), max(at), closed, min(before), max(before)))
+    check(at and all(0.5 * closed <= a <= 1.05 * closed for a in at) and max(before) < 0.1 * closed,
+          "the left foot presses the hi-hat's footboard at each chick and rests before it")
 
 
 if __name__ == "__main__":

@@ -403,7 +403,9 @@ int ScoreMode::step(StrikeEvent out[kStepStrikes])
         follow_rest(r.tips);
     r.trunk_synergy();
     if (feet_[0])
-        r.foot_on_pedal(feet_[0]->pedal().footboard_angle_rad());
+        r.foot_on_pedal(Side::right, feet_[0]->pedal().footboard_angle_rad());
+    if (feet_[1])
+        r.foot_on_pedal(Side::left, feet_[1]->pedal().footboard_angle_rad());
     r.tracker->step(r.step_body, &r.tips, true);
     const long first_seq = perf_.detector_.strikes();
     int n = detect_strikes(perf_.detector_, r.tracker->scene(), out, perf_.time_offset_s_);

@@ -166,11 +166,13 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
         r.kit_drums = scene.extra_drums;
     }
     r.drum_center_m = scene.drum.center_m;
-    // The right ankle over the floor, and its axis of plantar flexion (the
-    // performer's left) in the shank's frame.
+    // The right ankle over the floor, and each ankle's axis of plantar
+    // flexion (the performer's left) in its shank's frame.
     r.right_sole_m = frames.origin_m[model.body_index("r_foot")];
     r.right_sole_m.y() = 0.0;
-    r.r_ankle_axis = (frames.rotation[model.body_index("r_shank")].conjugate() * left).normalized();
+    for (const char *shank : {"l_shank", "r_shank"})
+        r.ankle_axis[shank[0] == 'l' ? 0 : 1] =
+            (frames.rotation[model.body_index(shank)].conjugate() * left).normalized();
     r.shoulder_m = {shoulder[0], shoulder[1]};
     r.frame = frame_for(scene.drum, options.character.stick.tip_radius_m, -left, forward,
                         &options.kit, &r.kit_drums, r.right_sole_m, &r.shoulder_m);
@@ -214,10 +216,13 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
 // tips) and turns the shoulder of the higher stick back (kTrunkTwist_rad_per_m
 // of the difference of the tips' heights), 40 % at the lumbar joint and 60 %
 // at the thorax; eq. 1 then follows it with the trunk's compliant gains.
-void ScoreRig::foot_on_pedal(double footboard_rad)
+void ScoreRig::foot_on_pedal(Side side, double footboard_rad)
 {
-    step_body.local[r_ankle] =
-        body.local[r_ankle] * Eigen::Quaterniond(Eigen::AngleAxisd(footboard_rad, r_ankle_axis));
+    const int s = static_cast<int>(side);
+    const int j = ankle[static_cast<size_t>(s)];
+    step_body.local[j] =
+        body.local[j] *
+        Eigen::Quaterniond(Eigen::AngleAxisd(footboard_rad, ankle_axis[static_cast<size_t>(s)]));
 }
 
 void ScoreRig::trunk_synergy()

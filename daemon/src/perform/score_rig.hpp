@@ -26,13 +26,14 @@ struct ScoreRig {
     PerformerFrame frame;
     Eigen::Vector3d drum_center_m = Eigen::Vector3d::Zero(); // where the drum goes
     std::vector<DrumParams> kit_drums; // a kit's drums after the first, placed
-    // The right foot: its ankle over the floor (world, y 0), where a kit's
-    // foot piece is placed from (KitDrum::foot), and the ankle's axis of
-    // plantar flexion in the shank's frame (the performer's left).
+    // The right foot's ankle over the floor (world, y 0), where a kit's foot
+    // piece is placed from (KitDrum::foot); each ankle's axis of plantar
+    // flexion in its shank's frame (the performer's left), [Side].
     Eigen::Vector3d right_sole_m = Eigen::Vector3d::Zero();
     std::array<Eigen::Vector3d, 2> shoulder_m{}; // [Side], world (PerformerFrame::shoulder_m)
-    int r_ankle = model.joint_index("r_ankle");
-    Eigen::Vector3d r_ankle_axis = Eigen::Vector3d::UnitX();
+    std::array<int, 2> ankle = {model.joint_index("l_ankle"), model.joint_index("r_ankle")};
+    std::array<Eigen::Vector3d, 2> ankle_axis = {Eigen::Vector3d::UnitX(),
+                                                 Eigen::Vector3d::UnitX()};
     TipTargets tips;
     ScoreRig(const CharacterModel &m, double ik_limit_margin_rad)
         : model(m), range_of_motion(model), ik_range_of_motion(model, ik_limit_margin_rad)
@@ -41,9 +42,10 @@ struct ScoreRig {
     // The trunk takes part in the strokes: step_body is body with the lean
     // and twist that the tip targets of this step call for.
     void trunk_synergy();
-    // The right foot on its pedal: step_body's right ankle turned toe down by
-    // the footboard's angle (rad; docs/pedal.md).
-    void foot_on_pedal(double footboard_rad);
+    // A foot on its pedal (the right on the kick's, the left on the
+    // hi-hat's): step_body's ankle of that side turned toe down by the
+    // footboard's angle (rad; docs/pedal.md).
+    void foot_on_pedal(Side side, double footboard_rad);
 
     // The trunk: eq. 1's natural frequency of the lumbar and thorax joints,
     // and how they follow the sticks.
