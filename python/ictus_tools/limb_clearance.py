@@ -3,23 +3,29 @@
 Reads performance.bvh (the simulated bodies, world metres, y up) and render.json's kit,
 computes each frame's joint positions by forward kinematics (an independent reading of the
 BVH: offsets, then the channels' Euler angles in their written order), and measures the
-clearance of each limb, a capsule about its bone, to each piece: a drum a solid cylinder
-below its head (the kick's lies along +z from its batter), a cymbal a 1 cm disc on its
-stand, a 2.5 cm rod from the floor to its centre (the hi-hat's rod goes on 10 cm above its
-plates, to the clutch). A negative clearance is a limb's volume in a piece; a negative clearance of its core (its
-bones' axes, the palm's midplane, the grip's axis) is a limb through a piece, and the exit
-status is then 1.
+clearance of each limb, a volume about its bones (LIMBS), to each piece: a drum a solid
+cylinder below its head (the kick's lies along +z from its batter), a cymbal a 1 cm disc on
+its stand, a 2.5 cm rod from the floor to its centre (the hi-hat's rod goes on 10 cm above
+its plates, to the clutch). The sticks are measured against the stands alone (the scene
+keeps them out of the pieces). A negative clearance is a limb's volume in a piece; a
+negative clearance of its core (its bones' axes, the palm's midplane, the grip's or the
+stick's axis) is a limb through a piece, and the exit status is then 1.
 
     PYTHONPATH=python python3 -m ictus_tools.limb_clearance RENDER_DIR
 """
 import argparse
 import collections
 import json
-import math
 import os
 import sys
 
 import numpy as np
+
+# The sticks (the score's default, character.hpp's StickParams: 0.406 m, a 14.5 mm shaft),
+# from the butt to the tip, are measured against the stands only: the scene's collisions
+# keep them out of the drums and cymbals (render.json's shell_passes).
+STICK_LENGTH_M = 0.406
+STICK_RADIUS_M = 0.00725
 
 # The limbs, each a set of points along or over its bones with a radius about each point:
 # (name, kind, joints, radii). Radii from adult men's girths over 2 pi and breadths, rounded
@@ -39,6 +45,8 @@ LIMBS = [
     ("right forearm", "bone", ("RightForeArm", "RightHand"), (0.045, 0.028)),
     ("right palm", "palm", ("RightHand", "RightHandIndex1_End", "RThumb_End"), (0.0165,)),
     ("right fingers", "grip", ("RightHandStick", "RightHandStick_End"), (0.017,)),
+    ("left stick", "stick", ("LeftHandStick", "LeftHandStick_End"), (STICK_RADIUS_M,)),
+    ("right stick", "stick", ("RightHandStick", "RightHandStick_End"), (STICK_RADIUS_M,)),
     ("left thigh", "bone", ("LeftUpLeg", "LeftLeg"), (0.06, 0.06)),
     ("left shank", "bone", ("LeftLeg", "LeftFoot"), (0.05, 0.05)),
     ("right thigh", "bone", ("RightUpLeg", "RightLeg"), (0.06, 0.06)),
@@ -183,8 +191,15 @@ def limb_points(pos, index, kind, joints, radii):
         pts = (p[0][:, None, :] + a[None, :, None] * length[:, None, :] +
                c[None, :, None] * across[:, None, :])
         return pts, np.full(a.size, radii[0])
+    along = _unit(p[1] - p[0])
+    if kind == "stick":
+        to_butt = STICK_LENGTH_M - np.linalg.norm(p[1] - p[0], axis=-1)
+        s = np.linspace(0.0, 1.0, 41)
+        butt = p[0] - to_butt[:, None] * along
+        pts = butt[:, None, :] + (p[1] - butt)[:, None, :] * s[None, :, None]
+        return pts, np.full(s.size, radii[0])
     s = np.linspace(-FINGERS_HALF_WIDTH_M, FINGERS_HALF_WIDTH_M, 9)
-    pts = p[0][:, None, :] + s[None, :, None] * _unit(p[1] - p[0])[:, None, :]
+    pts = p[0][:, None, :] + s[None, :, None] * along[:, None, :]
     return pts, np.full(s.size, radii[0])
 
 
@@ -201,7 +216,9 @@ def clearances(render_dir):
     out = {}
     for limb, kind, joints, radii in LIMBS:
         pts, r = limb_points(pos, index, kind, joints, radii)
-        for name, _, top, axis, depth, radius in pieces(rj):
+        for name, what, top, axis, depth, radius in pieces(rj):
+            if kind == "stick" and what != "stand":
+                continue
             core = cylinder_distance(pts, top, axis, depth, radius)
             d = (core - r[None, :]).min(axis=1)
             f = int(np.argmin(d))
