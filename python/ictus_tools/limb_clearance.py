@@ -56,7 +56,7 @@ PALM_BREADTH_M = 0.089
 FINGERS_HALF_WIDTH_M = 0.04
 STAND_RADIUS_M = 0.0125
 HIHAT_ROD_ABOVE_M = 0.10
-SAMPLES = 21  # points along each bone
+SAMPLES = 41  # points along each bone (1 cm apart or less: a cymbal is 1 cm thick)
 
 
 class Bvh:
@@ -186,7 +186,7 @@ def limb_points(pos, index, kind, joints, radii):
         thumb = p[2] - p[0]
         across = _unit(thumb - np.sum(thumb * along, axis=-1, keepdims=True) * along)
         half = 0.5 * PALM_BREADTH_M - radii[0]
-        a, c = np.meshgrid(np.linspace(0.0, 1.0, 11), np.linspace(-half, half, 5))
+        a, c = np.meshgrid(np.linspace(0.0, 1.0, 11), np.linspace(-half, half, 7))
         a, c = a.ravel(), c.ravel()
         pts = (p[0][:, None, :] + a[None, :, None] * length[:, None, :] +
                c[None, :, None] * across[:, None, :])
@@ -203,15 +203,18 @@ def limb_points(pos, index, kind, joints, radii):
     return pts, np.full(s.size, radii[0])
 
 
-def clearances(render_dir):
+def clearances(render_dir, bvh=None, pos=None):
     """{(limb, piece): Clearance}: the limb's volume's least clearance to the piece (m), its
     time (s), the frames with the volume inside the piece, and the least clearance of the
     limb's core (its points' own radius left out: its bones, the palm's midplane, the grip's
-    axis), negative when the limb is through the piece."""
+    axis), negative when the limb is through the piece. bvh and pos: performance.bvh already
+    read, and its positions."""
     with open(os.path.join(render_dir, "render.json")) as f:
         rj = json.load(f)
-    bvh = Bvh(os.path.join(render_dir, "performance.bvh"))
-    pos = bvh.positions()
+    if bvh is None:
+        bvh = Bvh(os.path.join(render_dir, "performance.bvh"))
+    if pos is None:
+        pos = bvh.positions()
     index = {n: i for i, n in enumerate(bvh.names)}
     out = {}
     for limb, kind, joints, radii in LIMBS:

@@ -149,7 +149,8 @@ def main():
     # whose left stick once flew off the crash's edge after three bounces and fired the guard;
     # every kick is struck either way, and a guard that fired is said. It now plays every
     # note of the hands within 5 ms, the tips never near the guard's 40 m/s (docs/kit.md,
-    # "Not done").
+    # "Not done"), so the guard firing beside the kicks is no longer exercised here (the
+    # guard's own test: tests/perform/test_live.cpp).
     runaway = os.path.join(args.workdir, "runaway.txt")
     with open(runaway, "w") as f:
         f.write("tempo 214\nr on tom2 legato\nrest 3/4, L 2/2 on tom2 staccato, tempo -> 95 over 1\n"

@@ -2,6 +2,7 @@
 // closer than 2 cm in plan, every drum within the arms' and sticks' reach of
 // a shoulder), the checks that refuse a bad kit, the scene built with every
 // drum, and the strike detector giving each strike its drum.
+#include "ictus/character/range_of_motion.hpp"
 #include "ictus/perform/kit.hpp"
 #include "ictus/perform/performance.hpp"
 #include "ictus/perform/perform_error.hpp"
@@ -187,7 +188,9 @@ TEST_CASE("kit: seated at the full kit, no leg through a drum, a stand or the ki
                               ankle = at((s + "foot").c_str());
         CHECK(knee.z() - hip.z() > 0.15);
         CHECK(std::abs(knee.y() - hip.y()) < 0.25);
-        CHECK(ankle.y() == Approx(0.08).margin(1e-6));
+        // Within 0.1 mm: the knee is a hinge, and the CMU shank's small offset
+        // from its flexion plane keeps the ankle off its place by tens of um.
+        CHECK(ankle.y() == Approx(0.08).margin(1e-4));
     }
     // Each leg a chain of capsules (radii: a thigh's 38 cm circumference at
     // the knee, a calf's 31 cm, an ankle's 22 cm, over 2 pi), sampled every
@@ -242,6 +245,19 @@ TEST_CASE("kit: seated at the full kit, no leg through a drum, a stand or the ki
                                                         kick_k.shell_depth_m, kick_k.radius_m));
                 }
         CHECK(clear >= kKitMinGap_m);
+    }
+    // The seated legs are within their joints' ranges, so that the scene's
+    // limits hold them where they are placed (a knee turned about anything but
+    // its hinge is clamped back toward standing, and the feet leave their
+    // pedals).
+    const RangeOfMotion rom(m);
+    for (const char *joint : {"l_hip", "l_knee", "l_ankle", "r_hip", "r_knee", "r_ankle"}) {
+        const int j = m.joint_index(joint);
+        const int child = j + 1, parent = m.bodies()[static_cast<size_t>(child)].parent;
+        const Eigen::Quaterniond local = f.rotation[static_cast<size_t>(parent)].conjugate() *
+                                         f.rotation[static_cast<size_t>(child)];
+        INFO(joint);
+        CHECK(rom.limit(j).excursion_rad(local) < 1e-6);
     }
     // The feet on their pedals: the kick's batter 0.27 m before the right
     // ankle, in line with it; the hi-hat's rod 0.2-0.3 m before the left.

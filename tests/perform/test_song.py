@@ -208,10 +208,15 @@ def check_body(out, strikes):
     # size (15 mm) and the 2 ms a 250 Hz frame may be off the strike.
     with open(os.path.join(out, "render.json")) as f:
         drums = json.load(f)["kit"]["drums"]
+    last = pos.shape[0] - 1
+
+    def frame(t):
+        return min(max(int(round(t / bvh.frame_time_s)), 0), last)
+
     off = []
     for s in strikes:
         if s["hand"] in (HANDS["left"], HANDS["right"]) and s["bounce"] == 0:
-            f = int(round(s["time_s"] / bvh.frame_time_s))
+            f = frame(s["time_s"])
             end = pos[f, index[("Left" if s["hand"] == 0 else "Right") + "HandStick_End"]]
             d = drums[s["drum"]]
             rel = end - np.array(d["center_m"])
@@ -222,7 +227,7 @@ def check_body(out, strikes):
                 off.append((s["seq"], d["name"], rel.round(4).tolist()))
     check(not off, "performance.bvh's sticks on their heads at the strikes: %d off %s"
           % (len(off), off[:4]))
-    c = limb_clearance.clearances(out)
+    c = limb_clearance.clearances(out, bvh, pos)
     core = min(c.items(), key=lambda kv: kv[1].core_m)
     volume = min(c.items(), key=lambda kv: kv[1].volume_m)
     print("  limbs: least clearance of a limb's core (bones, palm, grip) %.1f mm (%s to %s at "
@@ -240,14 +245,32 @@ def check_body(out, strikes):
     closed = 0.015 / (3.0 * 0.1)
     at, before = [], []
     for s in strikes:
-        if s["hand"] == HANDS["left-foot"] and s["bounce"] == 0:
-            f = int(round(s["time_s"] / bvh.frame_time_s))
-            at.append(pitch[f])
-            before.append(pitch[f - int(round(0.2 / bvh.frame_time_s))])
+        if s["hand"] == HANDS["left-foot"] and s["bounce"] == 0 and s["time_s"] >= 0.2:
+            at.append(pitch[frame(s["time_s"])])
+            before.append(pitch[frame(s["time_s"] - 0.2)])
+    if not check(at, "the song's chicks are in strikes.csv"):
+        return
     print("  left foot at the chicks: toe down %.4f .. %.4f rad (the plates meet at %.4f), "
           "0.2 s before %.4f .. %.4f" % (min(at), max(at), closed, min(before), max(before)))
-    check(at and all(0.5 * closed <= a <= 1.05 * closed for a in at) and max(before) < 0.1 * closed,
+    check(all(0.5 * closed <= a <= 1.05 * closed for a in at) and max(before) < 0.1 * closed,
           "the left foot presses the hi-hat's footboard at each chick and rests before it")
+    # The feet stay on their pedals (docs/kit.md, "The throne"): the kick's batter 0.27 m
+    # before the right ankle and in line with it, the hi-hat's rod 0.2-0.3 m before the left
+    # and within 0.1 m of it across, the ankles 8 cm up; an ankle only turns, so it stays put.
+    kick = next(d for d in drums if d["name"] == "kick")
+    hat = next(d for d in drums if d["name"] == "hihat")
+    right, left = pos[:, index["RightFoot"]], pos[:, index["LeftFoot"]]
+    drift = max(np.abs(right - right[0]).max(), np.abs(left - left[0]).max())
+    r0, l0 = right[0], left[0]
+    print("  ankles: right %s, left %s, moved at most %.2f mm; the kick's batter %s, the hi-hat "
+          "%s" % (r0.round(3), l0.round(3), 1e3 * drift, np.round(kick["center_m"], 3),
+                  np.round(hat["center_m"], 3)))
+    check(drift < 1e-3 and abs(kick["center_m"][2] - r0[2] - 0.27) < 0.005
+          and abs(kick["center_m"][0] - r0[0]) < 0.005 and abs(r0[1] - 0.08) < 0.005
+          and 0.2 < hat["center_m"][2] - l0[2] < 0.3 and abs(hat["center_m"][0] - l0[0]) < 0.1
+          and abs(l0[1] - 0.08) < 0.005,
+          "the feet stay on their pedals: the right ankle 0.27 m behind the kick's batter, the "
+          "left 0.2-0.3 m behind the hi-hat's rod, both 8 cm up, neither moving")
 
 
 if __name__ == "__main__":

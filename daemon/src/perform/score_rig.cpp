@@ -40,6 +40,7 @@ Eigen::Vector3d knee_between(const Eigen::Vector3d &h, const Eigen::Vector3d &a,
 
 void sit_on_throne(const CharacterModel &model, CharacterPose &pose)
 {
+    const RangeOfMotion rom(model);
     pose.pelvis_position_m.y() -= ScoreRig::kThroneDrop_m;
     BodyFrames frames;
     model.forward(pose, frames);
@@ -61,14 +62,34 @@ void sit_on_throne(const CharacterModel &model, CharacterPose &pose)
             knee_between(h, a, (k0 - h).norm(), (a0 - k0).norm(),
                          forward + 0.6 * out * Eigen::Vector3d::UnitX() + 0.5 * up);
         // World rotations of the thigh and shank that carry the standing
-        // segments onto the seated ones; the foot stays level.
-        const Eigen::Quaterniond rt = Eigen::Quaterniond::FromTwoVectors(k0 - h, k - h);
-        const Eigen::Quaterniond rs =
-            Eigen::Quaterniond::FromTwoVectors(rt * (a0 - k0), a - k) * rt;
+        // segments onto the seated ones, the knee a hinge: the thigh turned
+        // so that the knee's flexion axis (its range's u, in the thigh's
+        // frame) stands normal to the leg's plane (hip, knee, ankle), the
+        // shank then flexed about it alone, within the knee's range.
+        const Eigen::Vector3d hinge0 =
+            frames.rotation[thigh] * rom.limit(model.joint_index(side + "knee")).u;
+        const Eigen::Vector3d t0 = (k0 - h).normalized(), t1 = (k - h).normalized();
+        const Eigen::Vector3d n1 = t1.cross(a - k).normalized();
+        Eigen::Matrix3d from, to;
+        from.col(0) = t0;
+        from.col(1) = (hinge0 - hinge0.dot(t0) * t0).normalized();
+        from.col(2) = from.col(0).cross(from.col(1));
+        to.col(0) = t1;
+        to.col(1) = n1;
+        to.col(2) = t1.cross(n1);
+        const Eigen::Quaterniond rt(to * from.transpose());
+        const Eigen::Vector3d sv = rt * (a0 - k0), sw = a - k;
+        const Eigen::Vector3d pv = sv - sv.dot(n1) * n1, pw = sw - sw.dot(n1) * n1;
+        const double flex = std::atan2(pv.cross(pw).dot(n1), pv.dot(pw));
+        const Eigen::Quaterniond rs = Eigen::Quaterniond(Eigen::AngleAxisd(flex, n1)) * rt;
         const Eigen::Quaterniond p = pose.pelvis_rotation;
         pose.local[model.joint_index(side + "hip")] = p.conjugate() * rt * p;
         pose.local[model.joint_index(side + "knee")] = p.conjugate() * rt.conjugate() * rs * p;
-        pose.local[model.joint_index(side + "ankle")] = p.conjugate() * rs.conjugate() * p;
+        // The foot as level as the ankle's range lets it (the left one, under
+        // a knee turned out, rolls 6.5 degrees): the scene's limits would
+        // clamp it there anyway.
+        const int ankle = model.joint_index(side + "ankle");
+        pose.local[ankle] = rom.limit(ankle).clamp(p.conjugate() * rs.conjugate() * p);
     }
 }
 
@@ -218,11 +239,13 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
 // at the thorax; eq. 1 then follows it with the trunk's compliant gains.
 void ScoreRig::foot_on_pedal(Side side, double footboard_rad)
 {
+    // The axis is in the shank's (the joint's parent's) frame, so the turn
+    // comes before the ankle's own rotation.
     const int s = static_cast<int>(side);
     const int j = ankle[static_cast<size_t>(s)];
     step_body.local[j] =
-        body.local[j] *
-        Eigen::Quaterniond(Eigen::AngleAxisd(footboard_rad, ankle_axis[static_cast<size_t>(s)]));
+        Eigen::Quaterniond(Eigen::AngleAxisd(footboard_rad, ankle_axis[static_cast<size_t>(s)])) *
+        body.local[j];
 }
 
 void ScoreRig::trunk_synergy()
