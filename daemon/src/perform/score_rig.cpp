@@ -38,9 +38,8 @@ Eigen::Vector3d knee_between(const Eigen::Vector3d &h, const Eigen::Vector3d &a,
 }
 } // namespace
 
-void sit_on_throne(const CharacterModel &model, CharacterPose &pose)
+void sit_on_throne(const CharacterModel &model, const RangeOfMotion &rom, CharacterPose &pose)
 {
-    const RangeOfMotion rom(model);
     pose.pelvis_position_m.y() -= ScoreRig::kThroneDrop_m;
     BodyFrames frames;
     model.forward(pose, frames);
@@ -142,7 +141,7 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
     ScoreRig &r = *rig;
     r.body = model.pose_from_motion(motion, 0);
     if (kit_foot_piece(options.kit) >= 0)
-        sit_on_throne(model, r.body);
+        sit_on_throne(model, r.range_of_motion, r.body);
 
     // The drum in front of the performer: from the midpoint of the shoulders,
     // drum_forward_m along the facing direction and drum_below_m down, unless
@@ -191,9 +190,12 @@ std::unique_ptr<ScoreRig> make_score_rig(const PerformanceOptions &options,
     // flexion (the performer's left) in its shank's frame.
     r.right_sole_m = frames.origin_m[model.body_index("r_foot")];
     r.right_sole_m.y() = 0.0;
-    for (const char *shank : {"l_shank", "r_shank"})
-        r.ankle_axis[shank[0] == 'l' ? 0 : 1] =
-            (frames.rotation[model.body_index(shank)].conjugate() * left).normalized();
+    for (Side side : {Side::left, Side::right})
+        r.ankle_axis[static_cast<size_t>(side)] =
+            (frames.rotation[model.body_index(side == Side::left ? "l_shank" : "r_shank")]
+                 .conjugate() *
+             left)
+                .normalized();
     r.shoulder_m = {shoulder[0], shoulder[1]};
     r.frame = frame_for(scene.drum, options.character.stick.tip_radius_m, -left, forward,
                         &options.kit, &r.kit_drums, r.right_sole_m, &r.shoulder_m);

@@ -64,9 +64,9 @@ struct ScoreRig {
 
 // The standing default body (its legs straight, the identity pose) seated on
 // a throne: the pelvis lowered by ScoreRig::kThroneDrop_m, each knee placed
-// between its hip and its seated ankle (bent forward and a little out), the
-// feet level.
-void sit_on_throne(const CharacterModel &model, CharacterPose &pose);
+// between its hip and its seated ankle (bent forward and a little out, a
+// hinge), the feet as level as the ankles' ranges in rom allow.
+void sit_on_throne(const CharacterModel &model, const RangeOfMotion &rom, CharacterPose &pose);
 
 // The default body (stick_capture.hpp), standing with the hips 0.9 m up
 // (seated on a throne with a kit that has a foot piece), pelvis welded, facing +Z, in `pose` (joint
