@@ -9,6 +9,7 @@
              in a seeded order, high to low);
   bars 9-15  a crash (49) with the kick on the downbeat, then the ride (51) on 8ths, the snare
              and the hi-hat's pedal (44, the left foot's chick) on 2 and 4, the kick on 1 and 3;
+             on half the seeds that snare is a side stick (37, a cross-stick on the rim);
   bar 16     the groove again, and a last crash with the kick on the next downbeat.
 
 Every note must be one primary strike of its instrument within +-5 ms of its time: notes.csv
@@ -89,6 +90,8 @@ def song(path, rng):
     groove(15, range(8), 42)
     notes.append((16 * bar, 49, 120))
     notes.append((16 * bar, 36, 110))
+    if rng.random() < 0.5:  # the ride section's backbeat as a cross-stick: side stick 37
+        notes = [(t, 37 if n == 38 and 8 * bar <= t < 15 * bar else n, v) for t, n, v in notes]
     e2e_util.write_drum_midi(mido, path, notes, 120.0, tpq)
     return notes
 
@@ -183,6 +186,18 @@ def play(ictusd, workdir, seed, render_args):
     check(len(chicks) == sum(1 for _, note, _ in written if note == 44)
           and all(n["drum"] == "hihat" for n in chicks),
           "every pedal hi-hat (44) the left foot's chick on the hi-hat: %d" % len(chicks))
+    # The side sticks: the snare's notes at the 37s' times (120 bpm, tpq 480, after the lead-in).
+    plan = rj["performance"]["plan"]
+    side_ms = {round(1e3 * (plan["origin_s"] + plan["lead_in_s"]) + t / 480 * 500.0)
+               for t, note, _ in written if note == 37}
+    zones = [by_seq[int(n["strike_seq"])]["zone"] if int(n["strike_seq"]) in by_seq else None
+             for n in notes if n["drum"] == "snare" and round(1e3 * float(n["time_s"])) in side_ms]
+    others = [by_seq[int(n["strike_seq"])]["zone"] for n in notes if n["drum"] == "snare"
+              and round(1e3 * float(n["time_s"])) not in side_ms and int(n["strike_seq"]) in by_seq]
+    check(len(zones) == len(side_ms) and all(z == 1 for z in zones) and all(z == 0 for z in others),
+          "every side stick (37) on the snare's rim (zone 1), every other snare note on its head: "
+          "%d side sticks, zones %s; heads %s" % (len(side_ms), sorted(set(map(str, zones))),
+                                                  sorted(set(others))))
     check_body(out, strikes)
     return 0
 

@@ -403,9 +403,10 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         s.hand = hand == 0 ? Side::left : Side::right;
         s.dynamics = n.velocity / 127.0;
         s.theta_deg = kDefaultThetaDeg[hand];
-        if (n.note == kMidiSideStick)
+        if (n.note == kMidiSideStick) {
             s.r_over_a = kMidiSideStickRadiusFraction;
-        else if (n.note == kMidiRideBell)
+            s.theta_deg = kMidiSideStickThetaDeg;
+        } else if (n.note == kMidiRideBell)
             s.r_over_a = kMidiRideBellRadiusFraction;
         s.spot_given = n.note == kMidiSideStick || n.note == kMidiRideBell;
         if (n.note == kMidiClosedHihat || n.note == kMidiOpenHihat)

@@ -70,6 +70,9 @@ constexpr int kMidiSideStick = 37;
 constexpr int kMidiSnare = 38; // Acoustic Snare: a kit's snare's note; MIDI out writes a rim strike
                                // on it as the side stick
 constexpr double kMidiSideStickRadiusFraction = kMaxRadiusFraction;
+// ... on the hoop nearest the performer (theta 90 degrees, docs/kit.md), whichever hand plays
+// it: the hands' own sides (0 and 180 degrees) lie under the hi-hat and toward the floor tom.
+constexpr double kMidiSideStickThetaDeg = 90.0;
 // General MIDI's cymbals, played on a kit's cymbal of that note (docs/midi.md): crash 49 and
 // 57 on its crash (49), ride 51 and 59 on its ride (51), ride bell 53 on the ride's bell, a
 // stroke aimed this near the centre (a 20-inch ride's bell is about 6 inches across).
