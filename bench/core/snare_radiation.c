@@ -17,10 +17,18 @@
  * cos(m theta) modes of odd m cancel by symmetry.
  *
  * It reads the snare head's modes, so it includes snare_wires.c (the library's copy is
- * not linked). Run: build/bench/core/bench_snare_radiation [velocity]. */
+ * not linked). Run: build/bench/core/bench_snare_radiation [velocity].
+ *
+ * `bench_snare_radiation tom` asks the expression ladder's question of the same microphone
+ * (docs/sound.md, "Expression"): the `tom` preset struck by a 13.8 g stick at r/a 0.33 with
+ * the head's stretching (the Begley & Mackin k3 of its Mylar, stick_tip.h) at the ladder's
+ * impact speeds; it prints the spectral centroid of the first 50 ms (Hann window) of each
+ * pickup and of the batter's pressure at each elevation. */
 #include "snare_wires.c"
 #include "contact.h"
 #include "membrane_presets.h"
+#include "stick_tip.h"
+#include "ictus_param.h"
 
 #include <stdio.h>
 
@@ -83,6 +91,43 @@ static void head_weights(snare_wires *w, double phi, double *W)
     free(mm), free(jj);
 }
 
+/* The batter's weights W[f * modes + k] for the microphone at each elevation phis[f]. */
+static double *batter_weights(const membrane *m)
+{
+    const double a = m->radius, cm = sqrt(m->tension / m->density);
+    double *W = calloc((size_t)m->modes * NPHI, sizeof(double));
+    for (int f = 0; f < NPHI; f++)
+        for (int k = 0; k < m->modes; k++) {
+            const int mk = m->table.m[k];
+            const double ang = m->table.sin[k] ? sin(mk * MIC_THETA) : cos(mk * MIC_THETA);
+            W[f * m->modes + k] = weight(mk, m->table.j[k], m->mass_scale * m->table.norm[k], a,
+                                         m->table.j[k] * cm / a, phis[f], ang);
+        }
+    return W;
+}
+
+/* The batter's pressure at each elevation for the sample just processed, into out[f];
+ * prev[f] keeps the even modes' weighted velocity for the difference. Displacements
+ * grow downwards: the batter radiates up (-a). */
+static void batter_pressure(const membrane *m, const double *W, double *prev, double *out)
+{
+    for (int f = 0; f < NPHI; f++) {
+        double se = 0.0, so = 0.0;
+        for (int k = 0; k < m->modes; k++) {
+            double u = 0.0; /* the forces of the sample, not yet in the state */
+            for (int q = 0; q < m->point_count; q++)
+                u += m->points[q]->force_pending * m->points[q]->psi[k];
+            const double v = (double)m->sc[k] * m->p[k] + (double)m->ep[k] * u;
+            if (m->table.m[k] % 2)
+                so += W[f * m->modes + k] * v;
+            else
+                se += W[f * m->modes + k] * v;
+        }
+        out[f] = -((se - prev[f]) * SR + so);
+        prev[f] = se;
+    }
+}
+
 static void stroke(int wires, double velocity)
 {
     membrane *m = membrane_new(SR);
@@ -93,46 +138,30 @@ static void stroke(int wires, double velocity)
     contact *c = contact_new();
     membrane_attach_contact(m, c);
     contact_hit_mass(c, velocity, 0.3, 0.0, 0, 0.05);
-    const double a = m->radius, cm = sqrt(m->tension / m->density);
-    double *Wb = calloc((size_t)m->modes * NPHI, sizeof(double));
+    double *Wb = batter_weights(m);
     double *Ws = calloc((size_t)w->n * NPHI, sizeof(double));
-    for (int f = 0; f < NPHI; f++) {
-        for (int k = 0; k < m->modes; k++) {
-            const int mk = m->table.m[k];
-            const double ang = m->table.sin[k] ? sin(mk * MIC_THETA) : cos(mk * MIC_THETA);
-            Wb[f * m->modes + k] = weight(mk, m->table.j[k], m->mass_scale * m->table.norm[k], a,
-                                          m->table.j[k] * cm / a, phis[f], ang);
-        }
+    for (int f = 0; f < NPHI; f++)
         head_weights(w, phis[f], Ws + f * w->n);
-    }
     static double pick[SAMPLES], top[NPHI][SAMPLES], bottom[NPHI][SAMPLES];
     double prev_top[NPHI] = {0}, prev_bottom[NPHI] = {0};
     for (int i = 0; i < SAMPLES; i++) {
         float o0, o1, *o[2] = {&o0, &o1};
         membrane_process(m, NULL, o, 1);
         pick[i] = o0;
+        double p[NPHI];
+        batter_pressure(m, Wb, prev_top, p);
         for (int f = 0; f < NPHI; f++) {
-            double se = 0.0, so = 0.0, te = 0.0, to = 0.0;
-            for (int k = 0; k < m->modes; k++) {
-                double u = 0.0; /* the forces of the sample, not yet in the state */
-                for (int q = 0; q < m->point_count; q++)
-                    u += m->points[q]->force_pending * m->points[q]->psi[k];
-                const double v = (double)m->sc[k] * m->p[k] + (double)m->ep[k] * u;
-                if (m->table.m[k] % 2)
-                    so += Wb[f * m->modes + k] * v;
-                else
-                    se += Wb[f * m->modes + k] * v;
-            }
+            double te = 0.0, to = 0.0;
             for (int k = 0; k < w->n; k++) {
                 if (k >= w->ka.ne)
                     to += Ws[f * w->n + k] * w->v[k];
                 else
                     te += Ws[f * w->n + k] * w->v[k];
             }
-            /* Displacements grow downwards: the batter radiates up (-a), the snare head down. */
-            top[f][i] = -((se - prev_top[f]) * SR + so);
+            /* Displacements grow downwards: the snare head radiates down (+a). */
+            top[f][i] = p[f];
             bottom[f][i] = (te - prev_bottom[f]) * SR + to;
-            prev_top[f] = se, prev_bottom[f] = te;
+            prev_bottom[f] = te;
         }
     }
     double h;
@@ -158,8 +187,65 @@ static void stroke(int wires, double velocity)
     membrane_free(m);
 }
 
+/* Spectral centroid of x[0 .. n) under a Hann window (plain DFT). */
+static double centroid(const double *x, int n)
+{
+    double num = 0.0, den = 0.0;
+    for (int k = 0; k <= n / 2; k++) {
+        double re = 0.0, im = 0.0;
+        for (int i = 0; i < n; i++) {
+            const double xi = x[i] * (0.5 - 0.5 * cos(2.0 * M_PI * i / (n - 1)));
+            const double ph = -2.0 * M_PI * (double)((long)k * i % n) / n;
+            re += xi * cos(ph), im += xi * sin(ph);
+        }
+        num += (re * re + im * im) * k * SR / n, den += re * re + im * im;
+    }
+    return num / den;
+}
+
+/* The tom struck at the expression ladder's speeds: its pickups against the microphone. */
+static void tom_ladder(void)
+{
+    static const double speeds[] = {0.46, 1.02, 2.77, 5.87, 10.0};
+    printf("tom, 13.8 g at r/a 0.33: centroid of the first 50 ms, Hz\n  v m/s  pickup 1  pickup 2");
+    for (int f = 0; f < NPHI; f++)
+        printf("  mic %2.0f", phis[f]);
+    printf("\n");
+    for (size_t s = 0; s < sizeof speeds / sizeof speeds[0]; s++) {
+        membrane *m = membrane_new(SR);
+        membrane_apply_preset(m, membrane_preset_find("tom"));
+        contact *c = contact_new();
+        ictus_param_set(&contact_params, c, CONTACT_PARAM_STRETCH,
+                        stick_tip_head_k3(4.5e9, 0.38, m->density / 1390.0, m->radius));
+        membrane_attach_contact(m, c);
+        contact_hit_mass(c, speeds[s], 0.33, 0.0, 0, 0.0138);
+        double *W = batter_weights(m), prev[NPHI] = {0}, p[NPHI];
+        static double pick[2][SAMPLES], mic[NPHI][SAMPLES];
+        for (int i = 0; i < SAMPLES; i++) {
+            float o0, o1, *o[2] = {&o0, &o1};
+            membrane_process(m, NULL, o, 1);
+            pick[0][i] = o0, pick[1][i] = o1;
+            batter_pressure(m, W, prev, p);
+            for (int f = 0; f < NPHI; f++)
+                mic[f][i] = p[f];
+        }
+        printf("  %5.2f  %8.0f  %8.0f", speeds[s], centroid(pick[0], SAMPLES),
+               centroid(pick[1], SAMPLES));
+        for (int f = 0; f < NPHI; f++)
+            printf("  %6.0f", centroid(mic[f], SAMPLES));
+        printf("\n");
+        free(W);
+        contact_free(c);
+        membrane_free(m);
+    }
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "tom") == 0) {
+        tom_ladder();
+        return 0;
+    }
     const double velocity = argc > 1 ? atof(argv[1]) : 2.5;
     stroke(1, velocity);
     stroke(0, velocity);
