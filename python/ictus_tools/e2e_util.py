@@ -69,6 +69,26 @@ def read_strikes(path):
     return rows
 
 
+
+def read_kit_render(out):
+    """A kit render's outputs: (render.json, the kit's piece names by index, notes.csv's rows,
+    strikes.csv's strikes by seq)."""
+    import csv
+    with open(os.path.join(out, "render.json")) as f:
+        rj = json.load(f)
+    with open(os.path.join(out, "notes.csv")) as f:
+        notes = list(csv.DictReader(f))
+    strikes = {s["seq"]: s for s in read_strikes(os.path.join(out, "strikes.csv"))}
+    return rj, [d["name"] for d in rj["kit"]["drums"]], notes, strikes
+
+
+def note_found(note, strikes, names, tol_ms=5.0, hand=None):
+    """notes.csv's `note` got one primary strike on its piece within tol_ms (and of limb
+    `hand`, strikes.csv's number, when given): the whole kit's acceptance (docs/kit.md)."""
+    s = strikes.get(int(note["strike_seq"]))
+    return (s is not None and s["bounce"] == 0 and names[s["drum"]] == note["drum"]
+            and (hand is None or s["hand"] == hand) and abs(float(note["error_ms"])) <= tol_ms)
+
 def read_events(path):
     """events.txt -> list of (delay_us, words after the delay) per line, the
     delay in whole microseconds (the file writes ms with 3 decimals)."""

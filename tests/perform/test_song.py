@@ -30,7 +30,6 @@ fails. CTest `perform_song` plays seeds 1–7 and 16 (docs/kit.md, "The song").
         --seed 1 2 3 4 5 6 7 16
 """
 import argparse
-import csv
 import json
 import math
 import os
@@ -132,13 +131,8 @@ def play(ictusd, workdir, seed, render_args):
                  % (run.returncode, run.stderr[-2000:])):
         return 1
     check("left out" not in run.stderr, "no note left out: %s" % run.stderr[-500:])
-    with open(os.path.join(out, "render.json")) as f:
-        rj = json.load(f)
-    names = [d["name"] for d in rj["kit"]["drums"]]
-    with open(os.path.join(out, "notes.csv")) as f:
-        notes = list(csv.DictReader(f))
-    strikes = e2e_util.read_strikes(os.path.join(out, "strikes.csv"))
-    by_seq = {s["seq"]: s for s in strikes}
+    rj, names, notes, by_seq = e2e_util.read_kit_render(out)
+    strikes = list(by_seq.values())
     primary = [s for s in strikes if s["bounce"] == 0]
     check(len(notes) == len(written), "notes.csv: every note of the file: %d of %d"
           % (len(notes), len(written)))
@@ -146,10 +140,7 @@ def play(ictusd, workdir, seed, render_args):
     found, errors, wrong = 0, [], []
     by_drum = {}
     for n in notes:
-        s = by_seq.get(int(n["strike_seq"]))
-        ok = (s is not None and s["bounce"] == 0 and names[s["drum"]] == n["drum"]
-              and s["hand"] == HANDS[n["hand"]] and abs(float(n["error_ms"])) <= TOL_MS)
-        if ok:
+        if e2e_util.note_found(n, by_seq, names, TOL_MS, HANDS[n["hand"]]):
             found += 1
             errors.append(float(n["error_ms"]))
             by_drum.setdefault(n["drum"], []).append(float(n["error_ms"]))

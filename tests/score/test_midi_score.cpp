@@ -338,3 +338,48 @@ TEST_CASE("midi in: the right hand keeps time on the hi-hat and the ride, the le
     CHECK(part.score.notes[3].drum == "snare");
     CHECK(part.score.notes[3].line + 1 == part.score.notes[2].line);
 }
+
+TEST_CASE("midi in: a run of alternating strokes starts on the hand that leaves each the most time",
+          "[score][midi]")
+{
+    // The full kit's places (m: right, up, forward); 96 ticks a quarter at 120 bpm, a 16th
+    // (24 ticks) 125 ms. Four 16ths on tom1 after a rest, then the crash (the left hand's) a
+    // 16th after the last: R L R L leaves the left 125 ms for tom1 -> crash, 0.497 m (plus a
+    // stroke's 0.1 m: 4.8 m/s); L R L R leaves it 250 ms (2.4 m/s) and the right nothing to
+    // reach: the run starts on the left.
+    std::vector<MidiDrum> kit = {{"snare", 38, true, {0.0, 0.0, 0.0}},
+                                 {"tom1", 48, true, {-0.15, 0.23, 0.30}},
+                                 {"crash", 49, true, {-0.64, 0.30, 0.36}},
+                                 {"ride", 51, true, {0.62, 0.22, 0.28}}};
+    auto part = [&](bool ride) {
+        std::string t;
+        for (int k = 0; k < 4; ++k)
+            t += bytes({k == 0 ? 0 : 24, 0x99, 48, 100});
+        t += bytes({24, 0x99, 49, 120});
+        if (ride)
+            t += bytes({0, 0x99, 51, 90});
+        return drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t + kEnd), "r.mid"), kit,
+                               "r.mid");
+    };
+    const MidiDrumPart a = part(false);
+    REQUIRE(a.score.notes.size() == 5);
+    for (size_t i = 0; i < 4; ++i) {
+        INFO(i);
+        CHECK(a.score.notes[i].hand == (i % 2 == 0 ? Side::left : Side::right));
+        CHECK(a.score.notes[i].theta_deg == kDefaultThetaDeg[i % 2 == 0 ? 0 : 1]);
+    }
+    CHECK(a.score.notes[4].hand == Side::left);
+    // With the ride (the right hand's) on the crash's tick, L R L R would leave the right
+    // 125 ms for tom1 -> ride (0.77 + 0.1 m: 7.0 m/s) against R L R L's 4.8 (the left to the
+    // crash) and 3.5 m/s (the right to the ride in 250 ms): the run keeps the lead.
+    const MidiDrumPart b = part(true);
+    REQUIRE(b.score.notes.size() == 6);
+    for (size_t i = 0; i < 4; ++i)
+        CHECK(b.score.notes[i].hand == (i % 2 == 0 ? Side::right : Side::left));
+    // Without places the hand rule alone: R L R L.
+    for (MidiDrum &d : kit)
+        d.placed = false;
+    const MidiDrumPart c = part(false);
+    for (size_t i = 0; i < 4; ++i)
+        CHECK(c.score.notes[i].hand == (i % 2 == 0 ? Side::right : Side::left));
+}

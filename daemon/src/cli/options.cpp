@@ -375,7 +375,7 @@ void load_midi_score(PerformanceOptions &o)
         throw UsageError("--midi is a score: give one of --midi, --score, --mocap");
     std::vector<MidiDrum> drums;
     for (const KitDrum &d : o.kit.drums)
-        drums.push_back({d.name, d.midi_note});
+        drums.push_back({d.name, d.midi_note, true, {d.place_m.x(), d.place_m.y(), d.place_m.z()}});
     MidiDrumPart part = load_midi_drum_part(path, drums);
     std::ostringstream line;
     long skipped = 0;

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace ictus
@@ -306,6 +307,98 @@ int drum_channel(const Smf &smf)
     return -1;
 }
 
+// A hand's note, for the second look at the sticking (turn_runs).
+struct HandNote {
+    size_t index = 0; // in the score's notes
+    double t = 0.0;   // s
+    long tick = 0;
+    int drum = 0;
+    bool set = false; // its hand is its instrument's (a crash, the time-keeper)
+};
+
+// How fast a hand moves from note a to note b: the distance between their pieces, plus a
+// stroke's own travel, over the time between them (m/s); 0 when the pieces are not placed.
+double move_speed(const std::vector<MidiDrum> &drums, const HandNote &a, const HandNote &b)
+{
+    constexpr double kStrokeTravel_m = 0.1;
+    const MidiDrum &p = drums[static_cast<size_t>(a.drum)], &q = drums[static_cast<size_t>(b.drum)];
+    if (!p.placed || !q.placed)
+        return 0.0;
+    const double d = std::hypot(p.place_m[0] - q.place_m[0], p.place_m[1] - q.place_m[1],
+                                p.place_m[2] - q.place_m[2]);
+    return (d + kStrokeTravel_m) / std::max(b.t - a.t, 1e-9);
+}
+
+// The sticking's second look (docs/midi.md): a run of strokes that alternate between notes
+// whose hands are set (a crash, the time-keeper, two notes at once) or a rest of
+// kMidiAlternateBelow_s starts on the other hand when that makes the fastest move of a hand
+// into or out of it at most kMidiTurnRunGain of what it was (a fill ends on the hand that
+// does not go to the crash), each hand's strokes still kMidiSameHandMin_s apart.
+void turn_runs(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes,
+               const std::vector<MidiDrum> &drums)
+{
+    const size_t n = notes.size();
+    auto hand = [&](size_t i) { return score[notes[i].index].hand == Side::left ? 0 : 1; };
+    auto fixed = [&](size_t i) {
+        return notes[i].set || (i > 0 && notes[i - 1].tick == notes[i].tick) ||
+               (i + 1 < n && notes[i + 1].tick == notes[i].tick);
+    };
+    auto joined = [&](size_t i) { // note i continues the run of note i - 1
+        return !fixed(i) && !fixed(i - 1) && notes[i].t - notes[i - 1].t < kMidiAlternateBelow_s &&
+               hand(i) != hand(i - 1);
+    };
+    for (size_t s = 0, e = 0; s < n; s = e + 1) {
+        e = s;
+        if (fixed(s))
+            continue;
+        while (e + 1 < n && joined(e + 1))
+            ++e;
+        const bool open_in =
+            s == 0 || fixed(s - 1) || notes[s].t - notes[s - 1].t >= kMidiAlternateBelow_s;
+        const bool open_out =
+            e + 1 == n || fixed(e + 1) || notes[e + 1].t - notes[e].t >= kMidiAlternateBelow_s;
+        if (!open_in || !open_out)
+            continue;
+        // The fastest move into and out of the run with its hands as they are (turn 0) or
+        // turned (turn 1); infinite when a hand would strike too soon.
+        auto fastest = [&](int turn) {
+            double worst = 0.0;
+            for (int h = 0; h < 2; ++h) {
+                const HandNote *before = nullptr, *after = nullptr, *first = nullptr,
+                               *last = nullptr;
+                for (size_t i = s; i-- > 0;)
+                    if (hand(i) == h) {
+                        before = &notes[i];
+                        break;
+                    }
+                for (size_t i = e + 1; i < n && !after; ++i)
+                    after = hand(i) == h ? &notes[i] : nullptr;
+                for (size_t i = s; i <= e; ++i)
+                    if ((hand(i) ^ turn) == h) {
+                        first = first ? first : &notes[i];
+                        last = &notes[i];
+                    }
+                if (!first)
+                    continue;
+                if ((before && first->t - before->t < kMidiSameHandMin_s) ||
+                    (after && after->t - last->t < kMidiSameHandMin_s))
+                    return std::numeric_limits<double>::infinity();
+                worst = std::max({worst, before ? move_speed(drums, *before, *first) : 0.0,
+                                  after ? move_speed(drums, *last, *after) : 0.0});
+            }
+            return worst;
+        };
+        if (!(fastest(1) < kMidiTurnRunGain * fastest(0)))
+            continue;
+        for (size_t i = s; i <= e; ++i) {
+            ScoreNote &note = score[notes[i].index];
+            note.hand = note.hand == Side::left ? Side::right : Side::left;
+            if (!note.spot_given)
+                note.theta_deg = kDefaultThetaDeg[note.hand == Side::left ? 0 : 1];
+        }
+    }
+}
+
 } // namespace
 
 MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
@@ -323,6 +416,7 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
     double last_s = -1e300;
     long last_tick = -1;
     int last_hand = 1, at_tick = 0;
+    std::vector<HandNote> hand_notes;
     // The notes in file order, but at one tick the hi-hat's and the ride's first: the right
     // hand keeps time on them and the other hand plays what falls with them (crossed over
     // the hi-hat, as a right-handed drummer plays a groove).
@@ -415,12 +509,16 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         s.drum_line = line;
         if (!drums.empty())
             s.drum = drums[static_cast<size_t>(drum)].name;
+        hand_notes.push_back(
+            {part.score.notes.size(), t, n.tick, drum, left_hands(n.note) || keeps_time(n.note)});
         part.score.notes.push_back(s);
         last_of[hand] = t;
         last_s = t;
         last_tick = n.tick;
         last_hand = hand;
     }
+    if (!drums.empty())
+        turn_runs(part.score.notes, hand_notes, drums);
     for (size_t i = 0; i + 1 < part.score.notes.size(); ++i)
         part.score.notes[i].beats =
             std::max(kMinNoteBeats, part.score.notes[i + 1].beat - part.score.notes[i].beat);

@@ -317,7 +317,18 @@ void Scene::drive_motor(int j, const MotorCommand &cmd, const LimitStop &limit)
     // for the step: the range is not convex, so moving across the stop's
     // axis took joints further out (an elbow held on its stop axis went
     // from 0 to 2.4 and 4.4 deg out in two steps, random seed 2080).
-    const bool lock = stop && options_.stop_inelastic;
+    // Held there, a joint whose target lies across its stop (the geodesic to it leaves the
+    // range) would stay frozen while the stop engages at every step: a right shoulder
+    // after a ride-to-hi-hat move in 107 ms stood 0.8 rad from its target through the
+    // hi-hat's bars, the stick 37 cm off (perform_recover). After kStopDeadlockSteps steps,
+    // held that far, axes 2 and 3 are let go: the joint slides along the stop toward its target.
+    constexpr double kStopDeadlockRad = 0.3;
+    constexpr int kStopDeadlockSteps = 50;
+    MotorParams &held = motor_params_[j];
+    held.held_far = stop && options_.stop_inelastic && cmd.error_parent.norm() > kStopDeadlockRad
+                        ? held.held_far + 1
+                        : 0;
+    const bool lock = stop && options_.stop_inelastic && held.held_far <= kStopDeadlockSteps;
     Eigen::Vector3d axes[3];
     if (stop) {
         axes[0] = limit.axis;

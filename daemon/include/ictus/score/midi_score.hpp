@@ -62,6 +62,10 @@ Smf read_smf(const std::string &bytes, const std::string &source);
 struct MidiDrum {
     std::string name;
     int midi_note = 38;
+    // Where it stands (m, any fixed frame; the kit's), for the sticking's moves; without
+    // places (placed false) no run of alternating strokes is turned (docs/midi.md).
+    bool placed = false;
+    double place_m[3] = {0.0, 0.0, 0.0};
 };
 
 // General MIDI's side stick (37) is the snare's rim: a stroke aimed this far out, where the
@@ -101,6 +105,10 @@ constexpr double kMidiAlternateBelow_s = 0.3;
 // A hand strikes again no sooner than this after its previous stroke (the
 // planner refuses a stroke 40 ms after one of the same hand).
 constexpr double kMidiSameHandMin_s = 0.05;
+// A run of alternating strokes between notes whose hands are set (a crash, the time-keeper,
+// two at once, or a rest) starts on the other hand when that makes the fastest of the
+// hands' moves into and out of the run (distance over time) at most this fraction of it.
+constexpr double kMidiTurnRunGain = 0.8;
 
 // The score of a file's drum part, and what was left out.
 struct MidiDrumPart {

@@ -388,6 +388,9 @@ class Scene
                                       std::numeric_limits<double>::quiet_NaN()};
         bool stops_open = false; // the stop rows set to +-infinity
         bool locked = false;     // score mode: axes 2 and 3 held with the stop
+        // Score mode: consecutive steps the stop held the joint far from its target
+        // (drive_motor's deadlock rule).
+        int held_far = 0;
     };
     std::array<MotorParams, CharacterModel::kJoints> motor_params_{};
 
