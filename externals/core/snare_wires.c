@@ -70,6 +70,9 @@ struct snare_wires {
     snare_kernel_free_fn kfree;
     snare_kernel_force_fn kforce;
     double Kww[SNARE_WIRE_SEGMENTS][SNARE_WIRE_SEGMENTS], Kmw[SNARE_WIRE_SEGMENTS], Kmm;
+    /* Newton's compliance C (newton_forces), kept while its beta and G hold; c_beta NaN
+     * when the couplings changed. */
+    double C[SNARE_WIRE_SEGMENTS][SNARE_WIRE_SEGMENTS], c_beta, c_G;
     /* Wires. */
     int engaged;
     double y[SNARE_WIRE_SEGMENTS], yv[SNARE_WIRE_SEGMENTS], d[SNARE_WIRE_SEGMENTS];
@@ -123,10 +126,10 @@ static double grad_force(const snare_wires *w, double d0, double v0, double d1, 
         *df = 0.0;
         return 0.0;
     }
-    if (fabs(dx) > 1.0e-6 * scale) {
-        double f = (potential(w, d1) - v0) / dx;
-        double f1 = d1 > 0.0 ? w->k * d1 * sqrt(d1) : 0.0;
-        *df = (f1 - f) / dx;
+    if (fabs(dx) > 1.0e-6 * scale) { /* one square root, one division */
+        const double r1 = d1 > 0.0 ? sqrt(d1) : 0.0, f1 = w->k * d1 * r1, inv = 1.0 / dx;
+        const double f = (f1 * d1 / 2.5 - v0) * inv; /* V(d1) = d1 V'(d1) / 2.5 */
+        *df = (f1 - f) * inv;
         return f > 0.0 ? f : 0.0;
     }
     double mid = 0.5 * (d0 + d1);
@@ -205,17 +208,14 @@ static int solve_linear(double A[SNARE_WIRE_SEGMENTS][SNARE_WIRE_SEGMENTS], doub
  * diag(F'), from d = a, to |R| <= 1e-15 m. The same solution as the Gauss-Seidel sweeps
  * (solve_forces), in a few 8 x 8 solves instead of many scalar ones. 1 when converged
  * (F set), 0 to fall back to the sweeps. */
-static int newton_forces(const snare_wires *w, double alpha, double beta, const double *wf,
+static int newton_forces(snare_wires *w, double alpha, double beta, const double *wf,
                          const double *yfree, double G, double *F)
 {
     enum { N = SNARE_WIRE_SEGMENTS };
-    double a[N], C[N][N], d[N], v0[N], df[N];
+    double a[N], d[N], v0[N], df[N];
     int any = 0;
     for (int i = 0; i < N; i++) {
         a[i] = wf[i] - yfree[i] + w->Kmw[i] * alpha;
-        for (int j = 0; j < N; j++)
-            C[i][j] = w->Kww[i][j] + (i == j ? G : 0.0) - beta * w->Kmw[i] * w->Kmw[j];
-        v0[i] = potential(w, w->d[i]);
         any |= a[i] > 0.0 || w->d[i] > 0.0;
     }
     if (!any) { /* every gap stays open: no force */
@@ -223,22 +223,37 @@ static int newton_forces(const snare_wires *w, double alpha, double beta, const 
             F[i] = 0.0;
         return 1;
     }
+    if (!(beta == w->c_beta && G == w->c_G)) { /* beta follows the batter's tension */
+        for (int i = 0; i < N; i++)
+            for (int j = 0; j < N; j++)
+                w->C[i][j] = w->Kww[i][j] + (i == j ? G : 0.0) - beta * w->Kmw[i] * w->Kmw[j];
+        w->c_beta = beta, w->c_G = G;
+    }
+    const double(*C)[N] = (const double(*)[N])w->C;
+    for (int i = 0; i < N; i++)
+        v0[i] = potential(w, w->d[i]);
     for (int i = 0; i < N; i++)
         d[i] = a[i];
     for (int it = 0; it < 40; it++) {
         /* J's column j is the unit vector where F_j' = 0 (the gap open at both ends of
          * the sample): the step solves on the other, active, gaps alone. */
         double R[N], J[N][N], worst = 0.0, Ra[N];
-        int act[N], na = 0;
+        int act[N], na = 0, push[N], np = 0;
         for (int i = 0; i < N; i++) {
+            if (w->d[i] <= 0.0 && d[i] <= 0.0) { /* open at both ends of the sample */
+                F[i] = df[i] = 0.0;
+                continue;
+            }
             F[i] = grad_force(w, w->d[i], v0[i], d[i], &df[i]);
             if (df[i] != 0.0)
                 act[na++] = i;
+            if (F[i] != 0.0)
+                push[np++] = i;
         }
-        for (int i = 0; i < N; i++) {
+        for (int i = 0; i < N; i++) { /* C F over the forces that are not zero */
             double cf = 0.0;
-            for (int j = 0; j < N; j++)
-                cf += C[i][j] * F[j];
+            for (int q = 0; q < np; q++)
+                cf += C[i][push[q]] * F[push[q]];
             R[i] = d[i] - a[i] + cf;
             worst = fabs(R[i]) > worst ? fabs(R[i]) : worst;
         }
@@ -346,7 +361,8 @@ static void snare_step(snare_wires *w, double ub, double kb, double T,
     for (int i = 0; w->engaged && i < SNARE_WIRE_SEGMENTS; i++) {
         double y1 = yfree[i] + G * F[i], wh = wf[i] + w->Kmw[i] * fa;
         for (int j = 0; j < SNARE_WIRE_SEGMENTS; j++)
-            wh -= w->Kww[i][j] * F[j];
+            if (F[j] != 0.0)
+                wh -= w->Kww[i][j] * F[j];
         w->yv[i] = 2.0 / T * (y1 - w->y[i]) - w->yv[i];
         w->y[i] = y1;
         w->d[i] = wh - y1;
@@ -477,6 +493,7 @@ static double wire_shape(const snare_wires *w, int i, int k)
 
 static void head_couplings(snare_wires *w)
 {
+    w->c_beta = NAN; /* newton_forces builds C again */
     w->Kmm = 0.0;
     for (int i = 0; i < SNARE_WIRE_SEGMENTS; i++) {
         w->Kmw[i] = 0.0;
