@@ -682,6 +682,9 @@ TEST_CASE("render: missed notes and a score without notes are said on stderr, ex
     CHECK(far.wait() == 0);
     INFO(far.err);
     CHECK(far.err.find("4 of 4 notes of the score were not struck") != std::string::npos);
+    // Each missed note where it was written (all four on line 3), with its hand and time.
+    CHECK(far.err.find("not struck: line 3 (the right hand at ") != std::string::npos);
+    CHECK(far.err.find(", line 3 (the left hand at ") != std::string::npos);
     CHECK(far.err.find("--drum-pos") != std::string::npos);
     CHECK(lines(slurp((dir / "far" / "strikes.csv").string())).size() == 1); // the header only
     CHECK(slurp((dir / "far" / "render.json").string()).find("\"missed_notes\": 4") !=

@@ -122,6 +122,53 @@ TEST_CASE("plan: a cymbal's note without a spot is played on its bow toward the 
     CHECK(plan.notes[1].strike_point_m.z() < c.z() + 0.30);
 }
 
+TEST_CASE("plan: 'on NAME-bell' is a cymbal's bell, and the standard pieces' common spellings "
+          "find the kit's names",
+          "[score][kit]")
+{
+    PerformerFrame f = kit_frame();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.push_back({"ride", c + Eigen::Vector3d(-0.62, 0.22, 0.28), 0.254, true});
+    f.drums.push_back(
+        {"kick", c + Eigen::Vector3d(-0.18, -0.37, 0.10), 0.2794, false, false, true});
+    // The bell: r/a 0.12 (General MIDI's 53 on the same spot) on the hand's side; a spot
+    // written is kept; the bow's spot when no bell is named.
+    const Score s = parse_score("tempo 80\nR on ride-bell, L on RIDE_BELL, R on ride-bell at 0.2 "
+                                "90, R on ride, L on floor-tom, R on floortom, L on hi_hat\n"
+                                "RF on bass-drum",
+                                "t");
+    PerformerFrame hat = f;
+    hat.drums[4] = {"hihat", c + Eigen::Vector3d(0.42, 0.26, -0.02), 0.178, true, true};
+    const GesturePlan plan = plan_performance(s, db(), hat);
+    REQUIRE(plan.notes.size() == 7);
+    const int drum[7] = {5, 5, 5, 5, 3, 3, 4};
+    const double want[4][2] = {{0.12, 180.0}, {0.12, 0.0}, {0.2, 90.0}, {0.7, 110.0}};
+    for (size_t i = 0; i < 7; ++i) {
+        INFO(i);
+        const PlannedNote &n = plan.notes[i];
+        CHECK(n.drum == drum[i]);
+        if (i >= 4)
+            continue;
+        CHECK(n.r_over_a == Approx(want[i][0]));
+        CHECK(n.theta_deg == Approx(want[i][1]));
+        const PerformerFrame::Drum &d = hat.drums[5];
+        const double r = want[i][0] * d.membrane_radius_m, th = want[i][1] * M_PI / 180.0;
+        const Eigen::Vector3d spot =
+            d.membrane_center_m + Eigen::Vector3d(r * std::cos(th), 0.0, -r * std::sin(th));
+        CHECK((n.strike_point_m - spot).norm() < 1e-12);
+    }
+    REQUIRE(plan.foot_notes.size() == 1);
+    CHECK(plan.foot_notes[0].drum == 6);
+    // A bell on a drum, a bell of no piece, and a spelling of a piece the kit lacks.
+    refused("R\nR on tom1-bell", f, 2, 6,
+            "a bell is a cymbal's, and 'tom1' is not a cymbal "
+            "(the kit's cymbals: ride)");
+    refused("R on crash-bell", f, 1, 6,
+            "unknown drum 'crash-bell' (the kit: snare, tom1, tom2, "
+            "floor, timpani, ride, kick; a cymbal's bell: NAME-bell)");
+    refused("L on hi-hat", f, 1, 6, "unknown drum 'hi-hat'");
+}
+
 TEST_CASE(
     "plan: a note on a drum of the kit strikes that drum's spot and unknown drums are refused",
     "[score][kit]")

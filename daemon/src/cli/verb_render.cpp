@@ -26,6 +26,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -557,7 +558,38 @@ nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool
 // The notes of the score and how many of them were not struck.
 struct NoteCount {
     long notes = 0, missed = 0;
+    std::string first_missed; // where the first few were written
 };
+
+// "line L (the right hand on crash at 7.43 s)" for the first few notes not
+// struck, hands' and feet's in plan order.
+std::string missed_notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit)
+{
+    constexpr int kShown = 5;
+    std::ostringstream out;
+    int shown = 0;
+    auto one = [&](int line, const std::string &who, int drum, double t) {
+        if (shown++ >= kShown)
+            return;
+        out << (shown > 1 ? ", " : "") << "line " << line << " (" << who;
+        if (drum >= 0 && drum < static_cast<int>(kit.drums.size()))
+            out << " on " << kit.drums[static_cast<size_t>(drum)].name;
+        out << " at " << std::fixed << std::setprecision(2) << t << " s)";
+    };
+    for (size_t i = 0; i < plan.notes.size(); ++i)
+        if (m.notes[i].strike_seq < 0)
+            one(plan.notes[i].line,
+                plan.notes[i].hand == Side::right ? "the right hand" : "the left hand",
+                plan.notes[i].drum, plan.notes[i].time_s);
+    for (size_t i = 0; i < plan.foot_notes.size(); ++i)
+        if (m.foot_notes[i].strike_seq < 0)
+            one(plan.foot_notes[i].line,
+                plan.foot_notes[i].side == Side::right ? "the right foot" : "the left foot",
+                plan.foot_notes[i].drum, plan.foot_notes[i].time_s);
+    if (shown > kShown)
+        out << " and " << shown - kShown << " more";
+    return out.str();
+}
 
 // Every output but the sound, from memory; in score mode the notes matched
 // with the strikes (notes.csv, render.json's "performance").
@@ -581,6 +613,7 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
             match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s(), plan.foot_notes);
         count.notes = static_cast<long>(plan.notes.size() + plan.foot_notes.size());
         count.missed = count.notes - m.matched_notes;
+        count.first_missed = missed_notes_text(plan, m, perf.options().kit);
         text.str("");
         write_notes_csv(text, plan, m, perf.plan_origin_s(), perf.options().kit);
         files.notes_csv->write_and_close(text.str());
@@ -616,7 +649,8 @@ void print_render_summary(const Performance &perf, const RenderArgs &r, bool sco
         std::cerr << "ictusd render: warning: the score has no notes: nothing was played\n";
     else if (count.missed > 0)
         std::cerr << "ictusd render: warning: " << count.missed << " of " << count.notes
-                  << " notes of the score were not struck (strike_seq -1 in notes.csv"
+                  << " notes of the score were not struck: " << count.first_missed
+                  << " (strike_seq -1 in notes.csv"
                   << (count.missed == count.notes
                           ? "; is the drum within the sticks' reach? --drum-pos"
                           : "")
@@ -660,12 +694,13 @@ int render_wav(RenderArgs &r, const Performance &perf)
     if (result.interrupted) {
         // pd stopped before it said anything: an empty log is no output
         std::error_code ec;
-        if (std::filesystem::exists(pd.log, ec) && std::filesystem::file_size(pd.log, ec) == 0 && !ec) {
+        if (std::filesystem::exists(pd.log, ec) && std::filesystem::file_size(pd.log, ec) == 0 &&
+            !ec) {
             std::filesystem::remove(pd.log, ec);
             std::cerr << "ictusd render: interrupted: pd stopped, no " << r.wav << "\n";
         } else {
-            std::cerr << "ictusd render: interrupted: pd stopped, no " << r.wav << " (log: "
-                      << pd.log << ")\n";
+            std::cerr << "ictusd render: interrupted: pd stopped, no " << r.wav
+                      << " (log: " << pd.log << ")\n";
         }
         return 130;
     }

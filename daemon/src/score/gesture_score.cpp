@@ -368,7 +368,6 @@ class UnitCache
     std::map<std::tuple<int, int, int, double, long, long>, std::unique_ptr<UnitCurve>> units_;
 };
 
-using score_detail::drum_index;
 using score_detail::foot_note;
 using score_detail::note_openness;
 using score_detail::plan_duration;
@@ -385,7 +384,7 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
 {
     HandNotes by_hand;
     const double amount = humanize_amount(score, opt);
-    std::array<double, 2> score_time_prev = {0.0, 0.0}; // each hand's last note, without noise
+    std::array<double, 2> score_time_prev = {0.0, 0.0};   // each hand's last note, without noise
     std::array<double, 2> foot_written_prev = {0.0, 0.0}; // each foot's, likewise
     std::array<long, 2> foot_prev = {-1, -1};             // each foot's last, in plan.foot_notes
     for (size_t k = 0; k < score.notes.size(); ++k) {
@@ -434,18 +433,13 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         p.r_over_a = n.r_over_a;
         p.theta_deg = n.theta_deg;
         p.firmness = n.firmness;
-        p.drum = drum_index(score, n, frame);
+        p.drum = score_detail::note_drum_spot(score, n, frame, p.r_over_a, p.theta_deg);
         if (p.drum < static_cast<int>(frame.drums.size()) &&
             frame.drums[static_cast<size_t>(p.drum)].foot)
             throw ScoreError(score.source, n.drum_line, n.drum_column,
                              "drum '" + frame.drums[static_cast<size_t>(p.drum)].name +
                                  "' is played by the right foot on its pedal: write 'RF'");
         p.openness = note_openness(score, n, frame, p.drum);
-        if (!n.spot_given && p.drum < static_cast<int>(frame.drums.size()) &&
-            frame.drums[static_cast<size_t>(p.drum)].cymbal) {
-            p.r_over_a = kCymbalRadiusFraction;
-            p.theta_deg = kCymbalThetaDeg[static_cast<int>(n.hand)];
-        }
         p.strike_point_m = membrane_point(frame, p.r_over_a, p.theta_deg, p.drum);
         p.tip_target_m = p.strike_point_m - opt.strike_depth_m * frame.up;
         p.line = n.line;
@@ -662,7 +656,8 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
     // A move to or from rest passes over the cymbals and over any head that
     // stands within kit_clearance_m of the lower rest tip, or above it (the
     // full kit's rack toms, raised over its kick).
-    const double rest_y = std::min(frame.rest_tip_m[0].dot(frame.up), frame.rest_tip_m[1].dot(frame.up));
+    const double rest_y =
+        std::min(frame.rest_tip_m[0].dot(frame.up), frame.rest_tip_m[1].dot(frame.up));
     double lift = 0.0;
     constexpr int kPoints = 48;
     for (int i = 1; i < kPoints; ++i) {

@@ -11,17 +11,60 @@ namespace ictus
 namespace score_detail
 {
 
-// The index of the note's drum in the frame's kit; a ScoreError where the
-// drum was named when the kit has none of that name.
-int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &frame)
+namespace
+{
+
+int find_drum(const PerformerFrame &frame, const std::string &name)
+{
+    for (size_t i = 0; i < frame.drums.size(); ++i)
+        if (frame.drums[i].name == name)
+            return static_cast<int>(i);
+    return -1;
+}
+
+// The kit's name for a common spelling of a standard piece, or "".
+std::string standard_spelling(const std::string &name)
+{
+    static const char *const spellings[][2] = {
+        {"floor-tom", "floor"}, {"floor_tom", "floor"}, {"floortom", "floor"}, {"hi-hat", "hihat"},
+        {"hi_hat", "hihat"},    {"bass-drum", "kick"},  {"bass_drum", "kick"}, {"bassdrum", "kick"},
+    };
+    for (const auto &s : spellings)
+        if (name == s[0])
+            return s[1];
+    return "";
+}
+
+} // namespace
+
+NoteDrum note_drum(const Score &score, const ScoreNote &n, const PerformerFrame &frame)
 {
     if (n.drum.empty())
-        return 0;
-    std::string names;
-    for (size_t i = 0; i < frame.drums.size(); ++i) {
-        if (frame.drums[i].name == n.drum)
-            return static_cast<int>(i);
-        names += (i ? ", " : "") + frame.drums[i].name;
+        return {};
+    if (const int i = find_drum(frame, n.drum); i >= 0)
+        return {i, false};
+    if (const int i = find_drum(frame, standard_spelling(n.drum)); i >= 0)
+        return {i, false};
+    std::string names, cymbals;
+    for (const PerformerFrame::Drum &d : frame.drums) {
+        names += (names.empty() ? "" : ", ") + d.name;
+        if (d.cymbal)
+            cymbals += (cymbals.empty() ? "" : ", ") + d.name;
+    }
+    for (const char *suffix : {"-bell", "_bell"}) {
+        const size_t len = std::char_traits<char>::length(suffix);
+        if (n.drum.size() <= len || n.drum.compare(n.drum.size() - len, len, suffix) != 0)
+            continue;
+        const std::string base = n.drum.substr(0, n.drum.size() - len);
+        const int i = find_drum(frame, base);
+        if (i >= 0 && frame.drums[static_cast<size_t>(i)].cymbal)
+            return {i, true};
+        if (i >= 0)
+            throw ScoreError(
+                score.source, n.drum_line, n.drum_column,
+                "drum '" + n.drum + "': a bell is a cymbal's, and '" + base +
+                    "' is not a cymbal (" +
+                    (cymbals.empty() ? "the kit has none" : "the kit's cymbals: " + cymbals) + ")");
     }
     if (frame.drums.empty())
         throw ScoreError(score.source, n.drum_line, n.drum_column,
@@ -29,7 +72,28 @@ int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &fra
                              "': there is one drum and no kit (give the performance a kit, "
                              "e.g. --kit standard: docs/perform.md)");
     throw ScoreError(score.source, n.drum_line, n.drum_column,
-                     "unknown drum '" + n.drum + "' (the kit: " + names + ")");
+                     "unknown drum '" + n.drum + "' (the kit: " + names +
+                         (cymbals.empty() ? "" : "; a cymbal's bell: NAME-bell") + ")");
+}
+
+int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &frame)
+{
+    return note_drum(score, n, frame).index;
+}
+
+int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame &frame,
+                   double &r_over_a, double &theta_deg)
+{
+    const NoteDrum drum = note_drum(score, n, frame);
+    const bool cymbal = drum.index < static_cast<int>(frame.drums.size()) &&
+                        frame.drums[static_cast<size_t>(drum.index)].cymbal;
+    if (!n.spot_given && drum.bell) {
+        r_over_a = kBellRadiusFraction;
+    } else if (!n.spot_given && cymbal) {
+        r_over_a = kCymbalRadiusFraction;
+        theta_deg = kCymbalThetaDeg[static_cast<int>(n.hand)];
+    }
+    return drum.index;
 }
 
 // The note's pedal on a hi-hat (closed when it names none), -1 on another

@@ -12,9 +12,24 @@ namespace ictus
 namespace score_detail
 {
 
-// The index of the note's drum in the frame's kit (0 for none named); a
-// ScoreError where the drum was named when the kit has none of that name.
+// The note's piece of the frame's kit: its index (0 for none named), and
+// whether the name is a cymbal's bell (`ride-bell`: the cymbal `ride`, struck
+// on its bell where the note gives no spot). A name the kit does not use is
+// also found as the common spelling of a standard piece (`floor-tom` for
+// `floor`, `hi-hat` for `hihat`, `bass-drum` for `kick`: docs/score.md). A
+// ScoreError where the drum was named when the kit has no such piece.
+struct NoteDrum {
+    int index = 0;
+    bool bell = false;
+};
+NoteDrum note_drum(const Score &score, const ScoreNote &n, const PerformerFrame &frame);
 int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &frame);
+// The note's drum (note_drum) and, where the note gives no spot on a cymbal,
+// the cymbal's: its bell's (kBellRadiusFraction on the hand's side, as General
+// MIDI's 53) or its bow's toward the performer (kCymbalRadiusFraction at
+// kCymbalThetaDeg); r_over_a and theta_deg are left as they are elsewhere.
+int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame &frame,
+                   double &r_over_a, double &theta_deg);
 // The note's pedal on a hi-hat (closed when it names none), -1 on another
 // drum; a ScoreError at the word when it names one on a drum without a pedal.
 double note_openness(const Score &score, const ScoreNote &n, const PerformerFrame &frame, int drum);

@@ -40,8 +40,8 @@ struct Statement {
     int column = 0;
     // note
     Side hand = Side::right;
-    bool foot = false;              // RF: the right foot's (the kick's pedal), not a hand's
-    bool both_hands = false;        // R+L: one stroke of each hand on the same beat
+    bool foot = false;       // RF: the right foot's (the kick's pedal), not a hand's
+    bool both_hands = false; // R+L: one stroke of each hand on the same beat
     // `R ... + L ... + RF`: the next statement is another limb's note on the same beat
     // (the beat advances after the chord's last, by the longest of its durations)
     bool with_next = false;

@@ -78,12 +78,12 @@ constexpr double kMidiSideStickRadiusFraction = kMaxRadiusFraction;
 // it: the hands' own sides (0 and 180 degrees) lie under the hi-hat and toward the floor tom.
 constexpr double kMidiSideStickThetaDeg = 90.0;
 // General MIDI's cymbals, played on a kit's cymbal of that note (docs/midi.md): crash 49 and
-// 57 on its crash (49), ride 51 and 59 on its ride (51), ride bell 53 on the ride's bell, a
-// stroke aimed this near the centre (a 20-inch ride's bell is about 6 inches across).
+// 57 on its crash (49), ride 51 and 59 on its ride (51), ride bell 53 on the ride's bell
+// (kBellRadiusFraction, as `on ride-bell`).
 constexpr int kMidiCrash = 49;
 constexpr int kMidiRide = 51;
 constexpr int kMidiRideBell = 53;
-constexpr double kMidiRideBellRadiusFraction = 0.12;
+constexpr double kMidiRideBellRadiusFraction = kBellRadiusFraction;
 // General MIDI's hi-hat played by a hand on a kit's hi-hat (its note 42): closed 42 with the
 // pedal down, open 46 with it up (ScoreNote::openness). The pedal hi-hat 44 is the left
 // foot's chick on that hi-hat's pedal (`LF`, docs/pedal.md), no sooner than

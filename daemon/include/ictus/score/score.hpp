@@ -64,6 +64,9 @@ constexpr double kDefaultThetaDeg[2] = {0.0, 180.0}; // [Side::left, Side::right
 // own side of the point nearest the performer (theta 90).
 constexpr double kCymbalRadiusFraction = 0.7;
 constexpr double kCymbalThetaDeg[2] = {70.0, 110.0}; // [Side::left, Side::right]
+// A cymbal's bell (`on ride-bell`, General MIDI's 53): a stroke aimed this near
+// the centre, on the hand's side (a 20-inch ride's bell is about 6 inches across).
+constexpr double kBellRadiusFraction = 0.12;
 
 // The hi-hat's pedal as a note writes it (docs/score.md, `open`, `half`,
 // `closed`): membrane~'s `openness` (docs/plates.md, "The hi-hat"), 0 the
@@ -169,11 +172,11 @@ class TempoMap
 
 // A whole parsed score.
 struct Score {
-    std::string source;           // file name or "osc", for messages
-    std::vector<ScoreNote> notes; // in onset time order (ties: in the order written)
-    TempoMap tempo;               // beat -> time
+    std::string source;             // file name or "osc", for messages
+    std::vector<ScoreNote> notes;   // in onset time order (ties: in the order written)
+    TempoMap tempo;                 // beat -> time
     std::vector<ScoreMeter> meters; // in beat order; none: 4/4
-    double length_beats = 0.0;    // end of the last statement (note or rest)
+    double length_beats = 0.0;      // end of the last statement (note or rest)
     // `humanize AMOUNT` (docs/humanize.md); < 0: not written
     // (the performance's amount, 0 by default). The last statement wins.
     double humanize = -1.0;
