@@ -131,8 +131,8 @@ TEST_CASE("plan: 'on NAME-bell' is a cymbal's bell, and the standard pieces' com
     f.drums.push_back({"ride", c + Eigen::Vector3d(-0.62, 0.22, 0.28), 0.254, true});
     f.drums.push_back(
         {"kick", c + Eigen::Vector3d(-0.18, -0.37, 0.10), 0.2794, false, false, true});
-    // The bell: r/a 0.12 (General MIDI's 53 on the same spot) on the hand's side; a spot
-    // written is kept; the bow's spot when no bell is named.
+    // The bell: r/a 0.12 (General MIDI's 53 on the same spot) at the bow's angle toward the
+    // performer; a spot written is kept; the bow's spot when no bell is named.
     const Score s = parse_score("tempo 80\nR on ride-bell, L on RIDE_BELL, R on ride-bell at 0.2 "
                                 "90, R on ride, L on floor-tom, R on floortom, L on hi_hat\n"
                                 "RF on bass-drum",
@@ -142,7 +142,7 @@ TEST_CASE("plan: 'on NAME-bell' is a cymbal's bell, and the standard pieces' com
     const GesturePlan plan = plan_performance(s, db(), hat);
     REQUIRE(plan.notes.size() == 7);
     const int drum[7] = {5, 5, 5, 5, 3, 3, 4};
-    const double want[4][2] = {{0.12, 180.0}, {0.12, 0.0}, {0.2, 90.0}, {0.7, 110.0}};
+    const double want[4][2] = {{0.12, 110.0}, {0.12, 70.0}, {0.2, 90.0}, {0.7, 110.0}};
     for (size_t i = 0; i < 7; ++i) {
         INFO(i);
         const PlannedNote &n = plan.notes[i];

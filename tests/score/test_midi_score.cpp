@@ -151,6 +151,7 @@ TEST_CASE("midi in: General MIDI's cymbals on a kit's crash and ride", "[score][
         CHECK(part.score.notes[i].spot_given == (i == 4));
     }
     CHECK(part.score.notes[4].r_over_a == Approx(kMidiRideBellRadiusFraction));
+    CHECK(part.score.notes[4].theta_deg == Approx(kCymbalThetaDeg[1])); // toward the performer
     CHECK(part.skipped.at(42) == 1);
     // The crash's notes are the left hand's (on its side of the kit), the
     // ride's the right's.
@@ -337,6 +338,31 @@ TEST_CASE("midi in: the right hand keeps time on the hi-hat and the ride, the le
     CHECK(part.score.notes[2].drum == "hihat");
     CHECK(part.score.notes[3].drum == "snare");
     CHECK(part.score.notes[3].line + 1 == part.score.notes[2].line);
+}
+
+TEST_CASE("midi in: the ride and the hi-hat on one tick, the ride the right hand's",
+          "[score][midi][hihat]")
+{
+    // Quarters at 120 bpm (96 ticks a quarter): the ride with the closed or the open hi-hat or
+    // the bell with the hi-hat on each, the hi-hat written first. The ride stands on the
+    // right, the hi-hat on the left: the right hand on the ride, the left on the hi-hat
+    // (uncrossed), whichever is written first.
+    std::string t;
+    int delta = 0;
+    for (int ride : {51, 59, 53, 51})
+        for (int hat : {42, 46}) {
+            t += bytes({delta, 0x99, hat, 80}) + bytes({0, 0x99, ride, 90});
+            delta = 96;
+        }
+    t += kEnd;
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"crash", 49}, {"ride", 51}, {"hihat", 42}};
+    const MidiDrumPart part =
+        drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t), "t.mid"), kit, "t.mid");
+    REQUIRE(part.score.notes.size() == 16);
+    for (const ScoreNote &n : part.score.notes) {
+        INFO(n.drum << " at beat " << n.beat);
+        CHECK(n.hand == (n.drum == "ride" ? Side::right : Side::left));
+    }
 }
 
 TEST_CASE("midi in: a run of alternating strokes starts on the hand that leaves each the most time",

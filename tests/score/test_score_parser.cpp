@@ -522,6 +522,9 @@ TEST_CASE("score: errors name the source and line and column and the fault",
     require_error("L accent fff", 1, 10, "unexpected 'fff' in a note");
     require_error("L accent tenuto", 1, 10, "second nuance 'tenuto'");
     require_error("L accent f 0.5", 1, 12, "second dynamics");
+    // A whole beat written as a number reads as dynamics 1: the message says how to write it.
+    require_error("R on snare f 1", 1, 14,
+                  "second dynamics '1' in one note (for a duration write 'beats 1' or N/D)");
     require_error("L 1/2 beats 1", 1, 7, "second duration");
     require_error("L accent 1/0", 1, 10, "divides by zero");
     require_error("L accent 1/x", 1, 10, "malformed fraction '1/x'");

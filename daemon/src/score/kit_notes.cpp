@@ -87,10 +87,8 @@ int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame 
     const NoteDrum drum = note_drum(score, n, frame);
     const bool cymbal = drum.index < static_cast<int>(frame.drums.size()) &&
                         frame.drums[static_cast<size_t>(drum.index)].cymbal;
-    if (!n.spot_given && drum.bell) {
-        r_over_a = kBellRadiusFraction;
-    } else if (!n.spot_given && cymbal) {
-        r_over_a = kCymbalRadiusFraction;
+    if (!n.spot_given && (drum.bell || cymbal)) {
+        r_over_a = drum.bell ? kBellRadiusFraction : kCymbalRadiusFraction;
         theta_deg = kCymbalThetaDeg[static_cast<int>(n.hand)];
     }
     return drum.index;

@@ -417,9 +417,10 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
     long last_tick = -1;
     int last_hand = 1, at_tick = 0;
     std::vector<HandNote> hand_notes;
-    // The notes in file order, but at one tick the hi-hat's and the ride's first: the right
-    // hand keeps time on them and the other hand plays what falls with them (crossed over
-    // the hi-hat, as a right-handed drummer plays a groove).
+    // The notes in file order, but at one tick the ride's, then the hi-hat's first: the
+    // right hand keeps time on them and the other hand plays what falls with them (crossed
+    // over the hi-hat, as a right-handed drummer plays a groove; the hi-hat the left's
+    // beside the ride, on the right, uncrossed).
     std::vector<size_t> order(smf.notes.size());
     for (size_t i = 0; i < order.size(); ++i)
         order[i] = i;
@@ -427,10 +428,15 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         const SmfNote &x = smf.notes[a], &y = smf.notes[b];
         if (x.tick != y.tick)
             return x.tick < y.tick;
-        // At one tick: the right hand's time first, then the left's crash.
-        const int rx = keeps_time(x.note) ? 0 : left_hands(x.note) ? 1 : 2;
-        const int ry = keeps_time(y.note) ? 0 : left_hands(y.note) ? 1 : 2;
-        return rx < ry;
+        // At one tick: the right hand's time first (the ride before the hi-hat), then the
+        // left's crash.
+        auto rank = [](int note) {
+            return cymbal_of(note) == kMidiRide ? 0
+                   : keeps_time(note)           ? 1
+                   : left_hands(note)           ? 2
+                                                : 3;
+        };
+        return rank(x.note) < rank(y.note);
     });
     for (size_t index : order) {
         const SmfNote &n = smf.notes[index];
@@ -500,8 +506,10 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         if (n.note == kMidiSideStick) {
             s.r_over_a = kMidiSideStickRadiusFraction;
             s.theta_deg = kMidiSideStickThetaDeg;
-        } else if (n.note == kMidiRideBell)
+        } else if (n.note == kMidiRideBell) {
             s.r_over_a = kMidiRideBellRadiusFraction;
+            s.theta_deg = kCymbalThetaDeg[hand == 0 ? 0 : 1];
+        }
         s.spot_given = n.note == kMidiSideStick || n.note == kMidiRideBell;
         if (n.note == kMidiClosedHihat || n.note == kMidiOpenHihat)
             s.openness = n.note == kMidiOpenHihat ? kHihatOpen : kHihatClosed;

@@ -721,7 +721,9 @@ class LineParser
                 st.beats = duration(t, "note duration");
             } else if (starts_numeric(t.text)) {
                 if (st.dynamics)
-                    fail(t.column, "second dynamics '" + t.text + "' in one note");
+                    fail(t.column, "second dynamics '" + t.text +
+                                       "' in one note (for a duration write 'beats " + t.text +
+                                       "' or N/D)");
                 st.dynamics = dynamics_value(t);
             } else if (i == 1) {
                 fail(t.column, "unknown nuance '" + t.text + "' (valid: " + nuance_list() + ")");
