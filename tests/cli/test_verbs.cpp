@@ -205,8 +205,8 @@ TEST_CASE("render: two renders give identical bytes, the events add up to the st
         return;
     const fs::path dir = scratch("render");
     for (const char *sub : {"a", "b"})
-        REQUIRE(osctest::run({ICTUSD_PATH, "render", "--mocap", clip, "--duration", "4",
-                              "--out", (dir / sub).string()}) == 0);
+        REQUIRE(osctest::run({ICTUSD_PATH, "render", "--mocap", clip, "--duration", "4", "--out",
+                              (dir / sub).string()}) == 0);
     for (const char *f : {"strikes.csv", "events.txt", "render.json"})
         CHECK(slurp((dir / "a" / f).string()) == slurp((dir / "b" / f).string()));
 
@@ -685,6 +685,18 @@ TEST_CASE("render: missed notes and a score without notes are said on stderr, ex
     // Each missed note where it was written (all four on line 3), with its hand and time.
     CHECK(far.err.find("not struck: line 3 (the right hand at ") != std::string::npos);
     CHECK(far.err.find(", line 3 (the left hand at ") != std::string::npos);
+    // On a kit, a hand's note lost after a move from another piece says the move: the right
+    // hand from the floor tom to the crash, 1.3 m in a 16th at 112 bpm (0.13 s), a move no
+    // arm makes (10 m/s).
+    std::ofstream(dir / "cross.score") << "tempo 112\nbeats 1/4\nR on floor\nR on crash\n";
+    Daemon cross({"render", "--kit", "full", "--score", (dir / "cross.score").string(),
+                  "--bvh-rate", "0", "--tips-rate", "0", "--out", (dir / "cross").string()});
+    CHECK(cross.wait() == 0);
+    INFO(cross.err);
+    CHECK(cross.err.find("1 of 2 notes of the score were not struck: line 4 (the right hand on "
+                         "crash at ") != std::string::npos);
+    CHECK(cross.err.find(", from floor 1.3") != std::string::npos);
+    CHECK(cross.err.find(" m away 0.13 s before)") != std::string::npos);
     CHECK(far.err.find("--drum-pos") != std::string::npos);
     CHECK(lines(slurp((dir / "far" / "strikes.csv").string())).size() == 1); // the header only
     CHECK(slurp((dir / "far" / "render.json").string()).find("\"missed_notes\": 4") !=

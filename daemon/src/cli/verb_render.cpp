@@ -561,31 +561,50 @@ struct NoteCount {
     std::string first_missed; // where the first few were written
 };
 
-// "line L (the right hand on crash at 7.43 s)" for the first few notes not
-// struck, hands' and feet's in plan order.
+// "line L (the right hand on crash at 7.43 s, from floor 1.2 m away 0.27 s
+// before)" for the first few notes not struck, hands' and feet's in plan order;
+// a hand's move into the note is given when it came from another piece (most
+// notes lost on a kit asked the arm for a move it cannot make in the time).
 std::string missed_notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit)
 {
     constexpr int kShown = 5;
     std::ostringstream out;
+    out << std::fixed << std::setprecision(2);
     int shown = 0;
-    auto one = [&](int line, const std::string &who, int drum, double t) {
+    auto name = [&](int drum) {
+        return drum >= 0 && drum < static_cast<int>(kit.drums.size())
+                   ? kit.drums[static_cast<size_t>(drum)].name
+                   : std::string();
+    };
+    auto one = [&](int line, const std::string &who, int drum, double t, const std::string &move) {
         if (shown++ >= kShown)
             return;
         out << (shown > 1 ? ", " : "") << "line " << line << " (" << who;
-        if (drum >= 0 && drum < static_cast<int>(kit.drums.size()))
-            out << " on " << kit.drums[static_cast<size_t>(drum)].name;
-        out << " at " << std::fixed << std::setprecision(2) << t << " s)";
+        if (!name(drum).empty())
+            out << " on " << name(drum);
+        out << " at " << t << " s" << move << ")";
     };
-    for (size_t i = 0; i < plan.notes.size(); ++i)
-        if (m.notes[i].strike_seq < 0)
-            one(plan.notes[i].line,
-                plan.notes[i].hand == Side::right ? "the right hand" : "the left hand",
-                plan.notes[i].drum, plan.notes[i].time_s);
+    for (size_t i = 0; i < plan.notes.size(); ++i) {
+        if (m.notes[i].strike_seq >= 0)
+            continue;
+        const PlannedNote &n = plan.notes[i];
+        const PlannedNote *prev = nullptr;
+        for (const PlannedNote &q : plan.notes)
+            if (q.hand == n.hand && q.time_s < n.time_s && (!prev || q.time_s > prev->time_s))
+                prev = &q;
+        std::ostringstream move;
+        if (prev && prev->drum != n.drum && !name(prev->drum).empty())
+            move << std::fixed << std::setprecision(2) << ", from " << name(prev->drum) << " "
+                 << (n.strike_point_m - prev->strike_point_m).norm() << " m away "
+                 << n.time_s - prev->time_s << " s before";
+        one(n.line, n.hand == Side::right ? "the right hand" : "the left hand", n.drum, n.time_s,
+            move.str());
+    }
     for (size_t i = 0; i < plan.foot_notes.size(); ++i)
         if (m.foot_notes[i].strike_seq < 0)
             one(plan.foot_notes[i].line,
                 plan.foot_notes[i].side == Side::right ? "the right foot" : "the left foot",
-                plan.foot_notes[i].drum, plan.foot_notes[i].time_s);
+                plan.foot_notes[i].drum, plan.foot_notes[i].time_s, "");
     if (shown > kShown)
         out << " and " << shown - kShown << " more";
     return out.str();
