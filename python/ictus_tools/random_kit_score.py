@@ -165,6 +165,9 @@ class KitGenerator(rs.Generator):
         if kit not in KITS:
             raise ValueError("no random scores for kit %r (known: %s)" % (kit, ", ".join(KITS)))
         super().__init__(seed, nuances)
+        # The pieces' other names (`ride-bell`, `floor-tom`, `hi-hat`, `bass-drum`: docs/score.md)
+        # from a stream of their own, so that the scores are otherwise those drawn without them.
+        self.spell_rng = __import__("random").Random(seed * 7919 + 17)
         self.kit = kit
         self.current_drum = None  # the `drum` statement's as the statements are drawn
         self.in_repeat = False
@@ -247,7 +250,7 @@ class KitGenerator(rs.Generator):
         foot = limb in FOOT_LIMBS
         if foot:
             if rng.random() < 0.2:
-                words.append("on " + FOOT_LIMBS[limb])
+                words.append("on " + self.spelled(FOOT_LIMBS[limb]))
         else:
             drum = self.draw_piece(limb, chord, taken or set())
             if taken is not None:
@@ -255,7 +258,7 @@ class KitGenerator(rs.Generator):
             current = self.current_drum or next(iter(KITS[self.kit]))
             if drum != current or rng.random() < 0.4:
                 p["drum"] = drum
-                words.append("on " + drum)
+                words.append("on " + self.spelled(drum))
             piece = p["piece"] = drum
             if rng.random() < 0.85:
                 text, fields = rs._opt_nuance(rng, self)
@@ -268,6 +271,8 @@ class KitGenerator(rs.Generator):
                     rng.random() < (0.4 if piece == "ride" else 0.2):
                 p["at"] = self.draw_at(limb, piece)
                 words.append("at %s %s" % (rs.fmt_num(p["at"][0], 2), rs.fmt_num(p["at"][1], 1)))
+            elif piece == "ride" and "on ride" in words and self.spell_rng.random() < 0.3:
+                words[words.index("on ride")] = "on ride-bell"  # its bell, at no `at`
         if rng.random() < (0.7 if foot else 0.6):
             text, p["dynamics"] = rs.draw_dynamics(rng)
             words.append(text)
@@ -297,6 +302,17 @@ class KitGenerator(rs.Generator):
         if current in allowed and rng.random() < 0.4:
             return current
         return rng.choice(allowed)
+
+    # The other names of the full kit's pieces that a score may write (docs/score.md).
+    SPELLINGS = {"floor": ["floor-tom", "floor_tom", "floortom"], "hihat": ["hi-hat", "hi_hat"],
+                 "kick": ["bass-drum", "bass_drum", "bassdrum"]}
+
+    def spelled(self, piece):
+        """The piece's name as the score writes it: now and then another of its names."""
+        other = self.SPELLINGS.get(piece)
+        if other and self.spell_rng.random() < 0.25:
+            return self.spell_rng.choice(other)
+        return piece
 
     def draw_at(self, limb, piece):
         rng = self.rng
