@@ -66,9 +66,9 @@ constexpr double kCymbalRadiusFraction = 0.7;
 constexpr double kCymbalThetaDeg[2] = {70.0, 110.0}; // [Side::left, Side::right]
 // A cymbal's bell (`on ride-bell`, General MIDI's 53): a stroke aimed this near
 // the centre (a 20-inch ride's bell is about 6 inches across), at the bow's
-// kCymbalThetaDeg: the stick lies over the bow toward the performer. (At the
-// hand's drum angle, theta 180 for the right, a swing ride's bell put the
-// right palm 4 mm through the ride.)
+// kCymbalThetaDeg: the stick lies over the bow toward the performer. Aimed at
+// the hand's drum angle (theta 180 for the right) the palm comes down through
+// the ride's bow (4 mm in a swing ride at 140 bpm).
 constexpr double kBellRadiusFraction = 0.12;
 
 // The hi-hat's pedal as a note writes it (docs/score.md, `open`, `half`,
