@@ -37,6 +37,7 @@ What a hand is not asked to play, because docs/kit.md documents it as beyond the
   crash (played on their bow, "Cymbals").
 """
 import math
+import random
 
 from ictus_tools import random_score as rs
 
@@ -167,7 +168,7 @@ class KitGenerator(rs.Generator):
         super().__init__(seed, nuances)
         # The pieces' other names (`ride-bell`, `floor-tom`, `hi-hat`, `bass-drum`: docs/score.md)
         # from a stream of their own, so that the scores are otherwise those drawn without them.
-        self.spell_rng = __import__("random").Random(seed * 7919 + 17)
+        self.spell_rng = random.Random(seed * 7919 + 17)
         self.kit = kit
         self.current_drum = None  # the `drum` statement's as the statements are drawn
         self.in_repeat = False

@@ -589,9 +589,11 @@ std::string missed_notes_text(const GesturePlan &plan, const MatchSummary &m, co
             continue;
         const PlannedNote &n = plan.notes[i];
         const PlannedNote *prev = nullptr;
-        for (const PlannedNote &q : plan.notes)
+        for (size_t k = 0; shown < kShown && k < plan.notes.size(); ++k) { // shown ones only
+            const PlannedNote &q = plan.notes[k];
             if (q.hand == n.hand && q.time_s < n.time_s && (!prev || q.time_s > prev->time_s))
                 prev = &q;
+        }
         std::ostringstream move;
         if (prev && prev->drum != n.drum && !name(prev->drum).empty())
             move << std::fixed << std::setprecision(2) << ", from " << name(prev->drum) << " "
