@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Two passages of a drum part that ask more than the hands can do in time, and what the
+"""Three passages of a drum part that ask more than the hands can do in time, and what the
 drummer does with them (docs/midi.md, "Beyond the song"), through the real `ictusd render
---kit full --midi` of parts written here (mido, 140 bpm, 480 ticks a quarter):
+--kit full --midi` of parts written here (mido, 140 bpm unless said, 480 ticks a quarter):
 
 - **the time-keeper changes cymbal without a rest**: a bar of 16th notes on the ride, then
   two on the hi-hat (the snare on 2 and 4, the kick on 1 and 3). The right hand has one 16th,
@@ -17,29 +17,39 @@ drummer does with them (docs/midi.md, "Beyond the song"), through the real `ictu
   sticking starts it on the left (docs/midi.md), so the right plays the last 16th and the
   left has two. Asserted: every note found within 5 ms, the crash by the left hand, the
   fill begun on the left and ended on the right.
+- **a fill into a crash with the hi-hat going on**, seeded: a bar of the groove at 100-130 bpm,
+  then two beats of 16ths wandering over the toms and ending on the snare or tom1, the crash
+  and the kick on the downbeat, and a bar of 8th-note hi-hat. On the downbeat both hands cross
+  the kit in one 16th (the left to the crash, the right over it to the hi-hat, 107-150 ms):
+  one of those two may be lost (docs/midi.md, "Beyond the song"). Asserted: every note from
+  the second 8th on found within 5 ms (a right stick wedged on the hi-hat's rim lost the whole
+  bar), and no limb through the hi-hat's rod (the left palm swept through it on its way to the
+  crash, docs/kit.md, "Playing it").
 
     PYTHONPATH=python python3 tests/perform/test_recover.py --ictusd build/ictusd [--workdir DIR]
 """
 import argparse
 import os
+import random
 import subprocess
 import tempfile
 
-from ictus_tools import checks, e2e_util
+from ictus_tools import checks, e2e_util, limb_clearance
 from ictus_tools.checks import check
 
 BPM, TPQ = 140.0, 480
 TOL_MS = 5.0
 
 
-def render(ictusd, work, name, notes):
+def render(ictusd, work, name, notes, bpm=BPM, bvh=False):
     """notes.csv's rows, each with its strike (None when not struck), of the part `notes`."""
     mido = e2e_util.require_mido()
     path = os.path.join(work, name + ".mid")
-    e2e_util.write_drum_midi(mido, path, notes, BPM, TPQ)
+    e2e_util.write_drum_midi(mido, path, notes, bpm, TPQ)
     out = os.path.join(work, name)
     run = subprocess.run([ictusd, "render", "--kit", "full", "--midi", path, "--out", out,
-                          "--force", "--bvh-rate", "0"], capture_output=True, text=True,
+                          "--force"] + ([] if bvh else ["--bvh-rate", "0"]),
+                         capture_output=True, text=True,
                          timeout=900, env=e2e_util.pd_spawning_env(os.path.abspath(work)))
     check(run.returncode == 0, "%s: ictusd render exit %d %s" % (name, run.returncode,
                                                                  run.stderr[-1500:]))
@@ -109,6 +119,41 @@ def fill_into_crash(ictusd, work):
           "the fill begun on the left and ended on the right, the crash by the left")
 
 
+def fill_hihat_on(ictusd, work, seeds=range(1, 9)):
+    e8, e16 = TPQ // 2, TPQ // 4
+    for seed in seeds:
+        r = random.Random(seed)
+        bpm = r.choice([100, 110, 120, 130])
+        notes = []
+        for i in range(12):  # a bar of the groove and the half bar before the fill
+            notes.append((i * e8, 42, 80))
+            if i % 2 == 0:
+                notes.append((i * e8, 38 if (i // 2) % 2 else 36, 90))
+        toms, cur, end = [48, 45, 43], r.randrange(3), r.choice([2, 4])
+        last = r.choice([38, 48])
+        for k in range(8):
+            if k < 8 - end and r.random() < 0.4:
+                cur = min(2, max(0, cur + r.choice([-1, 1])))
+            notes.append((6 * TPQ + k * e16, toms[cur] if k < 8 - end else last, 100))
+        down = 8 * TPQ
+        notes += [(down, 49, 120), (down, 36, 110)]
+        notes += [(down + i * e8, 42, 80) for i in range(8)]
+        rows = render(ictusd, work, "fill-hihat-on-%d" % seed, notes, bpm, bvh=True)
+        t_down = min(r["t"] for r in rows if r["drum"] == "crash")
+        lost = [(r["t"], r["drum"], r["hand"], r["error_ms"]) for r in rows if not found(r)]
+        after = [x for x in lost if x[0] > t_down + 0.001]
+        rod = limb_clearance.clearances(os.path.join(work, "fill-hihat-on-%d" % seed))
+        rod_core = min(c.core_m for (limb, piece), c in rod.items() if piece == "hihat stand")
+        print("fill into a crash, the hi-hat on (seed %d, %d bpm, ending on %s): %d notes, "
+              "lost %s; least limb core clearance to the hi-hat's rod %.1f mm"
+              % (seed, bpm, "the snare" if last == 38 else "tom1", len(rows), lost,
+                 1e3 * rod_core))
+        check(not after, "seed %d: every note after the downbeat found within 5 ms: %s"
+              % (seed, after))
+        check(rod_core >= 0.0, "seed %d: no limb through the hi-hat's rod: %.1f mm"
+              % (seed, 1e3 * rod_core))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--ictusd", required=True)
@@ -116,9 +161,10 @@ def main():
     a = ap.parse_args()
     work = a.workdir or tempfile.mkdtemp(prefix="ictus-recover-")
     os.makedirs(work, exist_ok=True)
-    checks.keep_going()  # both passages are reported
+    checks.keep_going()  # every passage is reported
     cymbal_change(a.ictusd, work)
     fill_into_crash(a.ictusd, work)
+    fill_hihat_on(a.ictusd, work)
     checks.finish()
 
 

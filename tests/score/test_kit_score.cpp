@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 
 #include "support/score_test_util.hpp"
@@ -39,6 +40,17 @@ PerformerFrame kit_frame()
                {"tom2", c + Eigen::Vector3d(-0.19, 0.08, 0.32), 0.152},
                {"floor", c + Eigen::Vector3d(-0.40, -0.06, -0.05), 0.203},
                {"timpani", c + Eigen::Vector3d(0.57, 0.0, 0.06), 0.330}};
+    return f;
+}
+
+// kit_frame() with a 14-inch hi-hat in place of its last drum: its plate 0.42 m to the
+// left of the snare's centre, 0.26 m above it and `forward_m` beyond it.
+PerformerFrame hihat_frame(double forward_m)
+{
+    PerformerFrame f = kit_frame();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.pop_back();
+    f.drums.push_back({"hihat", c + Eigen::Vector3d(0.42, 0.26, forward_m), 0.1778, true, true});
     return f;
 }
 
@@ -366,10 +378,7 @@ TEST_CASE("plan: a hand going to or from its rest tip passes over a cymbal above
 {
     // The rest tips are 15 cm above the snare (performer_frame_for_drum); a hi-hat's plate
     // 26 cm above it, to the left: the left hand comes from rest to it, plays, and goes back.
-    PerformerFrame f = kit_frame();
-    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
-    f.drums.pop_back();
-    f.drums.push_back({"hihat", c + Eigen::Vector3d(0.42, 0.26, 0.02), 0.1778, true, true});
+    const PerformerFrame f = hihat_frame(0.02);
     const PerformerFrame::Drum &hat = f.drums.back();
     // Over its plate and the planner's margin round it (the stick's tip lags the plan:
     // a tip planned just past the edge below the plate came down on it).
@@ -385,6 +394,44 @@ TEST_CASE("plan: a hand going to or from its rest tip passes over a cymbal above
                 if (std::hypot(rel.x(), rel.z()) <= hat.membrane_radius_m + margin)
                     worst = std::min(worst, rel.y());
             }
+        CHECK(worst > -1e-3);
+    }
+}
+
+TEST_CASE("plan: a hand going to the crash over the hi-hat keeps its palm above the hi-hat's "
+          "rod",
+          "[score][kit][hihat]")
+{
+    // The full kit's hi-hat and crash about the snare (kit.cpp, render.json): a left hand
+    // moving from a drum to the crash sweeps its grip over the hi-hat's centre, where its
+    // rod stands 10 cm above the plates (as python/ictus_tools/limb_clearance.py has it).
+    PerformerFrame f = hihat_frame(-0.02);
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.push_back({"crash", c + Eigen::Vector3d(0.64, 0.30, 0.36), 0.2286, true, false});
+    const Eigen::Vector3d hat = f.drums[4].membrane_center_m;
+    // The grip 0.276 m behind the tip (the default stick's 0.406 m less 0.13 m from its
+    // butt); the palm reaches 5.7 cm below it and 4.5 cm to either side; the rod 1.25 cm
+    // in radius and 10 cm above the plates. The planner keeps its margin (3 cm) round
+    // that; the palm itself must never be over the rod below its top.
+    const double reach = 0.0125 + 0.045, above = 0.10 + 0.057;
+    const char *drums[] = {"snare", "tom1", "tom2", "floor"};
+    std::mt19937 rng(11);
+    for (int trial = 0; trial < 24; ++trial) {
+        const int tempo = 80 + static_cast<int>(rng() % 61);
+        const char *from = drums[rng() % 4];
+        const char *gap = rng() % 2 ? "1/4" : "1/2";
+        const std::string score = "tempo " + std::to_string(tempo) + "\nR on " + from +
+                                  " 1/4\nL on " + from + " " + gap + "\nL on crash beats 2\nrest 4";
+        INFO(score);
+        const GesturePlan plan = plan_performance(parse_score(score, "t"), db(), f);
+        const int left = static_cast<int>(Side::left);
+        double worst = 1.0;
+        for (size_t i = 0; i < plan.tips.time_s.size(); ++i) {
+            const Eigen::Vector3d grip =
+                plan.tips.tip_m[left][i] - 0.276 * plan.stick_dir[left][i] - hat;
+            if (std::hypot(grip.x(), grip.z()) <= reach)
+                worst = std::min(worst, grip.y() - above);
+        }
         CHECK(worst > -1e-3);
     }
 }

@@ -22,6 +22,7 @@
 
 #include "ictus/base/motor_noise.hpp"
 #include "kit_notes.hpp"
+#include "plan_inputs.hpp"
 #include "plan_timing.hpp"
 
 #include <algorithm>
@@ -247,86 +248,6 @@ double kit_bump(double x)
 {
     x = std::clamp(x, 0.0, 1.0);
     return 16.0 * x * x * (1.0 - x) * (1.0 - x);
-}
-
-void check_unit(const Eigen::Vector3d &v, const char *name)
-{
-    if (!v.allFinite() || std::abs(v.norm() - 1.0) > 1e-6)
-        throw std::invalid_argument(std::string("PerformerFrame: ") + name +
-                                    " must be a unit vector");
-}
-
-// A kit's drums in the frame and the planner's margins for it.
-void validate_kit(const PerformerFrame &f, const PlanOptions &o)
-{
-    for (const PerformerFrame::Drum &d : f.drums)
-        if (!d.membrane_center_m.allFinite() || !(d.membrane_radius_m > 0.0) ||
-            !std::isfinite(d.membrane_radius_m))
-            throw std::invalid_argument("PerformerFrame: kit drum '" + d.name +
-                                        "' needs a finite centre and a radius > 0");
-    if (!(o.kit_clearance_m >= 0.0 && o.kit_clearance_m <= 0.5 && o.kit_margin_m >= 0.0 &&
-          o.kit_margin_m <= 0.5))
-        throw std::invalid_argument(
-            "PlanOptions: kit_clearance_m and kit_margin_m must be 0..0.5 m");
-}
-
-void validate(const PerformerFrame &f, const PlanOptions &o)
-{
-    check_unit(f.right, "right");
-    check_unit(f.up, "up");
-    check_unit(f.forward, "forward");
-    if (std::abs(f.right.dot(f.up)) > 1e-6 || std::abs(f.up.dot(f.forward)) > 1e-6 ||
-        std::abs(f.forward.dot(f.right)) > 1e-6)
-        throw std::invalid_argument("PerformerFrame: right, up and forward must be orthogonal");
-    if (!(f.membrane_radius_m > 0.0) || !std::isfinite(f.membrane_radius_m))
-        throw std::invalid_argument("PerformerFrame: membrane_radius_m must be > 0");
-    if (!f.membrane_center_m.allFinite() || !f.rest_tip_m[0].allFinite() ||
-        !f.rest_tip_m[1].allFinite())
-        throw std::invalid_argument("PerformerFrame: positions must be finite");
-    validate_kit(f, o);
-    auto bad = [](const char *what, double v) {
-        std::ostringstream s;
-        s << "PlanOptions: " << what << ", got " << v;
-        throw std::invalid_argument(s.str());
-    };
-    if (!(o.lead_in_s >= 0.2 && o.lead_in_s <= 60.0))
-        bad("lead_in_s must be 0.2..60 s", o.lead_in_s);
-    if (!(o.tail_s >= 0.0 && o.tail_s <= 60.0))
-        bad("tail_s must be 0..60 s", o.tail_s);
-    if (!(o.humanize <= kMaxHumanize)) // < 0: the score's
-        bad("humanize must be 0..4", o.humanize);
-    if (!(o.rate_hz >= 50.0 && o.rate_hz <= 20000.0))
-        bad("rate_hz must be 50..20000", o.rate_hz);
-    if (!(std::abs(o.strike_depth_m) <= 0.1))
-        bad("strike_depth_m must be within +-0.1 m", o.strike_depth_m);
-    if (!(o.strike_aim_s >= 0.0 && o.strike_aim_s <= 0.01))
-        bad("strike_aim_s must be within 0..0.01 s", o.strike_aim_s);
-    if (!(o.strike_aim_from_mps >= 0.0 && o.strike_aim_from_mps <= 20.0))
-        bad("strike_aim_from_mps must be within 0..20 m/s", o.strike_aim_from_mps);
-    if (!(o.strike_aim_max_m >= 0.0 && o.strike_aim_max_m <= 0.05))
-        bad("strike_aim_max_m must be within 0..0.05 m", o.strike_aim_max_m);
-    if (!(o.contact_lead_m >= 0.0 && o.contact_lead_m <= 0.01))
-        bad("contact_lead_m must be within 0..0.01 m", o.contact_lead_m);
-    if (!(o.blend_margin > 0.0 && o.blend_margin < 0.5))
-        bad("blend_margin must be in (0, 0.5)", o.blend_margin);
-    if (!(o.max_turn_rate_rad_s > 0.0 && o.max_turn_rate_rad_s <= 1000.0))
-        bad("max_turn_rate_rad_s must be in (0, 1000]", o.max_turn_rate_rad_s);
-    if (!(o.move_margin_after >= 0.0 && o.move_margin_before >= 0.0 &&
-          o.move_margin_after + o.move_margin_before < 0.9))
-        bad("move margins must be >= 0 and leave > 10 % of the gap",
-            o.move_margin_after + o.move_margin_before);
-    if (!(o.idle_return_s > 0.0) || !std::isfinite(o.idle_return_s))
-        bad("idle_return_s must be > 0", o.idle_return_s);
-    if (!(o.return_time_s > 0.0 && o.return_time_s <= 10.0))
-        bad("return_time_s must be in (0, 10] s", o.return_time_s);
-    if (!(o.min_stroke_interval_s > 0.0 && o.min_stroke_interval_s <= 10.0))
-        bad("min_stroke_interval_s must be in (0, 10] s", o.min_stroke_interval_s);
-    if (!(o.min_foot_interval_s > 0.0 && o.min_foot_interval_s <= 10.0))
-        bad("min_foot_interval_s must be in (0, 10] s", o.min_foot_interval_s);
-    if (!(o.min_chick_interval_s > 0.0 && o.min_chick_interval_s <= 10.0))
-        bad("min_chick_interval_s must be in (0, 10] s", o.min_chick_interval_s);
-    if (!(o.max_duration_s > 0.0) || !std::isfinite(o.max_duration_s))
-        bad("max_duration_s must be > 0", o.max_duration_s);
 }
 
 } // namespace
@@ -638,6 +559,20 @@ Eigen::Vector3d pair_direction(const Item &a, const Item &b, const Window &w, do
 // lifted over it.
 constexpr double kShaftPoints_m[] = {0.1, 0.2, 0.3, 0.4};
 
+// The hand round the grip, kGrip_m from the tip (the default stick's 0.406 m
+// less its 0.13 m from the butt): its palm reaches kPalmBelowGrip_m below the
+// stick's axis (its midplane 3.7-4.1 cm below on the kit's renders, and half
+// its 3.3 cm thickness) and kPalmHalfBreadth_m to either side. A hi-hat's rod
+// stands kHihatRodAbove_m above its plates, to the clutch, kHihatRodRadius_m
+// about their centre (as tests/ and python/ictus_tools/limb_clearance.py
+// measure it): a left hand going to the crash after a fill sweeps its palm
+// over it, and a move keeps the grip above the rod's top by the palm.
+constexpr double kGrip_m = 0.276;
+constexpr double kPalmBelowGrip_m = 0.057;
+constexpr double kPalmHalfBreadth_m = 0.045;
+constexpr double kHihatRodAbove_m = 0.10;
+constexpr double kHihatRodRadius_m = 0.0125;
+
 // How far a move from drum a.drum to b.drum must rise (m): wherever the tip
 // is over a drum's disk (its radius plus kit_margin_m, in plan), it must be
 // above that head, and kit_clearance_m above it for a drum it does not play
@@ -682,6 +617,18 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
                     continue;
                 short_m = std::max(short_m, (played ? 0.0 : opt.kit_clearance_m) - height);
             }
+        }
+        const Eigen::Vector3d grip = tip - kGrip_m * dir;
+        for (size_t k = 0; k < frame.drums.size(); ++k) {
+            const PerformerFrame::Drum &d = frame.drums[k];
+            const bool played = static_cast<int>(k) == a.drum || static_cast<int>(k) == b.drum;
+            if (!d.pedal || (played && kit_bump(x) < 0.5))
+                continue;
+            const Eigen::Vector3d rel = grip - d.membrane_center_m;
+            const double height = rel.dot(frame.up);
+            if ((rel - height * frame.up).norm() <=
+                kHihatRodRadius_m + kPalmHalfBreadth_m + opt.kit_margin_m)
+                short_m = std::max(short_m, kHihatRodAbove_m + kPalmBelowGrip_m - height);
         }
         lift = std::max(lift, short_m / std::max(kit_bump(x), 0.05));
     }
@@ -843,7 +790,7 @@ double humanize_amount(const Score &score, const PlanOptions &options)
 GesturePlan plan_performance(const Score &score, const GestureDatabase &db,
                              const PerformerFrame &frame, const PlanOptions &opt)
 {
-    validate(frame, opt);
+    score_detail::validate_plan_inputs(frame, opt);
     Eigen::Matrix3d to_world;
     to_world.col(0) = frame.right;
     to_world.col(1) = frame.up;

@@ -135,6 +135,13 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         contact.geom = geoms[i];
         contact.surface.mode = dContactSoftERP | dContactSoftCFM | dContactApprox1;
         contact.surface.mu = self->drum(drum).friction;
+        // A shaft pressed on a plate's edge from the side slides on it: a real
+        // cymbal tilts on its felt away from the stick (the disc here is
+        // static). With friction there, a hand crossing to the hi-hat wedged
+        // its stick on the edge and could neither lift nor reach it for a bar.
+        if (!bead && self->drum(drum).plate_bending_n_m > 0.0 &&
+            geoms[i].normal[1] <= kHeadNormalMin)
+            contact.surface.mu = 0.0;
         contact.surface.soft_erp = self->contact_erp_[static_cast<size_t>(drum)];
         contact.surface.soft_cfm = self->contact_cfm_[static_cast<size_t>(drum)];
         const double k3 = self->head_k3_[static_cast<size_t>(drum)];
