@@ -122,18 +122,18 @@ def fill_into_crash(ictusd, work):
 def fill_hihat_on(ictusd, work, seeds=range(1, 9)):
     e8, e16 = TPQ // 2, TPQ // 4
     for seed in seeds:
-        r = random.Random(seed)
-        bpm = r.choice([100, 110, 120, 130])
+        rng = random.Random(seed)
+        bpm = rng.choice([100, 110, 120, 130])
         notes = []
         for i in range(12):  # a bar of the groove and the half bar before the fill
             notes.append((i * e8, 42, 80))
             if i % 2 == 0:
                 notes.append((i * e8, 38 if (i // 2) % 2 else 36, 90))
-        toms, cur, end = [48, 45, 43], r.randrange(3), r.choice([2, 4])
-        last = r.choice([38, 48])
+        toms, cur, end = [48, 45, 43], rng.randrange(3), rng.choice([2, 4])
+        last = rng.choice([38, 48])
         for k in range(8):
-            if k < 8 - end and r.random() < 0.4:
-                cur = min(2, max(0, cur + r.choice([-1, 1])))
+            if k < 8 - end and rng.random() < 0.4:
+                cur = min(2, max(0, cur + rng.choice([-1, 1])))
             notes.append((6 * TPQ + k * e16, toms[cur] if k < 8 - end else last, 100))
         down = 8 * TPQ
         notes += [(down, 49, 120), (down, 36, 110)]

@@ -559,15 +559,16 @@ Eigen::Vector3d pair_direction(const Item &a, const Item &b, const Window &w, do
 // lifted over it.
 constexpr double kShaftPoints_m[] = {0.1, 0.2, 0.3, 0.4};
 
-// The hand round the grip, kGrip_m from the tip (the default stick's 0.406 m
-// less its 0.13 m from the butt): its palm reaches kPalmBelowGrip_m below the
-// stick's axis (its midplane 3.7-4.1 cm below on the kit's renders, and half
-// its 3.3 cm thickness) and kPalmHalfBreadth_m to either side. A hi-hat's rod
+// The hand round the grip, kGrip_m from the tip (the default stick's, 0.276 m
+// of its 0.406 m: character.hpp's StickParams): its palm reaches
+// kPalmBelowGrip_m below the stick's axis (its midplane 3.7-4.1 cm below on
+// the kit's renders, and half its 3.3 cm thickness) and kPalmHalfBreadth_m to
+// either side. A hi-hat's rod
 // stands kHihatRodAbove_m above its plates, to the clutch, kHihatRodRadius_m
 // about their centre (as tests/ and python/ictus_tools/limb_clearance.py
 // measure it): a left hand going to the crash after a fill sweeps its palm
 // over it, and a move keeps the grip above the rod's top by the palm.
-constexpr double kGrip_m = 0.276;
+constexpr double kGrip_m = StickParams{}.length_m - StickParams{}.grip_from_butt_m;
 constexpr double kPalmBelowGrip_m = 0.057;
 constexpr double kPalmHalfBreadth_m = 0.045;
 constexpr double kHihatRodAbove_m = 0.10;
