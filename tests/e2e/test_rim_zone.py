@@ -13,6 +13,13 @@ Asserted:
    spring: depth = F / k, a bound: the stretching stiffens it) shows it does not.
 PITCH_MIN_DEG is a stated floor for the default grip, not measured here (strikes.csv has no
 stick pitch); the depth bound is computed per strike.
+
+Then near the edge of each drum of `--kit standard` (docs/rim.md, "A bead that meets only the
+edge"): `L on tom1 at 0.95 90`, whose bead lands outside the disk and meets only the edge, and
+16 seeded notes of either hand on any drum at r/a 0.85 .. 0.95 on the side toward the
+performer (theta 45 .. 135). Asserted: every note is one primary strike of its hand on its
+drum within 5 ms; no strike lands outside its disk (r/a <= 1); the tom1 case's strikes are on
+the rim; and rule 2 above with each drum's radius.
 """
 import argparse
 import csv
@@ -60,3 +67,35 @@ for r in prim:
         check(zone == 0, "r/a %.3f, %.1f mm from the rim (the shaft reaches %.1f mm at most): "
               "zone %d" % (ra, 1e3 * gap, 1e3 * reach, zone))
 check(heads >= 6, "%d strikes far enough from the rim to be head" % heads)
+
+# Near the edges of the standard kit.
+rng = random.Random(30)
+near = ["L on tom1 at 0.95 90"] * 3 + [
+    "%s on %s at %.3f %.1f" % (rng.choice("LR"), rng.choice(["snare", "tom1", "tom2", "floor"]),
+                               rng.uniform(0.85, 0.95), rng.uniform(45.0, 135.0))
+    for _ in range(16)]
+path = os.path.join(work, "edges.score")
+with open(path, "w") as f:
+    f.write("\n".join(["tempo 60"] + near) + "\n")
+out = os.path.join(work, "edges")
+subprocess.run([os.path.join(args.build, "ictusd"), "render", "--kit", "standard", "--score", path,
+                "--out", out, "--bvh-rate", "0"], check=True, timeout=600,
+               stdout=subprocess.DEVNULL)
+kit = json.load(open(os.path.join(out, "render.json")))["kit"]["drums"]
+strikes = {r["seq"]: r for r in csv.DictReader(open(os.path.join(out, "strikes.csv")))}
+notes = list(csv.DictReader(open(os.path.join(out, "notes.csv"))))
+check(len(notes) == len(near), "%d notes" % len(notes))
+for line, n in zip(near, notes):
+    hand, _, name = line.split()[:3]
+    s = strikes.get(n["strike_seq"])
+    found = (s is not None and s["bounce"] == "0" and kit[int(s["drum"])]["name"] == name
+             and int(s["hand"]) == (1 if hand == "R" else 0) and abs(float(n["error_ms"])) <= 5.0)
+    check(found, "%s: struck on %s, %s ms" % (line, s and kit[int(s["drum"])]["name"],
+                                                n["error_ms"] or "no strike"))
+    ra, zone = float(s["r_over_a"]), int(s["zone"])
+    check(ra <= 1.0, "%s lands at r/a %.4f, on its disk" % (line, ra))
+    if line == near[0]:
+        check(zone == 1, "%s: on the rim (r/a %.4f, zone %d)" % (line, ra, zone))
+    if kit[int(s["drum"])]["radius_m"] * (1.0 - ra) <= TIP_RADIUS_M:
+        check(zone == 1, "%s lands at r/a %.4f: the bead reaches the rim: zone %d"
+              % (line, ra, zone))

@@ -270,6 +270,53 @@ TEST_CASE("strike: no strike outside the disk, nor above the membrane", "[sim][s
     CHECK(det.strikes() == 0);
 }
 
+TEST_CASE("strike: a bead that meets only the edge, from outside the disk, strikes it on the edge",
+          "[sim][strike]")
+{
+    // The bead falls beside the head, its centre delta beyond the rim circle
+    // in plan: the sphere meets the circle when its centre is
+    // sqrt(r^2 - delta^2) above the plane (delta < r), never when delta > r.
+    const double r = 0.007, a = 0.178, v = 1.5, h0 = 0.03, dt = 1e-4;
+    std::mt19937 rng(20261130);
+    std::uniform_real_distribution<double> angle(-M_PI, M_PI), frac(0.02, 0.98);
+    for (int trial = 0; trial < 40; ++trial) {
+        const bool meets = trial % 2 == 0;
+        const double delta = meets ? frac(rng) * r : r * (1.0 + frac(rng));
+        const double phi = angle(rng);
+        StrikeDetector det(flat_membrane(5000.0, 0.0), continuous_samples());
+        std::vector<TipSample> s;
+        const double h_min = 0.0005, t_low = (h0 - h_min) / v; // still above the plane
+        for (int n = 0; n * dt < 2.0 * t_low; ++n) {
+            TipSample t;
+            t.time_s = n * dt;
+            // Down to h_min, then up again at the same speed.
+            const bool down = t.time_s < t_low;
+            const double h = down ? h0 - v * t.time_s : h_min + v * (t.time_s - t_low);
+            t.center_m =
+                Eigen::Vector3d((a + delta) * std::cos(phi), h, -(a + delta) * std::sin(phi));
+            t.velocity_mps = Eigen::Vector3d(0, down ? -v : v, 0);
+            s.push_back(t);
+        }
+        const auto ev = run_detector(det, 0, s);
+        CAPTURE(trial, delta, phi);
+        if (!meets) {
+            CHECK(ev.empty());
+            continue;
+        }
+        REQUIRE(ev.size() == 1);
+        const double t_on = (h0 - std::sqrt(r * r - delta * delta)) / v;
+        CHECK(ev[0].time_s == Approx(t_on).margin(dt));
+        CHECK(ev[0].r_over_a == Approx(1.0).epsilon(1e-12));
+        CHECK(ev[0].theta_deg == Approx(phi * 180.0 / M_PI).margin(1e-9));
+        // Along the edge's normal: the fall's part toward the circle, v h / r,
+        // with h the onset's height (known within one step's fall, v dt).
+        CHECK(ev[0].normal_velocity_mps ==
+              Approx(v * std::sqrt(r * r - delta * delta) / r).margin(v * v * dt / r));
+        // Released where it met the edge on the way up.
+        CHECK(ev[0].duration_ms == Approx(2e3 * (t_low - t_on)).margin(1e3 * dt));
+    }
+}
+
 TEST_CASE("strike: bounces of a dropped bead are tagged by the apex heights between contacts",
           "[sim][strike]")
 {

@@ -45,7 +45,7 @@ double parabola_peak(const double t[3], const double f[3])
 // regardless, gave re-contacts after a lift smaller than one step's motion a
 // negative normal velocity: the still rising bead's.
 Eigen::Vector3d approach_velocity(const TipSample &free, double g0, const TipSample &touching,
-                                  bool semi_implicit)
+                                  bool semi_implicit, const Eigen::Vector3d &normal)
 {
     const double dt = touching.time_s - free.time_s;
     if (!(dt > 0.0)) // times not increasing (bad input): no speed measurable, never a negative one
@@ -58,7 +58,7 @@ Eigen::Vector3d approach_velocity(const TipSample &free, double g0, const TipSam
     // otherwise; but only if it could have brought the bead across (towards
     // the membrane, by at least g0). If not (still rising, hovering,
     // creeping), the approach that crossed began inside the step: its mean.
-    const double free_approach_mps = -free.velocity_mps.dot(kNormal);
+    const double free_approach_mps = -free.velocity_mps.dot(normal);
     if (free_approach_mps > 0.0 && free_approach_mps * dt >= g0)
         return free.velocity_mps;
     return mean;
@@ -172,6 +172,34 @@ double StrikeDetector::gap_m(const Eigen::Vector3d &center_m) const
     return (center_m - cur().center_m).dot(kNormal) - cur().tip_radius_m;
 }
 
+// Above the plane and outside the disk, the bead's nearest point of the drum
+// is the edge: the circle where the head meets the shell (the sphere against
+// the solid cylinder's top). Elsewhere the plane's gap.
+double StrikeDetector::surface_gap_m(const Eigen::Vector3d &center_m) const
+{
+    if (!on_edge_side(center_m))
+        return gap_m(center_m);
+    double x, y;
+    to_membrane(center_m, x, y);
+    const double h = (center_m - cur().center_m).dot(kNormal);
+    return std::hypot(std::hypot(x, y) - cur().radius_m, h) - cur().tip_radius_m;
+}
+
+bool StrikeDetector::on_edge_side(const Eigen::Vector3d &center_m) const
+{
+    return (center_m - cur().center_m).dot(kNormal) > 0.0 && !over_membrane(center_m);
+}
+
+Eigen::Vector3d StrikeDetector::contact_normal(const Eigen::Vector3d &center_m) const
+{
+    if (!on_edge_side(center_m))
+        return kNormal;
+    const Eigen::Vector3d d = center_m - cur().center_m;
+    const Eigen::Vector3d plan = d - d.dot(kNormal) * kNormal;
+    const Eigen::Vector3d off = d - cur().radius_m * plan.normalized(); // from the edge's point
+    return off.norm() > 0.0 ? Eigen::Vector3d(off.normalized()) : kNormal;
+}
+
 bool StrikeDetector::over_membrane(const Eigen::Vector3d &center_m) const
 {
     double x, y;
@@ -211,9 +239,9 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
 
 bool StrikeDetector::update_hand(Hand &h, int hand, const TipSample &s, StrikeEvent &out)
 {
-    const double gap = gap_m(s.center_m);
-    const bool touching = gap < 0.0 && over_membrane(s.center_m);
-    const double depth_rate = -s.velocity_mps.dot(kNormal);
+    const double gap = surface_gap_m(s.center_m);
+    const bool touching = gap < 0.0 && (over_membrane(s.center_m) || on_edge_side(s.center_m));
+    const double depth_rate = -s.velocity_mps.dot(contact_normal(s.center_m));
     bool ended = false;
     if (entered_from_side(h, s, gap, touching))
         return false;
@@ -276,13 +304,26 @@ void StrikeDetector::begin_contact(Hand &h, int hand, const TipSample &s, double
     e.drum = cur().drum_id;
     e.time_s = t_on;
     to_membrane(p_on, e.x_m, e.y_m);
+    // A bead that met the edge from outside the disk touched it on the edge.
+    const double rho = std::hypot(e.x_m, e.y_m);
+    if (rho > cur().radius_m) {
+        e.x_m *= cur().radius_m / rho;
+        e.y_m *= cur().radius_m / rho;
+    }
     e.r_over_a = std::hypot(e.x_m, e.y_m) / cur().radius_m;
     e.theta_deg = std::atan2(e.y_m, e.x_m) * 180.0 / M_PI;
     if (e.theta_deg <= -180.0)
         e.theta_deg += 360.0;
-    const Eigen::Vector3d v = approach_velocity(before, g0, s, options_.semi_implicit_samples);
-    e.normal_velocity_mps = -v.dot(kNormal);
-    e.tangential_velocity_mps = (v - v.dot(kNormal) * kNormal).norm();
+    // Normal to what the bead met: the plane, or the edge (its circle's nearest point).
+    const Eigen::Vector3d n =
+        contact_normal(before.center_m + frac * (s.center_m - before.center_m));
+    const Eigen::Vector3d v = approach_velocity(before, g0, s, options_.semi_implicit_samples, n);
+    e.normal_velocity_mps = -v.dot(n);
+    // On the plane this is > 0 (approach_velocity()). The edge's normal turns
+    // within the step: if the bead moved along it, the gap's own rate (> 0).
+    if (!(e.normal_velocity_mps > 0.0) && s.time_s > before.time_s)
+        e.normal_velocity_mps = (g0 - gap) / (s.time_s - before.time_s);
+    e.tangential_velocity_mps = (v - v.dot(n) * n).norm();
     // Driven: the hand moved the stick toward the membrane within the
     // drive window, the onset's own step included (the held bead; a
     // rigid stick or a trajectory has none: always driven).
@@ -300,7 +341,7 @@ void StrikeDetector::begin_contact(Hand &h, int hand, const TipSample &s, double
     e.stroke = std::max(h.stroke, 0L);
     e.seq = next_seq_++;
     // The force law at the onset (the damper acts at once).
-    const double f_on = normal_force_n(0.0, -v.dot(kNormal));
+    const double f_on = normal_force_n(0.0, e.normal_velocity_mps);
     h.last_force_n = f_on;
     h.last_time_s = t_on;
     h.friction_sum.setZero();

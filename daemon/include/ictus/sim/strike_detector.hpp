@@ -136,6 +136,15 @@ class StrikeDetector
     // whether the bead is over the membrane disk.
     double gap_m(const Eigen::Vector3d &center_m) const;
     bool over_membrane(const Eigen::Vector3d &center_m) const;
+    // The bead's distance to the drum's top (m, < 0: touching): the plane's
+    // gap over the disk or below the plane, the distance to the edge circle
+    // above the plane outside the disk (a bead that meets only the edge, a
+    // stroke on the hoop); and whether the bead is there, on the edge's side.
+    double surface_gap_m(const Eigen::Vector3d &center_m) const;
+    bool on_edge_side(const Eigen::Vector3d &center_m) const;
+    // The normal of what the bead would meet there: the plane's (up), or on
+    // the edge's side the direction from the edge circle's nearest point.
+    Eigen::Vector3d contact_normal(const Eigen::Vector3d &center_m) const;
     // Whether the held bead moved toward the membrane at driven_speed_mps or
     // faster from a to b, starting above the membrane plane (false when
     // either has none): a hand pressing its stick into the head (a buzz) is
