@@ -20,6 +20,10 @@ edge"): `L on tom1 at 0.95 90`, whose bead lands outside the disk and meets only
 performer (theta 45 .. 135). Asserted: every note is one primary strike of its hand on its
 drum within 5 ms; no strike lands outside its disk (r/a <= 1); the tom1 case's strikes are on
 the rim; and rule 2 above with each drum's radius.
+
+Then `on NAME-rim` (docs/score.md): either hand on each drum of `--kit standard` and `--kit
+full`, one note a second: every note one primary strike of its hand on its drum within 5 ms,
+on the rim (zone 1).
 """
 import argparse
 import csv
@@ -99,3 +103,27 @@ for line, n in zip(near, notes):
     if kit[int(s["drum"])]["radius_m"] * (1.0 - ra) <= TIP_RADIUS_M:
         check(zone == 1, "%s lands at r/a %.4f: the bead reaches the rim: zone %d"
               % (line, ra, zone))
+
+# A drum's rim by name, each hand on each drum of both kits.
+for kit_name in ("standard", "full"):
+    rims = ["%s on %s-rim" % (hand, drum) for drum in ("snare", "tom1", "tom2", "floor")
+            for hand in "LR"]
+    path = os.path.join(work, "rims-%s.score" % kit_name)
+    with open(path, "w") as f:
+        f.write("\n".join(["tempo 60"] + rims) + "\n")
+    out = os.path.join(work, "rims-" + kit_name)
+    subprocess.run([os.path.join(args.build, "ictusd"), "render", "--kit", kit_name, "--score",
+                    path, "--out", out, "--bvh-rate", "0"], check=True, timeout=600,
+                   stdout=subprocess.DEVNULL)
+    kit = json.load(open(os.path.join(out, "render.json")))["kit"]["drums"]
+    strikes = {r["seq"]: r for r in csv.DictReader(open(os.path.join(out, "strikes.csv")))}
+    notes = list(csv.DictReader(open(os.path.join(out, "notes.csv"))))
+    check(len(notes) == len(rims), "%s: %d notes" % (kit_name, len(notes)))
+    for line, n in zip(rims, notes):
+        hand, _, name = line.split()
+        s = strikes.get(n["strike_seq"])
+        check(s is not None and s["bounce"] == "0" and abs(float(n["error_ms"])) <= 5.0
+              and kit[int(s["drum"])]["name"] == name[:-len("-rim")]
+              and int(s["hand"]) == (1 if hand == "R" else 0) and s["zone"] == "1",
+              "--kit %s, %s: %s" % (kit_name, line, s and "on %s at r/a %s, zone %s, %s ms" % (
+                  kit[int(s["drum"])]["name"], s["r_over_a"], s["zone"], n["error_ms"])))

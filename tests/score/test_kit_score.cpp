@@ -69,6 +69,17 @@ void refused(const std::string &text, const PerformerFrame &frame, int line, int
     }
 }
 
+// kit_frame() with a ride (a cymbal) and a kick (the right foot's).
+PerformerFrame kit_frame_with_ride_and_kick()
+{
+    PerformerFrame f = kit_frame();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.push_back({"ride", c + Eigen::Vector3d(-0.62, 0.22, 0.28), 0.254, true});
+    f.drums.push_back(
+        {"kick", c + Eigen::Vector3d(-0.18, -0.37, 0.10), 0.2794, false, false, true});
+    return f;
+}
+
 } // namespace
 
 TEST_CASE("score: 'drum NAME' sets the drum of the notes after it, 'on NAME' one note's",
@@ -138,11 +149,8 @@ TEST_CASE("plan: 'on NAME-bell' is a cymbal's bell, and the standard pieces' com
           "find the kit's names",
           "[score][kit]")
 {
-    PerformerFrame f = kit_frame();
+    const PerformerFrame f = kit_frame_with_ride_and_kick();
     const Eigen::Vector3d c = f.drums[0].membrane_center_m;
-    f.drums.push_back({"ride", c + Eigen::Vector3d(-0.62, 0.22, 0.28), 0.254, true});
-    f.drums.push_back(
-        {"kick", c + Eigen::Vector3d(-0.18, -0.37, 0.10), 0.2794, false, false, true});
     // The bell: r/a 0.12 (General MIDI's 53 on the same spot) at the bow's angle toward the
     // performer; a spot written is kept; the bow's spot when no bell is named.
     const Score s = parse_score("tempo 80\nR on ride-bell, L on RIDE_BELL, R on ride-bell at 0.2 "
@@ -177,8 +185,44 @@ TEST_CASE("plan: 'on NAME-bell' is a cymbal's bell, and the standard pieces' com
             "(the kit's cymbals: ride)");
     refused("R on crash-bell", f, 1, 6,
             "unknown drum 'crash-bell' (the kit: snare, tom1, tom2, "
-            "floor, timpani, ride, kick; a cymbal's bell: NAME-bell)");
+            "floor, timpani, ride, kick; a cymbal's bell: NAME-bell; a drum's rim: NAME-rim)");
     refused("L on hi-hat", f, 1, 6, "unknown drum 'hi-hat'");
+}
+
+TEST_CASE("plan: 'on NAME-rim' is a drum's rim, its edge facing the hand's shoulder",
+          "[score][kit]")
+{
+    const PerformerFrame f = kit_frame_with_ride_and_kick();
+    const Score s = parse_score("tempo 80\nR on snare-rim, L on snare-rim, R on tom2-rim, "
+                                "L on tom1_rim, R on floor-tom-rim, L on floor-rim, "
+                                "R on tom1-rim at 0.5 45",
+                                "t");
+    const GesturePlan plan = plan_performance(s, db(), f);
+    REQUIRE(plan.notes.size() == 7);
+    const int drum[7] = {0, 0, 2, 1, 3, 3, 1};
+    for (size_t i = 0; i < 6; ++i) {
+        INFO(i);
+        const PlannedNote &n = plan.notes[i];
+        REQUIRE(n.drum == drum[i]);
+        // Half the default bead's radius (3.5 mm) inside the edge, toward the hand's shoulder
+        // in plan.
+        const PerformerFrame::Drum &d = f.drums[static_cast<size_t>(drum[i])];
+        Eigen::Vector3d out = n.strike_point_m - d.membrane_center_m,
+                        to_shoulder =
+                            f.shoulder_m[static_cast<size_t>(n.hand)] - d.membrane_center_m;
+        out.y() = 0.0;
+        to_shoulder.y() = 0.0;
+        CHECK(n.strike_point_m.y() == Approx(d.membrane_center_m.y()));
+        CHECK(out.norm() == Approx(d.membrane_radius_m - 0.0035).margin(1e-12));
+        CHECK(out.normalized().dot(to_shoulder.normalized()) == Approx(1.0).margin(1e-12));
+    }
+    // A spot written is kept.
+    CHECK(plan.notes[6].r_over_a == Approx(0.5));
+    CHECK(plan.notes[6].theta_deg == Approx(45.0));
+    // A cymbal's edge is its own; the kick is the foot's.
+    refused("R on ride-rim", f, 1, 6, "drum 'ride-rim': 'ride' has no rim to strike (a cymbal's");
+    refused("R on kick-rim", f, 1, 6, "drum 'kick-rim': 'kick' has no rim to strike (its pedal's");
+    refused("R on gong-rim", f, 1, 6, "unknown drum 'gong-rim'");
 }
 
 TEST_CASE(
@@ -206,8 +250,8 @@ TEST_CASE(
     } catch (const ScoreError &e) {
         CHECK(e.line() == 2);
         CHECK(e.column() == 6);
-        CHECK_THAT(e.message(),
-                   Contains("unknown drum 'tom3' (the kit: snare, tom1, tom2, floor, timpani)"));
+        CHECK_THAT(e.message(), Contains("unknown drum 'tom3' (the kit: snare, tom1, tom2, floor, "
+                                         "timpani; a drum's rim: NAME-rim)"));
     }
     PerformerFrame one = performer_frame_for_drum(Eigen::Vector3d(0.0, 0.7, 0.45), 0.178);
     try {

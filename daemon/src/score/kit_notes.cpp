@@ -4,6 +4,7 @@
 #include "ictus/base/motor_noise.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace ictus
@@ -66,6 +67,24 @@ NoteDrum note_drum(const Score &score, const ScoreNote &n, const PerformerFrame 
                     "' is not a cymbal (" +
                     (cymbals.empty() ? "the kit has none" : "the kit's cymbals: " + cymbals) + ")");
     }
+    for (const char *suffix : {"-rim", "_rim"}) {
+        const size_t len = std::char_traits<char>::length(suffix);
+        if (n.drum.size() <= len || n.drum.compare(n.drum.size() - len, len, suffix) != 0)
+            continue;
+        const std::string base = n.drum.substr(0, n.drum.size() - len);
+        int i = find_drum(frame, base);
+        if (i < 0)
+            i = find_drum(frame, standard_spelling(base));
+        if (i < 0)
+            continue;
+        const PerformerFrame::Drum &d = frame.drums[static_cast<size_t>(i)];
+        if (!d.cymbal && !d.foot)
+            return {i, false, true};
+        throw ScoreError(
+            score.source, n.drum_line, n.drum_column,
+            "drum '" + n.drum + "': '" + d.name + "' has no rim to strike (" +
+                (d.foot ? "its pedal's beater plays it" : "a cymbal's edge is its own") + ")");
+    }
     if (frame.drums.empty())
         throw ScoreError(score.source, n.drum_line, n.drum_column,
                          "drum '" + n.drum +
@@ -73,7 +92,8 @@ NoteDrum note_drum(const Score &score, const ScoreNote &n, const PerformerFrame 
                              "e.g. --kit standard: docs/perform.md)");
     throw ScoreError(score.source, n.drum_line, n.drum_column,
                      "unknown drum '" + n.drum + "' (the kit: " + names +
-                         (cymbals.empty() ? "" : "; a cymbal's bell: NAME-bell") + ")");
+                         (cymbals.empty() ? "" : "; a cymbal's bell: NAME-bell") +
+                         "; a drum's rim: NAME-rim)");
 }
 
 int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &frame)
@@ -90,6 +110,13 @@ int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame 
     if (!n.spot_given && (drum.bell || cymbal)) {
         r_over_a = drum.bell ? kBellRadiusFraction : kCymbalRadiusFraction;
         theta_deg = kCymbalThetaDeg[static_cast<int>(n.hand)];
+    }
+    if (!n.spot_given && drum.rim) {
+        const PerformerFrame::Drum &d = frame.drums[static_cast<size_t>(drum.index)];
+        const Eigen::Vector3d to =
+            frame.shoulder_m[static_cast<size_t>(n.hand)] - d.membrane_center_m;
+        r_over_a = 1.0 - kRimInset_m / d.membrane_radius_m;
+        theta_deg = std::atan2(-to.z(), to.x()) * 180.0 / M_PI; // docs/osc.md: y_m is world -z
     }
     return drum.index;
 }

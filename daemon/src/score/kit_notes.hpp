@@ -21,13 +21,16 @@ namespace score_detail
 struct NoteDrum {
     int index = 0;
     bool bell = false;
+    bool rim = false; // `snare-rim`: the drum `snare`, struck on its rim
 };
 NoteDrum note_drum(const Score &score, const ScoreNote &n, const PerformerFrame &frame);
 int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &frame);
 // The note's drum (note_drum) and, where the note gives no spot on a cymbal,
 // the cymbal's toward the performer, at kCymbalThetaDeg: its bell's
 // (kBellRadiusFraction, as General MIDI's 53) or its bow's
-// (kCymbalRadiusFraction); r_over_a and theta_deg are left as they are elsewhere.
+// (kCymbalRadiusFraction); where it gives none on a drum's rim (`snare-rim`),
+// its edge nearest the performer facing the hand's shoulder (kRimInset_m inside it); r_over_a
+// and theta_deg are left as they are elsewhere.
 int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame &frame,
                    double &r_over_a, double &theta_deg);
 // The note's pedal on a hi-hat (closed when it names none), -1 on another

@@ -70,6 +70,16 @@ constexpr double kCymbalThetaDeg[2] = {70.0, 110.0}; // [Side::left, Side::right
 // the hand's drum angle (theta 180 for the right) the palm comes down through
 // the ride's bow (4 mm in a swing ride at 140 bpm).
 constexpr double kBellRadiusFraction = 0.12;
+// A drum's rim (`on snare-rim`): a stroke aimed at the head's edge where it
+// faces the hand's shoulder in plan, the stick's end kRimInset_m inside the
+// edge, half the default bead's radius: the bead's centre, a bead's radius
+// back along the stick from its end, is then within a bead's radius of the
+// edge whichever way the stick points, and the bead meets the hoop on any drum
+// (r/a 0.95 leaves 1 cm of head inside a 16-inch floor tom's edge: the bead on
+// the head). Facing the shoulder, the edge is in reach wherever the drum
+// stands (the left hand on the full kit's floor tom, far to the right, lost
+// its notes aimed at the edge nearest the performer).
+constexpr double kRimInset_m = 0.0035;
 
 // The hi-hat's pedal as a note writes it (docs/score.md, `open`, `half`,
 // `closed`): membrane~'s `openness` (docs/plates.md, "The hi-hat"), 0 the
