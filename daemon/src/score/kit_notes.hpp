@@ -29,8 +29,8 @@ int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &fra
 // the cymbal's toward the performer, at kCymbalThetaDeg: its bell's
 // (kBellRadiusFraction, as General MIDI's 53) or its bow's
 // (kCymbalRadiusFraction); where it gives none on a drum's rim (`snare-rim`),
-// its edge nearest the performer facing the hand's shoulder (kRimInset_m inside it); r_over_a
-// and theta_deg are left as they are elsewhere.
+// the edge where it faces the hand's shoulder in plan (kRimInset_m inside it);
+// r_over_a and theta_deg are left as they are elsewhere.
 int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame &frame,
                    double &r_over_a, double &theta_deg);
 // The note's pedal on a hi-hat (closed when it names none), -1 on another
