@@ -36,6 +36,18 @@ std::string standard_spelling(const std::string &name)
     return "";
 }
 
+// The name without `-SUFFIX` or `_SUFFIX` at its end, or "" when it has neither.
+std::string without_suffix(const std::string &name, const std::string &suffix)
+{
+    for (const char sep : {'-', '_'}) {
+        const std::string tail = sep + suffix;
+        if (name.size() > tail.size() &&
+            name.compare(name.size() - tail.size(), tail.size(), tail) == 0)
+            return name.substr(0, name.size() - tail.size());
+    }
+    return "";
+}
+
 } // namespace
 
 NoteDrum note_drum(const Score &score, const ScoreNote &n, const PerformerFrame &frame)
@@ -52,11 +64,7 @@ NoteDrum note_drum(const Score &score, const ScoreNote &n, const PerformerFrame 
         if (d.cymbal)
             cymbals += (cymbals.empty() ? "" : ", ") + d.name;
     }
-    for (const char *suffix : {"-bell", "_bell"}) {
-        const size_t len = std::char_traits<char>::length(suffix);
-        if (n.drum.size() <= len || n.drum.compare(n.drum.size() - len, len, suffix) != 0)
-            continue;
-        const std::string base = n.drum.substr(0, n.drum.size() - len);
+    if (const std::string base = without_suffix(n.drum, "bell"); !base.empty()) {
         const int i = find_drum(frame, base);
         if (i >= 0 && frame.drums[static_cast<size_t>(i)].cymbal)
             return {i, true};
@@ -67,19 +75,14 @@ NoteDrum note_drum(const Score &score, const ScoreNote &n, const PerformerFrame 
                     "' is not a cymbal (" +
                     (cymbals.empty() ? "the kit has none" : "the kit's cymbals: " + cymbals) + ")");
     }
-    for (const char *suffix : {"-rim", "_rim"}) {
-        const size_t len = std::char_traits<char>::length(suffix);
-        if (n.drum.size() <= len || n.drum.compare(n.drum.size() - len, len, suffix) != 0)
-            continue;
-        const std::string base = n.drum.substr(0, n.drum.size() - len);
-        int i = find_drum(frame, base);
-        if (i < 0)
-            i = find_drum(frame, standard_spelling(base));
-        if (i < 0)
-            continue;
-        const PerformerFrame::Drum &d = frame.drums[static_cast<size_t>(i)];
+    const std::string rim_of = without_suffix(n.drum, "rim");
+    int rim_i = rim_of.empty() ? -1 : find_drum(frame, rim_of);
+    if (!rim_of.empty() && rim_i < 0)
+        rim_i = find_drum(frame, standard_spelling(rim_of));
+    if (rim_i >= 0) {
+        const PerformerFrame::Drum &d = frame.drums[static_cast<size_t>(rim_i)];
         if (!d.cymbal && !d.foot)
-            return {i, false, true};
+            return {rim_i, false, true};
         throw ScoreError(
             score.source, n.drum_line, n.drum_column,
             "drum '" + n.drum + "': '" + d.name + "' has no rim to strike (" +

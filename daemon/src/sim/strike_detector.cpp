@@ -172,19 +172,6 @@ double StrikeDetector::gap_m(const Eigen::Vector3d &center_m) const
     return (center_m - cur().center_m).dot(kNormal) - cur().tip_radius_m;
 }
 
-// Above the plane and outside the disk, the bead's nearest point of the drum
-// is the edge: the circle where the head meets the shell (the sphere against
-// the solid cylinder's top). Elsewhere the plane's gap.
-double StrikeDetector::surface_gap_m(const Eigen::Vector3d &center_m) const
-{
-    if (!on_edge_side(center_m))
-        return gap_m(center_m);
-    double x, y;
-    to_membrane(center_m, x, y);
-    const double h = (center_m - cur().center_m).dot(kNormal);
-    return std::hypot(std::hypot(x, y) - cur().radius_m, h) - cur().tip_radius_m;
-}
-
 bool StrikeDetector::on_edge_side(const Eigen::Vector3d &center_m) const
 {
     return (center_m - cur().center_m).dot(kNormal) > 0.0 && !over_membrane(center_m);
@@ -239,9 +226,14 @@ bool StrikeDetector::update(int hand, const TipSample &s, StrikeEvent &out)
 
 bool StrikeDetector::update_hand(Hand &h, int hand, const TipSample &s, StrikeEvent &out)
 {
-    const double gap = surface_gap_m(s.center_m);
-    const bool touching = gap < 0.0 && (over_membrane(s.center_m) || on_edge_side(s.center_m));
-    const double depth_rate = -s.velocity_mps.dot(contact_normal(s.center_m));
+    // Over the disk, or beside it above the plane, where the bead's nearest
+    // point of the drum is the edge circle (the sphere against ODE's solid
+    // cylinder); below the plane beside it is the shell's side.
+    const bool edge = on_edge_side(s.center_m);
+    const double gap =
+        edge ? distance_to_rim_m(cur(), s.center_m) - cur().tip_radius_m : gap_m(s.center_m);
+    const bool touching = gap < 0.0 && (edge || over_membrane(s.center_m));
+    const double depth_rate = -s.velocity_mps.dot(edge ? contact_normal(s.center_m) : kNormal);
     bool ended = false;
     if (entered_from_side(h, s, gap, touching))
         return false;

@@ -136,11 +136,10 @@ class StrikeDetector
     // whether the bead is over the membrane disk.
     double gap_m(const Eigen::Vector3d &center_m) const;
     bool over_membrane(const Eigen::Vector3d &center_m) const;
-    // The bead's distance to the drum's top (m, < 0: touching): the plane's
-    // gap over the disk or below the plane, the distance to the edge circle
-    // above the plane outside the disk (a bead that meets only the edge, a
-    // stroke on the hoop); and whether the bead is there, on the edge's side.
-    double surface_gap_m(const Eigen::Vector3d &center_m) const;
+    // Whether the bead is above the plane outside the disk, where its nearest
+    // point of the drum's top is the edge circle (update() then takes its gap
+    // as the distance to that circle, distance_to_rim_m(): a bead that meets
+    // only the edge, a stroke on the hoop).
     bool on_edge_side(const Eigen::Vector3d &center_m) const;
     // The normal of what the bead would meet there: the plane's (up), or on
     // the edge's side the direction from the edge circle's nearest point.
