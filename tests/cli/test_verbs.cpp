@@ -686,16 +686,16 @@ TEST_CASE("render: missed notes and a score without notes are said on stderr, ex
     CHECK(far.err.find("not struck: line 3 (the right hand at ") != std::string::npos);
     CHECK(far.err.find(", line 3 (the left hand at ") != std::string::npos);
     // On a kit, a hand's note lost after a move from another piece says the move: the right
-    // hand from the floor tom to the crash, 1.3 m in a 16th at 112 bpm (0.13 s), a move no
+    // hand from the ride to the crash, 1.27 m in a 16th at 112 bpm (0.13 s), a move no
     // arm makes (10 m/s).
-    std::ofstream(dir / "cross.score") << "tempo 112\nbeats 1/4\nR on floor\nR on crash\n";
+    std::ofstream(dir / "cross.score") << "tempo 112\nbeats 1/4\nR on ride\nR on crash\n";
     Daemon cross({"render", "--kit", "full", "--score", (dir / "cross.score").string(),
                   "--bvh-rate", "0", "--tips-rate", "0", "--out", (dir / "cross").string()});
     CHECK(cross.wait() == 0);
     INFO(cross.err);
     CHECK(cross.err.find("1 of 2 notes of the score were not struck: line 4 (the right hand on "
                          "crash at ") != std::string::npos);
-    CHECK(cross.err.find(", from floor 1.3") != std::string::npos);
+    CHECK(cross.err.find(", from ride 1.27") != std::string::npos);
     CHECK(cross.err.find(" m away 0.13 s before)") != std::string::npos);
     CHECK(far.err.find("--drum-pos") != std::string::npos);
     CHECK(lines(slurp((dir / "far" / "strikes.csv").string())).size() == 1); // the header only

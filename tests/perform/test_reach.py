@@ -16,6 +16,11 @@ ictus_tools.limb_clearance: no limb's core inside one; its volume's clearance pr
 Printed, not asserted: the same scores with German sticks, where the arm crossed over to the
 hi-hat meets the wrist's limits.
 
+Beyond the arm's reach (docs/perform.md, "The trunk takes part"): seeded runs of 4-8 notes of
+the right hand on the crash, from rest, pp..ff, 60-140 bpm, some with the left on the snare,
+asserted as above; the same of the left hand on the ride printed, not asserted (its stick
+meets the ride's edge from across the kit on some seeds).
+
     PYTHONPATH=python python3 tests/perform/test_reach.py --ictusd build/ictusd
 """
 import argparse
@@ -49,6 +54,22 @@ def groove(seed, grip):
                 parts.append("L on crash 1/2 %s" % r.choice(DYNAMICS))
             lines.append(" + ".join(parts))
     lines.append("L on crash 1/1 %s" % r.choice(DYNAMICS))
+    return "\n".join(lines) + "\n"
+
+
+def far(seed, hand, piece):
+    """A score's text: 4-8 notes of one hand on a piece beyond the arm's reach from its
+    shoulder (the right hand on the crash, far left and high; the left on the ride, far
+    right), from rest, some with the other hand on the snare."""
+    r = random.Random(seed)
+    other = "L" if hand == "R" else "R"
+    lines = ["# far reach, seed %d: %s on %s" % (seed, hand, piece),
+             "tempo %d" % r.randint(60, 140)]
+    for _ in range(r.randint(4, 8)):
+        note = "%s on %s %s %s" % (hand, piece, r.choice(["1/2", "1/1"]), r.choice(DYNAMICS))
+        if r.random() < 0.3:
+            note += " + %s on snare %s" % (other, r.choice(DYNAMICS))
+        lines.append(note)
     return "\n".join(lines) + "\n"
 
 
@@ -113,6 +134,28 @@ def main():
         totals[grip] = (ok_all, n_all, passes_all)
     print("hands right: french %d of %d (stick parts through a piece %d), german %d of %d (%d)"
           % (totals["french"] + totals["german"]))
+    # Beyond the arm's reach: the trunk turns and leans toward the piece (docs/perform.md).
+    for hand, piece, asserted in (("R", "crash", True), ("L", "ride", False)):
+        n_all = ok_all = 0
+        for seed in range(args.first, args.first + args.count):
+            name = "far-%s-%s-%d" % (hand, piece, seed)
+            path = os.path.join(args.workdir, name + ".txt")
+            with open(path, "w") as f:
+                f.write(far(seed, hand, piece))
+            out, _ = e2e_util.render_kit(args.ictusd, args.workdir, name, "full",
+                                         ["--score", path], wav=False)
+            n, ok, wrong, passes, (core, volume) = judge(out)
+            n_all += n
+            ok_all += ok
+            message = "%s: %d of %d notes of the hands within %g ms%s (stick parts through a " \
+                "piece: %s; limbs: least clearance of a core %.1f mm)" % (
+                    name, ok, n, WINDOW_MS, "" if not wrong else ": " + "; ".join(wrong),
+                    passes or "none", 1e3 * core)
+            if asserted:
+                check(not wrong, message)
+            else:
+                print("reported:", message)
+        print("%s on %s: %d of %d notes of the hands right" % (hand, piece, ok_all, n_all))
     finish()
     return 0
 

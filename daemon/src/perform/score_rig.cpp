@@ -260,10 +260,25 @@ void ScoreRig::trunk_synergy()
                                (f.rest_tip_m[1] - f.membrane_center_m).dot(f.up));
     const int right = static_cast<int>(Side::right), left = static_cast<int>(Side::left);
     const double lean = kTrunkLean_rad_per_m * (rest - 0.5 * (height(left) + height(right)));
-    const double twist = -kTrunkTwist_rad_per_m * (height(right) - height(left));
+    double twist = -kTrunkTwist_rad_per_m * (height(right) - height(left));
+    // Reaching far: each shoulder toward its tip target.
+    Eigen::Quaterniond reach = Eigen::Quaterniond::Identity();
+    const Eigen::Vector3d mid = 0.5 * (r.shoulder_m[0] + r.shoulder_m[1]);
+    for (int s = 0; s < 2; ++s) {
+        Eigen::Vector3d to = tips.position_m[s] - r.shoulder_m[s];
+        to -= to.dot(f.up) * f.up;
+        const double excess = to.norm() - kReachFrom_m;
+        if (!(excess > 0.0))
+            continue;
+        to.normalize();
+        const Eigen::Vector3d swing = f.up.cross(r.shoulder_m[s] - mid).normalized();
+        twist += kReachTwist_rad_per_m * excess * to.dot(swing);
+        reach = reach * Eigen::Quaterniond(Eigen::AngleAxisd(kReachLean_rad_per_m * excess,
+                                                             f.up.cross(to).normalized()));
+    }
     // Lean about the performer's left axis (forward flexion), twist about up.
     const Eigen::Vector3d left_axis = -f.right;
-    const Eigen::Quaterniond q = Eigen::Quaterniond(Eigen::AngleAxisd(twist, f.up)) *
+    const Eigen::Quaterniond q = reach * Eigen::Quaterniond(Eigen::AngleAxisd(twist, f.up)) *
                                  Eigen::Quaterniond(Eigen::AngleAxisd(lean, left_axis));
     const Eigen::Quaterniond part = Eigen::Quaterniond::Identity().slerp(0.4, q);
     r.step_body.local[r.lumbar] = r.body.local[r.lumbar] * part;

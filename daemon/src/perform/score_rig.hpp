@@ -52,6 +52,14 @@ struct ScoreRig {
     static constexpr double kTrunkHz = 8.0;
     static constexpr double kTrunkLean_rad_per_m = 0.15;
     static constexpr double kTrunkTwist_rad_per_m = 0.2;
+    // A tip target further than kReachFrom_m from its shoulder in plan (the
+    // right hand at the crash, the left at the ride): the trunk turns that
+    // shoulder toward it, kReachTwist_rad_per_m times the excess times the
+    // share of the shoulder's swing that points at the target, and leans
+    // toward it, kReachLean_rad_per_m times the excess (docs/perform.md).
+    static constexpr double kReachFrom_m = 0.85;
+    static constexpr double kReachTwist_rad_per_m = 6.0;
+    static constexpr double kReachLean_rad_per_m = 3.0;
 
     // On a throne (a kit with a foot piece, docs/kit.md "The throne"): the
     // hips this much lower than standing, and the ankles' places (right, up,

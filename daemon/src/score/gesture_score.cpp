@@ -583,7 +583,10 @@ constexpr double kHihatRodRadius_m = 0.0125;
 // plays, only the middle of the move counts (kit_bump >= 0.5): near its ends
 // the tip belongs to the strokes, which may press it into their head (a buzz's
 // press, the strike's aim below the surface), and a lift there would be
-// divided by a vanishing bump into a leap of tens of cm.
+// divided by a vanishing bump into a leap of tens of cm. For the same reason a
+// shortfall the strokes themselves leave at the move's ends (the right stick
+// laid over the hi-hat to reach the crash) is not made up there: each point's
+// shortfall counts above the line between the two ends'.
 double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFrame &frame,
                 const PlanOptions &opt, bool cymbals_only = false)
 {
@@ -594,10 +597,8 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
     // full kit's rack toms, raised over its kick).
     const double rest_y =
         std::min(frame.rest_tip_m[0].dot(frame.up), frame.rest_tip_m[1].dot(frame.up));
-    double lift = 0.0;
-    constexpr int kPoints = 48;
-    for (int i = 1; i < kPoints; ++i) {
-        const double x = static_cast<double>(i) / kPoints;
+    // The shortfall at point x of the move.
+    auto shortfall = [&](double x) {
         const double t = w.move_begin + x * (w.move_end - w.move_begin);
         const Eigen::Vector3d tip = pair_position(a, b, w, t);
         const Eigen::Vector3d dir = pair_direction(a, b, w, t);
@@ -631,6 +632,17 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
                 kHihatRodRadius_m + kPalmHalfBreadth_m + opt.kit_margin_m)
                 short_m = std::max(short_m, kHihatRodAbove_m + kPalmBelowGrip_m - height);
         }
+        return short_m;
+    };
+    // What the strokes themselves leave short (a stick laid over the hi-hat
+    // to reach the crash) the move need not make up at its ends: it is
+    // measured against the line between the two ends' shortfalls.
+    const double short_begin = shortfall(0.0), short_end = shortfall(1.0);
+    double lift = 0.0;
+    constexpr int kPoints = 48;
+    for (int i = 1; i < kPoints; ++i) {
+        const double x = static_cast<double>(i) / kPoints;
+        const double short_m = shortfall(x) - ((1.0 - x) * short_begin + x * short_end);
         lift = std::max(lift, short_m / std::max(kit_bump(x), 0.05));
     }
     return lift;

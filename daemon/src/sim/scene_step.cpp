@@ -113,14 +113,19 @@ void Scene::near_callback(void *data, dGeomID a, dGeomID b)
         // A plate is soft in its contact (its bending) and 1 cm thick: an ff
         // bead sinks deeper than the disc, the shaft behind it follows, and
         // the capsule-cylinder collision (libccd) gives a nearly flat capsule
-        // deeper than the disc a sideways normal. On a plate, a shaft coming
-        // down at its first touch comes from above; one rising meets it from
-        // below.
-        if (!from_above && !bead && self->drum(drum).plate_bending_n_m > 0.0) {
+        // deeper than the disc a sideways normal; a bead skidding off a loud
+        // crash's edge comes back at its side. A plate lets a part through
+        // only from below: a normal pointing down, or a touch in the disc's
+        // lower half while the part rises. Anything else meets it.
+        const DrumParams &piece = self->drum(drum);
+        if (!from_above && piece.plate_bending_n_m > 0.0) {
             dVector3 v;
             dBodyGetPointVel(self->stick_body_[side], geoms[deepest].pos[0], geoms[deepest].pos[1],
                              geoms[deepest].pos[2], v);
-            from_above = v[1] < 0.0;
+            const bool lower_half =
+                geoms[deepest].pos[1] < piece.center_m.y() - 0.5 * piece.shell_depth_m;
+            from_above =
+                !(geoms[deepest].normal[1] < -kHeadNormalMin || (lower_half && v[1] > 0.0));
         }
         self->part_through_[static_cast<size_t>(part)] = !from_above;
         if (!from_above) {
