@@ -671,7 +671,7 @@ TEST_CASE("render: --out refuses a used folder, --force replaces render's own fi
 
 // A drum out of the sticks' reach played nothing, and render said only "0
 // strikes" on stdout (the count of missed notes was in render.json alone).
-TEST_CASE("render: missed notes and a score without notes are said on stderr, exit 0",
+TEST_CASE("render: missed and off-time notes and a score without notes are said on stderr, exit 0",
           "[cli][verbs]")
 {
     const fs::path dir = scratch("render-missed");
@@ -697,6 +697,23 @@ TEST_CASE("render: missed notes and a score without notes are said on stderr, ex
                          "crash at ") != std::string::npos);
     CHECK(cross.err.find(", from ride 1.27") != std::string::npos);
     CHECK(cross.err.find(" m away 0.13 s before)") != std::string::npos);
+    // A note struck, but far from its time, is said too, with its error: the right hand
+    // from the floor tom to the hi-hat, 1.03 m in a 16th at 112 bpm, lands 0.14 s late.
+    std::ofstream(dir / "late.score") << "tempo 112\nbeats 1/4\nR on floor\nR on hihat\n";
+    Daemon late({"render", "--kit", "full", "--score", (dir / "late.score").string(), "--bvh-rate",
+                 "0", "--tips-rate", "0", "--out", (dir / "late").string()});
+    CHECK(late.wait() == 0);
+    INFO(late.err);
+    CHECK(late.err.find("1 of 2 notes of the score were struck more than 5 ms from their time: "
+                        "line 4 (the right hand on hihat at 1.13 s, +") != std::string::npos);
+    CHECK(late.err.find(" ms, from floor 1.03 m away 0.13 s before) (error_ms in notes.csv)") !=
+          std::string::npos);
+    CHECK(late.err.find("not struck") == std::string::npos);
+    // The default score on the default drum: every note within 5 ms, nothing said.
+    Daemon near(
+        {"render", "--bvh-rate", "0", "--tips-rate", "0", "--out", (dir / "near").string()});
+    CHECK(near.wait() == 0);
+    CHECK(near.err.find("warning") == std::string::npos);
     CHECK(far.err.find("--drum-pos") != std::string::npos);
     CHECK(lines(slurp((dir / "far" / "strikes.csv").string())).size() == 1); // the header only
     CHECK(slurp((dir / "far" / "render.json").string()).find("\"missed_notes\": 4") !=

@@ -555,18 +555,33 @@ nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool
     return j;
 }
 
-// The notes of the score and how many of them were not struck.
+// The notes of the score, how many of them were not struck and how many were
+// struck more than kOffTime_ms from their time.
 struct NoteCount {
-    long notes = 0, missed = 0;
-    std::string first_missed; // where the first few were written
+    long notes = 0, missed = 0, off_time = 0;
+    std::string first_missed, first_off_time; // where the first few were written
 };
+constexpr double kOffTime_ms = 5.0; // docs/perform.md: a note is right within +-5 ms
 
 // "line L (the right hand on crash at 7.43 s, from floor 1.2 m away 0.27 s
-// before)" for the first few notes not struck, hands' and feet's in plan order;
-// a hand's move into the note is given when it came from another piece (most
-// notes lost on a kit asked the arm for a move it cannot make in the time).
-std::string missed_notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit)
+// before)" for the first few notes not struck (off_time false) or struck more
+// than kOffTime_ms from their time (true, with the error: "..., +12.40 ms"),
+// hands' and feet's in plan order; a hand's move into the note is given when it
+// came from another piece (most notes lost on a kit asked the arm for a move it
+// cannot make in the time).
+std::string missed_notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit,
+                              bool off_time = false)
 {
+    auto listed = [&](const NoteMatch &n) {
+        return off_time ? n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms
+                        : n.strike_seq < 0;
+    };
+    auto error = [&](const NoteMatch &n) {
+        std::ostringstream e;
+        if (off_time)
+            e << std::fixed << std::setprecision(2) << ", " << std::showpos << n.error_ms << " ms";
+        return e.str();
+    };
     constexpr int kShown = 5;
     std::ostringstream out;
     out << std::fixed << std::setprecision(2);
@@ -585,7 +600,7 @@ std::string missed_notes_text(const GesturePlan &plan, const MatchSummary &m, co
         out << " at " << t << " s" << move << ")";
     };
     for (size_t i = 0; i < plan.notes.size(); ++i) {
-        if (m.notes[i].strike_seq >= 0)
+        if (!listed(m.notes[i]))
             continue;
         const PlannedNote &n = plan.notes[i];
         const PlannedNote *prev = nullptr;
@@ -600,13 +615,13 @@ std::string missed_notes_text(const GesturePlan &plan, const MatchSummary &m, co
                  << (n.strike_point_m - prev->strike_point_m).norm() << " m away "
                  << n.time_s - prev->time_s << " s before";
         one(n.line, n.hand == Side::right ? "the right hand" : "the left hand", n.drum, n.time_s,
-            move.str());
+            error(m.notes[i]) + move.str());
     }
     for (size_t i = 0; i < plan.foot_notes.size(); ++i)
-        if (m.foot_notes[i].strike_seq < 0)
+        if (listed(m.foot_notes[i]))
             one(plan.foot_notes[i].line,
                 plan.foot_notes[i].side == Side::right ? "the right foot" : "the left foot",
-                plan.foot_notes[i].drum, plan.foot_notes[i].time_s, "");
+                plan.foot_notes[i].drum, plan.foot_notes[i].time_s, error(m.foot_notes[i]));
     if (shown > kShown)
         out << " and " << shown - kShown << " more";
     return out.str();
@@ -635,6 +650,10 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
         count.notes = static_cast<long>(plan.notes.size() + plan.foot_notes.size());
         count.missed = count.notes - m.matched_notes;
         count.first_missed = missed_notes_text(plan, m, perf.options().kit);
+        for (const auto *notes : {&m.notes, &m.foot_notes})
+            for (const NoteMatch &n : *notes)
+                count.off_time += n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms;
+        count.first_off_time = missed_notes_text(plan, m, perf.options().kit, true);
         text.str("");
         write_notes_csv(text, plan, m, perf.plan_origin_s(), perf.options().kit);
         files.notes_csv->write_and_close(text.str());
@@ -676,6 +695,11 @@ void print_render_summary(const Performance &perf, const RenderArgs &r, bool sco
                           ? "; is the drum within the sticks' reach? --drum-pos"
                           : "")
                   << ")\n";
+    if (count.off_time > 0)
+        std::cerr << "ictusd render: warning: " << count.off_time << " of " << count.notes
+                  << " notes of the score were struck more than " << kOffTime_ms
+                  << " ms from their time: " << count.first_off_time
+                  << " (error_ms in notes.csv)\n";
 }
 
 // --wav: events.txt played by Pd on the same drum. Returns the exit status.
