@@ -415,7 +415,7 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
                 m->tm_countdown = TM_INTERVAL;
         }
         if (m->bc_on && m->bc_countdown <= 0 && membrane_band_cascade_update_(m))
-            m->bc_countdown = BC_INTERVAL; /* absolute time, as the tension update */
+            m->bc_countdown = m->bc_interval; /* absolute time, as the tension update */
         membrane_point *act[MEMBRANE_MAX_POINTS];
         int na = gather_points(m, &a, act);
         a.points = na;

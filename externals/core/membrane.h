@@ -95,9 +95,9 @@ extern "C" {
 /* A plate's bending stiffness D = E h^3 / (12 (1 - nu^2)): 1 mm of bronze (E 100 GPa,
  * nu 0.33); a membrane does not use it. */
 #define MEMBRANE_DEFAULT_BENDING     9.35
-/* A plate's energy cascade (docs/plates.md, "The cascade"): 0 off (a bare plate; the
- * cymbal presets turn it on); and the von Karman coupling of its lowest modes: 0 off,
- * 1 bronze. */
+/* The energy cascade (docs/plates.md, "The cascade"; docs/membrane.md, "The energy
+ * cascade"): 0 off (a bare plate or head; the cymbal and most drum presets turn it on); and the von
+ * Karman coupling of its lowest modes: 0 off, 1 bronze. */
 #define MEMBRANE_DEFAULT_CASCADE     0.0
 #define MEMBRANE_DEFAULT_VON_KARMAN  0.0
 /* A hi-hat's pedal (docs/plates.md, "The hi-hat"): the default is the stand at rest, the
@@ -150,7 +150,8 @@ typedef enum membrane_param {
     /* A plate's energy cascade (docs/plates.md, "The cascade"): energy moves between
      * neighbouring third-octave bands of modes toward equal energy per mode, at a rate
      * cascade x Gamma, Gamma the frequency shift the in-plane stress of the vibration puts
-     * on every mode (1 = that rate; 0 = linear); a membrane ignores it */
+     * on every mode (1 = that rate; 0 = linear). On a membrane with tension modulation,
+     * at cascade x w01 x ((g - 1) / 0.1)^2, g its frequency factor (docs/membrane.md). */
     MEMBRANE_PARAM_CASCADE,
     /* A hi-hat (docs/plates.md, "The hi-hat"): the bottom plate pressed against a plate's
      * edge by the pedal acts as a dashpot spread along the edge, edgedamp N s/m^2 (N per

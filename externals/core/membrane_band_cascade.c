@@ -31,23 +31,38 @@
  * fraction 1 - exp(-Gamma dt) of its departure, never past the equilibrium, so no step
  * can overshoot. Even pairs then odd ones (operator splitting). The update waits while
  * a point (a stick) carries a force; it runs on absolute time (block-size independent).
- * Message time sets the bands and the rate's constant (no allocation anywhere). */
+ * Message time sets the bands and the rate's constant (no allocation anywhere).
+ *
+ * A drum head (docs/membrane.md, "The energy cascade") cascades the same way, with the
+ * rate its stretch sets: the tension modulation's frequency factor g = sqrt(1 + kappa E)
+ * shifts every mode by (g - 1) w_k, and a weakly nonlinear wave system exchanges energy
+ * at the kinetic rate ~ w (dw / w)^2 (weak turbulence: Zakharov, Lvov, Falkovich,
+ * "Kolmogorov Spectra of Turbulence I", Springer 1992). Here Gamma = cascade x w01 x
+ * ((g - 1) / 0.1)^2, w01 the fundamental's: the amplitude to the fourth, so a soft
+ * stroke stays linear. The same bands, steps and passivity. */
 #include "membrane_internal.h"
 
 #include <math.h>
 
 /* kg/m^3: cymbal bronze, for the thickness h = density / rho (docs/plates.md) */
 #define BC_BRONZE_RHO 8600.0
+/* A drum head's relative frequency shift g - 1 at which its exchange runs at cascade x
+ * w01 (docs/membrane.md, "The energy cascade"). */
+#define BC_DRUM_SHIFT 0.1
 /* J: a band below this takes no part (nothing to scale) */
 #define BC_E_MIN 1.0e-30
 
+/* Modes and shapes follow the head's tension in a membrane: its rate's constant is
+ * the head's kappa (membrane_tension_kappa), the plate's Gamma per unit of sum e_k / w_k. */
 void membrane_band_cascade_refresh_(membrane *m)
 {
     m->bc_on = 0;
     m->bc_bands = 0;
     const int live = m->modes;
-    if (!m->plate || !(m->cascade > 0.0) || !m->table.plate || live < 2)
+    if (!(m->cascade > 0.0) || live < 2)
         return;
+    if (m->plate ? !m->table.plate : !(membrane_tension_kappa(m) > 0.0))
+        return; /* a membrane's cascade rides on its stretch: none on a linear head */
     /* f_k = j_k c / (2 pi a): third-octave bands from the lowest mode up */
     const double step = pow(2.0, 1.0 / 3.0);
     double edge = m->table.j[0] * step;
@@ -64,11 +79,34 @@ void membrane_band_cascade_refresh_(membrane *m)
     m->bc_bands = b;
     if (m->bc_bands < 2)
         return;
-    const double nu = MODE_TABLE_PLATE_NU, h = m->density / BC_BRONZE_RHO;
-    const double mass = m->density * M_PI * m->radius * m->radius;
-    m->bc_gamma_per_ew = m->cascade * 3.0 * (1.0 - nu * nu) / (h * h * mass);
-    m->bc_dt = BC_INTERVAL / m->sample_rate;
+    m->bc_interval = m->plate ? BC_INTERVAL : BC_DRUM_INTERVAL;
+    m->bc_dt = m->bc_interval / m->sample_rate;
+    if (m->plate) {
+        const double nu = MODE_TABLE_PLATE_NU, h = m->density / BC_BRONZE_RHO;
+        const double mass = m->density * M_PI * m->radius * m->radius;
+        m->bc_gamma_per_ew = m->cascade * 3.0 * (1.0 - nu * nu) / (h * h * mass);
+    } else {
+        m->bc_gamma_per_ew = membrane_tension_kappa(m);
+    }
     m->bc_on = 1;
+}
+
+/* The fraction 1 - exp(-Gamma dt) of a pair's departure one update moves. A plate's Gamma:
+ * cascade x 3 (1 - nu^2) / (h^2 M) x sum e_k / w_k (sum_e_over_j = sum e_k / j_k); a
+ * membrane's: cascade x w01 x ((g - 1) / BC_DRUM_SHIFT)^2, g = sqrt(1 + kappa E) its
+ * tension modulation's frequency factor as the coefficients have it (updated every
+ * TM_INTERVAL samples from the same energy). */
+static double cascade_fraction(const membrane *m, double sum_e_over_j)
+{
+    const double cw = membrane_wave_speed_(m) / m->radius; /* w_k = j_k c / a */
+    double gamma;
+    if (m->plate) {
+        gamma = m->bc_gamma_per_ew * sum_e_over_j / cw;
+    } else {
+        const double eps = (m->tm_g - 1.0) / BC_DRUM_SHIFT;
+        gamma = m->cascade * m->table.j[0] * cw * eps * eps;
+    }
+    return -expm1(-gamma * m->bc_dt);
 }
 
 int membrane_band_cascade_update_(membrane *m)
@@ -76,23 +114,45 @@ int membrane_band_cascade_update_(membrane *m)
     for (int c = 0; c < m->point_count; c++)
         if (m->points[c]->active || m->points[c]->force_pending != 0.0)
             return 0;
+    double r = m->plate ? 0.0 : cascade_fraction(m, 0.0);
+    if (!m->plate && !(r > 1.0e-12 && r <= 1.0))
+        return 1; /* a head's rate needs no sums: nothing to move */
     const float h = (float)m->coef_h;
     const int nb = m->bc_bands;
     double e0[BC_MAX_BANDS], ew = 0.0;
-    /* e_k = ((h w' sc q)^2 + (sc p)^2) / 2 (the energy kernel's); sum e_k / j_k */
+    /* e_k = ((h w' sc q)^2 + (sc p)^2) / 2 (the energy kernel's); a plate's sum e_k / j_k */
     for (int b = 0; b < nb; b++) {
         double e = 0.0;
-        for (int k = m->bc_start[b]; k < m->bc_start[b + 1]; k++) {
-            const float x = h * m->wm[k] * m->sc[k] * m->q[k], v = m->sc[k] * m->p[k];
-            const double ek = 0.5 * ((double)x * x + (double)v * v);
-            e += ek;
-            ew += ek / m->table.j[k];
+        if (m->plate) {
+            for (int k = m->bc_start[b]; k < m->bc_start[b + 1]; k++) {
+                const float x = h * m->wm[k] * m->sc[k] * m->q[k], v = m->sc[k] * m->p[k];
+                const double ek = 0.5 * ((double)x * x + (double)v * v);
+                e += ek;
+                ew += ek / m->table.j[k];
+            }
+        } else {
+            /* in float, eight partial sums (vectorised): ~1e-7 of a band, far below what
+             * a head's weakest damping takes over an update (3e-4 at t60 60 s) */
+            float acc[8] = {0};
+            const int end = m->bc_start[b + 1];
+            int k = m->bc_start[b];
+            for (; k + 8 <= end; k += 8)
+                for (int l = 0; l < 8; l++) {
+                    const float x = h * m->wm[k + l] * m->sc[k + l] * m->q[k + l];
+                    const float v = m->sc[k + l] * m->p[k + l];
+                    acc[l] += x * x + v * v;
+                }
+            for (; k < end; k++) {
+                const float x = h * m->wm[k] * m->sc[k] * m->q[k], v = m->sc[k] * m->p[k];
+                acc[0] += x * x + v * v;
+            }
+            for (int l = 0; l < 8; l++)
+                e += 0.5 * acc[l];
         }
         e0[b] = m->bc_e[b] = e;
     }
-    /* 1 / w_k = a / (j_k c) */
-    const double gamma = m->bc_gamma_per_ew * ew * m->radius / membrane_wave_speed_(m);
-    const double r = -expm1(-gamma * m->bc_dt);
+    if (m->plate)
+        r = cascade_fraction(m, ew);
     if (!(r > 1.0e-12) || !(r <= 1.0))
         return 1; /* nothing to move (or a state that is not finite: left to emit_sample) */
     double *e = m->bc_e;

@@ -114,6 +114,8 @@ typedef struct membrane_point membrane_point;
 /* The energy cascade (membrane_band_cascade.c): updated every BC_INTERVAL samples of
  * absolute time (block-size independent), over bands a third of an octave wide. */
 #define BC_INTERVAL  32
+/* A drum head's: its rate is at most ~10^3 /s and changes with the tension's (TM_INTERVAL). */
+#define BC_DRUM_INTERVAL 128
 #define BC_MAX_BANDS 64
 
 struct membrane {
@@ -133,7 +135,7 @@ struct membrane {
      * its bands of modes (set at message time: band b holds modes bc_start[b] ..
      * bc_start[b + 1] - 1) and Gamma per unit of sum e_k / w_k (1/(J s^2)). */
     double cascade;
-    int bc_on, bc_countdown, bc_bands;
+    int bc_on, bc_countdown, bc_bands, bc_interval;
     int bc_start[BC_MAX_BANDS + 1];
     double bc_e[BC_MAX_BANDS], bc_gamma_per_ew, bc_dt;
     /* A plate's von Karman coupling of its lowest modes (membrane_cascade.c,
@@ -274,7 +276,8 @@ void membrane_cascade_step_(membrane *m, membrane_kernel_args *a, int input, dou
                             int picks);
 
 /* membrane_band_cascade.c. The bands and the rate for the modes and physics now
- * (message time, no allocation; off unless a plate with cascade > 0). */
+ * (message time, no allocation; off unless cascade > 0 on a plate, or on a membrane
+ * whose tension modulation is on). */
 void membrane_band_cascade_refresh_(membrane *m);
 /* One update: energy moved between neighbouring bands (audio thread: no allocation,
  * O(modes)). 0 when it has to wait (a point carries a force), 1 when done. */

@@ -27,6 +27,14 @@ static ictus_status geometry_changed(void *mv, ictus_status s)
     return physics_changed(m, s);
 }
 
+/* After the tension modulation's amount changed: it is read live, but a head's energy
+ * cascade rides on it (on only while it is). */
+static ictus_status stretch_changed(void *m, ictus_status s)
+{
+    membrane_band_cascade_refresh_(m);
+    return s;
+}
+
 ictus_status membrane_set_sample_rate(membrane *m, double sr)
 {
     ictus_status s = ictus_clamp(&sr, MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, 48000.0);
@@ -124,7 +132,8 @@ static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
                                    physics_changed},
     [MEMBRANE_PARAM_GAIN] = {"gain", "", RANGE(GAIN), FIELD(output_gain), NULL},
     /* Takes effect at the next tension update (TM_INTERVAL samples at most). */
-    [MEMBRANE_PARAM_TENSION_MOD] = {"tensionmod", "", RANGE(TENSION_MOD), FIELD(tension_mod), NULL},
+    [MEMBRANE_PARAM_TENSION_MOD] = {"tensionmod", "", RANGE(TENSION_MOD), FIELD(tension_mod),
+                                    stretch_changed},
     [MEMBRANE_PARAM_RADIATION] = {"radiation", "", RANGE(RADIATION), FIELD(radiation),
                                   physics_changed},
     [MEMBRANE_PARAM_LOSS_FACTOR] = {"lossfactor", "", RANGE(LOSS_FACTOR), FIELD(loss_factor),

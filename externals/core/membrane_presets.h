@@ -50,8 +50,8 @@ typedef struct membrane_preset {
      * N s/m^2); 0 for every other preset. The pedal (openness) is the player's: a preset
      * leaves it as it is. */
     double edge_damp_n_s_per_m2;
-    /* A cymbal's energy cascade (MEMBRANE_PARAM_CASCADE, docs/plates.md "The cascade");
-     * 0 for the drums. */
+    /* The energy cascade (MEMBRANE_PARAM_CASCADE, docs/plates.md "The cascade",
+     * docs/membrane.md "The energy cascade"); 0 for paper, floor-tom and kick. */
     double cascade;
 } membrane_preset;
 

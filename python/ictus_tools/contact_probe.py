@@ -55,6 +55,8 @@ def main():
     ap.add_argument("--mass", type=float, default=0.0138)
     ap.add_argument("--ra", type=float, default=0.33)
     ap.add_argument("--stretch", type=float, default=None)
+    ap.add_argument("--drum", action="append", default=[],
+                    help="a message to the drum after the preset, e.g. 'cascade 1' (repeatable)")
     ap.add_argument("--speeds", default="0.46,1.02,1.58,2.18,2.77,3.37,3.99,4.61,5.24,5.87")
     a = ap.parse_args()
     radius, tension, density = preset_head(a.preset)
@@ -69,7 +71,8 @@ def main():
     events = os.path.join(work, "events.txt")
     with open(events, "w") as f:
         for line in ["render-drum preset %s" % a.preset] + \
-                ["render-drum %s stretch %.9g" % (h, k3) for h in ("left", "right")]:
+                ["render-drum %s stretch %.9g" % (h, k3) for h in ("left", "right")] + \
+                ["render-drum " + msg for msg in a.drum]:
             f.write("0 %s;\n" % line)
         for i, v in enumerate(speeds):
             t = 0.1 + SPACING_S * i

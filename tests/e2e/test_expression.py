@@ -3,8 +3,9 @@ WAV, pickups mix, -20 dB, 32-bit float (far below the soft limiter), on the `tom
 
 - the ladder `R legato D`, D = 0.1 .. 1.0, one note every 2 s: the level (RMS of the first
   100 ms after each note's strike) rises monotonically and spans >= 26 dB (a drum spans
-  30-40 dB from pp to ff); the spectral centroid of the first 50 ms is printed (a recorded tom's soft
-  and hard hits differ 1.5x, 165 -> 248 Hz; this one does not: docs/sound.md, "Why a hard hit is darker");
+  30-40 dB from pp to ff); the spectral centroid of the first 50 ms at ff is >= 1.5 times pp's (a
+  recorded tom's soft and hard hits: 165 -> 248 Hz); whether it rises at every step is printed (it
+  does not: docs/sound.md, "Why the middle of the ladder is darker than pp");
 - the pitch glide (tension modulation): the (1,1) partial, the tom's pitch, read 5-65 ms
   after the strike is >= 10 cents above its pitch 400-460 ms after for ff, and within 2 cents
   for pp. The partial is found as the spectral peak within 10 % of the ideal membrane's
@@ -127,10 +128,12 @@ span = levels[-1] - levels[0]
 check(monotone(levels), "ladder: level rises with every step")
 # The stroke heights (d^1.3, docs/gestures.md) give the ladder 21x in impact speed.
 check(span >= 26.0, "ladder: level range %.1f dB (a drum: 26 dB and more)" % span)
-# The centroid is reported, not asserted: the contact shortens with speed (e2e_contact_ladder),
-# which first moves the energy from (1,1) down to (0,1); a rigid stick brightens a hit 1.5x
-# only near 21 m/s (docs/sound.md, "Why a hard hit is darker").
-print("ladder: centroid ff/pp %.2f (a recorded tom: 1.5)" % (centroids[-1] / centroids[0]))
+# The head's energy cascade brightens a ff hit (docs/membrane.md); in the middle of the ladder
+# the shortening contact first moves the energy from (1,1) down to (0,1), so the centroid dips
+# before it rises (printed, not asserted: docs/sound.md, "Expression").
+check(centroids[-1] >= 1.5 * centroids[0], "ladder: centroid ff/pp %.2f (>= 1.5; a recorded tom: 1.5)"
+      % (centroids[-1] / centroids[0]))
+print("ladder: the centroid %s at every step" % ("rises" if monotone(centroids) else "does not rise"))
 check(glides[-1] >= 10.0, "ff: (1,1) starts %.1f cents sharp (>= 10)" % glides[-1])
 check(abs(glides[0]) <= 2.0, "pp: (1,1) glides %.1f cents (<= 2)" % glides[0])
 
