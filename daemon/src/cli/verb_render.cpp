@@ -563,18 +563,25 @@ struct NoteCount {
 };
 constexpr double kOffTime_ms = 5.0; // docs/perform.md: a note is right within +-5 ms
 
-// "line L (the right hand on crash at 7.43 s, from floor 1.2 m away 0.27 s
-// before)" for the first few notes not struck (off_time false) or struck more
-// than kOffTime_ms from their time (true, with the error: "..., +12.40 ms"),
-// hands' and feet's in plan order; a hand's move into the note is given when it
-// came from another piece (most notes lost on a kit asked the arm for a move it
-// cannot make in the time).
-std::string missed_notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit,
-                              bool off_time = false)
+// The notes not struck (off_time false) or struck more than kOffTime_ms from
+// their time (true), hands' and feet's: how many, and "line L (the right hand
+// on crash at 7.43 s, from floor 1.2 m away 0.27 s before)" for the first few
+// in plan order (off time with the error: "..., +12.40 ms"); a hand's move into
+// the note is given when it came from another piece (most notes lost on a kit
+// asked the arm for a move it cannot make in the time).
+struct ListedNotes {
+    long count = 0;
+    std::string text;
+};
+ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit,
+                       bool off_time)
 {
+    ListedNotes listed_notes;
     auto listed = [&](const NoteMatch &n) {
-        return off_time ? n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms
-                        : n.strike_seq < 0;
+        const bool is = off_time ? n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms
+                                 : n.strike_seq < 0;
+        listed_notes.count += is;
+        return is;
     };
     auto error = [&](const NoteMatch &n) {
         std::ostringstream e;
@@ -624,7 +631,8 @@ std::string missed_notes_text(const GesturePlan &plan, const MatchSummary &m, co
                 plan.foot_notes[i].drum, plan.foot_notes[i].time_s, error(m.foot_notes[i]));
     if (shown > kShown)
         out << " and " << shown - kShown << " more";
-    return out.str();
+    listed_notes.text = out.str();
+    return listed_notes;
 }
 
 // Every output but the sound, from memory; in score mode the notes matched
@@ -649,11 +657,10 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
             match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s(), plan.foot_notes);
         count.notes = static_cast<long>(plan.notes.size() + plan.foot_notes.size());
         count.missed = count.notes - m.matched_notes;
-        count.first_missed = missed_notes_text(plan, m, perf.options().kit);
-        for (const auto *notes : {&m.notes, &m.foot_notes})
-            for (const NoteMatch &n : *notes)
-                count.off_time += n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms;
-        count.first_off_time = missed_notes_text(plan, m, perf.options().kit, true);
+        count.first_missed = notes_text(plan, m, perf.options().kit, false).text;
+        const ListedNotes off = notes_text(plan, m, perf.options().kit, true);
+        count.off_time = off.count;
+        count.first_off_time = off.text;
         text.str("");
         write_notes_csv(text, plan, m, perf.plan_origin_s(), perf.options().kit);
         files.notes_csv->write_and_close(text.str());
