@@ -368,6 +368,10 @@ void ScoreMode::follow_plan(TipTargets &tips)
         tips.stick_direction[s] = ps.direction_at(s, t, rig_->frame);
     }
     tips.has_direction = true;
+    for (int s = 0; s < 2; ++s)
+        rig_->ahead_m[static_cast<size_t>(s)] =
+            ps.target_at(s, t + ScoreRig::kReachLead_s, so.rebound_s, up);
+    rig_->has_ahead = true;
     apply_note_grips(plan_time_s_);
     if (plan_time_s_ >= ps.plan.duration_s) {
         plan_active_ = false;
@@ -399,8 +403,10 @@ int ScoreMode::step(StrikeEvent out[kStepStrikes])
     ScoreRig &r = *rig_;
     if (plan_active_)
         follow_plan(r.tips);
-    else
+    else {
         follow_rest(r.tips);
+        r.has_ahead = false;
+    }
     r.trunk_synergy();
     if (feet_[0])
         r.foot_on_pedal(Side::right, feet_[0]->pedal().footboard_angle_rad());

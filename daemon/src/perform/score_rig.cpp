@@ -264,9 +264,17 @@ void ScoreRig::trunk_synergy()
     // Reaching far: each shoulder toward its tip target.
     Eigen::Quaterniond reach = Eigen::Quaterniond::Identity();
     const Eigen::Vector3d mid = 0.5 * (r.shoulder_m[0] + r.shoulder_m[1]);
+    auto in_plan = [&](const Eigen::Vector3d &p, int s) {
+        const Eigen::Vector3d to = p - r.shoulder_m[s];
+        return Eigen::Vector3d(to - to.dot(f.up) * f.up);
+    };
     for (int s = 0; s < 2; ++s) {
-        Eigen::Vector3d to = tips.position_m[s] - r.shoulder_m[s];
-        to -= to.dot(f.up) * f.up;
+        Eigen::Vector3d to = in_plan(tips.position_m[s], s);
+        if (r.has_ahead) {
+            const Eigen::Vector3d ahead = in_plan(r.ahead_m[s], s);
+            if (ahead.norm() > to.norm())
+                to = ahead;
+        }
         const double excess = to.norm() - kReachFrom_m;
         if (!(excess > 0.0))
             continue;

@@ -35,6 +35,11 @@ struct ScoreRig {
     std::array<Eigen::Vector3d, 2> ankle_axis = {Eigen::Vector3d::UnitX(),
                                                  Eigen::Vector3d::UnitX()};
     TipTargets tips;
+    // Each hand's tip target kReachLead_s ahead of this step (the plan's; the
+    // current target between plans): the trunk's reach turns toward the
+    // farther of the two.
+    std::array<Eigen::Vector3d, 2> ahead_m{};
+    bool has_ahead = false;
     ScoreRig(const CharacterModel &m, double ik_limit_margin_rad)
         : model(m), range_of_motion(model), ik_range_of_motion(model, ik_limit_margin_rad)
     {
@@ -56,8 +61,11 @@ struct ScoreRig {
     // right hand at the crash, the left at the ride): the trunk turns that
     // shoulder toward it, kReachTwist_rad_per_m times the excess times the
     // share of the shoulder's swing that points at the target, and leans
-    // toward it, kReachLean_rad_per_m times the excess (docs/perform.md).
+    // toward it, kReachLean_rad_per_m times the excess (docs/perform.md). The
+    // reach takes the farther of the target now and kReachLead_s ahead: the
+    // trunk turns before the hand sets off across the kit.
     static constexpr double kReachFrom_m = 0.85;
+    static constexpr double kReachLead_s = 0.03;
     static constexpr double kReachTwist_rad_per_m = 6.0;
     static constexpr double kReachLean_rad_per_m = 3.0;
 
