@@ -114,7 +114,8 @@ typedef struct membrane_point membrane_point;
 /* The energy cascade (membrane_band_cascade.c): updated every BC_INTERVAL samples of
  * absolute time (block-size independent), over bands a third of an octave wide. */
 #define BC_INTERVAL  32
-/* A drum head's: its rate is at most ~10^3 /s and changes with the tension's (TM_INTERVAL). */
+/* A drum head's: its rate changes with the tension's (TM_INTERVAL); at ff it can exceed
+ * 1 / (128 samples), and each update then equalises the pairs it relaxes. */
 #define BC_DRUM_INTERVAL 128
 #define BC_MAX_BANDS 64
 

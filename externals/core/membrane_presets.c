@@ -11,8 +11,9 @@
  * (docs/plates.md, "The cascade"). */
 #define CYMBAL_CASCADE 3.0
 /* A drum head's: 1, the fundamental's rate at a tenth of a frequency shift
- * (docs/membrane.md, "The energy cascade"). Off on the floor tom and the kick: their slack
- * heads would carry it past the top of their 1024 modes at ff. */
+ * (docs/membrane.md, "The energy cascade"). Off on the floor tom and the kick (their slack
+ * heads would carry it past the top of their 1024 modes at ff) and on the snare (under its
+ * wires' air the batter's updates wait, as its tension modulation's). */
 #define DRUM_CASCADE 1.0
 
 /* clang-format off */
@@ -22,7 +23,7 @@ static const membrane_preset presets[] = {
      0.178, 3000.0, 0.262, 1.0, 1.0, 128, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 1, 0, 0.0, 0.0, 0.0},
     /* 14-inch snare, 0.25 mm batter (0.345 kg/m^2), (0,1) at 220 Hz. */
     {"snare", "14-inch snare drum, 0.25 mm Mylar batter, (0,1) at 220 Hz",
-     0.1778, 3603.0, 0.345, 0.5, 1.0, 0, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 1, 0, 0, 0.0, 0.0, DRUM_CASCADE},
+     0.1778, 3603.0, 0.345, 0.5, 1.0, 0, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 1, 0, 0, 0.0, 0.0, 0.0},
     /* 12-inch rack tom, 0.25 mm batter, (0,1) at 150 Hz. */
     {"tom", "12-inch tom, 0.25 mm Mylar batter, (0,1) at 150 Hz",
      0.1524, 1231.0, 0.345, 0.8, 1.0, 1024, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, DRUM_CASCADE},

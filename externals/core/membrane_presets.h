@@ -51,7 +51,7 @@ typedef struct membrane_preset {
      * leaves it as it is. */
     double edge_damp_n_s_per_m2;
     /* The energy cascade (MEMBRANE_PARAM_CASCADE, docs/plates.md "The cascade",
-     * docs/membrane.md "The energy cascade"); 0 for paper, floor-tom and kick. */
+     * docs/membrane.md "The energy cascade"); 0 for paper, snare, floor-tom and kick. */
     double cascade;
 } membrane_preset;
 

@@ -234,7 +234,8 @@ static void membrane_tilde_print(t_membrane_tilde *x)
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_VON_KARMAN),
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_OPENNESS),
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_EDGE_DAMP));
-    else if (ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_CASCADE) > 0.0)
+    else if (ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_CASCADE) > 0.0 &&
+             ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_TENSION_MOD) > 0.0)
         post("membrane~ %s: energy cascade %g (docs/membrane.md)",
              x->x_name != &s_ ? x->x_name->s_name : "(no name)",
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_CASCADE));

@@ -23,7 +23,8 @@ meets the ride's edge from across the kit on some seeds).
 
 From a fill to the crash (the trunk turns 30 ms ahead of the hand): docs/kit.md's groove, a
 fill of 16ths ending on the floor tom, then `R on crash f + L on snare + RF f`, asserted as
-above; seeded fills (80-130 bpm, pp..ff, down the toms in any order) printed, not asserted.
+above; seeded fills (80-130 bpm, pp..ff, 8 notes on snare, tom1 or tom2 in that order, then 8
+on the floor tom) printed, not asserted.
 
     PYTHONPATH=python python3 tests/perform/test_reach.py --ictusd build/ictusd
 """

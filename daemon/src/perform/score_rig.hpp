@@ -35,9 +35,9 @@ struct ScoreRig {
     std::array<Eigen::Vector3d, 2> ankle_axis = {Eigen::Vector3d::UnitX(),
                                                  Eigen::Vector3d::UnitX()};
     TipTargets tips;
-    // Each hand's tip target kReachLead_s ahead of this step (the plan's; the
-    // current target between plans): the trunk's reach turns toward the
-    // farther of the two.
+    // Each hand's tip target kReachLead_s ahead of this step, while a plan
+    // plays (has_ahead): the trunk's reach turns toward the farther of it and
+    // the target now.
     std::array<Eigen::Vector3d, 2> ahead_m{};
     bool has_ahead = false;
     ScoreRig(const CharacterModel &m, double ik_limit_margin_rad)
