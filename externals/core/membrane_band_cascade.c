@@ -81,12 +81,11 @@ void membrane_band_cascade_refresh_(membrane *m)
         return;
     m->bc_interval = m->plate ? BC_INTERVAL : BC_DRUM_INTERVAL;
     m->bc_dt = m->bc_interval / m->sample_rate;
+    m->bc_gamma_per_ew = 0.0;
     if (m->plate) {
         const double nu = MODE_TABLE_PLATE_NU, h = m->density / BC_BRONZE_RHO;
         const double mass = m->density * M_PI * m->radius * m->radius;
         m->bc_gamma_per_ew = m->cascade * 3.0 * (1.0 - nu * nu) / (h * h * mass);
-    } else {
-        m->bc_gamma_per_ew = 0.0;
     }
     m->bc_on = 1;
 }

@@ -131,10 +131,11 @@ struct membrane {
      * and do nothing. */
     int plate;
     double bending;
-    /* A plate's energy cascade (membrane_band_cascade.c, MEMBRANE_PARAM_CASCADE): its
-     * amount, whether the loop runs it, the samples to its next update (absolute time),
-     * its bands of modes (set at message time: band b holds modes bc_start[b] ..
-     * bc_start[b + 1] - 1) and Gamma per unit of sum e_k / w_k (1/(J s^2)). */
+    /* The energy cascade of a plate or a head (membrane_band_cascade.c,
+     * MEMBRANE_PARAM_CASCADE): its amount, whether the loop runs it, the samples to its next
+     * update and between two (absolute time), its bands of modes (set at message time: band b
+     * holds modes bc_start[b] .. bc_start[b + 1] - 1) and, for a plate, Gamma per unit of
+     * sum e_k / w_k (1/(J s^2)); a head's rate reads the tension modulation's tm_g. */
     double cascade;
     int bc_on, bc_countdown, bc_bands, bc_interval;
     int bc_start[BC_MAX_BANDS + 1];

@@ -388,6 +388,7 @@ void ScoreMode::follow_rest(TipTargets &tips)
     const double x = (perf_.time_s() + perf_.options_.scene.step_s - rest_move_start_s_) / move_s;
     const double w = smoothstep(x);
     const double dw = x > 0.0 && x < 1.0 ? 6.0 * x * (1.0 - x) / move_s : 0.0;
+    rig_->has_ahead = false; // no plan to look ahead in
     for (int s = 0; s < 2; ++s) {
         const Eigen::Vector3d d = r.frame.rest_tip_m[s] - rest_from_m_[s];
         tips.position_m[s] =
@@ -403,10 +404,8 @@ int ScoreMode::step(StrikeEvent out[kStepStrikes])
     ScoreRig &r = *rig_;
     if (plan_active_)
         follow_plan(r.tips);
-    else {
+    else
         follow_rest(r.tips);
-        r.has_ahead = false;
-    }
     r.trunk_synergy();
     if (feet_[0])
         r.foot_on_pedal(Side::right, feet_[0]->pedal().footboard_angle_rad());
