@@ -262,28 +262,52 @@ void ScoreRig::trunk_synergy()
     const double lean = kTrunkLean_rad_per_m * (rest - 0.5 * (height(left) + height(right)));
     double twist = -kTrunkTwist_rad_per_m * (height(right) - height(left));
     // Reaching far: each shoulder toward its tip target.
-    Eigen::Quaterniond reach = Eigen::Quaterniond::Identity();
     const Eigen::Vector3d mid = 0.5 * (r.shoulder_m[0] + r.shoulder_m[1]);
     auto in_plan = [&](const Eigen::Vector3d &p, int s) {
         const Eigen::Vector3d to = p - r.shoulder_m[s];
         return Eigen::Vector3d(to - to.dot(f.up) * f.up);
     };
-    for (int s = 0; s < 2; ++s) {
-        Eigen::Vector3d to = in_plan(tips.position_m[s], s);
-        if (r.has_ahead) {
-            const Eigen::Vector3d ahead = in_plan(r.ahead_m[s], s);
-            if (ahead.norm() > to.norm())
-                to = ahead;
-        }
+    // One hand's reach toward `to` (in plan, from its shoulder): the twist it
+    // adds and the lean's rotation vector; none within kReachFrom_m.
+    struct Reach {
+        double twist = 0.0;
+        Eigen::Vector3d lean = Eigen::Vector3d::Zero();
+    };
+    auto reach_to = [&](const Eigen::Vector3d &to, int s) {
+        Reach out;
         const double excess = to.norm() - kReachFrom_m;
         if (!(excess > 0.0))
-            continue;
-        to.normalize();
+            return out;
+        const Eigen::Vector3d dir = to.normalized();
         const Eigen::Vector3d swing = f.up.cross(r.shoulder_m[s] - mid).normalized();
-        twist += kReachTwist_rad_per_m * excess * to.dot(swing);
-        reach = reach * Eigen::Quaterniond(Eigen::AngleAxisd(kReachLean_rad_per_m * excess,
-                                                             f.up.cross(to).normalized()));
+        out.twist = kReachTwist_rad_per_m * excess * dir.dot(swing);
+        out.lean = kReachLean_rad_per_m * excess * f.up.cross(dir).normalized();
+        return out;
+    };
+    Eigen::Vector3d lean_by_reach = Eigen::Vector3d::Zero();
+    for (int s = 0; s < 2; ++s) {
+        const Eigen::Vector3d now = in_plan(tips.position_m[s], s);
+        Reach hand = reach_to(now, s);
+        if (r.has_ahead) {
+            // The farther of the two, blended across kReachBlend_m of their
+            // difference in length, so that the trunk's targets do not jump
+            // when the two cross.
+            const Eigen::Vector3d ahead = in_plan(r.ahead_m[s], s);
+            const double x =
+                std::clamp(0.5 + (ahead.norm() - now.norm()) / kReachBlend_m, 0.0, 1.0);
+            const double w = x * x * (3.0 - 2.0 * x);
+            const Reach far = reach_to(ahead, s);
+            hand.twist += w * (far.twist - hand.twist);
+            hand.lean += w * (far.lean - hand.lean);
+        }
+        twist += hand.twist;
+        lean_by_reach += hand.lean;
     }
+    const double reach_rad = lean_by_reach.norm();
+    const Eigen::Quaterniond reach =
+        reach_rad > 0.0
+            ? Eigen::Quaterniond(Eigen::AngleAxisd(reach_rad, lean_by_reach / reach_rad))
+            : Eigen::Quaterniond::Identity();
     // Lean about the performer's left axis (forward flexion), twist about up.
     const Eigen::Vector3d left_axis = -f.right;
     const Eigen::Quaterniond q = reach * Eigen::Quaterniond(Eigen::AngleAxisd(twist, f.up)) *

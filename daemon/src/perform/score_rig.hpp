@@ -37,7 +37,7 @@ struct ScoreRig {
     TipTargets tips;
     // Each hand's tip target kReachLead_s ahead of this step, while a plan
     // plays (has_ahead): the trunk's reach turns toward the farther of it and
-    // the target now.
+    // the target now (blended where the two are near: kReachBlend_m).
     std::array<Eigen::Vector3d, 2> ahead_m{};
     bool has_ahead = false;
     ScoreRig(const CharacterModel &m, double ik_limit_margin_rad)
@@ -62,10 +62,12 @@ struct ScoreRig {
     // shoulder toward it, kReachTwist_rad_per_m times the excess times the
     // share of the shoulder's swing that points at the target, and leans
     // toward it, kReachLean_rad_per_m times the excess (docs/perform.md). The
-    // reach takes the farther of the target now and kReachLead_s ahead: the
-    // trunk turns before the hand sets off across the kit.
+    // reach takes the farther of the target now and kReachLead_s ahead (the
+    // trunk turns before the hand sets off across the kit), the two blended
+    // while their lengths differ by less than half of kReachBlend_m.
     static constexpr double kReachFrom_m = 0.85;
     static constexpr double kReachLead_s = 0.03;
+    static constexpr double kReachBlend_m = 0.04;
     static constexpr double kReachTwist_rad_per_m = 6.0;
     static constexpr double kReachLean_rad_per_m = 3.0;
 
