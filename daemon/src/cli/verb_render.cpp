@@ -689,8 +689,9 @@ void print_render_summary(const Performance &perf, const RenderArgs &r, bool sco
     if (perf.runaways() > 0)
         std::cerr << "ictusd render: warning: the runaway guard fired " << perf.runaways()
                   << " time(s) (a stick tip over " << Performance::kRunawayTipSpeed_mps
-                  << " m/s): the sticks' strikes of the next " << Performance::kRunawayQuiet_s
-                  << " s held back, " << perf.withheld_strikes()
+                  << " m/s): the strikes it held back (a thrown stick's while it flew and "
+                  << Performance::kWhipSettle_s << " s after; with changed gains both sticks' for "
+                  << Performance::kRunawayQuiet_s << " s), " << perf.withheld_strikes()
                   << " in all (render.json's performance.runaways, withheld_strikes)\n";
     if (score_mode && count.notes == 0)
         std::cerr << "ictusd render: warning: the score has no notes: nothing was played\n";

@@ -251,7 +251,10 @@ bool Performance::withheld(const StrikeEvent &e) const
 {
     // The guard watches the sticks: a foot's strike (its pedal's own model)
     // is never held back by it.
-    return e.hand < 2 && e.time_s >= quiet_from_s_ && e.time_s < quiet_until_s_;
+    if (e.hand >= 2)
+        return false;
+    return (e.time_s >= quiet_from_s_ && e.time_s < quiet_until_s_) ||
+           (e.time_s >= whip_from_s_[e.hand] && e.time_s < whip_until_s_[e.hand]);
 }
 
 void Performance::hold_open_contacts()
@@ -338,10 +341,29 @@ void Performance::took_over(double previous_time_s)
 
 int Performance::guard_runaway(int k, StrikeEvent out[kStepStrikes])
 {
-    double speed = 0.0;
-    for (int s = 0; s < 2; ++s)
-        speed = std::max(speed, scene().tip_velocity(static_cast<Side>(s)).norm());
-    if (speed > kRunawayTipSpeed_mps && time_s() >= quiet_until_s_) {
+    double tip_mps[2], speed = 0.0;
+    for (int s = 0; s < 2; ++s) {
+        tip_mps[s] = scene().tip_velocity(static_cast<Side>(s)).norm();
+        speed = std::max(speed, tip_mps[s]);
+    }
+    const GainOptions built_in;
+    const bool whip = score_mode() && gain_scale_[0] == 1.0 && gain_scale_[1] == 1.0 &&
+                      options_.gains.natural_frequency_hz == built_in.natural_frequency_hz &&
+                      options_.gains.damping_ratio == built_in.damping_ratio &&
+                      options_.scene.limit_stops;
+    if (whip) {
+        // The built-in controller: a hand's move threw its stick. That hand
+        // is quiet while it is this fast and kWhipSettle_s after.
+        for (int s = 0; s < 2; ++s) {
+            if (!(tip_mps[s] > kRunawayTipSpeed_mps))
+                continue;
+            if (time_s() >= whip_until_s_[s]) {
+                ++runaways_;
+                whip_from_s_[s] = time_s();
+            }
+            whip_until_s_[s] = time_s() + kWhipSettle_s;
+        }
+    } else if (speed > kRunawayTipSpeed_mps && time_s() >= quiet_until_s_) {
         // No human stroke moves a stick tip this fast: the controller has
         // gone unstable. Default gains back, strikes held back meanwhile.
         ++runaways_;

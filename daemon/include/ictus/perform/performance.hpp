@@ -246,6 +246,12 @@ class Performance
     static constexpr double kDownStrokeRatio = 0.5;
     static constexpr double kRunawayTipSpeed_mps = 40.0;
     static constexpr double kRunawayQuiet_s = 1.0;
+    // With the built-in controller (default gains, scale 1 1, the joints'
+    // stops on), which does not run away, a tip that fast is the move
+    // throwing the stick (a whip across the kit): the guard then holds back
+    // that hand's strikes only, while its tip stays that fast and for
+    // kWhipSettle_s after, and leaves the gains as they are.
+    static constexpr double kWhipSettle_s = 0.1;
     long runaways() const { return runaways_; }
     // Strikes held back whole (onset and release) by the runaway guard.
     long withheld_strikes() const { return withheld_; }
@@ -312,6 +318,8 @@ class Performance
     long runaways_ = 0;
     double quiet_until_s_ = -1.0; // no strike with an onset before this time (runaway)
     double quiet_from_s_ = -1.0;  // and from this one on leaves
+    // A whip's quiet time, per hand [Side] (kWhipSettle_s).
+    double whip_from_s_[2] = {-1.0, -1.0}, whip_until_s_[2] = {-1.0, -1.0};
     long withheld_ = 0;
     long refused_statements_ = 0;
     // Counted by apply(stop), read by the worker: a play asked for before the
