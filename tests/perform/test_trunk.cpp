@@ -81,18 +81,27 @@ TEST_CASE("trunk: the reach follows the look-ahead without a jump where its leng
     // most of the whole change; blended, it spreads over many steps.
     CHECK(largest_step < 0.1 * whole);
 
-    // Far from the crossing the reach is the farther target's alone: the
-    // same trunk as with that target now and nothing ahead.
-    for (double len : {0.93, 1.07}) {
-        INFO("ahead " << len << " m");
-        r.ahead_m[kRight] = shoulder + len * ahead_dir + drop;
-        r.tips.position_m[kRight] = shoulder + 1.0 * now_dir + drop;
+    // Beyond half the blend's width (kReachBlend_m / 2) of the crossing the
+    // reach is the farther target's alone: the same trunk as with that target
+    // now and nothing ahead; within it, a blend that differs from both.
+    const double half = 0.5 * ScoreRig::kReachBlend_m;
+    auto alone_at = [&](const Eigen::Vector3d &target) {
+        r.tips.position_m[kRight] = target;
+        r.has_ahead = false;
+        return synergy(r);
+    };
+    const Eigen::Vector3d now_target = shoulder + 1.0 * now_dir + drop;
+    for (double d : {-1.05 * half, -0.95 * half, 0.95 * half, 1.05 * half}) {
+        INFO("ahead longer by " << d << " m");
+        const Eigen::Vector3d ahead_target = shoulder + (1.0 + d) * ahead_dir + drop;
+        r.tips.position_m[kRight] = now_target;
+        r.ahead_m[kRight] = ahead_target;
         r.has_ahead = true;
         const Trunk blended = synergy(r);
-        if (len > 1.0)
-            r.tips.position_m[kRight] = r.ahead_m[kRight];
-        r.has_ahead = false;
-        const Trunk alone = synergy(r);
-        CHECK(apart(blended, alone) < 1e-12);
+        const Trunk farther = alone_at(d > 0.0 ? ahead_target : now_target);
+        if (std::abs(d) > half)
+            CHECK(apart(blended, farther) < 1e-12);
+        else
+            CHECK(apart(blended, farther) > 1e-6);
     }
 }

@@ -193,6 +193,7 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
     j["trunk"] = {{"max_deg", b.trunk_max_deg}, {"rms_deg", b.trunk_rms_deg()}};
     // The runaway guard (docs/perform.md): times it fired, strikes it held back.
     j["runaways"] = perf.runaways();
+    j["whips"] = perf.whips();
     j["withheld_strikes"] = perf.withheld_strikes();
     j["sticks"] = {{"mount", o.scene.sticks == StickMount::fulcrum ? "fulcrum" : "rigid"},
                    {"grip_firmness", o.grip_firmness},

@@ -686,13 +686,20 @@ void print_render_summary(const Performance &perf, const RenderArgs &r, bool sco
                                "notes.csv"
                              : "/{strikes.csv,events.txt,render.json,performance.mid")
               << (rec.bvh ? ",performance.bvh}\n" : "}\n");
+    if (perf.whips() > 0)
+        std::cerr << "ictusd render: warning: " << perf.whips() << " stick(s) thrown faster than "
+                  << Performance::kRunawayTipSpeed_mps
+                  << " m/s by a move (a whip): that hand's strikes held back while it flew and "
+                  << Performance::kWhipSettle_s << " s after (render.json's performance.whips)\n";
     if (perf.runaways() > 0)
         std::cerr << "ictusd render: warning: the runaway guard fired " << perf.runaways()
                   << " time(s) (a stick tip over " << Performance::kRunawayTipSpeed_mps
-                  << " m/s): the strikes it held back (a thrown stick's while it flew and "
-                  << Performance::kWhipSettle_s << " s after; with changed gains both sticks' for "
-                  << Performance::kRunawayQuiet_s << " s), " << perf.withheld_strikes()
-                  << " in all (render.json's performance.runaways, withheld_strikes)\n";
+                  << " m/s): the sticks' strikes of the next " << Performance::kRunawayQuiet_s
+                  << " s held back (render.json's performance.runaways)\n";
+    if (perf.withheld_strikes() > 0)
+        std::cerr << "ictusd render: warning: " << perf.withheld_strikes()
+                  << " strike(s) held back by the guard (render.json's "
+                     "performance.withheld_strikes)\n";
     if (score_mode && count.notes == 0)
         std::cerr << "ictusd render: warning: the score has no notes: nothing was played\n";
     else if (count.missed > 0)

@@ -350,9 +350,9 @@ void print_summary(const Performance &perf, const OscSender &sender, const OscSe
               << " poses, " << sc.send_errors << " send errors; " << rc.packets << " packets in, "
               << rc.accepted << " accepted, " << rc.errors() << " errors (" << rc.errors_unanswered
               << " unanswered: error-reply budget), " << rc.refused_peers << " refused; "
-              << status.overruns.load() << " overruns, " << perf.runaways() << " runaways ("
-              << perf.withheld_strikes() << " strikes held back), " << perf.refused_statements()
-              << " score statements refused";
+              << status.overruns.load() << " overruns, " << perf.runaways() << " runaways, "
+              << perf.whips() << " whips (" << perf.withheld_strikes() << " strikes held back), "
+              << perf.refused_statements() << " score statements refused";
     if (csv)
         std::cout << "; strikes.csv: " << writer.written() << " rows, " << writer.dropped()
                   << " dropped (queue full), " << loop.out_of_order << " out of order";

@@ -253,8 +253,12 @@ bool Performance::withheld(const StrikeEvent &e) const
     // is never held back by it.
     if (e.hand >= 2)
         return false;
-    return (e.time_s >= quiet_from_s_ && e.time_s < quiet_until_s_) ||
-           (e.time_s >= whip_from_s_[e.hand] && e.time_s < whip_until_s_[e.hand]);
+    if (e.time_s >= quiet_from_s_ && e.time_s < quiet_until_s_)
+        return true;
+    for (const QuietWindow &w : whip_windows_[e.hand])
+        if (e.time_s >= w.from_s && e.time_s < w.until_s)
+            return true;
+    return false;
 }
 
 void Performance::hold_open_contacts()
@@ -351,19 +355,29 @@ int Performance::guard_runaway(int k, StrikeEvent out[kStepStrikes])
                       options_.gains.natural_frequency_hz == built_in.natural_frequency_hz &&
                       options_.gains.damping_ratio == built_in.damping_ratio &&
                       options_.scene.limit_stops;
-    if (whip) {
-        // The built-in controller: a hand's move threw its stick. That hand
-        // is quiet while it is this fast and kWhipSettle_s after.
-        for (int s = 0; s < 2; ++s) {
-            if (!(tip_mps[s] > kRunawayTipSpeed_mps))
-                continue;
-            if (time_s() >= whip_until_s_[s]) {
-                ++runaways_;
-                whip_from_s_[s] = time_s();
-            }
-            whip_until_s_[s] = time_s() + kWhipSettle_s;
+    bool runaway = false;
+    for (int s = 0; s < 2; ++s) {
+        if (!(tip_mps[s] > kRunawayTipSpeed_mps))
+            continue;
+        if (!whip) {
+            runaway = true;
+            continue;
         }
-    } else if (speed > kRunawayTipSpeed_mps && time_s() >= quiet_until_s_) {
+        // The built-in controller: a hand's move threw its stick. That hand
+        // is quiet while it is this fast and kWhipSettle_s after, unless the
+        // flight lasts or comes again (then a runaway, below).
+        if (time_s() >= whip_windows_[s][whip_newest_[s]].until_s) {
+            runaway |= time_s() - last_whip_s_ < kRunawayQuiet_s;
+            ++whips_;
+            last_whip_s_ = time_s();
+            whip_newest_[s] = (whip_newest_[s] + 1) % kWhipWindows;
+            whip_windows_[s][whip_newest_[s]].from_s = time_s();
+        } else {
+            runaway |= time_s() - whip_windows_[s][whip_newest_[s]].from_s > kWhipLongest_s;
+        }
+        whip_windows_[s][whip_newest_[s]].until_s = time_s() + kWhipSettle_s;
+    }
+    if (runaway && time_s() >= quiet_until_s_) {
         // No human stroke moves a stick tip this fast: the controller has
         // gone unstable. Default gains back, strikes held back meanwhile.
         ++runaways_;

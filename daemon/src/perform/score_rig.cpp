@@ -284,7 +284,7 @@ void ScoreRig::trunk_synergy()
         out.lean = kReachLean_rad_per_m * excess * f.up.cross(dir).normalized();
         return out;
     };
-    Eigen::Vector3d lean_by_reach = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond reach = Eigen::Quaterniond::Identity();
     for (int s = 0; s < 2; ++s) {
         const Eigen::Vector3d now = in_plan(tips.position_m[s], s);
         Reach hand = reach_to(now, s);
@@ -293,21 +293,19 @@ void ScoreRig::trunk_synergy()
             // difference in length, so that the trunk's targets do not jump
             // when the two cross.
             const Eigen::Vector3d ahead = in_plan(r.ahead_m[s], s);
+            const double longer = ahead.norm() - now.norm();
             const double x =
-                std::clamp(0.5 + (ahead.norm() - now.norm()) / kReachBlend_m, 0.0, 1.0);
+                std::isfinite(longer) ? std::clamp(0.5 + longer / kReachBlend_m, 0.0, 1.0) : 0.0;
             const double w = x * x * (3.0 - 2.0 * x);
             const Reach far = reach_to(ahead, s);
             hand.twist += w * (far.twist - hand.twist);
             hand.lean += w * (far.lean - hand.lean);
         }
         twist += hand.twist;
-        lean_by_reach += hand.lean;
+        const double lean_rad = hand.lean.norm();
+        if (lean_rad > 0.0)
+            reach = reach * Eigen::Quaterniond(Eigen::AngleAxisd(lean_rad, hand.lean / lean_rad));
     }
-    const double reach_rad = lean_by_reach.norm();
-    const Eigen::Quaterniond reach =
-        reach_rad > 0.0
-            ? Eigen::Quaterniond(Eigen::AngleAxisd(reach_rad, lean_by_reach / reach_rad))
-            : Eigen::Quaterniond::Identity();
     // Lean about the performer's left axis (forward flexion), twist about up.
     const Eigen::Vector3d left_axis = -f.right;
     const Eigen::Quaterniond q = reach * Eigen::Quaterniond(Eigen::AngleAxisd(twist, f.up)) *

@@ -247,12 +247,17 @@ class Performance
     static constexpr double kRunawayTipSpeed_mps = 40.0;
     static constexpr double kRunawayQuiet_s = 1.0;
     // With the built-in controller (default gains, scale 1 1, the joints'
-    // stops on), which does not run away, a tip that fast is the move
-    // throwing the stick (a whip across the kit): the guard then holds back
-    // that hand's strikes only, while its tip stays that fast and for
-    // kWhipSettle_s after, and leaves the gains as they are.
+    // stops on), which does not run away, a tip that fast is first taken for
+    // the move throwing the stick (a whip across the kit): the guard holds
+    // back that hand's strikes only, while its tip stays that fast and for
+    // kWhipSettle_s after, and leaves the gains as they are. A tip fast for
+    // longer than kWhipLongest_s, or a second whip within kRunawayQuiet_s of
+    // the last, is a runaway after all (a controller's oscillation lasts).
     static constexpr double kWhipSettle_s = 0.1;
+    static constexpr double kWhipLongest_s = 0.02;
     long runaways() const { return runaways_; }
+    // Sticks thrown past kRunawayTipSpeed_mps by a move (kWhipSettle_s).
+    long whips() const { return whips_; }
     // Strikes held back whole (onset and release) by the runaway guard.
     long withheld_strikes() const { return withheld_; }
     // Score statements over OSC (/ictus/score) refused: kMaxPendingStatements
@@ -318,8 +323,17 @@ class Performance
     long runaways_ = 0;
     double quiet_until_s_ = -1.0; // no strike with an onset before this time (runaway)
     double quiet_from_s_ = -1.0;  // and from this one on leaves
-    // A whip's quiet time, per hand [Side] (kWhipSettle_s).
-    double whip_from_s_[2] = {-1.0, -1.0}, whip_until_s_[2] = {-1.0, -1.0};
+    // The whips' quiet times, per hand [Side], the latest kWhipWindows (a
+    // strike is held back whole when its onset fell in one: kept while its
+    // contact may still be open).
+    struct QuietWindow {
+        double from_s = -1.0, until_s = -1.0;
+    };
+    static constexpr int kWhipWindows = 4;
+    QuietWindow whip_windows_[2][kWhipWindows];
+    int whip_newest_[2] = {0, 0};
+    double last_whip_s_ = -1e300;
+    long whips_ = 0;
     long withheld_ = 0;
     long refused_statements_ = 0;
     // Counted by apply(stop), read by the worker: a play asked for before the
