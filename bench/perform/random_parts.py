@@ -88,15 +88,10 @@ def score(out):
     return f1, worst, missed, rj["kit"].get("shell_passes"), 1e3 * core
 
 
-def seeds(text):
-    a, _, b = text.partition("-")
-    return range(int(a), int(b or a) + 1)
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--ictusd", required=True)
-    ap.add_argument("--seeds", type=seeds, default=seeds("1-20"))
+    ap.add_argument("--seeds", type=e2e_util.seed_range, default=e2e_util.seed_range("1-20"))
     ap.add_argument("--workdir", default=None)
     a = ap.parse_args()
     mido = e2e_util.require_mido()

@@ -417,3 +417,9 @@ def write_drum_midi(mido, path, events, bpm, tpq):
         now = tick
     track.append(mido.Message("note_off", channel=9, note=42, velocity=0, time=tpq))
     mid.save(path)
+
+
+def seed_range(text):
+    """Seeds "A-B" (or "A") as a range, for a script's --seeds."""
+    a, _, b = text.partition("-")
+    return range(int(a), int(b or a) + 1)
