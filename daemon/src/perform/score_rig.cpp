@@ -293,10 +293,8 @@ void ScoreRig::trunk_synergy()
             // difference in length, so that the trunk's targets do not jump
             // when the two cross.
             const Eigen::Vector3d ahead = in_plan(r.ahead_m[s], s);
-            const double longer = ahead.norm() - now.norm();
-            const double x =
-                std::isfinite(longer) ? std::clamp(0.5 + longer / kReachBlend_m, 0.0, 1.0) : 0.0;
-            const double w = x * x * (3.0 - 2.0 * x);
+            // (smoothstep takes a NaN for 0: the target now.)
+            const double w = smoothstep(0.5 + (ahead.norm() - now.norm()) / kReachBlend_m);
             const Reach far = reach_to(ahead, s);
             hand.twist += w * (far.twist - hand.twist);
             hand.lean += w * (far.lean - hand.lean);
