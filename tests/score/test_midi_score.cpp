@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -408,4 +409,70 @@ TEST_CASE("midi in: a run of alternating strokes starts on the hand that leaves 
     const MidiDrumPart c = part(false);
     for (size_t i = 0; i < 4; ++i)
         CHECK(c.score.notes[i].hand == (i % 2 == 0 ? Side::right : Side::left));
+}
+
+TEST_CASE("midi in: a closed hi-hat the right hand cannot reach while the left crashes is the "
+          "left foot's chick",
+          "[score][midi][hihat]")
+{
+    // The full kit's places (m: right, up, forward, from the snare). Four notes on the floor
+    // tom, then the crash (the left hand's) with the hi-hat on the next one. From the floor
+    // tom to the hi-hat is 1.03 m: with the right hand's last note a 16th (125 ms at 120 bpm)
+    // or two before, (1.03 + 0.1) / 0.25 = 4.5 m/s at the least, over 3.5: the left foot's.
+    // With the notes 0.5 s apart (8ths at 60 bpm) 2.3 m/s: the right hand's.
+    const std::vector<MidiDrum> kit = {{"snare", 38, true, {0.0, 0.0, 0.0}},
+                                       {"floor", 43, true, {0.56, 0.0, -0.20}},
+                                       {"crash", 49, true, {-0.64, 0.30, 0.36}},
+                                       {"hihat", 42, true, {-0.42, 0.26, -0.02}}};
+    const double d = std::hypot(0.56 + 0.42, 0.26, -0.20 + 0.02);
+    REQUIRE((d + 0.1) / 0.25 > kMidiPedalHihatAbove_mps);
+    REQUIRE((d + 0.1) / 0.5 < kMidiPedalHihatAbove_mps);
+    auto part = [&](int delta, int tempo_us, int hat, bool chick) {
+        std::string t =
+            bytes({0, 0xff, 0x51, 3, tempo_us >> 16, (tempo_us >> 8) & 0xff, tempo_us & 0xff});
+        for (int k = 0; k < 4; ++k)
+            t += bytes({k == 0 ? 0 : delta, 0x99, 43, 100});
+        t += bytes({delta, 0x99, 49, 120}) + bytes({0, 0x99, hat, 90});
+        if (chick)
+            t += bytes({0, 0x99, 44, 70});
+        return drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t + kEnd), "h.mid"), kit,
+                               "h.mid");
+    };
+    auto hat_note = [](const MidiDrumPart &p) {
+        const ScoreNote *hat = nullptr;
+        for (const ScoreNote &n : p.score.notes)
+            if (n.drum == "hihat")
+                hat = &n;
+        REQUIRE(hat);
+        return *hat;
+    };
+    // 16ths at 120 bpm: the chick, on the crash's beat, counted.
+    const MidiDrumPart fast = part(24, 500000, 42, false);
+    REQUIRE(fast.score.notes.size() == 6);
+    const ScoreNote a = hat_note(fast);
+    CHECK(a.foot);
+    CHECK(a.hand == Side::left);
+    CHECK(a.beat == Approx(1.0));
+    CHECK(fast.hihats_pedalled == 1);
+    for (const ScoreNote &n : fast.score.notes)
+        if (n.drum == "crash")
+            CHECK((n.hand == Side::left && !n.foot));
+    // 8ths at 60 bpm: the right hand's, crossed over.
+    const MidiDrumPart slow = part(48, 1000000, 42, false);
+    const ScoreNote b = hat_note(slow);
+    CHECK(!b.foot);
+    CHECK(b.hand == Side::right);
+    CHECK(slow.hihats_pedalled == 0);
+    // An open hi-hat (the pedal up) and a closed one with the foot's own chick on the tick
+    // stay the right hand's.
+    const MidiDrumPart open = part(24, 500000, 46, false);
+    CHECK(!hat_note(open).foot);
+    CHECK(open.hihats_pedalled == 0);
+    const MidiDrumPart busy = part(24, 500000, 42, true);
+    REQUIRE(busy.score.notes.size() == 7);
+    int feet = 0;
+    for (const ScoreNote &n : busy.score.notes)
+        feet += n.foot;
+    CHECK(feet == 1);
+    CHECK(busy.hihats_pedalled == 0);
 }

@@ -391,6 +391,11 @@ void load_midi_score(PerformanceOptions &o)
         std::cerr << "ictusd: warning: --midi " << path << ": " << part.too_fast
                   << " notes left out: no hand free (a third note at once, or under "
                   << kMidiSameHandMin_s * 1e3 << " ms after both hands' last)\n";
+    if (part.hihats_pedalled > 0)
+        std::cerr << "ictusd: --midi " << path << ": " << part.hihats_pedalled
+                  << " closed hi-hats played by the left foot (both hands taken on their tick, "
+                     "the right's move over "
+                  << kMidiPedalHihatAbove_mps << " m/s; docs/midi.md)\n";
     if (part.tempo_clamped > 0)
         std::cerr << "ictusd: warning: --midi " << path << ": " << part.tempo_clamped
                   << " tempi kept within " << kMinTempoBpm << ".." << kMaxTempoBpm << " bpm\n";

@@ -399,6 +399,55 @@ void turn_runs(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes
     }
 }
 
+// The closed hi-hats on ticks both hands play that the right hand would reach from its last
+// note faster than kMidiPedalHihatAbove_mps: the left foot's chicks when the foot is free
+// (no chick within kMidiChickMin_s, `chick_s` its chicks' times); they leave the hands'
+// notes. Returns how many.
+long pedal_crowded_hihats(std::vector<ScoreNote> &score, std::vector<HandNote> &notes,
+                          std::vector<double> &chick_s, const std::vector<MidiDrum> &drums)
+{
+    auto right = [&](size_t i) { return score[notes[i].index].hand == Side::right; };
+    auto left_on_tick = [&](size_t i) {
+        for (size_t j = i; j-- > 0 && notes[j].tick == notes[i].tick;)
+            if (!right(j))
+                return true;
+        for (size_t j = i + 1; j < notes.size() && notes[j].tick == notes[i].tick; ++j)
+            if (!right(j))
+                return true;
+        return false;
+    };
+    auto foot_free = [&](double t) {
+        for (double c : chick_s)
+            if (std::abs(c - t) < kMidiChickMin_s - 1e-9)
+                return false;
+        return true;
+    };
+    std::vector<HandNote> kept;
+    long pedalled = 0;
+    size_t last_right = notes.size();
+    for (size_t i = 0; i < notes.size(); ++i) {
+        ScoreNote &s = score[notes[i].index];
+        const bool closed_hat =
+            right(i) && drums[static_cast<size_t>(notes[i].drum)].midi_note == kMidiClosedHihat &&
+            s.openness == kHihatClosed;
+        if (closed_hat && last_right < notes.size() && left_on_tick(i) &&
+            move_speed(drums, notes[last_right], notes[i]) > kMidiPedalHihatAbove_mps &&
+            foot_free(notes[i].t)) {
+            s.foot = true;
+            s.hand = Side::left;
+            s.openness = -1.0;
+            chick_s.push_back(notes[i].t);
+            ++pedalled;
+            continue;
+        }
+        if (right(i))
+            last_right = i;
+        kept.push_back(notes[i]);
+    }
+    notes.swap(kept);
+    return pedalled;
+}
+
 } // namespace
 
 MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
@@ -417,6 +466,7 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
     long last_tick = -1;
     int last_hand = 1, at_tick = 0;
     std::vector<HandNote> hand_notes;
+    std::vector<double> chick_s; // the left foot's chicks (44)
     // The notes in file order, but at one tick the ride's, then the hi-hat's first: the
     // right hand keeps time on them and the other hand plays what falls with them (crossed
     // over the hi-hat, as a right-handed drummer plays a groove; the hi-hat the left's
@@ -474,6 +524,8 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
             s.drum = drums[static_cast<size_t>(drum)].name;
             part.score.notes.push_back(s);
             last_foot = t;
+            if (!kick)
+                chick_s.push_back(t);
             continue;
         }
         // Hands: at the same tick the other hand (two at once at most);
@@ -525,8 +577,13 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         last_tick = n.tick;
         last_hand = hand;
     }
-    if (!drums.empty())
+    if (!drums.empty()) {
+        // Before the second look, which then sees the right hand free, and after it, for a
+        // run it turned onto the right hand's last note.
+        part.hihats_pedalled = pedal_crowded_hihats(part.score.notes, hand_notes, chick_s, drums);
         turn_runs(part.score.notes, hand_notes, drums);
+        part.hihats_pedalled += pedal_crowded_hihats(part.score.notes, hand_notes, chick_s, drums);
+    }
     for (size_t i = 0; i + 1 < part.score.notes.size(); ++i)
         part.score.notes[i].beats =
             std::max(kMinNoteBeats, part.score.notes[i + 1].beat - part.score.notes[i].beat);
