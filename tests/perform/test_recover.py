@@ -22,11 +22,12 @@ drummer does with them (docs/midi.md, "Beyond the song"), through the real `ictu
   and the kick on the downbeat, and a bar of 8th-note hi-hat. On the downbeat both hands would
   cross the kit in one 16th (the left to the crash, the right over it to the hi-hat, 107-150
   ms): where the right's move is over 3.5 m/s the hi-hat is the left foot's chick, and the
-  crash may still be late (docs/midi.md, "Beyond the song"). Asserted: every hi-hat note
-  found within 5 ms, the downbeat's too (without the chick seeds 5-8 lost it: two not struck, two 32-37 ms early), every note from
-  the second 8th on found within 5 ms (a right stick wedged on the hi-hat's rim lost the whole
-  bar), and no limb through the hi-hat's rod (the left palm swept through it on its way to the
-  crash, docs/kit.md, "Playing it").
+  left's lift over the hi-hat peaks where the hi-hat is (docs/kit.md, "Playing it").
+  Asserted: every note found within 5 ms, the downbeat's two too (without the chick seeds 5-8
+  lost the hi-hat: two not struck, two 32-37 ms early; with the lift peaking mid-move the
+  crash was 9-31 ms off on the same seeds; a right stick wedged on the hi-hat's rim once lost
+  the whole bar after it), and no limb through the hi-hat's rod (the
+  left palm swept through it on its way to the crash).
 
     PYTHONPATH=python python3 tests/perform/test_recover.py --ictusd build/ictusd [--workdir DIR]
 """
@@ -141,20 +142,16 @@ def fill_hihat_on(ictusd, work, seeds=range(1, 9)):
         notes += [(down, 49, 120), (down, 36, 110)]
         notes += [(down + i * e8, 42, 80) for i in range(8)]
         rows = render(ictusd, work, "fill-hihat-on-%d" % seed, notes, bpm, bvh=True)
-        t_down = min(r["t"] for r in rows if r["drum"] == "crash")
         lost = [(r["t"], r["drum"], r["hand"], r["error_ms"]) for r in rows if not found(r)]
-        after = [x for x in lost if x[0] > t_down + 0.001]
         rod = limb_clearance.clearances(os.path.join(work, "fill-hihat-on-%d" % seed))
         rod_core = min(c.core_m for (limb, piece), c in rod.items() if piece == "hihat stand")
         print("fill into a crash, the hi-hat on (seed %d, %d bpm, ending on %s): %d notes, "
               "lost %s; least limb core clearance to the hi-hat's rod %.1f mm"
               % (seed, bpm, "the snare" if last == 38 else "tom1", len(rows), lost,
                  1e3 * rod_core))
-        check(not after, "seed %d: every note after the downbeat found within 5 ms: %s"
-              % (seed, after))
-        hats = [x for x in lost if x[1] == "hihat"]
-        check(not hats, "seed %d: every hi-hat note found within 5 ms, the downbeat's too (the "
-              "left foot's chick when the right hand cannot reach it): %s" % (seed, hats))
+        check(not lost, "seed %d: every note found within 5 ms, the downbeat's crash and hi-hat "
+              "too (the hi-hat the left foot's chick when the right hand cannot reach it): %s"
+              % (seed, lost))
         check(rod_core >= 0.0, "seed %d: no limb through the hi-hat's rod: %.1f mm"
               % (seed, 1e3 * rod_core))
 

@@ -480,6 +480,47 @@ TEST_CASE("plan: a hand going to the crash over the hi-hat keeps its palm above 
     }
 }
 
+TEST_CASE("plan: a stick crossing the kit passes over the hi-hat's rod, not through it",
+          "[score][kit][hihat]")
+{
+    // The hi-hat's rod (1.25 cm in radius) stands 10 cm above its plates, about their centre;
+    // a stick is 0.406 m long and 7.25 mm in radius (character.hpp's StickParams). Seeded
+    // moves of either hand between two pieces of a kit with a hi-hat and a crash: wherever a
+    // point of the planned stick (every 2 mm from its tip to its butt) is within the rod's
+    // radius plus the stick's of the rod's axis in plan, it is above the rod's top by the
+    // stick's radius. Measured along the stick point by point here; the planner finds the
+    // stick's point nearest the rod in closed form.
+    PerformerFrame f = hihat_frame(-0.02);
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums.push_back({"crash", c + Eigen::Vector3d(0.64, 0.30, 0.36), 0.2286, true, false});
+    const Eigen::Vector3d hat = f.drums[4].membrane_center_m;
+    const double near = 0.0125 + 0.00725, top = 0.10 + 0.00725, length = 0.406;
+    const char *pieces[] = {"snare", "tom1", "tom2", "floor", "crash", "hihat"};
+    std::mt19937 rng(5);
+    for (int trial = 0; trial < 40; ++trial) {
+        const int tempo = 70 + static_cast<int>(rng() % 81);
+        const char *a = pieces[rng() % 6];
+        const char *b = pieces[rng() % 6];
+        const bool right = rng() % 2;
+        const char *gap = rng() % 2 ? "1/4" : "1/2";
+        const std::string hand = right ? "R" : "L";
+        const std::string score = "tempo " + std::to_string(tempo) + "\n" + hand + " on " + a +
+                                  " " + gap + "\n" + hand + " on " + b + " beats 2\nrest 4";
+        INFO(score);
+        const GesturePlan plan = plan_performance(parse_score(score, "t"), db(), f);
+        const int h = static_cast<int>(right ? Side::right : Side::left);
+        double worst = 1.0;
+        for (size_t i = 0; i < plan.tips.time_s.size(); ++i)
+            for (double along = 0.0; along <= length; along += 0.002) {
+                const Eigen::Vector3d p =
+                    plan.tips.tip_m[h][i] - along * plan.stick_dir[h][i] - hat;
+                if (std::hypot(p.x(), p.z()) <= near)
+                    worst = std::min(worst, p.y() - top);
+            }
+        CHECK(worst > -1e-3);
+    }
+}
+
 TEST_CASE("plan: the right foot's notes are the kick's, timed as the hands', never a hand's",
           "[score][kit][kick]")
 {

@@ -225,8 +225,9 @@ struct Window {
     Eigen::Vector3d across = Eigen::Vector3d::Zero();
     double move_begin = 0.0, move_end = 0.0;
     // A move between two drums of a kit: lifted by lift times kit_bump()
-    // over [move_begin, move_end] (kit_lift()).
+    // over [move_begin, move_end], highest at lift_peak of it (kit_lift()).
     Eigen::Vector3d lift = Eigen::Vector3d::Zero();
+    double lift_peak = 0.5;
     // A turn of the stick's heading made apart from the units' cross-fade:
     // the second unit's heading less the first's (rad, within +-pi) about
     // `up`, over [turn_begin, turn_end] (within the move window); 0 where the
@@ -243,10 +244,12 @@ double smoothstep5(double x)
 }
 
 // The lift's shape over a move between drums: 0 -> 1 -> 0 with zero slope at
-// both ends (C1 with the units), 1 at the middle.
-double kit_bump(double x)
+// both ends (C1 with the units), 1 at `peak` (the middle unless given; the
+// halves on either side stretched to it, so the slope stays 0 there).
+double kit_bump(double x, double peak = 0.5)
 {
     x = std::clamp(x, 0.0, 1.0);
+    x = x < peak ? 0.5 * x / peak : 0.5 + 0.5 * (x - peak) / (1.0 - peak);
     return 16.0 * x * x * (1.0 - x) * (1.0 - x);
 }
 
@@ -573,6 +576,8 @@ constexpr double kPalmBelowGrip_m = 0.057;
 constexpr double kPalmHalfBreadth_m = 0.045;
 constexpr double kHihatRodAbove_m = 0.10;
 constexpr double kHihatRodRadius_m = 0.0125;
+constexpr double kStick_m = StickParams{}.length_m;
+constexpr double kStickRadius_m = StickParams{}.shaft_radius_m;
 
 // How far a move from drum a.drum to b.drum must rise (m): wherever the tip
 // is over a drum's disk (its radius plus kit_margin_m, in plan), it must be
@@ -588,8 +593,9 @@ constexpr double kHihatRodRadius_m = 0.0125;
 // laid over the hi-hat to reach the crash) is not made up there: each point's
 // shortfall counts above the line between the two ends'.
 double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFrame &frame,
-                const PlanOptions &opt, bool cymbals_only = false)
+                const PlanOptions &opt, double &peak, bool cymbals_only = false)
 {
+    peak = 0.5;
     if (!(w.move_end > w.move_begin) || frame.drums.size() < 2)
         return 0.0;
     // A move to or from rest passes over the cymbals and over any head that
@@ -631,20 +637,43 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
             if ((rel - height * frame.up).norm() <=
                 kHihatRodRadius_m + kPalmHalfBreadth_m + opt.kit_margin_m)
                 short_m = std::max(short_m, kHihatRodAbove_m + kPalmBelowGrip_m - height);
+            // The stick's point nearest the rod in plan stays above the rod's top.
+            const Eigen::Vector3d from = tip - d.membrane_center_m;
+            const Eigen::Vector3d from_plan = from - from.dot(frame.up) * frame.up;
+            const Eigen::Vector3d dir_plan = dir - dir.dot(frame.up) * frame.up;
+            const double s_near =
+                dir_plan.squaredNorm() > 1e-12
+                    ? std::clamp(from_plan.dot(dir_plan) / dir_plan.squaredNorm(), 0.0, kStick_m)
+                    : 0.0;
+            if ((from_plan - s_near * dir_plan).norm() <=
+                kHihatRodRadius_m + kStickRadius_m + opt.kit_margin_m)
+                short_m = std::max(short_m, kHihatRodAbove_m + kStickRadius_m -
+                                                (from - s_near * dir).dot(frame.up));
         }
         return short_m;
     };
     // What the strokes themselves leave short (a stick laid over the hi-hat
     // to reach the crash) the move need not make up at its ends: it is
     // measured against the line between the two ends' shortfalls.
+    // The lift is highest where the shortfall is (within the middle
+    // kLiftPeakSpan of the move): a hand lifted over the hi-hat on its way
+    // to the crash comes down again before the crash's stroke rises.
     const double short_begin = shortfall(0.0), short_end = shortfall(1.0);
-    double lift = 0.0;
     constexpr int kPoints = 48;
+    constexpr double kLiftPeakSpan = 0.4;
+    double rel[kPoints] = {}, most = 0.0;
     for (int i = 1; i < kPoints; ++i) {
         const double x = static_cast<double>(i) / kPoints;
-        const double short_m = shortfall(x) - ((1.0 - x) * short_begin + x * short_end);
-        lift = std::max(lift, short_m / std::max(kit_bump(x), 0.05));
+        rel[i] = shortfall(x) - ((1.0 - x) * short_begin + x * short_end);
+        if (rel[i] > most) {
+            most = rel[i];
+            peak = std::clamp(x, 0.5 - 0.5 * kLiftPeakSpan, 0.5 + 0.5 * kLiftPeakSpan);
+        }
     }
+    double lift = 0.0;
+    for (int i = 1; i < kPoints; ++i)
+        lift = std::max(lift,
+                        rel[i] / std::max(kit_bump(static_cast<double>(i) / kPoints, peak), 0.05));
     return lift;
 }
 
@@ -660,7 +689,7 @@ void lift_rest_move(const Item &a, const Item &b, Window &w, const PerformerFram
     Window m = w;
     m.move_begin = w.begin;
     m.move_end = w.end;
-    const double lift = kit_lift(a, b, m, frame, opt, true);
+    const double lift = kit_lift(a, b, m, frame, opt, m.lift_peak, true);
     if (lift > 0.0) {
         m.lift = lift * frame.up;
         w = m;
@@ -739,7 +768,7 @@ double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
             turn_for_window(std::remainder(placed[k + 1].yaw_rad - it.yaw_rad, 2.0 * M_PI), frame,
                             opt, w);
             if (it.drum != placed[k + 1].drum)
-                w.lift = kit_lift(it, placed[k + 1], w, frame, opt) * frame.up;
+                w.lift = kit_lift(it, placed[k + 1], w, frame, opt, w.lift_peak) * frame.up;
             line.windows.push_back(w);
         }
     }
@@ -780,7 +809,7 @@ void sample_hand(const std::vector<double> &times, const HandTimeline &line,
                                 : t > mv.end ? 1.0
                                              : smoothstep5((t - mv.begin) / (mv.end - mv.begin));
             const double x = (t - mv.move_begin) / (mv.move_end - mv.move_begin);
-            p0 += (smoothstep5(x) - made) * mv.across + kit_bump(x) * mv.lift;
+            p0 += (smoothstep5(x) - made) * mv.across + kit_bump(x, mv.lift_peak) * mv.lift;
             if (mv.turn_rad != 0.0) {
                 Eigen::Vector3d pa, da, pb, db;
                 its[m].eval(t, pa, da);
