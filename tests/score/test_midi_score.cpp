@@ -475,4 +475,66 @@ TEST_CASE("midi in: a closed hi-hat the right hand cannot reach while the left c
         feet += n.foot;
     CHECK(feet == 1);
     CHECK(busy.hihats_pedalled == 0);
+    // Without a left-hand note on its tick (no crash) the hi-hat stays the right hand's,
+    // however fast: the left could take it.
+    {
+        std::string t;
+        for (int k = 0; k < 4; ++k)
+            t += bytes({k == 0 ? 0 : 24, 0x99, 43, 100});
+        t += bytes({24, 0x99, 42, 90});
+        const MidiDrumPart alone = drum_part_score(
+            read_smf(header(0, 1) + chunk("MTrk", t + kEnd), "a.mid"), kit, "a.mid");
+        CHECK(!hat_note(alone).foot);
+        CHECK(alone.hihats_pedalled == 0);
+    }
+    // Two crowded hi-hats 62.5 ms apart (32nds at 120 bpm), each with a crash: the second
+    // is within 100 ms of the first's chick, so it stays a hand's.
+    {
+        std::string t;
+        for (int k = 0; k < 4; ++k)
+            t += bytes({k == 0 ? 0 : 24, 0x99, 43, 100});
+        t += bytes({24, 0x99, 49, 120}) + bytes({0, 0x99, 42, 90});
+        t += bytes({12, 0x99, 57, 120}) + bytes({0, 0x99, 42, 90});
+        const MidiDrumPart two = drum_part_score(
+            read_smf(header(0, 1) + chunk("MTrk", t + kEnd), "t.mid"), kit, "t.mid");
+        CHECK(two.hihats_pedalled == 1);
+        int feet = 0;
+        for (const ScoreNote &n : two.score.notes)
+            feet += n.foot;
+        CHECK(feet == 1);
+    }
+}
+
+TEST_CASE("midi in: a hi-hat made crowded by the sticking's second look is the foot's too",
+          "[score][midi][hihat]")
+{
+    // Four 16ths on the snare at 100 bpm (150 ms apart) after a rest, then the crash with the
+    // closed hi-hat. The hand rule plays them R L R L: the right's last note 300 ms before
+    // the hi-hat, 0.494 m away ((0.494 + 0.1) / 0.3 = 2.0 m/s): the right hand's. The second
+    // look turns the run (the left's move to the crash, 0.793 m: 6.0 m/s from one 16th
+    // before, 3.0 from two) to L R L R, and the right's last note is then one 16th before
+    // (4.0 m/s, over 3.5): the left foot's chick, found after the turn.
+    const std::vector<MidiDrum> kit = {{"snare", 38, true, {0.0, 0.0, 0.0}},
+                                       {"crash", 49, true, {-0.64, 0.30, 0.36}},
+                                       {"hihat", 42, true, {-0.42, 0.26, -0.02}}};
+    const double hat = std::hypot(0.42, 0.26, 0.02), crash = std::hypot(0.64, 0.30, 0.36);
+    REQUIRE((hat + 0.1) / 0.3 < kMidiPedalHihatAbove_mps);
+    REQUIRE((hat + 0.1) / 0.15 > kMidiPedalHihatAbove_mps);
+    REQUIRE((crash + 0.1) / 0.15 * kMidiTurnRunGain > (hat + 0.1) / 0.3);
+    std::string t = bytes({0, 0xff, 0x51, 3, 0x09, 0x27, 0xc0}); // 600000 us: 100 bpm
+    for (int k = 0; k < 4; ++k)
+        t += bytes({k == 0 ? 0 : 24, 0x99, 38, 100});
+    t += bytes({24, 0x99, 49, 120}) + bytes({0, 0x99, 42, 90});
+    const MidiDrumPart p =
+        drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t + kEnd), "s.mid"), kit, "s.mid");
+    REQUIRE(p.score.notes.size() == 6);
+    std::string hands;
+    for (const ScoreNote &n : p.score.notes)
+        if (n.drum == "snare")
+            hands += n.hand == Side::left ? 'L' : 'R';
+    CHECK(hands == "LRLR");
+    CHECK(p.hihats_pedalled == 1);
+    for (const ScoreNote &n : p.score.notes)
+        if (n.drum == "hihat")
+            CHECK((n.foot && n.hand == Side::left));
 }

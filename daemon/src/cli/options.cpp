@@ -392,8 +392,9 @@ void load_midi_score(PerformanceOptions &o)
                   << " notes left out: no hand free (a third note at once, or under "
                   << kMidiSameHandMin_s * 1e3 << " ms after both hands' last)\n";
     if (part.hihats_pedalled > 0)
-        std::cerr << "ictusd: --midi " << path << ": " << part.hihats_pedalled
-                  << " closed hi-hats played by the left foot (both hands taken on their tick, "
+        std::cerr << "ictusd: note: --midi " << path << ": " << part.hihats_pedalled
+                  << (part.hihats_pedalled == 1 ? " closed hi-hat" : " closed hi-hats")
+                  << " played by the left foot's pedal, a chick (both hands taken on the tick, "
                      "the right's move over "
                   << kMidiPedalHihatAbove_mps << " m/s; docs/midi.md)\n";
     if (part.tempo_clamped > 0)

@@ -245,10 +245,12 @@ double smoothstep5(double x)
 
 // The lift's shape over a move between drums: 0 -> 1 -> 0 with zero slope at
 // both ends (C1 with the units), 1 at `peak` (the middle unless given; the
-// halves on either side stretched to it, so the slope stays 0 there).
+// halves on either side stretched to it, so the slope stays 0 there: C1, its
+// curvature jumps at the peak unless it is the middle).
 double kit_bump(double x, double peak = 0.5)
 {
     x = std::clamp(x, 0.0, 1.0);
+    peak = std::clamp(peak, 0.05, 0.95);
     x = x < peak ? 0.5 * x / peak : 0.5 + 0.5 * (x - peak) / (1.0 - peak);
     return 16.0 * x * x * (1.0 - x) * (1.0 - x);
 }
@@ -585,7 +587,8 @@ constexpr double kStickRadius_m = StickParams{}.shaft_radius_m;
 // here. The lift is applied as kit_bump(), so it is the largest shortfall
 // over kit_bump at 48 points of the move (kit_bump taken as >= 0.05 near the
 // ends, where the tip is over its own drums' heads). Over the two drums it
-// plays, only the middle of the move counts (kit_bump >= 0.5): near its ends
+// plays, only the middle of the move counts (kit_bump >= 0.5, x within
+// 0.15-0.85, whatever the lift's peak): near its ends
 // the tip belongs to the strokes, which may press it into their head (a buzz's
 // press, the strike's aim below the surface), and a lift there would be
 // divided by a vanishing bump into a leap of tens of cm. For the same reason a
@@ -637,44 +640,56 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
             if ((rel - height * frame.up).norm() <=
                 kHihatRodRadius_m + kPalmHalfBreadth_m + opt.kit_margin_m)
                 short_m = std::max(short_m, kHihatRodAbove_m + kPalmBelowGrip_m - height);
-            // The stick's point nearest the rod in plan stays above the rod's top.
+            // The stick, wherever it is within reach of the rod in plan (the
+            // chord of tip - s dir, s in [0, length], inside that circle:
+            // its height is linear in s, so its ends), stays above the rod's top.
             const Eigen::Vector3d from = tip - d.membrane_center_m;
             const Eigen::Vector3d from_plan = from - from.dot(frame.up) * frame.up;
             const Eigen::Vector3d dir_plan = dir - dir.dot(frame.up) * frame.up;
-            const double s_near =
-                dir_plan.squaredNorm() > 1e-12
-                    ? std::clamp(from_plan.dot(dir_plan) / dir_plan.squaredNorm(), 0.0, kStick_m)
-                    : 0.0;
-            if ((from_plan - s_near * dir_plan).norm() <=
-                kHihatRodRadius_m + kStickRadius_m + opt.kit_margin_m)
-                short_m = std::max(short_m, kHihatRodAbove_m + kStickRadius_m -
-                                                (from - s_near * dir).dot(frame.up));
+            const double reach = kHihatRodRadius_m + kStickRadius_m + opt.kit_margin_m;
+            const double qa = dir_plan.squaredNorm(), qb = from_plan.dot(dir_plan);
+            const double qc = from_plan.squaredNorm() - reach * reach;
+            const bool upright = !(qa > 1e-12);
+            const double disc = qb * qb - qa * qc, root = std::sqrt(std::max(disc, 0.0));
+            const double s0 = upright ? 0.0 : std::max(0.0, (qb - root) / qa);
+            const double s1 = upright ? kStick_m : std::min(kStick_m, (qb + root) / qa);
+            if ((upright ? qc <= 0.0 : disc >= 0.0) && s0 <= s1)
+                for (const double s_at : {s0, s1})
+                    short_m = std::max(short_m, kHihatRodAbove_m + kStickRadius_m -
+                                                    (from - s_at * dir).dot(frame.up));
         }
         return short_m;
     };
     // What the strokes themselves leave short (a stick laid over the hi-hat
     // to reach the crash) the move need not make up at its ends: it is
     // measured against the line between the two ends' shortfalls.
-    // The lift is highest where the shortfall is (within the middle
-    // kLiftPeakSpan of the move): a hand lifted over the hi-hat on its way
-    // to the crash comes down again before the crash's stroke rises.
+    // The lift's peak is the one of 0.3, 0.4, ..., 0.7 and the largest
+    // shortfall's place (kept within them) that asks the least lift, that
+    // place first among equals: a hand lifted over the hi-hat on its way to
+    // the crash comes down again before the crash's stroke rises.
     const double short_begin = shortfall(0.0), short_end = shortfall(1.0);
     constexpr int kPoints = 48;
-    constexpr double kLiftPeakSpan = 0.4;
-    double rel[kPoints] = {}, most = 0.0;
+    double rel[kPoints] = {}, most = 0.0, at_most = 0.5;
     for (int i = 1; i < kPoints; ++i) {
         const double x = static_cast<double>(i) / kPoints;
         rel[i] = shortfall(x) - ((1.0 - x) * short_begin + x * short_end);
         if (rel[i] > most) {
             most = rel[i];
-            peak = std::clamp(x, 0.5 - 0.5 * kLiftPeakSpan, 0.5 + 0.5 * kLiftPeakSpan);
+            at_most = std::clamp(x, 0.3, 0.7);
         }
     }
-    double lift = 0.0;
-    for (int i = 1; i < kPoints; ++i)
-        lift = std::max(lift,
-                        rel[i] / std::max(kit_bump(static_cast<double>(i) / kPoints, peak), 0.05));
-    return lift;
+    auto lift_for = [&rel](double p) {
+        double lift = 0.0;
+        for (int i = 1; i < kPoints; ++i)
+            lift = std::max(lift,
+                            rel[i] / std::max(kit_bump(static_cast<double>(i) / kPoints, p), 0.05));
+        return lift;
+    };
+    peak = at_most;
+    for (const double p : {0.3, 0.4, 0.5, 0.6, 0.7})
+        if (lift_for(p) < lift_for(peak))
+            peak = p;
+    return lift_for(peak);
 }
 
 // A move between a stroke and the hand's rest tip (window w, from a to b),

@@ -407,12 +407,13 @@ long pedal_crowded_hihats(std::vector<ScoreNote> &score, std::vector<HandNote> &
                           std::vector<double> &chick_s, const std::vector<MidiDrum> &drums)
 {
     auto right = [&](size_t i) { return score[notes[i].index].hand == Side::right; };
+    auto left_hand = [&](size_t j) { return !right(j) && !score[notes[j].index].foot; };
     auto left_on_tick = [&](size_t i) {
         for (size_t j = i; j-- > 0 && notes[j].tick == notes[i].tick;)
-            if (!right(j))
+            if (left_hand(j))
                 return true;
         for (size_t j = i + 1; j < notes.size() && notes[j].tick == notes[i].tick; ++j)
-            if (!right(j))
+            if (left_hand(j))
                 return true;
         return false;
     };
@@ -433,9 +434,10 @@ long pedal_crowded_hihats(std::vector<ScoreNote> &score, std::vector<HandNote> &
         if (closed_hat && last_right < notes.size() && left_on_tick(i) &&
             move_speed(drums, notes[last_right], notes[i]) > kMidiPedalHihatAbove_mps &&
             foot_free(notes[i].t)) {
-            s.foot = true;
+            s.foot = true; // as a 44's note
             s.hand = Side::left;
-            s.openness = -1.0;
+            s.openness = ScoreNote{}.openness;
+            s.theta_deg = ScoreNote{}.theta_deg;
             chick_s.push_back(notes[i].t);
             ++pedalled;
             continue;
