@@ -686,10 +686,13 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
         return lift;
     };
     peak = at_most;
+    double lift = lift_for(peak);
     for (const double p : {0.3, 0.4, 0.5, 0.6, 0.7})
-        if (lift_for(p) < lift_for(peak))
+        if (const double l = lift_for(p); l < lift) {
+            lift = l;
             peak = p;
-    return lift_for(peak);
+        }
+    return lift;
 }
 
 // A move between a stroke and the hand's rest tip (window w, from a to b),
