@@ -321,9 +321,10 @@ double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
         } else {
             const double gap = placed[k + 1].strike_t - it.strike_t;
             Window w{it.strike_t + beta * gap, placed[k + 1].strike_t - beta * gap};
-            // The move across the head (not the strike aim's depth).
+            // The move across the head (not the strike aim's depth); between two
+            // pieces, the whole move, their heights' difference too.
             const Eigen::Vector3d move = placed[k + 1].origin - it.origin;
-            w.across = move - move.dot(frame.up) * frame.up;
+            w.across = it.drum != placed[k + 1].drum ? move : move - move.dot(frame.up) * frame.up;
             w.move_begin = it.strike_t + opt.move_margin_after * gap;
             w.move_end = placed[k + 1].strike_t - opt.move_margin_before * gap;
             turn_for_window(std::remainder(placed[k + 1].yaw_rad - it.yaw_rad, 2.0 * M_PI), frame,

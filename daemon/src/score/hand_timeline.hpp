@@ -180,7 +180,10 @@ struct Item {
 struct Window {
     double begin = 0.0, end = 0.0;
     // The move across the head between the two units' spots (zero for a
-    // window to or from the rest tip), spread over [move_begin, move_end].
+    // window to or from the rest tip), spread over [move_begin, move_end];
+    // between two pieces of a kit the whole move, up or down too: over the
+    // cross-fade alone, the floor tom to the ride in a 16th at 120 bpm rose
+    // 0.22 m at 6.6 m/s at its peak and the arm overshot by 16 cm.
     Eigen::Vector3d across = Eigen::Vector3d::Zero();
     double move_begin = 0.0, move_end = 0.0;
     // A move between two drums of a kit: lifted by lift times kit_bump()
