@@ -645,7 +645,8 @@ TEST_CASE("plan: a hand going to a higher piece rises over the whole move, as it
     // the same. Made over the cross-fade alone ([t_a + 0.25 g, t_b - 0.25 g]) the rise was
     // 0.85 / 0.5 times as fast, and the arm overshot it (docs/score.md). Seeded pieces and
     // tempi; far apart and small, so that no lift over a head enters the move (a move down
-    // to a lower piece, falling from the start, may be lifted over the head it leaves).
+    // to a lower piece, falling from the start, may be lifted over the head it leaves: 43
+    // of 309 such moves among random scores on a kit peaked higher, by up to 3 cm).
     std::mt19937 rng(20261201);
     std::uniform_real_distribution<double> uni(0.0, 1.0);
     const PlanOptions opt;
@@ -655,7 +656,10 @@ TEST_CASE("plan: a hand going to a higher piece rises over the whole move, as it
     };
     const char *dynamics[] = {"pp", "p", "mf", "f", "ff"};
     for (int trial = 0; trial < 24; ++trial) {
-        const double dh = 0.03 + 0.27 * uni(rng), bpm = 60.0 + 120.0 * uni(rng);
+        // In a 16th a rise of 0.28 m left the tip below the second piece's head while
+        // over it (two trials of twelve), and the move was lifted there, as it must be.
+        const double dh = 0.03 + (trial % 2 ? 0.09 : 0.27) * uni(rng),
+                     bpm = 60.0 + 120.0 * uni(rng);
         const double angle = M_PI * uni(rng), distance = 0.45 + 0.25 * uni(rng);
         const Eigen::Vector3d c(0.0, 0.7, 0.45);
         const Eigen::Vector3d across(distance * std::cos(angle), 0.0,
@@ -665,9 +669,11 @@ TEST_CASE("plan: a hand going to a higher piece rises over the whole move, as it
             f.drums = {{"a", c, 0.1}, {"b", c + across + Eigen::Vector3d(0.0, rise, 0.0), 0.1}};
             return f;
         };
-        const std::string text = "tempo " + std::to_string(bpm) + "\nR on a " +
-                                 dynamics[rng() % 5] + "\nR on b " + dynamics[rng() % 5] +
-                                 "\nrest 2\n";
+        // Quarters, or 16ths (gaps of 83-250 ms: the units' preparations and lifts
+        // compressed).
+        const std::string text = "tempo " + std::to_string(bpm) + (trial % 2 ? "\nbeats 1/4" : "") +
+                                 "\nR on a " + dynamics[rng() % 5] + "\nR on b " +
+                                 dynamics[rng() % 5] + "\nrest 2\n";
         INFO("trial " << trial << ": dh " << dh << " m at " << bpm << " bpm, " << text);
         const GesturePlan level = plan_performance(parse_score(text, "t"), db(), frame(0.0));
         const GesturePlan raised = plan_performance(parse_score(text, "t"), db(), frame(dh));

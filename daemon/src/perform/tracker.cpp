@@ -73,10 +73,17 @@ struct Tracker::Arm {
     Eigen::Vector3d integral_m = Eigen::Vector3d::Zero();
     Eigen::Quaterniond theta_target[4], kinematic_target[4], previous_kinematic[4];
     Eigen::Quaterniond posture[4];
+    int stuck_steps = 0; // kinematic solves in a row stuck away from the target
 };
 
 namespace
 {
+// A kinematic solve stuck this far from its target (m) for this many solves in a row
+// is tried again from the arm's posture; kept when nearer by kIkReseedGain_m.
+constexpr double kIkReseedAbove_m = 0.02;
+constexpr int kIkReseedSteps = 10;
+constexpr double kIkReseedGain_m = 0.005;
+
 void build_arm(const CharacterModel &model, int side, const CharacterPose &initial,
                const std::vector<JointLimitRef> &limits, int joint[4], int &base_body,
                KinematicChain *chains[2])
@@ -263,13 +270,36 @@ void Tracker::solve_kinematic(Arm &arm, Side side, const Eigen::Vector3d &tip_ta
     const bool orient =
         tips.has_direction && co.rotation_weight > 0.0 &&
         held_rotation(scene_->model(), side, tips.stick_direction[s], hand_target, &plane);
-    const IkResult r = orient ? solver_->solve(arm.kinematic, tip_target, hand_target,
-                                               co.rotation_weight * plane, arm.kinematic_target)
-                       : co.posture_weight > 0.0
-                           ? solver_->solve_with_posture(arm.kinematic, tip_target, arm.posture,
-                                                         co.posture_weight, arm.kinematic_target)
-                           : solver_->solve(arm.kinematic, tip_target, arm.kinematic_target);
+    auto solve = [&](Eigen::Quaterniond *out) {
+        return orient ? solver_->solve(arm.kinematic, tip_target, hand_target,
+                                       co.rotation_weight * plane, out)
+               : co.posture_weight > 0.0
+                   ? solver_->solve_with_posture(arm.kinematic, tip_target, arm.posture,
+                                                 co.posture_weight, out)
+                   : solver_->solve(arm.kinematic, tip_target, out);
+    };
+    const IkResult r = solve(arm.kinematic_target);
     count_solve(r);
+    // Warm-started from its own last solution, the solve can stay in a local minimum
+    // at a joint's limit: a right arm folded across the chest (elbow at 45 degrees)
+    // after crossing from the floor tom to the hi-hat in 0.3 s, 16-18 cm short of
+    // every hi-hat note for 6 s. Stuck for kIkReseedSteps solves, it is solved again
+    // from the arm's posture, and that solution kept when it is nearer the target by
+    // kIkReseedGain_m (the rate cap below still limits the step toward it).
+    if (r.status == IkStatus::converged || !(r.position_error_m > kIkReseedAbove_m)) {
+        arm.stuck_steps = 0;
+    } else if (++arm.stuck_steps >= kIkReseedSteps) {
+        arm.stuck_steps = 0;
+        Eigen::Quaterniond seeded[4];
+        arm.kinematic.set_rotations(arm.posture);
+        const IkResult again = solve(seeded);
+        count_solve(again);
+        if (again.position_error_m < r.position_error_m - kIkReseedGain_m) {
+            for (int k = 0; k < 4; ++k)
+                arm.kinematic_target[k] = seeded[k];
+            ++ik_stats_.reseeded;
+        }
+    }
     if (!(co.max_joint_speed_rad_s > 0.0 && steps_ > 0))
         return;
     const double cap = co.max_joint_speed_rad_s * scene_->options().step_s;

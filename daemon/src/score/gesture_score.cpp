@@ -18,6 +18,8 @@
 // successive motion units" in the Cartesian space); the warping and blending
 // are the classic motion-editing tools (Witkin & Popovic 1995 motion warping,
 // Kovar & Gleicher 2003 registration curves, cross-fades with ease curves).
+// Steps 1 and 4, the moves between spots and pieces and the lift over the kit
+// are in hand_timeline.cpp.
 #include "ictus/score/gesture_score.hpp"
 
 #include "ictus/base/motor_noise.hpp"
@@ -28,7 +30,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <limits>
 #include <map>
 #include <memory>

@@ -51,7 +51,7 @@ double kit_bump(double x, double peak = 0.5)
 }
 
 // The tip between two units of one hand at t in the move window: the units'
-// cross-fade and the move across (as sample_hand makes it), without a lift.
+// cross-fade and the move to the next spot (as sample_hand makes it), without a lift.
 Eigen::Vector3d pair_position(const Item &a, const Item &b, const Window &w, double t)
 {
     Eigen::Vector3d p0, d0;
@@ -66,7 +66,7 @@ Eigen::Vector3d pair_position(const Item &a, const Item &b, const Window &w, dou
                         : t > w.end ? 1.0
                                     : smoothstep5((t - w.begin) / (w.end - w.begin));
     const double x = (t - w.move_begin) / (w.move_end - w.move_begin);
-    return p0 + (smoothstep5(x) - made) * w.across;
+    return p0 + (smoothstep5(x) - made) * w.shift;
 }
 
 // Two units' stick directions cross-faded by weight w (0: d0, 1: d1), unit;
@@ -321,10 +321,10 @@ double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
         } else {
             const double gap = placed[k + 1].strike_t - it.strike_t;
             Window w{it.strike_t + beta * gap, placed[k + 1].strike_t - beta * gap};
-            // The move across the head (not the strike aim's depth); between two
-            // pieces, the whole move, their heights' difference too.
+            // On one piece the move across its head (not the aims' depths); between
+            // two pieces the whole move, their heights and aims too.
             const Eigen::Vector3d move = placed[k + 1].origin - it.origin;
-            w.across = it.drum != placed[k + 1].drum ? move : move - move.dot(frame.up) * frame.up;
+            w.shift = it.drum != placed[k + 1].drum ? move : move - move.dot(frame.up) * frame.up;
             w.move_begin = it.strike_t + opt.move_margin_after * gap;
             w.move_end = placed[k + 1].strike_t - opt.move_margin_before * gap;
             turn_for_window(std::remainder(placed[k + 1].yaw_rad - it.yaw_rad, 2.0 * M_PI), frame,
@@ -338,7 +338,7 @@ double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
 }
 
 // A hand's tip and stick direction at every sample time: the ruling item,
-// cross-faded with the next one inside a window, and the move across the head.
+// cross-faded with the next one inside a window, and the move to the next spot.
 void sample_hand(const std::vector<double> &times, const HandTimeline &line,
                  std::vector<Eigen::Vector3d> &tip, std::vector<Eigen::Vector3d> &dir)
 {
@@ -362,7 +362,7 @@ void sample_hand(const std::vector<double> &times, const HandTimeline &line,
             p0 = (1.0 - w) * p0 + w * p1;
             d0 = blend_directions(d0, d1, w);
         }
-        // The move across the head: the units' blend makes it over
+        // The move to the next spot: the units' blend makes it over
         // [begin, end]; it is made over [move_begin, move_end] instead
         // (smoothstep5 at both: C1 with the units).
         if (m < win.size() && t >= win[m].move_begin && win[m].move_end > win[m].move_begin) {
@@ -371,7 +371,7 @@ void sample_hand(const std::vector<double> &times, const HandTimeline &line,
                                 : t > mv.end ? 1.0
                                              : smoothstep5((t - mv.begin) / (mv.end - mv.begin));
             const double x = (t - mv.move_begin) / (mv.move_end - mv.move_begin);
-            p0 += (smoothstep5(x) - made) * mv.across + kit_bump(x, mv.lift_peak) * mv.lift;
+            p0 += (smoothstep5(x) - made) * mv.shift + kit_bump(x, mv.lift_peak) * mv.lift;
             if (mv.turn_rad != 0.0) {
                 Eigen::Vector3d pa, da, pb, db;
                 its[m].eval(t, pa, da);

@@ -1,6 +1,6 @@
 // hand_timeline.hpp -- a hand's gesture units placed on its strokes and the
 // moves between them: the timeline the planner samples (private to src/score;
-// docs/score.md, "From score to motion"; docs/kit.md, "Planning").
+// docs/score.md, "From score to motion"; docs/kit.md, "Playing it").
 #pragma once
 
 #include "ictus/score/gesture_score.hpp"
@@ -18,7 +18,7 @@ namespace score_detail
 
 // A unit's end state is extended beyond the unit by a motion that stops
 // within this time (constant deceleration): C1 at the unit's ends.
-constexpr double kStopTime_s = 0.05;
+inline constexpr double kStopTime_s = 0.05;
 // Cubic Hermite tangents of samples p[first..last] (spacing h): central
 // differences inside, second-order one-sided differences at the ends.
 std::vector<Eigen::Vector3d> hermite_tangents(const std::vector<Eigen::Vector3d> &p, int first,
@@ -179,12 +179,13 @@ struct Item {
 // Cross-fade between items[j] and items[j + 1] over [begin, end].
 struct Window {
     double begin = 0.0, end = 0.0;
-    // The move across the head between the two units' spots (zero for a
-    // window to or from the rest tip), spread over [move_begin, move_end];
-    // between two pieces of a kit the whole move, up or down too: over the
-    // cross-fade alone, the floor tom to the ride in a 16th at 120 bpm rose
-    // 0.22 m at 6.6 m/s at its peak and the arm overshot by 16 cm.
-    Eigen::Vector3d across = Eigen::Vector3d::Zero();
+    // The move from the first unit's strike target to the second's, made over
+    // [move_begin, move_end] instead of the cross-fade (zero for a window to or
+    // from the rest tip): on one piece the move across its head (not the aims'
+    // depths), between two pieces the whole move, their heights and aims too.
+    // Over the cross-fade alone, the floor tom to the ride in a 16th at 120 bpm
+    // rose 0.22 m at 6.6 m/s at its peak and the arm overshot by 16 cm.
+    Eigen::Vector3d shift = Eigen::Vector3d::Zero();
     double move_begin = 0.0, move_end = 0.0;
     // A move between two drums of a kit: lifted by lift times kit_bump()
     // over [move_begin, move_end], highest at lift_peak of it (kit_lift()).
@@ -216,7 +217,7 @@ struct HandTimeline {
 double build_timeline(const HandStrokes &h, const PerformerFrame &frame, int s,
                       const PlanOptions &opt, HandTimeline &line);
 // A hand's tip and stick direction at every sample time: the ruling item,
-// cross-faded with the next one inside a window, and the move across the head.
+// cross-faded with the next one inside a window, and the move to the next spot.
 void sample_hand(const std::vector<double> &times, const HandTimeline &line,
                  std::vector<Eigen::Vector3d> &tip, std::vector<Eigen::Vector3d> &dir);
 

@@ -134,6 +134,7 @@ struct TrackerIkStats {
     long iterations = 0;
     long solves = 0;
     long rate_capped = 0; // joint solutions held back by max_joint_speed_rad_s
+    long reseeded = 0;    // kinematic solutions taken from a solve started at the posture
     int max_iterations = 0;
     long not_converged = 0; // solves that ended other than `converged`
     double wall_s = 0.0;    // wall time in the IK
