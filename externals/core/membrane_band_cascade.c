@@ -166,6 +166,7 @@ int membrane_band_cascade_update_(membrane *m)
             e[b + 1] -= d;
         }
     }
+    int scaled = 0;
     for (int b = 0; b < nb; b++) {
         if (e[b] == e0[b] || !(e0[b] > BC_E_MIN) || !(e[b] > 0.0))
             continue;
@@ -174,6 +175,10 @@ int membrane_band_cascade_update_(membrane *m)
             m->q[k] *= s;
             m->p[k] *= s;
         }
+        scaled = 1;
     }
+    /* The von Karman coupling follows the rescaled state (membrane_cascade.c). */
+    if (scaled)
+        membrane_cascade_rescaled_(m);
     return 1;
 }

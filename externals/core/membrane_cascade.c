@@ -83,6 +83,25 @@ void membrane_cascade_cleared_(membrane *m)
         anchor(m);
 }
 
+/* The band-level cascade rescaled some modes between samples, conserving their linear
+ * energy: Y and g follow the new state, psi is kept, so the scheme's energy (linear +
+ * psi^2 / 2) is unchanged by the rescaling. Re-anchoring psi to V(Y) instead would add
+ * V's change, and counting the jump in Y as the coupling's motion would make work no
+ * force did: either lets the energy grow. */
+void membrane_cascade_rescaled_(membrane *m)
+{
+    if (!m->vk_on)
+        return;
+    plate_cascade *c = m->pc;
+    const float h = (float)m->coef_h;
+    for (int k = 0; k < c->modes; k++)
+        c->y[k] = h * m->sc[k] * m->q[k];
+    const double v = plate_cascade_potential(c, c->y, c->g);
+    const float is = (float)(1.0 / sqrt(2.0 * (v + c->floor)));
+    for (int k = 0; k < c->modes; k++)
+        c->g[k] *= is;
+}
+
 void membrane_cascade_step_(membrane *m, membrane_kernel_args *a, int input, double *extra,
                             int picks)
 {

@@ -113,11 +113,11 @@ typedef struct membrane_point membrane_point;
 
 /* The energy cascade (membrane_band_cascade.c): updated every BC_INTERVAL samples of
  * absolute time (block-size independent), over bands a third of an octave wide. */
-#define BC_INTERVAL  32
+#define BC_INTERVAL 32
 /* A drum head's: its rate changes with the tension's (TM_INTERVAL); at ff it can exceed
  * 1 / (128 samples), and each update then equalises the pairs it relaxes. */
 #define BC_DRUM_INTERVAL 128
-#define BC_MAX_BANDS 64
+#define BC_MAX_BANDS     64
 
 struct membrane {
     double sample_rate, radius, tension, density, t60, hf_damping, output_gain;
@@ -271,6 +271,9 @@ void membrane_cascade_refresh_(membrane *m);
 void membrane_cascade_free_(membrane *m);
 /* The state was cleared or set from outside: the cascade's variables follow it. */
 void membrane_cascade_cleared_(membrane *m);
+/* After the band-level cascade rescaled modes between samples: Y and g follow, psi is
+ * kept (the scheme's energy unchanged). Audio thread: no allocation. */
+void membrane_cascade_rescaled_(membrane *m);
 /* One sample of the coupling, after the kernel's step and the strikes (audio thread: no
  * allocation); input: a force acted on the plate this sample. Its force's direct path to
  * the pickups goes into extra, to the points' displacements into a->point_w. */

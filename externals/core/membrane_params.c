@@ -58,13 +58,14 @@ ictus_status membrane_set_modes(membrane *m, int count)
     return b == ICTUS_ENOMEM ? b : s;
 }
 
-/* A number of modes: a fraction rounds to the nearest count. */
+/* A number of modes: a fraction within the range rounds to the nearest count; one below
+ * it (0.5) is out of range, as 0 is. */
 static ictus_status set_modes(void *m, double value)
 {
     /* Clamped before the conversion to int, which is undefined out of range. */
-    double count = floor(value + 0.5);
     ictus_status s =
-        ictus_clamp(&count, MEMBRANE_MODES_MIN, MEMBRANE_MODES_MAX, MEMBRANE_DEFAULT_MODES);
+        ictus_clamp(&value, MEMBRANE_MODES_MIN, MEMBRANE_MODES_MAX, MEMBRANE_DEFAULT_MODES);
+    double count = floor(value + 0.5);
     ictus_status b = membrane_set_modes(m, (int)count);
     return b != ICTUS_OK ? b : s;
 }

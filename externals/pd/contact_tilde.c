@@ -25,6 +25,7 @@ typedef struct _contact_tilde {
     contact *x_core;
     t_symbol *x_name;             /* the membrane~ to play */
     t_membrane_tilde *x_membrane; /* attached membrane~, or NULL (cleared when it goes) */
+    int x_refused;                /* the last DSP sort found its membrane~ full: hits are refused */
     float *x_force;               /* force buffer the membrane's perform writes */
     int x_force_size;
     t_outlet *x_report_out;
@@ -55,8 +56,8 @@ static void contact_tilde_tip(t_contact_tilde *x, t_symbol *name)
         strncat(known, i ? ", " : "", sizeof(known) - strlen(known) - 1);
         strncat(known, stick_tips[i].name, sizeof(known) - strlen(known) - 1);
     }
-    pd_error(x, "contact~: tip: no stick tip named '%s' (%s); the tip is unchanged",
-             name->s_name, known);
+    pd_error(x, "contact~: tip: no stick tip named '%s' (%s); the tip is unchanged", name->s_name,
+             known);
 }
 
 /* The membrane~ whose sample clock times our messages: the attached one, else
@@ -113,6 +114,13 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
             mass = mass < CONTACT_MASS_MIN ? CONTACT_MASS_MIN
                                            : (mass > CONTACT_MASS_MAX ? CONTACT_MASS_MAX : mass);
         }
+    }
+    if (x->x_refused && !x->x_membrane) {
+        pd_error(x,
+                 "contact~: hit: membrane~ '%s' already has %d contact~s; this one is silent: "
+                 "ignored",
+                 x->x_name->s_name, MEMBRANE_MAX_CONTACTS);
+        return;
     }
     m = contact_tilde_timing_membrane(x);
     if (!m) {
@@ -218,12 +226,15 @@ static void contact_tilde_dsp(t_contact_tilde *x, t_signal **sp)
     if (x->x_force)
         memset(x->x_force, 0, sizeof(float) * x->x_force_size);
     contact_set_force_output(x->x_core, x->x_force, x->x_force_size);
+    x->x_refused = 0;
     if (m) {
         if (ictus_membrane_tilde_attach(m, x->x_core, x, contact_tilde_membrane_gone))
             x->x_membrane = m;
-        else
+        else {
+            x->x_refused = 1;
             pd_error(x, "contact~: membrane~ '%s' already has %d contact~s; this one is silent",
                      x->x_name->s_name, MEMBRANE_MAX_CONTACTS);
+        }
     }
     dsp_add(contact_tilde_perform, 3, x, sp[0]->s_vec, (t_int)n);
 }

@@ -106,11 +106,16 @@ TEST_CASE("Setters report clamping and keep the bound", "[core][params]")
     CHECK(ictus_param_get(&membrane_params, m, MEMBRANE_PARAM_DENSITY) == Approx(20.0));
     CHECK(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_MASS, 0.05) == ICTUS_OK);
     CHECK(ictus_param_get(&membrane_params, m, MEMBRANE_PARAM_MASS) == Approx(0.05));
-    // A fractional mode count rounds to the nearest; clamping is judged after rounding.
+    // A fractional mode count in the range rounds to the nearest; one outside it (0.5
+    // modes) is clamped and said so, as 0 is.
     CHECK(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_MODES, 2.6) == ICTUS_OK);
     CHECK(membrane_get_modes(m) == 3);
-    CHECK(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_MODES, 0.5) == ICTUS_OK);
+    CHECK(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_MODES, 1.4) == ICTUS_OK);
     CHECK(membrane_get_modes(m) == 1);
+    CHECK(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_MODES, 0.5) == ICTUS_CLAMPED);
+    CHECK(membrane_get_modes(m) == 1);
+    CHECK(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_MODES, 4096.4) == ICTUS_CLAMPED);
+    CHECK(membrane_get_modes(m) == 4096);
     CHECK(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_MODES, 0.4) == ICTUS_CLAMPED);
     CHECK(membrane_get_modes(m) == 1);
     CHECK(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_MODES, 1e30) == ICTUS_CLAMPED);
@@ -125,7 +130,7 @@ TEST_CASE("Setters follow the clamp rule on random values", "[core][params]")
 {
     // Every entry of both tables: a value in range is kept and said OK; out of range it
     // becomes the nearer limit, NaN the default, and the status says ICTUS_CLAMPED.
-    // The mode count rounds first; the mass is kept through the density.
+    // The mode count is clamped, then rounds; the mass is kept through the density.
     std::mt19937_64 rng(20240611);
     std::uniform_real_distribution<double> u01(0.0, 1.0);
     auto value = [&]() {
@@ -145,9 +150,10 @@ TEST_CASE("Setters follow the clamp rule on random values", "[core][params]")
         void *obj = is_membrane ? (void *)m : (void *)c;
         const int id = is_membrane ? which : which - 8;
         const ictus_range r = ictus_param_range(t, obj, id);
-        double want = id == MEMBRANE_PARAM_MODES && is_membrane ? std::floor(v + 0.5) : v;
-        const bool clamped = std::isnan(want) || want < r.min || want > r.max;
-        want = std::isnan(want) ? r.def : std::fmin(std::fmax(want, r.min), r.max);
+        const bool clamped = std::isnan(v) || v < r.min || v > r.max;
+        double want = std::isnan(v) ? r.def : std::fmin(std::fmax(v, r.min), r.max);
+        if (id == MEMBRANE_PARAM_MODES && is_membrane)
+            want = std::floor(want + 0.5);
         INFO("step " << i << " parameter " << which << " value " << v);
         REQUIRE(ictus_param_set(t, obj, id, v) == (clamped ? ICTUS_CLAMPED : ICTUS_OK));
         REQUIRE(ictus_param_get(t, obj, id) == Approx(want).epsilon(1e-12));

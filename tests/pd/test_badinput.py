@@ -32,6 +32,7 @@ membrane_cases = [
     ("mass -2", "membrane~: mass must be in [0.00125664, 2.51327] kg, got -2; using 0.00125664"),
     ("modes 0", "membrane~: modes must be in [1, 4096], got 0; using 1"),
     ("modes 1000000", "membrane~: modes must be in [1, 4096], got 1e+06; using 4096"),
+    ("modes 0.5", "membrane~: modes must be in [1, 4096], got 0.5; using 1"),
     ("modes 64", None),
     ("t60", "membrane~: t60: missing value"),
     ("t60 -1", "membrane~: t60 must be in [0.005, 60] s, got -1; using 0.005"),
@@ -102,12 +103,37 @@ for k, (text, _) in enumerate(contact_cases):
     p.connect(trig, 0, d, 0)
     p.connect(d, 0, m, 0)
     p.connect(m, 0, con, 0)
+# A membrane~ takes four contact~s: a fifth is silent, and says so when it is hit too.
+full = p.obj("membrane~ full-drum")
+extra = [p.obj("contact~ full-drum") for _ in range(5)]
+# ictus-drum: a lone number or a bang is not a strike; a hand out of 0..3 is refused.
+drum = p.obj("ictus-drum")
+drum_cases = [("3", "ictus-drum: expected a list <hand> <velocity m/s> <r/a> <theta deg> - got: 3"),
+              ("bang", "ictus-drum: expected a list <hand> <velocity m/s> <r/a> <theta deg> - got: "
+                       "bang"),
+              ("5 3 0.3 0", "ictus-drum: hand must be 0 (left) 1 (right) 2 (right foot) or 3 (left "
+                            "foot) - got: 5 3 0.3 0")]
+d = p.obj("delay 20")
+p.connect(trig, 0, d, 0)
+for c in extra:
+    m = p.msg("hit 1 0.3 0")
+    p.connect(d, 0, m, 0)
+    p.connect(m, 0, c, 0)
+for text, _ in drum_cases:
+    m = p.msg(text)
+    p.connect(d, 0, m, 0)
+    p.connect(m, 0, drum, 0)
 rc, log = run_pd(p.text(), args.build, sr=sr, workdir=work)
 print(log)
 check(rc == 0, "pd did not crash (exit %d)" % rc)
 for text, expect in membrane_cases + contact_cases:
     if expect:
         check(expect in log, "'%s' -> '%s'" % (text, expect))
+for text, expect in drum_cases:
+    check(expect in log, "ictus-drum '%s' -> '%s'" % (text, expect))
+check("membrane~: no method for 'bang'" not in log, "ictus-drum passes no bang to its membrane~")
+silent = "contact~: hit: membrane~ 'full-drum' already has 4 contact~s; this one is silent: ignored"
+check(log.count(silent) == 1, "the fifth contact~ says its hit is ignored, once (%d)" % log.count(silent))
 for bound in ["0.0001", "10"]:  # a bound is not out of bounds
     refused = "stick mass must be in [0.0001, 10] kg, got %s;" % bound
     check(refused not in log, "no error '%s'" % refused)
