@@ -163,6 +163,12 @@ TEST_CASE("ictusd track --out writes the CSV and a summary with the required fie
     CHECK(s.at("realtime_factor").get<double>() > 0.0);
     CHECK(s.at("diverged") == false);
     CHECK(s.at("duration_s").get<double>() == Approx(1.5));
+    // --despike-deg's default, 5 degrees exactly (not a rounded radian value).
+    CHECK(s.at("despike_deg").get<double>() == 5.0);
+    // A BVH: the errors against the unfiltered capture are measured.
+    CHECK(s.at("tip_rms_raw_mm").at("right").get<double>() >= 0.0);
+    CHECK(s.at("joint_rms_raw_deg_all").is_number());
+    CHECK(s.at("skip_frames").get<int>() == 1);
     std::ifstream csv(dir + "/track.csv");
     std::string header, line;
     std::getline(csv, header);
@@ -241,6 +247,15 @@ TEST_CASE("ictusd track: a stick-only capture runs in Cartesian mode, drum fitte
     CHECK(s.at("tip_rms_mm").at("left").get<double>() < 3.0);
     CHECK(s.at("tip_rms_mm").at("right").get<double>() < 3.0);
     CHECK(s.at("ik").at("elbow_flexion_rms_deg").is_null()); // no captured elbow
+    // The capture's 400 samples (not the default body's frames); no raw capture to
+    // measure against, no BVH scale, skip or joint clean-up: null, not 0.
+    CHECK(s.at("frames").get<int>() == 400);
+    for (const char *key : {"tip_rms_raw_mm", "tip_rms_raw_free_mm", "tip_rms_raw_contact_mm",
+                            "joint_rms_raw_deg_all", "scale_m_per_unit", "skip_frames", "smooth_hz",
+                            "despike_deg", "smooth_kernel", "spikes_removed"}) {
+        INFO(key);
+        CHECK(s.at(key).is_null());
+    }
     // No capture to learn limits from: a person's range of motion; the drum at
     // the strokes' turnarounds (nothing passes through it there).
     CHECK(s.at("limits") == "range_of_motion");
@@ -504,4 +519,76 @@ TEST_CASE("ictusd track --out writes strikes.csv, the same strikes render finds"
               Approx(std::stod(b.rows[i][static_cast<size_t>(vn)])).epsilon(0.01));
         CHECK(std::stod(a.rows[i][static_cast<size_t>(vn)]) > 0.0);
     }
+}
+
+// `ictusd --help`: exit status 3, the simulation diverged (and was reset). A physics
+// step ten times the default (--step 0.01) makes the arms' PD servos overshoot:
+// the scene diverges, and render says so on stderr and exits 3, as track does;
+// the files are still written, render.json counting the same divergences.
+TEST_CASE("ictusd render: a divergence is a warning and exit status 3", "[cli]")
+{
+    const std::string dir = simtest::temp_path("render-diverged");
+    const Run r =
+        ictusd("render --step 0.01 --duration 3 --bvh-rate 0 --progress-every 0 --out " + dir);
+    INFO(r.output);
+    CHECK(r.status == 3);
+    std::ifstream in(dir + "/render.json");
+    REQUIRE(in.good());
+    const long divergences = nlohmann::json::parse(in).at("divergences").get<long>();
+    CHECK(divergences > 0);
+    CHECK(r.output.find("ictusd render: warning: the simulation diverged " +
+                        std::to_string(divergences) + " time(s)") != std::string::npos);
+    // At the default step the same score does not diverge: exit 0, no such warning.
+    const std::string ok_dir = simtest::temp_path("render-default-step");
+    const Run ok = ictusd("render --duration 3 --bvh-rate 0 --progress-every 0 --out " + ok_dir);
+    INFO(ok.output);
+    CHECK(ok.status == 0);
+    CHECK(ok.output.find("simulation diverged") == std::string::npos);
+}
+
+// A clip whose sticks never reach the drum (placed 3 m above the floor, 3 m in
+// front) plays nothing: a warning says so; exit 0 (not an error in the data).
+TEST_CASE("ictusd render --mocap: no strike at all is a warning", "[cli]")
+{
+    const std::string dir = simtest::temp_path("render-no-strike");
+    const Run r = ictusd("render --mocap " + tiny_bvh() +
+                         " --drum-pos 0,3,3 --bvh-rate 0 --progress-every 0 --out " + dir);
+    INFO(r.output);
+    CHECK(r.status == 0);
+    CHECK(r.output.find(" 0 strikes") != std::string::npos);
+    CHECK(r.output.find("ictusd render: warning: no stick struck the drum") != std::string::npos);
+}
+
+// A skeleton without a joint the character needs: every verb names the file (the
+// joint has no line of its own), and gestures --import says it once, without ':0:'.
+TEST_CASE("ictusd: a BVH missing a required joint is named in the error", "[cli]")
+{
+    std::ifstream in(tiny_bvh());
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string renamed =
+        std::regex_replace(text.str(), std::regex("JOINT RightForeArm\\b"), "JOINT RightLowerArm");
+    const std::string bvh = simtest::write_temp("no_forearm.bvh", renamed);
+    const std::string expected = bvh + ": no joint named 'RightForeArm'";
+    const std::string dir = simtest::temp_path("no-forearm-out");
+    for (const std::string &args :
+         {"render --mocap " + bvh + " --out " + dir, "track --mode joint --quiet --mocap " + bvh,
+          "limits " + bvh,
+          "gestures --import " + bvh + " --grip french --nuance legato --hand right --out " + dir +
+              ".json"}) {
+        const Run r = ictusd(args);
+        INFO(args << "\n" << r.output);
+        CHECK(r.status == 1);
+        CHECK(r.output.find(expected) != std::string::npos);
+        CHECK(r.output.find(":0:") == std::string::npos);
+    }
+    // A scale error points at the OFFSET's line, the file named once.
+    const Run scale =
+        ictusd("gestures --import " + tiny_bvh() +
+               " --scale 1 --grip french --nuance legato --hand right --out " + dir + ".json");
+    INFO(scale.output);
+    CHECK(scale.status == 1);
+    CHECK(scale.output.find(tiny_bvh() + ":") != std::string::npos);
+    CHECK(scale.output.find(tiny_bvh() + ": " + tiny_bvh()) == std::string::npos);
+    CHECK(scale.output.find(":0:") == std::string::npos);
 }

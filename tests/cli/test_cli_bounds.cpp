@@ -193,7 +193,7 @@ TEST_CASE("ictusd: a frame time out of bounds is refused at its line, and --forc
     INFO(r.output);
     CHECK(r.status == 1);
     CHECK(r.output.find(far + ":" + std::to_string(far_line) +
-                        ": expected |position| * scale <= 100 m in column 0 (Hips Xposition") !=
+                        ": expected |position| * scale <= 100 m in column 1 (Hips Xposition") !=
           std::string::npos);
 }
 

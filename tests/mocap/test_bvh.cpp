@@ -272,9 +272,9 @@ TEST_CASE("BVH: malformed files give FILE:LINE errors", "[mocap][bvh][errors]")
     {
         require_error(
             minimal_bvh(20, "0 1 0 10 nan 0 0 0 5"), 20,
-            "expected a finite number (|x| <= 1e9) in column 4 (Hips Yrotation), got 'nan'");
+            "expected a finite number (|x| <= 1e9) in column 5 (Hips Yrotation), got 'nan'");
         require_error(minimal_bvh(19, "0 1 0 0 0 0 0 inf 0"), 19,
-                      "column 7 (Chest Yrotation), got 'inf'");
+                      "column 8 (Chest Yrotation), got 'inf'");
         require_error(minimal_bvh(19, "0 1 0 0 0 0 0 1e999 0"), 19, "got '1e999'");
         require_error(minimal_bvh(19, "0 1 0 0 0 0 0 x 0"), 19, "got 'x'");
         require_error(minimal_bvh(19, "0 1 0 0 0 0 0 -2e9 0"), 19, "got '-2e9'");
@@ -590,7 +590,7 @@ TEST_CASE("BVH: values out of the physical bounds of a capture are refused at th
         require_bound_error(minimal_bvh(12, "      OFFSET 0 0 -101"), 12, "joint Chest_End");
         require_bound_error(minimal_bvh(4, "  OFFSET 100.5 0 0"), 4, "joint Hips");
         require_bound_error(minimal_bvh(20, "0 1 1e9 10 0 0 0 0 5"), 20,
-                            "expected |position| * scale <= 100 m in column 2 (Hips Zposition, "
+                            "expected |position| * scale <= 100 m in column 3 (Hips Zposition, "
                             "scale 1), got '1e9' = 1e+09 m");
         require_bound_warning(minimal_bvh(20, "0 1 1e9 10 0 0 0 0 5"), 20, "Hips Zposition");
         // The scale decides: 1000 units are 56 m at the CMU scale, 1000 m at 1.
@@ -738,7 +738,7 @@ TEST_CASE("BVH: random files inside the bounds pass, one value outside fails at 
             file.frames[static_cast<std::size_t>(f)][static_cast<std::size_t>(trial % 3)] = outside;
             line = 19 + f;
             expected =
-                "expected |position| * scale <= 100 m in column " + std::to_string(trial % 3);
+                "expected |position| * scale <= 100 m in column " + std::to_string(trial % 3 + 1);
             break;
         }
         }

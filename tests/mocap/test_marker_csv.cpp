@@ -102,7 +102,21 @@ TEST_CASE("CSV: frame column with a rate", "[mocap][csv]")
     CHECK(capture.time_s[0] == Approx(0.004));
     CHECK(capture.time_s[2] == Approx(0.016));
     require_error("frame,m.x,m.y,m.z\n1,0,0,0\n", 1,
-                  "expected MarkerCsvOptions::rate_hz > 0 for a file with a frame column");
+                  "expected a frame rate (--rate HZ) for a file with a frame column and no time "
+                  "column, got none");
+}
+
+// TrajOptDrums' exports name their clock "Time (s)": seconds, as a `time` column.
+TEST_CASE("CSV: a Time (s) column is the time in seconds", "[mocap][csv]")
+{
+    for (const char *name : {"Time (s)", "time (s)", "TIME(S)"}) {
+        INFO(name);
+        const MarkerCapture capture =
+            parse(std::string(name) + ",m.x,m.y,m.z\n0,0,0,0\n0.004,1,1,1\n0.008,2,2,2\n");
+        REQUIRE(capture.time_s.size() == 3);
+        CHECK(capture.time_s[1] == 0.004);
+        CHECK(capture.time_s[2] == 0.008);
+    }
 }
 
 TEST_CASE("CSV: short interior gaps are interpolated with a warning", "[mocap][csv]")
@@ -163,7 +177,12 @@ TEST_CASE("CSV: malformed files give FILE:LINE errors", "[mocap][csv][errors]")
     require_error("time,m.x,m.z\n0,0,0\n", 1, "expected column m.y for object 'm', got none");
     require_error("time,m.x,m.y,m.z,m.qw\n0,0,0,0,1\n", 1,
                   "expected all of m.qw .qx .qy .qz, or none, got no m.qx");
-    require_error("m.x,m.y,m.z\n0,0,0\n", 1, "expected a time (s) or frame column, got neither");
+    require_error("m.x,m.y,m.z\n0,0,0\n", 1,
+                  "expected a column named time or Time (s) (seconds), or frame (with --rate HZ), "
+                  "got neither");
+    // Another separator: one column; said so.
+    require_error("time;m.x;m.y;m.z\n0;0;0;0\n", 1,
+                  "expected comma-separated columns, got one column holding ';'");
     require_error("time\n0\n", 1, "expected at least one object");
     require_error("time,m.x,m.y,m.z\n0,0,0,0\n0.02,0,0,0\n0.01,0,0,0\n", 4,
                   "expected time to increase");

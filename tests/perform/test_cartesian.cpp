@@ -151,6 +151,9 @@ TEST_CASE("Cartesian tracking of a synthetic swing: tips within millimetres",
     CHECK(j["mode"] == "cartesian");
     CHECK(j["ik"]["mean_iterations"].get<double>() >= 0.0);
     CHECK(j["ik"]["us_per_step"].get<double>() > 0.0);
+    // Reseeds are counted among the solves that did not converge (a reseed follows ten).
+    CHECK(j["ik"]["reseeded"].get<long>() >= 0);
+    CHECK(j["ik"]["reseeded"].get<long>() <= j["ik"]["not_converged"].get<long>());
     std::istringstream in(csv.str());
     std::string header;
     std::getline(in, header);

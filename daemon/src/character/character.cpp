@@ -129,9 +129,10 @@ int find_joint(const Skeleton &skeleton, const std::string &name)
     if (slash == std::string::npos) {
         const int j = skeleton.find(name);
         if (j < 0)
-            throw CharacterError("skeleton: no joint named '" + name +
-                                 "' (the character expects CMU joint names, see "
-                                 "docs/character.md)");
+            throw CharacterError(
+                (skeleton.source.empty() ? std::string("skeleton") : skeleton.source) +
+                ": no joint named '" + name +
+                "' (the character expects CMU joint names, see docs/character.md)");
         return j;
     }
     const int parent = find_joint(skeleton, name.substr(0, slash));

@@ -578,8 +578,8 @@ ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit
 {
     ListedNotes listed_notes;
     auto listed = [&](const NoteMatch &n) {
-        const bool is = off_time ? n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms
-                                 : n.strike_seq < 0;
+        const bool is =
+            off_time ? n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms : n.strike_seq < 0;
         listed_notes.count += is;
         return is;
     };
@@ -673,7 +673,7 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
 
 // The summary line on stdout, and on stderr what render.json says in
 // missed_notes, said where it is seen: a drum out of the sticks' reach
-// (--drum-pos) plays nothing and still exits 0.
+// (--drum-pos) plays nothing and still exits 0 (a divergence exits 3).
 void print_render_summary(const Performance &perf, const RenderArgs &r, bool score_mode,
                           const RenderRecording &rec, const NoteCount &count)
 {
@@ -700,8 +700,14 @@ void print_render_summary(const Performance &perf, const RenderArgs &r, bool sco
         std::cerr << "ictusd render: warning: " << perf.withheld_strikes()
                   << " strike(s) held back by the guard (render.json's "
                      "performance.withheld_strikes)\n";
+    if (perf.divergences() > 0)
+        std::cerr << "ictusd render: warning: the simulation diverged " << perf.divergences()
+                  << " time(s) and was reset (render.json's divergences; exit status 3)\n";
     if (score_mode && count.notes == 0)
         std::cerr << "ictusd render: warning: the score has no notes: nothing was played\n";
+    else if (!score_mode && rec.log.strikes().empty())
+        std::cerr << "ictusd render: warning: no stick struck the drum: nothing was played "
+                     "(is the drum within the sticks' reach? --drum-pos)\n";
     else if (count.missed > 0)
         std::cerr << "ictusd render: warning: " << count.missed << " of " << count.notes
                   << " notes of the score were not struck: " << count.first_missed
@@ -827,7 +833,11 @@ int cmd_render(Args &args)
     print_render_summary(perf, r, score_mode, rec, count);
     if (rec.interrupted)
         return 130;
-    return r.wav.empty() ? 0 : render_wav(r, perf);
+    // A divergence (exit status 3, as track) still renders the sound of what was played.
+    const int wav_status = r.wav.empty() ? 0 : render_wav(r, perf);
+    if (wav_status != 0)
+        return wav_status;
+    return perf.divergences() > 0 ? 3 : 0;
 }
 
 } // namespace cli

@@ -386,7 +386,6 @@ void check_gain_overrides(const CharacterModel &model, const std::vector<JointGa
     }
 }
 
-
 void load_track_input(TrackArgs &t, TrackInput &in)
 {
     MarkerCapture capture;
@@ -514,8 +513,10 @@ int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary
     const TrackOptions &options = t.options;
     nlohmann::json j = summary.to_json();
     j["mocap"] = t.mocap;
-    j["scale_m_per_unit"] = t.clip.scale;
-    j["skip_frames"] = t.clip.skip;
+    // A stick-only .csv capture has no BVH scale, skipped frames or joint clean-up: null.
+    const nlohmann::json not_used;
+    j["scale_m_per_unit"] = t.stick_only ? not_used : nlohmann::json(t.clip.scale);
+    j["skip_frames"] = t.stick_only ? not_used : nlohmann::json(t.clip.skip);
     j["step_s"] = options.scene.step_s;
     j["stepper"] = options.scene.stepper == Stepper::quick ? "quick" : "direct";
     j["quickstep_iterations"] = options.scene.quickstep_iterations;
@@ -529,10 +530,11 @@ int report(const TrackArgs &t, const TrackInput &in, const TrackSummary &summary
     j["gain_hz"] = options.gains.natural_frequency_hz;
     j["damping_ratio"] = options.gains.damping_ratio;
     j["drum_radius_m"] = options.scene.drum.radius_m;
-    j["smooth_hz"] = t.clip.filter.smooth_cutoff_hz;
-    j["despike_deg"] = t.clip.filter.spike_threshold_rad * 180.0 / M_PI;
-    j["smooth_kernel"] = to_string(t.clip.filter.kernel);
-    j["spikes_removed"] = in.reference->spikes_removed();
+    j["smooth_hz"] = t.stick_only ? not_used : nlohmann::json(t.clip.filter.smooth_cutoff_hz);
+    j["despike_deg"] =
+        t.stick_only ? not_used : nlohmann::json(t.clip.filter.spike_threshold_rad * 180.0 / M_PI);
+    j["smooth_kernel"] = t.stick_only ? not_used : nlohmann::json(to_string(t.clip.filter.kernel));
+    j["spikes_removed"] = t.stick_only ? not_used : nlohmann::json(in.reference->spikes_removed());
     j["tip_smooth_hz"] = t.stick_only           ? 0.0
                          : t.options.tip_motion ? t.tip_smooth_hz
                                                 : t.clip.filter.smooth_cutoff_hz;

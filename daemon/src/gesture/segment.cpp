@@ -268,19 +268,21 @@ std::vector<GestureUnit> import_capture(const std::string &path, Grip g, Nuance 
             for (size_t f = 0; f < cap.time_s.size(); ++f)
                 right += cap.tracks[tracks[1]].position_m[f] - cap.tracks[tracks[0]].position_m[f];
         } else {
-            throw GestureError(path + ":0: unknown capture type (expected .bvh or .csv)");
+            throw GestureError(path + ": unknown capture type (expected .bvh or .csv)");
         }
     } catch (const MocapError &e) {
         throw GestureError(e.what());
     } catch (const CharacterError &e) {
-        throw GestureError(path + ":0: " + e.what());
+        // The skeleton's errors name the file (and the OFFSET's line) already.
+        const std::string what = e.what();
+        throw GestureError(what.rfind(path, 0) == 0 ? what : path + ": " + what);
     }
     std::vector<GestureUnit> units;
     try {
         units = segment_strokes(time_s, tip, right, g, n, h, opts.segment,
                                 dir.empty() ? nullptr : &dir);
     } catch (const GestureError &e) {
-        throw GestureError(path + ":0: " + e.what());
+        throw GestureError(path + ": " + e.what());
     }
     for (auto &u : units)
         u.source = base_name(path);

@@ -417,13 +417,13 @@ class BvhParser
                     std::fabs(values[c]) > kMaxMagnitude)
                     throw MocapError(source_, line_number,
                                      "expected a finite number (|x| <= 1e9) in column " +
-                                         std::to_string(c) + " (" + channel_label(c) + "), got " +
-                                         quote(tokens[c]));
+                                         std::to_string(c + 1) + " (" + channel_label(c) +
+                                         "), got " + quote(tokens[c]));
                 if (position_column[c] && std::fabs(values[c] * options_.scale) > kMaxCoordinate_m)
                     out_of_bounds(line_number, "position",
                                   "expected |position| * scale <= " +
                                       number_text(kMaxCoordinate_m) + " m in column " +
-                                      std::to_string(c) + " (" + channel_label(c) + ", scale " +
+                                      std::to_string(c + 1) + " (" + channel_label(c) + ", scale " +
                                       number_text(options_.scale) + "), got " + quote(tokens[c]) +
                                       " = " + number_text(values[c] * options_.scale) + " m");
             }

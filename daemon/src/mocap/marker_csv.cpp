@@ -138,7 +138,8 @@ class CsvParser
             if (!seen.emplace(name, static_cast<int>(c)).second)
                 header_error("each column name once", "a duplicate column " + quote(name));
             const std::string key = lower(name);
-            if (key == "time") {
+            // "Time (s)" (TrajOptDrums' exports): seconds, said in the name.
+            if (key == "time" || key == "time (s)" || key == "time(s)") {
                 time_column_ = static_cast<int>(c);
                 continue;
             }
@@ -169,12 +170,20 @@ class CsvParser
             }
             objects_[found->second].index[component] = static_cast<int>(c);
         }
+        if (cells.size() == 1 &&
+            (cells[0].find(';') != std::string::npos || cells[0].find('\t') != std::string::npos))
+            header_error("comma-separated columns",
+                         std::string("one column holding ") +
+                             (cells[0].find(';') != std::string::npos ? "';'" : "tabs") +
+                             ": a file separated by another character (save it with commas)");
         if (time_column_ < 0 && frame_column_ < 0)
-            header_error("a time (s) or frame column", "neither");
+            header_error("a column named time or Time (s) (seconds), or frame (with --rate HZ)",
+                         "neither");
         if (time_column_ < 0 && (!std::isfinite(options_.rate_hz) || options_.rate_hz <= 0.0))
-            header_error("MarkerCsvOptions::rate_hz > 0 for a file with a frame column and no "
-                         "time column",
-                         std::to_string(options_.rate_hz));
+            header_error("a frame rate (--rate HZ) for a file with a frame column and no time "
+                         "column",
+                         options_.rate_hz == 0.0 ? std::string("none")
+                                                 : number_text(options_.rate_hz));
         if (objects_.empty())
             header_error("at least one object (NAME.x NAME.y NAME.z)", "none");
         for (const ObjectColumns &object : objects_) {

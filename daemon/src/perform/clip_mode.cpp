@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <iostream>
 
@@ -22,6 +23,43 @@ double median(std::vector<double> v)
     return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+// The strokes are looked for on a fixed time grid, the reference tips
+// interpolated linearly between the capture's frames, so that the window of a
+// minimum (2 samples either side, 1/60 s) and the approach speed (over 2
+// samples, 1/60 s) are durations, not frame counts: the drum goes at the same
+// place whatever the capture's frame rate. 120 Hz: the CMU captures' rate, at
+// which the window and the 1 m/s threshold were chosen.
+constexpr double kStrokeScanRateHz = 120.0;
+
+// The reference tips [hand] at the capture's frames, resampled to kStrokeScanRateHz.
+std::vector<std::array<Eigen::Vector3d, 2>> tips_on_scan_grid(const CharacterModel &model,
+                                                              const ReferenceMotion &reference)
+{
+    const int frames = reference.frames();
+    std::vector<std::array<Eigen::Vector3d, 2>> at_frames(static_cast<size_t>(frames));
+    for (int f = 0; f < frames; ++f)
+        at_frames[static_cast<size_t>(f)] = reference_tips(model, reference.frame(f));
+    const double rate = reference.frame_rate_hz();
+    std::vector<std::array<Eigen::Vector3d, 2>> grid;
+    if (frames < 2 || !(rate > 0.0))
+        return at_frames;
+    const double last = frames - 1;
+    for (long n = 0;; ++n) {
+        double x = static_cast<double>(n) * rate / kStrokeScanRateHz; // in frames
+        if (std::abs(x - std::round(x)) < 1e-9)
+            x = std::round(x); // on a frame (a 120 Hz capture: every sample)
+        if (x > last)
+            break;
+        const auto i = static_cast<size_t>(std::min(std::floor(x), last - 1.0));
+        const double u = x - static_cast<double>(i);
+        std::array<Eigen::Vector3d, 2> tip;
+        for (int hand = 0; hand < 2; ++hand)
+            tip[hand] = (1.0 - u) * at_frames[i][hand] + u * at_frames[i + 1][hand];
+        grid.push_back(tip);
+    }
+    return grid;
+}
+
 // Where the clip strikes: the reference stick tips' local minima of height
 // reached at more than 1 m/s downwards (the mimed strokes; a captured
 // performance without a drum still "hits" a plane). The membrane goes at the
@@ -31,18 +69,15 @@ double median(std::vector<double> v)
 Eigen::Vector3d strike_drum_center(const CharacterModel &model, const ReferenceMotion &reference,
                                    const Eigen::Vector3d &fallback)
 {
-    const int frames = reference.frames();
-    std::vector<std::array<Eigen::Vector3d, 2>> tips(static_cast<size_t>(frames));
-    for (int f = 0; f < frames; ++f)
-        tips[static_cast<size_t>(f)] = reference_tips(model, reference.frame(f));
+    const std::vector<std::array<Eigen::Vector3d, 2>> tips = tips_on_scan_grid(model, reference);
+    const int samples = static_cast<int>(tips.size());
     std::vector<double> xs, ys, zs;
-    const double rate = reference.frame_rate_hz();
     for (int hand = 0; hand < 2; ++hand)
-        for (int f = 2; f + 2 < frames; ++f) {
+        for (int f = 2; f + 2 < samples; ++f) {
             auto y = [&](int g) { return tips[static_cast<size_t>(g)][hand].y(); };
             const bool minimum =
                 y(f) < y(f - 1) && y(f) <= y(f + 1) && y(f) < y(f - 2) && y(f) <= y(f + 2);
-            const double approach_mps = (y(f - 2) - y(f)) * rate / 2.0;
+            const double approach_mps = (y(f - 2) - y(f)) * kStrokeScanRateHz / 2.0;
             if (minimum && approach_mps > 1.0) {
                 xs.push_back(tips[static_cast<size_t>(f)][hand].x());
                 ys.push_back(y(f));

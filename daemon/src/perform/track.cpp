@@ -171,13 +171,14 @@ nlohmann::json TrackSummary::to_json() const
         {"realtime_factor", realtime_factor},
         {"us_per_step", steps > 0 ? 1e6 * wall_time_s / steps : 0.0},
         {"tip_rms_mm", sides(tip_rms_mm)},
-        {"tip_rms_raw_mm", sides(tip_rms_raw_mm)},
-        {"joint_rms_raw_deg_all", joint_rms_raw_deg_all},
+        {"tip_rms_raw_mm", raw_measured ? sides(tip_rms_raw_mm) : nlohmann::json()},
+        {"joint_rms_raw_deg_all",
+         raw_measured ? nlohmann::json(joint_rms_raw_deg_all) : nlohmann::json()},
         {"tip_max_mm", sides(tip_max_mm)},
         {"tip_rms_free_mm", sides(tip_rms_free_mm)},
         {"tip_rms_contact_mm", sides(tip_rms_contact_mm)},
-        {"tip_rms_raw_free_mm", sides(tip_rms_raw_free_mm)},
-        {"tip_rms_raw_contact_mm", sides(tip_rms_raw_contact_mm)},
+        {"tip_rms_raw_free_mm", raw_measured ? sides(tip_rms_raw_free_mm) : nlohmann::json()},
+        {"tip_rms_raw_contact_mm", raw_measured ? sides(tip_rms_raw_contact_mm) : nlohmann::json()},
         {"captured_impacts", sides(captured_impacts)},
         {"diverged", diverged},
         {"interrupted", interrupted},
@@ -212,6 +213,7 @@ nlohmann::json TrackSummary::to_json() const
             {"max_iterations", ik_max_iterations},
             {"us_per_step", ik_us_per_step},
             {"not_converged", ik_not_converged},
+            {"reseeded", ik_reseeded},
             {"elbow_flexion_rms_deg", elbow_measured ? sides(elbow_ik_rms_deg) : nlohmann::json()}};
     }
     return j;
@@ -513,7 +515,10 @@ void TrackRun::set_capture_posture()
 void TrackRun::start_summary()
 {
     summary_.mode = to_string(options_.mode);
-    summary_.frames = reference_.frames();
+    // A stick-only capture's own samples, not the default body's two still frames.
+    summary_.frames = options_.tip_reference
+                          ? static_cast<int>(options_.tip_reference->time_s.size())
+                          : reference_.frames();
     summary_.drum_center_m = options_.scene.drum.center_m;
     summary_.drum_rule = !options_.drum_auto         ? "given"
                          : !have_impacts_            ? "lowest_tips"
@@ -775,12 +780,14 @@ void TrackRun::finish_summary(long n)
             have_impacts_ ? static_cast<int>(placement_.fit.impacts[s].size()) : 0;
     }
     summary_.joint_rms_raw_deg_all = std::sqrt(sums_.raw_joint_sum2 / (ns * nj));
+    summary_.raw_measured = raw_reference_ != nullptr && tips_in_ == nullptr;
     if (cartesian_) {
         const TrackerIkStats &ik = tracker_->ik_stats();
         summary_.ik_mean_iterations =
             ik.solves > 0 ? static_cast<double>(ik.iterations) / ik.solves : 0.0;
         summary_.ik_max_iterations = ik.max_iterations;
         summary_.ik_not_converged = ik.not_converged;
+        summary_.ik_reseeded = ik.reseeded;
         summary_.ik_us_per_step = n > 0 ? 1e6 * ik.wall_s / n : 0.0;
         for (int s = 0; s < 2; ++s)
             summary_.elbow_ik_rms_deg[s] = std::sqrt(sums_.elbow_sum2[s] / ns);

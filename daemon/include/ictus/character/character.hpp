@@ -184,7 +184,7 @@ struct ReferenceFilter {
     // A frame further than this from the midpoint of its two neighbours,
     // while the neighbours are closer than it to each other, is replaced by
     // that midpoint (one-frame spikes). 0 disables.
-    double spike_threshold_rad = 0.0873; // 5 degrees
+    double spike_threshold_rad = 5.0 * EIGEN_PI / 180.0; // 5 degrees
     // Zero-phase low-pass smoothing in each frame's tangent space. 0 disables.
     double smooth_cutoff_hz = 10.0;
     // Its kernel. gaussian: sigma = 1 / (2 pi cutoff), response

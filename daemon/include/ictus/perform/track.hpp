@@ -79,7 +79,7 @@ void validate(const TrackOptions &options);
 
 struct TrackSummary {
     std::string mode = "joint";
-    int frames = 0;  // reference frames
+    int frames = 0;  // the capture's frames (a stick-only capture's samples)
     int samples = 0; // rows measured (and written to the CSV)
     long steps = 0;
     double duration_s = 0.0;
@@ -97,6 +97,9 @@ struct TrackSummary {
     double tip_rms_raw_free_mm[2] = {0.0, 0.0}, tip_rms_raw_contact_mm[2] = {0.0, 0.0};
     int captured_impacts[2] = {0, 0};
     double joint_rms_raw_deg_all = 0.0;
+    // The *_raw_* errors were measured: an unfiltered full-body capture was given.
+    // Not measured (null in JSON) for stick-only captures, or without one.
+    bool raw_measured = false;
     std::vector<std::string> joint_names;
     std::vector<double> joint_rms_deg;
     std::vector<double> joint_max_deg;
@@ -121,6 +124,7 @@ struct TrackSummary {
     int ik_max_iterations = 0;
     double ik_us_per_step = 0.0; // wall time of the IK (both arms, both solves)
     long ik_not_converged = 0;   // solves that ended other than `converged`
+    long ik_reseeded = 0;        // stuck kinematic solves taken again from the posture
     // Elbow flexion (elbow_flexion_deg: the angle between upper arm and forearm), IK target
     // Theta^T vs the capture, RMS over the samples [side], degrees.
     // Not measured (null in JSON) for stick-only captures: no captured elbow.
