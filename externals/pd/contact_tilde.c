@@ -115,6 +115,9 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
                                            : (mass > CONTACT_MASS_MAX ? CONTACT_MASS_MAX : mass);
         }
     }
+    if (argc > 4)
+        pd_error(x, "contact~: hit takes at most four numbers (velocity, r/a, theta, stick mass); "
+                    "extra arguments ignored");
     if (x->x_refused && !x->x_membrane) {
         pd_error(x,
                  "contact~: hit: membrane~ '%s' already has %d contact~s; this one is silent: "

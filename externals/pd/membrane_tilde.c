@@ -41,7 +41,7 @@ struct _membrane_tilde {
     t_symbol *x_name; /* bound name for contact~, or &s_ */
     t_ictus_clock x_clock;
     t_membrane_tilde_attached x_attached[MEMBRANE_MAX_CONTACTS];
-    int x_silent; /* every mode above Nyquist: said once, when it became so */
+    int x_silent;         /* every mode above Nyquist: said once, when it became so */
     snare_wires *x_wires; /* NULL: no wires on the head */
 };
 
@@ -152,6 +152,8 @@ static void membrane_tilde_preset(t_membrane_tilde *x, t_symbol *s, int argc, t_
                  atom_getsymbol(&argv[0])->s_name, membrane_preset_names());
         return;
     }
+    if (argc > 1)
+        pd_error(x, "membrane~%s%s: preset takes one name; extra arguments ignored", sep, name);
     membrane_tilde_set_snare(x, 0, 0); /* the snare follows the new head */
     if (membrane_apply_preset(x->x_core, p) == ICTUS_ENOMEM)
         pd_error(x, "membrane~%s%s: preset %s: out of memory for %d modes; kept %d", sep, name,
@@ -241,8 +243,8 @@ static void membrane_tilde_print(t_membrane_tilde *x)
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_CASCADE));
     if (x->x_wires)
         post("membrane~ %s: snare head %d modes, wires %s",
-             x->x_name != &s_ ? x->x_name->s_name : "(no name)",
-             snare_wires_head_modes(x->x_wires), snare_wires_engaged(x->x_wires) ? "on" : "off");
+             x->x_name != &s_ ? x->x_name->s_name : "(no name)", snare_wires_head_modes(x->x_wires),
+             snare_wires_engaged(x->x_wires) ? "on" : "off");
     for (k = 0; k < count && k < 12; k++) {
         double f, t60;
         int bm, bn, sinp;

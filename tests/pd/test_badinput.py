@@ -55,6 +55,8 @@ membrane_cases = [
     ("strike 0.5 0 1e+09", "membrane~: strike: impulse must be in [0, 10] N s, got 1e+09; using 10"),
     ("strike 0.5 0 -1", "membrane~: strike: impulse must be in [0, 10] N s, got -1; using 0"),
     ("strike 0.4 0 0.01", None),
+    ("preset tom extra", "membrane~ bad-drum: preset takes one name; extra arguments ignored"),
+    ("preset paper", None),
 ]
 contact_cases = [
     ("mass 0", "contact~: mass must be in [0.0001, 10] kg, got 0; using 0.0001"),
@@ -79,6 +81,8 @@ contact_cases = [
                           "using 0.0001"),
     ("hit 2 0.3 0 0.0001", None),  # the bound itself, as a float reads it
     ("hit 2 0.3 0 10", None),
+    ("hit 2 0.3 0 0.05 7", "contact~: hit takes at most four numbers (velocity, r/a, theta, stick "
+                           "mass); extra arguments ignored"),
 ]
 
 sr = 48000
@@ -90,13 +94,15 @@ con = p.obj("contact~ bad-drum")
 p.obj("contact~")                       # no name
 p.obj("contact~ no-such-drum")          # nothing to play
 p.obj("contact~ no-such-drum granite")  # no such tip
-trig = recorder(p, [(mem, 0, "left"), (mem, 1, "right"), (con, 0, "force")], 0.5, sr, wav)
+trig = recorder(p, [(mem, 0, "left"), (mem, 1, "right"), (con, 0, "force")], 0.8, sr, wav)
 for k, (text, _) in enumerate(membrane_cases):
     d = p.obj("delay %g" % (5 + 3 * k))
     m = p.msg(text)
     p.connect(trig, 0, d, 0)
     p.connect(d, 0, m, 0)
     p.connect(m, 0, mem, 0)
+# every message lands before the recording ends (0.8 s)
+assert 150 + 20 * len(contact_cases) < 800
 for k, (text, _) in enumerate(contact_cases):
     d = p.obj("delay %g" % (150 + 20 * k))
     m = p.msg(text)
