@@ -432,6 +432,9 @@ TEST_CASE("score: lines end in LF, CRLF or a lone CR, and a byte order mark is n
     require_error("tempo 100\rR\rL acent\r", 3, 3, "acent");
     require_error("\xEF\xBB\xBFR, L acent\r\n", 1, 6, "acent");
     require_error("\xEF\xBB\xBF\xEF\xBB\xBFR\n", 1, 1, "unknown statement"); // one mark only
+    // UTF-16, either byte order: "tempo" with its NULs, said to be UTF-16.
+    require_error(std::string("\xFF\xFEt\0e\0m\0p\0o\0", 12), 1, 1, "UTF-16");
+    require_error(std::string("\xFE\xFF\0t\0e\0m\0p\0o", 12), 1, 1, "UTF-16");
 }
 
 TEST_CASE("score: an error shows control bytes as hex escapes, a NUL included",

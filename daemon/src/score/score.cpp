@@ -853,6 +853,12 @@ Score parse_score(const std::string &text, const std::string &source_name)
     // error would name the second's word. A UTF-8 byte order mark, which
     // Windows editors write, is not part of the first statement.
     std::size_t start = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+    // A UTF-16 file (its byte order mark, as Windows' Notepad may write) would read as
+    // one unknown statement of NULs: said for what it is.
+    if (text.compare(0, 2, "\xFF\xFE") == 0 || text.compare(0, 2, "\xFE\xFF") == 0)
+        throw ScoreError(source_name, 1, 1,
+                         "the file is UTF-16 text (it starts with a UTF-16 byte order mark): "
+                         "save the score as UTF-8 or ASCII");
     int number = 0;
     while (start < text.size()) {
         const std::size_t end = text.find_first_of("\r\n", start);
