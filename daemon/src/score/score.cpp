@@ -12,9 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 
 namespace ictus
@@ -843,64 +841,6 @@ Score ScoreBuilder::finish() const
         throw ScoreError(s.source, r.line, r.column, "'repeat' without 'end'");
     }
     return score_detail::execute_statements(s.source, s.statements);
-}
-
-Score parse_score(const std::string &text, const std::string &source_name)
-{
-    ScoreBuilder builder(source_name);
-    // Lines end in LF, CRLF or a lone CR (old Mac editors): a score saved
-    // with CRs alone would otherwise be one line, and its first statement's
-    // error would name the second's word. A UTF-8 byte order mark, which
-    // Windows editors write, is not part of the first statement.
-    std::size_t start = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
-    // A UTF-16 file (its byte order mark, as Windows' Notepad may write) would read as
-    // one unknown statement of NULs: said for what it is.
-    if (text.compare(0, 2, "\xFF\xFE") == 0 || text.compare(0, 2, "\xFE\xFF") == 0)
-        throw ScoreError(source_name, 1, 1,
-                         "the file is UTF-16 text (it starts with a UTF-16 byte order mark): "
-                         "save the score as UTF-8 or ASCII");
-    int number = 0;
-    while (start < text.size()) {
-        const std::size_t end = text.find_first_of("\r\n", start);
-        if (end == std::string::npos) {
-            builder.add_line(text.substr(start), ++number);
-            break;
-        }
-        builder.add_line(text.substr(start, end - start), ++number);
-        start = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
-    }
-    return builder.finish();
-}
-
-Score load_score(const std::string &path)
-{
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw ScoreError(path, 0, 0, "cannot read the score file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parse_score(text.str(), path);
-}
-
-const char *default_score_text()
-{
-    // The paper's Figure 5: legato and accent beats of both hands under a
-    // tempo change (here an accelerando then a ritardando), ~15 s.
-    return R"(# ictus default score: legato and accent beats under a tempo change
-# (the paper's Figure 5). See docs/score.md for the language.
-tempo 90
-grip french
-R legato, L legato, R legato, L legato
-R accent f, L legato, R accent f, L legato
-tempo 90 -> 160 over 8
-R legato, L accent f, R legato, L accent f
-R legato, L legato, R accent ff, L accent ff
-R legato 1/2, L legato 1/2, R legato 1/2, L legato 1/2, R accent f, L accent f
-R tenuto p, L tenuto p, R staccato, L staccato
-tempo 160 -> 100 over 6
-R legato, L legato, R vertical_accent f, L vertical_accent f
-R accent ff, L accent ff
-)";
 }
 
 } // namespace ictus
