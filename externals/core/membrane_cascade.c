@@ -84,10 +84,11 @@ void membrane_cascade_cleared_(membrane *m)
 }
 
 /* The band-level cascade rescaled some modes between samples, conserving their linear
- * energy: Y and g follow the new state, psi is kept, so the scheme's energy (linear +
- * psi^2 / 2) is unchanged by the rescaling. Re-anchoring psi to V(Y) instead would add
- * V's change, and counting the jump in Y as the coupling's motion would make work no
- * force did: either lets the energy grow. */
+ * energy but not V: Y follows the new state and psi is anchored to V(Y) again, so that the
+ * coupling's force stays -dV/dY (keeping psi instead leaves it off by what each rescaling
+ * changed V, and after a second it had the wrong sign). Re-anchoring removes energy when V
+ * fell; when V rose by dV, the coupled modes first give up dV of their own (scaled), so the
+ * scheme's energy (linear + psi^2 / 2) never grows. */
 void membrane_cascade_rescaled_(membrane *m)
 {
     if (!m->vk_on)
@@ -96,10 +97,25 @@ void membrane_cascade_rescaled_(membrane *m)
     const float h = (float)m->coef_h;
     for (int k = 0; k < c->modes; k++)
         c->y[k] = h * m->sc[k] * m->q[k];
-    const double v = plate_cascade_potential(c, c->y, c->g);
-    const float is = (float)(1.0 / sqrt(2.0 * (v + c->floor)));
+    double v = plate_cascade_potential(c, c->y, c->g);
+    const double rise = v + c->floor - 0.5 * c->psi * c->psi;
+    if (rise > 0.0) {
+        double ec = 0.0; /* the coupled modes' linear energy (the kernel's e_k) */
+        for (int k = 0; k < c->modes; k++) {
+            const double x = h * m->wm[k] * m->sc[k] * m->q[k], p = m->sc[k] * m->p[k];
+            ec += 0.5 * (x * x + p * p);
+        }
+        const float s = (float)sqrt(rise < ec ? (ec - rise) / ec : 0.0);
+        for (int k = 0; k < c->modes; k++) {
+            m->q[k] *= s;
+            m->p[k] *= s;
+            c->y[k] = h * m->sc[k] * m->q[k];
+        }
+        v = plate_cascade_potential(c, c->y, c->g);
+    }
+    c->psi = sqrt(2.0 * (v + c->floor));
     for (int k = 0; k < c->modes; k++)
-        c->g[k] *= is;
+        c->g[k] = (float)(c->g[k] / c->psi);
 }
 
 void membrane_cascade_step_(membrane *m, membrane_kernel_args *a, int input, double *extra,

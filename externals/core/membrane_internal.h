@@ -271,8 +271,8 @@ void membrane_cascade_refresh_(membrane *m);
 void membrane_cascade_free_(membrane *m);
 /* The state was cleared or set from outside: the cascade's variables follow it. */
 void membrane_cascade_cleared_(membrane *m);
-/* After the band-level cascade rescaled modes between samples: Y and g follow, psi is
- * kept (the scheme's energy unchanged). Audio thread: no allocation. */
+/* After the band-level cascade rescaled modes between samples: Y, psi and g follow V
+ * there, and the scheme's energy does not grow. Audio thread: no allocation. */
 void membrane_cascade_rescaled_(membrane *m);
 /* One sample of the coupling, after the kernel's step and the strikes (audio thread: no
  * allocation); input: a force acted on the plate this sample. Its force's direct path to
