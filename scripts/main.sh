@@ -98,11 +98,16 @@ wav=$out/performance.wav
 render=("$ictusd" render --out "$out" --force --wav "$wav" --wav-mix "$mix" --wav-bits "$bits"
         --wav-gain "$gain" --drum-preset "$drum_preset")
 [[ -n $score ]] && render+=(--score "$score")
-"${render[@]}" || {
+status=0
+"${render[@]}" || status=$?
+if ((status == 3)); then # the files and the WAV are written; ictusd said what diverged
+    echo "main.sh: the simulation diverged (ictusd render exit 3): $out holds what was played" >&2
+    exit 1
+elif ((status != 0)); then
     [[ -f $out/pd.log ]] && cat "$out/pd.log" >&2
     echo "main.sh: ictusd render --wav failed" >&2
     exit 1
-}
+fi
 for f in strikes.csv events.txt render.json performance.wav; do
     [[ -s $out/$f ]] || { echo "main.sh: ictusd render did not write $out/$f" >&2; exit 1; }
 done

@@ -143,6 +143,7 @@ static void contact_tilde_set(t_contact_tilde *x, t_symbol *name)
         return;
     }
     x->x_name = name;
+    x->x_refused = 0; /* the next DSP sort says whether the new membrane~ has room */
     canvas_update_dsp();
 }
 

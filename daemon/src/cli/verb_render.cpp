@@ -705,7 +705,8 @@ void print_render_summary(const Performance &perf, const RenderArgs &r, bool sco
                   << " time(s) and was reset (render.json's divergences; exit status 3)\n";
     if (score_mode && count.notes == 0)
         std::cerr << "ictusd render: warning: the score has no notes: nothing was played\n";
-    else if (!score_mode && rec.log.strikes().empty())
+    else if (!score_mode && rec.log.strikes().empty() && perf.withheld_strikes() == 0 &&
+             !rec.interrupted)
         std::cerr << "ictusd render: warning: no stick struck the drum: nothing was played "
                      "(is the drum within the sticks' reach? --drum-pos)\n";
     else if (count.missed > 0)
