@@ -391,6 +391,11 @@ void load_midi_score(PerformanceOptions &o)
         std::cerr << "ictusd: warning: --midi " << path << ": " << part.too_fast
                   << " notes left out: no hand free (a third note at once, or under "
                   << kMidiSameHandMin_s * 1e3 << " ms after both hands' last)\n";
+    if (part.feet_too_fast > 0)
+        std::cerr << "ictusd: warning: --midi " << path << ": " << part.feet_too_fast
+                  << " notes left out: a foot plays again no sooner than " << kMidiFootMin_s * 1e3
+                  << " ms (kick) or " << kMidiChickMin_s * 1e3
+                  << " ms (hi-hat pedal) after its last\n";
     if (part.hihats_pedalled > 0)
         std::cerr << "ictusd: note: --midi " << path << ": " << part.hihats_pedalled
                   << (part.hihats_pedalled == 1 ? " closed hi-hat" : " closed hi-hats")

@@ -124,6 +124,7 @@ struct MidiDrumPart {
     int channel = 9;             // the channel read (0..15), -1: all
     std::map<int, long> skipped; // note number -> notes the kit cannot play
     long too_fast = 0;           // notes no hand could strike in time
+    long feet_too_fast = 0;      // kicks and chicks sooner than their foot plays again
     long tempo_clamped = 0;      // tempi outside kMinTempoBpm..kMaxTempoBpm
     long hihats_pedalled = 0;    // closed hi-hats the left foot played (kMidiPedalHihatAbove_mps)
 };
