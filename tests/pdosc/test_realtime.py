@@ -194,7 +194,12 @@ check(-10.0 - lag_ms < fired_ms < 10.0,
 # ASan on a slow core fell short by 1.02 ms with rtt 0.24 ms).
 expected_late_ms = (late_fire - t_late) * 1000.0 + LATENCY_MS
 last = lates[-1] if lates else None
-check(last is not None and len(lates) == len(late_strikes) + 1
+# Before it, one report per late strike; any other is a strike pd handled late by less
+# than the 1 ms it is judged by (on a loaded machine: 0.19 ms), so on time above.
+slight = len(lates) - 1 - len(late_strikes)
+slight_ok = slight >= 0 and all(
+    r[2] <= 1.0 + rtt_ms for r in sorted(lates[:-1], key=lambda r: r[2])[:slight])
+check(last is not None and slight_ok
       and -1.0 - rtt_ms <= last[2] - expected_late_ms <= 1.0 and last[3] == len(lates),
       "the late bundle's report, %.2f ms late (expected %.2f, from 1 ms + the mapping's %.3f "
       "below to 1 ms above), counted %s: %s"
