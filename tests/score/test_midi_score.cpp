@@ -465,6 +465,50 @@ TEST_CASE("midi in: a run whose crash is out of reach as it stands is turned for
     CHECK(last_fill->hand == Side::right); // the fill ends on the hand that is not crashing
 }
 
+TEST_CASE("midi in: under the hi-hat a flam keeps its accent and leaves out its grace",
+          "[score][midi]")
+{
+    // 90 bpm (96 ticks a quarter, 0.667 s): 8th hi-hats; on beat 2 a grace snare (vel 50)
+    // 4 ticks (28 ms) before a main snare (vel 120). The grace takes the right hand (0.3 s
+    // after the hi-hat), so the beat's hi-hat goes left and the main note finds both hands
+    // 28 ms after a stroke: three notes in 28 ms for two hands. The accent is kept (the
+    // grace left out, counted), not the grace. Without the hi-hat both are played.
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"hihat", 42}};
+    const int us = static_cast<int>(std::lround(60e6 / 90.0));
+    auto part = [&](bool hihat) {
+        std::string t = bytes({0x00, 0xff, 0x51, 0x03, us >> 16, (us >> 8) & 0xff, us & 0xff});
+        int last = 0;
+        auto at = [&](int tick, int note, int velocity) {
+            t += bytes({tick - last, 0x99, note, velocity});
+            last = tick;
+        };
+        for (int e = 0; e < 4; ++e) {
+            if (e == 2)
+                at(92, 38, 50);
+            if (hihat || e != 2)
+                at(48 * e, 42, 80);
+            if (e == 2)
+                at(96, 38, 120);
+        }
+        return drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t + kEnd), "f.mid"), kit,
+                               "f.mid");
+    };
+    const MidiDrumPart with = part(true);
+    std::vector<double> snares;
+    for (const ScoreNote &n : with.score.notes)
+        if (n.drum == "snare")
+            snares.push_back(n.dynamics);
+    REQUIRE(snares.size() == 1);
+    CHECK(snares[0] == Approx(120.0 / 127.0));
+    CHECK(with.too_fast == 1);
+    CHECK(with.score.notes.size() == 5); // four hi-hats and the accent
+    for (size_t i = 0; i + 1 < with.score.notes.size(); ++i)
+        CHECK(with.score.notes[i].beats > 0.0);
+    const MidiDrumPart without = part(false);
+    CHECK(without.too_fast == 0);
+    CHECK(without.score.notes.size() == 5); // three hi-hats, the grace and the accent
+}
+
 TEST_CASE("midi in: a closed hi-hat the right hand cannot reach while the left crashes is the "
           "left foot's chick",
           "[score][midi][hihat]")

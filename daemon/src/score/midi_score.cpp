@@ -454,6 +454,27 @@ long pedal_crowded_hihats(std::vector<ScoreNote> &score, std::vector<HandNote> &
     return pedalled;
 }
 
+// Takes the notes marked in dropped out of the score, and out of the hands' notes, whose
+// indices follow.
+void drop_notes(std::vector<ScoreNote> &notes, std::vector<HandNote> &hand_notes,
+                const std::vector<bool> &dropped)
+{
+    std::vector<size_t> moved_to(notes.size());
+    size_t kept = 0;
+    for (size_t i = 0; i < notes.size(); ++i) {
+        moved_to[i] = kept;
+        if (!dropped[i])
+            notes[kept++] = notes[i];
+    }
+    notes.resize(kept);
+    std::vector<HandNote> still;
+    for (HandNote h : hand_notes)
+        if (!dropped[h.index]) {
+            h.index = moved_to[h.index];
+            still.push_back(h);
+        }
+    hand_notes = std::move(still);
+}
 } // namespace
 
 MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
@@ -465,8 +486,12 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
     part.channel = drum_channel(smf);
     const double tpq = smf.ticks_per_quarter;
     const TempoMap &map = part.score.tempo;
-    // The hands' last strokes (s; -inf: none yet) and the last note kept.
-    double last_of[2] = {-1e300, -1e300};
+    // The hands' last strokes (s; -inf: none yet) and the last note kept; each hand's last
+    // note (in hand_notes; -1: none) and the stroke before it, for a louder note that
+    // takes the hand from a soft one just before (a flam's grace under the hi-hat).
+    double last_of[2] = {-1e300, -1e300}, before_last_of[2] = {-1e300, -1e300};
+    long last_note_of[2] = {-1, -1};
+    std::vector<bool> dropped;
     double last_foot_s[2] = {-1e300, -1e300}; // the right foot's, the left's
     double last_s = -1e300;
     long last_tick = -1;
@@ -552,8 +577,21 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
                 hand = 1 - hand;
         }
         if (t - last_of[hand] < kMidiSameHandMin_s) {
+            // Both hands taken: a louder note than the hand's last, a soft note of its own
+            // choosing (not the time-keeper's or the crash's), takes the hand from it, as a
+            // drummer leaves out the grace and keeps the accent.
+            const HandNote *prev = last_note_of[hand] >= 0
+                                       ? &hand_notes[static_cast<size_t>(last_note_of[hand])]
+                                       : nullptr;
+            const bool takes = prev && !prev->set &&
+                               n.velocity / 127.0 > part.score.notes[prev->index].dynamics &&
+                               t - before_last_of[hand] >= kMidiSameHandMin_s;
             ++part.too_fast;
-            continue;
+            if (!takes)
+                continue;
+            dropped.resize(part.score.notes.size(), false); // the feet's notes too
+            dropped[prev->index] = true;
+            last_of[hand] = before_last_of[hand];
         }
         ScoreNote s;
         s.beat = beat;
@@ -575,14 +613,18 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         s.drum_line = line;
         if (!drums.empty())
             s.drum = drums[static_cast<size_t>(drum)].name;
+        last_note_of[hand] = static_cast<long>(hand_notes.size());
         hand_notes.push_back(
             {part.score.notes.size(), t, n.tick, drum, left_hands(n.note) || keeps_time(n.note)});
         part.score.notes.push_back(s);
+        before_last_of[hand] = last_of[hand];
         last_of[hand] = t;
         last_s = t;
         last_tick = n.tick;
         last_hand = hand;
     }
+    dropped.resize(part.score.notes.size(), false);
+    drop_notes(part.score.notes, hand_notes, dropped);
     if (!drums.empty()) {
         // Before the second look, which then sees the right hand free, and after it, for a
         // run it turned onto the right hand's last note.
