@@ -37,6 +37,24 @@ std::string header(int format, int tracks, int division = 96)
 }
 const std::string kEnd = bytes({0x00, 0xff, 0x2f, 0x00});
 
+// A format-0 file of one track at `bpm`, 96 ticks a quarter, notes on channel 10 in tick
+// order (deltas under 128 ticks).
+struct Track {
+    std::string events;
+    int last = 0;
+    explicit Track(double bpm)
+    {
+        const int us = static_cast<int>(std::lround(60e6 / bpm));
+        events = bytes({0x00, 0xff, 0x51, 0x03, us >> 16, (us >> 8) & 0xff, us & 0xff});
+    }
+    void at(int tick, int note, int velocity)
+    {
+        events += bytes({tick - last, 0x99, note, velocity});
+        last = tick;
+    }
+    std::string file() const { return header(0, 1) + chunk("MTrk", events + kEnd); }
+};
+
 std::string what_of(const std::string &file)
 {
     try {
@@ -428,13 +446,8 @@ TEST_CASE("midi in: a run whose crash is out of reach as it stands is turned for
         {"tom2", 47, true, {0.19, 0.21, 0.32}},    {"floor", 43, true, {0.56, 0.0, -0.20}},
         {"crash", 49, true, {-0.64, 0.30, 0.36}},  {"ride", 51, true, {0.62, 0.22, 0.28}},
         {"hihat", 42, true, {-0.42, 0.26, -0.02}}, {"kick", 36, true, {0.0, 0.28, 0.27}}};
-    const int us = static_cast<int>(std::lround(60e6 / 112.0));
-    std::string t = bytes({0x00, 0xff, 0x51, 0x03, us >> 16, (us >> 8) & 0xff, us & 0xff});
-    int last = 0;
-    auto at = [&](int tick, int note, int velocity) {
-        t += bytes({tick - last, 0x99, note, velocity});
-        last = tick;
-    };
+    Track track(112.0);
+    auto at = [&](int tick, int note, int velocity) { track.at(tick, note, velocity); };
     for (int e = 0; e < 8; ++e) {
         at(24 * e, 42, 80);
         if (e == 0)
@@ -449,8 +462,7 @@ TEST_CASE("midi in: a run whose crash is out of reach as it stands is turned for
         at(192 + 24 * k, fill[k], 100);
     at(384, 49, 120);
     at(384, 36, 110);
-    const MidiDrumPart part =
-        drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t + kEnd), "f.mid"), kit, "f.mid");
+    const MidiDrumPart part = drum_part_score(read_smf(track.file(), "f.mid"), kit, "f.mid");
     const ScoreNote *last_fill = nullptr, *crash = nullptr;
     for (const ScoreNote &n : part.score.notes) {
         if (n.drum == "crash")
@@ -474,14 +486,9 @@ TEST_CASE("midi in: under the hi-hat a flam keeps its accent and leaves out its 
     // 28 ms after a stroke: three notes in 28 ms for two hands. The accent is kept (the
     // grace left out, counted), not the grace. Without the hi-hat both are played.
     const std::vector<MidiDrum> kit = {{"snare", 38}, {"hihat", 42}};
-    const int us = static_cast<int>(std::lround(60e6 / 90.0));
     auto part = [&](bool hihat) {
-        std::string t = bytes({0x00, 0xff, 0x51, 0x03, us >> 16, (us >> 8) & 0xff, us & 0xff});
-        int last = 0;
-        auto at = [&](int tick, int note, int velocity) {
-            t += bytes({tick - last, 0x99, note, velocity});
-            last = tick;
-        };
+        Track track(90.0);
+        auto at = [&](int tick, int note, int velocity) { track.at(tick, note, velocity); };
         for (int e = 0; e < 4; ++e) {
             if (e == 2)
                 at(92, 38, 50);
@@ -490,8 +497,7 @@ TEST_CASE("midi in: under the hi-hat a flam keeps its accent and leaves out its 
             if (e == 2)
                 at(96, 38, 120);
         }
-        return drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t + kEnd), "f.mid"), kit,
-                               "f.mid");
+        return drum_part_score(read_smf(track.file(), "f.mid"), kit, "f.mid");
     };
     const MidiDrumPart with = part(true);
     std::vector<double> snares;
