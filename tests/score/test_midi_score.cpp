@@ -224,6 +224,15 @@ TEST_CASE("midi in: a malformed file names its byte and track", "[score][midi]")
           "t.mid: byte 24 (track 0): data byte expected, got status byte 144");
     CHECK(what_of(header(0, 1) + "MTrk" + bytes({0, 0, 1, 0})) ==
           "t.mid: byte 18: chunk length 256 runs past the end of the file");
+    CHECK(what_of(header(0, 1).substr(0, 10)) ==
+          "t.mid: byte 0: truncated header (10 bytes, 14 needed)");
+    // Fewer than 8 bytes after every declared track: padding, read past; before the
+    // declared tracks are all there: a truncated chunk header.
+    const std::string one = header(0, 1) + chunk("MTrk", bytes({0x00, 0x99, 38, 100}) + kEnd);
+    CHECK(what_of(one + bytes({0, 0, 0})) == "");
+    CHECK(read_smf(one + bytes({0, 0, 0}), "t.mid").notes.size() == 1);
+    CHECK(what_of(header(1, 2) + chunk("MTrk", kEnd) + "MTr") ==
+          "t.mid: byte 26: truncated chunk header");
 }
 
 TEST_CASE("midi in: General MIDI's hi-hat on a kit's hi-hat, closed 42 and open 46, the pedal 44 "

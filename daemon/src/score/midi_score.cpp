@@ -160,8 +160,10 @@ void read_track(Reader &r, int track, Smf &smf)
 Smf read_smf(const std::string &b, const std::string &source)
 {
     Reader head(b, 0, b.size(), source, -1);
-    if (b.size() < 14 || b.compare(0, 4, "MThd") != 0)
+    if (b.compare(0, 4, "MThd") != 0)
         head.fail("not a Standard MIDI File (no MThd header)", 0);
+    if (b.size() < 14)
+        head.fail("truncated header (" + std::to_string(b.size()) + " bytes, 14 needed)", 0);
     const long head_len = u32(b, 4);
     if (head_len < 6 || static_cast<size_t>(head_len) > b.size() - 8)
         head.fail("header length " + std::to_string(head_len), 4);
@@ -178,7 +180,12 @@ Smf read_smf(const std::string &b, const std::string &source)
     smf.ticks_per_quarter = division;
     size_t at = 8 + static_cast<size_t>(head_len);
     int track = 0;
+    const int declared =
+        (static_cast<unsigned char>(b[10]) << 8) | static_cast<unsigned char>(b[11]);
     while (at < b.size()) {
+        // A few bytes after every track the header declares: padding some writers leave.
+        if (b.size() - at < 8 && track > 0 && track >= declared)
+            break;
         if (b.size() - at < 8)
             head.fail("truncated chunk header", at);
         const long len = u32(b, at + 4);
