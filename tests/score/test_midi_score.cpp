@@ -651,3 +651,65 @@ TEST_CASE("midi in: a hi-hat made crowded by the sticking's second look is the f
         if (n.drum == "hihat")
             CHECK((n.foot && n.hand == Side::left));
 }
+
+TEST_CASE("midi in: the left hand keeps the hi-hat going while the right crosses to or from the "
+          "ride",
+          "[score][midi][hihat]")
+{
+    // The full kit's places. 16ths at 130 bpm (115 ms): a bar on the ride, a bar on the
+    // hi-hat, a bar on the ride, the snare on 2 and 4 (the left hand's). Ride to hi-hat is
+    // 1.083 m: the right hand's move, (1.083 + 0.1) / dt, is over kMidiLendHihatAbove_mps
+    // in one 16th and within it in two; the left's, hi-hat to snare, within
+    // kMidiPedalHihatAbove_mps in two 16ths, not in one.
+    const std::vector<MidiDrum> kit = {{"snare", 38, true, {0.0, 0.0, 0.0}},
+                                       {"ride", 51, true, {0.62, 0.22, 0.28}},
+                                       {"hihat", 42, true, {-0.42, 0.26, -0.02}}};
+    auto part = [&](double bpm) {
+        Track t(bpm);
+        for (int k = 0; k < 48; ++k) {
+            t.at(k * 24, k / 16 == 1 ? 42 : 51, 80);
+            if (k % 16 == 4 || k % 16 == 12)
+                t.at(k * 24, 38, 100);
+        }
+        return drum_part_score(read_smf(t.file(), "c.mid"), kit, "c.mid");
+    };
+    const double e16 = 60.0 / 130.0 / 4.0;
+    const double cross = std::hypot(0.62 + 0.42, 0.22 - 0.26, 0.28 + 0.02) + 0.1;
+    const double hat = std::hypot(0.42, 0.26, 0.02) + 0.1; // to the snare
+    REQUIRE(cross / e16 > kMidiLendHihatAbove_mps);
+    REQUIRE(cross / (2 * e16) < kMidiLendHihatAbove_mps);
+    REQUIRE(hat / (2 * e16) < kMidiPedalHihatAbove_mps);
+    REQUIRE(hat / e16 > kMidiPedalHihatAbove_mps);
+    const MidiDrumPart p = part(130.0);
+    REQUIRE(p.score.notes.size() == 54);
+    CHECK(p.too_fast == 0);
+    // Into the hi-hat its first 16th is the left's (the snares four 16ths away), and the
+    // right has two 16ths from the ride; out of it its last is the left's, and the right
+    // leaves the hi-hat two 16ths before the ride.
+    std::string hands;
+    for (const ScoreNote &n : p.score.notes)
+        if (n.drum == "hihat")
+            hands += n.hand == Side::left ? 'L' : 'R';
+    CHECK(hands == "LRRRRRRRRRRRRRRL");
+    CHECK(p.hihats_lent == 2);
+    for (const ScoreNote &n : p.score.notes)
+        if (n.drum == "ride")
+            CHECK(n.hand == Side::right);
+    // No hand strikes twice within 50 ms.
+    for (Side h : {Side::left, Side::right}) {
+        double last = -1.0;
+        for (const ScoreNote &n : p.score.notes)
+            if (n.hand == h && !n.foot) {
+                if (last >= 0.0)
+                    CHECK((n.beat - last) * 60.0 / 130.0 >= kMidiSameHandMin_s);
+                last = n.beat;
+            }
+    }
+    // At 60 bpm one 16th (250 ms) is enough: every hi-hat the right hand's.
+    REQUIRE(cross / 0.25 < kMidiLendHihatAbove_mps);
+    const MidiDrumPart q = part(60.0);
+    CHECK(q.hihats_lent == 0);
+    for (const ScoreNote &n : q.score.notes)
+        if (n.drum == "hihat")
+            CHECK(n.hand == Side::right);
+}

@@ -402,6 +402,12 @@ void load_midi_score(PerformanceOptions &o)
                   << " played by the left foot's pedal, a chick (both hands taken on the tick, "
                      "the right's move over "
                   << kMidiPedalHihatAbove_mps << " m/s; docs/midi.md)\n";
+    if (part.hihats_lent > 0)
+        std::cerr << "ictusd: note: --midi " << path << ": " << part.hihats_lent
+                  << (part.hihats_lent == 1 ? " hi-hat note" : " hi-hat notes")
+                  << " of the time-keeper played by the left hand while the right crosses the kit "
+                     "(its move over "
+                  << kMidiLendHihatAbove_mps << " m/s; docs/midi.md)\n";
     if (part.tempo_clamped > 0)
         std::cerr << "ictusd: warning: --midi " << path << ": " << part.tempo_clamped
                   << " tempi kept within " << kMinTempoBpm << ".." << kMaxTempoBpm << " bpm\n";

@@ -461,6 +461,75 @@ long pedal_crowded_hihats(std::vector<ScoreNote> &score, std::vector<HandNote> &
     return pedalled;
 }
 
+// The time-keeper's hi-hat notes that the right hand would reach, or leave for its next note,
+// faster than kMidiLendHihatAbove_mps (the time-keeper changing between the ride and the
+// hi-hat in a 16th, a metre) are the left hand's when it is free there: no note of its own
+// within kMidiSameHandMin_s, its moves into and out of the hi-hat within
+// kMidiPedalHihatAbove_mps, as a drummer keeps the hi-hat going with the left hand, uncrossed,
+// while the right crosses the kit. From the change outward, one note at a time, until the
+// right hand's move is within reach or the left is not free. Returns how many.
+long lend_hihats_to_left(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes,
+                         const std::vector<MidiDrum> &drums)
+{
+    const size_t n = notes.size();
+    auto right = [&](size_t i) { return score[notes[i].index].hand == Side::right; };
+    auto hihat = [&](size_t i) {
+        return drums[static_cast<size_t>(notes[i].drum)].midi_note == kMidiClosedHihat;
+    };
+    auto fast = [&](size_t a, size_t b, double above) {
+        return move_speed(drums, notes[a], notes[b]) > above;
+    };
+    auto left_free = [&](size_t j) {
+        if (!hihat(j))
+            return false;
+        for (size_t i = j; i-- > 0;)
+            if (!right(i)) {
+                if (notes[j].t - notes[i].t < kMidiSameHandMin_s ||
+                    fast(i, j, kMidiPedalHihatAbove_mps))
+                    return false;
+                break;
+            }
+        for (size_t i = j + 1; i < n; ++i)
+            if (!right(i)) {
+                if (notes[i].t - notes[j].t < kMidiSameHandMin_s ||
+                    fast(j, i, kMidiPedalHihatAbove_mps))
+                    return false;
+                break;
+            }
+        return true;
+    };
+    auto lend = [&](size_t j) {
+        ScoreNote &s = score[notes[j].index];
+        s.hand = Side::left;
+        if (!s.spot_given)
+            s.theta_deg = kDefaultThetaDeg[0];
+    };
+    long lent = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (!right(i))
+            continue;
+        // The right hand's note before it, and lending on either side until the move from
+        // it is within reach.
+        for (size_t guard = 0; guard < n; ++guard) {
+            size_t p = i;
+            while (p-- > 0 && !right(p)) {
+            }
+            if (p >= i || !fast(p, i, kMidiLendHihatAbove_mps))
+                break;
+            if (left_free(i)) {
+                lend(i);
+                ++lent;
+                break; // the next right note is measured from p
+            }
+            if (!left_free(p))
+                break;
+            lend(p);
+            ++lent;
+        }
+    }
+    return lent;
+}
+
 // Takes the notes marked in dropped out of the score, and out of the hands' notes, whose
 // indices follow.
 void drop_notes(std::vector<ScoreNote> &notes, std::vector<HandNote> &hand_notes,
@@ -638,6 +707,7 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         part.hihats_pedalled = pedal_crowded_hihats(part.score.notes, hand_notes, chick_s, drums);
         turn_runs(part.score.notes, hand_notes, drums);
         part.hihats_pedalled += pedal_crowded_hihats(part.score.notes, hand_notes, chick_s, drums);
+        part.hihats_lent = lend_hihats_to_left(part.score.notes, hand_notes, drums);
     }
     for (size_t i = 0; i + 1 < part.score.notes.size(); ++i)
         part.score.notes[i].beats =

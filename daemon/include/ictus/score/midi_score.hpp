@@ -117,6 +117,13 @@ constexpr double kMidiTurnRunGain = 0.8;
 // the random parts every such hi-hat or ride note the right hand reached at up to 3.55 m/s
 // was found within 5 ms; of those above, most were late or lost.
 constexpr double kMidiPedalHihatAbove_mps = 3.5;
+// The time-keeper's hi-hat notes that the right hand would reach, or leave for its next
+// note, faster than this (the same measure) are the left hand's when it is free: its other
+// notes kMidiSameHandMin_s away, its moves into and out of the hi-hat within
+// kMidiPedalHihatAbove_mps (docs/midi.md). On the random parts (seeds 41-100, before this
+// rule) the right hand found 55 of the 56 time-keeper notes it reached at 3.5-5.5 m/s within
+// 5 ms, 8 of 14 at 5.5-7 m/s and 3 of 18 faster.
+constexpr double kMidiLendHihatAbove_mps = 5.5;
 
 // The score of a file's drum part, and what was left out.
 struct MidiDrumPart {
@@ -127,6 +134,8 @@ struct MidiDrumPart {
     long feet_too_fast = 0;      // kicks and chicks sooner than their foot plays again
     long tempo_clamped = 0;      // tempi outside kMinTempoBpm..kMaxTempoBpm
     long hihats_pedalled = 0;    // closed hi-hats the left foot played (kMidiPedalHihatAbove_mps)
+    long hihats_lent =
+        0; // the time-keeper's hi-hats the left hand played (kMidiLendHihatAbove_mps)
 };
 
 // The drum part of `smf` (docs/midi.md): the notes on channel 10 if there
