@@ -151,9 +151,14 @@ void membrane_cascade_step_(membrane *m, membrane_kernel_args *a, int input, dou
     for (int p = 0; p < a->points; p++)
         a->point_w[p] += w[p];
     c->psi = 2.0 * psibar - c->psi;
-    /* An input (a stroke) changed the state from outside the scheme: psi follows V. */
-    if (input)
-        c->psi = sqrt(2.0 * (plate_cascade_potential(c, c->y, NULL) + c->floor));
+    /* An input (a stroke) changed the state from outside the scheme: psi follows V, but
+     * only down (never above sqrt(2 (V + floor)), never below 0): raised to V it would
+     * add energy that no force gave, every sample a stick presses (a thin plate's stick
+     * came back faster than it came). */
+    if (input) {
+        const double top = sqrt(2.0 * (plate_cascade_potential(c, c->y, NULL) + c->floor));
+        c->psi = c->psi > top ? top : c->psi > 0.0 ? c->psi : 0.0;
+    }
     /* g for the next sample at the state half a sample on (second order in time) */
     const double v = plate_cascade_potential(c, c->dy, c->g);
     const double s = sqrt(2.0 * (v + c->floor));

@@ -298,6 +298,14 @@ static void mode_arrays_install(membrane *m, mode_arrays *a, int cap)
         pt->psi_cap = cap;
     }
     m->capacity = cap;
+    /* A smaller set (the other kind of modes, laid after membrane_set_plate cleared the
+     * state): no mode beyond it rings or fades. */
+    if (m->fading_modes > cap || m->modes > cap) {
+        m->modes = m->modes < cap ? m->modes : cap;
+        m->fading_modes = m->modes;
+        m->fade_left = 0;
+        m->count = membrane_padded_(m->modes);
+    }
 }
 
 /* The count becomes `modes`. Shrinking while sounding, the dropped modes ring out
@@ -340,6 +348,10 @@ ictus_status membrane_set_plate(membrane *m, int plate)
     if (m->plate == plate)
         return ICTUS_OK;
     membrane_clear(m);
+    /* Nothing rings: the modes a preset dropped while sounding stop fading now. */
+    m->fading_modes = m->modes;
+    m->fade_left = 0;
+    m->count = membrane_padded_(m->modes);
     m->plate = plate;
     mode_table_free(&m->table); /* the next build lays the other kind's modes */
     return membrane_build_modes_(m, m->modes);

@@ -116,6 +116,11 @@ static int membrane_tilde_set_wires(t_membrane_tilde *x, int on)
 {
     if (!on && !x->x_wires)
         return 1;
+    if (on && membrane_is_plate(x->x_core)) {
+        pd_error(x, "membrane~%s%s: wires: a cymbal (a plate) has no snare wires; ignored",
+                 x->x_name != &s_ ? " " : "", x->x_name != &s_ ? x->x_name->s_name : "");
+        return 0;
+    }
     return membrane_tilde_set_snare(x, 1, on);
 }
 

@@ -2,13 +2,17 @@
 // default head exactly, the heads' densities are Mylar's at the documented thickness,
 // the lowest partials sit at the documented tunings, and the timpani's (m,1) partials
 // follow the ratios Rossing measured on kettle-loaded heads (written out here).
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <random>
 #include <string>
+#include <vector>
 
 #include "signal_tools.hpp"
 
 extern "C" {
+#include "contact.h"
 #include "membrane_presets.h"
 }
 
@@ -127,4 +131,72 @@ TEST_CASE("timpani: (m,1) partials at Rossing's ratios, (0,1) damped hard", "[co
     CHECK(mode_freq(m, 2, 1) / mode_freq(m, 1, 1) ==
           Approx(ictus_bessel_zero(2, 1) / ictus_bessel_zero(1, 1)).epsilon(1e-9));
     membrane_free(m);
+}
+
+TEST_CASE("Presets switched while the head rings, between membranes and plates, with a stick on it",
+          "[core][presets]")
+{
+    // A preset or a mode count that drops modes while the head rings lets them fade out;
+    // a switch to the other kind (membrane <-> plate) then lays a new, smaller set of
+    // modes. Seeded runs of: a preset struck by the stick, fewer modes while it rings (a
+    // preset or a count), then a preset of the other kind, each a few blocks apart, and a
+    // few more random steps. Every output sample finite and below the output bound; a
+    // sanitized build reads no mode beyond the arrays it has.
+    std::mt19937_64 rng(20261201);
+    auto uniform = [&rng](double a, double b) {
+        return std::uniform_real_distribution<double>(a, b)(rng);
+    };
+    const int presets = membrane_preset_count();
+    auto any_preset = [&]() {
+        return membrane_preset_at(static_cast<int>(uniform(0.0, presets - 0.001)));
+    };
+    for (int run = 0; run < 12; ++run) {
+        membrane *m = membrane_new(48000.0);
+        contact *c = contact_new();
+        REQUIRE(m);
+        REQUIRE(c);
+        REQUIRE(membrane_attach_contact(m, c) == ICTUS_OK);
+        std::vector<float> force(64), o0(64), o1(64);
+        float *outs[2] = {o0.data(), o1.data()};
+        contact_set_force_output(c, force.data(), 64);
+        double peak = 0.0;
+        bool finite = true;
+        auto blocks = [&](int n) {
+            for (int b = 0; b < n; ++b) {
+                membrane_process(m, nullptr, outs, 64);
+                for (int i = 0; i < 64; ++i) {
+                    finite = finite && std::isfinite(o0[i]) && std::isfinite(o1[i]);
+                    peak = std::max({peak, std::fabs(double(o0[i])), std::fabs(double(o1[i]))});
+                }
+            }
+        };
+        const membrane_preset *first = any_preset();
+        membrane_apply_preset(m, first);
+        contact_hit(c, uniform(1.0, 8.0), uniform(0.1, 0.8), 0.0, 0);
+        blocks(20 + static_cast<int>(uniform(0.0, 40.0)));
+        const int fewer = static_cast<int>(uniform(1.0, membrane_get_modes(m) - 1.0));
+        if (uniform(0.0, 1.0) < 0.5)
+            membrane_set_modes(m, fewer);
+        else
+            membrane_apply_preset(m, membrane_preset_find(first->plate ? "hihat" : "paper"));
+        blocks(1 + static_cast<int>(uniform(0.0, 5.0)));
+        membrane_apply_preset(m, membrane_preset_find(first->plate ? "kick" : "ride"));
+        blocks(1 + static_cast<int>(uniform(0.0, 5.0)));
+        for (int step = 0; step < 6; ++step) {
+            const double what = uniform(0.0, 3.0);
+            if (what < 1.0)
+                contact_hit(c, uniform(0.5, 8.0), uniform(0.1, 0.8), 0.0, 0);
+            else if (what < 2.0)
+                membrane_apply_preset(m, any_preset());
+            else
+                membrane_set_modes(m, static_cast<int>(uniform(1.0, 1200.0)));
+            blocks(1 + static_cast<int>(uniform(0.0, 40.0)));
+        }
+        INFO("run " << run << ", first " << first->name << ": peak " << peak);
+        CHECK(finite);
+        CHECK(peak <= 1.0e3);
+        membrane_detach_contact(m, c);
+        contact_free(c);
+        membrane_free(m);
+    }
 }
