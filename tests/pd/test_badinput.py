@@ -8,7 +8,10 @@ membrane~ that does not exist are all tried.
 Extra arguments are reported and the rest of the message is used: a drum and
 its contact~ given position, strike, pickup, tip and set with extra (or, for tip
 and set, wrong-typed) arguments sound sample for sample as a twin given the same
-messages without them."""
+messages without them. A hit on a head that moves at the stick faster than it
+(just after a strike at the same point) never touches it: its force outlet stays
+0 and it reports nothing; the contact~'s next hit reports the duration and peak
+of its force outlet."""
 import argparse
 import os
 
@@ -137,8 +140,17 @@ for name, first in [("extra-drum", "contact~ nowhere-drum"), ("twin-drum", "cont
     p.connect(push, 0, drum, 0)
     twins.append((drum, p.obj(first), p.obj("print %s-report" % name)))
     p.connect(twins[-1][1], 1, twins[-1][2], 0)
+# A strike, and 0.35 ms later a hit at the same point: the head there comes at the
+# stick faster than the hit (2 m/s), and draws back before the stick reaches it. A
+# second hit, 300 ms later, touches.
+moving = p.obj("membrane~ moving-drum")
+moving_con = p.obj("contact~ moving-drum")
+p.connect(moving_con, 1, p.obj("print moving-report"), 0)
+moving_cases = [(10, moving, "strike 0.3 0 0.05"), (10.35, moving_con, "hit 2 0.3 0"),
+                (310, moving_con, "hit 2 0.3 0")]
 trig = recorder(p, [(mem, 0, "left"), (mem, 1, "right"), (con, 0, "force"),
-                    (twins[0][0], 0, "extra"), (twins[1][0], 0, "twin")], 0.8, sr, wav)
+                    (twins[0][0], 0, "extra"), (twins[1][0], 0, "twin"),
+                    (moving_con, 0, "moving")], 0.8, sr, wav)
 for t, extra_text, _, twin_text in extra_cases:
     for (drum, _, _), text in zip(twins, [extra_text, twin_text]):
         d = p.obj("delay %g" % t)
@@ -160,6 +172,12 @@ for t, extra_text, _, twin_text in extra_contact_cases:
             p.connect(trig, 0, d, 0)
             p.connect(d, 0, m, 0)
             p.connect(m, 0, c, 0)
+for t, target, text in moving_cases:
+    d = p.obj("delay %g" % t)
+    m = p.msg(text)
+    p.connect(trig, 0, d, 0)
+    p.connect(d, 0, m, 0)
+    p.connect(m, 0, target, 0)
 for k, (text, _) in enumerate(membrane_cases):
     d = p.obj("delay %g" % (5 + 3 * k))
     m = p.msg(text)
@@ -231,9 +249,25 @@ check(np.array_equal(extra, twin), "extra-drum sounds as twin-drum (largest diff
 check(np.max(np.abs(extra[:int(0.06 * sr)])) == 0 and np.max(np.abs(extra)) > 0,
       "extra-drum is silent until the force at its position, then sounds")
 reports = {}
-for name in ["extra-drum", "twin-drum"]:
+for name in ["extra-drum", "twin-drum", "moving"]:
     reports[name] = [l.split(":", 1)[1].split() for l in log.splitlines()
                      if l.startswith("%s-report:" % name)]
 check(len(reports["extra-drum"]) == 1 and reports["extra-drum"] == reports["twin-drum"],
       "the twins' sticks report alike, once (%s, %s)" % (reports["extra-drum"],
                                                          reports["twin-drum"]))
+# The hit on the moving head: no force until the second hit, and no report for it;
+# the second hit's report is its force outlet's.
+force = x[:, 5].astype(np.float64)
+second = int(round(0.310 * sr))
+check(np.all(force[:second] == 0), "the hit on the moving head never touches (largest force "
+      "%g N before the second hit)" % np.max(force[:second]))
+check(len(reports["moving"]) == 1, "only the hit that touched reports (%s)" % reports["moving"])
+if len(reports["moving"]) == 1:
+    duration_ms, peak_n, rebound_mps = (float(v) for v in reports["moving"][0])
+    touching_ms = np.count_nonzero(force[second:]) * 1000.0 / sr
+    check(abs(duration_ms - touching_ms) <= 2000.0 / sr,
+          "the second hit's duration %g ms is its force's (%g ms)" % (duration_ms, touching_ms))
+    check(abs(peak_n - np.max(force)) <= 1e-5 * np.max(force),
+          "the second hit's peak %g N is its force's (%g N)" % (peak_n, np.max(force)))
+    check(0 < rebound_mps < 2.0, "the second hit's stick leaves slower than it came (%g m/s)"
+          % rebound_mps)
