@@ -433,14 +433,21 @@ static void contact_landed(membrane_point *pt, double displacement_m, double vel
     c->peak_force = c->impulse = 0.0;
 }
 
+/* The stroke is over. A stick that touched the head (a force, if only within one
+ * sample) is reported; one that never did is not: landing on a head that comes at it
+ * faster than the hit, and draws back before the stick reaches it, it goes off at the
+ * head's speed it was given on landing (contact_landed), which is no rebound, and
+ * there is no contact to report (docs/contact.md). */
 static void finish_stroke(contact *c, double dt)
 {
-    c->report.duration_ms =
-        (c->ever_touched ? (c->last_release - c->first_touch) * dt * 1000.0 : 0.0);
-    c->report.peak_force_n = c->peak_force;
-    c->report.rebound_velocity_mps = c->stick_v < 0.0 ? -c->stick_v : 0.0;
-    c->report.impulse_ns = c->impulse;
-    c->report_ready = 1;
+    if (c->ever_touched || c->peak_force > 0.0) {
+        c->report.duration_ms =
+            (c->ever_touched ? (c->last_release - c->first_touch) * dt * 1000.0 : 0.0);
+        c->report.peak_force_n = c->peak_force;
+        c->report.rebound_velocity_mps = c->stick_v < 0.0 ? -c->stick_v : 0.0;
+        c->report.impulse_ns = c->impulse;
+        c->report_ready = 1;
+    }
     c->point.active = 0;
     c->touching = 0;
 }

@@ -122,7 +122,9 @@ void contact_set_force_output(contact *c, float *buffer, int capacity);
 
 /* 1 while the stick is in a stroke (touching, or away but not yet released). */
 int contact_is_active(const contact *c);
-/* Returns 1 and fills *report once per finished stroke (then clears the flag). */
+/* Returns 1 and fills *report once per finished stroke (then clears the flag). A stroke
+ * whose stick never touched the head (it landed on a head coming at it faster than the
+ * hit, which drew back before the stick reached it) ends without a report. */
 int contact_take_report(contact *c, contact_report *report);
 /* Stick state (m, m/s; positive into the membrane) and the last force (N). */
 double contact_stick_position(const contact *c);

@@ -45,19 +45,50 @@ static void contact_tilde_setparam(t_contact_tilde *x, t_symbol *s, int argc, t_
     ictus_params_message(x, &contact_tilde_params, x->x_core, s, argc, argv);
 }
 
-/* tip NAME: alpha, stiffness and damping from the table of stick tips (stick_tip.h). */
-static void contact_tilde_tip(t_contact_tilde *x, t_symbol *name)
+/* The names of the stick tips, "wood, nylon, felt", into known. */
+static void contact_tilde_tip_names(char *known, size_t size)
 {
     int i;
-    char known[64] = "";
+    known[0] = '\0';
+    for (i = 0; i < STICK_TIP_COUNT; i++) {
+        strncat(known, i ? ", " : "", size - strlen(known) - 1);
+        strncat(known, stick_tips[i].name, size - strlen(known) - 1);
+    }
+}
+
+/* tip NAME: alpha, stiffness and damping from the table of stick tips (stick_tip.h). */
+static void contact_tilde_set_tip(t_contact_tilde *x, t_symbol *name)
+{
+    char known[64];
     if (contact_set_tip(x->x_core, name->s_name) == ICTUS_OK)
         return;
-    for (i = 0; i < STICK_TIP_COUNT; i++) {
-        strncat(known, i ? ", " : "", sizeof(known) - strlen(known) - 1);
-        strncat(known, stick_tips[i].name, sizeof(known) - strlen(known) - 1);
-    }
+    contact_tilde_tip_names(known, sizeof(known));
     pd_error(x, "contact~: tip: no stick tip named '%s' (%s); the tip is unchanged", name->s_name,
              known);
+}
+
+/* The "tip" message: one name; anything else is refused, the tip unchanged. */
+static void contact_tilde_tip(t_contact_tilde *x, t_symbol *s, int argc, t_atom *argv)
+{
+    char known[64], got[MAXPDSTRING];
+    (void)s;
+    if (argc < 1 || argv[0].a_type != A_SYMBOL) {
+        contact_tilde_tip_names(known, sizeof(known));
+        if (argc < 1)
+            pd_error(x, "contact~: tip: missing the name of a stick tip (%s); the tip is unchanged",
+                     known);
+        else {
+            atom_string(&argv[0], got, sizeof(got));
+            pd_error(x,
+                     "contact~: tip: expected the name of a stick tip (%s), got '%s'; the tip is "
+                     "unchanged",
+                     known, got);
+        }
+        return;
+    }
+    if (argc > 1)
+        pd_error(x, "contact~: tip takes one name; extra arguments ignored");
+    contact_tilde_set_tip(x, atom_getsymbol(&argv[0]));
 }
 
 /* The membrane~ whose sample clock times our messages: the attached one, else
@@ -135,14 +166,24 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
                      ictus_clock_offset_now(ictus_membrane_tilde_clock(m)), mass);
 }
 
-/* set NAME: play another membrane~ (takes effect at the next DSP sort, as delread~). */
-static void contact_tilde_set(t_contact_tilde *x, t_symbol *name)
+/* set NAME: play another membrane~ (takes effect at the next DSP sort, as delread~).
+ * Anything but a name is refused: the contact~ plays what it played. */
+static void contact_tilde_set(t_contact_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
-    if (name == &s_) {
+    (void)s;
+    if (argc < 1 || (argv[0].a_type == A_SYMBOL && atom_getsymbol(&argv[0]) == &s_)) {
         pd_error(x, "contact~: set: needs the name of a membrane~");
         return;
     }
-    x->x_name = name;
+    if (argv[0].a_type != A_SYMBOL) {
+        char got[MAXPDSTRING];
+        atom_string(&argv[0], got, sizeof(got));
+        pd_error(x, "contact~: set: needs the name of a membrane~, got '%s'; ignored", got);
+        return;
+    }
+    if (argc > 1)
+        pd_error(x, "contact~: set takes one name; extra arguments ignored");
+    x->x_name = atom_getsymbol(&argv[0]);
     x->x_refused = 0; /* the next DSP sort says whether the new membrane~ has room */
     canvas_update_dsp();
 }
@@ -268,7 +309,7 @@ static void *contact_tilde_new(t_symbol *s, int argc, t_atom *argv)
                     "silent until 'set NAME'");
     if (argc > 1) {
         if (argv[1].a_type == A_SYMBOL)
-            contact_tilde_tip(x, atom_getsymbol(&argv[1]));
+            contact_tilde_set_tip(x, atom_getsymbol(&argv[1]));
         else
             pd_error(x, "contact~: the second argument is a stick tip name (wood, nylon, felt); "
                         "ignored");
@@ -305,8 +346,8 @@ void ictus_contact_tilde_setup(void)
                             (t_method)contact_tilde_setparam);
     class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_hit, gensym("hit"), A_GIMME,
                     0);
-    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_set, gensym("set"), A_DEFSYM,
+    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_set, gensym("set"), A_GIMME,
                     0);
-    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_tip, gensym("tip"), A_DEFSYM,
+    class_addmethod(ictus_contact_tilde_class, (t_method)contact_tilde_tip, gensym("tip"), A_GIMME,
                     0);
 }

@@ -181,6 +181,9 @@ static void membrane_tilde_pickup(t_membrane_tilde *x, t_symbol *s, int argc, t_
     }
     if (!ictus_getpoint(x, "membrane~", "pickup", argc, argv, 1, &r, &theta))
         return;
+    if (argc > 3)
+        pd_error(x, "membrane~: pickup takes three numbers (index, r/a, theta); extra arguments "
+                    "ignored");
     membrane_set_pickup(x->x_core, (int)index - 1, r, theta);
 }
 
@@ -189,8 +192,11 @@ static void membrane_tilde_position(t_membrane_tilde *x, t_symbol *s, int argc, 
 {
     double r, theta;
     (void)s;
-    if (ictus_getpoint(x, "membrane~", "position", argc, argv, 0, &r, &theta))
-        membrane_set_strike_point(x->x_core, r, theta);
+    if (!ictus_getpoint(x, "membrane~", "position", argc, argv, 0, &r, &theta))
+        return;
+    if (argc > 2)
+        pd_error(x, "membrane~: position takes two numbers (r/a, theta); extra arguments ignored");
+    membrane_set_strike_point(x->x_core, r, theta);
 }
 
 /* strike <r/a> <theta deg> <impulse N s>, at this message's logical time. */
@@ -201,6 +207,9 @@ static void membrane_tilde_strike(t_membrane_tilde *x, t_symbol *s, int argc, t_
     if (!ictus_getpoint(x, "membrane~", "strike", argc, argv, 0, &r, &theta) ||
         !ictus_getnumber(x, "membrane~", "strike", "impulse (N s)", argc, argv, 2, &impulse))
         return;
+    if (argc > 3)
+        pd_error(x, "membrane~: strike takes three numbers (r/a, theta, impulse); extra arguments "
+                    "ignored");
     if (impulse < 0 || impulse > ICTUS_STRIKE_IMPULSE_MAX) {
         double used = impulse < 0 ? 0 : ICTUS_STRIKE_IMPULSE_MAX;
         pd_error(x, "membrane~: strike: impulse must be in [0, %g] N s, got %g; using %g",

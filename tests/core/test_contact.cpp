@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "signal_tools.hpp"
+#include "stick_tip.h"
 
 namespace
 {
@@ -462,4 +463,42 @@ TEST_CASE("A hit on a moving head meets it on its sample, at the hit's speed rel
     for (int b = 0; b < 100 && !contact_take_report(c, &rep); b++)
         membrane_process(m, nullptr, outs, 64);
     CHECK(rep.duration_ms > 0.0);
+}
+
+TEST_CASE("A hit that never touches the head ends without a report", "[core][contact]")
+{
+    // Just after a strike at the same point the head there comes at the stick faster
+    // than a 2 m/s hit and draws back before the stick reaches it: the stick, given the
+    // head's speed on landing, goes off without a touch. Hits 1..40 samples after the
+    // strike, each on a fresh head: those whose force stays 0 end their stroke without
+    // a report, the others report once, with the peak of their force.
+    const double fs = 48000.0, r = 0.3;
+    int untouched = 0, touched = 0;
+    for (int delay = 1; delay <= 40; delay++) {
+        StickRig rig(fs);
+        ictus_param_set(&contact_params, rig.c, CONTACT_PARAM_STRETCH, STICK_TIP_HEAD_K3_DEFAULT);
+        membrane_strike(rig.m, r, 0.0, 0.05, 0);
+        contact_hit(rig.c, 2.0, r, 0.0, delay);
+        double peak = 0.0;
+        int reports = 0;
+        contact_report rep{};
+        for (int b = 0; b < (int)(0.2 * fs) / 64; b++) {
+            membrane_process(rig.m, nullptr, rig.outs, 64);
+            for (float f : rig.force)
+                peak = std::max(peak, (double)f);
+            reports += contact_take_report(rig.c, &rep);
+        }
+        CHECK_FALSE(contact_is_active(rig.c)); // the stroke is over either way
+        if (peak == 0.0) {
+            untouched++;
+            CHECK(reports == 0);
+        } else {
+            touched++;
+            CHECK(reports == 1);
+            CHECK(rep.peak_force_n == Approx(peak).epsilon(1e-6));
+        }
+    }
+    INFO("untouched " << untouched << ", touched " << touched);
+    CHECK(untouched > 0);
+    CHECK(touched > 0);
 }
