@@ -764,6 +764,17 @@ int ScoreBuilder::statements() const
 {
     return state_->calls;
 }
+double ScoreBuilder::first_tempo_bpm() const
+{
+    double bpm = kDefaultTempoBpm;
+    for (const Statement &st : state_->statements) {
+        if (st.kind == Kind::note || st.kind == Kind::roll || st.kind == Kind::rest)
+            break;
+        if (st.kind == Kind::tempo && st.start_bpm)
+            bpm = *st.start_bpm;
+    }
+    return bpm;
+}
 std::size_t ScoreBuilder::parsed_statements() const
 {
     return state_->statements.size();
