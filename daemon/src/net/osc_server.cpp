@@ -575,13 +575,15 @@ void dispatch(const Request &r)
     }
     if (std::strcmp(r.types, method->types) != 0) {
         r.counters.bad_type_tags++;
-        if (method->handler != handle_command) { // a query: it takes no arguments
-            r.reply.error(r.path, std::string("type tags: expected none, got ,") + r.types);
-            return;
-        }
-        r.log("wrong type tags", std::string(r.path) + " ," + r.types);
+        if (method->handler == handle_command)
+            r.log("wrong type tags", std::string(r.path) + " ," + r.types);
+        // No arguments (a query, play, stop, score/clear) are "none", not an
+        // empty tag string, on either side.
+        auto tags = [](const char *types) {
+            return types[0] ? std::string(",") + types : std::string("none");
+        };
         r.reply.error(r.path,
-                      std::string("type tags: expected ,") + method->types + ", got ," + r.types);
+                      "type tags: expected " + tags(method->types) + ", got " + tags(r.types));
         return;
     }
     method->handler(r, method->command);
