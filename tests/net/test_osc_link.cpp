@@ -486,6 +486,11 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
     CHECK(d.types == "sfifiiiiiisss");
     CHECK(std::stod(d.args[1]) == Approx(12.5));
     CHECK(std::stoi(d.args[4]) == 42);
+    // Packets received, accepted, errors: each count includes this request
+    // (received before it is accepted): 5 commands, 10 refused, the status.
+    CHECK(std::stoi(d.args[5]) == 16);
+    CHECK(std::stoi(d.args[6]) == 6);
+    CHECK(std::stoi(d.args[7]) == 10);
     REQUIRE(d.args.size() == 13);
     CHECK(d.args[10] == "\"score\""); // oscdump quotes strings
     CHECK(d.args[11] == "\"cartesian\"");

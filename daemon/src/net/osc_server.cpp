@@ -449,7 +449,9 @@ void handle_status(const Request &r, const CommandSpec &)
     lo_message_add_int32(s, status ? status->playing.load() : 0);
     lo_message_add_float(s, status ? static_cast<float>(status->tempo_bpm.load()) : 0.0f);
     lo_message_add_int32(s, status ? static_cast<int>(status->strikes.load()) : 0);
-    lo_message_add_int32(s, static_cast<int>(c.packets.load()));
+    // This request is received and accepted: packets counts it only once
+    // it is handled (loop()), so it is added here.
+    lo_message_add_int32(s, static_cast<int>(c.packets.load() + 1));
     lo_message_add_int32(s, static_cast<int>(c.accepted.load()));
     const OscServerCounters snap = snapshot(c);
     lo_message_add_int32(s, static_cast<int>(snap.errors()));
