@@ -671,7 +671,8 @@ TEST_CASE("render: --out refuses a used folder, --force replaces render's own fi
 
 // A drum out of the sticks' reach played nothing, and render said only "0
 // strikes" on stdout (the count of missed notes was in render.json alone).
-TEST_CASE("render: missed and off-time notes and a score without notes are said on stderr, exit 0",
+TEST_CASE("render: missed and off-time notes, strikes of no note and a score without notes are "
+          "said on stderr, exit 0",
           "[cli][verbs]")
 {
     const fs::path dir = scratch("render-missed");
@@ -709,6 +710,21 @@ TEST_CASE("render: missed and off-time notes and a score without notes are said 
     CHECK(late.err.find(" ms, from floor 1.03 m away 0.13 s before) (error_ms in notes.csv)") !=
           std::string::npos);
     CHECK(late.err.find("not struck") == std::string::npos);
+    // A strike of no note is said too, by its seq, hand, piece and time: the right hand going
+    // from the floor tom over the crash to the ride meets tom2 on its way.
+    std::ofstream(dir / "extra.score") << "tempo 110\nbeats 1/4\ndrum floor-tom\nR, L, R, L\n"
+                                          "R on crash 1\nR on ride-bell 1/2\nR on ride 1/2\n";
+    Daemon extra({"render", "--kit", "full", "--score", (dir / "extra.score").string(),
+                  "--bvh-rate", "0", "--tips-rate", "0", "--out", (dir / "extra").string()});
+    CHECK(extra.wait() == 0);
+    INFO(extra.err);
+    const std::string extra_json = slurp((dir / "extra" / "render.json").string());
+    CHECK(extra_json.find("\"extra_strikes\": 1,") != std::string::npos);
+    CHECK(extra.err.find("warning: 1 of 7 strikes (bounces aside) were of no note of the score: "
+                         "seq ") != std::string::npos);
+    CHECK(extra.err.find(" (the right hand on tom2 at 1.") != std::string::npos);
+    CHECK(extra.err.find("(seq in strikes.csv; render.json's performance.extra_strikes)\n") !=
+          std::string::npos);
     // The default score on the default drum: every note within 5 ms, nothing said.
     Daemon near(
         {"render", "--bvh-rate", "0", "--tips-rate", "0", "--out", (dir / "near").string()});

@@ -453,6 +453,9 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
         {{"/ictus/mode", "s", "inverse"}, "/ictus/mode", "expected joint or cartesian"},
         {{"/ictus/score", "i", "4"}, "/ictus/score", "expected ,s, got ,i"},
         {{"/ictus/volume", "f", "1"}, "/ictus/volume", "unknown address"},
+        // An address without arguments: a command as a query.
+        {{"/ictus/play", "f", "1"}, "/ictus/play", "type tags: expected none, got ,f"},
+        {{"/ictus/ping", "f", "1"}, "/ictus/ping", "type tags: expected none, got ,f"},
     };
     for (const Bad &b : bad) {
         oscsend(b.args);
@@ -468,7 +471,7 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
     CHECK_FALSE(server.pop_command(c));
     const ictus::OscServerCounters k = server.counters();
     CHECK(k.accepted == 5);
-    CHECK(k.bad_type_tags == 2);
+    CHECK(k.bad_type_tags == 4);
     CHECK(k.unknown_address == 1);
     CHECK(k.bad_values == 5);
 
@@ -483,6 +486,11 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
     CHECK(d.types == "sfifiiiiiisss");
     CHECK(std::stod(d.args[1]) == Approx(12.5));
     CHECK(std::stoi(d.args[4]) == 42);
+    // Packets received, accepted, errors: each count includes this request
+    // (received before it is accepted): 5 commands, 10 refused, the status.
+    CHECK(std::stoi(d.args[5]) == 16);
+    CHECK(std::stoi(d.args[6]) == 6);
+    CHECK(std::stoi(d.args[7]) == 10);
     REQUIRE(d.args.size() == 13);
     CHECK(d.args[10] == "\"score\""); // oscdump quotes strings
     CHECK(d.args[11] == "\"cartesian\"");
@@ -573,8 +581,8 @@ TEST_CASE("osc in: score statements, score clear and the cartesian mode pass thr
         {{"/ictus/score", "i", "96"}, "type tags: expected ,s, got ,i"},
         {{"/ictus/score", "f", "0.8"}, "type tags: expected ,s, got ,f"},
         {{"/ictus/score", "ss", "R", "legato"}, "type tags: expected ,s, got ,ss"},
-        {{"/ictus/score"}, "type tags: expected ,s, got ,"},
-        {{"/ictus/score/clear", "s", "all"}, "type tags: expected ,, got ,s"},
+        {{"/ictus/score"}, "type tags: expected ,s, got none"},
+        {{"/ictus/score/clear", "s", "all"}, "type tags: expected none, got ,s"},
         {{"/ictus/mode", "s", "Cartesian"}, "mode: expected joint or cartesian, got 'Cartesian'"},
     };
     for (const Bad &b : bad) {

@@ -123,6 +123,47 @@ TEST_CASE("perform: /ictus/tempo in score mode scales the tempo map from the fir
     CHECK(perf.plan()->notes[1].time_s - perf.plan()->notes[0].time_s == Approx(1.0));
 }
 
+TEST_CASE("perform: a new score sent without /ictus/score/clear plays at its own tempi, not "
+          "at the live tempo of the score before it, and the stopped tempo says so",
+          "[perform][tempo]")
+{
+    PerformanceOptions o;
+    o.score.score_text = "tempo 100, repeat 4, R, L, end";
+    o.score.score_name = "test";
+    Performance perf(o);
+    std::string why;
+    REQUIRE(perf.apply(command(CommandKind::play), &why));
+    REQUIRE(perf.apply(command(CommandKind::tempo, 50.0), &why));
+    INFO(why);
+    CHECK(perf.tempo_scale() == Approx(0.5));
+    REQUIRE(perf.apply(command(CommandKind::stop), &why));
+    CHECK(perf.tempo_bpm() == Approx(50.0)); // a play now replays the score at its live scale
+
+    // The first statement received begins a new score: the next play plays
+    // it at its own tempo, and the stopped tempo is that one.
+    for (const char *statement : {"tempo 120", "R", "L", "R", "L"})
+        REQUIRE(perf.apply(command(CommandKind::score, 0.0, statement), &why));
+    CHECK(perf.tempo_bpm() == Approx(120.0));
+    REQUIRE(perf.apply(command(CommandKind::play), &why));
+    REQUIRE(perf.plan()->notes.size() == 4);
+    CHECK(perf.plan()->notes[1].time_s - perf.plan()->notes[0].time_s == Approx(0.5));
+    CHECK(perf.tempo_bpm() == Approx(120.0));
+    REQUIRE(perf.apply(command(CommandKind::stop), &why));
+
+    // A tempo asked while stopped, after the statements, starts the next play.
+    REQUIRE(perf.apply(command(CommandKind::tempo, 60.0), &why));
+    CHECK(perf.tempo_bpm() == Approx(60.0));
+    REQUIRE(perf.apply(command(CommandKind::play), &why));
+    CHECK(perf.plan()->notes[1].time_s - perf.plan()->notes[0].time_s == Approx(1.0));
+    REQUIRE(perf.apply(command(CommandKind::stop), &why));
+    // Statements appended to that score extend it: its scale stays.
+    REQUIRE(perf.apply(command(CommandKind::score, 0.0, "R"), &why));
+    CHECK(perf.tempo_bpm() == Approx(60.0));
+    REQUIRE(perf.apply(command(CommandKind::play), &why));
+    REQUIRE(perf.plan()->notes.size() == 5);
+    CHECK(perf.plan()->notes[4].time_s - perf.plan()->notes[3].time_s == Approx(1.0));
+}
+
 TEST_CASE("perform: a live tempo that would take the score's tempo map past 400 bpm is "
           "refused, naming the tempo, and the plan goes on unchanged",
           "[perform][tempo]")

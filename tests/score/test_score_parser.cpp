@@ -122,7 +122,9 @@ TEST_CASE("score: R+L strikes both hands on one beat", "[score][parser]")
     CHECK(s.notes[5].nuance == Nuance::staccato);
     CHECK(s.notes[6].beat == 2.5);
     CHECK(s.length_beats == 3.5);
-    require_error("R+L at 0.3 90", 1, 1, "'at' places one stick");
+    // The column is the faulty word's: the 'at'.
+    require_error("R+L at 0.3 90", 1, 5, "'at' places one stick");
+    require_error("both accent at 0.3 90", 1, 13, "'at' places one stick");
 }
 
 TEST_CASE("score: '+' joins a note of each hand on one beat, each with its options",

@@ -560,6 +560,9 @@ nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool
 struct NoteCount {
     long notes = 0, missed = 0, off_time = 0;
     std::string first_missed, first_off_time; // where the first few were written
+    // The strikes (bounces aside) and those of no note: how many, the first few.
+    long primary_strikes = 0, extra = 0;
+    std::string first_extra;
 };
 constexpr double kOffTime_ms = 5.0; // docs/perform.md: a note is right within +-5 ms
 
@@ -635,6 +638,30 @@ ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit
     return listed_notes;
 }
 
+// The strikes of no note (a stick that met a piece on its way, a second
+// strike of a note): "seq 37 (the right hand on hihat at 4.89 s)" for the
+// first few, in onset order, on the simulation clock as in strikes.csv.
+std::string extra_strikes_text(const MatchSummary &m, const std::vector<StrikeEvent> &strikes,
+                               const Kit &kit)
+{
+    constexpr size_t kShown = 5;
+    static const char *const kLimbs[] = {"the left hand", "the right hand", "the right foot",
+                                         "the left foot"};
+    std::ostringstream out;
+    out << std::fixed << std::setprecision(2);
+    for (size_t k = 0; k < m.extra.size() && k < kShown; ++k) {
+        const StrikeEvent &e = strikes[m.extra[k]];
+        out << (k > 0 ? ", " : "") << "seq " << e.seq << " ("
+            << (e.hand >= 0 && e.hand < 4 ? kLimbs[e.hand] : "a limb");
+        if (e.drum >= 0 && e.drum < static_cast<int>(kit.drums.size()))
+            out << " on " << kit.drums[static_cast<size_t>(e.drum)].name;
+        out << " at " << e.time_s << " s)";
+    }
+    if (m.extra.size() > kShown)
+        out << " and " << m.extra.size() - kShown << " more";
+    return out.str();
+}
+
 // Every output but the sound, from memory; in score mode the notes matched
 // with the strikes (notes.csv, render.json's "performance").
 NoteCount write_render_files(RenderFiles &files, const Performance &perf, const RenderArgs &r,
@@ -661,6 +688,9 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
         const ListedNotes off = notes_text(plan, m, perf.options().kit, true);
         count.off_time = off.count;
         count.first_off_time = off.text;
+        count.primary_strikes = m.primary_strikes;
+        count.extra = m.extra_strikes;
+        count.first_extra = extra_strikes_text(m, rec.log.strikes(), perf.options().kit);
         text.str("");
         write_notes_csv(text, plan, m, perf.plan_origin_s(), perf.options().kit);
         files.notes_csv->write_and_close(text.str());
@@ -722,6 +752,11 @@ void print_render_summary(const Performance &perf, const RenderArgs &r, bool sco
                   << " notes of the score were struck more than " << kOffTime_ms
                   << " ms from their time: " << count.first_off_time
                   << " (error_ms in notes.csv)\n";
+    if (count.extra > 0)
+        std::cerr << "ictusd render: warning: " << count.extra << " of " << count.primary_strikes
+                  << " strikes (bounces aside) were of no note of the score: " << count.first_extra
+                  << " (seq in strikes.csv; render.json's "
+                  << "performance.extra_strikes)\n";
 }
 
 // --wav: events.txt played by Pd on the same drum. Returns the exit status.

@@ -449,7 +449,9 @@ void handle_status(const Request &r, const CommandSpec &)
     lo_message_add_int32(s, status ? status->playing.load() : 0);
     lo_message_add_float(s, status ? static_cast<float>(status->tempo_bpm.load()) : 0.0f);
     lo_message_add_int32(s, status ? static_cast<int>(status->strikes.load()) : 0);
-    lo_message_add_int32(s, static_cast<int>(c.packets.load()));
+    // This request is received and accepted: packets counts it only once
+    // it is handled (loop()), so it is added here.
+    lo_message_add_int32(s, static_cast<int>(c.packets.load() + 1));
     lo_message_add_int32(s, static_cast<int>(c.accepted.load()));
     const OscServerCounters snap = snapshot(c);
     lo_message_add_int32(s, static_cast<int>(snap.errors()));
@@ -575,13 +577,15 @@ void dispatch(const Request &r)
     }
     if (std::strcmp(r.types, method->types) != 0) {
         r.counters.bad_type_tags++;
-        if (method->handler != handle_command) { // a query: it takes no arguments
-            r.reply.error(r.path, std::string("type tags: expected none, got ,") + r.types);
-            return;
-        }
-        r.log("wrong type tags", std::string(r.path) + " ," + r.types);
+        if (method->handler == handle_command)
+            r.log("wrong type tags", std::string(r.path) + " ," + r.types);
+        // No arguments (a query, play, stop, score/clear) are "none", not an
+        // empty tag string, on either side.
+        auto tags = [](const char *types) {
+            return types[0] ? std::string(",") + types : std::string("none");
+        };
         r.reply.error(r.path,
-                      std::string("type tags: expected ,") + method->types + ", got ," + r.types);
+                      "type tags: expected " + tags(method->types) + ", got " + tags(r.types));
         return;
     }
     method->handler(r, method->command);

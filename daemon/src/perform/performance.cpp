@@ -381,16 +381,40 @@ int Performance::guard_runaway(int k, StrikeEvent out[kStepStrikes])
         // No human stroke moves a stick tip this fast: the controller has
         // gone unstable. Default gains back, strikes held back meanwhile.
         ++runaways_;
+        const bool scaled = gain_scale_[0] != 1.0 || gain_scale_[1] != 1.0;
+        char cause[120];
+        if (scaled)
+            std::snprintf(cause, sizeof cause, "with the gains at x%g x%g (/ictus/gains)",
+                          gain_scale_[0], gain_scale_[1]);
+        else if (options_.gains.natural_frequency_hz != built_in.natural_frequency_hz ||
+                 options_.gains.damping_ratio != built_in.damping_ratio)
+            std::snprintf(cause, sizeof cause,
+                          "with the controller's gains at %g Hz, damping ratio %g",
+                          options_.gains.natural_frequency_hz, options_.gains.damping_ratio);
+        else if (clip_)
+            std::snprintf(cause, sizeof cause,
+                          "with the built-in gains, the clip at x%.3g (tempo %g bpm, clip %g "
+                          "bpm), %s grip",
+                          options_.tempo_bpm / options_.clip_bpm, options_.tempo_bpm,
+                          options_.clip_bpm, to_string(options_.character.grip));
+        else
+            std::snprintf(cause, sizeof cause,
+                          "with the built-in gains: a stick thrown for over %g ms or twice "
+                          "within %g s",
+                          1e3 * kWhipLongest_s, kRunawayQuiet_s);
         gain_scale_[0] = gain_scale_[1] = 1.0;
         apply_gains();
-        char buf[200];
+        char buf[240];
         std::snprintf(buf, sizeof buf,
-                      "runaway: a stick tip at %.1f m/s (> %g): gains back to 1 1, no strike "
+                      "runaway guard: the %s stick's tip at %.1f m/s (over %g m/s) %s; %sno strike "
                       "sent for %g s",
-                      speed, kRunawayTipSpeed_mps, kRunawayQuiet_s);
-        Command origin = last_gains_;
-        if (origin.address[0] == '\0')
-            std::snprintf(origin.address, sizeof origin.address, "/ictus/gains");
+                      tip_mps[1] >= tip_mps[0] ? "right" : "left", speed, kRunawayTipSpeed_mps,
+                      cause, scaled ? "gains back to 1 1, " : "", kRunawayQuiet_s);
+        // Reported as the refusal of the /ictus/gains that scaled the gains;
+        // else no command caused it (no address; the last peer is told).
+        Command origin;
+        if (scaled)
+            origin = last_gains_;
         refuse_later(origin, buf);
         quiet_from_s_ = time_s();
         quiet_until_s_ = time_s() + kRunawayQuiet_s;

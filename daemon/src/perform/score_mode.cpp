@@ -30,6 +30,8 @@ class ScoreMode::Job : public Work
     // starts it at start_bpm); tempo: the scale so far, the bpm asked for,
     // the plan's clock when it was asked and the plan time of beat 0.
     double tempo_scale = 1.0, start_bpm = 0.0, bpm = 0.0, plan_now_s = 0.0, score_start_s = 0.0;
+    // The score it plays (ScoreMode::score_epoch_ when it was made).
+    unsigned score_epoch = 0;
 
     // The result.
     std::unique_ptr<ScorePlan> plan;
@@ -159,7 +161,13 @@ double ScoreMode::tempo_bpm() const
             map.beat_at_time(std::max(0.0, plan_time_s_ - plan_->plan.score_start_s));
         return map.tempo_at_beat(std::max(0.0, beat));
     }
-    return start_bpm_ > 0.0 ? start_bpm_ : score_first_bpm_ * tempo_scale_;
+    // Stopped: the next play's, the statements received when there are any
+    // (a play plays them), else the current score.
+    if (start_bpm_ > 0.0)
+        return start_bpm_;
+    const double first =
+        builder_->statements() > 0 ? builder_->first_tempo_bpm() : score_first_bpm_;
+    return first * tempo_scale_;
 }
 
 double ScoreMode::planned_impact_speed_mps(size_t note) const
@@ -186,6 +194,7 @@ std::unique_ptr<ScoreMode::Job> ScoreMode::plan_job(const Command &origin, Work:
     job->frame = rig_->frame;
     job->options.score.plan = perf_.options_.score.plan_for(rig_->tracker->mode());
     job->tempo_scale = tempo_scale_;
+    job->score_epoch = score_epoch_;
     return job;
 }
 
@@ -265,16 +274,20 @@ bool ScoreMode::install(Work &work, std::string *why)
             // A stop came while it was planned: nothing starts. The score it
             // finished is the current one (its tempo with it); one never
             // planned leaves the next play its start tempo.
+            // A new score begun meanwhile keeps its own tempi.
             if (job.plan) {
-                tempo_scale_ = job.new_tempo_scale;
+                if (job.score_epoch == score_epoch_)
+                    tempo_scale_ = job.new_tempo_scale;
                 score_first_bpm_ = job.first_bpm;
-            } else if (start_bpm_ == 0.0) {
+            } else if (start_bpm_ == 0.0 && job.score_epoch == score_epoch_) {
                 start_bpm_ = job.start_bpm;
             }
             break;
         }
         install_plan(std::move(job.plan), true);
-        tempo_scale_ = job.new_tempo_scale;
+        plan_epoch_ = job.score_epoch;
+        if (job.score_epoch == score_epoch_)
+            tempo_scale_ = job.new_tempo_scale;
         score_first_bpm_ = job.first_bpm;
         break;
     case Work::Kind::tempo:
@@ -307,7 +320,10 @@ bool ScoreMode::install_tempo(Job &job, std::string *why)
                                "would change); send it again");
         install_plan(std::move(job.plan), false);
     }
-    tempo_scale_ = job.new_tempo_scale;
+    // The scale stays for the next plays of the score it was asked on, not
+    // for a new score begun since (that plays at its own tempi).
+    if ((plan_active_ ? plan_epoch_ : job.score_epoch) == score_epoch_)
+        tempo_scale_ = job.new_tempo_scale;
     return true;
 }
 
@@ -542,19 +558,30 @@ bool ScoreMode::score(const Command &c, std::string *why)
                                    " statements are waiting, the limit: send /ictus/score/clear "
                                    "(a longer score: ictusd run --score FILE)");
         }
+        // The first statement since the start or a clear begins a new
+        // score, which replaces the current one at the next play and plays
+        // at its own tempi: a live tempo asked before it is dropped.
+        if (builder_->statements() == 0)
+            begin_new_score();
         // Parsed now (an error names the statement and column); played at
         // the next /ictus/play. A score with a faulty statement never plays.
         builder_->add_statement(c.text);
         return true;
     }
-    // A new score: its own tempi; the selected nuance still applies to the
-    // statements that follow.
+    // A new score; the selected nuance still applies to the statements that
+    // follow.
     builder_->reset();
     if (default_nuance_ != Nuance::legato)
         builder_->set_default_nuance(default_nuance_);
+    begin_new_score();
+    return true;
+}
+
+void ScoreMode::begin_new_score()
+{
     tempo_scale_ = 1.0;
     start_bpm_ = 0.0;
-    return true;
+    ++score_epoch_;
 }
 
 } // namespace ictus

@@ -67,6 +67,8 @@ class ScoreMode final : public PerformMode
     void install_rig(std::unique_ptr<ScoreRig> rig, bool keep_pose);
     void install_plan(std::unique_ptr<ScorePlan> plan, bool start_now);
     void start_rest_move();
+    // Statements begin a new score: the live tempo is dropped.
+    void begin_new_score();
     void follow_plan(TipTargets &tips);
     void follow_rest(TipTargets &tips);
     void apply_note_grips(double plan_time_s);
@@ -84,6 +86,9 @@ class ScoreMode final : public PerformMode
     double start_bpm_ = 0.0;                 // > 0: the next play starts at this tempo
     bool play_pending_ = false;              // a play handed to the worker, not back yet
     double score_first_bpm_ = 120.0;         // the current score's own first tempo
+    // Counts the new scores begun (statements after the start or a clear); a
+    // live tempo is kept only for the score it was asked on.
+    unsigned score_epoch_ = 0, plan_epoch_ = 0; // plan_epoch_: of the plan installed
     Nuance default_nuance_ = Nuance::legato; // /ictus/nuance: of the statements that follow
     std::unique_ptr<ScorePlan> plan_;        // nullptr before the first
     bool plan_active_ = false;

@@ -44,13 +44,10 @@ MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
                 nearest = static_cast<long>(i);
             }
         }
-        if (nearest < 0) {
-            ++m.extra_strikes;
-            continue;
-        }
+        if (nearest < 0)
+            continue; // extra: no note of its limb on its drum
+        // A note given a second strike keeps the nearer; the other is extra.
         const size_t i = static_cast<size_t>(nearest);
-        if (matched[i].strike_seq >= 0)
-            ++m.extra_strikes; // the note already has one: one of the two is extra
         if (nearest_d < best[i]) {
             best[i] = nearest_d;
             matched[i].strike_seq = e.seq;
@@ -60,6 +57,16 @@ MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
             matched[i].duration_ms = e.duration_ms;
         }
     }
+    // The extra ones: the primary strikes no note kept.
+    std::vector<long> kept;
+    for (const NoteMatch &n : matched)
+        if (n.strike_seq >= 0)
+            kept.push_back(n.strike_seq);
+    std::sort(kept.begin(), kept.end());
+    for (size_t k = 0; k < strikes.size(); ++k)
+        if (!strikes[k].bounce && !std::binary_search(kept.begin(), kept.end(), strikes[k].seq))
+            m.extra.push_back(k);
+    m.extra_strikes = static_cast<long>(m.extra.size());
     double sum = 0.0;
     for (const NoteMatch &n : matched) {
         if (n.strike_seq < 0)

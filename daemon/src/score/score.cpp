@@ -418,8 +418,8 @@ class LineParser
                                              to_string(st.ornament) + " or L " +
                                              to_string(st.ornament));
             if (st.r_over_a)
-                fail(tk[0].column, "'at' places one stick; " + tk[0].text +
-                                       " plays each hand on its default spot");
+                fail(st.spot_column, "'at' places one stick; " + tk[0].text +
+                                         " plays each hand on its default spot");
         } else if (key == "tempo") {
             st.kind = Kind::tempo;
             size_t i = 1;
@@ -712,6 +712,7 @@ class LineParser
                     theta += 360.0;
                 st.r_over_a = ra;
                 st.theta_deg = theta;
+                st.spot_column = t.column;
                 i += 2;
             } else if (t.text.find('/') != std::string::npos && starts_numeric(t.text)) {
                 if (st.beats)
@@ -763,6 +764,17 @@ ScoreBuilder &ScoreBuilder::operator=(ScoreBuilder &&) noexcept = default;
 int ScoreBuilder::statements() const
 {
     return state_->calls;
+}
+double ScoreBuilder::first_tempo_bpm() const
+{
+    double bpm = kDefaultTempoBpm;
+    for (const Statement &st : state_->statements) {
+        if (st.kind == Kind::note || st.kind == Kind::roll || st.kind == Kind::rest)
+            break;
+        if (st.kind == Kind::tempo && st.start_bpm)
+            bpm = *st.start_bpm;
+    }
+    return bpm;
 }
 std::size_t ScoreBuilder::parsed_statements() const
 {

@@ -68,6 +68,7 @@ struct Statement {
     // and its column
     std::optional<std::string> drum;
     int drum_column = 0;
+    int spot_column = 0; // note: its 'at' word's column, for errors (r_over_a, theta_deg)
     // note: the hi-hat's pedal (`open`, `half`, `closed`) and its word's column
     std::optional<double> openness;
     int openness_column = 0;

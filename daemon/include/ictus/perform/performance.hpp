@@ -232,8 +232,9 @@ class Performance
     // lightly damped ones; a controller past its stability bound reached
     // 54 m/s). The guard then puts
     // the gains back to their defaults, sends no strike for
-    // kRunawayQuiet_s, counts it and reports it as a refusal of the last
-    // /ictus/gains command.
+    // kRunawayQuiet_s, counts it and reports it, naming its cause: as a
+    // refusal of the last /ictus/gains when that scaled the gains, else with
+    // no address (no command caused it).
     // The grip of a buzz note that gives none (docs/perform.md, "Buzz").
     static constexpr double kBuzzGripFirmness = 0.0;
     // A down stroke (drumming pedagogy: a stroke that stops the stick low,

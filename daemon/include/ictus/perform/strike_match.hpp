@@ -26,6 +26,7 @@ struct MatchSummary {
     long primary_strikes = 0, bounces = 0;
     long matched_notes = 0;
     long extra_strikes = 0; // primary strikes not matched to a note
+    std::vector<size_t> extra; // those, as indices into the strikes, in their order
     double mean_abs_error_ms = 0.0, max_abs_error_ms = 0.0;
 };
 // `origin_s`: simulation time of the plan's time 0. The feet's strikes

@@ -236,6 +236,10 @@ class ScoreBuilder
     // /ictus/nuance does in score mode.
     void set_default_nuance(Nuance nuance);
     int statements() const; // how many add_statement() calls so far
+    // The tempo the statements so far start at (their beat 0): that of the
+    // last `tempo` before the first note, roll or rest; the default (120 bpm)
+    // without one. What finish() would give as tempo.tempo_at_beat(0).
+    double first_tempo_bpm() const;
     // How many statements they held (a line may hold several; comments none).
     std::size_t parsed_statements() const;
     bool failed() const;
