@@ -22,6 +22,27 @@
 #define M_PI 3.14159265358979323846
 #endif
 
+void ictus_gauss_legendre(int n, double *x, double *w)
+{
+    for (int i = 0; i < n; i++) {
+        double z = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
+        for (int it = 0; it < 100; it++) {
+            double p0 = 1.0, p1 = z;
+            for (int k = 2; k <= n; k++) {
+                double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
+                p0 = p1, p1 = p2;
+            }
+            dp = n * (z * p1 - p0) / (z * z - 1.0);
+            double dz = p1 / dp;
+            z -= dz;
+            if (fabs(dz) < 1e-15)
+                break;
+        }
+        x[i] = 0.5 * (1.0 - z);
+        w[i] = 1.0 / ((1.0 - z * z) * dp * dp); /* 2 / (...) on [-1, 1], halved */
+    }
+}
+
 void ictus_bessel_j3(int m, double x, double out[3])
 {
     /* out = {J_{m-1}(x), J_m(x), J_{m+1}(x)}; J_{-1} = -J_1. x >= 0. */

@@ -1,6 +1,7 @@
 /* membrane_modes.c -- the membrane's modes: the arrays of the modal state and its
  * coefficients, built for a mode count (the table of modes itself is mode_table.c),
  * and the coefficients computed from the physics (docs/membrane.md). */
+#include "bessel_internal.h"
 #include "membrane_internal.h"
 
 #include <stdlib.h>
@@ -20,25 +21,9 @@ static int gauss_legendre(int n, const double **t, const double **w)
     n = row * GL_STEP;
     double *tt = gl_t[row - 1], *ww = gl_w[row - 1];
     if (!gl_ready[row - 1]) {
-        for (int i = 0; i < n; i++) {
-            /* Newton on P_n from the usual first guess (Numerical Recipes' gauleg). */
-            double z = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
-            for (int it = 0; it < 100; it++) {
-                double p1 = 1.0, p2 = 0.0;
-                for (int k = 1; k <= n; k++) {
-                    const double p3 = p2;
-                    p2 = p1;
-                    p1 = ((2.0 * k - 1.0) * z * p2 - (k - 1.0) * p3) / k;
-                }
-                dp = n * (z * p1 - p2) / (z * z - 1.0);
-                const double z1 = z;
-                z = z1 - p1 / dp;
-                if (fabs(z - z1) <= 1e-15)
-                    break;
-            }
-            tt[i] = (z + 1.0) * 0.25 * M_PI;
-            ww[i] = 0.25 * M_PI * 2.0 / ((1.0 - z * z) * dp * dp);
-        }
+        ictus_gauss_legendre(n, tt, ww); /* on [0, 1]: scaled to [0, pi/2] */
+        for (int i = 0; i < n; i++)
+            tt[i] *= 0.5 * M_PI, ww[i] *= 0.5 * M_PI;
         gl_ready[row - 1] = 1;
     }
     *t = tt;

@@ -1,6 +1,7 @@
 /* plate_cascade.c -- the von Karman coefficients of a free-edge plate's modes and the
  * nonlinear potential (plate_cascade.h; docs/plates.md, "The cascade"). */
 #include "plate_cascade.h"
+#include "bessel_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -10,29 +11,8 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-/* Gauss-Legendre points on [0, 1] for the radial integrals (weights include r). */
+/* Gauss-Legendre points on [0, 1] for the radial integrals (ictus_gauss_legendre). */
 #define RADIAL_POINTS 96
-
-static void gauss_legendre(int n, double *x, double *w)
-{
-    for (int i = 0; i < n; i++) {
-        double z = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
-        for (int it = 0; it < 100; it++) {
-            double p0 = 1.0, p1 = z;
-            for (int k = 2; k <= n; k++) {
-                double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-                p0 = p1, p1 = p2;
-            }
-            dp = n * (z * p1 - p0) / (z * z - 1.0);
-            double dz = p1 / dp;
-            z -= dz;
-            if (fabs(dz) < 1e-15)
-                break;
-        }
-        x[i] = 0.5 * (1.0 - z);
-        w[i] = 1.0 / ((1.0 - z * z) * dp * dp); /* 2 / (...) on [-1, 1], halved */
-    }
-}
 
 static double bessel_j_any(int m, double x)
 {
@@ -92,7 +72,7 @@ int plate_inplane_mode(int m, int s, plate_mode *out)
                     -ictus_bessel_j(m, out->lambda) / ictus_bessel_i_scaled(m, out->lambda);
                 out->norm = 1.0;
                 double x[RADIAL_POINTS], w[RADIAL_POINTS], sum = 0.0;
-                gauss_legendre(RADIAL_POINTS, x, w);
+                ictus_gauss_legendre(RADIAL_POINTS, x, w);
                 for (int k = 0; k < RADIAL_POINTS; k++) {
                     double v = plate_mode_radial(out, x[k]);
                     sum += w[k] * x[k] * v * v;
@@ -150,7 +130,7 @@ double plate_cascade_h(const plate_mode *a, int a_sin, const plate_mode *i, int 
 {
     double x[RADIAL_POINTS], w[RADIAL_POINTS], ra[RADIAL_POINTS];
     double ri[RADIAL_POINTS][3], rj[RADIAL_POINTS][3], c1, c2;
-    gauss_legendre(RADIAL_POINTS, x, w);
+    ictus_gauss_legendre(RADIAL_POINTS, x, w);
     for (int k = 0; k < RADIAL_POINTS; k++) {
         ra[k] = plate_mode_radial(a, x[k]);
         radial3(i, x[k], ri[k]);
@@ -236,7 +216,7 @@ static int push_entry(entry_list *l, int a, int i, int j, double h)
 static double all_entries(const plate_cascade *c, const mode_table *t, int modes, entry_list *l)
 {
     double x[RADIAL_POINTS], w[RADIAL_POINTS], big = 0.0;
-    gauss_legendre(RADIAL_POINTS, x, w);
+    ictus_gauss_legendre(RADIAL_POINTS, x, w);
     double(*rt)[RADIAL_POINTS][3] = malloc(sizeof(*rt) * (size_t)modes);
     double(*ra)[RADIAL_POINTS] = malloc(sizeof(*ra) * (size_t)c->inplane);
     if (!rt || !ra) {
