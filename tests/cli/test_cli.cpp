@@ -56,6 +56,18 @@ TEST_CASE("ictusd: unknown verbs and options are usage errors (exit 2)", "[cli]"
     CHECK(r.output.find("--mocap") != std::string::npos);
     r = ictusd("limits");
     CHECK(r.status == 2);
+    // Two motion sources, or a kit with a clip, for render and run alike.
+    for (const char *verb : {"render --out /nonexistent-dir/x", "run"}) {
+        const std::string clip = " --mocap " + tiny_bvh();
+        const std::string score = simtest::write_temp("two-sources.txt", "R\n");
+        for (const std::string &extra :
+             {" --score " + score, std::string(" --midi x.mid"), std::string(" --kit full")}) {
+            r = ictusd(std::string(verb) + clip + extra);
+            INFO(verb << clip << extra << " -> " << r.status << ": " << r.output);
+            CHECK(r.status == 2);
+            CHECK(r.output.find(extra.substr(1, extra.find(' ', 1) - 1)) != std::string::npos);
+        }
+    }
 }
 
 TEST_CASE("ictusd track: every option refuses a bad value, naming it", "[cli]")

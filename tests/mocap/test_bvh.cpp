@@ -140,6 +140,11 @@ TEST_CASE("BVH: hierarchy, channels, rate and mixed line endings", "[mocap][bvh]
     CHECK(bvh.motion.frames() == 3);
     CHECK(bvh.motion.frame_rate_hz == 25.0);
     CHECK(bvh.frame_time_s == 0.04);
+    // The same file with a UTF-8 byte order mark first (as Windows' Notepad saves it).
+    const TempFile marked("chain-bom.bvh", std::string("\xEF\xBB\xBF") + kChainBvh);
+    const BvhFile same = read_bvh(marked.path(), {}, &warnings);
+    CHECK(same.channel_count == bvh.channel_count);
+    CHECK(same.motion.frames() == bvh.motion.frames());
 }
 
 TEST_CASE("BVH: forward kinematics reproduces hand-computed joint positions", "[mocap][bvh]")

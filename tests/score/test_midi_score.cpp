@@ -55,6 +55,20 @@ struct Track {
     std::string file() const { return header(0, 1) + chunk("MTrk", events + kEnd); }
 };
 
+// No hand of a part at a steady `bpm` strikes twice within kMidiSameHandMin_s.
+void check_hands_apart(const MidiDrumPart &p, double bpm)
+{
+    for (Side h : {Side::left, Side::right}) {
+        double last = -1.0;
+        for (const ScoreNote &n : p.score.notes)
+            if (n.hand == h && !n.foot) {
+                if (last >= 0.0)
+                    CHECK((n.beat - last) * 60.0 / bpm >= kMidiSameHandMin_s);
+                last = n.beat;
+            }
+    }
+}
+
 std::string what_of(const std::string &file)
 {
     try {
@@ -139,6 +153,7 @@ TEST_CASE("midi in: hands as a drummer's, the drum channel, the GM toms", "[scor
     CHECK(part.score.notes[3].drum == "tom1");  // 50 -> the nearest, 48
     CHECK(part.score.notes[4].drum == "floor"); // 41 -> 43
     CHECK(part.too_fast == 1);
+    CHECK(part.other_channels == 1); // the channel 1 note, counted
     CHECK(part.score.notes[3].dynamics == Approx(1.0));
     // No channel 10: every channel is read.
     const std::string t1 = bytes({0x00, 0x90, 38, 40, 0x18, 0x91, 40, 50}) + kEnd;
@@ -146,6 +161,7 @@ TEST_CASE("midi in: hands as a drummer's, the drum channel, the GM toms", "[scor
         drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t1), "t.mid"), kit, "t.mid");
     CHECK(any.channel == -1);
     CHECK(any.score.notes.size() == 2);
+    CHECK(any.other_channels == 0);
 }
 
 TEST_CASE("midi in: General MIDI's cymbals on a kit's crash and ride", "[score][midi]")
@@ -695,16 +711,7 @@ TEST_CASE("midi in: the left hand keeps the hi-hat going while the right crosses
     for (const ScoreNote &n : p.score.notes)
         if (n.drum == "ride")
             CHECK(n.hand == Side::right);
-    // No hand strikes twice within 50 ms.
-    for (Side h : {Side::left, Side::right}) {
-        double last = -1.0;
-        for (const ScoreNote &n : p.score.notes)
-            if (n.hand == h && !n.foot) {
-                if (last >= 0.0)
-                    CHECK((n.beat - last) * 60.0 / 130.0 >= kMidiSameHandMin_s);
-                last = n.beat;
-            }
-    }
+    check_hands_apart(p, 130.0);
     // At 60 bpm one 16th (250 ms) is enough: every hi-hat the right hand's.
     REQUIRE(cross / 0.25 < kMidiLendHihatAbove_mps);
     const MidiDrumPart q = part(60.0);
@@ -712,4 +719,62 @@ TEST_CASE("midi in: the left hand keeps the hi-hat going while the right crosses
     for (const ScoreNote &n : q.score.notes)
         if (n.drum == "hihat")
             CHECK(n.hand == Side::right);
+}
+
+TEST_CASE("midi in: the right hand takes a crash the left cannot reach in time", "[score][midi]")
+{
+    // The full kit's places (the kit's frame, x to the right). A bar of 16th hi-hats (the
+    // right hand's), the snare on 2 and 4 and a ghost note on the last 16th (both the
+    // left's, under the hi-hat), then the crash with the kick on the next downbeat. From the
+    // ghost the left would cross 0.76 m to the crash in one 16th; the right, on the hi-hat
+    // beside the crash, is free on that tick.
+    const std::vector<MidiDrum> kit = {{"snare", 38, true, {0.0, 0.0, 0.0}},
+                                       {"crash", 49, true, {-0.64, 0.30, 0.36}},
+                                       {"ride", 51, true, {0.62, 0.22, 0.28}},
+                                       {"hihat", 42, true, {-0.42, 0.26, -0.02}},
+                                       {"kick", 36, true, {0.26, -0.32, 0.28}}};
+    auto part = [&](double bpm, bool ride_too) {
+        Track t(bpm);
+        for (int k = 0; k < 16; ++k) {
+            t.at(k * 24, 42, 80);
+            if (k == 4 || k == 12)
+                t.at(k * 24, 38, 100);
+            if (k == 15)
+                t.at(k * 24, 38, 35);
+        }
+        if (ride_too)
+            t.at(16 * 24, 51, 90);
+        t.at(16 * 24, 49, 120);
+        t.at(16 * 24, 36, 110);
+        return drum_part_score(read_smf(t.file(), "g.mid"), kit, "g.mid");
+    };
+    const double crash_from_snare = std::hypot(0.64, 0.30, 0.36) + 0.1;
+    const double crash_from_hihat = std::hypot(0.64 - 0.42, 0.30 - 0.26, 0.36 + 0.02) + 0.1;
+    const double e16 = 60.0 / 120.0 / 4.0;
+    REQUIRE(crash_from_snare / e16 > kMidiLendHihatAbove_mps);
+    REQUIRE(crash_from_hihat / e16 < kMidiLendHihatAbove_mps);
+    auto crash_hand = [](const MidiDrumPart &p) {
+        for (const ScoreNote &n : p.score.notes)
+            if (n.drum == "crash")
+                return n.hand;
+        FAIL("no crash note");
+        return Side::left;
+    };
+    const MidiDrumPart p = part(120.0, false);
+    CHECK(p.too_fast == 0);
+    CHECK(p.crashes_given == 1);
+    CHECK(crash_hand(p) == Side::right);
+    for (const ScoreNote &n : p.score.notes)
+        if (n.drum == "snare")
+            CHECK(n.hand == Side::left);
+    check_hands_apart(p, 120.0);
+    // The right hand busy on the ride on that tick: the crash stays the left's.
+    const MidiDrumPart busy = part(120.0, true);
+    CHECK(busy.crashes_given == 0);
+    CHECK(crash_hand(busy) == Side::left);
+    // At 60 bpm the left reaches the crash in a 16th (250 ms): the left's.
+    REQUIRE(crash_from_snare / (2.0 * e16) < kMidiLendHihatAbove_mps);
+    const MidiDrumPart slow = part(60.0, false);
+    CHECK(slow.crashes_given == 0);
+    CHECK(crash_hand(slow) == Side::left);
 }

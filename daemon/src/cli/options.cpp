@@ -368,6 +368,11 @@ void OutputFile::close()
 
 void load_midi_score(PerformanceOptions &o)
 {
+    if (!o.mocap.empty() && !o.score.score_text.empty())
+        throw UsageError("--score and --mocap are two motion sources: give one");
+    if (!o.mocap.empty() && !o.kit.empty())
+        throw UsageError("--kit: a kit is played from a score (--score, --midi or the default "
+                         "score), not with --mocap");
     const std::string &path = o.score.midi_path;
     if (path.empty())
         return;
@@ -407,6 +412,15 @@ void load_midi_score(PerformanceOptions &o)
                   << (part.hihats_lent == 1 ? " hi-hat note" : " hi-hat notes")
                   << " of the time-keeper played by the left hand while the right crosses the kit "
                      "(its move over "
+                  << kMidiLendHihatAbove_mps << " m/s; docs/midi.md)\n";
+    if (part.other_channels > 0)
+        std::cerr << "ictusd: note: --midi " << path << ": " << part.other_channels
+                  << " notes on channels other than 10 left out (channel 10 is the drum part's; "
+                     "docs/midi.md)\n";
+    if (part.crashes_given > 0)
+        std::cerr << "ictusd: note: --midi " << path << ": " << part.crashes_given
+                  << (part.crashes_given == 1 ? " crash note" : " crash notes")
+                  << " played by the right hand, free beside it (the left's move over "
                   << kMidiLendHihatAbove_mps << " m/s; docs/midi.md)\n";
     if (part.tempo_clamped > 0)
         std::cerr << "ictusd: warning: --midi " << path << ": " << part.tempo_clamped

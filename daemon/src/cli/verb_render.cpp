@@ -81,8 +81,8 @@ void render_usage(std::ostream &out)
            "\n"
            "score mode (run and render):\n"
            "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
-           "  --midi FILE         a Standard MIDI File's drum part as the score: snares and\n"
-           "                      toms of the General MIDI drum map (docs/midi.md, MIDI in)\n"
+           "  --midi FILE         a Standard MIDI File's drum part as the score: the General\n"
+           "                      MIDI drum map's notes the kit has (docs/midi.md, MIDI in)\n"
            "  --gestures DB.json  gesture database (default: the built-in one)\n"
            "  --mode M            cartesian (default, Algorithm 2) | joint (eq. 1, joint\n"
            "                      targets from the IK of the tip targets)\n"
@@ -368,8 +368,6 @@ bool parse_render_args(Args &args, RenderArgs &r)
     });
     if (!go_on)
         return false;
-    if (!r.o.mocap.empty() && !r.o.score.score_text.empty())
-        throw UsageError("--score and --mocap are two motion sources: give one");
     load_midi_score(r.o);
     if (r.out_dir.empty())
         throw UsageError("--out DIR is required");
@@ -568,7 +566,8 @@ constexpr double kOffTime_ms = 5.0; // docs/perform.md: a note is right within +
 
 // The notes not struck (off_time false) or struck more than kOffTime_ms from
 // their time (true), hands' and feet's: how many, and "line L (the right hand
-// on crash at 7.43 s, from floor 1.2 m away 0.27 s before)" for the first few
+// on crash at 7.43 s, from floor 1.2 m away 0.27 s before)" ("note N" for a MIDI
+// part's: unit) for the first few
 // in plan order (off time with the error: "..., +12.40 ms"); a hand's move into
 // the note is given when it came from another piece (most notes lost on a kit
 // asked the arm for a move it cannot make in the time).
@@ -577,7 +576,7 @@ struct ListedNotes {
     std::string text;
 };
 ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit,
-                       bool off_time)
+                       bool off_time, const char *unit)
 {
     ListedNotes listed_notes;
     auto listed = [&](const NoteMatch &n) {
@@ -604,7 +603,7 @@ ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit
     auto one = [&](int line, const std::string &who, int drum, double t, const std::string &move) {
         if (shown++ >= kShown)
             return;
-        out << (shown > 1 ? ", " : "") << "line " << line << " (" << who;
+        out << (shown > 1 ? ", " : "") << unit << " " << line << " (" << who;
         if (!name(drum).empty())
             out << " on " << name(drum);
         out << " at " << t << " s" << move << ")";
@@ -684,8 +683,10 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
             match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s(), plan.foot_notes);
         count.notes = static_cast<long>(plan.notes.size() + plan.foot_notes.size());
         count.missed = count.notes - m.matched_notes;
-        count.first_missed = notes_text(plan, m, perf.options().kit, false).text;
-        const ListedNotes off = notes_text(plan, m, perf.options().kit, true);
+        // A MIDI part's notes are numbered as the file's note-ons, in time order.
+        const char *unit = perf.options().score.midi_path.empty() ? "line" : "note";
+        count.first_missed = notes_text(plan, m, perf.options().kit, false, unit).text;
+        const ListedNotes off = notes_text(plan, m, perf.options().kit, true, unit);
         count.off_time = off.count;
         count.first_off_time = off.text;
         count.primary_strikes = m.primary_strikes;

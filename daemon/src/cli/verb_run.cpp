@@ -300,9 +300,6 @@ bool parse_run_args(Args &args, RunOptions &r)
     });
     if (!go_on)
         return false;
-    const PerformanceOptions &o = r.performance;
-    if (!o.mocap.empty() && !o.score.score_text.empty())
-        throw UsageError("--score and --mocap are two motion sources: give one");
     load_midi_score(r.performance);
     if (!r.server.reply_url.empty()) // as --target's, before anything loads
         check_osc_udp_url("--reply", r.server.reply_url);

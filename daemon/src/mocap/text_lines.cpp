@@ -48,6 +48,9 @@ std::vector<std::string> read_lines(std::istream &in, const std::string &source_
         throw MocapError(source_name, 0, "expected a readable stream, got a read error");
     if (!current.empty())
         lines.push_back(current);
+    // A UTF-8 byte order mark (as Windows' Notepad writes) is not the file's text.
+    if (!lines.empty() && lines.front().compare(0, 3, "\xEF\xBB\xBF") == 0)
+        lines.front().erase(0, 3);
     return lines;
 }
 

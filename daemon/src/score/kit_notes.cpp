@@ -105,7 +105,7 @@ int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &fra
 }
 
 int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame &frame,
-                   double &r_over_a, double &theta_deg)
+                   double &r_over_a, double &theta_deg, const Eigen::Vector3d *arriving_from)
 {
     const NoteDrum drum = note_drum(score, n, frame);
     const bool cymbal = drum.index < static_cast<int>(frame.drums.size()) &&
@@ -113,6 +113,13 @@ int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame 
     if (!n.spot_given && (drum.bell || cymbal)) {
         r_over_a = drum.bell ? kBellRadiusFraction : kCymbalRadiusFraction;
         theta_deg = kCymbalThetaDeg[static_cast<int>(n.hand)];
+        if (arriving_from && !drum.bell) {
+            const Eigen::Vector3d to =
+                *arriving_from - frame.drums[static_cast<size_t>(drum.index)].membrane_center_m;
+            const double face = std::atan2(-to.z(), to.x()) * 180.0 / M_PI; // docs/osc.md
+            theta_deg += std::clamp(std::remainder(face - theta_deg, 360.0), -kCymbalFaceMostDeg,
+                                    kCymbalFaceMostDeg);
+        }
     }
     if (!n.spot_given && drum.rim) {
         const PerformerFrame::Drum &d = frame.drums[static_cast<size_t>(drum.index)];

@@ -30,9 +30,12 @@ int drum_index(const Score &score, const ScoreNote &n, const PerformerFrame &fra
 // (kBellRadiusFraction, as General MIDI's 53) or its bow's
 // (kCymbalRadiusFraction); where it gives none on a drum's rim (`snare-rim`),
 // the edge where it faces the hand's shoulder in plan (kRimInset_m inside it);
-// r_over_a and theta_deg are left as they are elsewhere.
+// r_over_a and theta_deg are left as they are elsewhere. With arriving_from (the
+// point the hand comes from, fast: kCymbalFaceAbove_mps) a cymbal's bow spot is
+// turned toward it by at most kCymbalFaceMostDeg.
 int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame &frame,
-                   double &r_over_a, double &theta_deg);
+                   double &r_over_a, double &theta_deg,
+                   const Eigen::Vector3d *arriving_from = nullptr);
 // The note's pedal on a hi-hat (closed when it names none), -1 on another
 // drum; a ScoreError at the word when it names one on a drum without a pedal.
 double note_openness(const Score &score, const ScoreNote &n, const PerformerFrame &frame, int drum);

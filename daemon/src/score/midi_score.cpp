@@ -327,7 +327,6 @@ struct HandNote {
 // stroke's own travel, over the time between them (m/s); 0 when the pieces are not placed.
 double move_speed(const std::vector<MidiDrum> &drums, const HandNote &a, const HandNote &b)
 {
-    constexpr double kStrokeTravel_m = 0.1;
     const MidiDrum &p = drums[static_cast<size_t>(a.drum)], &q = drums[static_cast<size_t>(b.drum)];
     if (!p.placed || !q.placed)
         return 0.0;
@@ -530,6 +529,57 @@ long lend_hihats_to_left(std::vector<ScoreNote> &score, const std::vector<HandNo
     return lent;
 }
 
+// The crash notes the left hand would reach from its last note faster than
+// kMidiLendHihatAbove_mps (a ghost note on the snare a 16th before, 0.74 m away) are the right
+// hand's when it is free there: no note of its own on the tick or within kMidiSameHandMin_s,
+// its moves into and out of the crash within kMidiLendHihatAbove_mps and slower than the
+// left's, as a drummer keeping time on the hi-hat, beside the crash, takes the crash with the
+// right hand. Returns how many.
+long give_crashes_to_right(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes,
+                           const std::vector<MidiDrum> &drums)
+{
+    const size_t n = notes.size();
+    auto hand_of = [&](size_t i) { return score[notes[i].index].hand; };
+    // The note of `hand` before (step -1) or after (+1) note i; n when none.
+    auto next_of = [&](size_t i, Side hand, int step) {
+        for (size_t j = i; step < 0 ? j-- > 0 : ++j < n;)
+            if (hand_of(j) == hand)
+                return j;
+        return n;
+    };
+    long given = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (hand_of(i) != Side::left ||
+            drums[static_cast<size_t>(notes[i].drum)].midi_note != kMidiCrash)
+            continue;
+        const size_t from = next_of(i, Side::left, -1);
+        if (from == n)
+            continue;
+        const double left = move_speed(drums, notes[from], notes[i]);
+        if (left <= kMidiLendHihatAbove_mps)
+            continue;
+        const size_t before = next_of(i, Side::right, -1), after = next_of(i, Side::right, +1);
+        bool free = true;
+        double right = 0.0;
+        if (before < n) {
+            free = free && notes[i].t - notes[before].t >= kMidiSameHandMin_s;
+            right = std::max(right, move_speed(drums, notes[before], notes[i]));
+        }
+        if (after < n) {
+            free = free && notes[after].t - notes[i].t >= kMidiSameHandMin_s;
+            right = std::max(right, move_speed(drums, notes[i], notes[after]));
+        }
+        if (!free || right > kMidiLendHihatAbove_mps || right >= left)
+            continue;
+        ScoreNote &s = score[notes[i].index];
+        s.hand = Side::right;
+        if (!s.spot_given)
+            s.theta_deg = kDefaultThetaDeg[1];
+        ++given;
+    }
+    return given;
+}
+
 // Takes the notes marked in dropped out of the score, and out of the hands' notes, whose
 // indices follow.
 void drop_notes(std::vector<ScoreNote> &notes, std::vector<HandNote> &hand_notes,
@@ -598,8 +648,10 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
     for (size_t index : order) {
         const SmfNote &n = smf.notes[index];
         const int line = static_cast<int>(index) + 1;
-        if (part.channel >= 0 && n.channel != part.channel)
+        if (part.channel >= 0 && n.channel != part.channel) {
+            ++part.other_channels;
             continue;
+        }
         const int drum = drum_of(n.note, drums);
         if (drum < 0) {
             ++part.skipped[n.note];
@@ -707,6 +759,7 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         part.hihats_pedalled = pedal_crowded_hihats(part.score.notes, hand_notes, chick_s, drums);
         turn_runs(part.score.notes, hand_notes, drums);
         part.hihats_pedalled += pedal_crowded_hihats(part.score.notes, hand_notes, chick_s, drums);
+        part.crashes_given = give_crashes_to_right(part.score.notes, hand_notes, drums);
         part.hihats_lent = lend_hihats_to_left(part.score.notes, hand_notes, drums);
     }
     for (size_t i = 0; i + 1 < part.score.notes.size(); ++i)

@@ -703,7 +703,8 @@ class LineParser
                     fail(r.column, "r/a " + r.text + " is out of range (0..0.95 of the radius)");
                 double theta = number(th, "theta");
                 if (!std::isfinite(theta) || std::abs(theta) > 1e6)
-                    fail(th.column, "theta " + th.text + " is out of range");
+                    fail(th.column, "theta " + th.text +
+                                        " is out of range (-1e6..1e6 degrees, taken modulo 360)");
                 // Into (-180, 180] as docs/osc.md reports it.
                 theta = std::fmod(theta, 360.0);
                 if (theta > 180.0)

@@ -74,10 +74,11 @@ MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o
 
 // run and render: the motion source, the character, the drum, score mode.
 // Returns false when `option` is not one of them.
+// The motion sources checked (UsageError: --mocap with --score, --midi or --kit), then
 // --midi FILE (options.score.midi_path): the file's drum part as the score
 // (score/midi_score.hpp), on the kit given (--kit) or the one drum; a line on
 // stderr counts the notes left out. Throws UsageError with --score or
-// --mocap, MidiFileError for a malformed file. Nothing without --midi.
+// --mocap, MidiFileError for a malformed file. Nothing else without --midi.
 void load_midi_score(PerformanceOptions &options);
 
 bool parse_performance_option(const std::string &option, Args &args, PerformanceOptions &o,

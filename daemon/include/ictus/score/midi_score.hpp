@@ -136,6 +136,8 @@ struct MidiDrumPart {
     long hihats_pedalled = 0;    // closed hi-hats the left foot played (kMidiPedalHihatAbove_mps)
     long hihats_lent =
         0; // the time-keeper's hi-hats the left hand played (kMidiLendHihatAbove_mps)
+    long crashes_given = 0;  // crashes the right hand played (kMidiLendHihatAbove_mps)
+    long other_channels = 0; // notes on channels other than the drum part's (10) left out
 };
 
 // The drum part of `smf` (docs/midi.md): the notes on channel 10 if there

@@ -64,6 +64,15 @@ constexpr double kDefaultThetaDeg[2] = {0.0, 180.0}; // [Side::left, Side::right
 // own side of the point nearest the performer (theta 90).
 constexpr double kCymbalRadiusFraction = 0.7;
 constexpr double kCymbalThetaDeg[2] = {70.0, 110.0}; // [Side::left, Side::right]
+// A cymbal note, given no spot, that its hand reaches from a note on another piece faster
+// than kCymbalFaceAbove_mps (the distance from that note's strike point to the spot, plus a
+// stroke's kStrokeTravel_m, over the time between them) is played on its bow turned from
+// kCymbalThetaDeg toward that point by at most kCymbalFaceMostDeg: an arm crossing the kit
+// fast overshoots along its way, and from the near side it lands on the plate instead of
+// past its far edge (docs/kit.md, "The spot"; on bench/perform/random_parts.py's parts).
+constexpr double kStrokeTravel_m = 0.1;
+constexpr double kCymbalFaceAbove_mps = 3.5;
+constexpr double kCymbalFaceMostDeg = 45.0;
 // A cymbal's bell (`on ride-bell`, General MIDI's 53): a stroke aimed this near
 // the centre (a 20-inch ride's bell is about 6 inches across), at the bow's
 // kCymbalThetaDeg: the stick lies over the bow toward the performer. Aimed at
