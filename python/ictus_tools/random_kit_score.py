@@ -162,6 +162,8 @@ class KitState(rs.State):
 class KitGenerator(rs.Generator):
     """random_score.Generator over a kit: its notes are limbs' parts on the kit's pieces."""
 
+    extended = False  # no grip firmness, flams, drags, rolls or meters (random_score's)
+
     def __init__(self, seed, nuances, kit="full"):
         if kit not in KITS:
             raise ValueError("no random scores for kit %r (known: %s)" % (kit, ", ".join(KITS)))

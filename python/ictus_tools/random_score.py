@@ -16,13 +16,17 @@ and the same nuance list give the same bytes (Python's own `random.Random(seed)`
 of sets, no clock).
 
 What a score may hold (daemon/src/score/score.cpp is the grammar): statements `R`/`L`/`right`/
-`left` [options], `R+L`/`L+R`/`both` [options without `at`], `tempo BPM`, `tempo BPM -> BPM2
-over BEATS`, `tempo -> BPM2 over BEATS` (`to` for `->`), `grip french|german`, `rest [[beats]
-BEATS]`, `beats BEATS`, `dynamics D`, `repeat N` ... `end` (nesting); separated by newlines, `;`
-or `,`; `#` comments; words in any case. Note options, in any order, each at most once: a
-nuance, dynamics (a number 0..1 or pp p mp mf f ff), a duration (N/D or `beats X`), `at R/A
-THETA`. Here: tempi 40..220 bpm (the brief; the language allows 20..400), durations from the
-musical fractions below (whole notes to 1/32, triplets, dotted values, non-reduced forms).
+`left` [options], `R+L`/`L+R`/`both` [options without `at`, `flam`, `drag`], `tempo BPM`,
+`tempo BPM -> BPM2 over BEATS`, `tempo -> BPM2 over BEATS` (`to` for `->`), `grip
+french|german`, `rest [[beats] BEATS]`, `beats BEATS`, `dynamics D`, `firmness F`, `meter N/D`,
+`roll single|double|buzz BEATS`, `repeat N` ... `end` (nesting); separated by newlines, `;` or
+`,`; `#` comments; words in any case. Note options, in any order, each at most once: a nuance,
+dynamics (a number 0..1 or pp p mp mf f ff), a duration (N/D or `beats X`), `at R/A THETA`,
+`firmness F`, `flam` or `drag` (the other hand's grace strokes, 30 ms, or 70 and 30 ms, before
+the note: that hand kept free as for its own notes). Not drawn: `humanize` (its timing noise
+moves the strokes off the beats render_check holds them to), hairpins, the `nuance` default.
+Here: tempi 40..220 bpm (the brief; the language allows 20..400), durations from the musical
+fractions below (whole notes to 1/32, triplets, dotted values, non-reduced forms).
 
 Validity. The parser's ranges are kept by construction. The planner (gesture_score.cpp,
 `plan_performance`) also refuses a stroke that comes less than `min_stroke_interval_s` = 40 ms
@@ -32,7 +36,8 @@ tempo map itself (the closed-form integral of docs/score.md, written here again,
 the daemon) and keeps every hand's strokes >= MIN_STROKE_INTERVAL_S + 1 us apart: a note whose
 hand would come too soon goes to the other hand, and if neither hand can play it a rest comes
 first (a repeat whose later passes would break the rule gets a rest at the end of its body, or
-is played once). Scores are short (4..14 notes after repeats, at most SCORE_BUDGET_S of score),
+is played once). Scores are short (4..14 written notes after repeats and their grace strokes, at
+most SCORE_BUDGET_S of score),
 so the 900 s limit is never near. The callers count any score `ictusd render` refuses: a refusal
 means this model of the rule is wrong, and is reported as a failure.
 
@@ -41,7 +46,9 @@ nuance prints "unknown nuance '...' (valid: legato, tenuto, ...)" -- when an ict
 else from kNuanceNames in daemon/src/gesture/gesture_unit.cpp (the names the parser accepts),
 else FALLBACK_NUANCES. A new nuance (such as the `buzz`/press stroke) is thus drawn without
 touching this file. Other note options: NOTE_OPTIONS below is the one place to add one (e.g. a
-grip firmness) -- a name, a drawing function, and whether `R+L` may carry it.
+grip firmness) -- a name, a drawing function, and whether `R+L` may carry it. The grip
+firmness, flams, drags, rolls and meters are drawn from a stream of their own (Generator.extended),
+so that a seed's other statements are mostly those drawn without them.
 """
 import argparse
 import math
@@ -60,6 +67,15 @@ TEMPO_RANGE = (40.0, 220.0)   # the brief's range (the language's: 20..400)
 SCORE_BUDGET_S = 6.0          # at most this much score (beat 0 to the end of the last note)
 NOTES_RANGE = (4, 14)         # notes after repeats (R+L counts as two)
 LEAD_IN_S = 1.0               # PlanOptions::lead_in_s: beat 0 is at 1 s of the plan
+# Grace strokes (docs/score.md, "Flams, drags and rolls"), written again here: a flam's grace
+# FLAM_LEAD_S before its note, a drag's two FLAM_LEAD_S + DRAG_SPACING_S and FLAM_LEAD_S before,
+# legato at GRACE_DYNAMICS (or half the note's), the other hand's.
+FLAM_LEAD_S = 0.030
+DRAG_SPACING_S = 0.040
+GRACE_DYNAMICS = 0.15
+FIRMNESS_VALUES = [0.0, 0.1, 0.2, 0.25, 0.35, 0.5, 0.8, 1.0]
+METERS = [(4, 4), (3, 4), (2, 4), (6, 8), (7, 8), (5, 4), (2, 2), (12, 8), (1, 4)]
+ROLLS = ["single", "double", "buzz"]
 
 FALLBACK_NUANCES = ["legato", "tenuto", "accent", "vertical_accent", "staccato"]
 GRIPS = ["french", "german"]
@@ -216,6 +232,8 @@ class State:
             for hand in hands:
                 if not self.hand_free(hand, t):
                     raise Infeasible(hand)
+            if st.get("ornament"):
+                self.add_graces(st, t, dyn)
             for hand in hands:
                 self.notes.append({
                     "time_s": t, "hand": hand, "nuance": st.get("nuance") or "legato",
@@ -240,12 +258,51 @@ class State:
             self.default_label = st["label"]
         elif kind == "dynamics":
             self.default_dynamics = st["dynamics"]
+        elif kind in ("firmness", "meter"):
+            pass  # neither moves a note (the physics plays the firmness: render_check judges it)
+        elif kind == "roll":
+            self.execute_roll(st)
         elif kind == "repeat":
             for _ in range(st["count"]):
                 for inner in st["body"]:
                     self.execute(inner)
         else:
             raise ValueError(kind)
+
+    def add_graces(self, st, t, dyn):
+        """A flam's or drag's grace strokes: the other hand's, before the note at t."""
+        other = "left" if st["hand"] == "right" else "right"
+        leads = [FLAM_LEAD_S] if st["ornament"] == "flam" else \
+            [FLAM_LEAD_S + DRAG_SPACING_S, FLAM_LEAD_S]
+        if not self.hand_free(other, t - leads[0]):
+            raise Infeasible(other)
+        for lead in leads:
+            self.notes.append({
+                "time_s": t - lead, "hand": other, "nuance": "legato", "grip": self.grip,
+                "dynamics": min(GRACE_DYNAMICS, 0.5 * dyn), "beats": 0.0,
+                "tempo_bpm": self.tempo.tempo_at(self.beat), "both": False,
+                "r_over_a": DEFAULT_R_OVER_A, "theta_deg": DEFAULT_THETA[other], "at": False,
+                "label": st["ornament"] + " grace", "ramp": self.in_ramp(), "stmt": st,
+                "grace": st["ornament"]})
+        self.last_time[other] = t - leads[-1]
+
+    def execute_roll(self, st):
+        """`roll KIND BEATS`: a stroke at each `beats` subdivision, R L (single, buzz) or R R L L
+        (double), each a bare note's (legato, buzz for buzz; the defaults)."""
+        count = int(round(st["beats"] / self.default_beats))
+        for k in range(count):
+            hand = ("right", "left")[(k // 2 if st["roll"] == "double" else k) % 2]
+            t = self.time_s()
+            if not self.hand_free(hand, t):
+                raise Infeasible(hand)
+            self.notes.append({
+                "time_s": t, "hand": hand, "nuance": "buzz" if st["roll"] == "buzz" else "legato",
+                "grip": self.grip, "dynamics": self.default_dynamics, "beats": self.default_beats,
+                "tempo_bpm": self.tempo.tempo_at(self.beat), "both": False,
+                "r_over_a": DEFAULT_R_OVER_A, "theta_deg": DEFAULT_THETA[hand], "at": False,
+                "label": self.default_label, "ramp": self.in_ramp(), "stmt": st})
+            self.last_time[hand] = t
+            self.beat += self.default_beats
 
     def in_ramp(self):
         b0, s, e, ramp, _ = self.tempo._change_at(self.beat)
@@ -254,7 +311,9 @@ class State:
 
 def count_notes(st):
     if st["kind"] == "note":
-        return 2 if st["hand"] == "both" else 1
+        return 2 if st["hand"] == "both" else 1  # a flam's or drag's grace strokes not counted
+    if st["kind"] == "roll":
+        return st["count"]
     if st["kind"] == "repeat":
         return st["count"] * sum(count_notes(s) for s in st["body"])
     return 0
@@ -340,9 +399,15 @@ NOTE_OPTIONS = [
 # ------------------------------------------------------------------ the generator
 
 class Generator:
+    # The forms drawn from a stream of their own (grip firmness, flams and drags, rolls, meters),
+    # so that a score's other statements stay those drawn without them; the kit's generator
+    # draws none of them.
+    extended = True
+
     def __init__(self, seed, nuances):
         self.seed = seed
         self.rng = random.Random(seed)
+        self.extra_rng = random.Random(seed * 104729 + 7)
         self.nuances = list(nuances)
 
     # -- statements (dicts with "kind" and "text"; executed by State)
@@ -365,6 +430,13 @@ class Generator:
             st["label"] = label
             words.append(duration_text(rng, num, den))
         rng.shuffle(words)
+        if self.extended:
+            x = self.extra_rng
+            if x.random() < 0.15:
+                words.insert(x.randint(0, len(words)), "firmness " + fmt_num(x.choice(FIRMNESS_VALUES), 2))
+            if hand != "both" and x.random() < 0.15:  # the parser refuses a flam on R+L
+                st["ornament"] = x.choice(["flam", "drag"])
+                words.insert(x.randint(0, len(words)), st["ornament"])
         if hand == "both":
             head = rng.choice(["R+L", "L+R", "both", "r+l"])
         else:
@@ -419,6 +491,13 @@ class Generator:
 
     def other_statement(self, state):
         rng = self.rng
+        if self.extended and self.extra_rng.random() < 0.25:
+            x = self.extra_rng
+            if x.random() < 0.6:
+                f = x.choice(FIRMNESS_VALUES)
+                return {"kind": "firmness", "firmness": f, "text": "firmness " + fmt_num(f, 2)}
+            num, den = x.choice(METERS)
+            return {"kind": "meter", "text": "meter %d/%d" % (num, den)}
         r = rng.random()
         if r < 0.35:
             return self.tempo_statement(state)
@@ -464,7 +543,12 @@ class Generator:
                 pass
         # A rest long enough for every hand the note needs.
         needs = ["right", "left"] if st["hand"] == "both" else [st["hand"]]
-        t_need = max(state.last_time[h] for h in needs if state.last_time[h] is not None) \
+        # A flam's or drag's grace hand needs its time before the note's grace strokes.
+        lead = {"flam": FLAM_LEAD_S, "drag": FLAM_LEAD_S + DRAG_SPACING_S}.get(st.get("ornament"))
+        if lead:
+            needs.append("left" if st["hand"] == "right" else "right")
+        t_need = max(state.last_time[h] + (lead if lead and h not in needs[:1] else 0.0)
+                     for h in needs if state.last_time[h] is not None) \
             + MIN_STROKE_INTERVAL_S + 2 * INTERVAL_MARGIN_S
         beats_needed = 1.0 / 32.0
         while True:
@@ -511,6 +595,30 @@ class Generator:
                 body.append(self.rest())
         return None
 
+    def make_roll(self, state, notes_left):
+        """`roll single|double|buzz BEATS`: 2..6 strokes at the `beats` default (a whole number
+        of them: BEATS written as a fraction of it), or None when a stroke would come too soon."""
+        x = self.extra_rng
+        kind = x.choice(ROLLS)
+        count = min(x.randint(2, 6), notes_left)
+        if count < 2:
+            return None
+        from fractions import Fraction
+        sub = Fraction(state.default_beats).limit_denominator(96)
+        total = sub * count
+        if not Fraction(1, 32) <= total <= 64:
+            return None
+        st = {"kind": "roll", "roll": kind, "beats": float(total), "count": count,
+              "text": "roll %s %s" % (kind, "%d/%d" % (total.numerator, total.denominator)
+                                      if total.denominator > 1 else "%d" % total.numerator)}
+        trial = state.copy()
+        try:
+            trial.execute(st)
+        except Infeasible:
+            return None
+        state.__dict__.update(trial.__dict__)
+        return st
+
     count_notes = staticmethod(count_notes)
     new_state = State
 
@@ -555,6 +663,13 @@ class Generator:
                 if rep is not None:
                     out.append(rep)
                     notes += self.count_notes(rep)
+                    hand = None
+                    continue
+            if self.extended and self.extra_rng.random() < 0.06 and target - notes >= 2:
+                roll = self.make_roll(state, target - notes)
+                if roll is not None:
+                    out.append(roll)
+                    notes += roll["count"]
                     hand = None
                     continue
             hand = self.pick_hand(hand)
@@ -712,6 +827,11 @@ COVERAGE = [
     ("dynamics number", r"^(r|l|right|left|r\+l|l\+r|both)\b.* [+]?[0-9]*\.?[0-9]+(e-2)?( |$)"),
     ("dynamics .5 / 5e-2 / +0.5", r" (\.[0-9]|[0-9]+e-2|\+[0-9])"),
     ("vertical-accent spelling", r"vertical-accent"), ("upper case", r"[A-Z]{2,}"),
+    ("firmness F (default)", r"^firmness [0-9.]+$"),
+    ("note firmness F", r"^(r|l|right|left|r\+l|l\+r|both)\b.* firmness [0-9.]+"),
+    ("flam", r"^(r|l|right|left)\b.* flam\b"), ("drag", r"^(r|l|right|left)\b.* drag\b"),
+    ("roll single", r"^roll single "), ("roll double", r"^roll double "),
+    ("roll buzz", r"^roll buzz "), ("meter N/D", r"^meter \d+/\d+$"),
 ]
 
 

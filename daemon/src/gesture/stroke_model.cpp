@@ -42,6 +42,10 @@ constexpr double kReboundGainExponent = 0.35;
 // The lowest stroke: above the 1 cm a stick must rise between two strokes
 // for the second to be a stroke, not a bounce (docs/osc.md).
 constexpr double kMinHeight_m = 0.015;
+// A floored short stroke's downswing (stroke_model): the lowest exponent (a
+// constant acceleration from the apex) and the largest share of its period.
+constexpr double kMinExponent = 2.0;
+constexpr double kMaxDownswingShare = 0.75;
 
 struct NuanceShape {
     double height_scale;  // preparation height relative to legato
@@ -156,29 +160,55 @@ GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double prep_
     // share: the lift of one stroke then reaches the height the next one
     // starts from, and the first stroke after a rest is a whole one even when
     // the next follows at once.
-    const auto downswing_samples = [&](double p) {
-        return std::max(2, static_cast<int>(std::lround(s.prep_fraction *
-                                                        std::min(p, kNominalPeriod_s) * rate)));
-    };
-    const int strike_index = downswing_samples(prep_period);
-    const int lift_samples =
-        std::max(2, static_cast<int>(std::lround(period * rate)) - downswing_samples(period));
-    const double D = strike_index / rate, L = lift_samples / rate;
-    // Dynamics set the impact speed (p H / D), the nuance only within a
-    // narrow band (kSpeedScale): its own height scale is kept in shape but
-    // brought to that speed.
+    // Heights: the nuance's, brought to the dynamics' impact speed (p H / D)
+    // by kSpeedScale, in proportion to the period below the nominal one,
+    // raised for rebound strokes; never under kMinHeight_m.
     const NuanceShape &leg = kShapes[0];
     const double speed_norm = kSpeedScale[static_cast<int>(n)] *
                               (leg.exponent / leg.prep_fraction) /
                               (s.height_scale * s.exponent / s.prep_fraction);
-    const double H =
-        std::max(kMinHeight_m,
-                 kLegatoHeightFff_m * s.height_scale * speed_norm * dynamics_height_factor(d) *
-                     std::min(1.0, prep_period / kNominalPeriod_s) * rebound_gain(prep_period));
-    const double H_lift =
-        std::max(kMinHeight_m, s.lift_ratio * kLegatoHeightFff_m * s.height_scale * speed_norm *
-                                   dynamics_height_factor(d) *
-                                   std::min(1.0, period / kNominalPeriod_s) * rebound_gain(period));
+    const double level =
+        kLegatoHeightFff_m * s.height_scale * speed_norm * dynamics_height_factor(d);
+    const auto raw_height = [&](double p) {
+        return level * std::min(1.0, p / kNominalPeriod_s) * rebound_gain(p);
+    };
+    // The downswing of a stroke made for period p: prep_fraction of it (up to
+    // the nominal period) with the nuance's exponent, so that it hits at the
+    // speed it has at the nominal period (times the rebound raise). Where the
+    // floor raises a short stroke's height above its share (a soft rebound
+    // stroke: a drag's second grace, 40 ms after the first), the same fall in
+    // the same time would hit harder (p H / D): the exponent is lowered in
+    // proportion instead, down to kMinExponent (a constant acceleration), and
+    // below that the downswing lengthens, up to kMaxDownswingShare of the
+    // period, so the speed stays that one while it can.
+    struct Downswing {
+        int samples;
+        double exponent;
+    };
+    const auto downswing = [&](double p) {
+        const double base = s.prep_fraction * std::min(p, kNominalPeriod_s);
+        const double H_p = std::max(kMinHeight_m, raw_height(p));
+        const double speed = s.exponent * std::max(kMinHeight_m, level) * rebound_gain(p) /
+                             (s.prep_fraction * kNominalPeriod_s);
+        Downswing ds{std::max(2, static_cast<int>(std::lround(base * rate))), s.exponent};
+        if (s.exponent * H_p / base <= speed * (1.0 + 1e-9))
+            return ds;
+        ds.exponent = std::max(kMinExponent, speed * base / H_p);
+        const double wanted = ds.exponent * H_p / speed;
+        const double longest = std::max(base, kMaxDownswingShare * p);
+        ds.samples =
+            std::max(ds.samples, static_cast<int>(std::lround(std::min(wanted, longest) * rate)));
+        return ds;
+    };
+    const Downswing prep = downswing(prep_period);
+    const int strike_index = prep.samples;
+    const int lift_samples =
+        std::max(2, static_cast<int>(std::lround(period * rate)) - downswing(period).samples);
+    const double D = strike_index / rate, L = lift_samples / rate;
+    NuanceShape shape = s;
+    shape.exponent = prep.exponent;
+    const double H = std::max(kMinHeight_m, raw_height(prep_period));
+    const double H_lift = std::max(kMinHeight_m, s.lift_ratio * raw_height(period));
 
     // Stick at the strike (right hand): forward, yawed inward (-x), pitched down.
     const Eigen::Vector3d dir0(-std::sin(gs.inward_yaw_rad) * std::cos(gs.strike_pitch_rad),
@@ -222,7 +252,7 @@ GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double prep_
     // (vertical accent); computed after the rotation below.
     for (int k = 0; k < samples; ++k) {
         const double t = (k - strike_index) / rate;
-        const double hk = height(s, H, H_lift, D, L, t);
+        const double hk = height(shape, H, H_lift, D, L, t);
         const double rise_rot = rise_cap * std::tanh(gs.rotation_share * hk / rise_cap);
         const double target = std::clamp((vy + rise_rot / R - c0) / A, -1.0, 1.0);
         const double phi = delta - std::acos(target);

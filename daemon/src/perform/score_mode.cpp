@@ -354,9 +354,26 @@ void ScoreMode::apply_note_grips(double t)
         const bool before_press = ps.press[s][k] && t < beats[k];
         // A down stroke holds the stick firm from its strike to the next beat.
         const bool down = t >= beats[k] ? ps.down[s][k] : k > 0 && ps.down[s][k - 1];
-        const double f = down ? Performance::kDownStrokeGripFirmness
-                         : ps.firmness[s][k] >= 0.0 && !before_press ? ps.firmness[s][k]
-                                                                     : perf_.options_.grip_firmness;
+        const double held = down ? Performance::kDownStrokeGripFirmness
+                            : ps.firmness[s][k] >= 0.0 && !before_press
+                                ? ps.firmness[s][k]
+                                : perf_.options_.grip_firmness;
+        // The downswing (from halfway after the previous beat to the note's)
+        // is thrown with at least kSwingGripFirmness: a looser hold lets the
+        // stick lag the hand and ring on its fulcrum, and the note lands late.
+        // A soft note soon after a loud one is thrown as a down stroke's next
+        // (kDownStrokeGripFirmness), whatever grips the two notes give: the
+        // loose stick thrown back up by the head would fall on it early. The
+        // note's own grip rules from its strike, its contact and rebound,
+        // unless the hand's next stroke follows within kReboundGrip_s (a
+        // drag's first grace): the hand lifts the stick for it at once.
+        const bool next_soon =
+            k + 1 < beats.size() && beats[k + 1] - beats[k] < Performance::kReboundGrip_s;
+        const double least = t < beats[k] && ps.after_loud[s][k]
+                                 ? Performance::kDownStrokeGripFirmness
+                             : t < beats[k] || next_soon ? Performance::kSwingGripFirmness
+                                                         : 0.0;
+        const double f = std::max(held, least);
         if (f != perf_.applied_firmness_[s]) {
             rig_->tracker->scene().set_grip_firmness(static_cast<Side>(s), f);
             perf_.applied_firmness_[s] = f;

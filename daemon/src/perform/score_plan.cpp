@@ -91,11 +91,15 @@ std::unique_ptr<ScorePlan> make_score_plan(std::shared_ptr<const Score> score,
         // same hand, neither with a grip of its own.
         const size_t count = ps->beats[s].size();
         ps->down[s].assign(count, false);
-        for (size_t k = 0; k + 1 < count; ++k)
-            ps->down[s][k] =
-                ps->firmness[s][k] < 0.0 && ps->firmness[s][k + 1] < 0.0 && !ps->press[s][k + 1] &&
+        ps->after_loud[s].assign(count, false);
+        for (size_t k = 0; k + 1 < count; ++k) {
+            ps->after_loud[s][k + 1] =
+                !ps->press[s][k + 1] &&
                 ps->beats[s][k + 1] - ps->beats[s][k] <= Performance::kDownStrokeGap_s &&
                 ps->approach_mps[s][k + 1] < Performance::kDownStrokeRatio * ps->approach_mps[s][k];
+            ps->down[s][k] = ps->firmness[s][k] < 0.0 && ps->firmness[s][k + 1] < 0.0 &&
+                             ps->after_loud[s][k + 1];
+        }
     }
     return ps;
 }

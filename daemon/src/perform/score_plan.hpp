@@ -23,6 +23,9 @@ struct ScorePlan {
     std::array<std::vector<double>, 2> firmness; // < 0: the performance's
     std::array<std::vector<bool>, 2> press;      // a buzz: loose from its beat on
     std::array<std::vector<bool>, 2> down;       // a down stroke: firm until the next beat
+    // A stroke soon after a much louder one of the hand (as a down stroke's
+    // next, whatever the two notes' grips): its downswing is held firm.
+    std::array<std::vector<bool>, 2> after_loud;
     std::array<size_t, 2> grip_note = {0, 0};    // the note whose grip is applied
     std::vector<double> planned_speed_mps;       // [note of plan]
 

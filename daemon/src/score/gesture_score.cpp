@@ -57,6 +57,13 @@ using score_detail::UnitCurve;
 // A stroke's period when nothing sets it: gesture.hpp's nominal 0.5 s (120 bpm).
 constexpr double kNominalPeriod_s = 0.5;
 
+// The rebound aim (warp_units): none for a stroke kReboundAimFrom_s or more
+// after the hand's previous strike (the doubles of docs/score.md, "Rebound
+// strokes", 60 ms and slower), the whole from kReboundAimFull_s in.
+constexpr double kReboundAimFrom_s = 0.060;
+constexpr double kReboundAimFull_s = 0.045;
+constexpr double kReboundAimSpeed_mps = 0.8;
+
 // Units are shared by notes with the same grip, nuance, hand, dynamics
 // and periods. The parametric model's units are made at the hand's own
 // periods (the downswing for the time since its previous strike, the lift
@@ -294,8 +301,16 @@ void warp_units(HandStrokes &h, const std::vector<size_t> &idx, const PerformerF
         it.prep_t = std::min(it.curve->prep_s, (1.0 - beta) * before);
         it.lift_t = std::min(it.curve->lift_s, (1.0 - beta) * after);
         const Eigen::Vector3d impact = to_world * it.curve->impact_velocity();
+        // A stroke closer than kReboundAimFrom_s to the hand's previous one (a
+        // drag's second grace) turns twice within that time, and the arm
+        // tracks it later than its lag: it aims as deep as a stroke
+        // kReboundAimSpeed_mps past strike_aim_from_mps (reached at
+        // kReboundAimFull_s), whatever its own speed.
+        const double rebound = std::clamp(
+            (kReboundAimFrom_s - before) / (kReboundAimFrom_s - kReboundAimFull_s), 0.0, 1.0);
         const double aim =
-            opt.strike_aim_s * std::max(0.0, -impact.dot(frame.up) - opt.strike_aim_from_mps);
+            opt.strike_aim_s * std::max({0.0, -impact.dot(frame.up) - opt.strike_aim_from_mps,
+                                         rebound * kReboundAimSpeed_mps});
         it.origin -= std::min(aim, opt.strike_aim_max_m) * frame.up;
         plan.notes[idx[k]].tip_target_m = it.origin;
         it.prepare();

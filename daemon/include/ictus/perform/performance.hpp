@@ -243,6 +243,11 @@ class Performance
     // planned speed is held with this firmness from its strike to that next
     // beat, unless either note gives its own grip (docs/perform.md).
     static constexpr double kDownStrokeGripFirmness = 0.8;
+    // The least firmness a stroke is thrown with (docs/perform.md, "Grip
+    // firmness"): a note's looser grip holds from its strike, unless the
+    // hand's next stroke comes within kReboundGrip_s.
+    static constexpr double kSwingGripFirmness = kDefaultGripFirmness;
+    static constexpr double kReboundGrip_s = 0.1;
     static constexpr double kDownStrokeGap_s = 0.25;
     static constexpr double kDownStrokeRatio = 0.5;
     static constexpr double kRunawayTipSpeed_mps = 40.0;
