@@ -196,24 +196,31 @@ class Daemon:
 
 
 def case_log(ictusd, workdir):
-    """stderr unread: the physics goes on and the run ends; stderr a file: lines bounded."""
+    """stderr unread: the physics goes on and the run ends; stderr a file: lines bounded.
+    The two daemons run side by side, flooded by the same loop."""
     duration = 20.0
+    runs = []
     for kind in ("pipe", "file"):
         listener = Listener()
         out = os.path.join(workdir, "log-" + kind)
         err_path = os.path.join(workdir, "log-%s.stderr" % kind)
         stderr = subprocess.PIPE if kind == "pipe" else open(err_path, "wb")
         d = Daemon(ictusd, ["--autoplay", "--duration", str(duration)], out, listener, stderr)
+        runs.append((kind, listener, err_path, stderr, d))
+    for _, _, _, _, d in runs:
         d.handshake()
-        start = time.monotonic()
-        # ~3 s of drum changes, 20,000 a second (each past the planner's 64 is refused).
-        sent = 0
-        while time.monotonic() - start < 3.0:
-            for _ in range(200):
+    start = time.monotonic()
+    # ~3 s of drum changes, up to 20,000 a second to each (each past the planner's 64 is
+    # refused).
+    sent = 0
+    while time.monotonic() - start < 3.0:
+        for _ in range(200):
+            for _, _, _, _, d in runs:
                 d.send("/ictus/drum/radius", "f", 0.178 if sent % 2 else 0.18)
-                sent += 1
-            time.sleep(0.01)
-        code = d.wait(SLOW * duration + 30.0)
+            sent += 1
+        time.sleep(0.01)
+    codes = [d.wait(SLOW * duration + 30.0) for _, _, _, _, d in runs]
+    for (kind, listener, err_path, stderr, d), code in zip(runs, codes):
         listener.close()
         elapsed = time.monotonic() - start
         rows = d.strike_rows()
