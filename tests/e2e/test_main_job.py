@@ -227,6 +227,7 @@ if "LeftHandStick_End" in names and "RightHandStick_End" in names and os.path.is
     table = np.array([[float(v) for v in l.split(",")] for l in lines[1:]])
     t = table[:, header.index("time_s")]
     worst = {}
+    poses = {}  # frame -> its joints' positions, solved once for both hands
     for hand, end in (("left", "LeftHandStick_End"), ("right", "RightHandStick_End")):
         j = names.index(end)
         errs = []
@@ -234,7 +235,9 @@ if "LeftHandStick_End" in names and "RightHandStick_End" in names and os.path.is
             k = int(np.searchsorted(t, f_idx * frame_time))
             for kk in (k - 1, k):
                 if 0 <= kk < len(t) and abs(t[kk] - f_idx * frame_time) < 1e-6:
-                    errs.append(abs(fk(joints, data[f_idx])[j][1] - table[kk, cols[(hand, "sim")]]))
+                    if f_idx not in poses:
+                        poses[f_idx] = fk(joints, data[f_idx])
+                    errs.append(abs(poses[f_idx][j][1] - table[kk, cols[(hand, "sim")]]))
                     break
         worst[hand] = (max(errs) if errs else None, len(errs))
     print("BVH stick tips vs tips.csv (sim y): %s" % worst)

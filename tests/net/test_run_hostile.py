@@ -6,8 +6,9 @@ read back. Every wait is a handshake (/ictus/ping answered, a process ended) wit
                 the default score: the performance goes on (>= 30 of its 32 strikes in
                 strikes.csv) and the process ends at --duration; with stderr a file, the lines
                 written stay within the log's rate (base/async_log.hpp).
-  --case stop   a score of 11,000 notes, 100 seeded play/stop pairs (fewer where planning is
-                slow; the stop at any point of the planning), ending in stop: no strike after the last stop, status stopped.
+  --case stop   a score of 11,000 notes (--notes), 100 seeded play/stop pairs (fewer where
+                planning is slow, to fill --pair-seconds; the stop at any point of the
+                planning), ending in stop: no strike after the last stop, status stopped.
   --case grip   /ictus/grip toggled 20 times a second during the default score: every onset
                 received has its /ictus/strike/end and its strikes.csv row, and the reverse.
   --case score  10^6 score statements over OSC (nested `repeat 1`): refused past the
@@ -196,24 +197,31 @@ class Daemon:
 
 
 def case_log(ictusd, workdir):
-    """stderr unread: the physics goes on and the run ends; stderr a file: lines bounded."""
+    """stderr unread: the physics goes on and the run ends; stderr a file: lines bounded.
+    The two daemons run side by side, flooded by the same loop."""
     duration = 20.0
+    runs = []
     for kind in ("pipe", "file"):
         listener = Listener()
         out = os.path.join(workdir, "log-" + kind)
         err_path = os.path.join(workdir, "log-%s.stderr" % kind)
         stderr = subprocess.PIPE if kind == "pipe" else open(err_path, "wb")
         d = Daemon(ictusd, ["--autoplay", "--duration", str(duration)], out, listener, stderr)
+        runs.append((kind, listener, err_path, stderr, d))
+    for _, _, _, _, d in runs:
         d.handshake()
-        start = time.monotonic()
-        # ~3 s of drum changes, 20,000 a second (each past the planner's 64 is refused).
-        sent = 0
-        while time.monotonic() - start < 3.0:
-            for _ in range(200):
+    start = time.monotonic()
+    # ~3 s of drum changes, up to 20,000 a second to each (each past the planner's 64 is
+    # refused).
+    sent = 0
+    while time.monotonic() - start < 3.0:
+        for _ in range(200):
+            for _, _, _, _, d in runs:
                 d.send("/ictus/drum/radius", "f", 0.178 if sent % 2 else 0.18)
-                sent += 1
-            time.sleep(0.01)
-        code = d.wait(SLOW * duration + 30.0)
+            sent += 1
+        time.sleep(0.01)
+    codes = [d.wait(SLOW * duration + 30.0) for _, _, _, _, d in runs]
+    for (kind, listener, err_path, stderr, d), code in zip(runs, codes):
         listener.close()
         elapsed = time.monotonic() - start
         rows = d.strike_rows()
@@ -245,10 +253,11 @@ def write_big_score(path, notes):
             f.write("R 1/4, L 1/4\n")
 
 
-def case_stop(ictusd, workdir):
-    """100 play/stop pairs (fewer where planning is slow) on an 11,000-note score, the stop at any point of planning."""
+def case_stop(ictusd, workdir, notes=11000, pair_seconds=120.0):
+    """100 play/stop pairs (fewer where planning is slow) on an 11,000-note score, the stop at
+    any point of planning."""
     score = os.path.join(workdir, "big.txt")
-    write_big_score(score, 11000)
+    write_big_score(score, notes)
     listener = Listener()
     d = Daemon(ictusd, ["--score", score, "--duration", "600"], os.path.join(workdir, "stop"),
                listener, subprocess.DEVNULL)
@@ -262,11 +271,11 @@ def case_stop(ictusd, workdir):
     plan_s = time.monotonic() - asked
     d.send("/ictus/stop")
     d.handshake()
-    print("a play of 11,000 notes planned in %.2f s" % plan_s)
+    print("a play of %d notes planned in %.2f s" % (notes, plan_s))
     rng = random.Random(2911)
     # 100 pairs, fewer where planning is slow (a sanitizer build: ~0.75 plan_s a pair), so
-    # that the pairs take at most ~2 minutes; at least 10.
-    pairs = max(10, min(100, int(120.0 / (0.75 * plan_s))))
+    # that the pairs take at most pair_seconds (~2 minutes); at least 10.
+    pairs = max(10, min(100, int(pair_seconds / (0.75 * plan_s))))
     print("%d play/stop pairs" % pairs)
     for pair in range(pairs):
         d.send("/ictus/play")
@@ -400,11 +409,16 @@ def main():
     ap.add_argument("--ictusd", required=True)
     ap.add_argument("--case", required=True, choices=["log", "stop", "grip", "score"])
     ap.add_argument("--workdir")
+    ap.add_argument("--notes", type=int, default=11000, help="--case stop: the score's notes")
+    ap.add_argument("--pair-seconds", type=float, default=120.0,
+                    help="--case stop: the time the play/stop pairs may take (at most 100)")
     a = ap.parse_args()
     workdir = a.workdir or tempfile.mkdtemp(prefix="ictus-hostile-")
     os.makedirs(workdir, exist_ok=True)
-    {"log": case_log, "stop": case_stop, "grip": case_grip, "score": case_score}[a.case](
-        a.ictusd, workdir)
+    if a.case == "stop":
+        case_stop(a.ictusd, workdir, a.notes, a.pair_seconds)
+    else:
+        {"log": case_log, "grip": case_grip, "score": case_score}[a.case](a.ictusd, workdir)
     print("PASS")
 
 

@@ -37,7 +37,8 @@ drummer does with them (docs/midi.md, "Beyond the song"), through the real `ictu
   from its last one, once stayed folded across the chest, 16-18 cm short of the hi-hat, and
   the right hand lost 28 notes in a row; docs/ik.md).
 
-    PYTHONPATH=python python3 tests/perform/test_recover.py --ictusd build/ictusd [--workdir DIR]
+    PYTHONPATH=python python3 tests/perform/test_recover.py --ictusd build/ictusd [--workdir DIR] \
+        [--fill-seeds 1 2 ...]
 """
 import argparse
 import os
@@ -200,13 +201,15 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--ictusd", required=True)
     ap.add_argument("--workdir", default=None)
+    ap.add_argument("--fill-seeds", type=int, nargs="+", default=list(range(1, 9)),
+                    help="the seeds of the fills into a crash with the hi-hat on (default 1-8)")
     a = ap.parse_args()
     work = a.workdir or tempfile.mkdtemp(prefix="ictus-recover-")
     os.makedirs(work, exist_ok=True)
     checks.keep_going()  # every passage is reported
     cymbal_change(a.ictusd, work)
     fill_into_crash(a.ictusd, work)
-    fill_hihat_on(a.ictusd, work)
+    fill_hihat_on(a.ictusd, work, a.fill_seeds)
     song_crossings(a.ictusd, work)
     checks.finish()
 
