@@ -450,6 +450,8 @@ class Scene
     // drum in the last step, in this one, and passing through its shell
     // (near_callback).
     std::array<bool, 4 * kMaxDrums> part_touching_{}, part_touching_now_{}, part_through_{};
+    // A shaft whose touch began on a plate's edge, from the side (near_callback).
+    std::array<bool, 4 * kMaxDrums> part_edge_on_{};
     long shell_passes_ = 0;
     std::array<long, kMaxDrums> drum_shell_passes_{};
     int stops_active_ = 0;
