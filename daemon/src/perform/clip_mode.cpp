@@ -4,6 +4,7 @@
 #include "clip_mode.hpp"
 
 #include "ictus/character/character_limits.hpp"
+#include "ictus/character/stick_capture.hpp"
 #include "ictus/mocap/bvh.hpp"
 
 #include <algorithm>
@@ -23,70 +24,55 @@ double median(std::vector<double> v)
     return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-// The strokes are looked for on a fixed time grid, the reference tips
-// interpolated linearly between the capture's frames, so that the window of a
-// minimum (2 samples either side, 1/60 s) and the approach speed (over 2
-// samples, 1/60 s) are durations, not frame counts: the drum goes at the same
-// place whatever the capture's frame rate. 120 Hz: the CMU captures' rate, at
-// which the window and the 1 m/s threshold were chosen.
-constexpr double kStrokeScanRateHz = 120.0;
+// Where the clip strikes: the reference stick tips' turnarounds (the mimed
+// strokes; a captured performance without a drum still "hits" a plane) that
+// came down at 1 m/s or faster (kClipStrokeSpeed_mps), each refined between the
+// capture's frames (find_turnarounds: an impact's V or a smooth turn's
+// parabola, docs/mocap.md, "Drum placement"). The membrane goes at the median
+// height of those vertices, so that about half of the mimed strokes reach it
+// and are stopped by it, its centre (x, z) at the mean of the two sticks'
+// median points. (track.hpp's auto_drum_center puts the drum under the lowest
+// tips, which in a mimed clip are in the rest pose, not in a stroke.) The
+// lowest frame of a stroke lies up to half a frame's travel above its vertex
+// (a 3 m/s stroke at 60 Hz: 25 mm), and a median of both sticks' points pooled
+// jumps from one stick's strokes to the other's as their counts change: the
+// vertices and the per-stick medians keep the drum where it is at any frame
+// rate and phase.
+constexpr double kClipStrokeSpeed_mps = 1.0;
 
-// The reference tips [hand] at the capture's frames, resampled to kStrokeScanRateHz.
-std::vector<std::array<Eigen::Vector3d, 2>> tips_on_scan_grid(const CharacterModel &model,
-                                                              const ReferenceMotion &reference)
-{
-    const int frames = reference.frames();
-    std::vector<std::array<Eigen::Vector3d, 2>> at_frames(static_cast<size_t>(frames));
-    for (int f = 0; f < frames; ++f)
-        at_frames[static_cast<size_t>(f)] = reference_tips(model, reference.frame(f));
-    const double rate = reference.frame_rate_hz();
-    std::vector<std::array<Eigen::Vector3d, 2>> grid;
-    if (frames < 2 || !(rate > 0.0))
-        return at_frames;
-    const double last = frames - 1;
-    for (long n = 0;; ++n) {
-        double x = static_cast<double>(n) * rate / kStrokeScanRateHz; // in frames
-        if (std::abs(x - std::round(x)) < 1e-9)
-            x = std::round(x); // on a frame (a 120 Hz capture: every sample)
-        if (x > last)
-            break;
-        const auto i = static_cast<size_t>(std::min(std::floor(x), last - 1.0));
-        const double u = x - static_cast<double>(i);
-        std::array<Eigen::Vector3d, 2> tip;
-        for (int hand = 0; hand < 2; ++hand)
-            tip[hand] = (1.0 - u) * at_frames[i][hand] + u * at_frames[i + 1][hand];
-        grid.push_back(tip);
-    }
-    return grid;
-}
-
-// Where the clip strikes: the reference stick tips' local minima of height
-// reached at more than 1 m/s downwards (the mimed strokes; a captured
-// performance without a drum still "hits" a plane). The membrane goes at the
-// median of those points, so that about half of the mimed strokes reach it
-// and are stopped by it. (track.hpp's auto_drum_center puts the drum under
-// the lowest tips, which in a mimed clip are in the rest pose, not in a stroke.)
 Eigen::Vector3d strike_drum_center(const CharacterModel &model, const ReferenceMotion &reference,
                                    const Eigen::Vector3d &fallback)
 {
-    const std::vector<std::array<Eigen::Vector3d, 2>> tips = tips_on_scan_grid(model, reference);
-    const int samples = static_cast<int>(tips.size());
-    std::vector<double> xs, ys, zs;
-    for (int hand = 0; hand < 2; ++hand)
-        for (int f = 2; f + 2 < samples; ++f) {
-            auto y = [&](int g) { return tips[static_cast<size_t>(g)][hand].y(); };
-            const bool minimum =
-                y(f) < y(f - 1) && y(f) <= y(f + 1) && y(f) < y(f - 2) && y(f) <= y(f + 2);
-            const double approach_mps = (y(f - 2) - y(f)) * kStrokeScanRateHz / 2.0;
-            if (minimum && approach_mps > 1.0) {
-                xs.push_back(tips[static_cast<size_t>(f)][hand].x());
-                ys.push_back(y(f));
-                zs.push_back(tips[static_cast<size_t>(f)][hand].z());
-            }
-        }
-    if (xs.size() < 4)
+    const int frames = reference.frames();
+    const double rate = reference.frame_rate_hz();
+    if (frames < 5 || !(rate > 0.0))
         return fallback;
-    return Eigen::Vector3d(median(xs), median(ys), median(zs));
+    TipTrajectory tips;
+    for (int f = 0; f < frames; ++f) {
+        const std::array<Eigen::Vector3d, 2> at = reference_tips(model, reference.frame(f));
+        tips.time_s.push_back(f / rate);
+        for (int hand = 0; hand < 2; ++hand)
+            tips.tip_m[static_cast<size_t>(hand)].push_back(at[static_cast<size_t>(hand)]);
+    }
+    std::vector<double> ys;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int sticks = 0;
+    for (int hand = 0; hand < 2; ++hand) {
+        std::vector<double> xs, zs;
+        for (const StrokeTurnaround &ta :
+             find_turnarounds(tips, hand, 0.01, kClipStrokeSpeed_mps)) {
+            xs.push_back(ta.position_m.x());
+            ys.push_back(ta.position_m.y());
+            zs.push_back(ta.position_m.z());
+        }
+        if (xs.empty())
+            continue;
+        sum += Eigen::Vector3d(median(xs), 0.0, median(zs));
+        ++sticks;
+    }
+    if (ys.size() < 4)
+        return fallback;
+    return Eigen::Vector3d(sum.x() / sticks, median(ys), sum.z() / sticks);
 }
 } // namespace
 

@@ -340,7 +340,16 @@ void Scene::create_stick(int side, const BodyFrames &frames)
     const StickInHand &st = model_.stick(static_cast<Side>(side));
     if (fulcrum) {
         dBodyID body = dBodyCreate(world_);
-        const Eigen::Matrix3d &in = st.inertia_kg_m2;
+        // The stick's roll about its own axis is the hand's (the hinge allows
+        // none), but its own inertia there, m r^2 / 2 = 1.3e-6 kg m^2, is 1/380
+        // of the hand's (5e-4): QuickStep's iterations do not hold the hinge's row
+        // about that axis against a torque on it (the friction at a shaft
+        // pressed on a head, 7 mm off the axis), and the stick's roll rate
+        // flips sign every step, growing to the divergence bound (400 rad/s).
+        // kStickRollInertia_kg_m2 (the fingers closed round the stick, which
+        // roll with it) conditions that row (docs/character.md, "The fulcrum").
+        Eigen::Matrix3d in = st.inertia_kg_m2;
+        in += kStickRollInertia_kg_m2 * st.axis * st.axis.transpose();
         dMass mass;
         dMassSetParameters(&mass, sp.mass_kg, 0, 0, 0, in(0, 0), in(1, 1), in(2, 2), in(0, 1),
                            in(0, 2), in(1, 2));

@@ -85,6 +85,11 @@ struct GripSpring {
 // stick's inertia I about its fulcrum (docs/character.md, "The fulcrum").
 // Throws SimError outside [0, 1] or for a bad inertia or ratio.
 GripSpring grip_spring(double firmness, double stick_inertia_kg_m2, double damping_ratio);
+// Added to a fulcrum-mounted stick's inertia about its own axis, kg m^2 (the
+// rod's own is 1.3e-6, the hand's there 5e-4): the fingers closed round the stick roll with it.
+// Without it QuickStep lets the stick's roll chatter until the scene diverges
+// (Scene::create_stick, docs/character.md, "The fulcrum").
+constexpr double kStickRollInertia_kg_m2 = 1.0e-5;
 constexpr double kDefaultGripFirmness = 0.35;
 constexpr double kDefaultGripDampingRatio = 0.7;
 
@@ -445,6 +450,8 @@ class Scene
     // drum in the last step, in this one, and passing through its shell
     // (near_callback).
     std::array<bool, 4 * kMaxDrums> part_touching_{}, part_touching_now_{}, part_through_{};
+    // A shaft whose touch began on a plate's edge, from the side (near_callback).
+    std::array<bool, 4 * kMaxDrums> part_edge_on_{};
     long shell_passes_ = 0;
     std::array<long, kMaxDrums> drum_shell_passes_{};
     int stops_active_ = 0;
