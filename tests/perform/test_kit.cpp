@@ -699,6 +699,9 @@ TEST_CASE("kit: a stick thrown across the kit holds back its own hand's strikes 
     // runaway, the gains stay, no refusal is reported, the left hand plays
     // on, and the right's strikes come back kWhipSettle_s after its stick
     // slows down, not after kRunawayQuiet_s (which held back 6 notes here).
+    // The crash and the ride are written at the bow toward the performer:
+    // their spots turned toward where the hand comes from
+    // (kCymbalFaceAbove_mps) the stick is not thrown.
     PerformanceOptions o;
     o.kit = kit_named("full");
     o.score.score_text = "tempo 139\ngrip french\n"
@@ -711,7 +714,7 @@ TEST_CASE("kit: a stick thrown across the kit holds back its own hand's strikes 
                          "R on snare 1/4 mf\nL on snare 1/4 p\nR on tom2 1/4 mf\n"
                          "L on snare 1/4 ff\nR on tom2 1/4 ff\nL on snare 1/4 f\n"
                          "R on floor 1/4 mp\nL on tom1 1/4 mp\n"
-                         "R on crash 1/2 p + RF 1/2 p\nR on ride 1/2 ff\n"
+                         "R on crash 1/2 p at 0.7 110 + RF 1/2 p\nR on ride 1/2 ff at 0.7 110\n"
                          "R on ride 1/2 mp + L on snare 1/2 pp\nR on ride 1/2 pp\n"
                          "R on floor 1/4 ff\nL on tom2 1/4 p\nR on tom1 1/4 mf\n"
                          "L on tom2 1/4 f\nR on floor 1/4 ff\nL on tom2 1/4 f\n"
