@@ -159,7 +159,10 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         p.theta_deg = n.theta_deg;
         p.firmness = n.firmness;
         p.drum = score_detail::note_drum_spot(score, n, frame, p.r_over_a, p.theta_deg);
-        if (n.hand == Side::right && !by_hand[static_cast<int>(n.hand)].empty()) {
+        const bool cymbal = !n.spot_given && p.drum >= 0 &&
+                            p.drum < static_cast<int>(frame.drums.size()) &&
+                            frame.drums[static_cast<size_t>(p.drum)].cymbal;
+        if (cymbal && n.hand == Side::right && !by_hand[static_cast<int>(n.hand)].empty()) {
             // A cymbal the right hand reaches fast from another piece: its spot turned toward
             // where the hand comes from (a fast arm overshoots along its way: over the plate,
             // not past its far edge). Not the left's: its way to the crash passes over the
@@ -167,8 +170,9 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
             const PlannedNote &q = plan.notes[by_hand[static_cast<int>(n.hand)].back()];
             const double dt = score_time - score_time_prev[static_cast<int>(n.hand)];
             const Eigen::Vector3d here = membrane_point(frame, p.r_over_a, p.theta_deg, p.drum);
-            if (q.drum != p.drum && ((here - q.strike_point_m).norm() + kStrokeTravel_m) >
-                                        kCymbalFaceAbove_mps * std::max(dt, 1e-9)) {
+            if (q.drum != p.drum &&
+                ((here - q.strike_point_m).norm() + kStrokeTravel_m) >
+                    kCymbalFaceAbove_mps * std::max(dt, 1e-9)) {
                 p.r_over_a = n.r_over_a;
                 p.theta_deg = n.theta_deg;
                 score_detail::note_drum_spot(score, n, frame, p.r_over_a, p.theta_deg,
