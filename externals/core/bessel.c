@@ -43,11 +43,15 @@ void ictus_gauss_legendre(int n, double *x, double *w)
     }
 }
 
-void ictus_bessel_j3(int m, double x, double out[3])
+/* out = {J_{m-1}(x), J_m(x), J_{m+1}(x)}; J_{-1} = -J_1. x >= 0. With integral, also
+ * *integral = int_0^x J_m(t) dt = 2 sum_{k >= 0} J_{m+2k+1}(x) (Abramowitz & Stegun
+ * 11.1.2; its derivative telescopes to J_m), summed in the same recurrence. */
+static void bessel_j3_int(int m, double x, double out[3], double *integral)
 {
-    /* out = {J_{m-1}(x), J_m(x), J_{m+1}(x)}; J_{-1} = -J_1. x >= 0. */
     if (m < 0)
         m = 0;
+    if (integral)
+        *integral = 0.0;
     if (!(x > 0.0)) {
         out[0] = (m == 1) ? 1.0 : 0.0;
         out[1] = (m == 0) ? 1.0 : 0.0;
@@ -70,13 +74,15 @@ void ictus_bessel_j3(int m, double x, double out[3])
         }
         if (m == 0)
             out[0] = -0.5 * x; /* J_{-1} = -J_1 */
+        if (integral)          /* x J_m(x) / (m + 1), to the same order */
+            *integral = x * out[1] / (m + 1.0);
         return;
     }
     double top = (double)(m + 1) > x ? (double)(m + 1) : x;
     /* Start far enough above the turning point that J_start/J_top is below 1e-17. */
     int start = (int)(top + 30.0 + sqrt(160.0 * top));
     start += start & 1;
-    double bjp = 0.0, bj = 1.0e-30, sum = 0.0;
+    double bjp = 0.0, bj = 1.0e-30, sum = 0.0, tail = 0.0;
     double jm_m1 = 0.0, jm_0 = 0.0, jm_p1 = 0.0;
     for (int k = start; k > 0; k--) {
         double bjm = (2.0 * k / x) * bj - bjp; /* J_{k-1} */
@@ -87,6 +93,7 @@ void ictus_bessel_j3(int m, double x, double out[3])
             bj *= 1.0e-250;
             bjp *= 1.0e-250;
             sum *= 1.0e-250;
+            tail *= 1.0e-250;
             jm_m1 *= 1.0e-250;
             jm_0 *= 1.0e-250;
             jm_p1 *= 1.0e-250;
@@ -99,6 +106,8 @@ void ictus_bessel_j3(int m, double x, double out[3])
             jm_m1 = bj;
         if (order > 0 && (order & 1) == 0)
             sum += 2.0 * bj;
+        if (order > m && ((order - m) & 1))
+            tail += 2.0 * bj;
     }
     sum += bj; /* J_0 */
     if (m == 0)
@@ -106,6 +115,26 @@ void ictus_bessel_j3(int m, double x, double out[3])
     out[0] = jm_m1 / sum;
     out[1] = jm_0 / sum;
     out[2] = jm_p1 / sum;
+    if (integral)
+        *integral = tail / sum;
+}
+
+void ictus_bessel_j3(int m, double x, double out[3])
+{
+    bessel_j3_int(m, x, out, NULL);
+}
+
+double ictus_bessel_j_integral(int m, double x)
+{
+    double v[3], integral;
+    if (m < 0 || !isfinite(x))
+        return 0.0;
+    if (x < 0.0) { /* J_m is (-1)^m symmetric, so its integral from 0 is (-1)^(m+1) */
+        bessel_j3_int(m, -x, v, &integral);
+        return (m & 1) ? integral : -integral;
+    }
+    bessel_j3_int(m, x, v, &integral);
+    return integral;
 }
 
 double ictus_bessel_j(int m, double x)

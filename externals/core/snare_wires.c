@@ -39,6 +39,7 @@
 #define WIRE_T60_S     0.1    /* of that motion, away from the head */
 #define WIRE_STIFFNESS 1.0e9  /* N / m^alpha: steel wire on Mylar (a choice) */
 #define WIRE_ALPHA     1.5    /* the law's exponent (potential(), grad_force()) */
+#define WIRE_LENGTH    0.2    /* of the radius: a segment's length, lying along the head */
 #define PICK_R         0.5    /* the snare head's pickups: r/a, and degrees off the wires */
 #define MAX_SWEEPS     50
 
@@ -484,6 +485,16 @@ static double shape(int m, double j, double norm, double r, double theta)
     return norm * ictus_bessel_j(m, j * r) * cos(m * theta);
 }
 
+/* The shape's mean along a segment centred at r / a on the wires' diameter (theta 0):
+ * the segment lies on the head along its length, WIRE_LENGTH of the radius. The mean of
+ * J_m(j s) over [r - l/2, r + l/2] is the difference of its integral from 0. */
+static double line_shape(int m, double j, double norm, double r)
+{
+    const double lo = j * (r - 0.5 * WIRE_LENGTH), hi = j * (r + 0.5 * WIRE_LENGTH);
+    return norm * (ictus_bessel_j_integral(m, hi) - ictus_bessel_j_integral(m, lo)) /
+           (j * WIRE_LENGTH);
+}
+
 /* The shape of slot k at wire segment i ((-1)^m at the minus side: the odd group). */
 static double wire_shape(const snare_wires *w, int i, int k)
 {
@@ -562,7 +573,7 @@ static void lay_mode(snare_wires *w, int k, int m, double j, double c01, double 
     w->om[k] = j * c01 / a;
     w->mean[k] = (float)(m == 0 ? norm * 2.0 * ictus_bessel_j(1, j) / j : 0.0);
     for (int r = 0; r < SNARE_RADII; r++)
-        w->psi[r][k] = (float)shape(m, j, norm, wire_r[r], 0.0);
+        w->psi[r][k] = (float)line_shape(m, j, norm, wire_r[r]);
     w->pick[k] = (float)shape(m, j, norm, PICK_R, PICK_DEG * M_PI / 180.0);
 }
 

@@ -11,8 +11,9 @@
  *   the batter it acts through one coupling point whose shapes are each mode's mean
  *   over the head (a uniform pressure), so the batter's modes see it exactly as the
  *   membrane sees a stick.
- * - The wires are SNARE_WIRE_SEGMENTS light masses along a diameter of the snare head,
- *   each held by the wire's tension and colliding one-sidedly with the head under a
+ * - The wires are SNARE_WIRE_SEGMENTS light masses lying end to end along a diameter of
+ *   the snare head, each meeting the head's mean displacement along its length, held by
+ *   the wire's tension and colliding one-sidedly with the head under a
  *   power law, F = k [w_head - y_wire]+^alpha, solved implicitly each sample as an
  *   energy-consistent discrete gradient (Torin, Hamilton & Bilbao, DAFx-14).
  * The pickups hear both heads: the batter's pickups plus the snare head's velocity at

@@ -2,8 +2,10 @@
 // jn_zeros / jv, pasted here; not computed by the code under test).
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <random>
 
 extern "C" {
+#include "bessel_internal.h"
 #include "membrane.h"
 }
 
@@ -49,4 +51,36 @@ TEST_CASE("Bessel J_m(x) matches scipy", "[core][bessel]")
         // (J ~ 1e-21) relative accuracy of the tiny value itself.
         CHECK(std::fabs(v - row.j) <= 1e-11 * std::fabs(row.j) + 1e-14 / std::sqrt(row.x));
     }
+}
+
+TEST_CASE("the integral of J_m from 0 matches quadrature and the closed form for m = 1",
+          "[core][bessel]")
+{
+    // Independent of the recurrence: composite Simpson on std::cyl_bessel_j (C++17),
+    // 40 panels per unit of x, and int_0^x J_1 = 1 - J_0(x) (Abramowitz & Stegun
+    // 11.1.6 with nu = 0). Seeded draws of m and x, either sign.
+    std::mt19937 rng(20261201);
+    std::uniform_int_distribution<int> pick_m(0, 60);
+    std::uniform_real_distribution<double> pick_x(-120.0, 120.0);
+    for (int i = 0; i < 60; i++) {
+        const int m = i < 5 ? 1 : pick_m(rng);
+        const double x = pick_x(rng);
+        const int panels = 2 * (int)(20.0 * std::fabs(x) + 10.0);
+        const double h = std::fabs(x) / panels;
+        double simpson = 0.0;
+        for (int k = 0; k <= panels; k++) {
+            const double f = std::cyl_bessel_j((double)m, k * h);
+            simpson += (k == 0 || k == panels ? 1.0 : (k % 2 ? 4.0 : 2.0)) * f;
+        }
+        simpson *= h / 3.0;
+        if (x < 0.0 && m % 2 == 0) // J_m even: its integral from 0 is odd in x
+            simpson = -simpson;
+        const double got = ictus_bessel_j_integral(m, x);
+        INFO("m " << m << ", x " << x << ": recurrence " << got << ", Simpson " << simpson);
+        CHECK(std::fabs(got - simpson) <= 1e-9);
+        if (m == 1)
+            CHECK(std::fabs(got - (1.0 - std::cyl_bessel_j(0.0, std::fabs(x)))) <= 1e-12);
+    }
+    CHECK(ictus_bessel_j_integral(3, 0.0) == 0.0);
+    CHECK(ictus_bessel_j_integral(0, 1e-8) == Approx(1e-8).epsilon(1e-12));
 }

@@ -196,7 +196,7 @@ TEST_CASE("a detached snare leaves the batter as it is without one", "[core][wir
 TEST_CASE("the wires brighten a mezzo-forte stroke", "[core][wires]")
 {
     // 95 % bandwidth of the first 50 ms, pickup 1. The acceptance asks >= 4 kHz with
-    // the wires (a recorded snare: 8.2-8.6 kHz); this model does not reach it
+    // the wires (a recorded snare: 8.2-8.6 kHz); this stroke does not reach it
     // (docs/sound.md, "The snare", gives the numbers and why). Asserted: the wires
     // raise it, the heads alone stay below 1 kHz (their modes above it get little of a
     // 4 ms stick contact: the reference's low-pass near 2 / tau).

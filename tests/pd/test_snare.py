@@ -4,8 +4,9 @@ shell's air, wires), wires on and off. The wires collide with the snare head (on
 off differ within 5 ms of the stroke), they raise the bandwidth holding 95 % of the
 energy of the first 50 ms, the output stays finite, and a bad "wires" argument (or wires on
 a cymbal) is an error naming the object. The bandwidths are printed (docs/sound.md records them; the
-acceptance asks >= 4 kHz with the wires, which this model does not reach; a recorded
-snare reaches 8.2-8.6 kHz).
+acceptance asks >= 4 kHz with the wires at mf, which this 50 g stroke does not reach and the
+performer's strokes reach only at the edge, scripts/snare_render.py; a recorded snare reaches
+8.2-8.6 kHz).
 
 95 % bandwidth: the frequency below which the periodogram (rectangular window, the
 50 ms from the stroke's first sample) holds 95 % of the energy."""
