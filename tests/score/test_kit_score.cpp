@@ -195,7 +195,7 @@ TEST_CASE("plan: 'on NAME-rim' is a drum's rim, its edge facing the hand's shoul
     const PerformerFrame f = kit_frame_with_ride_and_kick();
     const Score s = parse_score("tempo 80\nR on snare-rim, L on snare-rim, R on tom2-rim, "
                                 "L on tom1_rim, R on floor-tom-rim, L on floor-rim, "
-                                "R on tom1-rim at 0.5 45",
+                                "R on tom1-rim at 0.93 45",
                                 "t");
     const GesturePlan plan = plan_performance(s, db(), f);
     REQUIRE(plan.notes.size() == 7);
@@ -216,9 +216,14 @@ TEST_CASE("plan: 'on NAME-rim' is a drum's rim, its edge facing the hand's shoul
         CHECK(out.norm() == Approx(d.membrane_radius_m - 0.0035).margin(1e-12));
         CHECK(out.normalized().dot(to_shoulder.normalized()) == Approx(1.0).margin(1e-12));
     }
-    // A spot written is kept.
-    CHECK(plan.notes[6].r_over_a == Approx(0.5));
+    // A spot written gives the place along the edge: its angle, struck at the edge as above.
+    const PerformerFrame::Drum &tom1 = f.drums[1];
+    CHECK(plan.notes[6].r_over_a == Approx(1.0 - 0.0035 / tom1.membrane_radius_m));
     CHECK(plan.notes[6].theta_deg == Approx(45.0));
+    // A spot on the head is not the rim: refused at its 'at', naming the head's way.
+    refused("R on tom1-rim at 0.5 45", f, 1, 15,
+            "'at 0.5' on drum 'tom1-rim': a rim is struck at its edge, and r/a 0.5 is on the head");
+    refused("tempo 90\nR\nL on snare-rim at 0.89 -90 ff", f, 3, 16, "'on snare at ...'");
     // A cymbal's edge is its own; the kick is the foot's.
     refused("R on ride-rim", f, 1, 6, "drum 'ride-rim': 'ride' has no rim to strike (a cymbal's");
     refused("R on kick-rim", f, 1, 6, "drum 'kick-rim': 'kick' has no rim to strike (its pedal's");

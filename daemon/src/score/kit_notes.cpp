@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace ictus
@@ -121,12 +122,24 @@ int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame 
                                     kCymbalFaceMostDeg);
         }
     }
-    if (!n.spot_given && drum.rim) {
+    if (drum.rim && (!n.spot_given || n.spot_column > 0)) {
         const PerformerFrame::Drum &d = frame.drums[static_cast<size_t>(drum.index)];
-        const Eigen::Vector3d to =
-            frame.shoulder_m[static_cast<size_t>(n.hand)] - d.membrane_center_m;
+        if (n.spot_given && n.r_over_a < kRimAtLeastRadiusFraction) {
+            char r[32];
+            std::snprintf(r, sizeof r, "%g", n.r_over_a);
+            throw ScoreError(score.source, n.line, n.spot_column,
+                             "'at " + std::string(r) + "' on drum '" + n.drum +
+                                 "': a rim is struck at its edge, and r/a " + r +
+                                 " is on the head (a rim note's 'at' gives the angle, with r/a "
+                                 "0.9 to 0.95; the head there: 'on " +
+                                 d.name + " at ...')");
+        }
         r_over_a = 1.0 - kRimInset_m / d.membrane_radius_m;
-        theta_deg = std::atan2(-to.z(), to.x()) * 180.0 / M_PI; // docs/osc.md: y_m is world -z
+        if (!n.spot_given) {
+            const Eigen::Vector3d to =
+                frame.shoulder_m[static_cast<size_t>(n.hand)] - d.membrane_center_m;
+            theta_deg = std::atan2(-to.z(), to.x()) * 180.0 / M_PI; // docs/osc.md: y_m is -z
+        }
     }
     return drum.index;
 }

@@ -139,6 +139,7 @@ class Executor
         n.dynamics = st.dynamics.value_or(n.dynamics);
         n.r_over_a = st.r_over_a.value_or(kDefaultRadiusFraction);
         n.spot_given = st.r_over_a.has_value() || st.theta_deg.has_value();
+        n.spot_column = n.spot_given ? st.spot_column : 0;
         n.firmness = st.firmness.value_or(default_firmness_);
         if (n.foot) {
             // The foot plays its pedal's drum (the planner finds the kit's

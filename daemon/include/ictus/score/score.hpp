@@ -89,6 +89,11 @@ constexpr double kBellRadiusFraction = 0.12;
 // stands (the left hand on the full kit's floor tom, far to the right, lost
 // its notes aimed at the edge nearest the performer).
 constexpr double kRimInset_m = 0.0035;
+// A rim note's `at R THETA` gives the place along the edge (THETA), struck as
+// above; R must be at least this, the spot's own way of saying "the edge"
+// (e2e_rim_zone: aimed at r/a 0.87 and inside, the bead lands on the head).
+// Below it the note names the rim and a spot on the head: a ScoreError.
+constexpr double kRimAtLeastRadiusFraction = 0.9;
 
 // The hi-hat's pedal as a note writes it (docs/score.md, `open`, `half`,
 // `closed`): membrane~'s `openness` (docs/plates.md, "The hi-hat"), 0 the
@@ -131,6 +136,7 @@ struct ScoreNote {
     double r_over_a = kDefaultRadiusFraction;
     double theta_deg = 180.0; // membrane frame, in (-180, 180]
     bool spot_given = false;  // by `at` (else the hand's default spot, or a cymbal's)
+    int spot_column = 0;      // its `at` word's column, 0 when not written (a MIDI note's)
     // The grip's firmness for this stroke, 0 (loose) .. 1 (clamped); < 0:
     // the performance's own (its default, or /ictus/grip/firmness).
     double firmness = -1.0;
