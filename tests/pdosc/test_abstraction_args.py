@@ -8,15 +8,24 @@ clamped with the width's error line; a symbol leaves the default 1; extra argume
 ignored, said so (they once reached the [clip 0 1] inside as its bounds: [ictus-out~ 0.2 9]
 mixed with a = 5, b = -4, and no later width message could bring it back).
 
+[ictus-receive PORT HOST] and its listen message (docs/pd-osc.md): a PORT that is not a whole
+number in 0..65535 is refused by name and nothing listens ([netreceive] took 70000 as 70000 mod
+65536 and bound port 4464 without a word, -5 and symbols said nothing or named [netreceive]); a
+HOST that is not a symbol falls back to loopback, said so; extra arguments are said. Read from
+the kernel's table of UDP sockets (/proc/net/udp) while pd runs, in real time.
+
     PYTHONPATH=python python3 tests/pdosc/test_abstraction_args.py --build build
 """
 import argparse
 import os
+import subprocess
+import time
 
 import numpy as np
 
 from ictus_tools.checks import check, keep_going, failed
-from ictus_tools.pdrun import Patch, make_workdir, read_wav_float, recorder, run_pd
+from ictus_tools.pdrun import (PD, PD_ENV, Patch, free_udp_port, make_workdir, read_wav_float,
+                                recorder, run_pd)
 
 SR, SECONDS, A = 48000, 0.2, 0.1
 
@@ -69,12 +78,80 @@ def out_args(build):
           % (want, len(lines), lines))
 
 
+def bound_ports():
+    """Every UDP port bound on this machine (/proc/net/udp)."""
+    with open("/proc/net/udp") as f:
+        rows = [line.split() for line in f.readlines()[1:]]
+    return {int(r[1].split(":")[1], 16) for r in rows}
+
+
+def receive_args(build):
+    wrap, host5, extra, later, ok = (free_udp_port() for _ in range(5))
+    # (arguments or listen message, the port it must bind or None, error lines expected)
+    cases = [
+        ("%d" % (wrap + 65536), None, ["ictus-receive: PORT must be a whole number in 0..65535 "
+                                       "(0: not listening) - ignored - got: %d" % (wrap + 65536)]),
+        ("-5", None, ["got: -5"]),
+        ("foo", None, ["got: foo"]),
+        ("1.5", None, ["got: 1.5"]),
+        ("%d 5" % host5, host5, ["ictus-receive: HOST must be an interface's name or address "
+                                 "(127.0.0.1 or 0.0.0.0) - using 127.0.0.1 - got: 5"]),
+        ("%d 127.0.0.1 more" % extra, extra,
+         ["ictus-receive: takes PORT and HOST - extra arguments ignored - got: more"]),
+        ("listen %d" % (later + 65536), None, ["got: %d" % (later + 65536)]),
+        ("listen", None, ["ictus-receive: listen needs a PORT in 0..65535 (0: stop)"]),
+        ("%d" % ok, ok, []),
+    ]
+    p = Patch()
+    lb = p.obj("loadbang")
+    for arg, _, _ in cases:
+        if arg.startswith("listen"):
+            r = p.obj("ictus-receive")
+            m = p.msg(arg)
+            p.connect(lb, 0, m, 0)
+            p.connect(m, 0, r, 0)
+        else:
+            p.obj("ictus-receive %s" % arg)
+    stop = p.obj("delay 20000")
+    quit_msg = p.msg("\\; pd quit")
+    p.connect(lb, 0, stop, 0)
+    p.connect(stop, 0, quit_msg, 0)
+    work = make_workdir("ictus-pdosc-args-")
+    path = os.path.join(work, "receive.pd")
+    with open(path, "w") as f:
+        f.write(p.text())
+    proc = subprocess.Popen([PD, "-nogui", "-nosound", "-stderr", "-path",
+                             os.path.join(build, "ictus"), "-open", path],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            env=PD_ENV)
+    # handshake: the last receiver is created and listening once its port is bound
+    deadline, ports = time.time() + 20, set()
+    while time.time() < deadline and proc.poll() is None:
+        ports = bound_ports()
+        if ok in ports:
+            break
+        time.sleep(0.05)
+    proc.terminate()
+    log = proc.communicate(timeout=20)[0]
+    check(ok in ports, "[ictus-receive %d] listens" % ok)
+    for arg, port, errors in cases:
+        if port:
+            check(port in ports, "[ictus-receive %s] listens on %d" % (arg, port))
+        for e in errors:
+            check(e in log, "[ictus-receive %s]: error line '%s'" % (arg, e))
+    for p_ in (wrap, later):
+        check(p_ not in ports, "nothing listens on %d (%d mod 65536)" % (p_, p_ + 65536))
+    check("netreceive" not in log, "no line names the [netreceive] inside: %s"
+          % [l for l in log.splitlines() if "netreceive" in l])
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", required=True)
     build = os.path.abspath(ap.parse_args().build)
     keep_going()
     out_args(build)
+    receive_args(build)
     if failed():
         raise SystemExit(1)
     print("ok")
