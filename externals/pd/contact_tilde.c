@@ -149,6 +149,14 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
     if (argc > 4)
         pd_error(x, "contact~: hit takes at most four numbers (velocity, r/a, theta, stick mass); "
                     "extra arguments ignored");
+    /* A contact~ created while DSP runs with nothing on its signal outlet has not been
+     * through a DSP sort (Pd sorts again for a new object only when a signal connection is
+     * made): it is not attached, and the hit would go to a stick nobody solves, in silence.
+     * Ask for the sort now (message time, as "set" does); its dsp method attaches it, or
+     * finds the membrane~ full. The membrane~'s clock re-anchors: this hit starts on the
+     * next block's first sample. */
+    if (!x->x_membrane && !x->x_refused && pd_getdspstate() && contact_tilde_timing_membrane(x))
+        canvas_update_dsp();
     if (x->x_refused && !x->x_membrane) {
         pd_error(x,
                  "contact~: hit: membrane~ '%s' already has %d contact~s; this one is silent: "
