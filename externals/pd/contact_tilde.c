@@ -25,8 +25,9 @@ typedef struct _contact_tilde {
     contact *x_core;
     t_symbol *x_name;             /* the membrane~ to play */
     t_membrane_tilde *x_membrane; /* attached membrane~, or NULL (cleared when it goes) */
-    int x_refused;                /* the last DSP sort found its membrane~ full: hits are refused */
-    float *x_force;               /* force buffer the membrane's perform writes */
+    int x_refused;  /* the last DSP sort found its membrane~ full: hits are refused (1: four
+                       contact~s, 2: fewer, its snare side takes the point left) */
+    float *x_force; /* force buffer the membrane's perform writes */
     int x_force_size;
     t_outlet *x_report_out;
     t_clock *x_report_clock;
@@ -157,6 +158,13 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
      * next block's first sample. */
     if (!x->x_membrane && !x->x_refused && pd_getdspstate() && contact_tilde_timing_membrane(x))
         canvas_update_dsp();
+    if (x->x_refused == 2 && !x->x_membrane) {
+        pd_error(x,
+                 "contact~: hit: membrane~ '%s' has no free coupling point (its snare side "
+                 "takes one of the %d); this one is silent: ignored",
+                 x->x_name->s_name, MEMBRANE_MAX_POINTS);
+        return;
+    }
     if (x->x_refused && !x->x_membrane) {
         pd_error(x,
                  "contact~: hit: membrane~ '%s' already has %d contact~s; this one is silent: "
@@ -283,10 +291,17 @@ static void contact_tilde_dsp(t_contact_tilde *x, t_signal **sp)
     if (m) {
         if (ictus_membrane_tilde_attach(m, x->x_core, x, contact_tilde_membrane_gone))
             x->x_membrane = m;
-        else {
+        else if (ictus_membrane_tilde_contacts(m) >= MEMBRANE_MAX_CONTACTS) {
             x->x_refused = 1;
             pd_error(x, "contact~: membrane~ '%s' already has %d contact~s; this one is silent",
                      x->x_name->s_name, MEMBRANE_MAX_CONTACTS);
+        } else {
+            /* the snare side (wires on or off) holds a coupling point of its own */
+            x->x_refused = 2;
+            pd_error(x,
+                     "contact~: membrane~ '%s' has no free coupling point: %d contact~s and its "
+                     "snare side take the %d; this one is silent",
+                     x->x_name->s_name, ictus_membrane_tilde_contacts(m), MEMBRANE_MAX_POINTS);
         }
     }
     dsp_add(contact_tilde_perform, 3, x, sp[0]->s_vec, (t_int)n);

@@ -45,6 +45,8 @@ typedef void (*t_ictus_gonefn)(void *owner);
  * once); gone(owner) is called if the membrane~ is deleted first. Returns 1 when
  * attached (or already), 0 when the membrane~ is full or memory cannot be had. */
 int ictus_membrane_tilde_attach(t_membrane_tilde *m, contact *c, void *owner, t_ictus_gonefn gone);
+/* How many objects have a contact attached (the snare side's point is not counted). */
+int ictus_membrane_tilde_contacts(const t_membrane_tilde *m);
 /* Detaches owner's contact; does nothing when owner is not attached. */
 void ictus_membrane_tilde_detach(t_membrane_tilde *m, void *owner);
 /* The membrane~'s sample clock: messages that act on its core are timed by it. */

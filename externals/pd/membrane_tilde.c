@@ -287,6 +287,14 @@ int ictus_membrane_tilde_attach(t_membrane_tilde *m, contact *c, void *owner, t_
     return 1;
 }
 
+int ictus_membrane_tilde_contacts(const t_membrane_tilde *m)
+{
+    int i, count = 0;
+    for (i = 0; i < MEMBRANE_MAX_CONTACTS; i++)
+        count += m->x_attached[i].a_owner != 0;
+    return count;
+}
+
 void ictus_membrane_tilde_detach(t_membrane_tilde *m, void *owner)
 {
     int i;
