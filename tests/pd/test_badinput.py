@@ -201,7 +201,10 @@ drum_cases = [("3", "ictus-drum: expected a list <hand> <velocity m/s> <r/a> <th
               ("bang", "ictus-drum: expected a list <hand> <velocity m/s> <r/a> <theta deg> - got: "
                        "bang"),
               ("5 3 0.3 0", "ictus-drum: hand must be 0 (left) 1 (right) 2 (right foot) or 3 (left "
-                            "foot) - got: 5 3 0.3 0")]
+                            "foot) - got: 5 3 0.3 0"),
+              # a negative stick mass: refused by the hand's contact~ (docs/pd-osc.md)
+              ("0 3 0.3 0 -0.02", "contact~: hit: stick mass must be >= 0 kg (0: unchanged), got "
+                                  "-0.02; the stick keeps its mass")]
 d = p.obj("delay 20")
 p.connect(trig, 0, d, 0)
 for c in extra:
