@@ -14,6 +14,10 @@ number in 0..65535 is refused by name and nothing listens ([netreceive] took 700
 HOST that is not a symbol falls back to loopback, said so; extra arguments are said. Read from
 the kernel's table of UDP sockets (/proc/net/udp) while pd runs, in real time.
 
+[ictus-midifile CHANNEL] and its channel message (docs/midi.md): 0 or a whole 1..16; out of
+range clamped, a symbol refused, extra arguments said, each by name ([ictus-midifile foo] left an
+internal [f $1] that "couldn't create", and -3 or 99 were taken without a word).
+
     PYTHONPATH=python python3 tests/pdosc/test_abstraction_args.py --build build
 """
 import argparse
@@ -145,6 +149,36 @@ def receive_args(build):
           % [l for l in log.splitlines() if "netreceive" in l])
 
 
+def midifile_args(build):
+    cases = [("10", []), ("0", []),
+             ("foo", ["ictus-midifile: CHANNEL must be a number 0..16 (unchanged) - got: foo"]),
+             ("-3", ["ictus-midifile: CHANNEL must be 0 (every channel) or a whole number 1..16 "
+                     "(clamped) - got: -3"]),
+             ("99", ["(clamped) - got: 99"]), ("2.5", ["(clamped) - got: 2.5"]),
+             ("1 2", ["ictus-midifile: takes one argument CHANNEL - extra arguments ignored - "
+                      "got: 2"])]
+    p = Patch()
+    for arg, _ in cases:
+        p.obj("ictus-midifile %s" % arg)
+    r = p.obj("ictus-midifile")
+    m = p.msg("channel 17")
+    lb = p.obj("loadbang")
+    p.connect(lb, 0, m, 0)
+    p.connect(m, 0, r, 0)
+    z = p.obj("sig~ 0")
+    work = make_workdir("ictus-pdosc-args-")
+    recorder(p, [(z, 0, "z")], 0.01, SR, os.path.join(work, "z.wav"))
+    rc, log = run_pd(p.text(), os.path.join(build, "ictus"), sr=SR, workdir=work)
+    check(rc == 0, "pd ran (rc %d)" % rc)
+    for arg, errors in cases:
+        for e in errors:
+            check(e in log, "[ictus-midifile %s]: error line '%s'" % (arg, e))
+    check("(clamped) - got: 17" in log, "channel 17 is clamped, said")
+    lines = [l for l in log.splitlines() if l.startswith("error:")]
+    check(len(lines) == 6 and all("ictus-midifile:" in l for l in lines),
+          "one line per bad channel, each naming ictus-midifile: %s" % lines)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", required=True)
@@ -152,6 +186,7 @@ def main():
     keep_going()
     out_args(build)
     receive_args(build)
+    midifile_args(build)
     if failed():
         raise SystemExit(1)
     print("ok")
