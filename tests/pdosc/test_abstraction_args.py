@@ -18,6 +18,10 @@ the kernel's table of UDP sockets (/proc/net/udp) while pd runs, in real time.
 range clamped, a symbol refused, extra arguments said, each by name ([ictus-midifile foo] left an
 internal [f $1] that "couldn't create", and -3 or 99 were taken without a word).
 
+ictus-render.pd's render-seconds (docs/pd-osc.md): outside 0.01..3600 s, or not a number, it is
+refused by name and the length stays (1e9 had pd size its tables past what an int holds and hang
+until the watchdog killed it; 0 and -1 wrote a WAV of one frame without a word).
+
     PYTHONPATH=python python3 tests/pdosc/test_abstraction_args.py --build build
 """
 import argparse
@@ -179,6 +183,34 @@ def midifile_args(build):
           "one line per bad channel, each naming ictus-midifile: %s" % lines)
 
 
+def render_seconds(build):
+    work = make_workdir("ictus-pdosc-args-")
+    events = os.path.join(work, "events.txt")
+    with open(events, "w") as f:
+        f.write("10 hit 1 0 0 3 0.3 0 10 0.01 1 0 0.01 0.05;\n")
+    lib = os.path.join(build, "ictus")
+    for bad, line in (("-1", "render-seconds must be in 0.01..3600 s (ignored - the length stays) - got: -1"),
+                      ("0", "render-seconds must be in 0.01..3600 s (ignored - the length stays) - got: 0"),
+                      ("1e9", "render-seconds must be in 0.01..3600 s (ignored - the length stays) - got: 1e+09"),
+                      ("foo", "render-seconds must be a number of seconds (ignored) - got: foo")):
+        wav = os.path.join(work, "render.wav")
+        if os.path.exists(wav):
+            os.remove(wav)
+        cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(SR), "-path", lib,
+               "-open", os.path.join(lib, "ictus-render.pd"), "-send", "render-file " + events,
+               "-send", "render-out " + wav, "-send", "render-seconds 0.2",
+               "-send", "render-seconds " + bad]
+        try:
+            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
+            rc, log = proc.returncode, proc.stdout + proc.stderr
+        except subprocess.TimeoutExpired:
+            rc, log = None, "(no answer in 60 s)"
+        check(rc == 0 and "error: ictus-render: " + line in log,
+              "render-seconds %s is refused by name: %s" % (bad, log[-300:]))
+        frames = len(read_wav_float(wav)[0]) if os.path.exists(wav) else 0
+        check(frames == int(0.2 * SR), "... and the render keeps its 0.2 s: %d frames" % frames)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", required=True)
@@ -187,6 +219,7 @@ def main():
     out_args(build)
     receive_args(build)
     midifile_args(build)
+    render_seconds(build)
     if failed():
         raise SystemExit(1)
     print("ok")
