@@ -20,7 +20,10 @@ internal [f $1] that "couldn't create", and -3 or 99 were taken without a word).
 
 ictus-render.pd's render-seconds (docs/pd-osc.md): outside 0.01..3600 s, or not a number, it is
 refused by name and the length stays (1e9 had pd size its tables past what an int holds and hang
-until the watchdog killed it; 0 and -1 wrote a WAV of one frame without a word).
+until the watchdog killed it; 0 and -1 wrote a WAV of one frame without a word); a symbol for
+render-gain or render-pan, or for ictus-out~'s gain and width, is refused by name (they reached a
+[t f f f] or a [clip] inside, whose errors named neither), and the render's report gives the gain
+ictus-out~ applies (40 for render-gain 1e30, not 1e+30).
 
     PYTHONPATH=python python3 tests/pdosc/test_abstraction_args.py --build build
 """
@@ -48,6 +51,9 @@ def out_args(build):
         ("-1", None, 0.0, ["ictus-out~: width must be in 0..1 (clamped) - got: -1"]),
         ("foo", None, 1.0, ["ictus-out~: the argument WIDTH must be a number"]),
         ("foo", "width 0.5", 0.5, ["ictus-out~: the argument WIDTH must be a number"]),
+        # a symbol for a number: said by name, the width or gain stays
+        ("0.5", "width foo", 0.5, ["ictus-out~: width must be a number in 0..1 - got: foo"]),
+        ("1", "gain foo", 1.0, ["ictus-out~: gain must be a number of dB - got: foo"]),
     ]
     p = Patch()
     osc = p.obj("osc~ 50")
@@ -68,8 +74,9 @@ def out_args(build):
     recorder(p, tables, SECONDS, SR, wav)
     rc, log = run_pd(p.text(), os.path.join(build, "ictus"), sr=SR, workdir=work)
     check(rc == 0, "pd ran (rc %d)" % rc)
-    check("clip:" not in log, "no argument reaches the [clip] inside: %s" %
-          [l for l in log.splitlines() if "clip:" in l])
+    check("clip:" not in log and "trigger:" not in log,
+          "no argument or message reaches a [clip] or [t f f f] inside: %s" %
+          [l for l in log.splitlines() if "clip:" in l or "trigger:" in l])
     y, _ = read_wav_float(wav)
     peak = np.abs(y[len(y) // 2:]).max(axis=0)
     for i, (arg, msg, w, errors) in enumerate(cases):
@@ -209,6 +216,20 @@ def render_seconds(build):
               "render-seconds %s is refused by name: %s" % (bad, log[-300:]))
         frames = len(read_wav_float(wav)[0]) if os.path.exists(wav) else 0
         check(frames == int(0.2 * SR), "... and the render keeps its 0.2 s: %d frames" % frames)
+    # render-gain and render-pan: a symbol refused by name; the report gives the gain applied
+    for send, line in (("render-gain foo", "error: ictus-render: render-gain must be a number of dB - "
+                                           "got: foo"),
+                       ("render-pan foo", "error: ictus-render: render-pan must be a number in 0..1 - "
+                                          "got: foo"),
+                       ("render-gain 1e30", "gain_db 40")):
+        wav = os.path.join(work, "render.wav")
+        cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(SR), "-path", lib,
+               "-open", os.path.join(lib, "ictus-render.pd"), "-send", "render-file " + events,
+               "-send", "render-out " + wav, "-send", "render-seconds 0.2", "-send", send]
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
+        log = proc.stdout + proc.stderr
+        check(proc.returncode == 0 and line in log and "trigger:" not in log and "clip:" not in log,
+              "%s: '%s' and nothing from a vanilla object inside: %s" % (send, line, log[-300:]))
 
 
 def main():
