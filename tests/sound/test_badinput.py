@@ -80,3 +80,22 @@ log = proc.stdout + proc.stderr
 print(log)
 check(proc.returncode == 0 and "error: ictus-sound-clips: clips/ictus-clips.wav" in log,
       "a missing clip file is named in an error line")
+
+# Every membrane~ message [ictus-sound] forwards to its models (docs/sound.md: "anything else:
+# to the modal model's membrane~") is taken without a word by the models it does not concern:
+# the synth said "unknown message" for tensionmod, radiation, lossfactor, patch, cascade,
+# bending, vonkarman, openness, edgedamp and wires, whatever the model playing.
+good = ["tensionmod 0.5", "radiation 0.5", "lossfactor 0.002", "patch 0.007", "cascade 1",
+        "bending 9", "vonkarman 0", "openness 1", "edgedamp 0", "wires on", "wires off",
+        "preset tom", "hfdamp 1", "modes 128", "gain 0.16", "pickup 1 0.5 0", "position 0.3 0"]
+with open(os.path.join(work, "forward.pd"), "w") as f:
+    f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound modal;\n#X obj 10 40 loadbang;\n"
+            "#X msg 10 70 %s;\n#X connect 1 0 2 0;\n#X connect 2 0 0 0;\n"
+            % " \\, ".join(good))
+proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
+                       os.path.join(build, "ictus"), "-open", os.path.join(work, "forward.pd"),
+                       "-send", "pd quit"], capture_output=True, text=True, timeout=60, env=PD_ENV)
+log = proc.stdout + proc.stderr
+bad = [l for l in log.splitlines() if "error" in l]
+check(proc.returncode == 0 and not bad,
+      "membrane~'s messages through [ictus-sound modal]: no error line (%s)" % bad)
