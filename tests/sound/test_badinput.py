@@ -99,3 +99,23 @@ log = proc.stdout + proc.stderr
 bad = [l for l in log.splitlines() if "error" in l]
 check(proc.returncode == 0 and not bad,
       "membrane~'s messages through [ictus-sound modal]: no error line (%s)" % bad)
+
+# A symbol where a number goes is refused by name: it reached a [t f f f] inside ictus-sound
+# (volume, fade), ictus-sound-synth (radius, tension, density, mass, t60) or the hoop of
+# ictus-drum (t60), whose "trigger: generic messages ..." named none of them.
+words = {"volume foo": "error: ictus-sound: volume must be a number in 0..1 - got: foo",
+         "fade foo": "error: ictus-sound: fade must be a number in 0..1000 ms - got: foo"}
+for name in ("radius", "tension", "density", "mass", "t60"):
+    words["%s foo" % name] = "error: ictus-sound-synth: expected a number for: %s foo" % name
+with open(os.path.join(work, "symbols.pd"), "w") as f:
+    f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound modal;\n#X obj 10 40 loadbang;\n"
+            "#X msg 10 70 %s;\n#X connect 1 0 2 0;\n#X connect 2 0 0 0;\n"
+            % " \\, ".join(words))
+proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
+                       os.path.join(build, "ictus"), "-open", os.path.join(work, "symbols.pd"),
+                       "-send", "pd quit"], capture_output=True, text=True, timeout=60, env=PD_ENV)
+log = proc.stdout + proc.stderr
+for msg, line in words.items():
+    check(line in log, "[ictus-sound modal] %s: '%s'" % (msg, line))
+check("trigger:" not in log, "no line from a [trigger] inside: %s"
+      % [l for l in log.splitlines() if "trigger:" in l])
