@@ -417,14 +417,49 @@ static void ictus_timetag_list(t_ictus_timetag *x, t_symbol *s, int argc, t_atom
     ictus_timetag_output(x, x->x_buf, argc, 0);
 }
 
-/* latency <ms>: audio output latency to subtract from every delay. */
-static void ictus_timetag_latency(t_ictus_timetag *x, t_floatarg ms)
+#define ICTUS_TIMETAG_LATENCY_MAX 10000.0 /* ms */
+
+/* Sets the latency (ms), clamped into [0, 10000] with an error line (NaN: 0). */
+static void ictus_timetag_set_latency(t_ictus_timetag *x, double ms)
 {
-    if (!(ms >= 0 && ms <= 10000)) {
-        pd_error(x, "ictus_timetag: latency must be in [0, 10000] ms, got %g; using 0", ms);
-        ms = 0;
+    if (!(ms >= 0 && ms <= ICTUS_TIMETAG_LATENCY_MAX)) {
+        double used = ms > ICTUS_TIMETAG_LATENCY_MAX ? ICTUS_TIMETAG_LATENCY_MAX : 0.0;
+        pd_error(x, "ictus_timetag: latency must be in [0, %g] ms, got %g; using %g",
+                 ICTUS_TIMETAG_LATENCY_MAX, ms, used);
+        ms = used;
     }
     x->x_latency_ms = ms;
+}
+
+/* The latency from atom i of a message or the creation arguments ("what": where it came
+ * from); a missing or non-number atom is said and leaves the latency as it is. */
+static void ictus_timetag_latency_atom(t_ictus_timetag *x, const char *what, int argc, t_atom *argv)
+{
+    char got[MAXPDSTRING];
+    if (argc < 1) {
+        pd_error(x, "ictus_timetag: %s: missing the latency (ms)", what);
+        return;
+    }
+    if (argv[0].a_type != A_FLOAT) {
+        atom_string(&argv[0], got, sizeof(got));
+        pd_error(x,
+                 "ictus_timetag: %s: the latency (ms) must be a number, got '%s'; it stays %g ms",
+                 what, got, x->x_latency_ms);
+        return;
+    }
+    ictus_timetag_set_latency(x, atom_getfloat(&argv[0]));
+    if (argc > 1)
+        pd_error(x,
+                 "ictus_timetag: %s takes one number, the latency (ms); extra arguments "
+                 "ignored",
+                 what);
+}
+
+/* latency <ms>: audio output latency to subtract from every delay. */
+static void ictus_timetag_latency(t_ictus_timetag *x, t_symbol *s, int argc, t_atom *argv)
+{
+    (void)s;
+    ictus_timetag_latency_atom(x, "latency", argc, argv);
 }
 
 /* status: `status offset_ms late malformed packets latency_ms` on the info outlet;
@@ -473,7 +508,7 @@ static void ictus_timetag_reset(t_ictus_timetag *x)
     ictus_timetag_schedule(x, 0);
 }
 
-static void *ictus_timetag_new(t_floatarg latency_ms)
+static void *ictus_timetag_new(t_symbol *s, int argc, t_atom *argv)
 {
     t_ictus_timetag *x = (t_ictus_timetag *)pd_new(ictus_timetag_class);
     struct timespec ts;
@@ -490,7 +525,10 @@ static void *ictus_timetag_new(t_floatarg latency_ms)
     x->x_bucket_index = 0;
     x->x_expect_count = 0;
     x->x_late_count = x->x_malformed_count = x->x_packet_count = 0;
-    ictus_timetag_latency(x, latency_ms);
+    (void)s;
+    x->x_latency_ms = 0;
+    if (argc > 0)
+        ictus_timetag_latency_atom(x, "creation argument", argc, argv);
     x->x_sample_clock = clock_new(x, (t_method)ictus_timetag_tick);
     ictus_timetag_schedule(x, 0);
     return x;
@@ -507,12 +545,12 @@ static void ictus_timetag_free(t_ictus_timetag *x)
 
 ICTUS_TIMETAG_EXPORT void ictus_timetag_setup(void)
 {
-    ictus_timetag_class = class_new(gensym("ictus_timetag"), (t_newmethod)ictus_timetag_new,
-                                    (t_method)ictus_timetag_free, sizeof(t_ictus_timetag),
-                                    CLASS_DEFAULT, A_DEFFLOAT, 0);
+    ictus_timetag_class =
+        class_new(gensym("ictus_timetag"), (t_newmethod)ictus_timetag_new,
+                  (t_method)ictus_timetag_free, sizeof(t_ictus_timetag), CLASS_DEFAULT, A_GIMME, 0);
     class_addlist(ictus_timetag_class, ictus_timetag_list);
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_latency, gensym("latency"),
-                    A_FLOAT, 0);
+                    A_GIMME, 0);
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_status, gensym("status"), 0);
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_reset, gensym("reset"), 0);
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_expect, gensym("expect"), A_SYMBOL,

@@ -25,6 +25,11 @@ render-gain or render-pan, or for ictus-out~'s gain and width, is refused by nam
 [t f f f] or a [clip] inside, whose errors named neither), and the render's report gives the gain
 ictus-out~ applies (40 for render-gain 1e30, not 1e+30).
 
+[ictus_timetag LATENCY] and its latency message (docs/pd-osc.md): a symbol is refused by name and
+the latency stays (the object took one float argument: [ictus_timetag foo] could not be created,
+and `latency foo` or a bare `latency` got Pd's "bad arguments"); out of 0..10000 ms it is clamped
+to the nearest limit (1e30 was taken as 0).
+
     PYTHONPATH=python python3 tests/pdosc/test_abstraction_args.py --build build
 """
 import argparse
@@ -232,6 +237,50 @@ def render_seconds(build):
               "%s: '%s' and nothing from a vanilla object inside: %s" % (send, line, log[-300:]))
 
 
+def timetag_args(build):
+    cases = [("foo", ["ictus_timetag: creation argument: the latency (ms) must be a number, got "
+                      "'foo'; it stays 0 ms"], 0),
+             ("2e4", ["ictus_timetag: latency must be in [0, 10000] ms, got 20000; using 10000"],
+              10000),
+             ("5 6", ["ictus_timetag: creation argument takes one number, the latency (ms); extra "
+                      "arguments ignored"], 5),
+             ("7", [], 7)]
+    p = Patch()
+    info = p.obj("print info")
+    lb = p.obj("loadbang")
+    st = p.msg("status")
+    p.connect(lb, 0, st, 0)
+    for arg, _, _ in cases:
+        t = p.obj("ictus_timetag %s" % arg)
+        p.connect(st, 0, t, 0)
+        p.connect(t, 2, info, 0)
+    # the messages, on one more
+    t = p.obj("ictus_timetag")
+    m = p.msg("latency foo \\, latency \\, latency 1e30 \\, status \\, latency -3 \\, status")
+    p.connect(lb, 0, m, 0)
+    p.connect(m, 0, t, 0)
+    p.connect(t, 2, p.obj("print info2"), 0)
+    z = p.obj("sig~ 0")
+    work = make_workdir("ictus-pdosc-args-")
+    recorder(p, [(z, 0, "z")], 0.01, SR, os.path.join(work, "z.wav"))
+    rc, log = run_pd(p.text(), os.path.join(build, "ictus"), sr=SR, workdir=work)
+    check(rc == 0 and "couldn't create" not in log and "bad arguments" not in log,
+          "every ictus_timetag is created and takes its messages: %s" % log[-400:])
+    for arg, errors, latency in cases:
+        for e in errors:
+            check(e in log, "[ictus_timetag %s]: error line '%s'" % (arg, e))
+    statuses = [l.split()[-1] for l in log.splitlines() if l.startswith("info: status")]
+    check(sorted(statuses, key=float) == ["0", "5", "7", "10000"],
+          "the latencies in use: 0, 5, 7, 10000 ms (status: %s)" % statuses)
+    statuses = [l.split()[-1] for l in log.splitlines() if l.startswith("info2: status")]
+    for e in ("ictus_timetag: latency: the latency (ms) must be a number, got 'foo'; it stays 0 ms",
+              "ictus_timetag: latency: missing the latency (ms)",
+              "ictus_timetag: latency must be in [0, 10000] ms, got 1e+30; using 10000",
+              "ictus_timetag: latency must be in [0, 10000] ms, got -3; using 0"):
+        check(e in log, "latency messages: '%s'" % e)
+    check(statuses == ["10000", "0"], "latency 1e30 sets 10000, -3 sets 0 (%s)" % statuses)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", required=True)
@@ -241,6 +290,7 @@ def main():
     receive_args(build)
     midifile_args(build)
     render_seconds(build)
+    timetag_args(build)
     if failed():
         raise SystemExit(1)
     print("ok")
