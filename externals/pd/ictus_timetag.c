@@ -479,9 +479,17 @@ static void ictus_timetag_status(t_ictus_timetag *x)
 /* expect ADDRESS TAGS: e.g. `expect /ictus/strike iiiiffffffffffffff` (tags
  * without the comma; an empty symbol for none). A new rule for the same
  * address replaces the old one. */
-static void ictus_timetag_expect(t_ictus_timetag *x, t_symbol *address, t_symbol *tags)
+static void ictus_timetag_expect(t_ictus_timetag *x, t_symbol *s, int argc, t_atom *argv)
 {
     int i;
+    (void)s;
+    if (argc < 1 || argc > 2 || argv[0].a_type != A_SYMBOL ||
+        (argc == 2 && argv[1].a_type != A_SYMBOL)) {
+        pd_error(x, "ictus_timetag: expect needs ADDRESS and TAGS, two symbols (e.g. expect "
+                    "/ictus/strike iiff; TAGS left out: no arguments); ignored");
+        return;
+    }
+    t_symbol *address = argv[0].a_w.w_symbol, *tags = argc == 2 ? argv[1].a_w.w_symbol : &s_;
     if (address->s_name[0] != '/') {
         pd_error(x, "ictus_timetag: expect: address must start with '/', got '%s'",
                  address->s_name);
@@ -553,6 +561,6 @@ ICTUS_TIMETAG_EXPORT void ictus_timetag_setup(void)
                     A_GIMME, 0);
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_status, gensym("status"), 0);
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_reset, gensym("reset"), 0);
-    class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_expect, gensym("expect"), A_SYMBOL,
-                    A_DEFSYMBOL, 0);
+    class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_expect, gensym("expect"), A_GIMME,
+                    0);
 }

@@ -256,7 +256,8 @@ def timetag_args(build):
         p.connect(t, 2, info, 0)
     # the messages, on one more
     t = p.obj("ictus_timetag")
-    m = p.msg("latency foo \\, latency \\, latency 1e30 \\, status \\, latency -3 \\, status")
+    m = p.msg("latency foo \\, latency \\, latency 1e30 \\, status \\, latency -3 \\, status "
+              "\\, expect \\, expect 5 ii \\, expect /a ii jj \\, expect /ictus/x ii")
     p.connect(lb, 0, m, 0)
     p.connect(m, 0, t, 0)
     p.connect(t, 2, p.obj("print info2"), 0)
@@ -278,6 +279,9 @@ def timetag_args(build):
               "ictus_timetag: latency must be in [0, 10000] ms, got 1e+30; using 10000",
               "ictus_timetag: latency must be in [0, 10000] ms, got -3; using 0"):
         check(e in log, "latency messages: '%s'" % e)
+    # expect with no address, a number for it, or three words: said by name, three times
+    check(log.count("ictus_timetag: expect needs ADDRESS and TAGS, two symbols") == 3,
+          "a bad expect is said by name, three times: %s" % log[-600:])
     check(statuses == ["10000", "0"], "latency 1e30 sets 10000, -3 sets 0 (%s)" % statuses)
 
 
