@@ -119,3 +119,17 @@ for msg, line in words.items():
     check(line in log, "[ictus-sound modal] %s: '%s'" % (msg, line))
 check("trigger:" not in log, "no line from a [trigger] inside: %s"
       % [l for l in log.splitlines() if "trigger:" in l])
+
+# Creation arguments: [ictus-sound MODEL] takes one; more are said by name and ignored (the
+# model still set), one or none says nothing.
+with open(os.path.join(work, "args.pd"), "w") as f:
+    f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound synth extra 3;\n"
+            "#X obj 10 40 ictus-sound modal;\n#X obj 10 70 ictus-sound;\n")
+proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
+                       os.path.join(build, "ictus"), "-open", os.path.join(work, "args.pd"),
+                       "-send", "pd quit"], capture_output=True, text=True, timeout=60, env=PD_ENV)
+log = proc.stdout + proc.stderr
+errors = [l for l in log.splitlines() if "error" in l]
+check(errors == ["error: ictus-sound: takes one argument (the model) - extra arguments ignored - "
+                 "got: extra 3"], "extra arguments said once, by name; one or none silent: %s"
+      % errors)
