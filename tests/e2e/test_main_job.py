@@ -90,15 +90,13 @@ if found:
 # and in the main job's own WAV (real drum, set by main.sh through -send): where
 # it departs from a render of the strikes before each one, the drum sent as
 # ictusd render sends it (e2e_util).
-# The sanitizer build (ICTUS_PD_PRELOAD) renders each cut at a fraction of real time:
-# there the first and last strikes and four drawn with a fixed seed, so that the check
-# stays within the test's time (the release build checks every strike).
+# The sanitizer build (ICTUS_PD_PRELOAD) renders each cut at a fraction of real time and
+# looks for memory faults, not timing: there the first strike (a cut of no hits) and the last
+# (a cut of every hit but one, the whole score's sound) only; the release build checks every
+# strike.
 indices = None
 if os.environ.get("ICTUS_PD_PRELOAD"):
-    rng = np.random.default_rng(1)
-    middle = rng.choice(np.arange(1, len(strikes) - 1), size=min(4, len(strikes) - 2),
-                        replace=False)
-    indices = sorted({0, len(strikes) - 1} | {int(k) for k in middle})
+    indices = sorted({0, len(strikes) - 1})
     print("sanitizer build: departure onsets of strikes %s only" % indices)
 departures, _ = u.departure_onsets(build, events, drum, x, work=work, header_sent=True,
                                    indices=indices)
@@ -173,33 +171,38 @@ def parse_bvh(path):
     return joints, frame_time, data
 
 
-def axis_matrix(axis, deg):
-    a = np.radians(deg)
-    c, s = np.cos(a), np.sin(a)
+def axis_matrices(axis, deg):
+    """The rotations about `axis` by each angle of `deg` (degrees), [n, 3, 3]."""
+    a = np.radians(np.asarray(deg, dtype=float))
+    c, s, one, zero = np.cos(a), np.sin(a), np.ones_like(a), np.zeros_like(a)
     if axis == "X":
-        return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-    if axis == "Y":
-        return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+        m = [[one, zero, zero], [zero, c, -s], [zero, s, c]]
+    elif axis == "Y":
+        m = [[c, zero, s], [zero, one, zero], [-s, zero, c]]
+    else:
+        m = [[c, -s, zero], [s, c, zero], [zero, zero, one]]
+    return np.moveaxis(np.array(m), (0, 1), (-2, -1))
 
 
-def fk(joints, row):
-    """World positions (file units) of every joint for one motion line:
-    R = product of the rotation channels in file order (intrinsic)."""
+def fk(joints, rows):
+    """World positions (file units) of every joint for each motion line of `rows` [n, k]
+    (one line per frame, solved together): [joint] -> [n, 3]. R = product of the rotation
+    channels in file order (intrinsic)."""
+    n = len(rows)
     pos, rot, k = [None] * len(joints), [None] * len(joints), 0
     for j, (name, parent, offset, channels, end) in enumerate(joints):
-        moved, r = np.zeros(3), np.eye(3)
+        moved, r = np.zeros((n, 3)), np.broadcast_to(np.eye(3), (n, 3, 3))
         for c in channels:
-            v = row[k]
+            v = rows[:, k]
             k += 1
             if c.endswith("position"):
-                moved["XYZ".index(c[0])] = v
+                moved[:, "XYZ".index(c[0])] = v
             else:
-                r = r @ axis_matrix(c[0], v)
+                r = r @ axis_matrices(c[0], v)
         if parent < 0:
             pos[j], rot[j] = offset + moved, r
         else:
-            pos[j] = pos[parent] + rot[parent] @ offset
+            pos[j] = pos[parent] + np.einsum("nij,j->ni", rot[parent], offset)
             rot[j] = rot[parent] @ r
     return pos
 
@@ -226,20 +229,21 @@ if "LeftHandStick_End" in names and "RightHandStick_End" in names and os.path.is
     cols = figure5.tip_columns(header)
     table = np.array([[float(v) for v in l.split(",")] for l in lines[1:]])
     t = table[:, header.index("time_s")]
+    # The tips.csv sample of each BVH frame: k - 1 or k (searchsorted), the first within 1 us.
+    frame_t = np.arange(len(data)) * frame_time
+    k = np.searchsorted(t, frame_t)
+    sample = np.full(len(data), -1)
+    for kk in (k - 1, k):
+        inside = (kk >= 0) & (kk < len(t))
+        near = np.abs(t[np.clip(kk, 0, len(t) - 1)] - frame_t) < 1e-6
+        take = (sample < 0) & inside & near
+        sample[take] = kk[take]
+    frames = np.flatnonzero(sample >= 0)
+    poses = fk(joints, data[frames])  # the frames' joints, solved once for both hands
     worst = {}
-    poses = {}  # frame -> its joints' positions, solved once for both hands
     for hand, end in (("left", "LeftHandStick_End"), ("right", "RightHandStick_End")):
-        j = names.index(end)
-        errs = []
-        for f_idx in range(len(data)):
-            k = int(np.searchsorted(t, f_idx * frame_time))
-            for kk in (k - 1, k):
-                if 0 <= kk < len(t) and abs(t[kk] - f_idx * frame_time) < 1e-6:
-                    if f_idx not in poses:
-                        poses[f_idx] = fk(joints, data[f_idx])
-                    errs.append(abs(poses[f_idx][j][1] - table[kk, cols[(hand, "sim")]]))
-                    break
-        worst[hand] = (max(errs) if errs else None, len(errs))
+        errs = np.abs(poses[names.index(end)][:, 1] - table[sample[frames], cols[(hand, "sim")]])
+        worst[hand] = (float(errs.max()) if len(errs) else None, len(errs))
     print("BVH stick tips vs tips.csv (sim y): %s" % worst)
     check(all(n > 0 for _, n in worst.values()), "BVH frames fall on tips.csv samples")
     check(all(e < 1e-3 for e, _ in worst.values()),

@@ -66,6 +66,8 @@ def main():
     ap.add_argument("--ictusd", required=True)
     ap.add_argument("--workdir", default="chick-test")
     ap.add_argument("--seed", type=int, default=44)
+    ap.add_argument("--both-feet-beats", type=int, default=BOTH_FEET_BEATS,
+                    help="seeded chords of both feet (the first K of the %d)" % BOTH_FEET_BEATS)
     args = ap.parse_args()
     os.makedirs(args.workdir, exist_ok=True)
     rng = random.Random(args.seed)
@@ -182,12 +184,15 @@ def main():
     chords = "tempo %d\n" % rng.randint(80, 160) + "".join(
         "RF %s + LF %s %s\n" % (rng.choice(dyn), rng.choice(dyn), rng.choice(("1/2", "1/4", "1/1")))
         for _ in range(BOTH_FEET_BEATS))
+    # the first --both-feet-beats chords (the seeded ones, whatever their number)
+    chords = "\n".join(chords.split("\n")[:1 + args.both_feet_beats]) + "\n"
     seed160 = ("tempo 71; grip german; R 1 on floor legato; L on snare vertical_accent at 0.57 "
                "10.2 0\nRF 0.5 on kick + r legato pp on ride\nR+L on snare beats 3/4 staccato\n"
                "lf 0 1/6 + left on snare VERTICAL_ACCENT 1/1 + right staccato half on hihat + "
                "right-foot 0.5 beats 1/8 on kick\nRIGHT-FOOT MF + R TENUTO OPEN ON HIHAT + LF "
                "BEATS 0.5\n")
-    for name, text, n_feet in (("both-feet", chords, 2 * BOTH_FEET_BEATS), ("seed-160", seed160, 5)):
+    for name, text, n_feet in (("both-feet", chords, 2 * args.both_feet_beats),
+                               ("seed-160", seed160, 5)):
         path = os.path.join(args.workdir, name + ".txt")
         with open(path, "w") as f:
             f.write(text)

@@ -20,7 +20,7 @@ Played over seeded tempi in 100-160 bpm (130 always: the tempo the report found)
   reported, not lost silently.
 
     PYTHONPATH=python python3 tests/perform/test_ghost_ending.py --ictusd build/ictusd \
-        [--workdir DIR] [--seed N]
+        [--workdir DIR] [--seed N] [--seeded-tempi K]
 """
 import argparse
 import csv
@@ -85,11 +85,13 @@ def main():
     ap.add_argument("--ictusd", required=True)
     ap.add_argument("--workdir", default="ghost-ending-test")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--seeded-tempi", type=int, default=3,
+                    help="seeded tempi played besides 130 bpm")
     args = ap.parse_args()
     work = os.path.abspath(args.workdir)
     os.makedirs(work, exist_ok=True)
     rng = random.Random(args.seed)
-    tempi = sorted({130} | set(rng.sample(range(100, 161), 3)))
+    tempi = sorted({130} | set(rng.sample(range(100, 161), 3)[:args.seeded_tempi]))
     print("ghost ending: seed %d, tempi %s bpm, kits %s, endings %s"
           % (args.seed, tempi, KITS, ENDINGS))
     jobs = [(kit, bpm, ending) for kit in KITS for bpm in tempi for ending in ENDINGS]

@@ -68,6 +68,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--ictusd", required=True)
     ap.add_argument("--workdir", default="humanize-out")
+    ap.add_argument("--amounts", default="0.5,1,2",
+                    help="amounts whose spreads must grow in turn (1 always played)")
     a = ap.parse_args()
     problems = []
     r = lambda name, args, text=SCORE: render(a.ictusd, a.workdir, name, text, args)
@@ -78,7 +80,8 @@ def main():
     if not sd0 < 0.1:
         problems.append("humanize 0: timing SD %.3f ms, want the physics' own (< 0.1 ms)" % sd0)
     by_amount = {}
-    for amount in ("0.5", "1", "2"):
+    amounts = sorted(set(a.amounts.split(",")) | {"1"}, key=float)
+    for amount in amounts:
         out = r("amount-" + amount, ["--humanize", amount])
         by_amount[amount] = spreads(out, problems, "amount " + amount)
     sd1, cv1 = by_amount["1"]
@@ -86,7 +89,7 @@ def main():
         problems.append("amount 1: timing SD %.3f ms, want %g-%g ms" % (sd1, *TIMING_MS))
     if not CV_PCT[0] <= cv1 <= CV_PCT[1]:
         problems.append("amount 1: impact-speed CV %.2f %%, want %g-%g %%" % (cv1, *CV_PCT))
-    for lo, hi in (("0.5", "1"), ("1", "2")):
+    for lo, hi in zip(amounts, amounts[1:]):
         for i, what in ((0, "timing SD"), (1, "impact-speed CV")):
             if not by_amount[hi][i] > by_amount[lo][i]:
                 problems.append("%s does not grow from amount %s (%.3f) to %s (%.3f)"
