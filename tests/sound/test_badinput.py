@@ -34,6 +34,18 @@ def run(model, items, head, seconds=0.6):
     return proc.returncode, proc.stdout + proc.stderr, x
 
 
+def open_lines(name, body):
+    """Opens a patch of the objects in body (its #X lines, after the canvas) in pd -batch and
+    quits: (return code, the log)."""
+    path = os.path.join(work, name)
+    with open(path, "w") as f:
+        f.write("#N canvas 0 0 400 300 12;\n" + body)
+    proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
+                           os.path.join(build, "ictus"), "-open", path, "-send", "pd quit"],
+                          capture_output=True, text=True, timeout=60, env=PD_ENV)
+    return proc.returncode, proc.stdout + proc.stderr
+
+
 for model in ("clips", "synth", "modal"):
     head = ["render-drum volume 3", "render-drum fade -5", "render-drum model guitar",
             "render-drum model 7", "render-drum radius -1", "render-drum tension 1e9",
@@ -88,16 +100,11 @@ check(proc.returncode == 0 and "error: ictus-sound-clips: clips/ictus-clips.wav"
 good = ["tensionmod 0.5", "radiation 0.5", "lossfactor 0.002", "patch 0.007", "cascade 1",
         "bending 9", "vonkarman 0", "openness 1", "edgedamp 0", "wires on", "wires off",
         "preset tom", "hfdamp 1", "modes 128", "gain 0.16", "pickup 1 0.5 0", "position 0.3 0"]
-with open(os.path.join(work, "forward.pd"), "w") as f:
-    f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound modal;\n#X obj 10 40 loadbang;\n"
-            "#X msg 10 70 %s;\n#X connect 1 0 2 0;\n#X connect 2 0 0 0;\n"
-            % " \\, ".join(good))
-proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
-                       os.path.join(build, "ictus"), "-open", os.path.join(work, "forward.pd"),
-                       "-send", "pd quit"], capture_output=True, text=True, timeout=60, env=PD_ENV)
-log = proc.stdout + proc.stderr
+MESSAGES = ("#X obj 10 10 ictus-sound modal;\n#X obj 10 40 loadbang;\n#X msg 10 70 %s;\n"
+            "#X connect 1 0 2 0;\n#X connect 2 0 0 0;\n")
+rc, log = open_lines("forward.pd", MESSAGES % " \\, ".join(good))
 bad = [l for l in log.splitlines() if "error" in l]
-check(proc.returncode == 0 and not bad,
+check(rc == 0 and not bad,
       "membrane~'s messages through [ictus-sound modal]: no error line (%s)" % bad)
 
 # A symbol where a number goes is refused by name: it reached a [t f f f] inside ictus-sound
@@ -107,14 +114,7 @@ words = {"volume foo": "error: ictus-sound: volume must be a number in 0..1 - go
          "fade foo": "error: ictus-sound: fade must be a number in 0..1000 ms - got: foo"}
 for name in ("radius", "tension", "density", "mass", "t60"):
     words["%s foo" % name] = "error: ictus-sound-synth: expected a number for: %s foo" % name
-with open(os.path.join(work, "symbols.pd"), "w") as f:
-    f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound modal;\n#X obj 10 40 loadbang;\n"
-            "#X msg 10 70 %s;\n#X connect 1 0 2 0;\n#X connect 2 0 0 0;\n"
-            % " \\, ".join(words))
-proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
-                       os.path.join(build, "ictus"), "-open", os.path.join(work, "symbols.pd"),
-                       "-send", "pd quit"], capture_output=True, text=True, timeout=60, env=PD_ENV)
-log = proc.stdout + proc.stderr
+_, log = open_lines("symbols.pd", MESSAGES % " \\, ".join(words))
 for msg, line in words.items():
     check(line in log, "[ictus-sound modal] %s: '%s'" % (msg, line))
 check("trigger:" not in log, "no line from a [trigger] inside: %s"
@@ -122,13 +122,8 @@ check("trigger:" not in log, "no line from a [trigger] inside: %s"
 
 # Creation arguments: [ictus-sound MODEL] takes one; more are said by name and ignored (the
 # model still set), one or none says nothing.
-with open(os.path.join(work, "args.pd"), "w") as f:
-    f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound synth extra 3;\n"
-            "#X obj 10 40 ictus-sound modal;\n#X obj 10 70 ictus-sound;\n")
-proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
-                       os.path.join(build, "ictus"), "-open", os.path.join(work, "args.pd"),
-                       "-send", "pd quit"], capture_output=True, text=True, timeout=60, env=PD_ENV)
-log = proc.stdout + proc.stderr
+_, log = open_lines("args.pd", "#X obj 10 10 ictus-sound synth extra 3;\n"
+                    "#X obj 10 40 ictus-sound modal;\n#X obj 10 70 ictus-sound;\n")
 errors = [l for l in log.splitlines() if "error" in l]
 check(errors == ["error: ictus-sound: takes one argument (the model) - extra arguments ignored - "
                  "got: extra 3"], "extra arguments said once, by name; one or none silent: %s"
