@@ -116,6 +116,15 @@ def run_pd(patch_text, libdir, sr=48000, extra_args=(), workdir=None, name="test
     return proc.returncode, proc.stdout + proc.stderr
 
 
+def run_recorded(p, libdir, sr, prefix):
+    """Runs Patch p, whose recorder() was given the path "WAV", with that path in a new
+    workdir: (returncode, log, samples [n, ch] or None when pd wrote no WAV)."""
+    work = make_workdir(prefix)
+    wav = os.path.join(work, "out.wav")
+    rc, log = run_pd(p.text().replace("WAV", wav), libdir, sr=sr, workdir=work)
+    return rc, log, read_wav_float(wav)[0] if os.path.exists(wav) else None
+
+
 def read_wav_float(path):
     """Reads a 32-bit float WAV (what soundfiler writes) -> (samples [n, ch], sr)."""
     with open(path, "rb") as f:

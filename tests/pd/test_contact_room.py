@@ -9,7 +9,7 @@ import os
 import numpy as np
 
 from ictus_tools.checks import check, keep_going, failed
-from ictus_tools.pdrun import make_workdir, Patch, read_wav_float, recorder, run_pd
+from ictus_tools.pdrun import Patch, recorder, run_recorded
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -36,12 +36,9 @@ for k in range(4):
     m = p.msg("\\; room-hit-%d hit 3 0.3 0" % k)
     p.connect(trig, 0, d, 0)
     p.connect(d, 0, m, 0)
-work = make_workdir("ictus-pd-room-")
-wav = os.path.join(work, "out.wav")
-rc, log = run_pd(p.text().replace("WAV", wav), os.path.join(args.build, "ictus"), sr=SR,
-                 workdir=work)
+rc, log, y = run_recorded(p, os.path.join(args.build, "ictus"), SR, "ictus-pd-room-")
 check(rc == 0, "pd ran (rc %d)" % rc)
-y = read_wav_float(wav)[0][:, 0]
+y = y[:, 0]
 check("already has 4 contact~s" not in log,
       "three contact~s and the snare side: no line says four contact~s: %s" % log[-500:])
 check("contact~: membrane~ 'room-drum' has no free coupling point: 3 contact~s and its snare "

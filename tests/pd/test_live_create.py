@@ -16,7 +16,7 @@ import os
 import numpy as np
 
 from ictus_tools.checks import check, keep_going, failed
-from ictus_tools.pdrun import make_workdir, Patch, read_wav_float, recorder, run_pd
+from ictus_tools.pdrun import Patch, recorder, run_recorded
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -40,12 +40,8 @@ def render(score, seconds=0.4, extra_contacts=0):
         m = p.msg(text)
         p.connect(trig, 0, d, 0)
         p.connect(d, 0, m, 0)
-    work = make_workdir("ictus-pd-live-")
-    wav = os.path.join(work, "out.wav")
-    text = p.text().replace("WAV", wav)
-    rc, log = run_pd(text, os.path.join(args.build, "ictus"), sr=SR, workdir=work)
+    rc, log, y = run_recorded(p, os.path.join(args.build, "ictus"), SR, "ictus-pd-live-")
     check(rc == 0, "pd ran (rc %d)" % rc)
-    y, _ = read_wav_float(wav)
     return y[:, 0], log
 
 

@@ -8,7 +8,7 @@ import os
 import numpy as np
 
 from ictus_tools.checks import check, keep_going, failed
-from ictus_tools.pdrun import make_workdir, Patch, read_wav_float, recorder, run_pd
+from ictus_tools.pdrun import Patch, recorder, run_recorded
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -32,11 +32,7 @@ for sr, preset, want1, want2 in DOC:
     s = p.msg("strike 0.3 0 0.01")
     p.connect(d, 0, s, 0)
     p.connect(s, 0, mem, 0)
-    work = make_workdir("ictus-pd-peaks-")
-    wav = os.path.join(work, "out.wav")
-    rc, log = run_pd(p.text().replace("WAV", wav), os.path.join(args.build, "ictus"), sr=sr,
-                     workdir=work)
-    y = read_wav_float(wav)[0]
+    rc, log, y = run_recorded(p, os.path.join(args.build, "ictus"), sr, "ictus-pd-peaks-")
     got1, got2 = np.abs(y[:, 0]).max(), np.abs(y[:, 1]).max()
     check(rc == 0 and abs(got1 - want1) <= 0.005 and abs(got2 - want2) <= 0.005,
           "%s at %d Hz: peaks %.4f and %.4f, documented %.2f and %.2f"

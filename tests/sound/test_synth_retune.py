@@ -15,7 +15,7 @@ import os
 import numpy as np
 
 from ictus_tools.checks import check, keep_going, failed
-from ictus_tools.pdrun import make_workdir, Patch, read_wav_float, recorder, run_pd
+from ictus_tools.pdrun import Patch, recorder, run_recorded
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -40,11 +40,8 @@ for change, lower in (("t60 0.005", 1.0), ("t60 0.02", 1.0), ("t60 60", 1.0),
         p.connect(trig, 0, d, 0)
         p.connect(d, 0, m, 0)
         p.connect(m, 0, synth, 0)
-    work = make_workdir("ictus-sound-retune-")
-    wav = os.path.join(work, "out.wav")
-    rc, log = run_pd(p.text().replace("WAV", wav), os.path.join(args.build, "ictus"), sr=SR,
-                     workdir=work)
-    y = np.abs(read_wav_float(wav)[0]).max(axis=1)
+    rc, log, y = run_recorded(p, os.path.join(args.build, "ictus"), SR, "ictus-sound-retune-")
+    y = np.abs(y).max(axis=1)
     at = int(CHANGE * SR)
     before = y[at - 480:at].max()  # the last 10 ms before the change
     after = y[at:].max()
