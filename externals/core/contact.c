@@ -26,7 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CONTACT_FORCE_CAP 1.0e12 /* N */
+#define CONTACT_FORCE_CAP MEMBRANE_FORCE_MAX /* N, as the membrane's force input */
 
 struct contact {
     membrane_point point; /* first: a membrane_point * is a contact * (contact_point_ops) */

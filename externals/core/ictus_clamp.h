@@ -26,4 +26,14 @@ static inline ictus_status ictus_clamp(double *v, double lo, double hi, double f
     return ICTUS_OK;
 }
 
+/* A force (N) from outside into the audio loop (membrane_process's force_in):
+ * NaN and +-inf become 0, finite values beyond +-cap are clamped to it. One test
+ * and a min and a max per sample, no allocation. */
+static inline float ictus_clamp_force(float f, float cap)
+{
+    if (!isfinite(f))
+        return 0.0f;
+    return fminf(fmaxf(f, -cap), cap);
+}
+
 #endif

@@ -402,11 +402,11 @@ void membrane_process(membrane *m, const float *force_in, float *const *out, int
     for (int c = 0; c < m->point_count; c++)
         m->points[c]->ops->block_begin(m->points[c], n);
     int next_landing = next_move(m, -1, n);
+    const float force_cap = (float)MEMBRANE_FORCE_MAX;
 
     for (int i = 0; i < n; i++) {
-        float fin = force_in ? force_in[i] : 0.0f;
-        if (!isfinite(fin))
-            fin = 0.0f;
+        /* NaN/inf: 0; beyond +-MEMBRANE_FORCE_MAX N (a contact's cap): the cap. */
+        float fin = force_in ? ictus_clamp_force(force_in[i], force_cap) : 0.0f;
         if (i == next_landing)
             next_landing = land_points(m, i, n);
         if (m->tension_mod > 0.0 || m->tm_g != 1.0) {

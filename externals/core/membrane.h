@@ -208,11 +208,15 @@ ictus_status membrane_strike(membrane *m, double r_over_a, double theta_deg, dou
 /* Silences every mode at once, and ends the stroke of every attached contact. */
 void membrane_clear(membrane *m);
 
+/* The largest force (N) the core applies: force_in beyond +-MEMBRANE_FORCE_MAX is
+ * clamped to it, and so is a contact's force (no drumstick pushes with a teranewton). */
+#define MEMBRANE_FORCE_MAX 1.0e12
+
 /* Advances n samples. force_in (may be NULL) is a force (N) applied at the
- * strike point; out[0..MEMBRANE_PICKUPS-1] receive the pickup signals
- * (membrane velocity, see docs/membrane.md). force_in may alias an output.
- * When out is not NULL but out[1] is, the second pickup is not computed at all
- * (one dot product per mode and sample less); pickup 0 is the same either way. */
+ * strike point (NaN and inf count as 0, beyond +-MEMBRANE_FORCE_MAX it is clamped);
+ * out[0..MEMBRANE_PICKUPS-1] receive the pickup signals (membrane velocity, see docs/membrane.md).
+ * force_in may alias an output. When out is not NULL but out[1] is, the second pickup is not
+ * computed at all (one dot product per mode and sample less); pickup 0 is the same either way. */
 void membrane_process(membrane *m, const float *force_in, float *const *out, int n);
 
 /* Read-back, for tests, help patches and the wrappers' error messages (the

@@ -1,5 +1,6 @@
 // Bad and extreme input: setters clamp (and say so), nothing is ever NaN.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -207,4 +208,63 @@ TEST_CASE("Setter fuzz: random doubles clamp and never produce NaN", "[core][rob
     CHECK(std::isfinite(membrane_energy(m)));
     membrane_free(m);
     contact_free(c);
+}
+
+extern "C" void membrane_use_generic_kernel_(membrane *m); // membrane_internal.h
+
+TEST_CASE("A force beyond MEMBRANE_FORCE_MAX is clamped to it, in either kernel", "[core][robust]")
+{
+    // On a linear head (tensionmod 0) the force input is linear in the force: fed
+    // +-1e30 N (finite, absurd) for 10 ms, the pickups must be those of 1 N times the
+    // cap (1e12 N, a contact's cap) with its sign, not 1e30 times, from the portable
+    // kernel as from the selected one. On the default (Mylar) head, whose pitch
+    // follows its energy, 1e30 N must sound as 1e12 N does, sample for sample.
+    REQUIRE(MEMBRANE_FORCE_MAX == 1.0e12);
+    auto run = [](float force, bool generic, bool linear = true) {
+        membrane *m = membrane_new(48000.0);
+        if (generic)
+            membrane_use_generic_kernel_(m);
+        membrane_set_modes(m, 100);
+        if (linear)
+            ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_TENSION_MOD, 0.0);
+        membrane_set_strike_point(m, 0.42, 75.0);
+        std::vector<float> fin(64), o0(64), o1(64), x;
+        float *outs[2] = {o0.data(), o1.data()};
+        for (int b = 0; b < 60; b++) { // 80 ms: 10 ms pushed, then ringing
+            for (int j = 0; j < 64; j++)
+                fin[j] = b * 64 + j < 480 ? force : 0.0f; // 480 samples: 10 ms
+            membrane_process(m, fin.data(), outs, 64);
+            x.insert(x.end(), o0.begin(), o0.end());
+            x.insert(x.end(), o1.begin(), o1.end());
+        }
+        membrane_free(m);
+        return x;
+    };
+    for (bool generic : {false, true}) {
+        const std::vector<float> unit = run(1.0f, generic);
+        double unit_peak = 0.0;
+        for (float v : unit)
+            unit_peak = std::max(unit_peak, (double)std::fabs(v));
+        REQUIRE(unit_peak > 0.0);
+        for (float sign : {1.0f, -1.0f}) {
+            const std::vector<float> huge = run(sign * 1e30f, generic);
+            REQUIRE(all_finite(huge));
+            double diff = 0.0, peak = 0.0;
+            for (size_t i = 0; i < huge.size(); i++) {
+                const double want = sign * MEMBRANE_FORCE_MAX * (double)unit[i];
+                diff = std::max(diff, std::fabs((double)huge[i] - want));
+                peak = std::max(peak, std::fabs((double)huge[i]));
+            }
+            INFO((generic ? "portable" : "selected")
+                 << " kernel, force " << sign * 1e30 << " N: peak " << peak
+                 << ", 1 N's peak x 1e12 " << unit_peak * MEMBRANE_FORCE_MAX
+                 << ", largest difference " << diff);
+            CHECK(diff <= 1e-4 * unit_peak * MEMBRANE_FORCE_MAX);
+            CHECK(peak <= 1.0001 * unit_peak * MEMBRANE_FORCE_MAX);
+            const std::vector<float> mylar = run(sign * 1e30f, generic, false);
+            const std::vector<float> at_cap = run(sign * 1e12f, generic, false);
+            REQUIRE(all_finite(mylar));
+            CHECK(mylar == at_cap);
+        }
+    }
 }
