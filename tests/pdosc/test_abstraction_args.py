@@ -30,6 +30,12 @@ the latency stays (the object took one float argument: [ictus_timetag foo] could
 and `latency foo` or a bare `latency` got Pd's "bad arguments"); out of 0..10000 ms it is clamped
 to the nearest limit (1e30 was taken as 0).
 
+[ictus-kit-drum N] (a kit's drum in ictus-render.pd and ictus-kit.pd, docs/pd-osc.md): N a whole
+number 1..7; out of range or not whole it is clamped (drum min(7, max(1, int N))), a symbol or no
+N takes drum 1, extra arguments are said, each naming ictus-kit-drum (9, foo and -1 were taken
+without a word, and [ictus-kit-drum 9] played the hit lines of a drum 9 no kit has). Checked by
+sound: the drum the clamp names sounds for its hit line, the bad number's does not.
+
     PYTHONPATH=python python3 tests/pdosc/test_abstraction_args.py --build build
 """
 import argparse
@@ -285,6 +291,46 @@ def timetag_args(build):
     check(statuses == ["10000", "0"], "latency 1e30 sets 10000, -3 sets 0 (%s)" % statuses)
 
 
+def kit_drum_args(build):
+    def clamped(arg):  # the drum a bad N is clamped to, computed here
+        try:
+            return min(7, max(1, int(float(arg.split()[0]))))
+        except (ValueError, IndexError):
+            return 1
+    # (arguments, error lines expected)
+    cases = [("9", ["ictus-kit-drum: N must be a whole number 1..7 (clamped) - got: 9"]),
+             ("-1", ["ictus-kit-drum: N must be a whole number 1..7 (clamped) - got: -1"]),
+             ("2.5", ["ictus-kit-drum: N must be a whole number 1..7 (clamped) - got: 2.5"]),
+             ("foo", ["ictus-kit-drum: N must be a number 1..7 - using 1 - got: foo"]),
+             ("", ["ictus-kit-drum: takes N (the kit's drum 1..7) - using: 1"]),
+             ("3 4", ["ictus-kit-drum: takes one argument N - extra arguments ignored - got: 4"]),
+             ("5", [])]
+    work = make_workdir("ictus-pdosc-args-")
+    for arg, errors in cases:
+        want = clamped(arg)
+        other = 9 if arg == "9" else (want % 7) + 1  # a drum this one must not play
+        peaks = []
+        for drum in (want, other):
+            p = Patch()
+            p.obj("ictus-kit-drum %s" % arg)
+            p.obj("r render-kit-%d" % drum)  # a receiver for drum 9's messages too
+            catch = p.obj("catch~ ictus-render-kit-l")
+            wav = os.path.join(work, "kit-%d.wav" % drum)
+            trig = recorder(p, [(catch, 0, "k")], SECONDS, SR, wav)
+            m = p.msg("\\; render-kit-%d dsp 1 \\; render-kit-hit 1 %d 0 3 0.3 0 10 0.01 1 0 0"
+                      % (drum, drum))
+            p.connect(trig, 2, m, 0)
+            rc, log = run_pd(p.text(), os.path.join(build, "ictus"), sr=SR, workdir=work)
+            check(rc == 0, "pd ran (rc %d)" % rc)
+            peaks.append(float(np.abs(read_wav_float(wav)[0]).max()))
+            lines = [l for l in log.splitlines() if l.startswith("error:")]
+            check(lines == ["error: " + e for e in errors],
+                  "[ictus-kit-drum %s]: error lines %s (got %s)" % (arg, errors, lines))
+        check(peaks[0] > 1e-4 and peaks[1] == 0.0,
+              "[ictus-kit-drum %s] plays drum %d (peak %.3g) and not drum %d (peak %.3g)"
+              % (arg, want, peaks[0], other, peaks[1]))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", required=True)
@@ -295,6 +341,7 @@ def main():
     midifile_args(build)
     render_seconds(build)
     timetag_args(build)
+    kit_drum_args(build)
     if failed():
         raise SystemExit(1)
     print("ok")
