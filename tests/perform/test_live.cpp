@@ -575,3 +575,54 @@ TEST_CASE("live: score statements over OSC wait at most kMaxPendingStatements, t
     REQUIRE(perf.apply(clear));
     CHECK(perf.apply(c, &why));
 }
+
+TEST_CASE("live: a stop just after a stroke sends its stick to rest without striking again",
+          "[perform][live]")
+{
+    // /ictus/stop: "the sticks return to rest" (docs/osc.md). A stick stopped
+    // within 60 ms of its stroke, rebounding from the head, was turned at once
+    // to the rest direction: the turn threw it back on the head, a new stroke
+    // at 0.9-2.6 m/s 11-23 ms after the stop (a bounce at 2.1-2.5 m/s right
+    // after the strike). Now nothing strikes after the stop but the rebounding
+    // stick's own bounce, slower than a third of the mf stroke it follows.
+    for (int hand = 0; hand < 2; ++hand)
+        for (int delay_ms = 0; delay_ms <= 50; delay_ms += 10) {
+            PerformanceOptions o;
+            o.score.score_text = "tempo 100\nbeats 1/2\nrepeat 16\nR, L\nend\n";
+            Performance perf(o);
+            StrikeEvent ev[kStepStrikes];
+            Command play, stop;
+            play.kind = CommandKind::play;
+            stop.kind = CommandKind::stop;
+            REQUIRE(perf.apply(play));
+            int strokes = 0;
+            double last_s = 0.0, last_mps = 0.0;
+            while (strokes < 4 && perf.time_s() < 10.0) {
+                const int n = perf.step(ev);
+                for (int i = 0; i < n; ++i)
+                    if (ev[i].hand == hand && !ev[i].bounce) {
+                        ++strokes;
+                        last_s = ev[i].time_s;
+                        last_mps = ev[i].normal_velocity_mps;
+                    }
+            }
+            REQUIRE(strokes == 4);
+            REQUIRE(last_mps > 2.5); // an mf stroke (docs/score.md: ~3 m/s)
+            while (perf.time_s() < last_s + 1e-3 * delay_ms)
+                perf.step(ev);
+            REQUIRE(perf.apply(stop));
+            const double stop_s = perf.time_s();
+            while (perf.time_s() < stop_s + 1.5) {
+                const int n = perf.step(ev);
+                for (int i = 0; i < n; ++i) {
+                    INFO("hand " << hand << ", stopped " << delay_ms
+                                 << " ms after its stroke: " << (ev[i].bounce ? "bounce" : "stroke")
+                                 << " of hand " << ev[i].hand << " " << ev[i].time_s - stop_s
+                                 << " s after the stop at " << ev[i].normal_velocity_mps << " m/s");
+                    CHECK(ev[i].bounce);
+                    CHECK(ev[i].normal_velocity_mps < last_mps / 3.0);
+                }
+            }
+            CHECK_FALSE(perf.playing());
+        }
+}

@@ -121,8 +121,10 @@ void ScoreMode::install_rig(std::unique_ptr<ScoreRig> rig, bool keep_pose)
     r.frame = frame_for(o.scene.drum, o.character.stick.tip_radius_m, r.frame.right,
                         r.frame.forward, &o.kit, &r.kit_drums, r.right_sole_m, &r.shoulder_m);
     r.tracker->set_mode(mode);
-    if (!keep_pose)
+    if (!keep_pose) {
         rest_from_m_ = r.frame.rest_tip_m;
+        rest_from_direction_ = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    }
     perf_.took_over(previous_time);
     if (rig && perf_.worker_)
         perf_.discard(std::make_unique<Disposal<ScoreRig>>(std::move(rig)));
@@ -332,8 +334,11 @@ bool ScoreMode::install_tempo(Job &job, std::string *why)
 void ScoreMode::start_rest_move()
 {
     perf_.set_grips(perf_.options_.grip_firmness);
-    for (int s = 0; s < 2; ++s)
+    for (int s = 0; s < 2; ++s) {
         rest_from_m_[s] = rig_->tips.position_m[s];
+        rest_from_direction_[s] =
+            rig_->tips.has_direction ? rig_->tips.stick_direction[s] : Eigen::Vector3d::Zero();
+    }
     rest_move_start_s_ = perf_.time_s();
 }
 
@@ -427,7 +432,12 @@ void ScoreMode::follow_rest(TipTargets &tips)
         tips.position_m[s] =
             x >= 1.0 ? r.frame.rest_tip_m[s] : Eigen::Vector3d(rest_from_m_[s] + w * d);
         tips.velocity_mps[s] = dw * d;
-        tips.stick_direction[s] = rest_stick_direction(r.frame, s);
+        const Eigen::Vector3d rest = rest_stick_direction(r.frame, s);
+        const Eigen::Vector3d from = rest_from_direction_[s];
+        const Eigen::Vector3d blend = (1.0 - w) * from + w * rest;
+        tips.stick_direction[s] = x >= 1.0 || (from - rest).norm() < 1e-9 || blend.norm() < 1e-6
+                                      ? rest
+                                      : Eigen::Vector3d(blend.normalized());
     }
     tips.has_direction = true;
 }

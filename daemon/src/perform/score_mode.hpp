@@ -93,8 +93,13 @@ class ScoreMode final : public PerformMode
     std::unique_ptr<ScorePlan> plan_;        // nullptr before the first
     bool plan_active_ = false;
     double plan_origin_s_ = 0.0, plan_time_s_ = 0.0;
-    // Between plans the tips move to (and hold) the rest tips.
+    // Between plans the tips move to (and hold) the rest tips, and the sticks
+    // turn from their directions at the plan's end (a stop) to the rest
+    // direction over the same move: turned at once, a stick just lifted from
+    // its stroke was thrown back on the head.
     std::array<Eigen::Vector3d, 2> rest_from_m_;
+    std::array<Eigen::Vector3d, 2> rest_from_direction_ = {Eigen::Vector3d::Zero(),
+                                                           Eigen::Vector3d::Zero()};
     double rest_move_start_s_ = -1e9;
     BodyStats body_stats_;
     // The feet: [0] the right on the kit's kick, [1] the left on its hi-hat's
