@@ -556,6 +556,33 @@ TEST_CASE("live: in clip mode a stop cancels the play of a rebuild still being p
     CHECK(perf.playing());
 }
 
+TEST_CASE("live: in clip mode /ictus/mode cartesian is refused as a clip's limit, naming the "
+          "score mode that has it",
+          "[perform][live]")
+{
+    // docs/osc.md: "a clip plays in joint space only (`cartesian` is refused
+    // there)". The refusal said "only joint is implemented", as if Cartesian
+    // tracking did not exist; it is score mode's default.
+    const std::string bvh = simtest::write_temp(
+        "live_clip_mode.bvh",
+        simtest::default_skeleton_bvh(
+            120, 1.0 / 120.0, [](int, const std::string &) { return Eigen::Vector3d::Zero(); }));
+    PerformanceOptions o;
+    o.mocap = bvh;
+    Performance perf(o);
+    Command mode;
+    mode.kind = CommandKind::mode;
+    std::snprintf(mode.text, sizeof mode.text, "cartesian");
+    std::string why;
+    CHECK_FALSE(perf.apply(mode, &why));
+    CHECK(why == "mode: a clip plays in joint space only (eq. 1); cartesian tracks a score's "
+                 "stick tips: start ictusd without --mocap");
+    std::snprintf(mode.text, sizeof mode.text, "joint");
+    why.clear();
+    CHECK(perf.apply(mode, &why));
+    CHECK(why.empty());
+}
+
 TEST_CASE("live: score statements over OSC wait at most kMaxPendingStatements, the rest refused",
           "[perform][live]")
 {

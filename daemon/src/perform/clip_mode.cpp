@@ -222,7 +222,8 @@ bool ClipMode::nuance(const Command &, std::string *why)
 bool ClipMode::mode(const Command &c, std::string *why)
 {
     if (std::strcmp(c.text, "joint") != 0)
-        return refuse(why, "mode: only joint is implemented");
+        return refuse(why, "mode: a clip plays in joint space only (eq. 1); cartesian tracks a "
+                           "score's stick tips: start ictusd without --mocap");
     return true;
 }
 
