@@ -686,6 +686,20 @@ TEST_CASE("render: missed and off-time notes, strikes of no note and a score wit
     // Each missed note where it was written (all four on line 3), with its hand and time.
     CHECK(far.err.find("not struck: line 3 (the right hand at ") != std::string::npos);
     CHECK(far.err.find(", line 3 (the left hand at ") != std::string::npos);
+    // A grace stroke is said as one: its line is its note's, where a flam or a drag
+    // writes one to three strokes. 120 bpm, the note on beat 0 (1 s): the drag's graces
+    // at 0.93 and 0.97 s, the flam's (line 2, 1.5 s) at 1.47 s (docs/score.md).
+    std::ofstream(dir / "graces.score") << "L drag\nR flam\n";
+    Daemon graces({"render", "--score", (dir / "graces.score").string(), "--bvh-rate", "0",
+                   "--tips-rate", "0", "--drum-pos", "0,-5,0", "--out", (dir / "graces").string()});
+    CHECK(graces.wait() == 0);
+    INFO(graces.err);
+    CHECK(
+        graces.err.find("5 of 5 notes of the score were not struck: line 1 (the right hand's "
+                        "drag grace stroke at 0.93 s), line 1 (the right hand's drag grace "
+                        "stroke at 0.97 s), line 1 (the left hand at 1.00 s), line 2 (the left "
+                        "hand's flam grace stroke at 1.47 s), line 2 (the right hand at 1.50 s)") !=
+        std::string::npos);
     // On a kit, a hand's note lost after a move from another piece says the move: the right
     // hand from the ride to the crash, 1.19 m in a 16th at 112 bpm (0.13 s; the crash's spot
     // turned toward the ride, kCymbalFaceMostDeg), a move no arm makes (10 m/s).

@@ -623,8 +623,11 @@ ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit
             move << std::fixed << std::setprecision(2) << ", from " << name(prev->drum) << " "
                  << (n.strike_point_m - prev->strike_point_m).norm() << " m away "
                  << n.time_s - prev->time_s << " s before";
-        one(n.line, n.hand == Side::right ? "the right hand" : "the left hand", n.drum, n.time_s,
-            error(m.notes[i]) + move.str());
+        // A flam's or drag's grace stroke is said as one: its line is its note's.
+        std::string who = n.hand == Side::right ? "the right hand" : "the left hand";
+        if (n.grace != Grace::none)
+            who += std::string("'s ") + to_string(n.grace) + " grace stroke";
+        one(n.line, who, n.drum, n.time_s, error(m.notes[i]) + move.str());
     }
     for (size_t i = 0; i < plan.foot_notes.size(); ++i)
         if (listed(m.foot_notes[i]))
