@@ -155,6 +155,12 @@ std::string force_help(std::size_t column)
 
 namespace
 {
+// "1 note", "3 notes": a count and its noun, for the --midi lines on stderr.
+std::string counted(long n, const char *one, const char *many)
+{
+    return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
 // A reader's out-of-bounds error, with the way to insist.
 MocapBoundError with_force_hint(const MocapBoundError &e)
 {
@@ -389,16 +395,18 @@ void load_midi_score(PerformanceOptions &o)
         skipped += count;
     }
     if (skipped > 0)
-        std::cerr << "ictusd: warning: --midi " << path << ": " << skipped << " notes the "
-                  << (drums.empty() ? "drum" : "kit") << " cannot play left out (" << line.str()
-                  << ")\n";
+        std::cerr << "ictusd: warning: --midi " << path << ": " << counted(skipped, "note", "notes")
+                  << " the " << (drums.empty() ? "drum" : "kit") << " cannot play left out ("
+                  << line.str() << ")\n";
     if (part.too_fast > 0)
-        std::cerr << "ictusd: warning: --midi " << path << ": " << part.too_fast
-                  << " notes left out: no hand free (a third note at once, or under "
+        std::cerr << "ictusd: warning: --midi " << path << ": "
+                  << counted(part.too_fast, "note", "notes")
+                  << " left out: no hand free (a third note at once, or under "
                   << kMidiSameHandMin_s * 1e3 << " ms after both hands' last)\n";
     if (part.feet_too_fast > 0)
-        std::cerr << "ictusd: warning: --midi " << path << ": " << part.feet_too_fast
-                  << " notes left out: a foot plays again no sooner than " << kMidiFootMin_s * 1e3
+        std::cerr << "ictusd: warning: --midi " << path << ": "
+                  << counted(part.feet_too_fast, "note", "notes")
+                  << " left out: a foot plays again no sooner than " << kMidiFootMin_s * 1e3
                   << " ms (kick) or " << kMidiChickMin_s * 1e3
                   << " ms (hi-hat pedal) after its last\n";
     if (part.hihats_pedalled > 0)
@@ -415,7 +423,8 @@ void load_midi_score(PerformanceOptions &o)
                   << kMidiLendHihatAbove_mps << " m/s; docs/midi.md)\n";
     if (part.other_channels > 0)
         std::cerr << "ictusd: note: --midi " << path << ": " << part.other_channels
-                  << " notes on channels other than 10 left out (channel 10 is the drum part's; "
+                  << (part.other_channels == 1 ? " note on a channel" : " notes on channels")
+                  << " other than 10 left out (channel 10 is the drum part's; "
                      "docs/midi.md)\n";
     if (part.crashes_given > 0)
         std::cerr << "ictusd: note: --midi " << path << ": " << part.crashes_given
@@ -423,9 +432,11 @@ void load_midi_score(PerformanceOptions &o)
                   << " played by the right hand, free beside it (the left's move over "
                   << kMidiLendHihatAbove_mps << " m/s; docs/midi.md)\n";
     if (part.tempo_clamped > 0)
-        std::cerr << "ictusd: warning: --midi " << path << ": " << part.tempo_clamped
-                  << " tempi kept within " << kMinTempoBpm << ".." << kMaxTempoBpm << " bpm\n";
-    std::cerr << "ictusd: --midi " << path << ": " << part.score.notes.size() << " notes from "
+        std::cerr << "ictusd: warning: --midi " << path << ": "
+                  << counted(part.tempo_clamped, "tempo", "tempi") << " kept within "
+                  << kMinTempoBpm << ".." << kMaxTempoBpm << " bpm\n";
+    std::cerr << "ictusd: --midi " << path << ": "
+              << counted(static_cast<long>(part.score.notes.size()), "note", "notes") << " from "
               << (part.channel < 0 ? "every channel" : "channel 10") << "\n";
     o.score.score = std::make_shared<const Score>(std::move(part.score));
 }
