@@ -230,6 +230,14 @@ TEST_CASE("BVH: position channels on a non-root joint", "[mocap][bvh]")
     const BvhFile bvh = parse_bvh(in, "nonroot.bvh", {}, &warnings);
     REQUIRE(warnings.size() == 1);
     CHECK(warnings[0].find("bvh_forward_kinematics") != std::string::npos);
+    // It names the joint and the line of its position channel (line 9: `CHANNELS 6
+    // Xposition ...`), and says what the character does with them: `ictusd --mocap`
+    // plays the joints' rotations, and a forearm moved 17 cm by its channels played the
+    // same strikes as without them. The warning used to give a C++ function to a
+    // command-line user.
+    CHECK(warnings[0].find("nonroot.bvh:9: joint 'a' has position channels") == 0);
+    CHECK(warnings[0].find("the character (ictusd --mocap) plays the joints' rotations on "
+                           "the OFFSETs and ignores them") != std::string::npos);
     const auto p = bvh_forward_kinematics(bvh, 0);
     require_near(p[1], {0, 0, -1.5}, 1e-12);
     require_near(p[2], {0, 0, -0.5}, 1e-12);

@@ -289,8 +289,12 @@ class BvhParser
                 if (seen == channel)
                     cursor_.fail("each channel once per joint", channel_name);
             channels.push_back(channel);
-            if (is_position(channel) && parent >= 0)
+            if (is_position(channel) && parent >= 0 && !has_joint_translation_) {
                 has_joint_translation_ = true;
+                first_translation_line_ = cursor_.token_line();
+                first_translation_joint_ =
+                    bvh_.skeleton.joints[static_cast<std::size_t>(index)].name;
+            }
         }
         bvh_.channel_count += static_cast<int>(count);
     }
@@ -442,9 +446,13 @@ class BvhParser
                 std::to_string(extra_lines) +
                 " motion line(s) beyond the declared Frames: " + std::to_string(declared));
         if (has_joint_translation_ && warnings_)
-            warnings_->push_back(source_ + ": non-root joints have position channels; "
-                                           "forward_kinematics(Skeleton, Motion) ignores them, use "
-                                           "bvh_forward_kinematics");
+            warnings_->push_back(
+                source_ + ":" + std::to_string(first_translation_line_) + ": joint '" +
+                first_translation_joint_ +
+                "' has position channels (the first of the non-root joints that have them): the "
+                "character (ictusd --mocap) plays the joints' rotations on the OFFSETs and "
+                "ignores them (bvh_forward_kinematics reads them, forward_kinematics(Skeleton, "
+                "Motion) does not)");
     }
 
     // A value out of the physical bounds of a capture (capture_bounds.hpp):
@@ -504,6 +512,8 @@ class BvhParser
     Cursor cursor_;
     BvhFile bvh_;
     bool has_joint_translation_ = false;
+    int first_translation_line_ = 0;      // the first non-root position channel's line
+    std::string first_translation_joint_; // and its joint
     int frame_time_line_ = 0;
     int frames_line_ = 0;
     BoundsReport bounds_{source_, options_.accept_out_of_bounds, warnings_};
