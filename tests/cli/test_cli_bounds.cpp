@@ -400,6 +400,40 @@ TEST_CASE("ictusd: a score or database that cannot be read is a file error (exit
     }
 }
 
+TEST_CASE("ictusd: a capture, score or MIDI file that cannot be read says why: no such file, or "
+          "a folder",
+          "[cli]")
+{
+    // "nope.bvh: expected a readable BVH file, got one that cannot be opened" for a
+    // file that is not there, "/tmp: expected a readable stream, got a read error"
+    // for a folder given as --mocap: the reason was left for the user to guess.
+    const std::string out = simtest::write_temp("unused-why.txt", "") + ".out";
+    const std::string folder = std::filesystem::path(out).parent_path().string();
+    struct Case {
+        std::string args, says;
+    };
+    for (const Case &c : std::vector<Case>{
+             {"render --mocap /nonexistent/clip.bvh --out " + out,
+              "/nonexistent/clip.bvh: expected a readable BVH file, got one that cannot be "
+              "opened (No such file or directory)"},
+             {"render --mocap " + folder + " --out " + out,
+              folder + ": expected a readable BVH file, got a folder"},
+             {"track --mode cartesian --quiet --mocap /nonexistent/sticks.csv",
+              "/nonexistent/sticks.csv: expected a readable CSV file, got one that cannot be "
+              "opened (No such file or directory)"},
+             {"render --midi /nonexistent/part.mid --out " + out,
+              "/nonexistent/part.mid: cannot be read (No such file or directory)"},
+             {"render --midi " + folder + " --out " + out, folder + ": a folder, not a MIDI file"},
+             {"render --score /nonexistent/a.score --out " + out,
+              "--score: cannot read '/nonexistent/a.score' (No such file or directory)"},
+         }) {
+        const Run r = ictusd(c.args);
+        INFO(c.args << "\n" << r.output);
+        CHECK(r.status == 1);
+        CHECK(r.output.find(c.says) != std::string::npos);
+    }
+}
+
 TEST_CASE("ictusd: every --help lists each option once, and its examples name files that exist",
           "[cli]")
 {

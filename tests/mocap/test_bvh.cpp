@@ -355,7 +355,7 @@ TEST_CASE("BVH: malformed files give FILE:LINE errors", "[mocap][bvh][errors]")
         } catch (const MocapError &error) {
             CHECK(std::string(error.what()) ==
                   "/nonexistent/x.bvh: expected a readable BVH file, got one that cannot be "
-                  "opened");
+                  "opened (No such file or directory)");
         }
     }
 }

@@ -5,7 +5,9 @@
 #include "ictus/score/midi_score.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -202,9 +204,12 @@ MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o
 // it is more (/dev/zero, a FIFO: no size to ask for first).
 std::string read_score_file(const std::string &path)
 {
+    errno = 0;
     std::ifstream in(path, std::ios::binary);
     if (!in)
-        throw std::runtime_error("--score: cannot read '" + path + "'");
+        throw std::runtime_error(
+            "--score: cannot read '" + path + "'" +
+            (errno != 0 ? " (" + std::string(std::strerror(errno)) + ")" : ""));
     std::string text;
     char buf[65536];
     while (text.size() <= kMaxScoreFileBytes && in.read(buf, sizeof buf).gcount() > 0)

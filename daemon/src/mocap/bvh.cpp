@@ -544,9 +544,7 @@ BvhFile parse_bvh(std::istream &in, const std::string &source_name, const BvhOpt
 
 BvhFile read_bvh(const std::string &path, const BvhOptions &options, MocapWarnings *warnings)
 {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw MocapError(path, 0, "expected a readable BVH file, got one that cannot be opened");
+    std::ifstream in = detail::open_capture(path, "BVH");
     return parse_bvh(in, path, options, warnings);
 }
 

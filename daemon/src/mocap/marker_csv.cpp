@@ -452,9 +452,7 @@ MarkerCapture parse_marker_csv(std::istream &in, const std::string &source_name,
 MarkerCapture read_marker_csv(const std::string &path, const MarkerCsvOptions &options,
                               MocapWarnings *warnings)
 {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw MocapError(path, 0, "expected a readable CSV file, got one that cannot be opened");
+    std::ifstream in = detail::open_capture(path, "CSV");
     return parse_marker_csv(in, path, options, warnings);
 }
 

@@ -4,9 +4,12 @@
 #include "ictus/mocap/mocap_error.hpp"
 
 #include <cctype>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <system_error>
 
 namespace ictus::detail
@@ -52,6 +55,21 @@ std::vector<std::string> read_lines(std::istream &in, const std::string &source_
     if (!lines.empty() && lines.front().compare(0, 3, "\xEF\xBB\xBF") == 0)
         lines.front().erase(0, 3);
     return lines;
+}
+
+std::ifstream open_capture(const std::string &path, const char *what)
+{
+    const std::string expected = std::string("expected a readable ") + what + " file, got ";
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw MocapError(path, 0, expected + "a folder");
+    errno = 0;
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw MocapError(path, 0,
+                         expected + "one that cannot be opened" +
+                             (errno != 0 ? " (" + std::string(std::strerror(errno)) + ")" : ""));
+    return in;
 }
 
 std::vector<std::string> split_blanks(const std::string &line)

@@ -1,6 +1,7 @@
 // text_lines.hpp -- shared text helpers of the readers (private to src/mocap).
 #pragma once
 
+#include <fstream>
 #include <istream>
 #include <string>
 #include <vector>
@@ -13,6 +14,11 @@ namespace ictus::detail
 // read the same as clean ones. Refuses streams larger than max_bytes.
 std::vector<std::string> read_lines(std::istream &in, const std::string &source_name,
                                     std::size_t max_bytes);
+
+// Opens a capture file `what` ("BVH", "CSV") for reading: a folder, or a
+// file that cannot be opened, is a MocapError that says so, with the
+// system's reason ("No such file or directory").
+std::ifstream open_capture(const std::string &path, const char *what);
 
 // Splits on blanks (space, tab, and any other isspace character).
 std::vector<std::string> split_blanks(const std::string &line);

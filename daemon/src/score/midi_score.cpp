@@ -6,7 +6,10 @@
 #include "ictus/score/midi_score.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -772,9 +775,14 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
 
 MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<MidiDrum> &drums)
 {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw MidiFileError(path + ": a folder, not a MIDI file");
+    errno = 0;
     std::ifstream in(path, std::ios::binary);
     if (!in)
-        throw MidiFileError(path + ": cannot be read");
+        throw MidiFileError(path + ": cannot be read" +
+                            (errno != 0 ? " (" + std::string(std::strerror(errno)) + ")" : ""));
     std::ostringstream bytes;
     bytes << in.rdbuf();
     MidiDrumPart part = drum_part_score(read_smf(bytes.str(), path), drums, path);
