@@ -2,13 +2,11 @@
 // BVH clip is read, how a stick-only CSV is read, the performance options of
 // run and render, the grip and the mode; and the output files of a verb.
 #include "ictus/cli/options.hpp"
+#include "ictus/base/input_file.hpp"
 #include "ictus/score/midi_score.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -204,12 +202,12 @@ MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o
 // it is more (/dev/zero, a FIFO: no size to ask for first).
 std::string read_score_file(const std::string &path)
 {
-    errno = 0;
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw std::runtime_error(
-            "--score: cannot read '" + path + "'" +
-            (errno != 0 ? " (" + std::string(std::strerror(errno)) + ")" : ""));
+    InputFile file = open_input_file(path);
+    if (file.is_folder) // it would open, and read as empty
+        throw std::runtime_error("--score: '" + path + "' is a folder, not a score file");
+    if (!file.opened)
+        throw std::runtime_error("--score: cannot read '" + path + "'" + file.reason_suffix());
+    std::ifstream &in = file.stream;
     std::string text;
     char buf[65536];
     while (text.size() <= kMaxScoreFileBytes && in.read(buf, sizeof buf).gcount() > 0)
@@ -280,9 +278,6 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
     } else if (a == "--score") {
         // A score that cannot be read is a file error (exit 1), not a usage error.
         const std::string path = value();
-        std::error_code ec;
-        if (std::filesystem::is_directory(path, ec)) // opens, and reads as empty
-            throw std::runtime_error("--score: '" + path + "' is a folder, not a score file");
         o.score.score_text = read_score_file(path);
         o.score.score_name = path;
         if (o.score.score_text.empty())

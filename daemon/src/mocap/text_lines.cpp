@@ -3,13 +3,12 @@
 
 #include "ictus/mocap/mocap_error.hpp"
 
+#include "ictus/base/input_file.hpp"
+
 #include <cctype>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
-#include <filesystem>
 #include <system_error>
 
 namespace ictus::detail
@@ -60,16 +59,12 @@ std::vector<std::string> read_lines(std::istream &in, const std::string &source_
 std::ifstream open_capture(const std::string &path, const char *what)
 {
     const std::string expected = std::string("expected a readable ") + what + " file, got ";
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
+    InputFile f = open_input_file(path);
+    if (f.is_folder)
         throw MocapError(path, 0, expected + "a folder");
-    errno = 0;
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw MocapError(path, 0,
-                         expected + "one that cannot be opened" +
-                             (errno != 0 ? " (" + std::string(std::strerror(errno)) + ")" : ""));
-    return in;
+    if (!f.opened)
+        throw MocapError(path, 0, expected + "one that cannot be opened" + f.reason_suffix());
+    return std::move(f.stream);
 }
 
 std::vector<std::string> split_blanks(const std::string &line)

@@ -5,11 +5,10 @@
 // 51, time signature FF 58), system exclusive F0/F7 length data.
 #include "ictus/score/midi_score.hpp"
 
+#include "ictus/base/input_file.hpp"
+
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -775,16 +774,13 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
 
 MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<MidiDrum> &drums)
 {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
+    InputFile in = open_input_file(path);
+    if (in.is_folder)
         throw MidiFileError(path + ": a folder, not a MIDI file");
-    errno = 0;
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        throw MidiFileError(path + ": cannot be read" +
-                            (errno != 0 ? " (" + std::string(std::strerror(errno)) + ")" : ""));
+    if (!in.opened)
+        throw MidiFileError(path + ": cannot be read" + in.reason_suffix());
     std::ostringstream bytes;
-    bytes << in.rdbuf();
+    bytes << in.stream.rdbuf();
     MidiDrumPart part = drum_part_score(read_smf(bytes.str(), path), drums, path);
     if (part.score.notes.empty())
         throw MidiFileError(path + ": no note the " + (drums.empty() ? "drum" : "kit") +
