@@ -77,10 +77,12 @@ try:
         if i % 10 == 9:
             time.sleep(0.005)
     time.sleep(0.3)
-    t = now() + 0.05
+    # All ten at once, the first 0.5 s ahead: what is judged is pd after the
+    # flood, not this sender's pacing (paced 50 ms ahead, as the daemon does, a
+    # loaded CI run stalled this script past three strikes' lookahead; the
+    # daemon's lookahead is test_realtime.py's).
+    t = now() + 0.5
     for seq in range(1, 11):
-        while now() < t - 0.05:
-            time.sleep(0.0005)
         out.sendto(bundle(timetag(t), strike(seq, seq % 2)), ("127.0.0.1", pd_port))
         sent[seq] = t
         t += 0.04
@@ -116,7 +118,7 @@ offset = wall_of_logical(records)
 fires = {int(a[10]): a for _, a in records if a[0] == "fire" and int(a[10]) != 999}
 check(sorted(fires) == sorted(sent), "exactly the 10 good strikes came out: %s" % sorted(fires))
 # As in test_realtime.py: a strike pd handled after its time (the sender or pd
-# stalled past the 50 ms lookahead: once 26 ms late under a loaded CI run) fires
+# stalled past its lookahead) fires
 # at once by design and is reported late with its lateness (docs/pd-osc.md).
 # Each strike more than 1 ms off must be one of those, its report's lateness its
 # own error within 1 ms, and most must be on time, or the run judged nothing.
