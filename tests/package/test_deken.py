@@ -61,7 +61,8 @@ for pattern in ("patches/*.pd", "patches/sound/*.pd", "patches/ui/*.pd"):
             expected.add("ictus/" + os.path.basename(p))
 expected |= {"ictus/examples/scores/" + os.path.basename(p)
              for p in glob.glob(os.path.join(REPO, "examples", "scores", "*.txt"))}
-expected |= {"ictus/%s.pd_linux" % n for n in ("membrane~", "contact~", "ictus_timetag", "ictus")}
+expected |= {"ictus/%s.pd_linux" % n for n in ("membrane~", "contact~", "ictus_timetag", "ictus_error",
+                                                "ictus")}
 expected |= {"ictus/libictus_pd.so", "ictus/clips/ictus-clips.wav", "ictus/README.md",
              "ictus/LICENSE", "ictus/ictusd"}
 # The references beside the help patches: every page of docs/ as Markdown and HTML,

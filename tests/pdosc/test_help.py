@@ -1,4 +1,4 @@
-"""The help patches of ictus-receive, ictus-drum and ictus_timetag (copied into
+"""The help patches of ictus-receive, ictus-drum, ictus_timetag and ictus_error (copied into
 <build>/ictus/ with the abstractions) open in pd without an error line, also
 with DSP on, and have the parts of a vanilla help patch; patches/ictus-render.pd
 loads (with a file that does not exist it must only complain about that file)."""
@@ -15,7 +15,7 @@ args = ap.parse_args()
 build = os.path.abspath(args.build)
 
 for name, obj in (("ictus-receive-help.pd", "ictus-receive"), ("ictus-drum-help.pd", "ictus-drum"),
-                  ("ictus_timetag-help.pd", "ictus_timetag")):
+                  ("ictus_timetag-help.pd", "ictus_timetag"), ("ictus_error-help.pd", "ictus_error")):
     path = os.path.join(build, "ictus", name)
     check(os.path.isfile(path), "%s is in the library folder" % name)
     cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-path", build, "-open", path,
@@ -29,5 +29,5 @@ for name, obj in (("ictus-receive-help.pd", "ictus-receive"), ("ictus-drum-help.
     check("pd reference" in text and "See also" in text and "ictus 0.1.0" in text,
           "%s has [pd reference], see also and the version" % name)
     check(("#X obj 20 14 %s" % obj) in text, "%s shows %s on top" % (name, obj))
-    if obj != "ictus_timetag":
+    if obj not in ("ictus_timetag", "ictus_error"):
         check("dac~" in text, "%s has a working example with dac~" % name)

@@ -81,7 +81,11 @@ for model in ("clips", "synth", "modal"):
 # A clips abstraction whose clip file is missing names the file.
 lib = os.path.join(work, "lib")
 os.makedirs(lib)
-for f in ("ictus-sound-clips.pd", "ictus-sound-clips-voice.pd"):
+# the library folder without its clips: the two abstractions and [ictus_error], whose
+# binary reports their errors
+errors_binary = [f for f in os.listdir(os.path.join(build, "ictus"))
+                 if f.startswith("ictus_error.") and not f.endswith(".pd")]
+for f in ["ictus-sound-clips.pd", "ictus-sound-clips-voice.pd"] + errors_binary:
     shutil.copy(os.path.join(build, "ictus", f), lib)
 with open(os.path.join(lib, "t.pd"), "w") as f:
     f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound-clips;\n")
