@@ -3,8 +3,15 @@
 check(cond, message) prints "ok: message" when cond holds, else "FAIL: message" and ends
 the test with exit status 1 (pdrun keeps its temporary folders for inspection then). A
 test that surveys many files and reports every failure before ending calls keep_going()
-first and finish() last: failures are then counted and finish() exits with 1 if any."""
+first and finish() last: failures are then counted and finish() exits with 1 if any.
+
+inconclusive(message) ends a run that judged too little to say pass or fail (a real-time test
+whose sender the machine stalled past its lookahead, every late strike reported as such):
+exit status INCONCLUSIVE (75, sysexits' EX_TEMPFAIL), which `python3 -m ictus_tools.retry`
+answers by running the test again, a bounded number of times."""
 import sys
+
+INCONCLUSIVE = 75
 
 _keep_going = [False]
 _failures = []
@@ -32,6 +39,13 @@ def fail(message):
     print("FAIL:", message)
     _failures.append(message)
     sys.exit(1)
+
+
+def inconclusive(message):
+    """Ends a run that judged too little: prints "INCONCLUSIVE: message", exit status 75."""
+    print("INCONCLUSIVE:", message)
+    sys.stdout.flush()
+    sys.exit(INCONCLUSIVE)
 
 
 def failed():

@@ -17,7 +17,7 @@ import time
 from ictus_tools.oscpacket import bundle, message, now, osc_string, strike, timetag
 from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd,
                               wait_for_ticks, unexplained_late, wall_of_logical)
-from ictus_tools.checks import check
+from ictus_tools.checks import check, inconclusive
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -121,13 +121,17 @@ check(sorted(fires) == sorted(sent), "exactly the 10 good strikes came out: %s" 
 # stalled past its lookahead) fires
 # at once by design and is reported late with its lateness (docs/pd-osc.md).
 # Each strike more than 1 ms off must be one of those, its report's lateness its
-# own error within 1 ms, and most must be on time, or the run judged nothing.
+# own error within 1 ms, and most must be on time, or the run judged too little
+# (inconclusive: CTest's command, ictus_tools.retry, runs it again).
 errors = {s: (offset + fires[s][1] / 1000.0 - sent[s]) * 1000.0 for s in sent}
 reported = [a[2] for _, a in records if a[0] == "info" and len(a) > 2 and a[1] == "late"]
 unexplained = unexplained_late([(s, e) for s, e in sorted(errors.items()) if abs(e) > 1.0],
                                reported, 1.0)
 on_time = [abs(e) for e in errors.values() if abs(e) <= 1.0]
-check(not unexplained and len(on_time) >= len(sent) - 2,
+check(not unexplained,
       "after the malformed packets, strikes start at their timetag within 1 ms (worst %.3f ms, "
       "%d of %d), or were handled late and reported so (unexplained: %s)"
       % (max(on_time) if on_time else float("inf"), len(on_time), len(sent), unexplained))
+if len(on_time) < len(sent) - 2:
+    inconclusive("%d of %d strikes on time, the rest handled late and reported so: too few to "
+                 "judge" % (len(on_time), len(sent)))

@@ -23,7 +23,7 @@ import time
 from ictus_tools.oscpacket import bundle, message, now, strike, timetag, IMMEDIATE
 from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd,
                               wait_for_ticks, unexplained_late, wall_of_logical)
-from ictus_tools.checks import check
+from ictus_tools.checks import check, inconclusive
 from ictus_tools.pdrun import error_lines
 
 ap = argparse.ArgumentParser()
@@ -160,7 +160,8 @@ lates = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "lat
 # lookahead on a loaded machine) is not on time by design: it fires at once and
 # is reported late with its lateness (docs/pd-osc.md). Each strike more than
 # 1 ms late must be one of those, the report's lateness its own error within
-# 1 ms; and most strikes must be on time, or the run judged nothing.
+# 1 ms; and most strikes must be on time, or the run judged too little: it is
+# inconclusive and CTest's command (ictus_tools.retry) runs it again.
 judged = [max(e - rtt_ms, 0.0) if e > 0 else -e for e in errors_ms]
 late_strikes = [(seq, e) for seq, e, j in zip(sorted(sent), errors_ms, judged) if j > 1.0]
 unexplained = unexplained_late(late_strikes, [a[2] for a in lates], 1.0 + rtt_ms)
@@ -168,10 +169,13 @@ on_time = [j for j in judged if j <= 1.0]
 worst = max(on_time) if on_time else float("inf")
 if late_strikes:
     print("strikes handled late and reported late (seq, ms): %s" % late_strikes)
-check(not unexplained and len(on_time) >= N_STRIKES - 4,
+check(not unexplained,
       "every strike starts at its timetag (minus 10 ms for the second half, after 'latency 10') "
       "within 1 ms (worst %.3f ms, %d of %d), or was handled late and reported so (%d; "
       "unexplained: %s)" % (worst, len(on_time), N_STRIKES, len(late_strikes), unexplained))
+if len(on_time) < N_STRIKES - 4:
+    inconclusive("%d of %d strikes on time, the rest handled late and reported so: the machine "
+                 "stalled past the lookahead; too few to judge" % (len(on_time), N_STRIKES))
 
 t_arr, a = fires.get(late_seq, (None, None))
 check(a is not None, "the late bundle fired")
