@@ -33,6 +33,11 @@ CASES = [
     ("ictus-sound synth", "ictus-sound modal", "volume 5",
      "error: ictus-sound: volume must be in 0..1 (clamped) - got: 5"),
     ("ictus-receive 0", "ictus-receive 70000", None, "error: ictus-receive"),
+    # ictus-drum takes no arguments (an extra one is not read): the word only tells the boxes apart
+    ("ictus-drum", "ictus-drum bad", "5 3 0.3 0",
+     "error: ictus-drum: hand must be 0 (left) 1 (right) 2 (right foot) or 3 (left foot) - got: 5"),
+    ("ictus-drum", "ictus-drum bad", "bang",
+     "error: ictus-drum: expected a list <hand> <velocity m/s> <r/a> <theta deg> - got: bang"),
 ]
 
 for good, bad, message, error_start in CASES:
