@@ -36,6 +36,12 @@ CASES = [
     # ictus-drum takes no arguments (an extra one is not read): the word only tells the boxes apart
     ("ictus-drum", "ictus-drum bad", "5 3 0.3 0",
      "error: ictus-drum: hand must be 0 (left) 1 (right) 2 (right foot) or 3 (left foot) - got: 5"),
+    # not a strike list: ictus-sound's own error, not its models' (two lines, from inside)
+    ("ictus-sound modal", "ictus-sound synth", "bang",
+     "error: ictus-sound: expected a strike list <hand> <velocity m/s> <r/a> <theta deg> - got: "
+     "bang"),
+    ("ictus-sound modal", "ictus-sound clips", "5",
+     "error: ictus-sound: expected a strike list <hand> <velocity m/s> <r/a> <theta deg> - got: 5"),
     ("ictus-drum", "ictus-drum bad", "bang",
      "error: ictus-drum: expected a list <hand> <velocity m/s> <r/a> <theta deg> - got: bang"),
 ]
