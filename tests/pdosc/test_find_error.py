@@ -36,6 +36,10 @@ CASES = [
     # ictus-drum takes no arguments (an extra one is not read): the word only tells the boxes apart
     ("ictus-drum", "ictus-drum bad", "5 3 0.3 0",
      "error: ictus-drum: hand must be 0 (left) 1 (right) 2 (right foot) or 3 (left foot) - got: 5"),
+    ("ictus-midifile", "ictus-midifile 10", "open /nonexistent/ictus-no-such.mid",
+     "error: ictus-midifile: no MIDI file /nonexistent/ictus-no-such.mid"),
+    ("ictus-midifile", "ictus-midifile 10", "start",
+     "error: ictus-midifile: unknown message (open play stop loop channel) - got: start"),
     # not a strike list: ictus-sound's own error, not its models' (two lines, from inside)
     ("ictus-sound modal", "ictus-sound synth", "bang",
      "error: ictus-sound: expected a strike list <hand> <velocity m/s> <r/a> <theta deg> - got: "
