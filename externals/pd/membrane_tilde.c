@@ -58,8 +58,9 @@ static const membrane_param membrane_tilde_args[] = {MEMBRANE_PARAM_RADIUS, MEMB
 #define NARGS (int)(sizeof(membrane_tilde_args) / sizeof(membrane_tilde_args[0]))
 
 /* A head whose lowest mode lies above the core's cutoff (0.95 x Nyquist) makes no
- * sound at all: a tiny radius, a huge tension or a low sample rate. Said once when
- * a parameter or the sample rate takes it there, not again until it has sounded. */
+ * sound at all: a tiny radius, a huge tension (a plate's bending) or a low sample
+ * rate. Said once when a parameter or the sample rate takes it there, not again
+ * until it has sounded. A plate's modes do not depend on the tension. */
 static void membrane_tilde_check_silent(t_membrane_tilde *x)
 {
     int silent = membrane_get_sounding_modes(x->x_core) == 0;
@@ -68,10 +69,11 @@ static void membrane_tilde_check_silent(t_membrane_tilde *x)
         membrane_get_mode(x->x_core, 0, &lowest, 0, 0, 0, 0);
         pd_error(x,
                  "membrane~%s%s: all %d modes lie above Nyquist (lowest %g Hz, modes ring "
-                 "below %g Hz at sr %g Hz): silent; lower the tension, raise the density or "
+                 "below %g Hz at sr %g Hz): silent; lower the %s, raise the density or "
                  "enlarge the radius",
                  x->x_name != &s_ ? " " : "", x->x_name != &s_ ? x->x_name->s_name : "",
-                 membrane_get_modes(x->x_core), lowest, 0.95 * 0.5 * sr, sr);
+                 membrane_get_modes(x->x_core), lowest, 0.95 * 0.5 * sr, sr,
+                 membrane_is_plate(x->x_core) ? "bending" : "tension");
     }
     x->x_silent = silent;
 }

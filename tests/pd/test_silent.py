@@ -85,3 +85,34 @@ t_strike, t_silent = int(0.2 * sr), int(0.3 * sr)
 check(np.all(np.isfinite(y)), "output finite")
 check(np.max(np.abs(y[:t_strike])) == 0, "silent until tension 1 and the strike")
 check(np.max(np.abs(y[t_strike:t_silent])) > 0, "rings at tension 1")
+
+# A plate (a cymbal preset): its modes follow its bending stiffness, not the tension, so the
+# word says to lower the bending; the tension leaves it silent, the bending makes it ring.
+work = make_workdir("ictus-silent-plate-")
+wav = os.path.join(work, "plate.wav")
+p = Patch(declare="-path %s/ictus" % args.build)
+cym = p.obj("membrane~ cym")
+trig = recorder(p, [(cym, 0, "out")], 0.3, sr, wav)
+# 1 cm and 0.01 kg/m^2: the crash's lowest mode (16.7 Hz at 0.2286 m, 8.6 kg/m^2, f ~ 1 / a^2
+# sqrt(D / rho h)) goes to 16.7 x (0.2286 / 0.01)^2 x sqrt(8.6 / 0.01) = 2.6e5 Hz; bending
+# 0.001 (from 9.35) brings it to 2.6e5 x sqrt(0.001 / 9.35) = 2.6 kHz.
+steps = [(1, "preset crash"), (2, "radius 0.01"), (3, "density 0.01"),
+         (100, "tension 1"), (101, "strike 0.3 0 1e-05"),
+         (200, "bending 0.001"), (201, "strike 0.3 0 1e-05")]
+for ms, text in steps:
+    d = p.obj("delay %g" % ms)
+    m = p.msg(text)
+    p.connect(trig, 0, d, 0)
+    p.connect(d, 0, m, 0)
+    p.connect(m, 0, cym, 0)
+rc, log = run_pd(p.text(), args.build, sr=sr, workdir=work)
+print(log)
+check(rc == 0, "pd exited cleanly (plate)")
+said = [l for l in log.splitlines() if "lie above Nyquist" in l]
+check(len(said) == 1 and said[0] in error_lines(log), "the plate said it once, as an error line")
+check(said[0].endswith("silent; lower the bending, raise the density or enlarge the radius"),
+      "the plate's word names its bending, not the tension: %s" % said[0])
+y = read_wav_float(wav)[0][:, 0]
+check(np.all(np.isfinite(y)), "plate output finite")
+check(np.max(np.abs(y[:int(0.2 * sr)])) == 0, "tension 1 leaves the plate silent, struck")
+check(np.max(np.abs(y[int(0.2 * sr):])) > 0, "bending 0.001 makes it ring")

@@ -33,6 +33,21 @@ CASES = [
     ("ictus-sound synth", "ictus-sound modal", "volume 5",
      "error: ictus-sound: volume must be in 0..1 (clamped) - got: 5"),
     ("ictus-receive 0", "ictus-receive 70000", None, "error: ictus-receive"),
+    # ictus-drum takes no arguments (an extra one is not read): the word only tells the boxes apart
+    ("ictus-drum", "ictus-drum bad", "5 3 0.3 0",
+     "error: ictus-drum: hand must be 0 (left) 1 (right) 2 (right foot) or 3 (left foot) - got: 5"),
+    ("ictus-midifile", "ictus-midifile 10", "open /nonexistent/ictus-no-such.mid",
+     "error: ictus-midifile: no MIDI file /nonexistent/ictus-no-such.mid"),
+    ("ictus-midifile", "ictus-midifile 10", "start",
+     "error: ictus-midifile: unknown message (open play stop loop channel) - got: start"),
+    # not a strike list: ictus-sound's own error, not its models' (two lines, from inside)
+    ("ictus-sound modal", "ictus-sound synth", "bang",
+     "error: ictus-sound: expected a strike list <hand> <velocity m/s> <r/a> <theta deg> - got: "
+     "bang"),
+    ("ictus-sound modal", "ictus-sound clips", "5",
+     "error: ictus-sound: expected a strike list <hand> <velocity m/s> <r/a> <theta deg> - got: 5"),
+    ("ictus-drum", "ictus-drum bad", "bang",
+     "error: ictus-drum: expected a list <hand> <velocity m/s> <r/a> <theta deg> - got: bang"),
 ]
 
 for good, bad, message, error_start in CASES:

@@ -122,7 +122,7 @@ proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_EN
 log = proc.stdout + proc.stderr
 with open(reports) as f:
     rows = [r.split() for r in f.read().split(";") if r.strip()]
-check(proc.returncode == 0 and "ictus-render: a hit line needs 11 numbers" in log
+check(proc.returncode == 0 and "error: ictus-render: a hit line needs 11 numbers" in log
       and "0 0 0 2 0.3 45" in log and len(rows) == 1 and rows[0][1] == "1",
       "a 6-number hit line is refused with an error naming ictus-render, the 11-number one "
       "plays: %s %s" % (log, rows))

@@ -147,7 +147,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-midifile-") as work:
     # A missing file: the error, and nothing plays.
     for name in (os.path.join(work, "missing.mid"), "missing.mid"):
         log = run(patch_for(name, 10), work, "missing.pd")
-        check(any("ictus-midifile: error: no MIDI file" in l and name in l
+        check(any("error: ictus-midifile: no MIDI file" in l and name in l
                   for l in log.splitlines()), "a missing file is named in an error line: %s"
               % log[-500:])
         check(not any(l.startswith("got: ") for l in log.splitlines()), "and no note comes out")
