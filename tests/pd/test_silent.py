@@ -18,6 +18,17 @@ from scipy.special import jn_zeros
 from ictus_tools.checks import check
 from ictus_tools.pdrun import make_workdir, Patch, error_lines, read_wav_float, recorder, run_pd
 
+
+def schedule(patch, trig, target, steps):
+    """Each (ms, text) of steps: a [delay ms] from trig's start, then the message to target."""
+    for ms, text in steps:
+        d = patch.obj("delay %g" % ms)
+        m = patch.msg(text)
+        patch.connect(trig, 0, d, 0)
+        patch.connect(d, 0, m, 0)
+        patch.connect(m, 0, target, 0)
+
+
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
 args = ap.parse_args()
@@ -46,12 +57,7 @@ trig = recorder(p, [(tiny, 0, "out")], 0.5, sr, wav)
 # silent again (a word, with the new count), ringing again.
 steps = [(50, "tension 90000"), (100, "modes 64"), (150, "tension 1"),
          (200, "strike 0.3 0 1e-05"), (300, "tension 100000"), (350, "tension 3000")]
-for ms, text in steps:
-    d = p.obj("delay %g" % ms)
-    m = p.msg(text)
-    p.connect(trig, 0, d, 0)
-    p.connect(d, 0, m, 0)
-    p.connect(m, 0, tiny, 0)
+schedule(p, trig, tiny, steps)
 rc, log = run_pd(p.text(), args.build, sr=sr, workdir=work)
 print(log)
 check(rc == 0, "pd exited cleanly")
@@ -99,12 +105,7 @@ trig = recorder(p, [(cym, 0, "out")], 0.3, sr, wav)
 steps = [(1, "preset crash"), (2, "radius 0.01"), (3, "density 0.01"),
          (100, "tension 1"), (101, "strike 0.3 0 1e-05"),
          (200, "bending 0.001"), (201, "strike 0.3 0 1e-05")]
-for ms, text in steps:
-    d = p.obj("delay %g" % ms)
-    m = p.msg(text)
-    p.connect(trig, 0, d, 0)
-    p.connect(d, 0, m, 0)
-    p.connect(m, 0, cym, 0)
+schedule(p, trig, cym, steps)
 rc, log = run_pd(p.text(), args.build, sr=sr, workdir=work)
 print(log)
 check(rc == 0, "pd exited cleanly (plate)")
