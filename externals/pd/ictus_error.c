@@ -15,11 +15,7 @@
 #include "m_pd.h"
 #include "g_canvas.h"
 
-#if defined(__GNUC__)
-#define ICTUS_EXPORT __attribute__((visibility("default")))
-#else
-#define ICTUS_EXPORT
-#endif
+#include "ictus_export.h"
 
 static t_class *ictus_error_class;
 

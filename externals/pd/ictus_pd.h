@@ -17,11 +17,7 @@
 #include "contact.h"
 #include "ictus_pd_common.h"
 
-#if defined(__GNUC__)
-#define ICTUS_EXPORT __attribute__((visibility("default")))
-#else
-#define ICTUS_EXPORT
-#endif
+#include "ictus_export.h"
 
 #define ICTUS_PD_VERSION "0.1.0"
 

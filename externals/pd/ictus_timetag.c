@@ -57,11 +57,7 @@
 
 #include "m_pd.h"
 
-#if defined(__GNUC__)
-#define ICTUS_TIMETAG_EXPORT __attribute__((visibility("default")))
-#else
-#define ICTUS_TIMETAG_EXPORT
-#endif
+#include "ictus_export.h"
 
 #define ICTUS_TIMETAG_SAMPLE_MS    2.0   /* offset sampling period (at least) */
 #define ICTUS_TIMETAG_TICK_SAMPLES 64    /* Pd's scheduler tick (DEFDACBLKSIZE) */
@@ -551,7 +547,7 @@ static void ictus_timetag_free(t_ictus_timetag *x)
         freebytes(x->x_atoms, sizeof(t_atom) * x->x_atoms_size);
 }
 
-ICTUS_TIMETAG_EXPORT void ictus_timetag_setup(void)
+ICTUS_EXPORT void ictus_timetag_setup(void)
 {
     ictus_timetag_class =
         class_new(gensym("ictus_timetag"), (t_newmethod)ictus_timetag_new,
