@@ -84,10 +84,13 @@ def read_kit_render(out):
 
 def note_found(note, strikes, names, tol_ms=5.0, hand=None):
     """notes.csv's `note` got one primary strike on its piece within tol_ms (and of limb
-    `hand`, strikes.csv's number, when given): the whole kit's acceptance (docs/kit.md)."""
+    `hand`, strikes.csv's number, when given): the whole kit's acceptance (docs/kit.md). The
+    error is the strike's time in strikes.csv less the note's in notes.csv, not notes.csv's
+    error_ms (the daemon's own)."""
     s = strikes.get(int(note["strike_seq"]))
     return (s is not None and s["bounce"] == 0 and names[s["drum"]] == note["drum"]
-            and (hand is None or s["hand"] == hand) and abs(float(note["error_ms"])) <= tol_ms)
+            and (hand is None or s["hand"] == hand)
+            and abs(1e3 * (float(s["time_s"]) - float(note["time_s"]))) <= tol_ms)
 
 def read_events(path):
     """events.txt -> list of (delay_us, words after the delay) per line, the

@@ -12,6 +12,9 @@
              on half the seeds that snare is a side stick (37, a cross-stick on the rim);
   bar 16     the groove again, and a last crash with the kick on the next downbeat.
 
+With --downbeat-ride the ride plays bar 9's downbeat too, with the crash: the right hand comes
+to it from the fill's last floor tom, 0.37 m in one 16th (docs/score.md, "Rehearsal").
+
 Every note must be one primary strike of its instrument within +-5 ms of its time: notes.csv
 matches each note to a strike (docs/midi.md); a note counts as found when its strike is
 primary, on the note's drum and within 5 ms. Precision is found notes over primary strikes,
@@ -51,7 +54,7 @@ TOL_MS = 5.0
 HANDS = {"left": 0, "right": 1, "right-foot": 2, "left-foot": 3}
 
 
-def song(path, rng):
+def song(path, rng, downbeat_ride=False):
     """The 16 bars (tpq 480, 120 bpm): the notes as (tick, note, velocity)."""
     tpq, e8, e16 = 480, 240, 120
     bar = 8 * e8
@@ -84,6 +87,8 @@ def song(path, rng):
             notes.append((b * bar, 49, rng.randint(110, 127)))
             notes.append((b * bar, 36, 120))
             groove(b, range(1, 8), 51)
+            if downbeat_ride:
+                notes.append((b * bar, 51, 90))
         else:
             groove(b, range(8), 51)
     groove(15, range(8), 42)
@@ -105,6 +110,8 @@ def main():
     ap.add_argument("--render-arg", action="append", default=[],
                     help="an argument more for `ictusd render` (repeat it), e.g. --render-arg=--grip "
                     "--render-arg=german")
+    ap.add_argument("--downbeat-ride", action="store_true",
+                    help="the ride on the first crash's downbeat too")
     args = ap.parse_args()
     checks.keep_going()  # every check is printed, for every seed
     workdir = args.workdir or tempfile.mkdtemp(prefix="ictus-song-")
@@ -112,16 +119,16 @@ def main():
     for seed in args.seed:
         print("seed %d:" % seed)
         status |= play(args.ictusd, os.path.join(workdir, "seed-%d" % seed), seed,
-                       args.render_arg)
+                       args.render_arg, args.downbeat_ride)
     return status
 
 
-def play(ictusd, workdir, seed, render_args):
+def play(ictusd, workdir, seed, render_args, downbeat_ride=False):
     """The song of `seed` rendered in workdir and checked; 1 when the render failed."""
     os.makedirs(workdir, exist_ok=True)
     rng = random.Random(seed)
     part = os.path.join(workdir, "song.mid")
-    written = song(part, rng)
+    written = song(part, rng, downbeat_ride)
     out = os.path.join(workdir, "song")
     env = e2e_util.pd_spawning_env(os.path.abspath(workdir))
     run = subprocess.run([ictusd, "render", "--kit", "full", "--midi", part, "--out", out,
@@ -136,6 +143,15 @@ def play(ictusd, workdir, seed, render_args):
     primary = [s for s in strikes if s["bounce"] == 0]
     check(len(notes) == len(written), "notes.csv: every note of the file: %d of %d"
           % (len(notes), len(written)))
+    # Its times are the file's (120 bpm, tpq 480) after one lead-in, whatever a rehearsal
+    # planned: each note's error below is its strike's time less that.
+    file_s = sorted(tick * 0.5 / 480 for tick, _, _ in written)
+    csv_s = sorted(float(n["time_s"]) for n in notes)
+    if len(file_s) == len(csv_s):
+        off = [c - f for c, f in zip(csv_s, file_s)]
+        check(max(off) - min(off) < 2e-6 and abs(off[0] - 1.0) < 2e-6,
+              "notes.csv's times are the file's after the 1 s lead-in: %.6f .. %.6f s"
+              % (min(off), max(off)))
 
     found, errors, wrong = 0, [], []
     by_drum = {}
@@ -150,6 +166,8 @@ def play(ictusd, workdir, seed, render_args):
     recall = found / len(notes) if notes else 0.0
     f1 = 2 * precision * recall / (precision + recall) if found else 0.0
     worst = max(abs(e) for e in errors) if errors else float("nan")
+    rehearsal = rj["performance"].get("rehearsal", {})
+    print("rehearsal: %s" % rehearsal)
     print("song: %d notes, %d primary strikes, %d found within %.0f ms: precision %.3f, recall "
           "%.3f, F1 %.3f, worst error %.2f ms" % (len(notes), len(primary), found, TOL_MS,
                                                   precision, recall, f1, worst))

@@ -520,6 +520,45 @@ TEST_CASE("plan: an idle hand waits at its rest tip", "[score][plan]")
     CHECK((f.rest_tip_m[0] - (kCenter + Eigen::Vector3d(0.1, 0.15, -0.05))).norm() < 1e-12);
 }
 
+TEST_CASE("plan: a note's lead plans its stroke that much earlier and keeps its written time",
+          "[score][plan][rehearsal]")
+{
+    // Leads in s per score note: one late note planned earlier, one early note later, one
+    // past the bound (held to kMaxNoteLead_s), one not a number (none), one beyond the list.
+    const Score score = score_of("tempo 120\nR\nL\nR\nL\nR\nR\n");
+    const GesturePlan clean = plan_performance(score, db(), frame(), PlanOptions{});
+    PlanOptions opt;
+    opt.note_lead_s = {0.0, 0.008, -0.004, 0.05, std::nan("")};
+    const double expect[] = {0.0, 0.008, -0.004, kMaxNoteLead_s, 0.0, 0.0};
+    const GesturePlan plan = plan_performance(score, db(), frame(), opt);
+    REQUIRE(plan.notes.size() == 6);
+    for (size_t k = 0; k < plan.notes.size(); ++k) {
+        const PlannedNote &n = plan.notes[k];
+        INFO("note " << k);
+        CHECK(n.score_note == static_cast<int>(k));
+        CHECK(n.lead_s == Approx(expect[k]).margin(1e-15));
+        CHECK(n.written_time_s() == Approx(clean.notes[k].time_s).margin(1e-12));
+        CHECK(n.time_s == Approx(clean.notes[k].time_s - expect[k]).margin(1e-12));
+        // The plan strikes at the planned time: a sample there, on the note's target.
+        const size_t i = index_at(plan, n.time_s);
+        REQUIRE(i < plan.tips.time_s.size());
+        CHECK(plan.tips.time_s[i] == Approx(n.time_s).margin(1e-12));
+        CHECK((plan.tips.tip_m[static_cast<int>(n.hand)][i] - n.tip_target_m).norm() < 1e-9);
+    }
+    // A lead never brings a stroke closer than the hand plays to its previous one: two right
+    // strokes 50 ms apart (300 bpm, 16ths), the second led by 15 ms, keep 40 ms between them.
+    const Score close = score_of("tempo 300\nR 1/4\nR 1/4\n");
+    PlanOptions near;
+    near.note_lead_s = {0.0, 0.015};
+    const GesturePlan p = plan_performance(close, db(), frame(), near);
+    const GesturePlan c = plan_performance(close, db(), frame(), PlanOptions{});
+    REQUIRE(p.notes.size() == 2);
+    CHECK(p.notes[1].time_s - p.notes[0].time_s ==
+          Approx(near.min_stroke_interval_s).margin(1e-12));
+    CHECK(p.notes[1].lead_s == Approx(0.010).margin(1e-12));
+    CHECK(p.notes[1].written_time_s() == Approx(c.notes[1].time_s).margin(1e-12));
+}
+
 TEST_CASE("plan: the timing noise never makes a hand play faster than it can",
           "[score][plan][humanize]")
 {

@@ -67,7 +67,7 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
         const PlannedNote &n = plan.notes[i];
         const NoteMatch &k = m.notes[i];
         std::snprintf(buf, sizeof buf, "%zu,%.6f,%s,%s,%s,%.3f,%.4f,%.3f,%d,%ld,", i,
-                      origin_s + n.time_s, to_string(n.hand), to_string(n.nuance),
+                      origin_s + n.written_time_s(), to_string(n.hand), to_string(n.nuance),
                       to_string(n.grip), n.dynamics, n.beats, n.tempo_bpm, n.line, k.strike_seq);
         out << buf;
         write_match(out, k);
@@ -206,7 +206,8 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
     for (size_t i = 0; i < plan.notes.size(); ++i) {
         const PlannedNote &p = plan.notes[i];
         const NoteMatch &k = m.notes[i];
-        nlohmann::json e = {{"time_s", perf.plan_origin_s() + p.time_s},
+        nlohmann::json e = {{"time_s", perf.plan_origin_s() + p.written_time_s()},
+                            {"lead_ms", 1e3 * p.lead_s},
                             {"hand", to_string(p.hand)},
                             {"nuance", to_string(p.nuance)},
                             {"dynamics", p.dynamics},

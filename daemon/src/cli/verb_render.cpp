@@ -65,6 +65,10 @@ void render_usage(std::ostream &out)
            "                      notes (docs/midi.md; default 1)\n"
            "  --progress-every S  a progress line on stderr every S s of wall time (default 2;\n"
            "                      0: none)\n"
+           "  --rehearse N        a score's notes struck more than 5 ms off their time: their\n"
+           "                      strokes planned earlier or later by their errors and the\n"
+           "                      score played again, up to N times (0..5, default 3; 0: none;\n"
+           "                      docs/score.md, \"Rehearsal\")\n"
            "\n"
            "the sound (Pd in batch mode, as scripts/main.sh: patches/ictus-render.pd on the\n"
            "drum of render.json; docs/main-job.md):\n"
@@ -303,6 +307,7 @@ struct RenderArgs {
     std::string out_dir;
     bool force = false;
     double progress_every = 2.0;
+    int rehearse = 3; // rehearsal passes at most (docs/score.md, "Rehearsal")
     std::string wav;
     PdRenderOptions pd;
 };
@@ -325,6 +330,14 @@ OptionTable render_options(RenderArgs &r)
                                   "'");
          }},
         {"--progress-every", store(r.progress_every, parse_number, 0.0, 3600.0)},
+        {"--rehearse",
+         [&r](const std::string &a, Args &args) {
+             const std::string text = args.value(a);
+             const double n = parse_number(a, text, 0, 5);
+             if (n != std::floor(n))
+                 throw UsageError("--rehearse: expected a whole number 0..5, got '" + text + "'");
+             r.rehearse = static_cast<int>(n);
+         }},
         {"--wav", store_text(r.wav)},
         {"--wav-mix",
          [&pd](const std::string &a, Args &args) {
@@ -412,6 +425,11 @@ struct RenderRecording {
     std::unique_ptr<BvhRecorder> bvh;
     bool interrupted = false;
     double wall_s = 0.0;
+    // Rehearsal: the passes simulated after the first, whose plan was kept
+    // (0: the first), and the leads it gave (PlannedNote::lead_s).
+    int passes = 0, kept_pass = 0;
+    long leads = 0;
+    double max_lead_ms = 0.0;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start)
@@ -622,12 +640,12 @@ ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit
         if (prev && prev->drum != n.drum && !name(prev->drum).empty())
             move << std::fixed << std::setprecision(2) << ", from " << name(prev->drum) << " "
                  << (n.strike_point_m - prev->strike_point_m).norm() << " m away "
-                 << n.time_s - prev->time_s << " s before";
+                 << n.written_time_s() - prev->written_time_s() << " s before";
         // A flam's or drag's grace stroke is said as one: its line is its note's.
         std::string who = n.hand == Side::right ? "the right hand" : "the left hand";
         if (n.grace != Grace::none)
             who += std::string("'s ") + to_string(n.grace) + " grace stroke";
-        one(n.line, who, n.drum, n.time_s, error(m.notes[i]) + move.str());
+        one(n.line, who, n.drum, n.written_time_s(), error(m.notes[i]) + move.str());
     }
     for (size_t i = 0; i < plan.foot_notes.size(); ++i)
         if (listed(m.foot_notes[i]))
@@ -666,6 +684,132 @@ std::string extra_strikes_text(const MatchSummary &m, const std::vector<StrikeEv
 
 // Every output but the sound, from memory; in score mode the notes matched
 // with the strikes (notes.csv, render.json's "performance").
+// Rehearsal (docs/score.md, "Rehearsal"): when a note was struck more than
+// kOffTime_ms off its time, each note more than kRehearseAbove_ms off moves
+// its stroke's plan by its error, and the score is played again; again while
+// a note is more than kRehearseAbove_ms off, up to r.rehearse passes after the
+// first. A pass is kept when it strikes more notes within kOffTime_ms (then:
+// loses fewer, then: a smaller worst error) than the best before it; else the
+// next pass tries half of its change.
+constexpr double kRehearseAbove_ms = 2.5;
+constexpr double kRehearseUpTo_ms = 25.0; // further off: not a lag to correct
+
+struct PassScore {
+    long wrong = 0; // notes not struck, or struck more than kOffTime_ms off
+    long lost = 0;  // of those, not struck: a note played late is not traded for none
+    double worst_ms = 0.0;
+    bool better_than(const PassScore &o) const
+    {
+        if (wrong != o.wrong)
+            return wrong < o.wrong;
+        if (lost != o.lost)
+            return lost < o.lost;
+        return worst_ms < o.worst_ms - 1e-6;
+    }
+};
+
+PassScore pass_score(const MatchSummary &m)
+{
+    PassScore p;
+    for (const std::vector<NoteMatch> *v : {&m.notes, &m.foot_notes})
+        for (const NoteMatch &k : *v) {
+            if (k.strike_seq < 0 || std::abs(k.error_ms) > kOffTime_ms)
+                ++p.wrong;
+            if (k.strike_seq < 0)
+                ++p.lost;
+            if (k.strike_seq >= 0)
+                p.worst_ms = std::max(p.worst_ms, std::abs(k.error_ms));
+        }
+    return p;
+}
+
+MatchSummary match_of(const Performance &perf, const RenderRecording &rec)
+{
+    const GesturePlan &plan = *perf.plan();
+    return match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s(), plan.foot_notes);
+}
+
+// The leads a pass asks for: the plan's, plus each off note's error; false
+// when no note moves.
+bool next_leads(const GesturePlan &plan, const MatchSummary &m, std::vector<double> &lead)
+{
+    bool moved = false;
+    for (size_t i = 0; i < plan.notes.size(); ++i) {
+        const PlannedNote &n = plan.notes[i];
+        const double e = m.notes[i].error_ms;
+        if (n.score_note < 0 || m.notes[i].strike_seq < 0 || std::abs(e) <= kRehearseAbove_ms ||
+            std::abs(e) > kRehearseUpTo_ms)
+            continue;
+        const size_t k = static_cast<size_t>(n.score_note);
+        if (lead.size() <= k)
+            lead.resize(k + 1, 0.0);
+        const double next = std::clamp(n.lead_s + 1e-3 * e, -kMaxNoteLead_s, kMaxNoteLead_s);
+        moved = moved || std::abs(next - lead[k]) > 1e-6;
+        lead[k] = next;
+    }
+    return moved;
+}
+
+void rehearse(std::unique_ptr<Performance> &perf, std::unique_ptr<RenderRecording> &rec,
+              RenderArgs &r)
+{
+    PassScore best = pass_score(match_of(*perf, *rec));
+    std::vector<double> step; // the last pass's change of the leads, when it was not kept
+    for (int pass = 1; pass <= r.rehearse && !rec->interrupted; ++pass) {
+        const std::vector<double> &kept = r.o.score.plan.note_lead_s;
+        std::vector<double> lead = kept;
+        if (step.empty()) {
+            // The first pass when a note is off; the next ones while any is
+            // further off than kRehearseAbove_ms.
+            const MatchSummary m = match_of(*perf, *rec);
+            const double above_ms = pass == 1 ? kOffTime_ms : kRehearseAbove_ms;
+            bool off = false;
+            for (const NoteMatch &k : m.notes)
+                off = off || (k.strike_seq >= 0 && std::abs(k.error_ms) > above_ms &&
+                              std::abs(k.error_ms) <= kRehearseUpTo_ms);
+            if (!off || !next_leads(*perf->plan(), m, lead))
+                break;
+        } else {
+            // The last step overshot (a stroke planned earlier moves faster and
+            // lags more): half of it.
+            lead.resize(std::max(lead.size(), step.size()), 0.0);
+            for (size_t k = 0; k < step.size(); ++k)
+                lead[k] += 0.5 * step[k];
+        }
+        RenderArgs again = r;
+        again.o.score.plan.note_lead_s = lead;
+        auto p = std::make_unique<Performance>(again.o);
+        p->start_score();
+        auto q = std::make_unique<RenderRecording>();
+        simulate(*p, again, true, *q);
+        const double wall_s = rec->wall_s + q->wall_s;
+        rec->wall_s = wall_s;
+        rec->passes = pass;
+        if (q->interrupted)
+            break;
+        const PassScore score = pass_score(match_of(*p, *q));
+        if (!score.better_than(best)) {
+            step.assign(lead.size(), 0.0);
+            for (size_t k = 0; k < lead.size(); ++k)
+                step[k] = lead[k] - (k < kept.size() ? kept[k] : 0.0);
+            continue;
+        }
+        best = score;
+        step.clear();
+        r.o.score.plan.note_lead_s = lead;
+        perf = std::move(p);
+        rec = std::move(q);
+        rec->passes = pass;
+        rec->kept_pass = pass;
+        rec->wall_s = wall_s;
+    }
+    for (const PlannedNote &n : perf->plan()->notes)
+        if (n.lead_s != 0.0) {
+            ++rec->leads;
+            rec->max_lead_ms = std::max(rec->max_lead_ms, 1e3 * std::abs(n.lead_s));
+        }
+}
+
 NoteCount write_render_files(RenderFiles &files, const Performance &perf, const RenderArgs &r,
                              bool score_mode, const RenderRecording &rec)
 {
@@ -700,6 +844,10 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
         files.notes_csv->write_and_close(text.str());
         files.tips_csv->write_and_close(rec.tips.str());
         j["performance"] = performance_json(r.o, perf, m);
+        j["performance"]["rehearsal"] = {{"passes", rec.passes},
+                                         {"kept_pass", rec.kept_pass},
+                                         {"notes_led", rec.leads},
+                                         {"max_lead_ms", rec.max_lead_ms}};
     }
     files.render_json.write_and_close(j.dump(2) + "\n");
     return count;
@@ -751,6 +899,12 @@ void print_render_summary(const Performance &perf, const RenderArgs &r, bool sco
                           ? "; is the drum within the sticks' reach? --drum-pos"
                           : "")
                   << ")\n";
+    if (rec.passes > 0)
+        std::cerr << "ictusd render: rehearsed " << rec.passes << " time(s), kept pass "
+                  << rec.kept_pass << ": " << rec.leads
+                  << " note(s) planned earlier or later, by up to " << rec.max_lead_ms
+                  << " ms, to land on their time (--rehearse 0: none; render.json's "
+                     "performance.rehearsal)\n";
     if (count.off_time > 0)
         std::cerr << "ictusd render: warning: " << count.off_time << " of " << count.notes
                   << " notes of the score were struck more than " << kOffTime_ms
@@ -856,28 +1010,30 @@ int cmd_render(Args &args)
         return 0;
     const bool score_mode = r.o.mocap.empty();
     prepare_out_dir(r.out_dir, r.force);
-    Performance perf(r.o);
+    auto perf = std::make_unique<Performance>(r.o);
     if (score_mode)
-        perf.start_score();
+        perf->start_score();
     if (r.duration <= 0.0)
-        r.duration = perf.clip_duration_s();
+        r.duration = perf->clip_duration_s();
     if (r.duration > kMaxRenderSeconds)
         throw std::runtime_error("--duration: the clip is " + std::to_string(r.duration) +
                                  " s long; render takes at most " +
                                  std::to_string(static_cast<int>(kMaxRenderSeconds)) +
                                  " s (give --duration to render its start)");
     RenderFiles files(r.out_dir, score_mode);
-    RenderRecording rec;
-    simulate(perf, r, score_mode, rec);
-    const NoteCount count = write_render_files(files, perf, r, score_mode, rec);
-    print_render_summary(perf, r, score_mode, rec, count);
-    if (rec.interrupted)
+    auto rec = std::make_unique<RenderRecording>();
+    simulate(*perf, r, score_mode, *rec);
+    if (score_mode)
+        rehearse(perf, rec, r);
+    const NoteCount count = write_render_files(files, *perf, r, score_mode, *rec);
+    print_render_summary(*perf, r, score_mode, *rec, count);
+    if (rec->interrupted)
         return 130;
     // A divergence (exit status 3, as track) still renders the sound of what was played.
-    const int wav_status = r.wav.empty() ? 0 : render_wav(r, perf);
+    const int wav_status = r.wav.empty() ? 0 : render_wav(r, *perf);
     if (wav_status != 0)
         return wav_status;
-    return perf.divergences() > 0 ? 3 : 0;
+    return perf->divergences() > 0 ? 3 : 0;
 }
 
 } // namespace cli

@@ -20,7 +20,7 @@ MatchSummary match_strikes(const std::vector<PlannedNote> &notes,
     std::vector<Target> all;
     all.reserve(notes.size() + foot_notes.size());
     for (const PlannedNote &n : notes)
-        all.push_back({n.time_s, static_cast<int>(n.hand), n.drum});
+        all.push_back({n.written_time_s(), static_cast<int>(n.hand), n.drum});
     for (const PlannedFootNote &n : foot_notes)
         all.push_back({n.time_s, n.side == Side::right ? kFootRight : kFootLeft, n.drum});
     MatchSummary m;

@@ -153,6 +153,11 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
             const double scale = 1.0 + amount * kHumanizeForceCv * noise.normal();
             p.dynamics = std::clamp(n.dynamics * scale, 0.0, 1.0);
         }
+        p.score_note = static_cast<int>(k);
+        if (k < opt.note_lead_s.size() && std::isfinite(opt.note_lead_s[k])) {
+            p.lead_s = std::clamp(opt.note_lead_s[k], -kMaxNoteLead_s, kMaxNoteLead_s);
+            p.time_s -= p.lead_s;
+        }
         p.beats = n.beats;
         p.tempo_bpm = score.tempo.tempo_at_beat(n.beat);
         p.r_over_a = n.r_over_a;
@@ -194,8 +199,13 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
         if (!same.empty()) {
             const PlannedNote &prev = plan.notes[same.back()];
             const double written = score_time - score_time_prev[static_cast<int>(n.hand)];
-            if (amount > 0.0 && written >= opt.min_stroke_interval_s - 1e-9)
-                p.time_s = std::max(p.time_s, prev.time_s + opt.min_stroke_interval_s);
+            if ((amount > 0.0 || p.lead_s != 0.0) && written >= opt.min_stroke_interval_s - 1e-9) {
+                const double w = p.written_time_s();
+                const double t = std::max(p.time_s, prev.time_s + opt.min_stroke_interval_s);
+                if (t > p.time_s && p.lead_s > 0.0)
+                    p.lead_s = std::max(0.0, w - t); // what the interval leaves of it
+                p.time_s = t;
+            }
             if (written < opt.min_stroke_interval_s - 1e-9) {
                 auto what = [](const PlannedNote &q) {
                     return q.grace == Grace::none

@@ -112,6 +112,12 @@ struct PlannedNote {
     int line = 0;           // where the note is written
     int column = 0;
     Grace grace = Grace::none; // a flam's or a drag's grace stroke (ScoreNote::grace)
+    // The stroke is planned this long before the note's time (a rehearsal's
+    // correction, PlanOptions::note_lead_s): time_s is the planned strike,
+    // written_time_s() the note's own time, against which it is judged.
+    double lead_s = 0.0;
+    int score_note = -1; // the note's index in Score::notes
+    double written_time_s() const { return time_s + lead_s; }
 };
 
 // A note of a foot (docs/pedal.md): the right foot's (`RF`) on the kick's
@@ -197,7 +203,16 @@ struct PlanOptions {
     // picks the noise (each note draws its own stream of it).
     double humanize = -1.0;
     std::uint64_t seed = 1;
+    // Rehearsal (docs/score.md, "Rehearsal"): each hand note of the score
+    // (index into Score::notes) planned this long before its time (s; a late
+    // note's lead > 0). Empty, or a note beyond it: 0. Each lead is held to
+    // +-kMaxNoteLead_s, and never brings a stroke closer than
+    // min_stroke_interval_s to its hand's previous one.
+    std::vector<double> note_lead_s;
 };
+
+// The largest lead (either way) PlanOptions::note_lead_s may give a note.
+constexpr double kMaxNoteLead_s = 0.015;
 
 // The motor noise at amount 1 (docs/humanize.md): each
 // stroke's timing is shifted by a normal draw of SD kHumanizeTimingSd_s and
