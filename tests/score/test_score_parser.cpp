@@ -34,6 +34,17 @@ bool same_notes(const Score &a, const Score &b)
     return true;
 }
 
+// The same notes as `ref`, each at its line and column.
+void same_notes_at_same_places(const Score &m, const Score &ref)
+{
+    REQUIRE(m.notes.size() == ref.notes.size());
+    CHECK(same_notes(m, ref));
+    for (size_t i = 0; i < ref.notes.size(); ++i) {
+        CHECK(m.notes[i].line == ref.notes[i].line);
+        CHECK(m.notes[i].column == ref.notes[i].column);
+    }
+}
+
 } // namespace
 
 TEST_CASE("score: a bare note takes every default", "[score][parser]")
@@ -423,13 +434,7 @@ TEST_CASE("score: lines end in LF, CRLF or a lone CR, and a byte order mark is n
         for (char c : text)
             mixed += c == '\n' ? ends[rng() % 3] : std::string(1, c);
         INFO("trial " << trial);
-        const Score m = parse_score(mixed, "mixed");
-        REQUIRE(m.notes.size() == lf.notes.size());
-        CHECK(same_notes(m, lf));
-        for (size_t i = 0; i < lf.notes.size(); ++i) {
-            CHECK(m.notes[i].line == lf.notes[i].line);
-            CHECK(m.notes[i].column == lf.notes[i].column);
-        }
+        same_notes_at_same_places(parse_score(mixed, "mixed"), lf);
     }
     require_error("tempo 100\rR\rL acent\r", 3, 3, "acent");
     require_error("\xEF\xBB\xBFR, L acent\r\n", 1, 6, "acent");
@@ -456,13 +461,7 @@ TEST_CASE("score: a no-break space separates words as a space does, and columns 
         for (char c : text)
             mixed += c == ' ' && rng() % 2 ? std::string("\xC2\xA0") : std::string(1, c);
         INFO("trial " << trial);
-        const Score m = parse_score(mixed, "nbsp");
-        REQUIRE(m.notes.size() == plain.notes.size());
-        CHECK(same_notes(m, plain));
-        for (size_t i = 0; i < plain.notes.size(); ++i) {
-            CHECK(m.notes[i].line == plain.notes[i].line);
-            CHECK(m.notes[i].column == plain.notes[i].column);
-        }
+        same_notes_at_same_places(parse_score(mixed, "nbsp"), plain);
     }
     require_error("R\xC2\xA0legatto\n", 1, 3, "unknown nuance 'legatto'");
     require_error("R on tom1\xC2\xA0\xC2\xA0"
