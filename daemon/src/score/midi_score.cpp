@@ -295,13 +295,13 @@ void add_timing(const Smf &smf, MidiDrumPart &part)
             ++part.tempo_clamped;
         return kept;
     };
-    const bool at0 = !smf.tempo.empty() && smf.tempo.front().tick == 0;
-    part.score.tempo = TempoMap(at0 ? bpm_of(smf.tempo.front().us_per_quarter) : kDefaultTempoBpm);
-    for (const SmfTempo &t : smf.tempo)
-        if (t.tick > 0) {
-            const double bpm = bpm_of(t.us_per_quarter);
-            part.score.tempo.add(static_cast<double>(t.tick) / tpq, bpm, bpm, 0.0);
-        }
+    // Of two tempo events at one tick, the later in the file wins (TempoMap::add), at
+    // tick 0 too: the first of them played the whole part at the wrong tempo.
+    part.score.tempo = TempoMap(kDefaultTempoBpm);
+    for (const SmfTempo &t : smf.tempo) {
+        const double bpm = bpm_of(t.us_per_quarter);
+        part.score.tempo.add(static_cast<double>(t.tick) / tpq, bpm, bpm, 0.0);
+    }
     for (const SmfMeter &m : smf.meters)
         part.score.meters.push_back(
             {static_cast<double>(m.tick) / tpq, m.numerator, m.denominator, 0});
