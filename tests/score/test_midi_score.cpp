@@ -253,6 +253,31 @@ TEST_CASE("midi in: a malformed file names its byte and track", "[score][midi]")
     CHECK(read_smf(one + bytes({0, 0, 0}), "t.mid").notes.size() == 1);
     CHECK(what_of(header(1, 2) + chunk("MTrk", kEnd) + "MTr") ==
           "t.mid: byte 26: truncated chunk header");
+    // A file that ends where a chunk ends, before the declared tracks are all there: cut
+    // short (mido refuses it too), not its first tracks played alone. Seeded files of 2..5
+    // tracks of 1..4 notes each, cut after each of their chunks but the last.
+    CHECK(what_of(header(1, 2) + chunk("MTrk", kEnd)) ==
+          "t.mid: byte 26: the file ends after 1 of the 2 tracks its header declares (cut "
+          "short?)");
+    std::mt19937 rng(20261202);
+    for (int trial = 0; trial < 12; ++trial) {
+        const int tracks = 2 + static_cast<int>(rng() % 4);
+        std::string file = header(1, tracks);
+        for (int k = 0; k < tracks; ++k) {
+            std::string events;
+            for (int n = 0, count = 1 + static_cast<int>(rng() % 4); n < count; ++n)
+                events += bytes({0x10, 0x99, 38, 100});
+            file += chunk("MTrk", events + kEnd);
+            INFO("trial " << trial << ": cut after track " << k << " of " << tracks);
+            if (k + 1 < tracks)
+                CHECK(what_of(file) == "t.mid: byte " + std::to_string(file.size()) +
+                                           ": the file ends after " + std::to_string(k + 1) +
+                                           " of the " + std::to_string(tracks) +
+                                           " tracks its header declares (cut short?)");
+            else
+                CHECK(what_of(file).empty());
+        }
+    }
 }
 
 TEST_CASE("midi in: General MIDI's hi-hat on a kit's hi-hat, closed 42 and open 46, the pedal 44 "

@@ -203,6 +203,12 @@ Smf read_smf(const std::string &b, const std::string &source)
     }
     if (track == 0)
         head.fail("no track (MTrk chunk)", at);
+    // A file that ends where a chunk does, before every track the header declares: cut
+    // short (its other tracks' notes would be lost without a word).
+    if (track < declared)
+        head.fail("the file ends after " + std::to_string(track) + " of the " +
+                      std::to_string(declared) + " tracks its header declares (cut short?)",
+                  at);
     auto by_tick = [](const auto &x, const auto &y) { return x.tick < y.tick; };
     std::stable_sort(smf.notes.begin(), smf.notes.end(), by_tick);
     std::stable_sort(smf.tempo.begin(), smf.tempo.end(), by_tick);
