@@ -709,35 +709,44 @@ TEST_CASE("plan: a move across the edge of a head it plays lifts the bead over i
 {
     // The bead (7 mm, character.hpp's StickParams) lies up to its radius below the stick's
     // end, the planned tip: a tip that crosses a head's edge lower than that above its plane
-    // meets the edge. Moves between two drums are checked over their middle, where the move
+    // meets the edge, and one coming to a head lower than that over it meets the head before
+    // its stroke. Moves between two drums are checked over their middle, where the move
     // is the hand's (16x²(1-x)² >= 0.5 over the move window [t_a + 0.05 g, t_b - 0.1 g], x
     // from 0.2301 to 0.7699; its ends belong to the strokes). Found on the full kit: `R on
     // snare, L on tom1 flam` at 100 bpm, the right hand's grace (soft and low) grazed tom1's
-    // edge, its end 5 mm above the plane, one extra strike 0.29 s before the grace. Seeded
-    // pairs of drums, tempi, soft notes, flams and drags of either hand, on the kit and on
-    // it with the rack toms raised 0.13 m (the full kit's, docs/kit.md).
+    // edge, its end 5 mm above the plane, one extra strike 0.29 s before the grace; `R on
+    // snare-rim flam, rest, L on ride-bell drag` at 90 bpm, the right hand touched the ride's
+    // bow 0.49 s before the drag's graces, its end 8 mm above the plate. Seeded pairs of
+    // drums, tempi, soft notes, flams and drags of either hand, on the kit and on it with the
+    // rack toms raised 0.13 m (the full kit's, docs/kit.md).
     const double bead_m = 0.007;
     const PlanOptions opt;
-    const char *drums[] = {"snare", "tom1", "tom2", "floor"};
+    const char *drums[] = {"snare", "tom1", "tom2", "floor", "ride"};
     const char *soft[] = {"pp", "p", "flam", "drag"};
     std::mt19937 rng(20261202);
     int edges = 0;
-    for (int trial = 0; trial < 48; ++trial) {
-        PerformerFrame f = kit_frame();
+    // The two found (the right hand moving), then the seeded ones.
+    const char *const found[] = {
+        "tempo 100\nR on snare\nL on tom1 flam\nrest 2\n",
+        "tempo 90\nR on snare-rim flam\nrest\nL on ride-bell drag\nrest 2\n"};
+    for (int trial = 0; trial < 50; ++trial) {
+        PerformerFrame f = kit_frame_with_ride_and_kick();
         if (trial % 2)
             for (int k : {1, 2})
                 f.drums[k].membrane_center_m.y() += 0.13;
         const int tempo = 60 + static_cast<int>(rng() % 121);
-        const char *from = drums[rng() % 4];
-        const char *to = drums[rng() % 4];
-        const bool right = rng() % 2;
+        const char *from = drums[rng() % 5];
+        const char *to = drums[rng() % 5];
+        const bool right = trial < 2 || rng() % 2;
         const std::string mover = right ? "R" : "L", other = right ? "L" : "R";
         const char *how = soft[rng() % 4];
         const std::string second = std::string(how) == "flam" || std::string(how) == "drag"
                                        ? other + " on " + to + " " + how
                                        : mover + " on " + to + " " + how;
-        const std::string text = "tempo " + std::to_string(tempo) + "\n" + mover + " on " + from +
-                                 "\n" + second + "\nrest 2\n";
+        const std::string text = trial < 2 ? std::string(found[trial])
+                                           : "tempo " + std::to_string(tempo) + "\n" + mover +
+                                                 " on " + from + (rng() % 2 ? "\nrest\n" : "\n") +
+                                                 second + "\nrest 2\n";
         INFO("trial " << trial << (trial % 2 ? " (rack toms raised)" : "") << ":\n" << text);
         const GesturePlan plan = plan_performance(parse_score(text, "t"), db(), f);
         const int s = right ? 1 : 0;
@@ -762,14 +771,18 @@ TEST_CASE("plan: a move across the edge of a head it plays lifts the bead over i
                 for (int k : {a.drum, b.drum}) {
                     const PerformerFrame::Drum &d = f.drums[static_cast<size_t>(k)];
                     const Eigen::Vector3d rel = plan.tips.tip_m[s][i] - d.membrane_center_m;
-                    if (std::abs(std::hypot(rel.x(), rel.z()) - d.membrane_radius_m) > bead_m)
+                    const double off = std::hypot(rel.x(), rel.z()) - d.membrane_radius_m;
+                    if (off > bead_m || (k == a.drum && off < -bead_m))
                         continue;
                     ++edges;
                     worst = std::min(worst, rel.y());
                 }
             }
         }
-        CHECK(worst >= bead_m - 1e-9);
+        // The planner lifts a move by its shortfall at 48 points of it: between two a smooth
+        // dip over the head may be lifted short by hundredths of a millimetre (measured
+        // 0.03 mm at most here).
+        CHECK(worst >= bead_m - 1e-4);
     }
     CHECK(edges > 0); // the moves cross edges in their middle
 }

@@ -130,10 +130,11 @@ constexpr double kStick_m = StickParams{}.length_m;
 constexpr double kStickRadius_m = StickParams{}.shaft_radius_m;
 // The bead's lowest point lies up to its radius below the stick's end (the
 // tip the plan places): level, its centre is the end's height. A move across
-// the edge of a head it plays keeps the end that high above it near the edge:
-// `R on snare, L on tom1 flam` at the full kit, the right hand's grace
-// (planned low) grazed tom1's edge, its end 5 mm above the head's plane and
-// 3 mm outside it in plan, one extra strike 0.29 s before the grace.
+// the edge of a head it plays keeps the end that high above it near the edge,
+// and over the head it goes to: at the full kit the right hand's graces,
+// planned low, grazed tom1's edge 5 mm under the end (`R on snare, L on tom1
+// flam`) and touched the ride's bow 8 mm under it (`R on snare-rim flam, rest,
+// L on ride-bell drag`), an extra strike 0.29 and 0.49 s before the grace.
 constexpr double kBeadBelowEnd_m = StickParams{}.tip_radius_m;
 
 // How far a move from drum a.drum to b.drum must rise (m): wherever the tip
@@ -185,9 +186,11 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
                 // Crossing the edge of a head it plays, the bead (the tip, j < 0)
                 // clears the edge: wherever the tip is within kit_margin_m of it in
                 // plan, wider than the bead's reach, so that the move's points
-                // (kPoints) need not fall within the bead's reach to keep it clear.
+                // (kPoints) need not fall within the bead's reach to keep it clear;
+                // over the head it goes to, the head, before the stroke's own descent.
                 const double bead_m =
-                    j < 0 && std::abs(off_m - d.membrane_radius_m) <= opt.kit_margin_m
+                    j < 0 && (std::abs(off_m - d.membrane_radius_m) <= opt.kit_margin_m ||
+                              static_cast<int>(k) == b.drum)
                         ? kBeadBelowEnd_m
                         : 0.0;
                 short_m = std::max(short_m, (played ? bead_m : opt.kit_clearance_m) - height);
