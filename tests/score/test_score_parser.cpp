@@ -34,6 +34,17 @@ bool same_notes(const Score &a, const Score &b)
     return true;
 }
 
+// The same notes as `ref`, each at its line and column.
+void same_notes_at_same_places(const Score &m, const Score &ref)
+{
+    REQUIRE(m.notes.size() == ref.notes.size());
+    CHECK(same_notes(m, ref));
+    for (size_t i = 0; i < ref.notes.size(); ++i) {
+        CHECK(m.notes[i].line == ref.notes[i].line);
+        CHECK(m.notes[i].column == ref.notes[i].column);
+    }
+}
+
 } // namespace
 
 TEST_CASE("score: a bare note takes every default", "[score][parser]")
@@ -423,13 +434,7 @@ TEST_CASE("score: lines end in LF, CRLF or a lone CR, and a byte order mark is n
         for (char c : text)
             mixed += c == '\n' ? ends[rng() % 3] : std::string(1, c);
         INFO("trial " << trial);
-        const Score m = parse_score(mixed, "mixed");
-        REQUIRE(m.notes.size() == lf.notes.size());
-        CHECK(same_notes(m, lf));
-        for (size_t i = 0; i < lf.notes.size(); ++i) {
-            CHECK(m.notes[i].line == lf.notes[i].line);
-            CHECK(m.notes[i].column == lf.notes[i].column);
-        }
+        same_notes_at_same_places(parse_score(mixed, "mixed"), lf);
     }
     require_error("tempo 100\rR\rL acent\r", 3, 3, "acent");
     require_error("\xEF\xBB\xBFR, L acent\r\n", 1, 6, "acent");
@@ -437,6 +442,50 @@ TEST_CASE("score: lines end in LF, CRLF or a lone CR, and a byte order mark is n
     // UTF-16, either byte order: "tempo" with its NULs, said to be UTF-16.
     require_error(std::string("\xFF\xFEt\0e\0m\0p\0o\0", 12), 1, 1, "UTF-16");
     require_error(std::string("\xFE\xFF\0t\0e\0m\0p\0o", 12), 1, 1, "UTF-16");
+}
+
+TEST_CASE("score: a no-break space separates words as a space does, and columns count "
+          "characters",
+          "[score][parser]")
+{
+    // Option-Space on a Mac, or a score copied from a web page, puts no-break spaces
+    // (U+00A0, UTF-8 C2 A0) between words: "unknown statement 'R L'" named a word the
+    // user could not see. The default score with its spaces (seeded) made no-break: the
+    // same notes, at the same lines and columns (a column is a character, as an editor
+    // counts, not a byte).
+    const std::string text = default_score_text();
+    const Score plain = parse_score(text, "plain");
+    std::mt19937 rng(20261202);
+    for (int trial = 0; trial < 20; ++trial) {
+        std::string mixed;
+        for (char c : text)
+            mixed += c == ' ' && rng() % 2 ? std::string("\xC2\xA0") : std::string(1, c);
+        INFO("trial " << trial);
+        same_notes_at_same_places(parse_score(mixed, "nbsp"), plain);
+    }
+    require_error("R\xC2\xA0legatto\n", 1, 3, "unknown nuance 'legatto'");
+    require_error("R on tom1\xC2\xA0\xC2\xA0"
+                  "flm\n",
+                  1, 12, "unexpected 'flm' in a note");
+    require_error("R accent, \xC3\xA9 L, X\n", 1, 11, "unknown statement '\xC3\xA9'");
+    require_error("R 0.5, \xC3\xA9\xC3\xA9, X\n", 1, 8, "unknown statement");
+}
+
+TEST_CASE("score: a '+' written without its spaces is named as such, at the word",
+          "[score][parser][errors]")
+{
+    // "R +L" said "unknown nuance '+L'" and "R+ L" "unknown statement 'R+'": the chord's
+    // '+' stands between spaces. Words of limbs and '+' only; R+L and L+R are one note
+    // of both hands, and other words keep their own errors.
+    const char *const glued[] = {"+L", "R+", "RF+LF", "R+L+RF", "l+rf", "++", "right+left-foot"};
+    for (const char *w : glued) {
+        require_error(std::string("R, ") + w + "\n", 1, 4,
+                      std::string("'") + w + "': '+' joins notes with a space on each side");
+        require_error(std::string("R on snare ") + w + " on tom1\n", 1, 12, "'+' joins notes");
+    }
+    require_error("R+X\n", 1, 1, "unknown statement 'R+X'");
+    require_error("R +2\n", 1, 3, "dynamics +2 is out of range");
+    CHECK(parse_score("R+L, l+r, R + L, tempo 1e+2, R\n", "t").notes.size() == 7);
 }
 
 TEST_CASE("score: an error shows control bytes as hex escapes, a NUL included",

@@ -128,6 +128,14 @@ constexpr double kHihatRodAbove_m = 0.10;
 constexpr double kHihatRodRadius_m = 0.0125;
 constexpr double kStick_m = StickParams{}.length_m;
 constexpr double kStickRadius_m = StickParams{}.shaft_radius_m;
+// The bead's lowest point lies up to its radius below the stick's end (the
+// tip the plan places): level, its centre is the end's height. A move across
+// the edge of a head it plays keeps the end that high above it near the edge,
+// and over the head it goes to: at the full kit the right hand's graces,
+// planned low, grazed tom1's edge 5 mm under the end (`R on snare, L on tom1
+// flam`) and touched the ride's bow 8 mm under it (`R on snare-rim flam, rest,
+// L on ride-bell drag`), an extra strike 0.29 and 0.49 s before the grace.
+constexpr double kBeadBelowEnd_m = StickParams{}.tip_radius_m;
 
 // How far a move from drum a.drum to b.drum must rise (m): wherever the tip
 // is over a drum's disk (its radius plus kit_margin_m, in plan), it must be
@@ -169,12 +177,23 @@ double kit_lift(const Item &a, const Item &b, const Window &w, const PerformerFr
                     continue;
                 const Eigen::Vector3d rel = p - d.membrane_center_m;
                 const double height = rel.dot(frame.up);
-                if ((rel - height * frame.up).norm() > d.membrane_radius_m + opt.kit_margin_m)
+                const double off_m = (rel - height * frame.up).norm();
+                if (off_m > d.membrane_radius_m + opt.kit_margin_m)
                     continue;
                 const bool played = static_cast<int>(k) == a.drum || static_cast<int>(k) == b.drum;
                 if (played && kit_bump(x) < 0.5)
                     continue;
-                short_m = std::max(short_m, (played ? 0.0 : opt.kit_clearance_m) - height);
+                // Crossing the edge of a head it plays, the bead (the tip, j < 0)
+                // clears the edge: wherever the tip is within kit_margin_m of it in
+                // plan, wider than the bead's reach, so that the move's points
+                // (kPoints) need not fall within the bead's reach to keep it clear;
+                // over the head it goes to, the head, before the stroke's own descent.
+                const double bead_m =
+                    j < 0 && (std::abs(off_m - d.membrane_radius_m) <= opt.kit_margin_m ||
+                              static_cast<int>(k) == b.drum)
+                        ? kBeadBelowEnd_m
+                        : 0.0;
+                short_m = std::max(short_m, (played ? bead_m : opt.kit_clearance_m) - height);
             }
         }
         const Eigen::Vector3d grip = tip - kGrip_m * dir;

@@ -203,6 +203,12 @@ Smf read_smf(const std::string &b, const std::string &source)
     }
     if (track == 0)
         head.fail("no track (MTrk chunk)", at);
+    // A file that ends where a chunk does, before every track the header declares: cut
+    // short (its other tracks' notes would be lost without a word).
+    if (track < declared)
+        head.fail("the file ends after " + std::to_string(track) + " of the " +
+                      std::to_string(declared) + " tracks its header declares (cut short?)",
+                  at);
     auto by_tick = [](const auto &x, const auto &y) { return x.tick < y.tick; };
     std::stable_sort(smf.notes.begin(), smf.notes.end(), by_tick);
     std::stable_sort(smf.tempo.begin(), smf.tempo.end(), by_tick);
@@ -295,13 +301,13 @@ void add_timing(const Smf &smf, MidiDrumPart &part)
             ++part.tempo_clamped;
         return kept;
     };
-    const bool at0 = !smf.tempo.empty() && smf.tempo.front().tick == 0;
-    part.score.tempo = TempoMap(at0 ? bpm_of(smf.tempo.front().us_per_quarter) : kDefaultTempoBpm);
-    for (const SmfTempo &t : smf.tempo)
-        if (t.tick > 0) {
-            const double bpm = bpm_of(t.us_per_quarter);
-            part.score.tempo.add(static_cast<double>(t.tick) / tpq, bpm, bpm, 0.0);
-        }
+    // Of two tempo events at one tick, the later in the file wins (TempoMap::add), at
+    // tick 0 too: the first of them played the whole part at the wrong tempo.
+    part.score.tempo = TempoMap(kDefaultTempoBpm);
+    for (const SmfTempo &t : smf.tempo) {
+        const double bpm = bpm_of(t.us_per_quarter);
+        part.score.tempo.add(static_cast<double>(t.tick) / tpq, bpm, bpm, 0.0);
+    }
     for (const SmfMeter &m : smf.meters)
         part.score.meters.push_back(
             {static_cast<double>(m.tick) / tpq, m.numerator, m.denominator, 0});

@@ -203,6 +203,18 @@ bool starts_numeric(const std::string &s)
             (std::isdigit(static_cast<unsigned char>(s[1])) || s[1] == '.'));
 }
 
+// The length of the space at text[i]: 1 for an ASCII one, 2 for a no-break space
+// (U+00A0, UTF-8 C2 A0: Option-Space, a copy from a web page), else 0.
+size_t space_at(const std::string &text, size_t i)
+{
+    if (std::isspace(static_cast<unsigned char>(text[i])))
+        return 1;
+    if (static_cast<unsigned char>(text[i]) == 0xC2 && i + 1 < text.size() &&
+        static_cast<unsigned char>(text[i + 1]) == 0xA0)
+        return 2;
+    return 0;
+}
+
 class LineParser
 {
   public:
@@ -217,7 +229,7 @@ class LineParser
                 chord(tokens, out);
             tokens.clear();
         };
-        size_t i = 0;
+        size_t i = 0, counted = 0, continuations = 0;
         while (i < text.size()) {
             const char c = text[i];
             if (c == '#')
@@ -227,14 +239,19 @@ class LineParser
                 ++i;
                 continue;
             }
-            if (std::isspace(static_cast<unsigned char>(c))) {
-                ++i;
+            if (const size_t n = space_at(text, i)) {
+                i += n;
                 continue;
             }
             Token t;
-            t.column = static_cast<int>(i) + 1;
-            while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i])) &&
-                   text[i] != ',' && text[i] != ';' && text[i] != '#')
+            // The column in characters, as an editor counts them: UTF-8's
+            // continuation bytes (10xxxxxx) before the word are not characters.
+            for (; counted < i; ++counted)
+                if ((static_cast<unsigned char>(text[counted]) & 0xC0) == 0x80)
+                    ++continuations;
+            t.column = static_cast<int>(i - continuations) + 1;
+            while (i < text.size() && !space_at(text, i) && text[i] != ',' && text[i] != ';' &&
+                   text[i] != '#')
                 t.text += text[i++];
             t.lower = t.text;
             for (char &ch : t.lower)
@@ -257,6 +274,10 @@ class LineParser
         std::vector<std::vector<Token>> parts(1);
         std::vector<int> plus_columns;
         for (const Token &t : tk) {
+            if (glued_plus(t))
+                fail(t.column, "'" + t.text +
+                                   "': '+' joins notes with a space on each side: 'R + L' "
+                                   "('R+L' is one note of both hands)");
             if (t.text != "+") {
                 parts.back().push_back(t);
                 continue;
@@ -294,6 +315,25 @@ class LineParser
         for (size_t i = 0; i + 1 < notes.size(); ++i)
             notes[i].with_next = true;
         out.insert(out.end(), notes.begin(), notes.end());
+    }
+
+    // A word of limbs and '+' written without its spaces ('+L', 'R+', 'RF+LF'): each
+    // piece between the '+' a limb's word or nothing; not the hands' 'R+L' or 'L+R'.
+    static bool glued_plus(const Token &t)
+    {
+        if (t.text == "+" || t.text.find('+') == std::string::npos || t.lower == "r+l" ||
+            t.lower == "l+r")
+            return false;
+        size_t from = 0;
+        for (;;) {
+            const size_t plus = t.lower.find('+', from);
+            const std::string piece = t.lower.substr(from, plus - from);
+            if (!piece.empty() && !hand_word(piece) && !foot_word(piece) && !left_foot_word(piece))
+                return false;
+            if (plus == std::string::npos)
+                return true;
+            from = plus + 1;
+        }
     }
 
     static std::string limb_name(const Statement &st)
