@@ -5,7 +5,10 @@
 #include "ictus/sim/strike_event.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <iomanip>
+#include <sstream>
 
 namespace ictus
 {
@@ -91,6 +94,95 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
             out << ',' << kit.drums[static_cast<size_t>(n.drum)].name;
         out << '\n';
     }
+}
+
+ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit,
+                       bool off_time, const char *unit)
+{
+    ListedNotes listed_notes;
+    auto listed = [&](const NoteMatch &n) {
+        const bool is =
+            off_time ? n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms : n.strike_seq < 0;
+        listed_notes.count += is;
+        return is;
+    };
+    auto error = [&](const NoteMatch &n) {
+        std::ostringstream e;
+        if (off_time)
+            e << std::fixed << std::setprecision(2) << ", " << std::showpos << n.error_ms << " ms";
+        return e.str();
+    };
+    constexpr int kShown = 5;
+    std::ostringstream out;
+    out << std::fixed << std::setprecision(2);
+    int shown = 0;
+    auto name = [&](int drum) {
+        return drum >= 0 && drum < static_cast<int>(kit.drums.size())
+                   ? kit.drums[static_cast<size_t>(drum)].name
+                   : std::string();
+    };
+    auto one = [&](int line, const std::string &who, int drum, double t, const std::string &move) {
+        if (shown++ >= kShown)
+            return;
+        out << (shown > 1 ? ", " : "") << unit << " " << line << " (" << who;
+        if (!name(drum).empty())
+            out << " on " << name(drum);
+        out << " at " << t << " s" << move << ")";
+    };
+    for (size_t i = 0; i < plan.notes.size(); ++i) {
+        if (!listed(m.notes[i]))
+            continue;
+        const PlannedNote &n = plan.notes[i];
+        const PlannedNote *prev = nullptr;
+        for (size_t k = 0; shown < kShown && k < plan.notes.size(); ++k) { // shown ones only
+            const PlannedNote &q = plan.notes[k];
+            if (q.hand == n.hand && q.time_s < n.time_s && (!prev || q.time_s > prev->time_s))
+                prev = &q;
+        }
+        std::ostringstream move;
+        if (prev && prev->drum != n.drum && !name(prev->drum).empty())
+            move << std::fixed << std::setprecision(2) << ", from " << name(prev->drum) << " "
+                 << (n.strike_point_m - prev->strike_point_m).norm() << " m away "
+                 << n.written_time_s() - prev->written_time_s() << " s before";
+        // A flam's or drag's grace stroke is said as one: its line is its note's.
+        std::string who = n.hand == Side::right ? "the right hand" : "the left hand";
+        if (n.grace != Grace::none)
+            who += std::string("'s ") + to_string(n.grace) + " grace stroke";
+        one(n.line, who, n.drum, n.written_time_s(), error(m.notes[i]) + move.str());
+    }
+    for (size_t i = 0; i < plan.foot_notes.size(); ++i)
+        if (listed(m.foot_notes[i]))
+            one(plan.foot_notes[i].line,
+                plan.foot_notes[i].side == Side::right ? "the right foot" : "the left foot",
+                plan.foot_notes[i].drum, plan.foot_notes[i].time_s, error(m.foot_notes[i]));
+    if (shown > kShown)
+        out << " and " << shown - kShown << " more";
+    listed_notes.text = out.str();
+    return listed_notes;
+}
+
+// The strikes of no note (a stick that met a piece on its way, a second
+// strike of a note): "seq 37 (the right hand on hihat at 4.89 s)" for the
+// first few, in onset order, on the simulation clock as in strikes.csv.
+std::string extra_strikes_text(const MatchSummary &m, const std::vector<StrikeEvent> &strikes,
+                               const Kit &kit)
+{
+    constexpr size_t kShown = 5;
+    static const char *const kLimbs[] = {"the left hand", "the right hand", "the right foot",
+                                         "the left foot"};
+    std::ostringstream out;
+    out << std::fixed << std::setprecision(2);
+    for (size_t k = 0; k < m.extra.size() && k < kShown; ++k) {
+        const StrikeEvent &e = strikes[m.extra[k]];
+        out << (k > 0 ? ", " : "") << "seq " << e.seq << " ("
+            << (e.hand >= 0 && e.hand < 4 ? kLimbs[e.hand] : "a limb");
+        if (e.drum >= 0 && e.drum < static_cast<int>(kit.drums.size()))
+            out << " on " << kit.drums[static_cast<size_t>(e.drum)].name;
+        out << " at " << e.time_s << " s)";
+    }
+    if (m.extra.size() > kShown)
+        out << " and " << m.extra.size() - kShown << " more";
+    return out.str();
 }
 
 nlohmann::json drum_json(const Performance &p)

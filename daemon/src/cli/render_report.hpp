@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include <ostream>
+#include <string>
+#include <vector>
 
 namespace ictus
 {
@@ -26,6 +28,28 @@ nlohmann::json kit_json(const Performance &p);
 // render.json's "performance": how the strikes met the notes.
 nlohmann::json performance_json(const PerformanceOptions &o, const Performance &perf,
                                 const MatchSummary &m);
+
+constexpr double kOffTime_ms = 5.0; // docs/perform.md: a note is right within +-5 ms
+
+// The notes not struck (off_time false) or struck more than kOffTime_ms from
+// their time (true), hands' and feet's: how many, and "line L (the right hand
+// on crash at 7.43 s, from floor 1.2 m away 0.27 s before)" ("note N" for a MIDI
+// part's: unit) for the first few
+// in plan order (off time with the error: "..., +12.40 ms"); a hand's move into
+// the note is given when it came from another piece (most notes lost on a kit
+// asked the arm for a move it cannot make in the time).
+struct ListedNotes {
+    long count = 0;
+    std::string text;
+};
+ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit,
+                       bool off_time, const char *unit);
+
+// The strikes of no note (a stick that met a piece on its way, a second
+// strike of a note): "seq 37 (the right hand on hihat at 4.89 s)" for the
+// first few, in onset order, on the simulation clock as in strikes.csv.
+std::string extra_strikes_text(const MatchSummary &m, const std::vector<StrikeEvent> &strikes,
+                               const Kit &kit);
 
 } // namespace cli
 } // namespace ictus

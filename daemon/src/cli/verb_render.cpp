@@ -12,6 +12,7 @@
 #include "ictus/cli/verbs.hpp"
 #include "ictus/perform/strike_log.hpp"
 
+#include "rehearsal.hpp"
 #include "render_report.hpp"
 
 #include <nlohmann/json.hpp>
@@ -312,6 +313,16 @@ struct RenderArgs {
     PdRenderOptions pd;
 };
 
+// A whole number in lo..hi for option `a`, else a UsageError naming it.
+int parse_whole(const std::string &a, const std::string &text, double lo, double hi,
+                const char *what)
+{
+    const double v = parse_number(a, text, lo, hi);
+    if (v != std::floor(v))
+        throw UsageError(a + ": expected a whole number " + what + ", got '" + text + "'");
+    return static_cast<int>(v);
+}
+
 // render's own options (parse_performance_option has the shared ones).
 OptionTable render_options(RenderArgs &r)
 {
@@ -322,21 +333,13 @@ OptionTable render_options(RenderArgs &r)
         {"--bvh-rate", store(r.bvh_rate, parse_number, 0.0, 1000.0)},
         {"--midi-channel",
          [&r](const std::string &a, Args &args) {
-             const std::string text = args.value(a);
-             r.midi_channel = parse_number(a, text, 1, 16);
+             r.midi_channel = parse_whole(a, args.value(a), 1, 16, "1..16");
              r.midi_channel_given = true;
-             if (r.midi_channel != std::floor(r.midi_channel))
-                 throw UsageError("--midi-channel: expected a whole number 1..16, got '" + text +
-                                  "'");
          }},
         {"--progress-every", store(r.progress_every, parse_number, 0.0, 3600.0)},
         {"--rehearse",
          [&r](const std::string &a, Args &args) {
-             const std::string text = args.value(a);
-             const double n = parse_number(a, text, 0, 5);
-             if (n != std::floor(n))
-                 throw UsageError("--rehearse: expected a whole number 0..5, got '" + text + "'");
-             r.rehearse = static_cast<int>(n);
+             r.rehearse = parse_whole(a, args.value(a), 0, 5, "0..5");
          }},
         {"--wav", store_text(r.wav)},
         {"--wav-mix",
@@ -356,11 +359,7 @@ OptionTable render_options(RenderArgs &r)
         {"--wav-gain", store(pd.gain_db, parse_number, -120.0, 40.0)},
         {"--wav-rate",
          [&pd](const std::string &a, Args &args) {
-             const std::string text = args.value(a);
-             const double rate = parse_number(a, text, 8000, 192000);
-             if (rate != std::floor(rate))
-                 throw UsageError("--wav-rate: expected a whole number of Hz, got '" + text + "'");
-             pd.sample_rate = static_cast<int>(rate);
+             pd.sample_rate = parse_whole(a, args.value(a), 8000, 192000, "of Hz");
          }},
         {"--pd", store_text(pd.pd)},
         {"--pd-lib", store_text(pd.library)},
@@ -580,176 +579,14 @@ struct NoteCount {
     long primary_strikes = 0, extra = 0;
     std::string first_extra;
 };
-constexpr double kOffTime_ms = 5.0; // docs/perform.md: a note is right within +-5 ms
-
-// The notes not struck (off_time false) or struck more than kOffTime_ms from
-// their time (true), hands' and feet's: how many, and "line L (the right hand
-// on crash at 7.43 s, from floor 1.2 m away 0.27 s before)" ("note N" for a MIDI
-// part's: unit) for the first few
-// in plan order (off time with the error: "..., +12.40 ms"); a hand's move into
-// the note is given when it came from another piece (most notes lost on a kit
-// asked the arm for a move it cannot make in the time).
-struct ListedNotes {
-    long count = 0;
-    std::string text;
-};
-ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit,
-                       bool off_time, const char *unit)
-{
-    ListedNotes listed_notes;
-    auto listed = [&](const NoteMatch &n) {
-        const bool is =
-            off_time ? n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms : n.strike_seq < 0;
-        listed_notes.count += is;
-        return is;
-    };
-    auto error = [&](const NoteMatch &n) {
-        std::ostringstream e;
-        if (off_time)
-            e << std::fixed << std::setprecision(2) << ", " << std::showpos << n.error_ms << " ms";
-        return e.str();
-    };
-    constexpr int kShown = 5;
-    std::ostringstream out;
-    out << std::fixed << std::setprecision(2);
-    int shown = 0;
-    auto name = [&](int drum) {
-        return drum >= 0 && drum < static_cast<int>(kit.drums.size())
-                   ? kit.drums[static_cast<size_t>(drum)].name
-                   : std::string();
-    };
-    auto one = [&](int line, const std::string &who, int drum, double t, const std::string &move) {
-        if (shown++ >= kShown)
-            return;
-        out << (shown > 1 ? ", " : "") << unit << " " << line << " (" << who;
-        if (!name(drum).empty())
-            out << " on " << name(drum);
-        out << " at " << t << " s" << move << ")";
-    };
-    for (size_t i = 0; i < plan.notes.size(); ++i) {
-        if (!listed(m.notes[i]))
-            continue;
-        const PlannedNote &n = plan.notes[i];
-        const PlannedNote *prev = nullptr;
-        for (size_t k = 0; shown < kShown && k < plan.notes.size(); ++k) { // shown ones only
-            const PlannedNote &q = plan.notes[k];
-            if (q.hand == n.hand && q.time_s < n.time_s && (!prev || q.time_s > prev->time_s))
-                prev = &q;
-        }
-        std::ostringstream move;
-        if (prev && prev->drum != n.drum && !name(prev->drum).empty())
-            move << std::fixed << std::setprecision(2) << ", from " << name(prev->drum) << " "
-                 << (n.strike_point_m - prev->strike_point_m).norm() << " m away "
-                 << n.written_time_s() - prev->written_time_s() << " s before";
-        // A flam's or drag's grace stroke is said as one: its line is its note's.
-        std::string who = n.hand == Side::right ? "the right hand" : "the left hand";
-        if (n.grace != Grace::none)
-            who += std::string("'s ") + to_string(n.grace) + " grace stroke";
-        one(n.line, who, n.drum, n.written_time_s(), error(m.notes[i]) + move.str());
-    }
-    for (size_t i = 0; i < plan.foot_notes.size(); ++i)
-        if (listed(m.foot_notes[i]))
-            one(plan.foot_notes[i].line,
-                plan.foot_notes[i].side == Side::right ? "the right foot" : "the left foot",
-                plan.foot_notes[i].drum, plan.foot_notes[i].time_s, error(m.foot_notes[i]));
-    if (shown > kShown)
-        out << " and " << shown - kShown << " more";
-    listed_notes.text = out.str();
-    return listed_notes;
-}
-
-// The strikes of no note (a stick that met a piece on its way, a second
-// strike of a note): "seq 37 (the right hand on hihat at 4.89 s)" for the
-// first few, in onset order, on the simulation clock as in strikes.csv.
-std::string extra_strikes_text(const MatchSummary &m, const std::vector<StrikeEvent> &strikes,
-                               const Kit &kit)
-{
-    constexpr size_t kShown = 5;
-    static const char *const kLimbs[] = {"the left hand", "the right hand", "the right foot",
-                                         "the left foot"};
-    std::ostringstream out;
-    out << std::fixed << std::setprecision(2);
-    for (size_t k = 0; k < m.extra.size() && k < kShown; ++k) {
-        const StrikeEvent &e = strikes[m.extra[k]];
-        out << (k > 0 ? ", " : "") << "seq " << e.seq << " ("
-            << (e.hand >= 0 && e.hand < 4 ? kLimbs[e.hand] : "a limb");
-        if (e.drum >= 0 && e.drum < static_cast<int>(kit.drums.size()))
-            out << " on " << kit.drums[static_cast<size_t>(e.drum)].name;
-        out << " at " << e.time_s << " s)";
-    }
-    if (m.extra.size() > kShown)
-        out << " and " << m.extra.size() - kShown << " more";
-    return out.str();
-}
-
-// Every output but the sound, from memory; in score mode the notes matched
-// with the strikes (notes.csv, render.json's "performance").
-// Rehearsal (docs/score.md, "Rehearsal"): when a note was struck more than
-// kOffTime_ms off its time, each note more than kRehearseAbove_ms off moves
-// its stroke's plan by its error, and the score is played again; again while
-// a note is more than kRehearseAbove_ms off, up to r.rehearse passes after the
-// first. A pass is kept when it strikes more notes within kOffTime_ms (then:
-// loses fewer, then: a smaller worst error) than the best before it; else the
-// next pass tries half of its change.
-constexpr double kRehearseAbove_ms = 2.5;
-constexpr double kRehearseUpTo_ms = 25.0; // further off: not a lag to correct
-
-struct PassScore {
-    long wrong = 0; // notes not struck, or struck more than kOffTime_ms off
-    long lost = 0;  // of those, not struck: a note played late is not traded for none
-    double worst_ms = 0.0;
-    bool better_than(const PassScore &o) const
-    {
-        if (wrong != o.wrong)
-            return wrong < o.wrong;
-        if (lost != o.lost)
-            return lost < o.lost;
-        return worst_ms < o.worst_ms - 1e-6;
-    }
-};
-
-PassScore pass_score(const MatchSummary &m)
-{
-    PassScore p;
-    for (const std::vector<NoteMatch> *v : {&m.notes, &m.foot_notes})
-        for (const NoteMatch &k : *v) {
-            if (k.strike_seq < 0 || std::abs(k.error_ms) > kOffTime_ms)
-                ++p.wrong;
-            if (k.strike_seq < 0)
-                ++p.lost;
-            if (k.strike_seq >= 0)
-                p.worst_ms = std::max(p.worst_ms, std::abs(k.error_ms));
-        }
-    return p;
-}
-
 MatchSummary match_of(const Performance &perf, const RenderRecording &rec)
 {
     const GesturePlan &plan = *perf.plan();
     return match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s(), plan.foot_notes);
 }
 
-// The leads a pass asks for: the plan's, plus each off note's error; false
-// when no note moves.
-bool next_leads(const GesturePlan &plan, const MatchSummary &m, std::vector<double> &lead)
-{
-    bool moved = false;
-    for (size_t i = 0; i < plan.notes.size(); ++i) {
-        const PlannedNote &n = plan.notes[i];
-        const double e = m.notes[i].error_ms;
-        if (n.score_note < 0 || m.notes[i].strike_seq < 0 || std::abs(e) <= kRehearseAbove_ms ||
-            std::abs(e) > kRehearseUpTo_ms)
-            continue;
-        const size_t k = static_cast<size_t>(n.score_note);
-        if (lead.size() <= k)
-            lead.resize(k + 1, 0.0);
-        const double next = std::clamp(n.lead_s + 1e-3 * e, -kMaxNoteLead_s, kMaxNoteLead_s);
-        moved = moved || std::abs(next - lead[k]) > 1e-6;
-        lead[k] = next;
-    }
-    return moved;
-}
-
+// Rehearsal (docs/score.md, "Rehearsal"; rehearsal.hpp): the performance
+// played again, each off note led by its error, while that helps.
 void rehearse(std::unique_ptr<Performance> &perf, std::unique_ptr<RenderRecording> &rec,
               RenderArgs &r)
 {
@@ -810,6 +647,8 @@ void rehearse(std::unique_ptr<Performance> &perf, std::unique_ptr<RenderRecordin
         }
 }
 
+// Every output but the sound, from memory; in score mode the notes matched
+// with the strikes (notes.csv, render.json's "performance").
 NoteCount write_render_files(RenderFiles &files, const Performance &perf, const RenderArgs &r,
                              bool score_mode, const RenderRecording &rec)
 {
