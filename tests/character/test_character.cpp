@@ -212,6 +212,76 @@ TEST_CASE("reference clean-up: the Butterworth kernel has the zero-phase 2nd-ord
     }
 }
 
+// track's de-spiking took every stroke's turn of a capture at 30 Hz for a
+// spike: a turn of angular acceleration a lies a h^2 / 2 off its neighbours'
+// midpoint, 16 times further at 30 Hz than at 120 Hz. Its threshold holds at
+// 120 Hz and above and grows as (120 / rate)^2 below.
+TEST_CASE(
+    "reference clean-up: a stroke's turn is no spike at any frame rate, a one-frame glitch is",
+    "[character][track]")
+{
+    const Skeleton skel = default_skeleton();
+    const CharacterModel m = CharacterModel::from_skeleton(skel);
+    const int elbow = m.joint_index("r_elbow");
+    std::mt19937 rng(2026);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const double rates[] = {25.0, 30.0, 40.0, 50.0, 60.0, 100.0, 120.0, 240.0};
+    for (int trial = 0; trial < 24; ++trial) {
+        const double rate = rates[trial % 8];
+        // Strokes of 20-60 degrees at 3-6 Hz: the peak acceleration amp (2 pi f)^2
+        // puts a turn at most 2.96 degrees off its neighbours at 120 Hz.
+        const double amp = (20.0 + 40.0 * u(rng)) * M_PI / 180.0;
+        const double freq = 3.0 + 3.0 * u(rng), phase = 2.0 * M_PI * u(rng);
+        const int frames = static_cast<int>(2.0 * rate) + 1;
+        const double threshold_deg = 5.0 * std::pow(std::max(1.0, 120.0 / rate), 2.0);
+        const int glitch = 2 + static_cast<int>((frames - 4) * u(rng));
+        auto swing = [&](int f) {
+            return Eigen::Quaterniond(Eigen::AngleAxisd(
+                amp * std::cos(2.0 * M_PI * freq * f / rate + phase), Eigen::Vector3d::UnitY()));
+        };
+        auto angle_deg = [](const Eigen::Quaterniond &a, const Eigen::Quaterniond &b) {
+            return 2.0 * std::acos(std::min(1.0, std::fabs(a.dot(b)))) * 180.0 / M_PI;
+        };
+        // The glitch, about an axis across the swing's: twice the threshold and
+        // twice its neighbours' distance from each other (a spike stands out of
+        // the motion around it); possible where that stays under 170 degrees.
+        const double glitch_deg =
+            std::max(2.0 * threshold_deg, 2.0 * angle_deg(swing(glitch - 1), swing(glitch + 1)));
+        const double glitch_rad = glitch_deg * M_PI / 180.0;
+        const bool glitched = glitch_deg < 170.0;
+        for (const bool with_glitch : {false, true}) {
+            if (with_glitch && !glitched)
+                continue;
+            const Motion motion =
+                simtest::make_motion(skel, frames, rate, [&](int f, const std::string &j) {
+                    if (j != "RightForeArm")
+                        return Eigen::Quaterniond::Identity();
+                    if (with_glitch && f == glitch)
+                        return Eigen::Quaterniond(
+                            swing(f) * Eigen::AngleAxisd(glitch_rad, Eigen::Vector3d::UnitX()));
+                    return swing(f);
+                });
+            ReferenceFilter filter; // 5 degrees at 120 Hz and above (track's)
+            filter.spike_reference_rate_hz = 120.0;
+            filter.smooth_cutoff_hz = 0.0;
+            const ReferenceMotion ref(m, motion, filter);
+            INFO("trial " << trial << ": " << rate << " Hz, " << amp * 180 / M_PI << " deg at "
+                          << freq << " Hz, glitch " << with_glitch << " at frame " << glitch);
+            if (!with_glitch) {
+                CHECK(ref.spikes_removed() == 0);
+                continue;
+            }
+            CHECK(ref.spikes_removed() == 1);
+            // Replaced by its neighbours' midpoint, which lies within the
+            // turn's 2.96 (120 / rate)^2 degrees of the swing.
+            const Eigen::Quaterniond &cleaned = ref.frame(glitch).local[elbow];
+            CHECK(angle_deg(cleaned, swing(glitch - 1).slerp(0.5, swing(glitch + 1))) < 1e-4);
+            const double from_swing_deg = angle_deg(cleaned, swing(glitch));
+            CHECK(from_swing_deg <= 2.96 * std::pow(std::max(1.0, 120.0 / rate), 2.0) + 1e-6);
+        }
+    }
+}
+
 namespace
 {
 

@@ -673,18 +673,22 @@ ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &moti
         throw CharacterError("reference filter: spike threshold must be >= 0 rad");
     if (!(std::isfinite(filter.smooth_cutoff_hz) && filter.smooth_cutoff_hz >= 0.0))
         throw CharacterError("reference filter: smoothing cutoff must be >= 0 Hz");
+    if (!(std::isfinite(filter.spike_reference_rate_hz) && filter.spike_reference_rate_hz >= 0.0))
+        throw CharacterError("reference filter: spike reference rate must be >= 0 Hz");
     const int n = frames();
     auto angle = [](const Eigen::Quaterniond &a, const Eigen::Quaterniond &b) {
         return 2.0 * std::acos(std::min(1.0, std::fabs(a.dot(b))));
     };
     if (filter.spike_threshold_rad > 0.0) {
+        const double slower = std::max(1.0, filter.spike_reference_rate_hz / frame_rate_hz_);
+        const double threshold_rad = filter.spike_threshold_rad * slower * slower;
         for (int j = 0; j < CharacterModel::kJoints; ++j) {
             for (int f = 1; f + 1 < n; ++f) {
                 const Eigen::Quaterniond &a = frames_[f - 1].local[j];
                 const Eigen::Quaterniond &b = frames_[f + 1].local[j];
                 const Eigen::Quaterniond mid = a.slerp(0.5, b);
                 const double off = angle(frames_[f].local[j], mid);
-                if (off > filter.spike_threshold_rad && angle(a, b) < off) {
+                if (off > threshold_rad && angle(a, b) < off) {
                     frames_[f].local[j] = mid;
                     ++spikes_removed_;
                 }

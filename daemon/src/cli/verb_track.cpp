@@ -88,7 +88,7 @@ void track_usage(std::ostream &out)
            "  --smooth-kernel butterworth|gaussian   its kernel (default butterworth: the\n"
            "                         zero-phase 2nd-order Butterworth, docs/mocap.md)\n"
            "  --despike-deg DEG      replace one-frame spikes larger than DEG (default 5;\n"
-           "                         0: off)\n"
+           "                         0: off; below 120 Hz, DEG x (120 / rate)^2)\n"
            "  --tip-smooth-hz HZ     low-pass of the stick tips (X^T and the errors; default:\n"
            "                         --smooth-hz; 0: de-spiked only)\n"
            "  --ik-iterations N      feedback IK iterations per step (default 2; 0: to\n"
