@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <random>
 #include <regex>
 #include <set>
 #include <thread>
@@ -571,8 +572,6 @@ TEST_CASE("ictusd render --mocap: no strike at all is a warning", "[cli]")
     CHECK(r.output.find("ictusd render: warning: no stick struck the drum") != std::string::npos);
 }
 
-// A skeleton without a joint the character needs: every verb names the file (the
-// joint has no line of its own), and gestures --import says it once, without ':0:'.
 // track took every turn of a capture at 30 Hz for a one-frame spike (a fixed
 // 5 degrees; a turn lies a h^2 / 2 off its neighbours), and cleaned the
 // strokes away: 80_13 at 30 Hz had 179 replacements and its cleaned tips
@@ -610,6 +609,50 @@ TEST_CASE("ictusd track: a capture at 25-60 Hz keeps its strokes' turns, a glitc
     }
 }
 
+// A stick capture of one row, or of sticks held still, was refused without
+// the file's name ("stick capture: expected at least two frames of both
+// tips", "--drum auto: no strokes in the stick capture").
+TEST_CASE("ictusd track: a stick-only capture of one row or of no stroke is refused, naming "
+          "the file",
+          "[cli][cartesian]")
+{
+    const std::string header = "time,stick_l.x,stick_l.y,stick_l.z,stick_r.x,stick_r.y,stick_r.z\n";
+    const std::string one_row =
+        simtest::write_temp("one_row.csv", header + "0,0.15,0.7,0.4,-0.15,0.7,0.4\n");
+    Run r = ictusd("track --mode cartesian --quiet --mocap " + one_row);
+    INFO(r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find(one_row +
+                        ": expected at least two frames (data rows) of the sticks, got 1") !=
+          std::string::npos);
+
+    // Sticks held still, a wobble under 1 mm (seeded): no turnaround 1 cm deep.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> wobble(-0.0005, 0.0005);
+    std::ostringstream still;
+    still << header;
+    for (int f = 0; f < 120; ++f) {
+        still << f / 120.0;
+        for (const double x : {0.15, -0.15})
+            still << ',' << x + wobble(rng) << ',' << 0.7 + wobble(rng) << ',' << 0.4 + wobble(rng);
+        still << '\n';
+    }
+    const std::string csv = simtest::write_temp("still_sticks.csv", still.str());
+    r = ictusd("track --mode cartesian --quiet --mocap " + csv);
+    INFO(r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find(csv + ": --drum auto: no strokes in the stick capture") !=
+          std::string::npos);
+    CHECK(r.output.find("--drum X,Y,Z") != std::string::npos);
+    // With the drum given it runs.
+    const std::string dir = simtest::temp_path("still_sticks_out");
+    r = ictusd("track --mode cartesian --quiet --mocap " + csv + " --drum 0,0.5,0.4 --out " + dir);
+    INFO(r.output);
+    CHECK(r.status == 0);
+}
+
+// A skeleton without a joint the character needs: every verb names the file (the
+// joint has no line of its own), and gestures --import says it once, without ':0:'.
 TEST_CASE("ictusd: a BVH missing a required joint is named in the error", "[cli]")
 {
     std::ifstream in(tiny_bvh());
