@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <random>
+#include <tuple>
 
 using namespace ictus;
 
@@ -83,6 +84,68 @@ TEST_CASE("a missing CMU joint or a bad option is refused with its name", "[char
     CHECK_THROWS_WITH(CharacterModel::from_skeleton(good, opt), Catch::Contains("stick length"));
     CHECK_THROWS_WITH(grip_from_string("italian"), Catch::Contains("italian"));
     CHECK(grip_from_string("German") == Grip::german);
+}
+
+// A CMU-named skeleton exported without fingers or toes was refused ("no
+// joint named 'LeftHandIndex1'"). The hand and the foot end at their own
+// End Site instead; every other joint is still required by name.
+TEST_CASE("a skeleton without fingers or toes ends its hands and feet at their End Sites",
+          "[character]")
+{
+    const Skeleton full = default_skeleton();
+    const std::vector<std::string> dropped = {
+        "LeftFingerBase", "LeftHandIndex1",  "LeftHandIndex1_end", "LThumb",
+        "LThumb_end",     "RightFingerBase", "RightHandIndex1",    "RightHandIndex1_end",
+        "RThumb",         "RThumb_end",      "LeftToeBase",        "LeftToeBase_end",
+        "RightToeBase",   "RightToeBase_end"};
+    // The joints kept, parents renumbered; then an End Site where the fingers
+    // (the toes) ended: the same stretch of skeleton as FingerBase + HandIndex1.
+    auto without = [&](bool with_end_sites) {
+        Skeleton s;
+        std::vector<int> index(full.joints.size(), -1);
+        for (size_t j = 0; j < full.joints.size(); ++j) {
+            if (std::find(dropped.begin(), dropped.end(), full.joints[j].name) != dropped.end())
+                continue;
+            SkeletonJoint joint = full.joints[j];
+            joint.parent = joint.parent < 0 ? -1 : index[static_cast<size_t>(joint.parent)];
+            index[j] = static_cast<int>(s.joints.size());
+            s.joints.push_back(joint);
+        }
+        if (with_end_sites)
+            for (const auto &[joint, first, last] :
+                 {std::tuple<const char *, const char *, const char *>{"LeftHand", "LeftFingerBase",
+                                                                       "LeftHandIndex1"},
+                  {"RightHand", "RightFingerBase", "RightHandIndex1"},
+                  {"LeftFoot", "LeftToeBase", "LeftToeBase_end"},
+                  {"RightFoot", "RightToeBase", "RightToeBase_end"}}) {
+                SkeletonJoint end;
+                end.name = std::string(joint) + "_End";
+                end.parent = s.find(joint);
+                end.end_site = true;
+                end.offset_m =
+                    full.joints[full.find(first)].offset_m + full.joints[full.find(last)].offset_m;
+                s.joints.push_back(end);
+            }
+        return s;
+    };
+    const CharacterModel reference = CharacterModel::from_skeleton(full);
+    const CharacterModel m = CharacterModel::from_skeleton(without(true));
+    for (int b = 0; b < CharacterModel::kBodies; ++b) {
+        const BodySpec &got = m.bodies()[b], &want = reference.bodies()[b];
+        INFO("body " << got.name);
+        CHECK((got.distal_m - want.distal_m).norm() < 1e-12);
+        CHECK(got.mass_kg == Approx(want.mass_kg));
+        CHECK((got.com_m - want.com_m).norm() < 1e-12);
+        CHECK((got.inertia_kg_m2 - want.inertia_kg_m2).norm() < 1e-12);
+    }
+    for (const Side side : {Side::left, Side::right}) {
+        // The default thumb lies along +z across the fingers: so does the fallback's.
+        CHECK((m.stick(side).tip_m - reference.stick(side).tip_m).norm() < 1e-12);
+        CHECK((m.stick(side).axis - reference.stick(side).axis).norm() < 1e-12);
+    }
+    // Without an End Site either, the CMU joint is named.
+    CHECK_THROWS_WITH(CharacterModel::from_skeleton(without(false)),
+                      Catch::Contains("no joint named 'LeftHandIndex1'"));
 }
 
 TEST_CASE("grips: German sticks lie in the palm plane, French ones in the finger-palm plane",

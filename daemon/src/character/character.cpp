@@ -142,6 +142,26 @@ int find_joint(const Skeleton &skeleton, const std::string &name)
     throw CharacterError("skeleton: joint '" + name.substr(0, slash) + "' has no end site");
 }
 
+// The distal end of a row's body. A hand without fingers or a foot without
+// toes (a skeleton exported without them) ends at its own joint's End Site:
+// their inertia comes from de Leva's lengths, the skeleton only gives their
+// direction (and the grip's place along the hand). Else the CMU joint is
+// required, and its absence named.
+int find_distal(const Skeleton &skeleton, const MapRow &row)
+{
+    try {
+        return find_joint(skeleton, row.distal);
+    } catch (const CharacterError &) {
+        if (row.segment != DeLevaSegment::hand && row.segment != DeLevaSegment::foot)
+            throw;
+        const int own = skeleton.find(row.source);
+        for (int j = 0; j < static_cast<int>(skeleton.joints.size()); ++j)
+            if (skeleton.joints[j].parent == own && skeleton.joints[j].end_site)
+                return j;
+        throw;
+    }
+}
+
 // Mocap joints from `ancestor` (exclusive) down to `joint` (inclusive), parent-most first.
 std::vector<int> path_between(const Skeleton &skeleton, int ancestor, int joint)
 {
@@ -420,7 +440,7 @@ CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
     std::vector<int> source(kBodies), distal(kBodies);
     for (int b = 0; b < kBodies; ++b) {
         source[b] = find_joint(skeleton, kMap[b].source);
-        distal[b] = find_joint(skeleton, kMap[b].distal);
+        distal[b] = find_distal(skeleton, kMap[b]);
     }
     check_segment_lengths(skeleton, source, distal);
     const double size_ratio = limb_size_ratio(skeleton, source, distal);
