@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <random>
+#include <tuple>
 
 using namespace ictus;
 
@@ -83,6 +84,68 @@ TEST_CASE("a missing CMU joint or a bad option is refused with its name", "[char
     CHECK_THROWS_WITH(CharacterModel::from_skeleton(good, opt), Catch::Contains("stick length"));
     CHECK_THROWS_WITH(grip_from_string("italian"), Catch::Contains("italian"));
     CHECK(grip_from_string("German") == Grip::german);
+}
+
+// A CMU-named skeleton exported without fingers or toes was refused ("no
+// joint named 'LeftHandIndex1'"). The hand and the foot end at their own
+// End Site instead; every other joint is still required by name.
+TEST_CASE("a skeleton without fingers or toes ends its hands and feet at their End Sites",
+          "[character]")
+{
+    const Skeleton full = default_skeleton();
+    const std::vector<std::string> dropped = {
+        "LeftFingerBase", "LeftHandIndex1",  "LeftHandIndex1_end", "LThumb",
+        "LThumb_end",     "RightFingerBase", "RightHandIndex1",    "RightHandIndex1_end",
+        "RThumb",         "RThumb_end",      "LeftToeBase",        "LeftToeBase_end",
+        "RightToeBase",   "RightToeBase_end"};
+    // The joints kept, parents renumbered; then an End Site where the fingers
+    // (the toes) ended: the same stretch of skeleton as FingerBase + HandIndex1.
+    auto without = [&](bool with_end_sites) {
+        Skeleton s;
+        std::vector<int> index(full.joints.size(), -1);
+        for (size_t j = 0; j < full.joints.size(); ++j) {
+            if (std::find(dropped.begin(), dropped.end(), full.joints[j].name) != dropped.end())
+                continue;
+            SkeletonJoint joint = full.joints[j];
+            joint.parent = joint.parent < 0 ? -1 : index[static_cast<size_t>(joint.parent)];
+            index[j] = static_cast<int>(s.joints.size());
+            s.joints.push_back(joint);
+        }
+        if (with_end_sites)
+            for (const auto &[joint, first, last] :
+                 {std::tuple<const char *, const char *, const char *>{"LeftHand", "LeftFingerBase",
+                                                                       "LeftHandIndex1"},
+                  {"RightHand", "RightFingerBase", "RightHandIndex1"},
+                  {"LeftFoot", "LeftToeBase", "LeftToeBase_end"},
+                  {"RightFoot", "RightToeBase", "RightToeBase_end"}}) {
+                SkeletonJoint end;
+                end.name = std::string(joint) + "_End";
+                end.parent = s.find(joint);
+                end.end_site = true;
+                end.offset_m =
+                    full.joints[full.find(first)].offset_m + full.joints[full.find(last)].offset_m;
+                s.joints.push_back(end);
+            }
+        return s;
+    };
+    const CharacterModel reference = CharacterModel::from_skeleton(full);
+    const CharacterModel m = CharacterModel::from_skeleton(without(true));
+    for (int b = 0; b < CharacterModel::kBodies; ++b) {
+        const BodySpec &got = m.bodies()[b], &want = reference.bodies()[b];
+        INFO("body " << got.name);
+        CHECK((got.distal_m - want.distal_m).norm() < 1e-12);
+        CHECK(got.mass_kg == Approx(want.mass_kg));
+        CHECK((got.com_m - want.com_m).norm() < 1e-12);
+        CHECK((got.inertia_kg_m2 - want.inertia_kg_m2).norm() < 1e-12);
+    }
+    for (const Side side : {Side::left, Side::right}) {
+        // The default thumb lies along +z across the fingers: so does the fallback's.
+        CHECK((m.stick(side).tip_m - reference.stick(side).tip_m).norm() < 1e-12);
+        CHECK((m.stick(side).axis - reference.stick(side).axis).norm() < 1e-12);
+    }
+    // Without an End Site either, the CMU joint is named.
+    CHECK_THROWS_WITH(CharacterModel::from_skeleton(without(false)),
+                      Catch::Contains("no joint named 'LeftHandIndex1'"));
 }
 
 TEST_CASE("grips: German sticks lie in the palm plane, French ones in the finger-palm plane",
@@ -209,6 +272,76 @@ TEST_CASE("reference clean-up: the Butterworth kernel has the zero-phase 2nd-ord
         INFO(to_string(kernel) << ": peak " << peak * 180 / M_PI << " deg");
         // The frames sample the 4 Hz cosine at its peaks (every 30th frame).
         CHECK(peak / amp == Approx(expected).margin(2e-3));
+    }
+}
+
+// track's de-spiking took every stroke's turn of a capture at 30 Hz for a
+// spike: a turn of angular acceleration a lies a h^2 / 2 off its neighbours'
+// midpoint, 16 times further at 30 Hz than at 120 Hz. Its threshold holds at
+// 120 Hz and above and grows as (120 / rate)^2 below.
+TEST_CASE(
+    "reference clean-up: a stroke's turn is no spike at any frame rate, a one-frame glitch is",
+    "[character][track]")
+{
+    const Skeleton skel = default_skeleton();
+    const CharacterModel m = CharacterModel::from_skeleton(skel);
+    const int elbow = m.joint_index("r_elbow");
+    std::mt19937 rng(2026);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const double rates[] = {25.0, 30.0, 40.0, 50.0, 60.0, 100.0, 120.0, 240.0};
+    for (int trial = 0; trial < 24; ++trial) {
+        const double rate = rates[trial % 8];
+        // Strokes of 20-60 degrees at 3-6 Hz: the peak acceleration amp (2 pi f)^2
+        // puts a turn at most 2.96 degrees off its neighbours at 120 Hz.
+        const double amp = (20.0 + 40.0 * u(rng)) * M_PI / 180.0;
+        const double freq = 3.0 + 3.0 * u(rng), phase = 2.0 * M_PI * u(rng);
+        const int frames = static_cast<int>(2.0 * rate) + 1;
+        const double threshold_deg = 5.0 * std::pow(std::max(1.0, 120.0 / rate), 2.0);
+        const int glitch = 2 + static_cast<int>((frames - 4) * u(rng));
+        auto swing = [&](int f) {
+            return Eigen::Quaterniond(Eigen::AngleAxisd(
+                amp * std::cos(2.0 * M_PI * freq * f / rate + phase), Eigen::Vector3d::UnitY()));
+        };
+        auto angle_deg = [](const Eigen::Quaterniond &a, const Eigen::Quaterniond &b) {
+            return 2.0 * std::acos(std::min(1.0, std::fabs(a.dot(b)))) * 180.0 / M_PI;
+        };
+        // The glitch, about an axis across the swing's: twice the threshold and
+        // twice its neighbours' distance from each other (a spike stands out of
+        // the motion around it); possible where that stays under 170 degrees.
+        const double glitch_deg =
+            std::max(2.0 * threshold_deg, 2.0 * angle_deg(swing(glitch - 1), swing(glitch + 1)));
+        const double glitch_rad = glitch_deg * M_PI / 180.0;
+        const bool glitched = glitch_deg < 170.0;
+        for (const bool with_glitch : {false, true}) {
+            if (with_glitch && !glitched)
+                continue;
+            const Motion motion =
+                simtest::make_motion(skel, frames, rate, [&](int f, const std::string &j) {
+                    if (j != "RightForeArm")
+                        return Eigen::Quaterniond::Identity();
+                    if (with_glitch && f == glitch)
+                        return Eigen::Quaterniond(
+                            swing(f) * Eigen::AngleAxisd(glitch_rad, Eigen::Vector3d::UnitX()));
+                    return swing(f);
+                });
+            ReferenceFilter filter; // 5 degrees at 120 Hz and above (track's)
+            filter.spike_reference_rate_hz = 120.0;
+            filter.smooth_cutoff_hz = 0.0;
+            const ReferenceMotion ref(m, motion, filter);
+            INFO("trial " << trial << ": " << rate << " Hz, " << amp * 180 / M_PI << " deg at "
+                          << freq << " Hz, glitch " << with_glitch << " at frame " << glitch);
+            if (!with_glitch) {
+                CHECK(ref.spikes_removed() == 0);
+                continue;
+            }
+            CHECK(ref.spikes_removed() == 1);
+            // Replaced by its neighbours' midpoint, which lies within the
+            // turn's 2.96 (120 / rate)^2 degrees of the swing.
+            const Eigen::Quaterniond &cleaned = ref.frame(glitch).local[elbow];
+            CHECK(angle_deg(cleaned, swing(glitch - 1).slerp(0.5, swing(glitch + 1))) < 1e-4);
+            const double from_swing_deg = angle_deg(cleaned, swing(glitch));
+            CHECK(from_swing_deg <= 2.96 * std::pow(std::max(1.0, 120.0 / rate), 2.0) + 1e-6);
+        }
     }
 }
 

@@ -142,6 +142,26 @@ int find_joint(const Skeleton &skeleton, const std::string &name)
     throw CharacterError("skeleton: joint '" + name.substr(0, slash) + "' has no end site");
 }
 
+// The distal end of a row's body. A hand without fingers or a foot without
+// toes (a skeleton exported without them) ends at its own joint's End Site:
+// their inertia comes from de Leva's lengths, the skeleton only gives their
+// direction (and the grip's place along the hand). Else the CMU joint is
+// required, and its absence named.
+int find_distal(const Skeleton &skeleton, const MapRow &row)
+{
+    try {
+        return find_joint(skeleton, row.distal);
+    } catch (const CharacterError &) {
+        if (row.segment != DeLevaSegment::hand && row.segment != DeLevaSegment::foot)
+            throw;
+        const int own = skeleton.find(row.source);
+        for (int j = 0; j < static_cast<int>(skeleton.joints.size()); ++j)
+            if (skeleton.joints[j].parent == own && skeleton.joints[j].end_site)
+                return j;
+        throw;
+    }
+}
+
 // Mocap joints from `ancestor` (exclusive) down to `joint` (inclusive), parent-most first.
 std::vector<int> path_between(const Skeleton &skeleton, int ancestor, int joint)
 {
@@ -420,7 +440,7 @@ CharacterModel CharacterModel::from_skeleton(const Skeleton &skeleton,
     std::vector<int> source(kBodies), distal(kBodies);
     for (int b = 0; b < kBodies; ++b) {
         source[b] = find_joint(skeleton, kMap[b].source);
-        distal[b] = find_joint(skeleton, kMap[b].distal);
+        distal[b] = find_distal(skeleton, kMap[b]);
     }
     check_segment_lengths(skeleton, source, distal);
     const double size_ratio = limb_size_ratio(skeleton, source, distal);
@@ -673,18 +693,22 @@ ReferenceMotion::ReferenceMotion(const CharacterModel &model, const Motion &moti
         throw CharacterError("reference filter: spike threshold must be >= 0 rad");
     if (!(std::isfinite(filter.smooth_cutoff_hz) && filter.smooth_cutoff_hz >= 0.0))
         throw CharacterError("reference filter: smoothing cutoff must be >= 0 Hz");
+    if (!(std::isfinite(filter.spike_reference_rate_hz) && filter.spike_reference_rate_hz >= 0.0))
+        throw CharacterError("reference filter: spike reference rate must be >= 0 Hz");
     const int n = frames();
     auto angle = [](const Eigen::Quaterniond &a, const Eigen::Quaterniond &b) {
         return 2.0 * std::acos(std::min(1.0, std::fabs(a.dot(b))));
     };
     if (filter.spike_threshold_rad > 0.0) {
+        const double slower = std::max(1.0, filter.spike_reference_rate_hz / frame_rate_hz_);
+        const double threshold_rad = filter.spike_threshold_rad * slower * slower;
         for (int j = 0; j < CharacterModel::kJoints; ++j) {
             for (int f = 1; f + 1 < n; ++f) {
                 const Eigen::Quaterniond &a = frames_[f - 1].local[j];
                 const Eigen::Quaterniond &b = frames_[f + 1].local[j];
                 const Eigen::Quaterniond mid = a.slerp(0.5, b);
                 const double off = angle(frames_[f].local[j], mid);
-                if (off > filter.spike_threshold_rad && angle(a, b) < off) {
+                if (off > threshold_rad && angle(a, b) < off) {
                     frames_[f].local[j] = mid;
                     ++spikes_removed_;
                 }

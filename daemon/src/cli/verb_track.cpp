@@ -88,7 +88,7 @@ void track_usage(std::ostream &out)
            "  --smooth-kernel butterworth|gaussian   its kernel (default butterworth: the\n"
            "                         zero-phase 2nd-order Butterworth, docs/mocap.md)\n"
            "  --despike-deg DEG      replace one-frame spikes larger than DEG (default 5;\n"
-           "                         0: off)\n"
+           "                         0: off; below 120 Hz, DEG x (120 / rate)^2)\n"
            "  --tip-smooth-hz HZ     low-pass of the stick tips (X^T and the errors; default:\n"
            "                         --smooth-hz; 0: de-spiked only)\n"
            "  --ik-iterations N      feedback IK iterations per step (default 2; 0: to\n"
@@ -392,6 +392,10 @@ void load_track_input(TrackArgs &t, TrackInput &in)
     std::array<int, 2> stick_tracks = {-1, -1};
     if (t.stick_only) {
         capture = load_marker_csv(t.mocap, t.sticks.csv);
+        if (capture.time_s.size() < 2) // no motion to track, nor a rate
+            throw MocapError(t.mocap, 0,
+                             "expected at least two frames (data rows) of the sticks, got " +
+                                 std::to_string(capture.time_s.size()));
         try {
             stick_tracks = find_stick_tracks(capture, t.sticks.left_stick, t.sticks.right_stick);
         } catch (const CharacterError &e) {
@@ -417,6 +421,17 @@ void load_track_input(TrackArgs &t, TrackInput &in)
     if (t.stick_only) {
         in.tips = place_behind_sticks(model, in.reference->frame(0), capture, stick_tracks);
         t.options.tip_reference = &in.tips;
+        if (t.options.drum_auto) {
+            // A capture with no stroke (sticks held still) has nowhere to put
+            // the drum: say which file, and what to give instead.
+            try {
+                fit_drum_to_turnarounds(in.tips, t.character.stick.tip_radius_m);
+            } catch (const CharacterError &e) {
+                throw MocapError(t.mocap, 0,
+                                 std::string(e.what()) +
+                                     "; give the drum's place instead: --drum X,Y,Z (m)");
+            }
+        }
     } else if (t.tip_smooth_hz >= 0.0 && t.tip_smooth_hz != t.clip.filter.smooth_cutoff_hz) {
         // The stick tips' own clean-up (docs/mocap.md): de-spiked as the joints,
         // low-passed at --tip-smooth-hz.

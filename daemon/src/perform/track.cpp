@@ -97,6 +97,7 @@ ReferenceFilter track_reference_filter()
 {
     ReferenceFilter f;
     f.kernel = ReferenceFilter::Kernel::butterworth;
+    f.spike_reference_rate_hz = 120.0; // 80_13's rate, where 5 degrees was chosen
     return f;
 }
 

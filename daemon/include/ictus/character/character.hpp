@@ -185,6 +185,13 @@ struct ReferenceFilter {
     // while the neighbours are closer than it to each other, is replaced by
     // that midpoint (one-frame spikes). 0 disables.
     double spike_threshold_rad = 5.0 * EIGEN_PI / 180.0; // 5 degrees
+    // 0: the threshold holds at any frame rate. > 0 (track_reference_filter:
+    // 120 Hz): it holds at this rate and above and grows as (this rate / the
+    // motion's rate)^2 below: a real turn of angular acceleration a lies
+    // a h^2 / 2 off its neighbours' midpoint (h the frame interval), so a
+    // stroke's turn 3 degrees off at 120 Hz is 48 degrees off at 30 Hz, and a
+    // fixed 5 degrees takes every stroke's turn of a 30 Hz capture for a spike.
+    double spike_reference_rate_hz = 0.0;
     // Zero-phase low-pass smoothing in each frame's tangent space. 0 disables.
     double smooth_cutoff_hz = 10.0;
     // Its kernel. gaussian: sigma = 1 / (2 pi cutoff), response
