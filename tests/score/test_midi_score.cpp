@@ -485,6 +485,13 @@ TEST_CASE("midi in: a run of alternating strokes starts on the hand that leaves 
         CHECK(c.score.notes[i].hand == (i % 2 == 0 ? Side::right : Side::left));
 }
 
+// The full kit's places (m: right, up, forward; kit.cpp), for the sticking's moves.
+const std::vector<MidiDrum> kFullKit = {
+    {"snare", 38, true, {0.0, 0.0, 0.0}},      {"tom1", 48, true, {-0.15, 0.23, 0.30}},
+    {"tom2", 47, true, {0.19, 0.21, 0.32}},    {"floor", 43, true, {0.56, 0.0, -0.20}},
+    {"crash", 49, true, {-0.64, 0.30, 0.36}},  {"ride", 51, true, {0.62, 0.22, 0.28}},
+    {"hihat", 42, true, {-0.42, 0.26, -0.02}}, {"kick", 36, true, {0.0, 0.28, 0.27}}};
+
 TEST_CASE("midi in: a run whose crash is out of reach as it stands is turned for any gain",
           "[score][midi]")
 {
@@ -495,11 +502,7 @@ TEST_CASE("midi in: a run whose crash is out of reach as it stands is turned for
     // 134 ms, 6.3 m/s, and the crash was 33 ms late. Turned, its fastest move is 5.2 m/s:
     // less than the 0.8 gain asks, but as it stands no arm makes it (above
     // kMidiPedalHihatAbove_mps), so any gain turns it.
-    const std::vector<MidiDrum> kit = {
-        {"snare", 38, true, {0.0, 0.0, 0.0}},      {"tom1", 48, true, {-0.15, 0.23, 0.30}},
-        {"tom2", 47, true, {0.19, 0.21, 0.32}},    {"floor", 43, true, {0.56, 0.0, -0.20}},
-        {"crash", 49, true, {-0.64, 0.30, 0.36}},  {"ride", 51, true, {0.62, 0.22, 0.28}},
-        {"hihat", 42, true, {-0.42, 0.26, -0.02}}, {"kick", 36, true, {0.0, 0.28, 0.27}}};
+    const std::vector<MidiDrum> &kit = kFullKit;
     Track track(112.0);
     auto at = [&](int tick, int note, int velocity) { track.at(tick, note, velocity); };
     for (int e = 0; e < 8; ++e) {
@@ -541,11 +544,7 @@ TEST_CASE("midi in: a ghost note a 16th after the right hand's hi-hat, before a 
     // fill on the left, a 16th from the crash; turned, the ghost is the right's, from the
     // hi-hat (0.49 m + a stroke's 0.1 m) in one 16th, 3.9 m/s: it struck 30 ms early. With
     // a double somewhere in the run no hand has to move that fast.
-    const std::vector<MidiDrum> kit = {
-        {"snare", 38, true, {0.0, 0.0, 0.0}},      {"tom1", 48, true, {-0.15, 0.23, 0.30}},
-        {"tom2", 47, true, {0.19, 0.21, 0.32}},    {"floor", 43, true, {0.56, 0.0, -0.20}},
-        {"crash", 49, true, {-0.64, 0.30, 0.36}},  {"ride", 51, true, {0.62, 0.22, 0.28}},
-        {"hihat", 42, true, {-0.42, 0.26, -0.02}}, {"kick", 36, true, {0.0, 0.28, 0.27}}};
+    const std::vector<MidiDrum> &kit = kFullKit;
     const double bpm = 99.0;
     Track track(bpm);
     for (int e = 0; e < 8; ++e) {
