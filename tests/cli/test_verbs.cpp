@@ -754,7 +754,8 @@ TEST_CASE("render: missed and off-time notes, strikes of no note and a score wit
 
 // --wav-bits 8 was refused as "got '8.000000'", --wav-rate 44100.5 was cut to
 // 44100 without a word, and --score given a folder said it was empty.
-TEST_CASE("render: a bad value is quoted as typed, a fractional rate refused, a folder is no score",
+TEST_CASE("render: a bad value is quoted as typed, a fractional count or rate refused, a folder is "
+          "no score, a stick capture is track's",
           "[cli][verbs]")
 {
     const fs::path dir = scratch("render-values");
@@ -767,7 +768,13 @@ TEST_CASE("render: a bad value is quoted as typed, a fractional rate refused, a 
         {{"--wav-bits", "8"}, 2, "--wav-bits: expected 16, 24 or 32, got '8'"},
         {{"--wav-rate", "44100.5"}, 2, "--wav-rate: expected a whole number of Hz, got '44100.5'"},
         {{"--midi-channel", "2.5"}, 2, "--midi-channel: expected a whole number 1..16, got '2.5'"},
+        {{"--rehearse", "1.5"}, 2, "--rehearse: expected a whole number 0..5, got '1.5'"},
         {{"--score", dir.string()}, 1, "--score: '" + dir.string() + "' is a folder"},
+        // A stick-only capture is track's, not render's: said before any file is read.
+        {{"--mocap", "take.CSV"},
+         2,
+         "--mocap take.CSV: run and render play a BVH capture of the whole body; a stick-only "
+         ".csv capture is played by `ictusd track --mode cartesian --mocap take.CSV`"},
     };
     int k = 0;
     for (const auto &c : cases) {

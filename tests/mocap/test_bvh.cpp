@@ -214,6 +214,41 @@ TEST_CASE("BVH: the channel order decides the composition", "[mocap][bvh]")
     require_near(tip("Xrotation Zrotation"), {-1, 0, 0}, 1e-12);
 }
 
+TEST_CASE("BVH: a body lying in the first frame (a z-up capture) is said, not refused",
+          "[mocap][bvh]")
+{
+    // Hips -> Spine -> Head, the spine along `axis`; the root turned by `turn` degrees
+    // about x in the motion. Upright (y): nothing said. Along z, or y turned -90 about x
+    // (a z-up exporter's frame): a warning with the angle from +y, computed here from the
+    // axis: 90 degrees. Seeded tilts: said exactly when the tilt is beyond 60 degrees.
+    auto warned = [](const std::string &axis, double turn) {
+        const std::string text = "HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 3 Xrotation "
+                                 "Yrotation Zrotation\nJOINT Spine\n{\nOFFSET " +
+                                 axis + "\nCHANNELS 0\nJOINT Head\n{\nOFFSET " + axis +
+                                 "\nCHANNELS 0\nEnd Site\n{\nOFFSET 0 0 0\n}\n}\n}\n}\n"
+                                 "MOTION\nFrames: 1\nFrame Time: 0.01\n" +
+                                 std::to_string(turn) + " 0 0\n";
+        std::istringstream in(text);
+        MocapWarnings warnings;
+        parse_bvh(in, "up.bvh", {}, &warnings);
+        return warnings;
+    };
+    CHECK(warned("0 0.3 0", 0.0).empty());
+    const MocapWarnings z = warned("0 0 0.3", 0.0);
+    REQUIRE(z.size() == 1);
+    CHECK(z[0].find("up.bvh: the body's hips-to-head line is 90 degrees from up (+y)") == 0);
+    CHECK(warned("0 0.3 0", -90.0).size() == 1);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> tilt(0.0, 120.0);
+    for (int k = 0; k < 20; ++k) {
+        const double t = tilt(rng);
+        if (std::abs(t - 60.0) < 0.5)
+            continue;
+        INFO("tilt " << t);
+        CHECK(warned("0 0.3 0", t).size() == (t > 60.0 ? 1u : 0u));
+    }
+}
+
 TEST_CASE("BVH: position channels on a non-root joint", "[mocap][bvh]")
 {
     // Root turned 90 deg about y, which maps (x, y, z) to (z, y, -x). Joint a

@@ -485,6 +485,13 @@ TEST_CASE("midi in: a run of alternating strokes starts on the hand that leaves 
         CHECK(c.score.notes[i].hand == (i % 2 == 0 ? Side::right : Side::left));
 }
 
+// The full kit's places (m: right, up, forward; kit.cpp), for the sticking's moves.
+const std::vector<MidiDrum> kFullKit = {
+    {"snare", 38, true, {0.0, 0.0, 0.0}},      {"tom1", 48, true, {-0.15, 0.23, 0.30}},
+    {"tom2", 47, true, {0.19, 0.21, 0.32}},    {"floor", 43, true, {0.56, 0.0, -0.20}},
+    {"crash", 49, true, {-0.64, 0.30, 0.36}},  {"ride", 51, true, {0.62, 0.22, 0.28}},
+    {"hihat", 42, true, {-0.42, 0.26, -0.02}}, {"kick", 36, true, {0.0, 0.28, 0.27}}};
+
 TEST_CASE("midi in: a run whose crash is out of reach as it stands is turned for any gain",
           "[score][midi]")
 {
@@ -495,11 +502,7 @@ TEST_CASE("midi in: a run whose crash is out of reach as it stands is turned for
     // 134 ms, 6.3 m/s, and the crash was 33 ms late. Turned, its fastest move is 5.2 m/s:
     // less than the 0.8 gain asks, but as it stands no arm makes it (above
     // kMidiPedalHihatAbove_mps), so any gain turns it.
-    const std::vector<MidiDrum> kit = {
-        {"snare", 38, true, {0.0, 0.0, 0.0}},      {"tom1", 48, true, {-0.15, 0.23, 0.30}},
-        {"tom2", 47, true, {0.19, 0.21, 0.32}},    {"floor", 43, true, {0.56, 0.0, -0.20}},
-        {"crash", 49, true, {-0.64, 0.30, 0.36}},  {"ride", 51, true, {0.62, 0.22, 0.28}},
-        {"hihat", 42, true, {-0.42, 0.26, -0.02}}, {"kick", 36, true, {0.0, 0.28, 0.27}}};
+    const std::vector<MidiDrum> &kit = kFullKit;
     Track track(112.0);
     auto at = [&](int tick, int note, int velocity) { track.at(tick, note, velocity); };
     for (int e = 0; e < 8; ++e) {
@@ -529,6 +532,71 @@ TEST_CASE("midi in: a run whose crash is out of reach as it stands is turned for
     CHECK(crash->hand == Side::left);
     CHECK(last_fill->drum == "snare");
     CHECK(last_fill->hand == Side::right); // the fill ends on the hand that is not crashing
+}
+
+TEST_CASE("midi in: a ghost note a 16th after the right hand's hi-hat, before a fill into a "
+          "crash, is the left's: a double, not a cross",
+          "[score][midi]")
+{
+    // A new user's groove (99 bpm, a 16th 152 ms): hi-hat 8ths, the snare on 2 and 4, the
+    // kick on 1 and 3, a ghost snare a 16th after the last hi-hat, a fill of 16ths 38 38 48
+    // 48 47 47 43 43, the crash and kick a 16th after it. Singles from the ghost on end the
+    // fill on the left, a 16th from the crash; turned, the ghost is the right's, from the
+    // hi-hat (0.49 m + a stroke's 0.1 m) in one 16th, 3.9 m/s: it struck 30 ms early. With
+    // a double somewhere in the run no hand has to move that fast.
+    const std::vector<MidiDrum> &kit = kFullKit;
+    const double bpm = 99.0;
+    Track track(bpm);
+    for (int e = 0; e < 8; ++e) {
+        track.at(48 * e, 42, 80);
+        if (e == 0 || e == 4)
+            track.at(48 * e, 36, 100);
+        if (e == 2 || e == 6)
+            track.at(48 * e, 38, 100);
+    }
+    track.at(360, 38, 21);
+    const int fill[8] = {38, 38, 48, 48, 47, 47, 43, 43};
+    for (int k = 0; k < 8; ++k)
+        track.at(384 + 24 * k, fill[k], 100);
+    track.at(576, 49, 120);
+    track.at(576, 36, 110);
+    const MidiDrumPart part = drum_part_score(read_smf(track.file(), "g.mid"), kit, "g.mid");
+    REQUIRE(part.score.notes.size() == 23);
+    check_hands_apart(part, bpm);
+    // Each hand's moves, from the places here: no move faster than an arm reaches in time.
+    auto place = [&](const std::string &name) {
+        const auto d =
+            std::find_if(kit.begin(), kit.end(), [&](const MidiDrum &k) { return k.name == name; });
+        REQUIRE(d != kit.end());
+        return d->place_m;
+    };
+    auto apart = [&](const std::string &a, const std::string &b) {
+        const double *p = place(a), *q = place(b);
+        return std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+    };
+    for (Side h : {Side::left, Side::right}) {
+        const ScoreNote *last = nullptr;
+        for (const ScoreNote &n : part.score.notes) {
+            if (n.foot || n.hand != h)
+                continue;
+            if (last && n.beat > last->beat) {
+                const double dt = (n.beat - last->beat) * 60.0 / bpm;
+                const double v = (apart(n.drum, last->drum) + 0.1) / dt;
+                INFO((h == Side::left ? "left " : "right ")
+                     << last->drum << " -> " << n.drum << " in " << dt << " s");
+                CHECK(v <= kMidiPedalHihatAbove_mps);
+            }
+            last = &n;
+        }
+    }
+    for (const ScoreNote &n : part.score.notes) {
+        if (n.drum == "snare" && n.beat == Approx(3.75))
+            CHECK(n.hand == Side::left); // the ghost
+        if (n.drum == "crash")
+            CHECK(n.hand == Side::left);
+        if (n.drum == "hihat")
+            CHECK(n.hand == Side::right);
+    }
 }
 
 TEST_CASE("midi in: under the hi-hat a flam keeps its accent and leaves out its grace",

@@ -6,7 +6,9 @@
 #include "ictus/score/midi_score.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -264,9 +266,18 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
                               double &duration)
 {
     auto value = [&]() { return args.value(a); };
-    if (a == "--mocap")
+    if (a == "--mocap") {
         o.mocap = value();
-    else if (parse_bvh_option(a, args, o.scale_m_per_unit, o.skip_frames))
+        std::string ext = std::filesystem::path(o.mocap).extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(),
+                       [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        if (ext == ".csv")
+            throw UsageError("--mocap " + o.mocap +
+                             ": run and render play a BVH capture of the whole body; a "
+                             "stick-only .csv capture is played by `ictusd track --mode "
+                             "cartesian --mocap " +
+                             o.mocap + "` (docs/mocap.md)");
+    } else if (parse_bvh_option(a, args, o.scale_m_per_unit, o.skip_frames))
         ;
     else if (a == "--duration")
         duration = parse_number(a, value(), 1e-3, 1e7);

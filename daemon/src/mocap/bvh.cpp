@@ -8,6 +8,7 @@
 #include "ictus/mocap/capture_bounds.hpp"
 #include "text_lines.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -519,6 +520,29 @@ class BvhParser
     BoundsReport bounds_{source_, options_.accept_out_of_bounds, warnings_};
 };
 
+// A body whose hips-to-head line in the first frame is further than
+// kUprightMaxDeg from +y (BVH is read y up): most likely a z-up capture, which
+// the character would play lying down. Said, not refused (a performer may lie).
+constexpr double kUprightMaxDeg = 60.0;
+
+void warn_if_not_upright(const BvhFile &bvh, const std::string &source, MocapWarnings *warnings)
+{
+    const int hips = bvh.skeleton.find("Hips"), head = bvh.skeleton.find("Head");
+    if (!warnings || hips < 0 || head < 0 || bvh.motion.frames() == 0)
+        return;
+    const std::vector<Eigen::Vector3d> p = bvh_forward_kinematics(bvh, 0);
+    const Eigen::Vector3d up =
+        p[static_cast<std::size_t>(head)] - p[static_cast<std::size_t>(hips)];
+    if (up.norm() < 1e-9)
+        return;
+    const double deg = std::acos(std::clamp(up.normalized().y(), -1.0, 1.0)) * 180.0 / M_PI;
+    if (deg > kUprightMaxDeg)
+        warnings->push_back(source + ": the body's hips-to-head line is " +
+                            std::to_string(static_cast<int>(std::lround(deg))) +
+                            " degrees from up (+y) in the first frame: a z-up capture? BVH is "
+                            "read y up: the character would play it lying (docs/mocap.md)");
+}
+
 } // namespace
 
 int BvhFile::channelled_joints() const
@@ -539,7 +563,9 @@ BvhFile parse_bvh(std::istream &in, const std::string &source_name, const BvhOpt
 {
     const std::vector<std::string> lines = detail::read_lines(in, source_name, kMaxFileBytes);
     BvhParser parser(lines, source_name, options, warnings);
-    return parser.parse();
+    BvhFile bvh = parser.parse();
+    warn_if_not_upright(bvh, source_name, warnings);
+    return bvh;
 }
 
 BvhFile read_bvh(const std::string &path, const BvhOptions &options, MocapWarnings *warnings)

@@ -373,10 +373,13 @@ void turn_runs(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes
             e + 1 == n || fixed(e + 1) || notes[e + 1].t - notes[e].t >= kMidiAlternateBelow_s;
         if (!open_in || !open_out)
             continue;
-        // The fastest move into and out of the run with its hands as they are (turn 0) or
-        // turned (turn 1); infinite when a hand would strike too soon.
-        auto fastest = [&](int turn) {
+        // The fastest move into and out of the run with its notes from `from` on turned
+        // (e + 1: as they are; s: all), and, when from is inside it, between the notes
+        // from - 1 and from, which one hand then plays (a double); infinite when a hand
+        // would strike too soon.
+        auto fastest = [&](size_t from) {
             double worst = 0.0;
+            auto played = [&](size_t i) { return hand(i) ^ (i >= from ? 1 : 0); };
             for (int h = 0; h < 2; ++h) {
                 const HandNote *before = nullptr, *after = nullptr, *first = nullptr,
                                *last = nullptr;
@@ -388,7 +391,7 @@ void turn_runs(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes
                 for (size_t i = e + 1; i < n && !after; ++i)
                     after = hand(i) == h ? &notes[i] : nullptr;
                 for (size_t i = s; i <= e; ++i)
-                    if ((hand(i) ^ turn) == h) {
+                    if (played(i) == h) {
                         first = first ? first : &notes[i];
                         last = &notes[i];
                     }
@@ -400,15 +403,40 @@ void turn_runs(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes
                 worst = std::max({worst, before ? move_speed(drums, *before, *first) : 0.0,
                                   after ? move_speed(drums, *last, *after) : 0.0});
             }
+            if (from > s && from <= e) {
+                if (notes[from].t - notes[from - 1].t < kMidiSameHandMin_s)
+                    return std::numeric_limits<double>::infinity();
+                worst = std::max(worst, move_speed(drums, notes[from - 1], notes[from]));
+            }
             return worst;
         };
         // Turned when that gains enough, or at all when a move as it is is beyond what an
         // arm reaches in time (a fill's last note a 16th before the crash, 0.74 m away).
-        const double as_is = fastest(0), turned = fastest(1);
-        if (!(turned < kMidiTurnRunGain * as_is ||
-              (as_is > kMidiPedalHihatAbove_mps && turned < as_is)))
-            continue;
-        for (size_t i = s; i <= e; ++i) {
+        const double as_is = fastest(e + 1), turned = fastest(s);
+        size_t from = e + 1;
+        if (turned < kMidiTurnRunGain * as_is ||
+            (as_is > kMidiPedalHihatAbove_mps && turned < as_is))
+            from = s;
+        // When the better of the two still asks a move beyond what an arm reaches in time
+        // (a ghost note a 16th after the right hand's hi-hat, before a fill that ends on the
+        // right for the crash), turned from a later note on when that gains enough: the
+        // hand of the note before it plays it too, a double (the ghost and the fill's first
+        // note by the left).
+        const double best = std::min(as_is, turned);
+        if (best > kMidiPedalHihatAbove_mps) {
+            double split = std::numeric_limits<double>::infinity();
+            size_t at = 0;
+            for (size_t j = s + 1; j <= e; ++j) {
+                const double v = fastest(j);
+                if (v < split) {
+                    split = v;
+                    at = j;
+                }
+            }
+            if (at > 0 && split < kMidiTurnRunGain * best)
+                from = at;
+        }
+        for (size_t i = from; i <= e; ++i) {
             ScoreNote &note = score[notes[i].index];
             note.hand = note.hand == Side::left ? Side::right : Side::left;
             if (!note.spot_given)
