@@ -377,7 +377,7 @@ void turn_runs(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes
         // (e + 1: as they are; s: all), and, when from is inside it, between the notes
         // from - 1 and from, which one hand then plays (a double); infinite when a hand
         // would strike too soon.
-        auto fastest = [&](size_t from) {
+        auto fastest = [&](size_t from, double *entry = nullptr) {
             double worst = 0.0;
             auto played = [&](size_t i) { return hand(i) ^ (i >= from ? 1 : 0); };
             for (int h = 0; h < 2; ++h) {
@@ -400,8 +400,10 @@ void turn_runs(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes
                 if ((before && first->t - before->t < kMidiSameHandMin_s) ||
                     (after && after->t - last->t < kMidiSameHandMin_s))
                     return std::numeric_limits<double>::infinity();
-                worst = std::max({worst, before ? move_speed(drums, *before, *first) : 0.0,
-                                  after ? move_speed(drums, *last, *after) : 0.0});
+                const double in = before ? move_speed(drums, *before, *first) : 0.0;
+                if (entry)
+                    *entry = std::max(*entry, in);
+                worst = std::max({worst, in, after ? move_speed(drums, *last, *after) : 0.0});
             }
             if (from > s && from <= e) {
                 if (notes[from].t - notes[from - 1].t < kMidiSameHandMin_s)
@@ -417,13 +419,15 @@ void turn_runs(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes
         if (turned < kMidiTurnRunGain * as_is ||
             (as_is > kMidiPedalHihatAbove_mps && turned < as_is))
             from = s;
-        // When the better of the two still asks a move beyond what an arm reaches in time
-        // (a ghost note a 16th after the right hand's hi-hat, before a fill that ends on the
-        // right for the crash), turned from a later note on when that gains enough: the
-        // hand of the note before it plays it too, a double (the ghost and the fill's first
-        // note by the left).
-        const double best = std::min(as_is, turned);
-        if (best > kMidiPedalHihatAbove_mps) {
+        // When the way chosen still asks a hand to come into the run faster than an arm
+        // reaches in time (a ghost note a 16th after the right hand's hi-hat, before a fill
+        // that ends on the right for the crash), turned from a later note on when that
+        // brings its fastest move to at most kMidiTurnRunGain of what it was: the hand of
+        // the note before it plays it too, a double (the ghost the left's, the fill ending
+        // on two strokes of the right on the floor tom).
+        double entry = 0.0;
+        const double chosen = fastest(from, &entry);
+        if (entry > kMidiPedalHihatAbove_mps) {
             double split = std::numeric_limits<double>::infinity();
             size_t at = 0;
             for (size_t j = s + 1; j <= e; ++j) {
@@ -433,7 +437,7 @@ void turn_runs(std::vector<ScoreNote> &score, const std::vector<HandNote> &notes
                     at = j;
                 }
             }
-            if (at > 0 && split < kMidiTurnRunGain * best)
+            if (at > 0 && split < kMidiTurnRunGain * chosen)
                 from = at;
         }
         for (size_t i = from; i <= e; ++i) {
