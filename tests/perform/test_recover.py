@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Four passages of a drum part that ask more than the hands can do in time, and what the
+"""Five passages of a drum part that ask more than the hands can do in time, and what the
 drummer does with them (docs/midi.md, "Beyond the song"), through the real `ictusd render
 --kit full --midi` of parts written here (mido, 140 bpm unless said, 480 ticks a quarter):
 
@@ -18,6 +18,12 @@ drummer does with them (docs/midi.md, "Beyond the song"), through the real `ictu
   sticking starts it on the left (docs/midi.md), so the right plays the last 16th and the
   left has two. Asserted: every note found within 5 ms, the crash by the left hand, the
   fill begun on the left and ended on the right.
+- **a ghost note into a fill** (99 bpm): a bar of 8th-note hi-hat and backbeat, a ghost snare
+  a 16th after the last hi-hat, a fill of 16ths (snare, tom1, tom2, floor tom, two each) into a
+  crash with the kick. Singles from the ghost on would end the fill on the left, a 16th from
+  the crash; turned whole, the ghost was the right's, from the hi-hat in a 16th, 30 ms early.
+  The sticking gives the ghost to the left and ends the fill on a double of the right on the
+  floor tom (docs/midi.md). Asserted: every note found within 5 ms, the ghost the left's.
 - **a fill into a crash with the hi-hat going on**, seeded: a bar of the groove at 100-130 bpm,
   then two beats of 16ths wandering over the toms and ending on the snare or tom1, the crash
   and the kick on the downbeat, and a bar of 8th-note hi-hat. On the downbeat both hands would
@@ -131,6 +137,32 @@ def fill_into_crash(ictusd, work):
           "the fill begun on the left and ended on the right, the crash by the left")
 
 
+def ghost_into_fill(ictusd, work):
+    """A new user's groove at 99 bpm: hi-hat 8ths, a ghost snare a 16th after the last one,
+    a fill of 16ths 38 38 48 48 47 47 43 43 into a crash with the kick."""
+    e8, e16 = TPQ // 2, TPQ // 4
+    notes = []
+    for i in range(8):
+        notes.append((i * e8, 42, 80))
+        if i in (0, 4):
+            notes.append((i * e8, 36, 100))
+        if i in (2, 6):
+            notes.append((i * e8, 38, 100))
+    notes.append((7 * e8 + e16, 38, 21))
+    fill = [38, 38, 48, 48, 47, 47, 43, 43]
+    notes += [(4 * TPQ + k * e16, tom, 100) for k, tom in enumerate(fill)]
+    notes += [(6 * TPQ, 49, 120), (6 * TPQ, 36, 110)]
+    rows = render(ictusd, work, "ghost-into-fill", notes, bpm=99.0)
+    ghost = [r for r in rows if r["drum"] == "snare" and abs(r["t"] - (1.0 + 3.75 * 60 / 99.0))
+             < 1e-4]
+    lost = [(r["t"], r["drum"], r["hand"], r["error_ms"]) for r in rows if not found(r)]
+    print("ghost into a fill: %d notes, the ghost's hand %s" % (len(rows),
+                                                                [r["hand"] for r in ghost]))
+    check(not lost, "every note found within 5 ms (the ghost was the right's, from the hi-hat "
+          "in a 16th, 30 ms early): %s" % lost)
+    check([r["hand"] for r in ghost] == ["left"], "the ghost the left's")
+
+
 def fill_hihat_on(ictusd, work, seeds=range(1, 9)):
     e8, e16 = TPQ // 2, TPQ // 4
     for seed in seeds:
@@ -209,6 +241,7 @@ def main():
     checks.keep_going()  # every passage is reported
     cymbal_change(a.ictusd, work)
     fill_into_crash(a.ictusd, work)
+    ghost_into_fill(a.ictusd, work)
     fill_hihat_on(a.ictusd, work, a.fill_seeds)
     song_crossings(a.ictusd, work)
     checks.finish()
