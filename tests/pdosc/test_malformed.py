@@ -60,6 +60,26 @@ for _ in range(300):
         b[i] ^= 1 << rng.randrange(8)
     fuzz.append(bytes(b))
 
+SENTINEL = message("/ictus/strike", "ii", 3, 4)
+TAGGED_BAD = 8  # the strikes of `bad` refused for their type tags (checked below)
+HANDSHAKE_S = 30.0
+
+
+def tagged(malformed):
+    return sum(1 for m in malformed if m[3] == "unexpected-type-tags")
+
+
+def wait_for_malformed(done, timeout=HANDSHAKE_S):
+    """Polls pd's reports until done(the `malformed` records so far), or the deadline."""
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        if done([a for _, a in fudi_records(reports.snapshot())
+                 if a[0] == "info" and len(a) > 3 and a[1] == "malformed"]):
+            return True
+        time.sleep(0.005)
+    return False
+
+
 reports = Listener()
 pd_port = free_udp_port()
 proc, work = start_pd(build_patch(build, pd_port, reports.port, 5.0), build)
@@ -67,16 +87,26 @@ out = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 sent = {}
 try:
     check(wait_for_ticks(reports), "pd runs in real time and reports ticks")
-    for i, packet in enumerate(bad):
-        out.sendto(packet, ("127.0.0.1", pd_port))
-        if i % 10 == 9:
-            time.sleep(0.005)  # stay well inside the socket's receive buffer
+    # Ten packets at a time, each ten waited for by handshake: pd's count of the
+    # malformed ones, reported to this script (a paced flood, 5 ms between tens, lost
+    # packets under a loaded ASan run: a socket's buffer overflows when pd or this
+    # script's listener is off the CPU, and a count was missing).
+    for i in range(0, len(bad), 10):
+        for packet in bad[i:i + 10]:
+            out.sendto(packet, ("127.0.0.1", pd_port))
+        n = min(i + 10, len(bad))
+        check(wait_for_malformed(lambda m: len(m) >= n), "pd counted the first %d malformed "
+              "packets within %.0f s" % (n, HANDSHAKE_S))
     out.sendto(good[:16], ("127.0.0.1", pd_port))
-    for i, packet in enumerate(fuzz):
-        out.sendto(packet, ("127.0.0.1", pd_port))
-        if i % 10 == 9:
-            time.sleep(0.005)
-    time.sleep(0.3)
+    # The fuzzed ones may be well formed or not: each ten is followed by a strike with
+    # the wrong type tags (no bit flip of the framing makes one), waited for as above.
+    for i in range(0, len(fuzz), 10):
+        for packet in fuzz[i:i + 10]:
+            out.sendto(packet, ("127.0.0.1", pd_port))
+        out.sendto(SENTINEL, ("127.0.0.1", pd_port))
+        n = TAGGED_BAD + i // 10 + 1
+        check(wait_for_malformed(lambda m: tagged(m) >= n), "pd took the fuzzed packets "
+              "%d-%d within %.0f s" % (i + 1, min(i + 10, len(fuzz)), HANDSHAKE_S))
     # All ten at once, the first 0.5 s ahead: what is judged is pd after the
     # flood, not this sender's pacing (paced 50 ms ahead, as the daemon does, a
     # loaded CI run stalled this script past three strikes' lookahead; the
@@ -99,8 +129,9 @@ check(proc.returncode == 0, "pd exited normally (%s)" % proc.returncode)
 malformed = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "malformed"]
 check(len(malformed) >= len(bad) and malformed[len(bad) - 1][2] == len(bad)
       and [m[2] for m in malformed] == list(range(1, len(malformed) + 1)),
-      "each of the %d malformed packets counted once (then %d of %d fuzzed ones)"
-      % (len(bad), len(malformed) - len(bad), len(fuzz)))
+      "each of the %d malformed packets counted once (then %d of %d fuzzed ones, and %d "
+      "strikes with the wrong type tags after each ten)"
+      % (len(bad), len(malformed) - len(bad) - len(fuzz) // 10, len(fuzz), len(fuzz) // 10))
 lines = [l for l in log.splitlines() if l.strip()]
 timetag_errors = [l for l in lines if "ictus_timetag: malformed OSC packet" in l]
 check(len(timetag_errors) == 5, "the first 5 malformed packets are reported by name (%d)"

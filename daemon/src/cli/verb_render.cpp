@@ -622,8 +622,10 @@ void rehearse(std::unique_ptr<Performance> &perf, std::unique_ptr<RenderRecordin
         const double wall_s = rec->wall_s + q->wall_s;
         rec->wall_s = wall_s;
         rec->passes = pass;
-        if (q->interrupted)
+        if (q->interrupted) { // Ctrl-C: the last whole pass is written, exit 130
+            rec->interrupted = true;
             break;
+        }
         const PassScore score = pass_score(match_of(*p, *q));
         if (!score.better_than(best)) {
             step.assign(lead.size(), 0.0);
