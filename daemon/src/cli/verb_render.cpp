@@ -68,7 +68,7 @@ void render_usage(std::ostream &out)
            "                      0: none)\n"
            "  --rehearse N        a score's notes struck more than 5 ms off their time: their\n"
            "                      strokes planned earlier or later by their errors and the\n"
-           "                      score played again, up to N times (0..5, default 3; 0: none;\n"
+           "                      score played again, up to N times (0..5, default 2; 0: none;\n"
            "                      docs/score.md, \"Rehearsal\")\n"
            "\n"
            "the sound (Pd in batch mode, as scripts/main.sh: patches/ictus-render.pd on the\n"
@@ -308,7 +308,7 @@ struct RenderArgs {
     std::string out_dir;
     bool force = false;
     double progress_every = 2.0;
-    int rehearse = 3; // rehearsal passes at most (docs/score.md, "Rehearsal")
+    int rehearse = 2; // rehearsal passes at most (docs/score.md, "Rehearsal")
     std::string wav;
     PdRenderOptions pd;
 };
@@ -590,7 +590,8 @@ MatchSummary match_of(const Performance &perf, const RenderRecording &rec)
 void rehearse(std::unique_ptr<Performance> &perf, std::unique_ptr<RenderRecording> &rec,
               RenderArgs &r)
 {
-    PassScore best = pass_score(match_of(*perf, *rec));
+    MatchSummary kept_match = match_of(*perf, *rec);
+    PassScore best = pass_score(kept_match);
     std::vector<double> step; // the last pass's change of the leads, when it was not kept
     for (int pass = 1; pass <= r.rehearse && !rec->interrupted; ++pass) {
         const std::vector<double> &kept = r.o.score.plan.note_lead_s;
@@ -598,7 +599,7 @@ void rehearse(std::unique_ptr<Performance> &perf, std::unique_ptr<RenderRecordin
         if (step.empty()) {
             // The first pass when a note is off; the next ones while any is
             // further off than kRehearseAbove_ms.
-            const MatchSummary m = match_of(*perf, *rec);
+            const MatchSummary &m = kept_match;
             const double above_ms = pass == 1 ? kOffTime_ms : kRehearseAbove_ms;
             bool off = false;
             for (const NoteMatch &k : m.notes)
@@ -626,7 +627,8 @@ void rehearse(std::unique_ptr<Performance> &perf, std::unique_ptr<RenderRecordin
             rec->interrupted = true;
             break;
         }
-        const PassScore score = pass_score(match_of(*p, *q));
+        MatchSummary match = match_of(*p, *q);
+        const PassScore score = pass_score(match);
         if (!score.better_than(best)) {
             step.assign(lead.size(), 0.0);
             for (size_t k = 0; k < lead.size(); ++k)
@@ -634,6 +636,7 @@ void rehearse(std::unique_ptr<Performance> &perf, std::unique_ptr<RenderRecordin
             continue;
         }
         best = score;
+        kept_match = std::move(match);
         step.clear();
         r.o.score.plan.note_lead_s = lead;
         perf = std::move(p);
