@@ -49,6 +49,8 @@ extern "C" {
 #define MEMBRANE_TENSION_MOD_MAX 100.0
 #define MEMBRANE_RADIATION_MIN   0.0 /* 0: no air radiation loss */
 #define MEMBRANE_RADIATION_MAX   100.0
+#define MEMBRANE_AIR_MASS_MIN    0.0 /* 0: no air's mass on the head */
+#define MEMBRANE_AIR_MASS_MAX    4.0
 #define MEMBRANE_LOSS_FACTOR_MIN 0.0 /* 0: no internal loss */
 #define MEMBRANE_LOSS_FACTOR_MAX 0.5
 #define MEMBRANE_PATCH_MIN       0.0 /* m; 0: a point */
@@ -87,6 +89,9 @@ extern "C" {
  * one side) and the film's internal loss factor eta (decay rate eta w / 2). */
 #define MEMBRANE_DEFAULT_RADIATION   0.5
 #define MEMBRANE_DEFAULT_LOSS_FACTOR 0.002
+/* The air's mass on the modes (docs/membrane.md, "The air's mass"): 0 for the bare head;
+ * 1 = the air on one face of a head in an infinite baffle. */
+#define MEMBRANE_DEFAULT_AIR_MASS 0.0
 /* The contact patch (docs/membrane.md, "The contact patch"): forces come in spread
  * evenly over a disc of this radius and a stick feels the static compliance of the modes
  * left out. 0 (the bare head's default): a point, no correction; the drum presets take
@@ -163,6 +168,12 @@ typedef enum membrane_param {
      * the stretching stiffness E h (1 = the bronze plate of that D and density; 0 = off);
      * a membrane ignores it */
     MEMBRANE_PARAM_VON_KARMAN,
+    /* The air's mass on a membrane's modes (docs/membrane.md, "The air's mass"): a factor
+     * on the mass the air on one face of the head in an infinite baffle adds to each mode
+     * (the reactive part of the radiation the "radiation" loss is the resistive part of;
+     * 1 = that air, 0 = none). Heavier, every mode rings lower, the (0, n) modes most; a
+     * plate ignores it. */
+    MEMBRANE_PARAM_AIR_MASS,
     MEMBRANE_PARAM_COUNT
 } membrane_param;
 

@@ -123,6 +123,7 @@ struct membrane {
     double sample_rate, radius, tension, density, t60, hf_damping, output_gain;
     double tension_mod;            /* dimensionless, MEMBRANE_PARAM_TENSION_MOD */
     double radiation, loss_factor; /* MEMBRANE_PARAM_RADIATION, MEMBRANE_PARAM_LOSS_FACTOR */
+    double air_mass;               /* MEMBRANE_PARAM_AIR_MASS (table.scale carries it) */
     double patch;                  /* m, MEMBRANE_PARAM_PATCH */
     /* A free-edge plate instead of a membrane (membrane_set_plate): its modes are the
      * plate's (mode_table.h) and ring at j c / (2 pi a) with c = sqrt(bending / density)

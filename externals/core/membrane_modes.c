@@ -104,8 +104,9 @@ static double mode_decay_rate(const membrane *m, int k, double omega)
     const double closed = 1.0 - m->openness;
     if (m->edge_damp > 0.0 && m->table.edge)
         rate += closed * closed * m->edge_damp * m->table.edge[k] / (2.0 * m->density * m->radius);
+    /* The power over the mode's energy, its air's mass included (scale^2 = 1 / (1 + beta)) */
     if (m->radiation > 0.0)
-        rate += m->radiation * radiation_rate(m, k, omega);
+        rate += m->radiation * radiation_rate(m, k, omega) * m->table.scale[k] * m->table.scale[k];
     return rate;
 }
 
@@ -120,7 +121,14 @@ void membrane_update_coefficients_(membrane *m, int rescale)
     m->mass_scale = 1.0 / sqrt(m->density * m->radius * m->radius);
     m->coef_h = h;
     const double scale = m->mass_scale;
+    /* The air's mass on each mode (a plate's table has none): its scale before and now */
+    const double beta = m->plate ? 0.0 : m->air_mass * MEMBRANE_AIR_RHO * m->radius / m->density;
+    if (beta > 0.0)
+        mode_table_prepare_air(&m->table);
     for (int k = 0; k < m->capacity; k++) {
+        const double air_was = m->table.scale[k];
+        m->table.scale[k] = beta > 0.0 ? 1.0 / sqrt(1.0 + beta * m->table.air[k]) : 1.0;
+        const double air_ratio = air_was / m->table.scale[k];
         double old_omega = m->omega_model[k];
         int fading = k >= m->modes;
         double freq = (k < m->fading_modes) ? mode_table_tuned_j(&m->table, k, &m->tuning) * c /
@@ -171,7 +179,7 @@ void membrane_update_coefficients_(membrane *m, int rescale)
             /* y = q / (sqrt(M) w'), y' = p / sqrt(M), sqrt(M) proportional to 1/scale;
              * q = h w' r, so r scales by old_h / h (w' cancels); the stored r / sc and
              * p / sc by old_sc / sc besides. */
-            double r = old_scale / scale * (old_sc / m->sc[k]);
+            double r = old_scale / scale * (old_sc / m->sc[k]) * air_ratio;
             m->q[k] = (float)(m->q[k] * r * old_h / h);
             m->p[k] = (float)(m->p[k] * r);
         } else if (rescale) {
@@ -295,6 +303,8 @@ static void mode_arrays_install(membrane *m, mode_arrays *a, int cap)
         memcpy(f[ARR_SC], m->sc, sizeof(float) * (size_t)keep); /* the state's scale */
         memcpy(f[ARR_WM], m->wm, sizeof(float) * (size_t)keep);
         memcpy(a->omega_model, m->omega_model, sizeof(double) * (size_t)keep);
+        if (m->table.scale && m->table.size >= keep) /* the air's scale the state is in */
+            memcpy(a->table.scale, m->table.scale, sizeof(double) * (size_t)keep);
     }
     membrane_free_mode_arrays_(m);
     m->table = a->table;

@@ -16,15 +16,18 @@ static ictus_status physics_changed(void *m, ictus_status s)
     return s;
 }
 
-/* After the radius or the contact patch changed: the input shapes follow (their
- * patch is relative to the radius), then as physics_changed. */
+/* After the radius, the density, the air's mass or the contact patch changed: as
+ * physics_changed, the shapes following the coefficients (the air's load on each mode
+ * scales its shape; a patch is relative to the radius). */
 static ictus_status geometry_changed(void *mv, ictus_status s)
 {
     membrane *m = mv;
     membrane_flush_points_(m);
+    membrane_update_coefficients_(m, 1);
     if (m->table.j)
         membrane_refresh_shapes_(m);
-    return physics_changed(m, s);
+    membrane_refresh_couplings_(m);
+    return s;
 }
 
 /* After the tension modulation's amount changed: it is read live, but a head's energy
@@ -125,7 +128,7 @@ static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
     [MEMBRANE_PARAM_RADIUS] = {"radius", "m", RANGE(RADIUS), FIELD(radius), geometry_changed},
     [MEMBRANE_PARAM_TENSION] = {"tension", "N/m", RANGE(TENSION), FIELD(tension), physics_changed},
     [MEMBRANE_PARAM_DENSITY] = {"density", "kg/m^2", RANGE(DENSITY), FIELD(density),
-                                physics_changed},
+                                geometry_changed},
     [MEMBRANE_PARAM_MASS] = {"mass", "kg", {0, 0, 0}, 0, NULL, set_mass, get_mass, mass_range},
     [MEMBRANE_PARAM_MODES] = {"modes", "", RANGE(MODES), 0, NULL, set_modes, get_modes, NULL},
     [MEMBRANE_PARAM_T60] = {"t60", "s", RANGE(T60), FIELD(t60), physics_changed},
@@ -147,6 +150,7 @@ static const ictus_param_def membrane_param_def[MEMBRANE_PARAM_COUNT] = {
                                   physics_changed},
     [MEMBRANE_PARAM_VON_KARMAN] = {"vonkarman", "", RANGE(VON_KARMAN), FIELD(von_karman),
                                    physics_changed},
+    [MEMBRANE_PARAM_AIR_MASS] = {"airmass", "", RANGE(AIR_MASS), FIELD(air_mass), geometry_changed},
 };
 #undef RANGE
 #undef FIELD

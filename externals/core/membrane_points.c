@@ -52,8 +52,12 @@ static double residual_compliance(const membrane *m, const membrane_point *pt)
     if (m->plate || !pt->static_correction || !(eps > 0.0) || u * u >= 1.0 - eps)
         return 0.0;
     double modal = 0.0;
-    for (int k = 0; k < m->modes && k < m->table.size; k++)
-        modal += (double)pt->psi[k] * pt->psi[k] / (m->table.j[k] * m->table.j[k]);
+    for (int k = 0; k < m->modes && k < m->table.size; k++) {
+        /* psi carries the air's scale, and the mode rings at j scale: its static
+         * compliance is the bare mode's */
+        const double js = m->table.j[k] * m->table.scale[k];
+        modal += (double)pt->psi[k] * pt->psi[k] / (js * js);
+    }
     const double whole = (log((1.0 - u * u) / eps) + 0.25) / (2.0 * M_PI);
     return whole > modal ? (whole - modal) / m->tension : 0.0;
 }

@@ -50,6 +50,7 @@ ictus_status membrane_apply_preset(membrane *m, const membrane_preset *p)
         {MEMBRANE_PARAM_MODES, p->modes > 0 ? p->modes : MEMBRANE_DEFAULT_MODES},
         {MEMBRANE_PARAM_TENSION_MOD, bare ? 0.0 : MEMBRANE_DEFAULT_TENSION_MOD},
         {MEMBRANE_PARAM_RADIATION, bare ? 0.0 : MEMBRANE_DEFAULT_RADIATION},
+        {MEMBRANE_PARAM_AIR_MASS, bare ? 0.0 : p->air_mass},
         {MEMBRANE_PARAM_LOSS_FACTOR, p->plate ? MEMBRANE_PRESET_BRONZE_LOSS
                                      : bare   ? 0.0
                                               : MEMBRANE_DEFAULT_LOSS_FACTOR},

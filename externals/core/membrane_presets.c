@@ -20,41 +20,41 @@
 static const membrane_preset presets[] = {
     /* The head of the paper's figures and of the Bessel tests: membrane.h's head without tension modulation or physical losses. */
     {"paper", "14-inch Mylar head, 0.19 mm, 3000 N/m, linear (the paper's head)",
-     0.178, 3000.0, 0.262, 1.0, 1.0, 128, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 1, 0, 0.0, 0.0, 0.0},
+     0.178, 3000.0, 0.262, 1.0, 1.0, 128, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 1, 0, 0.0, 0.0, 0.0, 0.0},
     /* 14-inch snare, 0.25 mm batter (0.345 kg/m^2), (0,1) at 220 Hz. */
     {"snare", "14-inch snare drum, 0.25 mm Mylar batter, (0,1) at 220 Hz",
-     0.1778, 3603.0, 0.345, 0.5, 1.0, 0, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 1, 0, 0, 0.0, 0.0, 0.0},
+     0.1778, 3603.0, 0.345, 0.5, 1.0, 0, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 1, 0, 0, 0.0, 0.0, 0.0, 0.0},
     /* 12-inch rack tom, 0.25 mm batter, (0,1) at 150 Hz. */
     {"tom", "12-inch tom, 0.25 mm Mylar batter, (0,1) at 150 Hz",
-     0.1524, 1231.0, 0.345, 0.8, 1.0, 1024, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, DRUM_CASCADE},
+     0.1524, 1231.0, 0.345, 0.8, 1.0, 1024, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, DRUM_CASCADE, 0.0},
     /* 16-inch floor tom, 0.25 mm batter, (0,1) at 95 Hz. */
     {"floor-tom", "16-inch floor tom, 0.25 mm Mylar batter, (0,1) at 95 Hz",
-     0.2032, 878.0, 0.345, 1.2, 1.0, 1024, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, 0.0},
+     0.2032, 878.0, 0.345, 1.2, 1.0, 1024, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, 0.0, 0.0},
     /* 26-inch timpani, 0.19 mm head (0.262 kg/m^2), (1,1) at 110 Hz (A2) once air-loaded:
      * the kettle's air makes (m,1) near harmonic (Rossing 2000): 1 : 1.50 : 1.98 : 2.44 :
      * 2.90; (5,1) keeps its ideal frequency, so the ideal (1,1) is 110 / 0.789 Hz.
      * Struck a quarter of the way in from the rim; (0,1) radiates and dies fast. */
     {"timpani", "26-inch timpani, 0.19 mm Mylar, kettle-loaded, (1,1) at 110 Hz",
      0.3302, 1493.0, 0.262, 3.0, 0.3, 1024, 0.75, {0.75, 0.6}, {0.0, 90.0},
-     6, {0.0, 1.0, 1.50, 1.98, 2.44, 2.90}, 10.0, 0, 0, 0, 0.0, 0.0, DRUM_CASCADE},
+     6, {0.0, 1.0, 1.50, 1.98, 2.44, 2.90}, 10.0, 0, 0, 0, 0.0, 0.0, DRUM_CASCADE, 0.0},
     /* 18-inch frame drum: no shell, a thin head at low tension, (0,1) at 80 Hz. */
     {"frame", "18-inch frame drum, 0.19 mm Mylar, no shell, (0,1) at 80 Hz",
-     0.2286, 599.0, 0.262, 0.4, 2.0, 1024, 0.5, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, DRUM_CASCADE},
+     0.2286, 599.0, 0.262, 0.4, 2.0, 1024, 0.5, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, DRUM_CASCADE, 0.0},
     /* 22-inch bass drum (kick), 0.25 mm batter, (0,1) at 55 Hz, muffled (a pad inside
      * touching the head, as most kit kicks are: T60 0.4 s); the beater strikes near the
      * centre. Played with the felt tip (stick_tip.h). */
     {"kick", "22-inch bass drum, 0.25 mm Mylar batter, (0,1) at 55 Hz, muffled",
-     0.2794, 556.1, 0.345, 0.4, 1.0, 1024, 0.15, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, 0.0},
+     0.2794, 556.1, 0.345, 0.4, 1.0, 1024, 0.15, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, 0.0, 0.0},
     /* Cymbals: flat free-edge plates of cymbal bronze (CuSn20: E 100 GPa, 8600 kg/m^3,
      * nu 0.33), D = E h^3 / (12 (1 - nu^2)), density 8600 h; docs/plates.md. An 18-inch
      * crash 1.0 mm thick, struck at the edge; modes to about 18 kHz. */
     {"crash", "18-inch crash cymbal, 1.0 mm bronze plate, free edge",
      0.2286, 0.0, 8.6, 4.0, 0.0, 1400, 0.9, {0.5, 0.7}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0,
-     1, 9.35, 0.0, CYMBAL_CASCADE},
+     1, 9.35, 0.0, CYMBAL_CASCADE, 0.0},
     /* A 20-inch ride 1.4 mm thick, struck on the bow; modes to about 16 kHz. */
     {"ride", "20-inch ride cymbal, 1.4 mm bronze plate, free edge",
      0.254, 0.0, 12.04, 6.0, 0.0, 1400, 0.6, {0.5, 0.7}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0,
-     1, 25.66, 0.0, CYMBAL_CASCADE},
+     1, 25.66, 0.0, CYMBAL_CASCADE, 0.0},
     /* A 14-inch hi-hat: the top cymbal 1.1 mm thick (a flat disc of 0.94 kg), struck on
      * the bow; the bottom cymbal is the loss along its edge when the pedal closes the
      * pair (edgedamp, docs/plates.md "The hi-hat"); modes to about 22 kHz. edgedamp 20
@@ -63,7 +63,7 @@ static const membrane_preset presets[] = {
      * places, not all round, and the bottom one gives back much of what it takes. */
     {"hihat", "14-inch hi-hat, 1.1 mm bronze top plate, the bottom plate on its edge",
      0.1778, 0.0, 9.46, 3.0, 0.0, 1000, 0.7, {0.5, 0.7}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0,
-     1, 12.45, 20.0, CYMBAL_CASCADE},
+     1, 12.45, 20.0, CYMBAL_CASCADE, 0.0},
 };
 /* clang-format on */
 

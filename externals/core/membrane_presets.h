@@ -53,6 +53,10 @@ typedef struct membrane_preset {
     /* The energy cascade (MEMBRANE_PARAM_CASCADE, docs/plates.md "The cascade",
      * docs/membrane.md "The energy cascade"); 0 for paper, snare, floor-tom and kick. */
     double cascade;
+    /* The air's mass on the head's modes (MEMBRANE_PARAM_AIR_MASS, docs/membrane.md "The
+     * air's mass"); 0 where a row leaves it out. The tension is the one that puts (0, 1)
+     * at the frequency `what` names with it. */
+    double air_mass;
 } membrane_preset;
 
 /* The presets, in the order the docs list them; count via membrane_preset_count(). */

@@ -12,11 +12,11 @@
 void mode_table_free(mode_table *t)
 {
     free(t->j), free(t->norm), free(t->m), free(t->n), free(t->sin), free(t->plate);
-    free(t->edge);
-    t->j = t->norm = t->edge = NULL;
+    free(t->edge), free(t->air), free(t->scale);
+    t->j = t->norm = t->edge = t->air = t->scale = NULL;
     t->m = t->n = t->sin = NULL;
     t->plate = NULL;
-    t->size = 0;
+    t->size = t->air_valid = 0;
 }
 
 static int alloc_entries(mode_table *t, int size)
@@ -27,7 +27,12 @@ static int alloc_entries(mode_table *t, int size)
     t->n = malloc(sizeof(int) * (size_t)size);
     t->sin = malloc(sizeof(int) * (size_t)size);
     t->edge = calloc((size_t)size, sizeof(double));
-    return t->j && t->norm && t->m && t->n && t->sin && t->edge;
+    t->air = calloc((size_t)size, sizeof(double));
+    t->scale = malloc(sizeof(double) * (size_t)size);
+    if (t->scale)
+        for (int k = 0; k < size; k++)
+            t->scale[k] = 1.0;
+    return t->j && t->norm && t->m && t->n && t->sin && t->edge && t->air && t->scale;
 }
 
 /* A plate's table: the free-edge modes below a lambda that Weyl's law for the plate
@@ -81,10 +86,10 @@ ictus_status mode_table_build(mode_table *t, int size, int plate)
     double x_max = 2.0 * sqrt((double)size) + 4.0;
     ictus_bessel_zero_entry *zeros = NULL;
     int count = 0, modes = 0;
-    t->j = t->norm = t->edge = NULL;
+    t->j = t->norm = t->edge = t->air = t->scale = NULL;
     t->m = t->n = t->sin = NULL;
     t->plate = NULL;
-    t->size = 0;
+    t->size = t->air_valid = 0;
     if (plate)
         return build_plate(t, size);
     for (;;) {
@@ -123,6 +128,51 @@ ictus_status mode_table_build(mode_table *t, int size, int plate)
     return ICTUS_OK;
 }
 
+/* Gauss-Legendre nodes on [0, 1], for the panels of mode_table_air_g. */
+#define AIR_NODES 8
+static double air_x[AIR_NODES], air_w[AIR_NODES];
+static int air_ready;
+
+double mode_table_air_g(int m, double j)
+{
+    if (!air_ready) {
+        ictus_gauss_legendre(AIR_NODES, air_x, air_w);
+        air_ready = 1;
+    }
+    /* Panels of pi/2 (J_m^2 oscillates with period pi) to U = 2 j + 20; past U,
+     * J_m(u)^2 averages 1 / (pi u) and (j^2 - u^2)^2 >= (3/4)^2 u^4: the tail,
+     * 1 / (4 pi U^4) over (3/4)^2 at most, is below 1e-4 of the whole. */
+    const double dj = ictus_bessel_j(m + 1, j); /* |J_m'(j)| at a zero of J_m */
+    const double panel = 0.5 * M_PI, end = 2.0 * j + 20.0;
+    double sum = 0.0;
+    for (double a = 0.0; a < end; a += panel)
+        for (int i = 0; i < AIR_NODES; i++) {
+            const double u = a + panel * air_x[i], den = j * j - u * u;
+            double v;
+            if (fabs(den) < 1e-6 * j * j) {
+                v = dj * dj / (4.0 * j * j); /* the limit at u = j */
+            } else {
+                const double r = ictus_bessel_j(m, u) / den;
+                v = r * r;
+            }
+            sum += panel * air_w[i] * v;
+        }
+    const double u4 = end * end * end * end;
+    sum += 1.0 / (4.0 * M_PI * u4); /* the tail as if (j^2 - u^2)^2 were u^4: within 1e-4 */
+    return 2.0 * j * j * sum;
+}
+
+void mode_table_prepare_air(mode_table *t)
+{
+    if (t->plate)
+        return;
+    for (int k = t->air_valid; k < t->size; k++)
+        t->air[k] = (k > t->air_valid && t->j[k] == t->j[k - 1] && t->m[k] == t->m[k - 1])
+                        ? t->air[k - 1] /* the sin partner */
+                        : mode_table_air_g(t->m[k], t->j[k]);
+    t->air_valid = t->size;
+}
+
 /* Mass-normalised shape of every mode at a point:
  *     psi_k = J_m(j r/a) {cos, sin}(m theta) / sqrt(pi J_{m+1}(j)^2 / eps_m),
  * eps_0 = 1, eps_m = 2, so that b_k = psi_k / sqrt(sigma a^2) = phi_k / sqrt(M_k). */
@@ -140,7 +190,7 @@ void mode_table_shapes(const mode_table *t, int live, double r_over_a, double th
             radial = t->plate ? plate_mode_radial(&t->plate[k], r_over_a)
                               : ictus_bessel_j(t->m[k], t->j[k] * r_over_a);
         double angular = t->sin[k] ? sin(t->m[k] * theta) : cos(t->m[k] * theta);
-        psi[k] = (float)(radial * angular * t->norm[k]);
+        psi[k] = (float)(radial * angular * t->norm[k] * t->scale[k]);
     }
 }
 
@@ -162,15 +212,15 @@ double mode_table_shape(const mode_table *t, int k, double r_over_a, double thet
 {
     const double radial = t->plate ? plate_mode_radial(&t->plate[k], r_over_a)
                                    : ictus_bessel_j(t->m[k], t->j[k] * r_over_a);
-    return radial * t->norm[k] *
+    return radial * t->norm[k] * t->scale[k] *
            (t->sin[k] ? sin(t->m[k] * theta_rad) : cos(t->m[k] * theta_rad));
 }
 
 double mode_table_tuned_j(const mode_table *t, int k, const mode_tuning *u)
 {
     if (!u || t->plate || t->n[k] != 1 || t->m[k] >= u->count)
-        return t->j[k];
-    return t->j[k] * u->factor_m1[t->m[k]];
+        return t->j[k] * t->scale[k];
+    return t->j[k] * u->factor_m1[t->m[k]] * t->scale[k];
 }
 
 double mode_table_decay_factor(const mode_table *t, int k, const mode_tuning *u)

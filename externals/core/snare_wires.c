@@ -397,7 +397,7 @@ static void air_shapes(const membrane *m, const membrane_point *pt, int live, fl
         psi[k] = 0.0f;
         if (k < live && m->table.m[k] == 0) {
             double j = m->table.j[k];
-            psi[k] = (float)(m->table.norm[k] * 2.0 * ictus_bessel_j(1, j) / j);
+            psi[k] = (float)(m->table.norm[k] * m->table.scale[k] * 2.0 * ictus_bessel_j(1, j) / j);
         }
     }
 }

@@ -257,6 +257,11 @@ static void membrane_tilde_print(t_membrane_tilde *x)
         post("membrane~ %s: energy cascade %g (docs/membrane.md)",
              x->x_name != &s_ ? x->x_name->s_name : "(no name)",
              ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_CASCADE));
+    if (!membrane_is_plate(core) &&
+        ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_AIR_MASS) > 0.0)
+        post("membrane~ %s: airmass %g (the air's mass on the modes, docs/membrane.md)",
+             x->x_name != &s_ ? x->x_name->s_name : "(no name)",
+             ictus_param_get(&membrane_params, core, MEMBRANE_PARAM_AIR_MASS));
     if (x->x_wires)
         post("membrane~ %s: snare head %d modes, wires %s",
              x->x_name != &s_ ? x->x_name->s_name : "(no name)", snare_wires_head_modes(x->x_wires),
