@@ -101,7 +101,7 @@ check(proc.returncode == 0 and "error: ictus-sound-clips: clips/ictus-clips.wav"
 # to the modal model's membrane~") is taken without a word by the models it does not concern:
 # the synth said "unknown message" for tensionmod, radiation, lossfactor, patch, cascade,
 # bending, vonkarman, openness, edgedamp and wires, whatever the model playing.
-good = ["tensionmod 0.5", "radiation 0.5", "lossfactor 0.002", "patch 0.007", "cascade 1",
+good = ["tensionmod 0.5", "radiation 0.5", "lossfactor 0.002", "airmass 0", "patch 0.007", "cascade 1",
         "bending 9", "vonkarman 0", "openness 1", "edgedamp 0", "wires on", "wires off",
         "preset tom", "hfdamp 1", "modes 128", "gain 0.16", "pickup 1 0.5 0", "position 0.3 0"]
 MESSAGES = ("#X obj 10 10 ictus-sound modal;\n#X obj 10 40 loadbang;\n#X msg 10 70 %s;\n"
