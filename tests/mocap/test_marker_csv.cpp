@@ -5,7 +5,9 @@
 #include "ictus/mocap/capture_bounds.hpp"
 #include "ictus/mocap/marker_csv.hpp"
 
+#include <algorithm>
 #include <iomanip>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -376,5 +378,277 @@ TEST_CASE("CSV: random takes inside the bounds pass, out of them fail at the rig
                             "in column " + std::to_string(2 + axis) + " (m." +
                                 std::string(1, static_cast<char>('x' + axis)) + ")",
                             options);
+    }
+}
+
+namespace
+{
+
+// Both captures hold the same numbers, bit for bit, and the same names.
+void require_same_capture(const MarkerCapture &a, const MarkerCapture &b)
+{
+    REQUIRE(a.time_s == b.time_s);
+    REQUIRE(a.tracks.size() == b.tracks.size());
+    for (std::size_t k = 0; k < a.tracks.size(); ++k) {
+        const MarkerTrack &p = a.tracks[k];
+        const MarkerTrack &q = b.tracks[k];
+        CHECK(p.name == q.name);
+        REQUIRE(p.position_m.size() == q.position_m.size());
+        for (std::size_t f = 0; f < p.position_m.size(); ++f)
+            CHECK(p.position_m[f] == q.position_m[f]);
+        REQUIRE(p.orientation.size() == q.orientation.size());
+        for (std::size_t f = 0; f < p.orientation.size(); ++f)
+            CHECK(p.orientation[f].coeffs() == q.orientation[f].coeffs());
+    }
+}
+
+// A file as lines: a comment (kept as is) or the cells of the header or a row.
+struct CsvLine {
+    std::string comment;
+    std::vector<std::string> cells;
+};
+
+// The text of `lines`, each data line ended by "," when `trailing` (a
+// spreadsheet's empty last field), every line by `eol`.
+std::string csv_text(const std::vector<CsvLine> &lines, bool trailing, const char *eol)
+{
+    std::string text;
+    for (const CsvLine &line : lines) {
+        if (line.cells.empty()) {
+            text += line.comment + eol;
+            continue;
+        }
+        for (std::size_t c = 0; c < line.cells.size(); ++c)
+            text += (c ? "," : "") + line.cells[c];
+        text += std::string(trailing ? "," : "") + eol;
+    }
+    return text;
+}
+
+} // namespace
+
+// Spreadsheet exporters end every line with a comma: the header and each row
+// then have an empty last field, which is not data.
+TEST_CASE("CSV: a trailing comma on every line reads as the same capture", "[mocap][csv]")
+{
+    const std::vector<CsvLine> lines = {
+        {"# exported by a spreadsheet", {}},
+        {"", {"time", "m.x", "m.y", "m.z", "m.qw", "m.qx", "m.qy", "m.qz", "m.residual"}},
+        {"", {"0", "1", "2", "3", "1", "0", "0", "0", "0.1"}},
+        {"", {"0.01", "", "", "", "", "", "", "", ""}},
+        {"", {}},
+        {"", {"0.02", "3", "6", "", "0", "0", "0", "1", "0.2"}}, // a gap: the last value empty
+        {"", {"0.03", "4", "8", "12", "0", "0", "0", "1", "0.3"}},
+    };
+    for (const char *eol : {"\n", "\r\n"}) {
+        INFO((eol[0] == '\r' ? "CRLF" : "LF"));
+        MocapWarnings plain_warnings, trailing_warnings;
+        const MarkerCapture plain = parse(csv_text(lines, false, eol), {}, &plain_warnings);
+        const MarkerCapture trailing = parse(csv_text(lines, true, eol), {}, &trailing_warnings);
+        require_same_capture(plain, trailing);
+        CHECK(trailing_warnings == plain_warnings);
+        // The numbers by hand: frames 1-2 filled linearly between (1, 2, 3) at
+        // 0 s and (4, 8, 12) at 0.03 s; orientation by slerp (half a turn at 0.03 s).
+        REQUIRE(trailing.time_s == std::vector<double>{0, 0.01, 0.02, 0.03});
+        REQUIRE(trailing.tracks.size() == 1);
+        const MarkerTrack &m = trailing.tracks[0];
+        CHECK((m.position_m[1] - Eigen::Vector3d(2, 4, 6)).norm() < 1e-12);
+        CHECK((m.position_m[2] - Eigen::Vector3d(3, 6, 9)).norm() < 1e-12);
+        CHECK((m.orientation[3].toRotationMatrix() - rot_z(deg(180))).norm() < 1e-12);
+        REQUIRE(trailing_warnings.size() == 2);
+        CHECK(trailing_warnings[0] == "take.csv:2: column 9 'm.residual' ignored (not time, "
+                                      "frame or NAME.x|y|z|qw|qx|qy|qz)");
+        CHECK(trailing_warnings[1] == "take.csv:4: interpolated 2 missing frame(s) of object 'm' "
+                                      "frames 1-2 (lines 4-6)");
+    }
+    // Blanks after the last comma are an empty field too.
+    require_same_capture(parse("time,m.x,m.y,m.z, \n0,1,2,3,\t\n0.01,4,5,6, \n"),
+                         parse("time,m.x,m.y,m.z\n0,1,2,3\n0.01,4,5,6\n"));
+}
+
+TEST_CASE("CSV: trailing commas that the header and a row do not agree on are refused",
+          "[mocap][csv][errors]")
+{
+    for (const char *eol : {"\n", "\r\n"}) {
+        INFO((eol[0] == '\r' ? "CRLF" : "LF"));
+        const std::string e(eol);
+        const std::string head = "# take" + e + "time,m.x,m.y,m.z," + e + "0,1,2,3," + e;
+        // A row without the trailing comma, with a missing value, with a stray
+        // empty field in the middle, with a value under the header's empty column.
+        require_error(head + "0.01,1,2,3" + e, 4, "expected 5 cells (as the header), got 4");
+        require_error(head + "0.01,1,2," + e, 4, "expected 5 cells (as the header), got 4");
+        require_error(head + "0.01,1,,2,3," + e, 4, "expected 5 cells (as the header), got 6");
+        require_error(head + "0.01,1,2,3,4" + e, 4,
+                      "expected an empty cell in column 5 (the header ends with a comma), "
+                      "got '4'");
+        // Rows that end with a comma under a header that does not.
+        require_error("time,m.x,m.y,m.z" + e + "0,1,2,3," + e, 2,
+                      "expected 4 cells (as the header), got 5");
+        // Only one empty last column; an empty name elsewhere is still refused.
+        require_error("time,m.x,m.y,m.z,," + e + "0,1,2,3,," + e, 1,
+                      "expected a column name in column 5, got an empty cell");
+        require_error("time,,m.x,m.y,m.z," + e + "0,0,1,2,3," + e, 1,
+                      "expected a column name in column 2, got an empty cell");
+        require_error("time," + e + "0," + e, 1, "expected at least one object");
+        require_error("time;m.x;m.y;m.z;," + e + "0;1;2;3;," + e, 1,
+                      "expected comma-separated columns, got one column holding ';'");
+    }
+}
+
+// Property: random takes (objects with and without orientations, columns in
+// any order, an ignored column, gaps, comments, LF or CRLF) read the same with
+// and without a trailing comma on every line, and hold the numbers written;
+// one row broken in a random way is refused at its line. Seeded.
+TEST_CASE("CSV: random takes with trailing commas read as without, broken rows are named",
+          "[mocap][csv]")
+{
+    std::mt19937 rng(40561);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    auto pick = [&](int n) { return static_cast<int>(unit(rng) * n) % n; };
+    for (int trial = 0; trial < 150; ++trial) {
+        const int objects = 1 + pick(3);
+        std::vector<bool> rotated(static_cast<std::size_t>(objects));
+        std::vector<std::string> names = {"time", "extra"};
+        for (int k = 0; k < objects; ++k) {
+            const std::string o = "o" + std::to_string(k);
+            rotated[static_cast<std::size_t>(k)] = unit(rng) < 0.5;
+            for (const char *c : {"x", "y", "z", "qw", "qx", "qy", "qz"})
+                if (c[1] == 0 || rotated[static_cast<std::size_t>(k)])
+                    names.push_back(o + "." + c);
+        }
+        std::shuffle(names.begin(), names.end(), rng);
+        const int rows = 3 + pick(25);
+        const double rate = 50.0 + 950.0 * unit(rng);
+        std::vector<CsvLine> lines = {{"# take " + std::to_string(trial), {}}, {"", names}};
+        std::vector<int> row_line; // [row] -> line in the file
+        // [row][column name] -> value written; a gap is left empty.
+        std::vector<std::map<std::string, double>> written(static_cast<std::size_t>(rows));
+        std::vector<std::vector<bool>> gap(static_cast<std::size_t>(rows),
+                                           std::vector<bool>(static_cast<std::size_t>(objects)));
+        for (int r = 0; r < rows; ++r) {
+            if (unit(rng) < 0.1)
+                lines.push_back({unit(rng) < 0.5 ? "" : "# note", {}});
+            auto &values = written[static_cast<std::size_t>(r)];
+            values["time"] = (r + 0.2 * (unit(rng) - 0.5)) / rate;
+            values["extra"] = unit(rng);
+            for (int k = 0; k < objects; ++k) {
+                const std::string o = "o" + std::to_string(k);
+                for (const char *c : {"x", "y", "z"})
+                    values[o + "." + c] = (2.0 * unit(rng) - 1.0) * 50.0;
+                Eigen::Quaterniond q(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5,
+                                     unit(rng) - 0.5);
+                q.normalize();
+                values[o + ".qw"] = q.w(), values[o + ".qx"] = q.x();
+                values[o + ".qy"] = q.y(), values[o + ".qz"] = q.z();
+                gap[static_cast<std::size_t>(r)][static_cast<std::size_t>(k)] =
+                    r > 0 && r + 1 < rows && unit(rng) < 0.15;
+            }
+            std::vector<std::string> cells;
+            for (const std::string &name : names) {
+                const std::size_t dot = name.find('.');
+                const bool in_gap = dot != std::string::npos &&
+                                    gap[static_cast<std::size_t>(r)][std::stoul(name.substr(1))] &&
+                                    unit(rng) < 0.6; // some cells of a missing sample are empty
+                std::ostringstream cell;
+                cell << std::setprecision(17) << values[name];
+                cells.push_back(in_gap ? "" : cell.str());
+            }
+            // At least one empty cell makes the sample missing.
+            for (int k = 0; k < objects; ++k)
+                if (gap[static_cast<std::size_t>(r)][static_cast<std::size_t>(k)]) {
+                    const std::string z = "o" + std::to_string(k) + ".z";
+                    cells[static_cast<std::size_t>(std::find(names.begin(), names.end(), z) -
+                                                   names.begin())] = "";
+                }
+            row_line.push_back(static_cast<int>(lines.size()) + 1);
+            lines.push_back({"", cells});
+        }
+        const char *eol = trial % 2 ? "\r\n" : "\n";
+        INFO("trial " << trial << "\n" << csv_text(lines, true, "\n"));
+        MocapWarnings plain_warnings, trailing_warnings;
+        const MarkerCapture plain = parse(csv_text(lines, false, eol), {}, &plain_warnings);
+        const MarkerCapture trailing = parse(csv_text(lines, true, eol), {}, &trailing_warnings);
+        require_same_capture(plain, trailing);
+        CHECK(trailing_warnings == plain_warnings);
+        // The numbers written: exact where sampled, on the line between the
+        // neighbouring samples in a gap.
+        REQUIRE(trailing.time_s.size() == static_cast<std::size_t>(rows));
+        REQUIRE(trailing.tracks.size() == static_cast<std::size_t>(objects));
+        for (int k = 0; k < objects; ++k) {
+            const std::string o = "o" + std::to_string(k);
+            const MarkerTrack &track = trailing.tracks[static_cast<std::size_t>(trailing.find(o))];
+            CHECK(track.orientation.size() ==
+                  (rotated[static_cast<std::size_t>(k)] ? static_cast<std::size_t>(rows) : 0));
+            auto position = [&](int r) {
+                auto &v = written[static_cast<std::size_t>(r)];
+                return Eigen::Vector3d(v[o + ".x"], v[o + ".y"], v[o + ".z"]);
+            };
+            for (int r = 0; r < rows; ++r) {
+                const double t = written[static_cast<std::size_t>(r)]["time"];
+                CHECK(trailing.time_s[static_cast<std::size_t>(r)] == t);
+                const Eigen::Vector3d &p = track.position_m[static_cast<std::size_t>(r)];
+                if (!gap[static_cast<std::size_t>(r)][static_cast<std::size_t>(k)]) {
+                    CHECK(p == position(r));
+                    auto &v = written[static_cast<std::size_t>(r)];
+                    if (rotated[static_cast<std::size_t>(k)])
+                        CHECK((track.orientation[static_cast<std::size_t>(r)].coeffs() -
+                               Eigen::Quaterniond(v[o + ".qw"], v[o + ".qx"], v[o + ".qy"],
+                                                  v[o + ".qz"])
+                                   .coeffs())
+                                  .norm() < 1e-14);
+                    continue;
+                }
+                int before = r, after = r;
+                while (gap[static_cast<std::size_t>(before)][static_cast<std::size_t>(k)])
+                    --before;
+                while (gap[static_cast<std::size_t>(after)][static_cast<std::size_t>(k)])
+                    ++after;
+                const double t0 = written[static_cast<std::size_t>(before)]["time"];
+                const double t1 = written[static_cast<std::size_t>(after)]["time"];
+                const double u = (t - t0) / (t1 - t0);
+                CHECK((p - (position(before) + u * (position(after) - position(before)))).norm() <
+                      1e-9);
+            }
+        }
+        // One row broken: its line is named, CRLF or not. A trailing comma is
+        // an empty last cell: `ended` gives one to every data line but row r.
+        const int r = pick(rows);
+        const std::size_t columns = names.size();
+        const std::size_t broken_line =
+            static_cast<std::size_t>(row_line[static_cast<std::size_t>(r)] - 1);
+        std::vector<CsvLine> ended = lines;
+        for (std::size_t l = 0; l < ended.size(); ++l)
+            if (!ended[l].cells.empty() && l != broken_line)
+                ended[l].cells.push_back("");
+        std::vector<CsvLine> broken = lines;
+        std::vector<std::string> &cells = broken[broken_line].cells;
+        const auto at = cells.begin() + 1 + pick(static_cast<int>(columns) - 1);
+        std::string text;
+        std::size_t header_cells = columns + 1, got = 0;
+        switch (trial % 4) {
+        case 0: // a stray empty field in the middle
+            cells.insert(at, "");
+            text = csv_text(broken, true, eol);
+            got = columns + 2;
+            break;
+        case 1: // a value missing
+            cells.erase(at);
+            text = csv_text(broken, true, eol);
+            got = columns;
+            break;
+        case 2: // this row alone without its trailing comma
+            text = csv_text(ended, false, eol);
+            got = columns;
+            break;
+        default: // this row alone with a trailing comma, under a header without
+            cells.push_back("");
+            text = csv_text(broken, false, eol);
+            header_cells = columns;
+            got = columns + 1;
+            break;
+        }
+        const std::string expected = "expected " + std::to_string(header_cells) +
+                                     " cells (as the header), got " + std::to_string(got);
+        require_error(text, row_line[static_cast<std::size_t>(r)], expected);
     }
 }

@@ -129,9 +129,13 @@ class CsvParser
             header_error("at most " + std::to_string(kMaxColumns) + " columns",
                          std::to_string(cells.size()));
         column_count_ = cells.size();
+        // A comma at the end of the header (as spreadsheets export) is an empty
+        // last column, not data: each row must end with an empty cell too.
+        trailing_empty_ = cells.size() > 1 && cells.back().empty();
+        const std::size_t named = cells.size() - (trailing_empty_ ? 1 : 0);
         std::map<std::string, int> seen;
         std::map<std::string, std::size_t> object_of;
-        for (std::size_t c = 0; c < cells.size(); ++c) {
+        for (std::size_t c = 0; c < named; ++c) {
             const std::string &name = cells[c];
             if (name.empty())
                 header_error("a column name in column " + std::to_string(c + 1), "an empty cell");
@@ -170,7 +174,7 @@ class CsvParser
             }
             objects_[found->second].index[component] = static_cast<int>(c);
         }
-        if (cells.size() == 1 &&
+        if (named == 1 &&
             (cells[0].find(';') != std::string::npos || cells[0].find('\t') != std::string::npos))
             header_error("comma-separated columns",
                          std::string("one column holding ") +
@@ -229,6 +233,10 @@ class CsvParser
             throw MocapError(source_, line,
                              "expected " + std::to_string(column_count_) +
                                  " cells (as the header), got " + std::to_string(cells.size()));
+        if (trailing_empty_ && !cells.back().empty())
+            throw MocapError(source_, line,
+                             "expected an empty cell in column " + std::to_string(cells.size()) +
+                                 " (the header ends with a comma), got " + quote(cells.back()));
         if (static_cast<long>(capture_.time_s.size()) >= options_.max_frames)
             throw MocapError(source_, line,
                              "expected at most " + std::to_string(options_.max_frames) +
@@ -433,6 +441,7 @@ class CsvParser
     std::vector<std::vector<bool>> missing_; // [object][frame]
     std::vector<int> row_lines_;             // [frame] -> file line
     std::size_t column_count_ = 0;
+    bool trailing_empty_ = false; // the header's last cell is empty (a trailing comma)
     int header_line_ = 0;
     int time_column_ = -1;
     int frame_column_ = -1;

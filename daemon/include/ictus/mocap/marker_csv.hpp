@@ -2,7 +2,8 @@
 //
 // Header row: a `time` column (s) or a `frame` column (then options.rate_hz is
 // required), and per object NAME.x NAME.y NAME.z, optionally NAME.qw NAME.qx
-// NAME.qy NAME.qz. Comma separated; empty cells, NaN or nan mark gaps.
+// NAME.qy NAME.qz. Comma separated; empty cells, NaN or nan mark gaps. A
+// comma ending the header and every row (an empty last column) is ignored.
 // Output: MarkerCapture in metres, right-handed, y up. Values out of the
 // physical bounds of a capture (capture_bounds.hpp) throw MocapBoundError
 // unless accepted. See docs/mocap.md.
