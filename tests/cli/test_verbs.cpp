@@ -753,13 +753,21 @@ TEST_CASE("render: missed and off-time notes, strikes of no note and a score wit
 }
 
 // --wav-bits 8 was refused as "got '8.000000'", --wav-rate 44100.5 was cut to
-// 44100 without a word, and --score given a folder said it was empty.
+// 44100 without a word, --score given a folder said it was empty, and an empty score
+// file was refused while one of comments only played nothing with a warning.
 TEST_CASE("render: a bad value is quoted as typed, a fractional count or rate refused, a folder is "
-          "no score, a stick capture is track's",
+          "no score, nor a file with no statement, a stick capture is track's",
           "[cli][verbs]")
 {
     const fs::path dir = scratch("render-values");
     fs::create_directories(dir);
+    // No statement: empty, blank lines, comments only; each refused as having no notes.
+    const std::string empty = (dir / "empty.score").string(),
+                      blank = (dir / "blank.score").string(),
+                      comments = (dir / "comments.score").string();
+    std::ofstream(empty, std::ios::binary) << "";
+    std::ofstream(blank, std::ios::binary) << " \n\t\r\n\n";
+    std::ofstream(comments, std::ios::binary) << "# a groove, to write\n\n  # tempo 100\n";
     const struct {
         std::vector<std::string> args;
         int status;
@@ -770,6 +778,13 @@ TEST_CASE("render: a bad value is quoted as typed, a fractional count or rate re
         {{"--midi-channel", "2.5"}, 2, "--midi-channel: expected a whole number 1..16, got '2.5'"},
         {{"--rehearse", "1.5"}, 2, "--rehearse: expected a whole number 0..5, got '1.5'"},
         {{"--score", dir.string()}, 1, "--score: '" + dir.string() + "' is a folder"},
+        {{"--score", empty}, 1, "--score: '" + empty + "' has no notes (the file is empty)\n"},
+        {{"--score", blank},
+         1,
+         "--score: '" + blank + "' has no notes (nothing but blank lines and comments)\n"},
+        {{"--score", comments},
+         1,
+         "--score: '" + comments + "' has no notes (nothing but blank lines and comments)\n"},
         // A stick-only capture is track's, not render's: said before any file is read.
         {{"--mocap", "take.CSV"},
          2,

@@ -421,6 +421,44 @@ TEST_CASE("plan: a hi-hat note carries its pedal, and another drum refuses one a
     }
 }
 
+TEST_CASE("plan: a chord's two hands on the hi-hat at one instant ask for one pedal, else refused "
+          "at the second's word",
+          "[score][kit][hihat]")
+{
+    const PerformerFrame f = hihat_frame(0.02);
+    const std::string both = "at once: the right hand's note on it at this instant (line ";
+    // Columns counted by hand: the second note's pedal word, or the note where it writes none.
+    refused("R on hihat closed + L on hihat open", f, 1, 32,
+            "hi-hat 'hihat' open and closed " + both +
+                "1) is closed, and its pedal sets one openness (give both notes the same word)");
+    refused("tempo 90\nR on hihat open + L on hihat", f, 2, 19,
+            "hi-hat 'hihat' closed (no pedal word) and open " + both + "2) is open,");
+    refused("drum hihat\nR + L half", f, 2, 7,
+            "'hihat' half and closed " + both +
+                "2) is closed "
+                "(no pedal word),");
+    refused("L on hihat half + R on hihat open", f, 1, 30,
+            "open and half at once: the left hand's note on it at this instant (line 1) is half");
+    refused("R on tom1, R on hi-hat closed + L on hihat open", f, 1, 44, "open and closed");
+    // One openness, a hi-hat beside another piece, and the pedal changed between two
+    // instants, however close: played as written.
+    const char *played[] = {"R on hihat open + L on hihat open", "drum hihat\nR+L half",
+                            "R on hihat + L on hihat closed", "R on hihat closed + L on snare",
+                            "tempo 90\nR on hihat closed 1/8, L on hihat open"};
+    const double want[][2] = {{kHihatOpen, kHihatOpen},
+                              {kHihatHalf, kHihatHalf},
+                              {kHihatClosed, kHihatClosed},
+                              {kHihatClosed, -1.0},
+                              {kHihatClosed, kHihatOpen}};
+    for (size_t i = 0; i < 5; ++i) {
+        INFO(played[i]);
+        const GesturePlan plan = plan_performance(parse_score(played[i], "t.txt"), db(), f);
+        REQUIRE(plan.notes.size() == 2);
+        for (size_t k = 0; k < 2; ++k)
+            CHECK(plan.notes[k].openness == want[i][k]);
+    }
+}
+
 TEST_CASE("plan: a hand going to or from its rest tip passes over a cymbal above it, never "
           "through",
           "[score][kit][hihat]")

@@ -13,6 +13,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace ictus;
@@ -326,6 +327,40 @@ TEST_CASE("midi in: General MIDI's hi-hat on a kit's hi-hat, closed 42 and open 
         CHECK(none.skipped.at(46) == 1);
         CHECK(none.skipped.at(44) == 3);
     }
+}
+
+TEST_CASE("midi in: a closed and an open hi-hat on one tick are one open note (one pedal)",
+          "[score][midi][hihat]")
+{
+    // Quarters at 120 bpm: 42 then 46 on a tick, 46 then 42, 42 alone, 42 with the snare,
+    // 46 with 42 on channel 1 (not the drum part's).
+    std::string t;
+    for (int pair : {0, 1, 2, 3, 4}) {
+        const int first = pair == 1 ? 46 : 42;
+        t += bytes({pair == 0 ? 0 : 96, 0x99, first, 90});
+        if (pair < 2)
+            t += bytes({0, 0x99, first == 42 ? 46 : 42, 70});
+        else if (pair == 3)
+            t += bytes({0, 0x99, 38, 70});
+        else if (pair == 4)
+            t += bytes({0, 0x90, 46, 70});
+    }
+    t += kEnd;
+    const std::vector<MidiDrum> kit = {{"snare", 38}, {"crash", 49}, {"hihat", 42}};
+    const MidiDrumPart part =
+        drum_part_score(read_smf(header(0, 1) + chunk("MTrk", t), "t.mid"), kit, "t.mid");
+    CHECK(part.hihats_opened == 2);
+    CHECK(part.other_channels == 1);
+    CHECK(part.too_fast == 0);
+    // Each note as (beat, drum and pedal word), in any order on a tick.
+    std::vector<std::pair<double, std::string>> got;
+    for (const ScoreNote &n : part.score.notes)
+        got.push_back({n.beat, n.drum + " " + hihat_openness_word(n.openness)});
+    std::sort(got.begin(), got.end());
+    const std::vector<std::pair<double, std::string>> want = {
+        {0.0, "hihat open"},   {1.0, "hihat open"}, {2.0, "hihat closed"},
+        {3.0, "hihat closed"}, {3.0, "snare "},     {4.0, "hihat closed"}};
+    CHECK(got == want);
 }
 
 TEST_CASE("midi in: General MIDI's bass drums 35 and 36 on a kit's kick, the right foot's",

@@ -758,3 +758,21 @@ TEST_CASE("score: a builder counts the statements its lines held", "[score][pars
     REQUIRE_THROWS(b.add_statement("end"));
     CHECK(b.parsed_statements() == 6u); // a refused line adds nothing
 }
+
+TEST_CASE("score: a text of blank lines and comments only holds no statement, as an empty one",
+          "[score][parser]")
+{
+    // `--score` refuses such a file as one with no notes (tests/cli, test_verbs.cpp).
+    for (const char *none :
+         {"", " \t\n\n", "# a comment\n\n  # another", "\xEF\xBB\xBF# x\r\n\r", "\xC2\xA0\r\n"}) {
+        INFO('"' << none << '"');
+        CHECK_FALSE(score_text_has_statements(none));
+        CHECK(parse_score(none, "t").notes.empty());
+    }
+    // One statement, a note or not, faulty or not, after comments and blank lines.
+    for (const char *some : {"R", "# a comment\n\nR legato", "\r\rgrip german # no note",
+                             "\xEF\xBB\xBF"
+                             "rest",
+                             "# c\nR legatto"})
+        CHECK(score_text_has_statements(some));
+}

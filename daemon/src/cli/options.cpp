@@ -291,8 +291,13 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         const std::string path = value();
         o.score.score_text = read_score_file(path);
         o.score.score_name = path;
-        if (o.score.score_text.empty())
-            throw std::runtime_error("--score: '" + path + "' is empty");
+        // Empty, or blank lines and comments only: no notes, said alike.
+        if (!score_text_has_statements(o.score.score_text))
+            throw std::runtime_error("--score: '" + path + "' has no notes (" +
+                                     (o.score.score_text.empty()
+                                          ? "the file is empty"
+                                          : "nothing but blank lines and comments") +
+                                     ")");
     } else if (a == "--midi") {
         o.score.midi_path = value();
         o.score.score_name = o.score.midi_path;
@@ -432,6 +437,11 @@ void load_midi_score(PerformanceOptions &o)
                   << " of the time-keeper played by the left hand while the right crosses the kit "
                      "(its move over "
                   << kMidiLendHihatAbove_mps << " m/s; docs/midi.md)\n";
+    if (part.hihats_opened > 0)
+        std::cerr << "ictusd: warning: --midi " << path << ": "
+                  << counted(part.hihats_opened, "closed hi-hat", "closed hi-hats")
+                  << " (42) left out for the open one (46) on the same tick (one pedal: the open "
+                     "one wins; docs/midi.md)\n";
     if (part.other_channels > 0)
         std::cerr << "ictusd: note: --midi " << path << ": " << part.other_channels
                   << (part.other_channels == 1 ? " note on a channel" : " notes on channels")

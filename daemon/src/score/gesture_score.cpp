@@ -190,6 +190,9 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
                              "drum '" + frame.drums[static_cast<size_t>(p.drum)].name +
                                  "' is played by the right foot on its pedal: write 'RF'");
         p.openness = note_openness(score, n, frame, p.drum);
+        const std::vector<size_t> &other = by_hand[1 - static_cast<int>(n.hand)];
+        if (p.openness >= 0.0 && !other.empty())
+            score_detail::check_one_pedal(score, n, p, plan.notes[other.back()], frame);
         p.strike_point_m = membrane_point(frame, p.r_over_a, p.theta_deg, p.drum);
         p.tip_target_m = p.strike_point_m - opt.strike_depth_m * frame.up;
         p.line = n.line;

@@ -164,6 +164,26 @@ double note_openness(const Score &score, const ScoreNote &n, const PerformerFram
             (hihats.empty() ? "the kit has none" : "the kit's hi-hat: " + hihats) + ")");
 }
 
+void check_one_pedal(const Score &score, const ScoreNote &n, const PlannedNote &p,
+                     const PlannedNote &other, const PerformerFrame &frame)
+{
+    if (other.drum != p.drum || other.openness == p.openness || other.score_note < 0)
+        return;
+    const ScoreNote &o = score.notes[static_cast<size_t>(other.score_note)];
+    if (score.note_time_s(o) != score.note_time_s(n))
+        return;
+    const std::string word = hihat_openness_word(p.openness);
+    const std::string was = hihat_openness_word(other.openness);
+    auto none = [](double written) { return written < 0.0 ? " (no pedal word)" : ""; };
+    throw ScoreError(score.source, n.line, n.openness_column > 0 ? n.openness_column : n.column,
+                     "hi-hat '" + frame.drums[static_cast<size_t>(p.drum)].name + "' " + word +
+                         none(n.openness) + " and " + was + " at once: the " +
+                         (o.hand == Side::right ? "right" : "left") +
+                         " hand's note on it at this instant (line " + std::to_string(o.line) +
+                         ") is " + was + none(o.openness) +
+                         ", and its pedal sets one openness (give both notes the same word)");
+}
+
 // A foot's note: its time (with the motor noise of `humanize`, as a hand's)
 // and its drum: the right foot's the kit's foot piece, the left foot's its
 // hi-hat (the first, or the one it names); a ScoreError where the kit has none

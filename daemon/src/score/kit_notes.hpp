@@ -39,6 +39,11 @@ int note_drum_spot(const Score &score, const ScoreNote &n, const PerformerFrame 
 // The note's pedal on a hi-hat (closed when it names none), -1 on another
 // drum; a ScoreError at the word when it names one on a drum without a pedal.
 double note_openness(const Score &score, const ScoreNote &n, const PerformerFrame &frame, int drum);
+// One hi-hat, one pedal: a ScoreError at `n`'s pedal word (at the note where it writes
+// none) when `other`, the other hand's last planned note, is on the same hi-hat at the
+// same written instant (a chord's) with another openness (`p`: n planned so far).
+void check_one_pedal(const Score &score, const ScoreNote &n, const PlannedNote &p,
+                     const PlannedNote &other, const PerformerFrame &frame);
 // A foot's note (score note k): its time (with the motor noise of `humanize`,
 // as a hand's) and its drum, the kit's foot piece (the first, or the one it
 // names); a ScoreError where the kit has none or it names a piece of the hands.

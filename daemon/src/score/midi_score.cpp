@@ -11,6 +11,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 
 namespace ictus
@@ -685,6 +686,10 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         };
         return rank(x.note) < rank(y.note);
     });
+    std::set<long> open_hihat_ticks; // the drum part's 46s (42's drum, when the kit has one)
+    for (const SmfNote &n : smf.notes)
+        if (n.note == kMidiOpenHihat && (part.channel < 0 || n.channel == part.channel))
+            open_hihat_ticks.insert(n.tick);
     for (size_t index : order) {
         const SmfNote &n = smf.notes[index];
         const int line = static_cast<int>(index) + 1;
@@ -695,6 +700,10 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
         const int drum = drum_of(n.note, drums);
         if (drum < 0) {
             ++part.skipped[n.note];
+            continue;
+        }
+        if (n.note == kMidiClosedHihat && open_hihat_ticks.count(n.tick)) {
+            ++part.hihats_opened; // one pedal: the open hi-hat on its tick wins
             continue;
         }
         const double beat = static_cast<double>(n.tick) / tpq;

@@ -85,7 +85,8 @@ constexpr int kMidiRide = 51;
 constexpr int kMidiRideBell = 53;
 constexpr double kMidiRideBellRadiusFraction = kBellRadiusFraction;
 // General MIDI's hi-hat played by a hand on a kit's hi-hat (its note 42): closed 42 with the
-// pedal down, open 46 with it up (ScoreNote::openness). The pedal hi-hat 44 is the left
+// pedal down, open 46 with it up (ScoreNote::openness); a 42 on a 46's tick is left out
+// (one pedal: the open one wins, MidiDrumPart::hihats_opened). The pedal hi-hat 44 is the left
 // foot's chick on that hi-hat's pedal (`LF`, docs/pedal.md), no sooner than
 // kMidiChickMin_s after the last (sooner: left out, MidiDrumPart::too_fast).
 // General MIDI's bass drums, Acoustic (35) and Bass Drum 1 (36), played by the right foot
@@ -137,6 +138,7 @@ struct MidiDrumPart {
     long hihats_lent =
         0; // the time-keeper's hi-hats the left hand played (kMidiLendHihatAbove_mps)
     long crashes_given = 0;  // crashes the right hand played (kMidiLendHihatAbove_mps)
+    long hihats_opened = 0;  // closed hi-hats (42) left out for an open one (46) on their tick
     long other_channels = 0; // notes on channels other than the drum part's (10) left out
 };
 

@@ -272,6 +272,9 @@ class ScoreBuilder
 // newlines, ';' or ','; '#' starts a comment. Throws ScoreError at the first
 // fault, naming `source_name`, the line and the column.
 Score parse_score(const std::string &text, const std::string &source_name);
+// Whether a score's text holds a statement, faulty or not: false for an empty text or one
+// of blank lines and comments only (a score file with no notes, refused as one).
+bool score_text_has_statements(const std::string &text);
 // Reads and parses a file; throws ScoreError (line 0) when it cannot be read.
 Score load_score(const std::string &path);
 
