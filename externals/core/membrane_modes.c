@@ -121,7 +121,8 @@ void membrane_update_coefficients_(membrane *m, int rescale)
     m->mass_scale = 1.0 / sqrt(m->density * m->radius * m->radius);
     m->coef_h = h;
     const double scale = m->mass_scale;
-    /* The air's mass on each mode (a plate's table has none): its scale before and now */
+    /* The air's mass on each mode (none on a plate): scale[k] = 1 / sqrt(1 + beta g_k), the
+     * state rescaled by the old over the new (air_ratio) so the motion stays continuous */
     const double beta = m->plate ? 0.0 : m->air_mass * MEMBRANE_AIR_RHO * m->radius / m->density;
     if (beta > 0.0)
         mode_table_prepare_air(&m->table);

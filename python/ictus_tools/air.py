@@ -2,8 +2,8 @@
 for the tests by a route of its own: the mode's Hankel transform by quadrature over the head,
 then the low-frequency radiation reactance of a baffled head (Morse & Ingard, Theoretical
 Acoustics, sec. 7.4), M_air = rho_air a^3 (2 pi or pi) int_0^inf H(k)^2 dk, over the mode's
-own mass sigma a^2 (2 pi or pi) J_m'(j)^2 / 2. membrane~ computes the same g by the closed
-Lommel form; the two agree to 1e-4."""
+own mass sigma a^2 (2 pi or pi) J_m'(j)^2 / 2. membrane~ integrates the transform's closed
+Lommel form instead (mode_table_air_g); the two agree to 1e-4."""
 import functools
 import math
 
@@ -29,4 +29,3 @@ def air_g(m, n):
                 for a, b in zip(edges[:-1], edges[1:]))
     total += (j * jv(m + 1, j)) ** 2 / (4.0 * math.pi * edges[-1] ** 4)
     return total / (0.5 * jv(m + 1, j) ** 2)
-
