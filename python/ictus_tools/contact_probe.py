@@ -9,7 +9,7 @@ pd and patches/ictus-render.pd (pickups mix, 32-bit float, -40 dB: far below its
 limiter), on membrane~'s
 preset with `contact~` given the stick mass and the head's stretching k3 (default: the
 Begley & Mackin k3 of the preset's Mylar film, docs/contact.md; 0: a linear head), and
-prints per hit: contact~'s duration and peak force (render-reports), the RMS of the
+prints per hit: contact~'s duration, peak force and rebound speed (render-reports), the RMS of the
 first 100 ms, the spectral centroid of the first 50 ms (Hann window, the two pickups'
 power summed, as tests/e2e/test_expression.py) and the share of that energy in the
 bands of the (0,1) and (1,1) modes (split halfway between the ideal membrane's f01,
@@ -93,7 +93,7 @@ def main():
     with open(reports) as f:
         reps = [[float(w) for w in r.split()] for r in f.read().split(";") if r.split()]
     cut1, cut2 = 0.5 * (f01 + f11), 0.5 * (f11 + f21)
-    print("  v m/s  contact ms  peak N  RMS dB  centroid Hz  (0,1) band  (1,1) band")
+    print("  v m/s  contact ms  peak N  RMS dB  centroid Hz  (0,1) band  (1,1) band  rebound m/s")
     for i, v in enumerate(speeds):
         t = 0.1 + SPACING_S * i
         rep = min((r for r in reps if r[0] >= t * 1e3 - 1.0), key=lambda r: r[0])
@@ -102,10 +102,10 @@ def main():
         seg = x[n0:n0 + int(0.05 * sr)]
         p = np.sum(np.abs(np.fft.rfft(seg * np.hanning(len(seg))[:, None], axis=0)) ** 2, axis=1)
         f = np.fft.rfftfreq(len(seg), 1.0 / sr)
-        print("  %5.2f  %10.2f  %6.1f  %6.1f  %11.0f  %9.0f%%  %9.0f%%"
+        print("  %5.2f  %10.2f  %6.1f  %6.1f  %11.0f  %9.0f%%  %9.0f%%  %11.2f"
               % (v, rep[2], rep[3], 10 * math.log10(np.mean(np.sum(rms ** 2, axis=1)) + 1e-30),
                  np.sum(p * f) / np.sum(p), 100 * np.sum(p[f < cut1]) / np.sum(p),
-                 100 * np.sum(p[(f >= cut1) & (f < cut2)]) / np.sum(p)))
+                 100 * np.sum(p[(f >= cut1) & (f < cut2)]) / np.sum(p), rep[4]))
 
 
 if __name__ == "__main__":
