@@ -25,6 +25,7 @@ import numpy as np
 
 from ictus_tools import ROOT
 from ictus_tools.pdrun import PD, PD_ENV, error_lines, read_wav_any
+from ictus_tools.presets import preset_head
 
 # Bessel zeros j01, j11, j21 (Abramowitz & Stegun, table 9.5)
 J01, J11, J21 = 2.404825557695773, 3.831705970207512, 5.135622301840683
@@ -37,15 +38,6 @@ def begley_mackin_k3(radius_m, density_kg_per_m2):
     e, nu, rho = MYLAR
     q = 1.0 / (1.05 - 0.15 * nu - 0.16 * nu * nu)
     return e * (density_kg_per_m2 / rho) * q ** 3 / radius_m ** 2
-
-
-def preset_head(name):
-    """(radius, tension, density) of a preset, read from membrane_presets.c."""
-    with open(os.path.join(ROOT, "externals", "core", "membrane_presets.c")) as f:
-        text = f.read()
-    i = text.index('{"%s",' % name)
-    body = text[text.index("\n", text.index('",', text.index('",', i) + 2)) + 1:]
-    return tuple(float(w) for w in body.split(",")[:3])
 
 
 def main():
