@@ -2,7 +2,8 @@
 """The snare as the performer plays it: `ictusd render --drum-preset snare` of one typed
 score (pp, mf, ff, legato and accent, one note every 2 s), and per strike the 95 %
 bandwidth of the first 50 ms and its share above 4 kHz, for each pickup and for both
-together (the WAV's energy), measured in the WAV (pickups, -20 dB, 32-bit float: no
+together (the WAV's energy), and the spectral centroid of the same 50 ms (Hann window, both
+pickups' power), measured in the WAV (pickups, -20 dB, 32-bit float: no
 limiter). docs/sound.md, "The snare", records the figures.
 
 Usage: PYTHONPATH=python scripts/snare_render.py --build BUILD
@@ -47,8 +48,8 @@ def main():
         notes = list(csv.DictReader(f))
     with open(os.path.join(out, "strikes.csv")) as f:
         strikes = {r["seq"]: r for r in csv.DictReader(f)}
-    print("| note | speed, m/s | pickup 1 | pickup 2 | both |")
-    print("|---|---|---|---|---|")
+    print("| note | speed, m/s | pickup 1 | pickup 2 | both | centroid |")
+    print("|---|---|---|---|---|---|")
     for word, note in zip(NOTES, notes):
         s = strikes.get(note.get("strike_seq", ""))
         if s is None:
@@ -59,8 +60,11 @@ def main():
         power = np.abs(np.fft.rfft(seg, axis=0)) ** 2
         f = np.fft.rfftfreq(len(seg), 1.0 / sr)
         cells = [band(p, f) for p in (power[:, 0], power[:, 1], power.sum(axis=1))]
-        print("| %s | %.2f | %s |" % (word, float(s["normal_velocity_mps"]),
-                                      " | ".join("%d Hz, %.1f %%" % c for c in cells)))
+        hann = np.abs(np.fft.rfft(seg * np.hanning(len(seg))[:, None], axis=0)) ** 2
+        both = hann.sum(axis=1)
+        print("| %s | %.2f | %s | %.0f Hz |" % (word, float(s["normal_velocity_mps"]),
+                                                " | ".join("%d Hz, %.1f %%" % c for c in cells),
+                                                np.sum(both * f) / np.sum(both)))
 
 
 if __name__ == "__main__":

@@ -31,7 +31,7 @@
 struct contact {
     membrane_point point; /* first: a membrane_point * is a contact * (contact_point_ops) */
     double mass_kg, stiffness, alpha, damping, stretch;
-    double stretch_force; /* N, the stretching's force on the stick in the last sample */
+    double stretch_force; /* N, the stretching's force on the head in the last sample */
     double hit_velocity; /* m/s, of the hit waiting to land (point.move_pending) */
     double hit_mass_kg;  /* the stick's mass from that hit on; 0: unchanged */
     /* Stroke state (double: the contact law is stiff and nonlinear). */
@@ -459,8 +459,9 @@ static double head_k3(const contact *c)
     return c->point.owner && c->point.owner->plate ? 0.0 : c->stretch;
 }
 
-/* The stretching's force on the stick over a step of its depth s0 -> s1 (m): the
- * discrete gradient of U(s) = k3 s+^4 / 4, so that its work is U's change. */
+/* The stretching's force on the head under the stick over a step of its depth
+ * s0 -> s1 (m): the discrete gradient of U(s) = k3 s+^4 / 4, so that its work is
+ * U's change. */
 static double stretch_step_force(double k3, double s0, double s1)
 {
     if (!(k3 > 0.0) || (s0 <= 0.0 && s1 <= 0.0))
@@ -475,24 +476,25 @@ static double stretch_step_force(double k3, double s0, double s1)
 }
 
 /* One stick alone: the scalar solve of its compression, and (stretch > 0) the
- * stretching's force G on the stick, made consistent with the stick's new depth by
- * re-solving until that depth stops moving (2-3 solves). Returns F; *g gets G. */
+ * stretching's force G on the head under it, made consistent with the head's new
+ * depth there by re-solving until that depth stops moving (2-3 solves). The head
+ * takes F - G, so the compression is x_free - C F + K G. Returns F; *g gets G. */
 static double contact_solve_one(contact *c, double xfree, double K, double T, double *x1, double *g)
 {
     double C = T * T / (2.0 * c->mass_kg) + K;
-    double h = T * T / (2.0 * c->mass_kg); /* depth moved per N of force on the stick */
-    double s0 = c->stick_x, s_coast = s0 + T * c->stick_v;
-    double s1 = s_coast - h * (c->force + c->stretch_force); /* the last sample's forces */
+    double w0 = c->stick_x - c->compression;               /* the head's depth under the stick */
+    double wfree = c->stick_x + T * c->stick_v - xfree;    /* ... without this sample's forces */
+    double w1 = wfree + K * (c->force - c->stretch_force); /* with the last sample's */
     double G = 0.0, F = 0.0;
     for (int pass = 0; pass < 4; pass++) {
-        G = stretch_step_force(head_k3(c), s0, s1);
+        G = stretch_step_force(head_k3(c), w0, w1);
         double ug = -1.0;
         if (c->force > 0.0 && c->lin_valid && pass == 0) {
             /* The last sample's force law, linearised, in x1 = x_free - C F: the
              * membrane's part of the move (x_free) is exact, the law's curvature
              * is the error. */
             double Cd1 = C * c->lin_d1;
-            ug = (xfree - h * G - C * (c->lin_f + c->lin_d0 * (c->compression - c->lin_x0)) +
+            ug = (xfree + K * G - C * (c->lin_f + c->lin_d0 * (c->compression - c->lin_x0)) +
                   Cd1 * c->lin_u) /
                  (1.0 + Cd1);
         } else if (c->force > 0.0 && c->compression > 0.0 && c->compression_before > 0.0) {
@@ -500,17 +502,17 @@ static double contact_solve_one(contact *c, double xfree, double K, double T, do
         }
         contact_lin lin = {0, 0.0, 0.0, 0.0, 0.0};
         double x0 = c->compression;
-        F = contact_solve(c, x0, xfree - h * G, C, T, c->force, ug, x1, &lin);
+        F = contact_solve(c, x0, xfree + K * G, C, T, c->force, ug, x1, &lin);
         c->lin_valid = lin.valid;
         c->lin_x0 = x0;
         c->lin_u = lin.u;
         c->lin_f = lin.f;
         c->lin_d0 = lin.d0;
         c->lin_d1 = lin.d1;
-        double s_new = s_coast - h * (F + G);
-        double moved = fabs(s_new - s1);
-        s1 = s_new;
-        if (!(head_k3(c) > 0.0) || moved <= 1.0e-13 + 1.0e-10 * fabs(s1))
+        double w_new = wfree + K * (F - G);
+        double moved = fabs(w_new - w1);
+        w1 = w_new;
+        if (!(head_k3(c) > 0.0) || moved <= 1.0e-13 + 1.0e-10 * fabs(w1))
             break;
     }
     *g = G;
@@ -536,12 +538,12 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
         F[0] = contact_solve_one(point_contact(pts[0]), xfree[0], K[0][0], T, &x1[0], &G[0]);
     } else {
         for (int i = 0; i < na; i++) {
-            /* The stretching at the depth the last sample's forces predict. */
+            /* The stretching at the head's depth the last sample's forces predict. */
             contact *c = point_contact(pts[i]);
-            double h = T * T / (2.0 * c->mass_kg);
-            double s1 = c->stick_x + T * c->stick_v - h * (c->force + c->stretch_force);
-            G[i] = stretch_step_force(head_k3(c), c->stick_x, s1);
-            xfree[i] -= h * G[i];
+            double w0 = c->stick_x - c->compression;
+            double w1 = w_free[i] + K[i][i] * (c->force - c->stretch_force);
+            G[i] = stretch_step_force(head_k3(c), w0, w1);
+            xfree[i] += K[i][i] * G[i];
         }
         for (int s = 0; s < 30; s++) {
             double change = 0.0;
@@ -550,7 +552,7 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
                 double xf = xfree[i];
                 for (int j = 0; j < na; j++)
                     if (j != i)
-                        xf -= K[i][j] * F[j];
+                        xf -= K[i][j] * (F[j] - G[j]);
                 double C = T * T / (2.0 * c->mass_kg) + K[i][i];
                 double Fi =
                     contact_solve(c, c->compression, xf, C, T, c->force, -1.0, &x1[i], NULL);
@@ -565,14 +567,15 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
     for (int i = 0; i < na; i++) {
         contact *c = point_contact(pts[i]);
         double Fi = F[i];
-        /* Midpoint rule for the stick: m (v+ - v) = -T (F + G), x+ = x + T (v + v+) / 2. */
-        double v1 = c->stick_v - T * (Fi + G[i]) / c->mass_kg;
+        /* Midpoint rule for the stick: m (v+ - v) = -T F, x+ = x + T (v + v+) / 2; the
+         * head takes F - G. */
+        double v1 = c->stick_v - T * Fi / c->mass_kg;
         c->stretch_force = G[i];
         c->stick_x += 0.5 * T * (c->stick_v + v1);
         c->stick_v = v1;
         double xw = x1[i], xprev = c->compression;
         c->force = Fi;
-        c->point.force_pending = Fi;
+        c->point.force_pending = Fi - G[i];
         c->stroke_samples++;
         double t_end = (double)c->stroke_samples, t_start = t_end - 1.0;
         /* Touching = compressed at the end of the sample; the sample in which x
@@ -595,7 +598,7 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
             c->peak_force = Fi;
         c->impulse += Fi * T;
         for (int j = 0; j < MEMBRANE_PICKUPS; j++)
-            out_extra[j] += Fi * c->point.pick_coupling[j];
+            out_extra[j] += (Fi - G[i]) * c->point.pick_coupling[j];
         /* Release: away from the surface and moving away, and either clear of it
          * (5 mm) or 50 ms after the last touch; before the first touch the stroke
          * waits (a stick moving away from the start never touches: 50 ms). */

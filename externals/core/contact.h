@@ -10,11 +10,12 @@
  * of stick tips (stick_tip.h: wood, nylon, felt).
  * The head's stretching under a point load (stick_tip_head_k3 in stick_tip.h: a
  * force k3 y^3 on top of the modes' linear stiffness, y the head's deflection under
- * the stick) is the "stretch" parameter, k3 in N/m^3. It is carried on the stick:
- * the stick feels the potential k3 s^4 / 4 of its depth s below the rest plane
- * (s > 0), and the modes take the contact force F alone, i.e. the force net of the
- * stretching's push-back, so that with a stiff tip the stick meets F + k3 s^3,
- * the physics' head F = k1 y + k3 y^3 (daemon/src/sim) with the modes as k1.
+ * the stick) is the "stretch" parameter, k3 in N/m^3. It is carried by the head
+ * under the stick while a stroke lasts: the potential k3 w^4 / 4 of the head's depth
+ * w there (w > 0), so the modes take F - k3 w^3 and the stick F alone. With a stiff
+ * tip the two move together and the stick meets the physics' head F = k1 y + k3 y^3
+ * (daemon/src/sim), the modes as k1; when the head falls behind the stick, the stick
+ * no longer feels the stretching (docs/contact.md, "Stick tips").
  * The contact is solved jointly with the membrane's modes, sample by sample
  * (Avanzini & Rocchesso), with an energy-consistent discretisation: the
  * spring term is a discrete gradient of V(x) = k x^(alpha+1)/(alpha+1) and the

@@ -24,9 +24,11 @@ static const membrane_preset presets[] = {
     /* 14-inch snare, 0.25 mm batter (0.345 kg/m^2), (0,1) at 220 Hz. */
     {"snare", "14-inch snare drum, 0.25 mm Mylar batter, (0,1) at 220 Hz",
      0.1778, 3603.0, 0.345, 0.5, 1.0, 0, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 1, 0, 0, 0.0, 0.0, 0.0, 0.0},
-    /* 12-inch rack tom, 0.25 mm batter, (0,1) at 150 Hz. */
-    {"tom", "12-inch tom, 0.25 mm Mylar batter, (0,1) at 150 Hz",
-     0.1524, 1231.0, 0.345, 0.8, 1.0, 1024, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, DRUM_CASCADE, 0.0},
+    /* 12-inch rack tom, a two-ply batter (2 x 0.178 mm, the common tom head), the air's
+     * mass on both faces (airmass 2: the room's above, the shell's below), (0,1) at
+     * 110 Hz with it. */
+    {"tom", "12-inch tom, two-ply Mylar batter (2 x 0.178 mm), the air on both faces, (0,1) at 110 Hz",
+     0.1524, 1465.7, 0.491, 0.8, 1.0, 1024, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, DRUM_CASCADE, 2.0},
     /* 16-inch floor tom, 0.25 mm batter, (0,1) at 95 Hz. */
     {"floor-tom", "16-inch floor tom, 0.25 mm Mylar batter, (0,1) at 95 Hz",
      0.2032, 878.0, 0.345, 1.2, 1.0, 1024, 0.3, {0.5, 0.5}, {0.0, 90.0}, 0, {0}, 1.0, 0, 0, 0, 0.0, 0.0, 0.0, 0.0},

@@ -133,43 +133,96 @@ ictus_status mode_table_build(mode_table *t, int size, int plate)
 static double air_x[AIR_NODES], air_w[AIR_NODES];
 static int air_ready;
 
-double mode_table_air_g(int m, double j)
+/* Panels of pi/2 (J_m^2 oscillates with period pi) to U = 2 j + 20; past U, J_m(u)^2
+ * averages 1 / (pi u) and (j^2 - u^2)^2 >= (3/4)^2 u^4: the tail, 1 / (4 pi U^4) over
+ * (3/4)^2 at most, is below 1e-4 of the whole. */
+static int air_panels(double j)
+{
+    return (int)ceil((2.0 * j + 20.0) / (0.5 * M_PI));
+}
+
+/* g from J_m at the panels' nodes (jm[p * AIR_NODES + i]: node i of panel p), as many
+ * panels as air_panels(j). */
+static double air_g_from(const double *jm, int m, double j)
+{
+    const double dj = ictus_bessel_j(m + 1, j); /* |J_m'(j)| at a zero of J_m */
+    const double panel = 0.5 * M_PI;
+    const int panels = air_panels(j);
+    double sum = 0.0;
+    for (int p = 0; p < panels; p++)
+        for (int i = 0; i < AIR_NODES; i++) {
+            const double u = p * panel + panel * air_x[i], den = j * j - u * u;
+            double v;
+            if (fabs(den) < 1e-6 * j * j) {
+                v = dj * dj / (4.0 * j * j); /* the limit at u = j */
+            } else {
+                const double r = jm[p * AIR_NODES + i] / den;
+                v = r * r;
+            }
+            sum += panel * air_w[i] * v;
+        }
+    const double end = panels * panel, u4 = end * end * end * end;
+    sum += 1.0 / (4.0 * M_PI * u4); /* the tail as if (j^2 - u^2)^2 were u^4: within 1e-4 */
+    return 2.0 * j * j * sum;
+}
+
+/* J_m at the nodes of the first `panels` panels. */
+static void air_nodes(int m, int panels, double *jm)
 {
     if (!air_ready) {
         ictus_gauss_legendre(AIR_NODES, air_x, air_w);
         air_ready = 1;
     }
-    /* Panels of pi/2 (J_m^2 oscillates with period pi) to U = 2 j + 20; past U,
-     * J_m(u)^2 averages 1 / (pi u) and (j^2 - u^2)^2 >= (3/4)^2 u^4: the tail,
-     * 1 / (4 pi U^4) over (3/4)^2 at most, is below 1e-4 of the whole. */
-    const double dj = ictus_bessel_j(m + 1, j); /* |J_m'(j)| at a zero of J_m */
-    const double panel = 0.5 * M_PI, end = 2.0 * j + 20.0;
-    double sum = 0.0;
-    for (double a = 0.0; a < end; a += panel)
-        for (int i = 0; i < AIR_NODES; i++) {
-            const double u = a + panel * air_x[i], den = j * j - u * u;
-            double v;
-            if (fabs(den) < 1e-6 * j * j) {
-                v = dj * dj / (4.0 * j * j); /* the limit at u = j */
-            } else {
-                const double r = ictus_bessel_j(m, u) / den;
-                v = r * r;
-            }
-            sum += panel * air_w[i] * v;
-        }
-    const double u4 = end * end * end * end;
-    sum += 1.0 / (4.0 * M_PI * u4); /* the tail as if (j^2 - u^2)^2 were u^4: within 1e-4 */
-    return 2.0 * j * j * sum;
+    const double panel = 0.5 * M_PI;
+    for (int p = 0; p < panels; p++)
+        for (int i = 0; i < AIR_NODES; i++)
+            jm[p * AIR_NODES + i] = ictus_bessel_j(m, p * panel + panel * air_x[i]);
 }
 
+double mode_table_air_g(int m, double j)
+{
+    const int panels = air_panels(j);
+    double *jm = malloc(sizeof(double) * (size_t)panels * AIR_NODES);
+    if (!jm)
+        return 0.0;
+    air_nodes(m, panels, jm);
+    double g = air_g_from(jm, m, j);
+    free(jm);
+    return g;
+}
+
+/* The modes of one m share the nodes (the panels start at 0), so J_m is evaluated once
+ * per m, to the largest j of that m among the modes to compute, not once per mode. */
 void mode_table_prepare_air(mode_table *t)
 {
-    if (t->plate)
+    if (t->plate || t->air_valid >= t->size)
         return;
-    for (int k = t->air_valid; k < t->size; k++)
-        t->air[k] = (k > t->air_valid && t->j[k] == t->j[k - 1] && t->m[k] == t->m[k - 1])
-                        ? t->air[k - 1] /* the sin partner */
-                        : mode_table_air_g(t->m[k], t->j[k]);
+    int top_m = 0;
+    double top_j = 0.0;
+    for (int k = t->air_valid; k < t->size; k++) {
+        top_m = t->m[k] > top_m ? t->m[k] : top_m;
+        top_j = t->j[k] > top_j ? t->j[k] : top_j;
+    }
+    double *jm = malloc(sizeof(double) * (size_t)air_panels(top_j) * AIR_NODES);
+    for (int m = 0; m <= top_m; m++) {
+        double jmax = 0.0;
+        for (int k = t->air_valid; k < t->size; k++)
+            if (t->m[k] == m && t->j[k] > jmax)
+                jmax = t->j[k];
+        if (!(jmax > 0.0))
+            continue;
+        if (jm)
+            air_nodes(m, air_panels(jmax), jm);
+        for (int k = t->air_valid; k < t->size; k++) {
+            if (t->m[k] != m)
+                continue;
+            if (k > t->air_valid && t->j[k] == t->j[k - 1] && t->m[k] == t->m[k - 1])
+                t->air[k] = t->air[k - 1]; /* the sin partner */
+            else
+                t->air[k] = jm ? air_g_from(jm, m, t->j[k]) : mode_table_air_g(m, t->j[k]);
+        }
+    }
+    free(jm);
     t->air_valid = t->size;
 }
 

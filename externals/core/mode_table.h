@@ -49,7 +49,8 @@ void mode_table_free(mode_table *t);
  * infinite membrane's rho / k) as j grows. Exported for the tests. */
 double mode_table_air_g(int m, double j);
 /* Computes air[k] for the modes that lack it (none for a plate): only a head with air
- * on it asks, at message time, once per mode (0.16 s for 1024 modes, 1.9 s for 4096). */
+ * on it asks, at message time, once per mode, J_m at the quadrature nodes once per m
+ * (setting airmass on a head of 1024 modes: 41 ms, 4096: 0.24 s). */
 void mode_table_prepare_air(mode_table *t);
 
 /* psi[k] = J_m(j r/a) {cos, sin}(m theta) * norm for k < live, 0 for live <= k < size:

@@ -7,7 +7,7 @@ import random
 from ictus_tools.random_score import RandomScore
 
 # the drum presets and their tensions, N/m (externals/core/membrane_presets.c, docs/sound.md)
-PRESET_TENSION = {"paper": 3000.0, "snare": 3603.0, "tom": 1231.0, "floor-tom": 878.0,
+PRESET_TENSION = {"paper": 3000.0, "snare": 3603.0, "tom": 1465.7, "floor-tom": 878.0,
                   "timpani": 1493.0, "frame": 599.0}
 DRUM_PRESETS = list(PRESET_TENSION)
 STICK_TIPS = ["wood", "nylon", "felt"]

@@ -13,7 +13,8 @@ prints per hit: contact~'s duration, peak force and rebound speed (render-report
 first 100 ms, the spectral centroid of the first 50 ms (Hann window, the two pickups'
 power summed, as tests/e2e/test_expression.py) and the share of that energy in the
 bands of the (0,1) and (1,1) modes (split halfway between the ideal membrane's f01,
-f11 and f21, from the preset's radius, tension and density).
+f11 and f21 with the air's mass, ictus_tools.drumtone.mode_hz, from the preset's radius,
+tension, density and airmass as the --drum messages leave them).
 """
 import argparse
 import math
@@ -25,9 +26,9 @@ import numpy as np
 
 from ictus_tools import ROOT
 from ictus_tools.pdrun import PD, PD_ENV, error_lines, read_wav_any
+from ictus_tools.drumtone import mode_hz
+from ictus_tools.presets import preset_air_mass, preset_head
 
-# Bessel zeros j01, j11, j21 (Abramowitz & Stegun, table 9.5)
-J01, J11, J21 = 2.404825557695773, 3.831705970207512, 5.135622301840683
 MYLAR = (4.5e9, 0.38, 1390.0)  # E (Pa), nu, rho (kg/m^3): docs/membrane.md
 SPACING_S = 2.0
 
@@ -37,15 +38,6 @@ def begley_mackin_k3(radius_m, density_kg_per_m2):
     e, nu, rho = MYLAR
     q = 1.0 / (1.05 - 0.15 * nu - 0.16 * nu * nu)
     return e * (density_kg_per_m2 / rho) * q ** 3 / radius_m ** 2
-
-
-def preset_head(name):
-    """(radius, tension, density) of a preset, read from membrane_presets.c."""
-    with open(os.path.join(ROOT, "externals", "core", "membrane_presets.c")) as f:
-        text = f.read()
-    i = text.index('{"%s",' % name)
-    body = text[text.index("\n", text.index('",', text.index('",', i) + 2)) + 1:]
-    return tuple(float(w) for w in body.split(",")[:3])
 
 
 def main():
@@ -59,14 +51,19 @@ def main():
                     help="a message to the drum after the preset, e.g. 'cascade 1' (repeatable)")
     ap.add_argument("--speeds", default="0.46,1.02,1.58,2.18,2.77,3.37,3.99,4.61,5.24,5.87")
     a = ap.parse_args()
-    radius, tension, density = preset_head(a.preset)
+    head = dict(zip(("radius", "tension", "density"), preset_head(a.preset)))
+    head["airmass"] = preset_air_mass(a.preset)
+    for msg in a.drum:  # the head as the --drum messages leave it
+        words = msg.split()
+        if len(words) == 2 and words[0] in head:
+            head[words[0]] = float(words[1])
+    radius, tension, density = head["radius"], head["tension"], head["density"]
     k3 = begley_mackin_k3(radius, density) if a.stretch is None else a.stretch
     speeds = [float(v) for v in a.speeds.split(",")]
-    c = math.sqrt(tension / density)
-    f01, f11, f21 = (j * c / (2.0 * math.pi * radius) for j in (J01, J11, J21))
-    print("%s: a %.4f m, T %g N/m, sigma %g kg/m^2; f01 %.0f, f11 %.0f, f21 %.0f Hz; "
-          "stick %.4f kg at r/a %.2f, k3 %.3g N/m^3" % (a.preset, radius, tension, density,
-                                                      f01, f11, f21, a.mass, a.ra, k3))
+    f01, f11, f21 = (mode_hz(radius, tension, density, m, 1, head["airmass"]) for m in (0, 1, 2))
+    print("%s: a %.4f m, T %g N/m, sigma %g kg/m^2, airmass %g; f01 %.0f, f11 %.0f, f21 %.0f "
+          "Hz; stick %.4f kg at r/a %.2f, k3 %.3g N/m^3"
+          % (a.preset, radius, tension, density, head["airmass"], f01, f11, f21, a.mass, a.ra, k3))
     work = tempfile.mkdtemp(prefix="ictus-contact-probe-")
     events = os.path.join(work, "events.txt")
     with open(events, "w") as f:

@@ -1,14 +1,32 @@
-"""A drum's lowest mode and the power of one frequency in a signal, for tests that tell
-drums apart by ear: the ideal membrane's (0,1) mode, j01 / (2 pi a) sqrt(T / sigma), and
-Goertzel's single-bin power."""
+"""A drum's modes and the power of one frequency in a signal, for tests that tell drums
+apart by ear: the ideal membrane's (m, n) mode, j_mn / (2 pi a) sqrt(T / sigma), with the
+air's mass when a head has it, and Goertzel's single-bin power."""
 import math
 
 J01 = 2.404825557695773  # first zero of the Bessel function J0
 
 
-def f01(radius, tension, density):
-    """The (0,1) mode of an ideal circular membrane, Hz (radius m, tension N/m, kg/m^2)."""
-    return J01 / (2.0 * math.pi * radius) * math.sqrt(tension / density)
+def mode_hz(radius, tension, density, m=0, n=1, airmass=0.0):
+    """Mode (m, n) of an ideal circular membrane, Hz (radius m, tension N/m, kg/m^2),
+    j_mn / (2 pi a) sqrt(T / sigma), with `airmass` baffled faces' air on it (membrane~'s
+    airmass; docs/membrane.md, "The air's mass"): over sqrt(1 + airmass rho_air a / sigma
+    g_mn), g_mn from ictus_tools.air."""
+    j = J01 if (m, n) == (0, 1) else _zero(m, n)
+    ideal = j / (2.0 * math.pi * radius) * math.sqrt(tension / density)
+    if airmass <= 0.0:
+        return ideal
+    from ictus_tools.air import RHO_AIR, air_g
+    return ideal / math.sqrt(1.0 + airmass * RHO_AIR * radius / density * air_g(m, n))
+
+
+def _zero(m, n):
+    from scipy.special import jn_zeros
+    return float(jn_zeros(m, n)[-1])
+
+
+def f01(radius, tension, density, airmass=0.0):
+    """The (0,1) mode (mode_hz)."""
+    return mode_hz(radius, tension, density, 0, 1, airmass)
 
 
 def goertzel_power(x, rate, freq):

@@ -19,8 +19,9 @@ extern "C" {
 
 namespace
 {
-// the tom preset's head (docs/sound.md's table) and Mylar (docs/membrane.md)
-constexpr double kA = 0.1524, kT0 = 1231.0, kSigma = 0.345;
+// the tom preset's head (docs/sound.md's table) and Mylar (docs/membrane.md); the rate
+// test takes the air's mass off it (its frequencies are then the ideal membrane's)
+constexpr double kA = 0.1524, kT0 = 1465.7, kSigma = 0.491;
 constexpr double kY = 4.5e9, kNu = 0.38, kRho = 1390.0, kJ01 = 2.404825557695773;
 
 membrane *head(const char *preset, double cascade)
@@ -82,6 +83,7 @@ TEST_CASE("drum cascade: one update moves energy at the rate the head's stretch 
     // each band pair (even, then odd) whose lower band holds more energy per mode relaxes toward
     // equal energy per mode by 1 - exp(-Gamma dt), dt = 128 / 48000 s.
     membrane *m = head("tom", 1.0);
+    REQUIRE(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_AIR_MASS, 0.0) == ICTUS_OK);
     REQUIRE(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_T60, 60.0) == ICTUS_OK);
     REQUIRE(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_LOSS_FACTOR, 0.0) == ICTUS_OK);
     REQUIRE(ictus_param_set(&membrane_params, m, MEMBRANE_PARAM_RADIATION, 0.0) == ICTUS_OK);

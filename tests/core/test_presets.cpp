@@ -96,7 +96,7 @@ TEST_CASE("Preset heads: Mylar densities and the documented tunings", "[core][pr
         double hz;
     };
     const expect e[] = {
-        {"snare", 14 * 0.0127, 0.25, 0, 220.0},    {"tom", 12 * 0.0127, 0.25, 0, 150.0},
+        {"snare", 14 * 0.0127, 0.25, 0, 220.0},    {"tom", 12 * 0.0127, 0.356, 0, 110.0},
         {"floor-tom", 16 * 0.0127, 0.25, 0, 95.0}, {"timpani", 26 * 0.0127, 0.19, 1, 110.0},
         {"frame", 18 * 0.0127, 0.19, 0, 80.0},     {"kick", 22 * 0.0127, 0.25, 0, 55.0}};
     for (const expect &x : e) {
@@ -126,8 +126,8 @@ TEST_CASE("timpani: (m,1) partials at Rossing's ratios, (0,1) damped hard", "[co
     // The ideal membrane's (2,1)/(1,1) = 1.340 would miss by 11 %.
     CHECK(std::fabs(ictus_bessel_zero(2, 1) / ictus_bessel_zero(1, 1) - 1.50) > 0.1);
     CHECK(t01 < 0.2 * t11);
-    // Back to an untuned head: the ideal ratios return.
-    REQUIRE(membrane_apply_preset(m, membrane_preset_find("tom")) == ICTUS_OK);
+    // Back to an untuned head without the air's mass: the ideal ratios return.
+    REQUIRE(membrane_apply_preset(m, membrane_preset_find("floor-tom")) == ICTUS_OK);
     CHECK(mode_freq(m, 2, 1) / mode_freq(m, 1, 1) ==
           Approx(ictus_bessel_zero(2, 1) / ictus_bessel_zero(1, 1)).epsilon(1e-9));
     membrane_free(m);

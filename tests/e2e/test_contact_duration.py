@@ -22,7 +22,7 @@ law    synthetic events files, no daemon: sticks of 0.01-0.05 kg at 0.5-10 m/s
 
 ladder `ictusd render --drum-preset tom` plays the dynamics ladder R legato 0.1 .. 1.0
        (tempo 30, as e2e_expression): render.json's head stretching is the
-       Begley & Mackin k3 of the tom's film computed here (0.345 kg/m^2 of Mylar,
+       Begley & Mackin k3 of the tom's film computed here (0.491 kg/m^2 of Mylar,
        a 0.1524 m); every note's contact~ duration within 25 % of the physics'
        (PER STRIKE), and the log-log slope of duration against impact speed
        <= -0.1 for the law (integrated here), the physics and contact~. In a
@@ -102,8 +102,9 @@ def physics_duration_ms(m, k, c):
 # the default Mylar head: E 4.5 GPa, nu 0.38, h = 0.262 kg/m^2 / 1390 kg/m^3, a 0.178 m.
 _Q = 1.0 / (1.05 - 0.15 * 0.38 - 0.16 * 0.38 ** 2)
 K3 = 4.5e9 * (0.262 / 1390.0) * _Q ** 3 / 0.178 ** 2
-# The tom preset's head (membrane_presets.c: a 12-inch, 0.25 mm Mylar batter at 1231 N/m).
-TOM = {"radius_m": 0.1524, "tension_n_per_m": 1231.0, "density_kg_per_m2": 0.345}
+# The tom preset's head (membrane_presets.c: a 12-inch two-ply Mylar batter, 2 x 0.178 mm,
+# at 1465.7 N/m).
+TOM = {"radius_m": 0.1524, "tension_n_per_m": 1465.7, "density_kg_per_m2": 0.491}
 K3_TOM = 4.5e9 * (TOM["density_kg_per_m2"] / 1390.0) * _Q ** 3 / TOM["radius_m"] ** 2
 
 

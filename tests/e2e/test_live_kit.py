@@ -9,7 +9,7 @@ strike of strikes.csv arrives, with its stick tip (felt, in strikes.csv and in t
 which gives it to every drum's sticks), and each sounds loudest at its own drum's lowest mode: of the
 four drums' (0,1) frequencies, f01 = j01 / (2 pi a) sqrt(T / sigma) from each preset's head
 (externals/core/membrane_presets.c; the 10-inch tom1 is the tom preset's head on a 10-inch
-shell, docs/kit.md), the one with the most energy (Goertzel) in the 150 ms after its onset.
+shell, docs/kit.md; the toms' with the air's mass on both faces, ictus_tools.drumtone.f01), the one with the most energy (Goertzel) in the 150 ms after its onset.
 The onset is where the patch played it: the strike's logical time, printed by the patch,
 from the start of the recording (the play message, however long the daemon took to start). Every wait is a handshake on pd's printed lines or the
 daemon's exit, with a deadline.
@@ -45,8 +45,8 @@ R on tom1, L on tom2, R on snare, L on snare
 NOTES = 16
 # The kit's drums (docs/kit.md's table): name, (radius m, tension N/m, density kg/m^2) of the
 # preset's head on the kit's shell.
-HEADS = [("snare", (0.1778, 3603.0, 0.345)), ("tom1", (0.127, 1231.0, 0.345)),
-         ("tom2", (0.1524, 1231.0, 0.345)), ("floor", (0.2032, 878.0, 0.345))]
+HEADS = [("snare", (0.1778, 3603.0, 0.345)), ("tom1", (0.127, 1465.7, 0.491, 2.0)),
+         ("tom2", (0.1524, 1465.7, 0.491, 2.0)), ("floor", (0.2032, 878.0, 0.345))]
 TIP, TIP_CODE = "felt", 3  # the sticks' tip and its code in the strike record (docs/osc.md)
 SR = 48000
 RECORD_S = 180  # the recording's length (s): the score is 11 s after play, longer when the

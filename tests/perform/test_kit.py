@@ -6,9 +6,12 @@ Each written note gets one primary strike of its hand on its written drum within
 +-5 ms (notes.csv, whose strike matching requires the drum, and strikes.csv's drum column), no
 extra primary strike, no stick part through a shell (render.json's kit.shell_passes), and each
 strike sounds from its own drum's membrane~: in the 150 ms after each strike onset, of the
-drums' lowest frequencies, the one with the most energy (Goertzel) is its drum's. The
-frequencies are the ideal membrane's, f01 = 2.405 / (2 pi a) sqrt(T / sigma), from the preset
-values written here (docs/sound.md, "Presets"), and the timpani's air-loaded (1,1) at 110 Hz.
+drums' pairs of lowest ringing partials, the one with the most energy (Goertzel, summed over
+the pair) is its drum's (a pair, as tom2's (0,1) and the timpani's (1,1) are both 110 Hz). The
+partials are the ideal membrane's (0,1) and (1,1), j_mn / (2 pi a) sqrt(T / sigma), from the
+preset values written here (docs/sound.md, "Presets"), the toms' with the air's mass on both
+faces (ictus_tools.drumtone.mode_hz), and the timpani's air-loaded (1,1) and (2,1) at 110 and
+165 Hz.
 
     PYTHONPATH=python python3 tests/perform/test_kit.py --ictusd build/ictusd
 """
@@ -21,7 +24,7 @@ import sys
 
 from ictus_tools import e2e_util
 from ictus_tools.checks import check
-from ictus_tools.drumtone import f01, goertzel_power
+from ictus_tools.drumtone import f01, goertzel_power, mode_hz
 
 SCORE = """tempo 100
 drum snare
@@ -50,9 +53,9 @@ L on timpani1 at 0.5 70, R on timpani2 at 0.5 110
 """
 # radius m, tension N/m, density kg/m^2 (externals/core/membrane_presets.c; the 10-inch tom is
 # the tom preset's head on a 10-inch shell).
-HEADS = {"snare": (0.1778, 3603.0, 0.345), "tom1": (0.127, 1231.0, 0.345),
-         "tom2": (0.1524, 1231.0, 0.345)}
-F_TIMPANI = 110.0  # (1,1), air-loaded
+HEADS = {"snare": (0.1778, 3603.0, 0.345), "tom1": (0.127, 1465.7, 0.491, 2.0),
+         "tom2": (0.1524, 1465.7, 0.491, 2.0)}
+F_TIMPANI = (110.0, 165.0)  # (1,1) and (2,1), air-loaded (Rossing's 1 : 1.50)
 
 
 
@@ -109,20 +112,22 @@ def main():
     if not ok:
         return 1
     notes, strikes, names, primaries, ok = played_right(out, ["snare", "timpani", "tom1", "tom2"])
-    # Each strike's sound: its drum's lowest mode has the most energy of the drums' modes.
-    freq = {k: f01(*v) for k, v in HEADS.items()}
+    # Each strike's sound: its drum's two lowest ringing partials have the most energy of
+    # the drums' pairs (tom2's (0,1) and the timpani's (1,1) are both A2, 110 Hz).
+    freq = {k: (f01(*v), mode_hz(*v[:3], 1, 1, *v[3:])) for k, v in HEADS.items()}
     freq["timpani"] = F_TIMPANI
     rate, x = e2e_util.read_wav_mono(wav)
     right = 0
     for s in primaries:
         i0 = int(round(float(s["time_s"]) * rate)) + int(0.005 * rate)
         seg = x[i0:i0 + int(0.15 * rate)]
-        power = {k: goertzel_power(seg, rate, f) for k, f in freq.items()}
+        power = {k: sum(goertzel_power(seg, rate, f) for f in fs) for k, fs in freq.items()}
         loudest = max(power, key=power.get)
         right += loudest == names[int(s["drum"])]
     ok &= check(right == len(primaries),
-                "each strike sounds loudest at its drum's lowest mode: %d of %d (modes %s Hz)"
-                % (right, len(primaries), {k: round(v, 1) for k, v in freq.items()}))
+                "each strike sounds loudest at its drum's two lowest partials: %d of %d "
+                "(partials %s Hz)" % (right, len(primaries),
+                                     {k: [round(f, 1) for f in v] for k, v in freq.items()}))
     print("kit: %d notes, %d of %d strikes sound from their drum" % (len(notes), right,
                                                                     len(primaries)))
     # Two timpani (no sound): the hands on their own drums and crossing over.

@@ -4,11 +4,11 @@ recorded after the preset is chosen, by a click on the selector (a number to its
 name, ictus-sound-panel-preset) or by the panel's inlet (preset NAME). The recording
 must have a spectral peak within 2 % of the preset head's (0,1) mode computed here,
 f01 = j01 / (2 pi a) sqrt(T / sigma), from the head in membrane_presets.c (radius,
-tension, areal density; the largest within +-10 %, parabolic refinement), and of the four
+tension, areal density; the tom's with the air's mass on both faces,
+ictus_tools.drumtone.f01; the largest within +-10 %, parabolic refinement), and of the four
 heads' f01 its own must be the loudest. The selector shows the chosen name; an unknown name is named in an
 error line and sends nothing."""
 import argparse
-import math
 import os
 import subprocess
 import tempfile
@@ -17,6 +17,7 @@ import numpy as np
 
 from ictus_tools import uitest
 from ictus_tools.checks import check
+from ictus_tools.drumtone import f01
 from ictus_tools.pdrun import read_wav_float
 
 ap = argparse.ArgumentParser()
@@ -24,17 +25,12 @@ ap.add_argument("--build", required=True)
 args = ap.parse_args()
 build = os.path.abspath(args.build)
 
-J01 = 2.404825557695773  # first zero of J0
 SR = 48000
 NAMES = ["paper", "snare", "tom", "floor-tom", "timpani", "frame", "kick"]  # the selector's order
-# radius m, tension N/m, areal density kg/m^2 (externals/core/membrane_presets.c)
-HEADS = {"paper": (0.178, 3000.0, 0.262), "tom": (0.1524, 1231.0, 0.345),
+# radius m, tension N/m, areal density kg/m^2, the air's faces (externals/core/membrane_presets.c)
+HEADS = {"paper": (0.178, 3000.0, 0.262), "tom": (0.1524, 1465.7, 0.491, 2.0),
          "floor-tom": (0.2032, 878.0, 0.345), "frame": (0.2286, 599.0, 0.262),
          "kick": (0.2794, 556.1, 0.345)}
-
-
-def f01(radius, tension, density):
-    return J01 / (2.0 * math.pi * radius) * math.sqrt(tension / density)
 
 
 def render(choose, work, tag):
