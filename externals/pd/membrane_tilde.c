@@ -221,8 +221,9 @@ static void membrane_tilde_strike(t_membrane_tilde *x, t_symbol *s, int argc, t_
     long dropped = membrane_dropped_strikes(x->x_core);
     membrane_strike(x->x_core, r, theta, impulse, ictus_clock_offset_now(&x->x_clock));
     if (membrane_dropped_strikes(x->x_core) != dropped)
-        pd_error(x, "membrane~%s%s: strike: more strikes wait for this block than it has samples "
-                    "(twice over); dropped",
+        pd_error(x,
+                 "membrane~%s%s: strike: more strikes wait for this block than it has samples "
+                 "(twice over); dropped",
                  x->x_name != &s_ ? " " : "", x->x_name != &s_ ? x->x_name->s_name : "");
 }
 
