@@ -34,6 +34,15 @@ struct contact {
     double stretch_force; /* N, the stretching's force on the head in the last sample */
     double hit_velocity; /* m/s, of the hit waiting to land (point.move_pending) */
     double hit_mass_kg;  /* the stick's mass from that hit on; 0: unchanged */
+    /* Hits after that one, in the order of their samples: a block longer than the gap
+     * between two hits (block~ 2048 holds 43 ms) lands them all on their samples. Offsets
+     * count from the start of the last block processed; queue_shift is that block's
+     * length, taken off at the next block's start. */
+    struct queued_hit {
+        double velocity, mass_kg, r_over_a, theta_deg;
+        int offset;
+    } queue[CONTACT_HIT_QUEUE];
+    int queued, queue_shift;
     /* Stroke state (double: the contact law is stiff and nonlinear). */
     int touching, ever_touched;
     double stick_x, stick_v;   /* m, m/s, positive into the membrane */
@@ -47,8 +56,10 @@ struct contact {
     long stroke_samples;
     double first_touch, last_release; /* samples since the stroke began (interpolated) */
     double peak_force, impulse;
-    int report_ready;
-    contact_report report;
+    /* Finished strokes not yet taken (contact_take_report), oldest first: a long block
+     * may end several. */
+    contact_report reports[CONTACT_REPORT_QUEUE];
+    int reports_ready;
     float *force_out;
     int force_cap;
 };
@@ -112,6 +123,12 @@ const ictus_param_table contact_params = {contact_param_def, CONTACT_PARAM_COUNT
 ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, double theta_deg,
                          int sample_offset)
 {
+    return contact_hit_mass(c, velocity_mps, r_over_a, theta_deg, sample_offset, 0.0);
+}
+
+ictus_status contact_hit_mass(contact *c, double velocity_mps, double r_over_a, double theta_deg,
+                              int sample_offset, double mass_kg)
+{
     ictus_status s = ictus_clamp(&velocity_mps, 0.0, CONTACT_VELOCITY_MAX, 1.0);
     if (membrane_clamp_point_(&r_over_a, &theta_deg) != ICTUS_OK)
         s = ICTUS_CLAMPED;
@@ -119,23 +136,37 @@ ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, doubl
         sample_offset = 0;
         s = ICTUS_CLAMPED;
     }
+    if (mass_kg != 0.0 &&
+        ictus_clamp(&mass_kg, CONTACT_MASS_MIN, CONTACT_MASS_MAX, CONTACT_DEFAULT_MASS) != ICTUS_OK)
+        s = ICTUS_CLAMPED;
+    if (c->point.owner && c->point.move_pending && sample_offset > c->point.move_offset) {
+        /* After the hit waiting to land: it waits behind it. A later hit on the same
+         * sample or before one queued replaces those (as it replaces a pending one). */
+        int at = sample_offset + c->queue_shift;
+        while (c->queued > 0 && c->queue[c->queued - 1].offset >= at)
+            c->queued--;
+        if (c->queued == CONTACT_HIT_QUEUE)
+            return ICTUS_ENOMEM;
+        struct queued_hit *h = &c->queue[c->queued++];
+        h->velocity = velocity_mps;
+        h->mass_kg = mass_kg;
+        h->r_over_a = r_over_a;
+        h->theta_deg = theta_deg;
+        h->offset = at;
+        /* Its shapes into the membrane's cache now, so that landing finds them. */
+        membrane_impulse_shape_(c->point.owner, r_over_a, theta_deg);
+        return s;
+    }
+    c->queued = 0; /* they all came after the one this hit replaces */
     c->hit_velocity = velocity_mps;
-    c->hit_mass_kg = 0.0;
+    c->hit_mass_kg = mass_kg;
     membrane_point_move_(&c->point, r_over_a, theta_deg, sample_offset);
     return s;
 }
 
-ictus_status contact_hit_mass(contact *c, double velocity_mps, double r_over_a, double theta_deg,
-                              int sample_offset, double mass_kg)
+int contact_hits_waiting(const contact *c)
 {
-    ictus_status s = contact_hit(c, velocity_mps, r_over_a, theta_deg, sample_offset);
-    if (mass_kg != 0.0) {
-        double m = mass_kg;
-        if (ictus_clamp(&m, CONTACT_MASS_MIN, CONTACT_MASS_MAX, CONTACT_DEFAULT_MASS) != ICTUS_OK)
-            s = ICTUS_CLAMPED;
-        c->hit_mass_kg = m;
-    }
-    return s;
+    return c->point.move_pending + c->queued;
 }
 
 void contact_set_force_output(contact *c, float *buffer, int capacity)
@@ -151,11 +182,12 @@ int contact_is_active(const contact *c)
 
 int contact_take_report(contact *c, contact_report *report)
 {
-    if (!c->report_ready)
+    if (c->reports_ready == 0)
         return 0;
     if (report)
-        *report = c->report;
-    c->report_ready = 0;
+        *report = c->reports[0];
+    c->reports_ready--;
+    memmove(c->reports, c->reports + 1, sizeof(c->reports[0]) * (size_t)c->reports_ready);
     return 1;
 }
 
@@ -431,6 +463,15 @@ static void contact_landed(membrane_point *pt, double displacement_m, double vel
     c->stroke_samples = 0;
     c->first_touch = c->last_release = 0.0;
     c->peak_force = c->impulse = 0.0;
+    if (c->queued > 0 && pt->owner) {
+        /* The next hit waits for its own sample, later in this block or a later one. */
+        struct queued_hit next = c->queue[0];
+        c->queued--;
+        memmove(c->queue, c->queue + 1, sizeof(c->queue[0]) * (size_t)c->queued);
+        c->hit_velocity = next.velocity;
+        c->hit_mass_kg = next.mass_kg;
+        membrane_point_move_(pt, next.r_over_a, next.theta_deg, next.offset);
+    }
 }
 
 /* The stroke is over. A stick that touched the head (a force, if only within one
@@ -441,12 +482,15 @@ static void contact_landed(membrane_point *pt, double displacement_m, double vel
 static void finish_stroke(contact *c, double dt)
 {
     if (c->ever_touched || c->peak_force > 0.0) {
-        c->report.duration_ms =
-            (c->ever_touched ? (c->last_release - c->first_touch) * dt * 1000.0 : 0.0);
-        c->report.peak_force_n = c->peak_force;
-        c->report.rebound_velocity_mps = c->stick_v < 0.0 ? -c->stick_v : 0.0;
-        c->report.impulse_ns = c->impulse;
-        c->report_ready = 1;
+        if (c->reports_ready == CONTACT_REPORT_QUEUE) { /* none taken for long: keep the newest */
+            c->reports_ready--;
+            memmove(c->reports, c->reports + 1, sizeof(c->reports[0]) * (size_t)c->reports_ready);
+        }
+        contact_report *r = &c->reports[c->reports_ready++];
+        r->duration_ms = (c->ever_touched ? (c->last_release - c->first_touch) * dt * 1000.0 : 0.0);
+        r->peak_force_n = c->peak_force;
+        r->rebound_velocity_mps = c->stick_v < 0.0 ? -c->stick_v : 0.0;
+        r->impulse_ns = c->impulse;
     }
     c->point.active = 0;
     c->touching = 0;
@@ -619,6 +663,9 @@ static void contact_solve_points(membrane_point *const *pts, int na, const doubl
 static void contact_block_begin(membrane_point *pt, int n)
 {
     contact *c = point_contact(pt);
+    for (int i = 0; i < c->queued; i++)
+        c->queue[i].offset -= c->queue_shift;
+    c->queue_shift = n;
     int have = n < c->force_cap ? n : c->force_cap;
     if (c->force_out && have > 0)
         memset(c->force_out, 0, sizeof(float) * (size_t)have);
@@ -631,6 +678,7 @@ static void contact_cleared(membrane_point *pt)
     c->force = 0.0;
     c->stick_v = c->stick_x = c->compression = c->compression_before = 0.0;
     c->lin_valid = 0;
+    c->queued = 0;
 }
 
 static void contact_detached(membrane_point *pt)
@@ -638,6 +686,8 @@ static void contact_detached(membrane_point *pt)
     contact *c = point_contact(pt);
     c->point.active = c->touching = 0;
     c->force = 0.0;
+    c->queued = 0; /* their offsets were the old membrane's */
+    c->queue_shift = 0;
 }
 
 static const membrane_point_ops contact_point_ops = {

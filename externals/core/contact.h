@@ -48,6 +48,10 @@ extern "C" {
 #define CONTACT_VELOCITY_MAX  50.0 /* m/s, |hit velocity| */
 #define CONTACT_STRETCH_MIN   0.0  /* k3, N/m^3 */
 #define CONTACT_STRETCH_MAX   1.0e12
+/* Hits waiting behind the next one, and finished strokes not yet taken: a long block
+ * (block~ 2048 is 43 ms at 48 kHz) holds a roll's hits and ends their strokes. */
+#define CONTACT_HIT_QUEUE    64
+#define CONTACT_REPORT_QUEUE 64
 
 /* Contacts attached to one membrane at once: each is one of its coupling points. */
 #define MEMBRANE_MAX_CONTACTS MEMBRANE_MAX_POINTS
@@ -106,7 +110,10 @@ void membrane_detach_contact(membrane *m, contact *c);
 /* Starts a stroke: the stick arrives at the membrane surface at (r/a, theta)
  * moving into it at velocity_mps (> 0), `sample_offset` samples into the next
  * membrane_process() call of the membrane it is attached to. Values out of
- * range are clamped (status says so). A new hit replaces a stroke in progress. */
+ * range are clamped (status says so). A new hit replaces a stroke in progress when it
+ * lands. Hits for later samples than one waiting to land wait behind it (up to
+ * CONTACT_HIT_QUEUE; more: ICTUS_ENOMEM, the hit is dropped), each landing on its own
+ * sample; a hit for the same or an earlier sample replaces the hits waiting there and after. */
 ictus_status contact_hit(contact *c, double velocity_mps, double r_over_a, double theta_deg,
                          int sample_offset);
 
@@ -123,10 +130,13 @@ void contact_set_force_output(contact *c, float *buffer, int capacity);
 
 /* 1 while the stick is in a stroke (touching, or away but not yet released). */
 int contact_is_active(const contact *c);
-/* Returns 1 and fills *report once per finished stroke (then clears the flag). A stroke
+/* Returns 1 and fills *report with the oldest finished stroke not yet taken (up to
+ * CONTACT_REPORT_QUEUE are kept; beyond, the oldest go). A stroke
  * whose stick never touched the head (it landed on a head coming at it faster than the
  * hit, which drew back before the stick reached it) ends without a report. */
 int contact_take_report(contact *c, contact_report *report);
+/* Hits waiting to land (the next one and those queued behind it). */
+int contact_hits_waiting(const contact *c);
 /* Stick state (m, m/s; positive into the membrane) and the last force (N). */
 double contact_stick_position(const contact *c);
 double contact_stick_velocity(const contact *c);

@@ -71,11 +71,27 @@ membrane *membrane_new(double sample_rate_hz)
     const char *want = getenv("ICTUS_MEMBRANE_KERNEL");
     if (want && strcmp(want, "generic") == 0)
         membrane_use_generic_kernel_(m);
-    if (membrane_build_modes_(m, MEMBRANE_DEFAULT_MODES) != ICTUS_OK) {
+    if (membrane_reserve_strikes(m, STRIKE_QUEUE) != ICTUS_OK ||
+        membrane_build_modes_(m, MEMBRANE_DEFAULT_MODES) != ICTUS_OK) {
         membrane_free(m);
         return NULL;
     }
     return m;
+}
+
+ictus_status membrane_reserve_strikes(membrane *m, int count)
+{
+    if (count <= m->queue_cap)
+        return ICTUS_OK;
+    pending_strike *q = malloc(sizeof(*q) * (size_t)count);
+    if (!q)
+        return ICTUS_ENOMEM;
+    if (m->queued > 0)
+        memcpy(q, m->queue, sizeof(*q) * (size_t)m->queued);
+    free(m->queue);
+    m->queue = q;
+    m->queue_cap = count;
+    return ICTUS_OK;
 }
 
 void membrane_free(membrane *m)
@@ -86,6 +102,7 @@ void membrane_free(membrane *m)
         membrane_point_detach_(m, m->points[m->point_count - 1]);
     membrane_free_mode_arrays_(m);
     membrane_cascade_free_(m);
+    free(m->queue);
     free(m);
 }
 

@@ -212,9 +212,14 @@ ictus_status membrane_set_strike_point(membrane *m, double r_over_a, double thet
 
 /* An ideal impulse (N s) at (r/a, theta), landing `sample_offset` samples into the
  * next membrane_process() call (offsets past that block carry over to later
- * blocks). Up to 64 pending strikes are queued; more are dropped and counted. */
+ * blocks). Up to 64 pending strikes are queued (membrane_reserve_strikes: more); more
+ * are dropped and counted (membrane_dropped_strikes). */
 ictus_status membrane_strike(membrane *m, double r_over_a, double theta_deg, double impulse_ns,
                              int sample_offset);
+
+/* Room for `count` pending strikes (at least 64): a block of n samples may hold one on
+ * every sample. Never shrinks. ICTUS_ENOMEM: the room stays as it was. Allocates. */
+ictus_status membrane_reserve_strikes(membrane *m, int count);
 
 /* Silences every mode at once, and ends the stroke of every attached contact. */
 void membrane_clear(membrane *m);

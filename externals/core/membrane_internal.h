@@ -192,8 +192,8 @@ struct membrane {
     double mass_scale; /* 1 / sqrt(density * radius^2) */
     double strike_r, strike_theta;
     double pick_r[MEMBRANE_PICKUPS], pick_theta[MEMBRANE_PICKUPS];
-    pending_strike queue[STRIKE_QUEUE];
-    int queued;
+    pending_strike *queue; /* queue_cap entries (membrane_reserve_strikes) */
+    int queued, queue_cap;
     long dropped;
     impulse_shape impulse_cache[IMPULSE_CACHE];
     int impulse_next;

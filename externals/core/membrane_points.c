@@ -250,7 +250,7 @@ ictus_status membrane_strike(membrane *m, double r_over_a, double theta_deg, dou
         sample_offset = 0;
         s = ICTUS_CLAMPED;
     }
-    if (m->queued >= STRIKE_QUEUE) {
+    if (m->queued >= m->queue_cap) {
         m->dropped++;
         return ICTUS_CLAMPED;
     }

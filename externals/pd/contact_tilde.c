@@ -31,7 +31,10 @@ typedef struct _contact_tilde {
     int x_force_size;
     t_outlet *x_report_out;
     t_clock *x_report_clock;
-    contact_report x_report; /* the last finished stroke, output from the clock */
+    /* Finished strokes taken in perform, output from the clock (a long block may end
+     * several) */
+    contact_report x_reports[CONTACT_REPORT_QUEUE];
+    int x_reports_ready;
 } t_contact_tilde;
 
 t_class *ictus_contact_tilde_class;
@@ -178,8 +181,11 @@ static void contact_tilde_hit(t_contact_tilde *x, t_symbol *s, int argc, t_atom 
         pd_error(x, "contact~: hit: no membrane~ named '%s'; ignored", x->x_name->s_name);
         return;
     }
-    contact_hit_mass(x->x_core, velocity, r, theta,
-                     ictus_clock_offset_now(ictus_membrane_tilde_clock(m)), mass);
+    if (contact_hit_mass(x->x_core, velocity, r, theta,
+                         ictus_clock_offset_now(ictus_membrane_tilde_clock(m)),
+                         mass) == ICTUS_ENOMEM)
+        pd_error(x, "contact~: hit: %d hits already wait for their samples; ignored",
+                 contact_hits_waiting(x->x_core));
 }
 
 /* set NAME: play another membrane~ (takes effect at the next DSP sort, as delread~).
@@ -233,11 +239,18 @@ static void contact_tilde_membrane_gone(void *owner)
 
 static void contact_tilde_report_tick(t_contact_tilde *x)
 {
-    t_atom list[3];
-    SETFLOAT(&list[0], (t_float)x->x_report.duration_ms);
-    SETFLOAT(&list[1], (t_float)x->x_report.peak_force_n);
-    SETFLOAT(&list[2], (t_float)x->x_report.rebound_velocity_mps);
-    outlet_list(x->x_report_out, &s_list, 3, list);
+    contact_report reports[CONTACT_REPORT_QUEUE];
+    int i, count = x->x_reports_ready;
+    /* Copied first: a receiver of the list may send a hit, whose stroke cannot end now. */
+    memcpy(reports, x->x_reports, sizeof(reports[0]) * (size_t)count);
+    x->x_reports_ready = 0;
+    for (i = 0; i < count; i++) {
+        t_atom list[3];
+        SETFLOAT(&list[0], (t_float)reports[i].duration_ms);
+        SETFLOAT(&list[1], (t_float)reports[i].peak_force_n);
+        SETFLOAT(&list[2], (t_float)reports[i].rebound_velocity_mps);
+        outlet_list(x->x_report_out, &s_list, 3, list);
+    }
 }
 
 /* ---------------- DSP ---------------- */
@@ -256,8 +269,10 @@ static t_int *contact_tilde_perform(t_int *w)
     }
     for (; i < n; i++)
         out[i] = 0;
-    if (contact_take_report(x->x_core, &x->x_report))
-        clock_delay(x->x_report_clock, 0);
+    while (x->x_reports_ready < CONTACT_REPORT_QUEUE &&
+           contact_take_report(x->x_core, &x->x_reports[x->x_reports_ready]))
+        if (x->x_reports_ready++ == 0)
+            clock_delay(x->x_report_clock, 0);
     return (w + 4);
 }
 
@@ -321,7 +336,7 @@ static void *contact_tilde_new(t_symbol *s, int argc, t_atom *argv)
     x->x_membrane = 0;
     x->x_force = 0;
     x->x_force_size = 0;
-    memset(&x->x_report, 0, sizeof(x->x_report));
+    x->x_reports_ready = 0;
     x->x_name = &s_;
     /* The head's stretching under the stick: the default head's, as the physics'. */
     ictus_param_set(&contact_params, core, CONTACT_PARAM_STRETCH, STICK_TIP_HEAD_K3_DEFAULT);

@@ -268,13 +268,17 @@ static const char *ictus_timetag_check_message(const t_ictus_timetag *x, const u
             if ((size = ictus_timetag_osc_string(p + pos, n - pos)) < 0)
                 return "string-argument";
             break;
-        case 'b':
+        case 'b': {
+            /* in 64 bits: a 32-bit size within 3 of 2^32 rounds up to 0 in 32 */
+            uint64_t padded;
             if (pos + 4 > n)
                 return "blob-size";
-            size = 4 + (int)((ictus_timetag_u32(p + pos) + 3u) & ~3u);
-            if (size < 4)
+            padded = ((uint64_t)ictus_timetag_u32(p + pos) + 3u) & ~(uint64_t)3u;
+            if (padded > (uint64_t)(n - pos - 4))
                 return "blob-size";
+            size = 4 + (int)padded;
             break;
+        }
         default:
             return "unknown-type-tag";
         }

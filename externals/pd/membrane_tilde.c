@@ -218,7 +218,13 @@ static void membrane_tilde_strike(t_membrane_tilde *x, t_symbol *s, int argc, t_
                  ICTUS_STRIKE_IMPULSE_MAX, impulse, used);
         impulse = used;
     }
+    long dropped = membrane_dropped_strikes(x->x_core);
     membrane_strike(x->x_core, r, theta, impulse, ictus_clock_offset_now(&x->x_clock));
+    if (membrane_dropped_strikes(x->x_core) != dropped)
+        pd_error(x,
+                 "membrane~%s%s: strike: more strikes wait for this block than it has samples "
+                 "(twice over); dropped",
+                 x->x_name != &s_ ? " " : "", x->x_name != &s_ ? x->x_name->s_name : "");
 }
 
 static void membrane_tilde_clear(t_membrane_tilde *x)
@@ -342,6 +348,12 @@ static void membrane_tilde_dsp(t_membrane_tilde *x, t_signal **sp)
         pd_error(x, "membrane~: sample rate %g Hz is outside [%g, %g]; using %g", sr,
                  MEMBRANE_SR_MIN, MEMBRANE_SR_MAX, membrane_get_sample_rate(x->x_core));
     ictus_clock_dsp(&x->x_clock, membrane_get_sample_rate(x->x_core));
+    /* Strikes wait for the block that holds their sample: room for one on every sample
+     * of the window a block covers (max(n, one tick)), and as many again. */
+    int window = sp[0]->s_n > sys_getblksize() ? sp[0]->s_n : sys_getblksize();
+    if (membrane_reserve_strikes(x->x_core, 2 * window) != ICTUS_OK)
+        pd_error(x, "membrane~: out of memory for %d pending strikes; a block holds fewer",
+                 2 * window);
     membrane_tilde_check_silent(x);
     /* Pd rebuilds the DSP chain whenever a connection changes, so asking here is
      * enough. An unconnected signal outlet's buffer is read by nobody. */
