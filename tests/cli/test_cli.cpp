@@ -428,6 +428,26 @@ TEST_CASE("ictusd gestures is a verb of ictusd: help, export of the built-in dat
     INFO(r.output);
     CHECK(r.status == 0);
     CHECK(r.output.find("usage: ictusd gestures") != std::string::npos);
+    // The help names every nuance the database holds (`--list`'s second column; the
+    // buzz was left out).
+    const std::string help = r.output;
+    const Run list = ictusd("gestures --list");
+    REQUIRE(list.status == 0);
+    std::set<std::string> nuances;
+    std::istringstream rows(list.output);
+    std::string row;
+    std::getline(rows, row); // the header
+    while (std::getline(rows, row)) {
+        std::istringstream cells(row);
+        std::string grip, nuance;
+        if (cells >> grip >> nuance)
+            nuances.insert(nuance);
+    }
+    CHECK(nuances.size() == 6);
+    for (const std::string &n : nuances) {
+        INFO("nuance " << n);
+        CHECK(std::regex_search(help, std::regex("Nuances:[^.]*\\b" + n + "\\b")));
+    }
     // The built-in database holds one unit per grip x nuance x hand (docs/gestures.md):
     // 2 x 6 x 2 = 24.
     const std::string path = simtest::temp_path("gestures.json");
