@@ -296,6 +296,32 @@ TEST_CASE("CSV: a clock or a coordinate out of the physical bounds is refused at
         rate.rate_hz = 0.01; // --rate in the wrong unit: one frame per 100 s
         require_bound_error("frame,m.x,m.y,m.z\n0,0,1,0\n1,0,1,0\n2,0,1,0\n", 3,
                             "from the frame column / rate_hz 0.01, got 100 s", rate);
+        // The fault is the rate, not a time column's unit (there is none): seeded rates
+        // below 2 Hz (k / 100) and above 2 kHz (whole), said as the suspect.
+        std::mt19937 rng(20261202);
+        for (int trial = 0; trial < 12; ++trial) {
+            const bool slow = trial % 2 == 0;
+            const int k = slow ? std::uniform_int_distribution<int>(1, 199)(rng)
+                               : std::uniform_int_distribution<int>(2001, 999999)(rng);
+            rate.rate_hz = slow ? k / 100.0 : k;
+            const std::string written = slow ? "" : std::to_string(k); // as typed
+            std::string text = "frame,m.x,m.y,m.z\n";
+            for (int f = 0; f < 5; ++f)
+                text += std::to_string(f) + ",0,1,0\n";
+            INFO("rate_hz " << rate.rate_hz);
+            std::string what;
+            try {
+                parse(text, rate);
+            } catch (const MocapBoundError &e) {
+                what = e.what();
+            }
+            CHECK(what.find("; is rate_hz ") != std::string::npos);
+            CHECK(what.find(" the capture's frame rate?)") != std::string::npos);
+            if (!written.empty())
+                CHECK(what.find("; is rate_hz " + written + " the capture's frame rate?)") !=
+                      std::string::npos);
+            CHECK(what.find("a time column") == std::string::npos);
+        }
     }
     SECTION("duration: at most 3 h from the first row")
     {
