@@ -394,8 +394,9 @@ bool parse_render_args(Args &args, RenderArgs &r)
         find_pd_binary(r.pd.pd);
         r.pd.library = find_pd_library(r.pd.library);
         r.wav = std::filesystem::absolute(r.wav).lexically_normal().string();
-        check_wav_path(r.wav);
-        check_pd_path("--out", std::filesystem::absolute(r.out_dir).lexically_normal().string());
+        const std::string out = std::filesystem::absolute(r.out_dir).lexically_normal().string();
+        check_wav_path(r.wav, out);
+        check_pd_path("--out", out);
         check_pd_path("--pd-lib", r.pd.library);
     }
     return true;
