@@ -416,6 +416,17 @@ TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[cli]")
     const Run empty = ictusd("limits " + tiny_bvh() + " --skip-frames 500");
     INFO(empty.output);
     CHECK(empty.status == 1);
+    // A marker or stick .csv capture has no joint rotations to learn from: said so up front
+    // (it read as a BVH, "expected 'HIERARCHY', got 'time,...'"), a usage error as in render.
+    const std::string csv = simtest::temp_path("sticks.CSV");
+    std::ofstream(csv) << "time,stick_l.x,stick_l.y,stick_l.z\n0,0,1,0\n0.01,0,1,0\n";
+    const Run sticks = ictusd("limits " + csv);
+    INFO(sticks.output);
+    CHECK(sticks.status == 2);
+    CHECK(sticks.output.find("ictusd limits: " + csv + ": limits are learned from a BVH") !=
+          std::string::npos);
+    CHECK(sticks.output.find("HIERARCHY") == std::string::npos);
+    std::remove(csv.c_str());
 }
 
 TEST_CASE("ictusd gestures is a verb of ictusd: help, export of the built-in database, usage "
