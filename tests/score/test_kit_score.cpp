@@ -672,6 +672,10 @@ TEST_CASE("plan: the left foot's chicks are the hi-hat's, timed as the hands', a
     refused("LF on kick", f, 1, 7, "the left foot plays hihat");
     // 16ths at 200 bpm are 75 ms apart: faster than the hi-hat's pedal (100 ms).
     refused("tempo 200\nLF 1/4\nLF", f, 3, 1, "faster than the left foot plays the hi-hat's");
+    // The message names what the foot plays (it read "plays the hi-hat's (minimum ...").
+    refused("tempo 200\nLF 1/4\nLF", f, 3, 1,
+            "this chick comes 75 ms after the previous one (line 2), faster than the left foot "
+            "plays the hi-hat's pedal (minimum 100 ms)");
     PerformerFrame no_hat = kit_frame();
     refused("R\nLF", no_hat, 2, 1, "this kit has no hi-hat");
     refused("LF", performer_frame_for_drum(c, 0.178), 1, 1, "there is no kit");
