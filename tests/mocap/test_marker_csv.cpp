@@ -40,6 +40,15 @@ void require_error(const std::string &text, int line, const std::string &expecte
     FAIL("no MocapError for a malformed file (expected '" << expected << "')");
 }
 
+// `text` (ASCII) as UTF-16: little- or big-endian, with or without its byte order mark.
+std::string utf16(const std::string &text, bool big, bool mark)
+{
+    std::string out = mark ? (big ? std::string("\xFE\xFF") : std::string("\xFF\xFE")) : "";
+    for (char c : text)
+        out += big ? std::string(1, '\0') + c : std::string(1, c) + '\0';
+    return out;
+}
+
 const char *const kGapCsv = "time,m.x,m.y,m.z\n"
                             "0,0,0,0\n"
                             "0.01,NaN,NaN,NaN\n"
@@ -47,6 +56,19 @@ const char *const kGapCsv = "time,m.x,m.y,m.z\n"
                             "0.04,4,8,-4\n";
 
 } // namespace
+
+// A spreadsheet's "Unicode text" export is UTF-16: it read as "expected a column named
+// time ..., got neither". Said to be UTF-16 at line 1, either byte order, with or without
+// its byte order mark.
+TEST_CASE("CSV: a UTF-16 file is said to be one", "[mocap][csv]")
+{
+    for (const bool big : {false, true})
+        for (const bool mark : {false, true}) {
+            INFO((big ? "big" : "little")
+                 << "-endian, " << (mark ? "with" : "without") << " its mark");
+            require_error(utf16(kGapCsv, big, mark), 1, "UTF-16");
+        }
+}
 
 TEST_CASE("CSV: millimetres and z up become metres and y up", "[mocap][csv]")
 {
