@@ -75,6 +75,7 @@ void check_wav_path(const std::string &path, const std::string &made_dir)
     std::error_code ec;
     if (fs::is_directory(path, ec))
         throw std::runtime_error("--wav: '" + path + "' is a folder: give a file NAME.wav");
+    check_pd_path("--wav", path);
     // "out/" normalises to "out/": its trailing empty name is not the folder's.
     auto folder_of = [](const fs::path &p) {
         const fs::path n = p.lexically_normal();
@@ -85,7 +86,6 @@ void check_wav_path(const std::string &path, const std::string &made_dir)
         (made_dir.empty() || folder_of(folder) != folder_of(made_dir)))
         throw std::runtime_error("--wav: no folder '" + folder.string() + "' for '" + path +
                                  "' (Pd makes none: create it, or write the WAV in --out's)");
-    check_pd_path("--wav", path);
 }
 
 std::string find_pd_library(const std::string &given)
