@@ -416,6 +416,17 @@ TEST_CASE("ictusd limits prints the 19 joints and writes JSON", "[cli]")
     const Run empty = ictusd("limits " + tiny_bvh() + " --skip-frames 500");
     INFO(empty.output);
     CHECK(empty.status == 1);
+    // A marker or stick .csv capture has no joint rotations to learn from: said so up front
+    // (it read as a BVH, "expected 'HIERARCHY', got 'time,...'"), a usage error as in render.
+    const std::string csv = simtest::temp_path("sticks.CSV");
+    std::ofstream(csv) << "time,stick_l.x,stick_l.y,stick_l.z\n0,0,1,0\n0.01,0,1,0\n";
+    const Run sticks = ictusd("limits " + csv);
+    INFO(sticks.output);
+    CHECK(sticks.status == 2);
+    CHECK(sticks.output.find("ictusd limits: " + csv + ": limits are learned from a BVH") !=
+          std::string::npos);
+    CHECK(sticks.output.find("HIERARCHY") == std::string::npos);
+    std::remove(csv.c_str());
 }
 
 TEST_CASE("ictusd gestures is a verb of ictusd: help, export of the built-in database, usage "
@@ -428,6 +439,26 @@ TEST_CASE("ictusd gestures is a verb of ictusd: help, export of the built-in dat
     INFO(r.output);
     CHECK(r.status == 0);
     CHECK(r.output.find("usage: ictusd gestures") != std::string::npos);
+    // The help names every nuance the database holds (`--list`'s second column; the
+    // buzz was left out).
+    const std::string help = r.output;
+    const Run list = ictusd("gestures --list");
+    REQUIRE(list.status == 0);
+    std::set<std::string> nuances;
+    std::istringstream rows(list.output);
+    std::string row;
+    std::getline(rows, row); // the header
+    while (std::getline(rows, row)) {
+        std::istringstream cells(row);
+        std::string grip, nuance;
+        if (cells >> grip >> nuance)
+            nuances.insert(nuance);
+    }
+    CHECK(nuances.size() == 6);
+    for (const std::string &n : nuances) {
+        INFO("nuance " << n);
+        CHECK(std::regex_search(help, std::regex("Nuances:[^.]*\\b" + n + "\\b")));
+    }
     // The built-in database holds one unit per grip x nuance x hand (docs/gestures.md):
     // 2 x 6 x 2 = 24.
     const std::string path = simtest::temp_path("gestures.json");

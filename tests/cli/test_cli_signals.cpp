@@ -427,6 +427,24 @@ TEST_CASE("ictusd render --wav takes only a NAME.wav it will write, never a fold
     CHECK_THAT(p.output(), Catch::Contains("'" + (dir / "folder.wav") + "' is a folder"));
     CHECK(fs::is_directory(dir / "empty"));
     CHECK(fs::is_directory(dir / "folder.wav"));
+    // A NAME.wav in a folder that does not exist (Pd makes none) was found after the
+    // physics, when Pd could not write it: refused before, naming the folder; in --out's
+    // folder, which render makes, it is taken (the fake pd then writes no WAV).
+    for (const std::string &missing : {dir / "nowhere", out + "/sub"}) {
+        const std::string wav = missing + "/take.wav";
+        INFO(wav);
+        Proc q({"timeout", "60", ICTUSD_PATH, "render", "--out", out, "--duration", "0.5", "--wav",
+                wav, "--pd", fake, "--pd-lib", dir / "lib"});
+        CHECK(q.wait_exit(90.0) == 1);
+        CHECK_THAT(q.output(), Catch::Contains("--wav: no folder '" + missing + "' for '" + wav));
+        CHECK_FALSE(fs::exists(out));
+        CHECK_FALSE(fs::exists(missing));
+    }
+    const std::string made = dir / "made";
+    Proc in_out({"timeout", "60", ICTUSD_PATH, "render", "--out", made, "--duration", "0.5",
+                 "--wav", made + "/take.wav", "--pd", fake, "--pd-lib", dir / "lib"});
+    CHECK(in_out.wait_exit(90.0) == 1);
+    CHECK_THAT(in_out.output(), Catch::Contains("pd wrote no '" + made + "/take.wav'"));
 }
 
 TEST_CASE("ictusd run --reply is checked as --target is", "[cli][bounds]")

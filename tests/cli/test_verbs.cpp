@@ -752,6 +752,53 @@ TEST_CASE("render: missed and off-time notes, strikes of no note and a score wit
     fs::remove_all(dir);
 }
 
+// A --duration shorter than the score left its last notes unplayed, and render said
+// they "were not struck", when none was, adding "is the drum within the sticks' reach?
+// --drum-pos". Now the notes after the render's end are said as such, and the others
+// are judged alone. Seeded scores: N alternating notes at a random tempo, cut midway
+// between two of them (the lead-in 1 s: note k at 1 + 60 k / tempo s).
+TEST_CASE("render: notes after --duration's end are said as such, not as notes missed",
+          "[cli][verbs]")
+{
+    const fs::path dir = scratch("render-duration");
+    fs::create_directories(dir);
+    std::mt19937 rng(20261202);
+    for (int trial = 0; trial < 3; ++trial) {
+        const int tempo = std::uniform_int_distribution<int>(60, 180)(rng);
+        const int notes = std::uniform_int_distribution<int>(3, 6)(rng);
+        // Played: the first `kept` notes (none in the first trial: the cut before beat 0).
+        const int kept = trial == 0 ? 0 : std::uniform_int_distribution<int>(1, notes - 1)(rng);
+        const double beat_s = 60.0 / tempo;
+        const double end_s = 1.0 + (kept - 0.5) * beat_s;
+        std::ostringstream score;
+        score << "tempo " << tempo << "\n";
+        for (int k = 0; k < notes; ++k)
+            score << (k % 2 ? "L" : "R") << "\n";
+        const fs::path file = dir / ("cut" + std::to_string(trial) + ".score");
+        std::ofstream(file) << score.str();
+        char duration[32];
+        std::snprintf(duration, sizeof duration, "%g", std::round(end_s * 1e3) / 1e3);
+        Daemon cut({"render", "--score", file.string(), "--duration", duration, "--bvh-rate", "0",
+                    "--tips-rate", "0", "--out", (dir / ("out" + std::to_string(trial))).string()});
+        CHECK(cut.wait() == 0);
+        INFO("tempo " << tempo << ", " << notes << " notes, --duration " << duration << "\n"
+                      << cut.err);
+        const int after = notes - kept;
+        char first[96];
+        std::snprintf(first, sizeof first, "line %d (the %s hand at %.2f s)", kept + 2,
+                      kept % 2 ? "left" : "right", 1.0 + kept * beat_s);
+        CHECK(cut.err.find("warning: " + std::to_string(after) + " of " + std::to_string(notes) +
+                           " notes of the score come after the end of the render (--duration " +
+                           duration + " s): " + first) != std::string::npos);
+        CHECK(cut.err.find("not struck") == std::string::npos); // the notes played were struck
+        CHECK(cut.err.find("--drum-pos") == std::string::npos);
+        CHECK(
+            lines(slurp((dir / ("out" + std::to_string(trial)) / "strikes.csv").string())).size() ==
+            static_cast<size_t>(kept) + 1);
+    }
+    fs::remove_all(dir);
+}
+
 // --wav-bits 8 was refused as "got '8.000000'", --wav-rate 44100.5 was cut to
 // 44100 without a word, --score given a folder said it was empty, and an empty score
 // file was refused while one of comments only played nothing with a warning.

@@ -97,7 +97,13 @@ check(proc.returncode == 1 and "x.wav" in proc.stderr and "Pd's messages" in pro
       not os.path.exists(out), "a WAV path with a space: exit 1 naming it, before any output (%s)"
       % proc.stderr.strip()[-300:])
 bad = os.path.join(work, "missing-folder", "x.wav")
+proc = render(out, "--wav", bad)
+check(proc.returncode == 1 and "no folder '%s'" % os.path.dirname(bad) in proc.stderr and
+      not os.path.exists(out), "a WAV in a folder that does not exist: exit 1 naming it, before "
+      "any output (%s)" % proc.stderr.strip()[-300:])
+# A folder where no file can be made, even by root: pd fails to write the WAV.
+bad = "/proc/ictus-render-wav-%d.wav" % os.getpid()
 proc = render(out, "--force", "--wav", bad)
-check(proc.returncode == 1 and "missing-folder/x.wav" in proc.stderr and "pd.log" in proc.stderr,
+check(proc.returncode == 1 and bad in proc.stderr and "pd.log" in proc.stderr,
       "a WAV pd cannot write: exit 1 naming it and the log (%s)" % proc.stderr.strip()[-400:])
 print("PASS")

@@ -120,6 +120,15 @@ void require_error(const std::string &text, int line, const std::string &expecte
     FAIL("no MocapError for a malformed file (expected '" << expected << "')");
 }
 
+// `text` (ASCII) as UTF-16: little- or big-endian, with or without its byte order mark.
+std::string utf16(const std::string &text, bool big, bool mark)
+{
+    std::string out = mark ? (big ? std::string("\xFE\xFF") : std::string("\xFF\xFE")) : "";
+    for (char c : text)
+        out += big ? std::string(1, '\0') + c : std::string(1, c) + '\0';
+    return out;
+}
+
 } // namespace
 
 TEST_CASE("BVH: hierarchy, channels, rate and mixed line endings", "[mocap][bvh]")
@@ -145,6 +154,19 @@ TEST_CASE("BVH: hierarchy, channels, rate and mixed line endings", "[mocap][bvh]
     const BvhFile same = read_bvh(marked.path(), {}, &warnings);
     CHECK(same.channel_count == bvh.channel_count);
     CHECK(same.motion.frames() == bvh.motion.frames());
+}
+
+// A BVH saved as UTF-16 (Windows' "Unicode") read as "expected 'HIERARCHY', got
+// '??H?I?E?R?...'": said to be UTF-16, at line 1, in either byte order, with or without
+// its byte order mark.
+TEST_CASE("BVH: a UTF-16 file is said to be one", "[mocap][bvh]")
+{
+    for (const bool big : {false, true})
+        for (const bool mark : {false, true}) {
+            INFO((big ? "big" : "little")
+                 << "-endian, " << (mark ? "with" : "without") << " its mark");
+            require_error(utf16(kChainBvh, big, mark), 1, "UTF-16");
+        }
 }
 
 TEST_CASE("BVH: forward kinematics reproduces hand-computed joint positions", "[mocap][bvh]")

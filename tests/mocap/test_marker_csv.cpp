@@ -40,6 +40,15 @@ void require_error(const std::string &text, int line, const std::string &expecte
     FAIL("no MocapError for a malformed file (expected '" << expected << "')");
 }
 
+// `text` (ASCII) as UTF-16: little- or big-endian, with or without its byte order mark.
+std::string utf16(const std::string &text, bool big, bool mark)
+{
+    std::string out = mark ? (big ? std::string("\xFE\xFF") : std::string("\xFF\xFE")) : "";
+    for (char c : text)
+        out += big ? std::string(1, '\0') + c : std::string(1, c) + '\0';
+    return out;
+}
+
 const char *const kGapCsv = "time,m.x,m.y,m.z\n"
                             "0,0,0,0\n"
                             "0.01,NaN,NaN,NaN\n"
@@ -47,6 +56,19 @@ const char *const kGapCsv = "time,m.x,m.y,m.z\n"
                             "0.04,4,8,-4\n";
 
 } // namespace
+
+// A spreadsheet's "Unicode text" export is UTF-16: it read as "expected a column named
+// time ..., got neither". Said to be UTF-16 at line 1, either byte order, with or without
+// its byte order mark.
+TEST_CASE("CSV: a UTF-16 file is said to be one", "[mocap][csv]")
+{
+    for (const bool big : {false, true})
+        for (const bool mark : {false, true}) {
+            INFO((big ? "big" : "little")
+                 << "-endian, " << (mark ? "with" : "without") << " its mark");
+            require_error(utf16(kGapCsv, big, mark), 1, "UTF-16");
+        }
+}
 
 TEST_CASE("CSV: millimetres and z up become metres and y up", "[mocap][csv]")
 {
@@ -296,6 +318,32 @@ TEST_CASE("CSV: a clock or a coordinate out of the physical bounds is refused at
         rate.rate_hz = 0.01; // --rate in the wrong unit: one frame per 100 s
         require_bound_error("frame,m.x,m.y,m.z\n0,0,1,0\n1,0,1,0\n2,0,1,0\n", 3,
                             "from the frame column / rate_hz 0.01, got 100 s", rate);
+        // The fault is the rate, not a time column's unit (there is none): seeded rates
+        // below 2 Hz (k / 100) and above 2 kHz (whole), said as the suspect.
+        std::mt19937 rng(20261202);
+        for (int trial = 0; trial < 12; ++trial) {
+            const bool slow = trial % 2 == 0;
+            const int k = slow ? std::uniform_int_distribution<int>(1, 199)(rng)
+                               : std::uniform_int_distribution<int>(2001, 999999)(rng);
+            rate.rate_hz = slow ? k / 100.0 : k;
+            const std::string written = slow ? "" : std::to_string(k); // as typed
+            std::string text = "frame,m.x,m.y,m.z\n";
+            for (int f = 0; f < 5; ++f)
+                text += std::to_string(f) + ",0,1,0\n";
+            INFO("rate_hz " << rate.rate_hz);
+            std::string what;
+            try {
+                parse(text, rate);
+            } catch (const MocapBoundError &e) {
+                what = e.what();
+            }
+            CHECK(what.find("; is rate_hz ") != std::string::npos);
+            CHECK(what.find(" the capture's frame rate?)") != std::string::npos);
+            if (!written.empty())
+                CHECK(what.find("; is rate_hz " + written + " the capture's frame rate?)") !=
+                      std::string::npos);
+            CHECK(what.find("a time column") == std::string::npos);
+        }
     }
     SECTION("duration: at most 3 h from the first row")
     {

@@ -189,6 +189,40 @@ TEST_CASE("plan: 'on NAME-bell' is a cymbal's bell, and the standard pieces' com
     refused("L on hi-hat", f, 1, 6, "unknown drum 'hi-hat'");
 }
 
+// 'on floor-tom-rim' found the floor tom's rim, but 'on hi-hat-bell' was an unknown drum: the
+// common spellings were looked up under a rim's suffix, not a bell's. Seeded spellings of
+// the hi-hat with a bell's suffix, in any case, each hand: the hi-hat's bell (r/a 0.12, the
+// bow's angle toward the performer: 110 degrees right, 70 left); the floor tom's refused as
+// a drum's, named by the kit's name.
+TEST_CASE("plan: a standard piece's common spelling finds its bell as it finds its rim",
+          "[score][kit]")
+{
+    PerformerFrame f = kit_frame_with_ride_and_kick();
+    const Eigen::Vector3d c = f.drums[0].membrane_center_m;
+    f.drums[4] = {"hihat", c + Eigen::Vector3d(0.42, 0.26, -0.02), 0.178, true, true};
+    std::mt19937 rng(20261202);
+    const char *const spellings[] = {"hi-hat", "hi_hat", "hihat"};
+    const char seps[] = {'-', '_'};
+    for (int trial = 0; trial < 12; ++trial) {
+        std::string name = std::string(spellings[rng() % 3]) + seps[rng() % 2] + "bell";
+        for (char &ch : name)
+            if (rng() % 2)
+                ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+        const bool right = rng() % 2;
+        const std::string text = std::string("tempo 90\n") + (right ? "R" : "L") + " on " + name;
+        INFO(text);
+        const GesturePlan plan = plan_performance(parse_score(text, "t"), db(), f);
+        REQUIRE(plan.notes.size() == 1);
+        const PlannedNote &n = plan.notes[0];
+        CHECK(n.drum == 4);
+        CHECK(n.r_over_a == Approx(0.12));
+        CHECK(n.theta_deg == Approx(right ? 110.0 : 70.0));
+    }
+    refused("R on floor-tom-bell", f, 1, 6,
+            "a bell is a cymbal's, and 'floor' is not a cymbal (the kit's cymbals: hihat, ride)");
+    refused("R on bass_drum_bell", f, 1, 6, "a bell is a cymbal's, and 'kick' is not a cymbal");
+}
+
 TEST_CASE("plan: 'on NAME-rim' is a drum's rim, its edge facing the hand's shoulder",
           "[score][kit]")
 {
@@ -638,6 +672,10 @@ TEST_CASE("plan: the left foot's chicks are the hi-hat's, timed as the hands', a
     refused("LF on kick", f, 1, 7, "the left foot plays hihat");
     // 16ths at 200 bpm are 75 ms apart: faster than the hi-hat's pedal (100 ms).
     refused("tempo 200\nLF 1/4\nLF", f, 3, 1, "faster than the left foot plays the hi-hat's");
+    // The message names what the foot plays (it read "plays the hi-hat's (minimum ...").
+    refused("tempo 200\nLF 1/4\nLF", f, 3, 1,
+            "this chick comes 75 ms after the previous one (line 2), faster than the left foot "
+            "plays the hi-hat's pedal (minimum 100 ms)");
     PerformerFrame no_hat = kit_frame();
     refused("R\nLF", no_hat, 2, 1, "this kit has no hi-hat");
     refused("LF", performer_frame_for_drum(c, 0.178), 1, 1, "there is no kit");

@@ -281,6 +281,39 @@ TEST_CASE("midi in: a malformed file names its byte and track", "[score][midi]")
     }
 }
 
+// A note past the score's 100000 beats was refused as "note 2 at beat 268435455.000000, past
+// the score's 100000.000000". Seeded files: a snare at 0, a second one at a tick past the
+// limit (whole or half beats, 2..2000 ticks a quarter); the beat said as written, the limit
+// named as one.
+TEST_CASE("midi in: a note past the score's beats is refused, its place and beat said plainly",
+          "[score][midi]")
+{
+    std::mt19937 rng(20261202);
+    for (int trial = 0; trial < 16; ++trial) {
+        // Even (half a beat is whole) and at most 2000: the tick within a delta's 4 bytes.
+        const int tpq = 2 * (1 + static_cast<int>(rng() % 1000));
+        const long room = 0x0fffffffL / tpq - 1 - 100001;
+        const long beats = 100001 + static_cast<long>(rng() % static_cast<unsigned long>(room));
+        const bool half = trial % 2 == 1;
+        const long tick = beats * tpq + (half ? tpq / 2 : 0);
+        std::string delta;
+        for (long v = tick, first = 1; first || v > 0; v >>= 7, first = 0)
+            delta.insert(delta.begin(), static_cast<char>((v & 0x7f) | (first ? 0 : 0x80)));
+        const std::string events = bytes({0x00, 0x99, 38, 100}) + delta + bytes({0x99, 38, 90});
+        const std::string file = header(0, 1, tpq) + chunk("MTrk", events + kEnd);
+        const std::string beat = std::to_string(beats) + (half ? ".5" : "");
+        INFO("trial " << trial << ": " << tpq << " ticks a quarter, tick " << tick);
+        std::string what;
+        try {
+            drum_part_score(read_smf(file, "t.mid"), {}, "t.mid");
+        } catch (const MidiFileError &e) {
+            what = e.what();
+        }
+        CHECK(what == "t.mid: note 2 at beat " + beat +
+                          " is past the score's limit of 100000 beats (docs/score.md)");
+    }
+}
+
 TEST_CASE("midi in: General MIDI's hi-hat on a kit's hi-hat, closed 42 and open 46, the pedal 44 "
           "the left foot's chick",
           "[score][midi][hihat]")

@@ -496,6 +496,36 @@ TEST_CASE("score: an error shows control bytes as hex escapes, a NUL included",
     require_error(nul, 1, 4, "unknown statement 'X\\x00Y'");
     require_error(nul, 1, 4, "tempo"); // the rest of the message is there
     require_error("R, Z\x1b[2J\n", 1, 4, "'Z\\x1b[2J'");
+    // Bytes that are not UTF-8 (a Latin-1 file's accents, a binary file) were quoted raw,
+    // which a terminal shows as replacement characters: escaped as a control byte is.
+    // UTF-8 itself (an accent, an arrow) is quoted as typed.
+    require_error("R, \x89PNG\n", 1, 4, "unknown statement '\\x89PNG'");
+    require_error("R caf\xe9\n", 1, 3, "unknown nuance 'caf\\xe9'");
+    require_error("R \xc3\n", 1, 3, "unknown nuance '\\xc3'"); // a lead byte cut short
+    require_error("R \xc3\xa9\xa9\n", 1, 3, "unknown nuance '\xc3\xa9\\xa9'");
+    require_error("R \xe2\x86\x92 L\n", 1, 3, "unknown nuance '\xe2\x86\x92'");
+}
+
+TEST_CASE("score: a UTF-16 file without a byte order mark is said to be one",
+          "[score][parser][errors]")
+{
+    // Written as UTF-16 without its mark (Python's 'utf-16-le'), a score read as one
+    // statement "R\x00" whose NULs follow every character. Seeded texts of the language,
+    // little- and big-endian: refused at 1:1 as UTF-16, as one with the mark is.
+    const char *const texts[] = {"R, L\n", "tempo 96\nR legato\n", "# a comment\nR\n",
+                                 "repeat 2\nR+L ff\nend\n", "L\r\nR accent\r\n"};
+    std::mt19937 rng(20261202);
+    for (int trial = 0; trial < 10; ++trial) {
+        const std::string text = texts[rng() % 5];
+        const bool big = trial % 2 == 1;
+        std::string wide;
+        for (char c : text)
+            wide += big ? std::string(1, '\0') + c : std::string(1, c) + '\0';
+        INFO("trial " << trial << (big ? " big-endian" : " little-endian"));
+        require_error(wide, 1, 1, "UTF-16");
+    }
+    // One NUL in an ASCII score is no UTF-16: named where it is.
+    require_error(std::string("R, X") + '\0' + "Y\n", 1, 4, "unknown statement 'X\\x00Y'");
 }
 
 TEST_CASE("score: a Pd message box - statements one by one - equals the file", "[score][parser]")

@@ -64,7 +64,7 @@ void check_pd_path(const char *what, const std::string &path)
                                  "cannot carry: choose another path");
 }
 
-void check_wav_path(const std::string &path)
+void check_wav_path(const std::string &path, const std::string &made_dir)
 {
     const std::string suffix = ".wav";
     const std::string name = fs::path(path).filename().string();
@@ -76,6 +76,16 @@ void check_wav_path(const std::string &path)
     if (fs::is_directory(path, ec))
         throw std::runtime_error("--wav: '" + path + "' is a folder: give a file NAME.wav");
     check_pd_path("--wav", path);
+    // "out/" normalises to "out/": its trailing empty name is not the folder's.
+    auto folder_of = [](const fs::path &p) {
+        const fs::path n = p.lexically_normal();
+        return n.has_filename() ? n : n.parent_path();
+    };
+    const fs::path folder = fs::path(path).parent_path();
+    if (!fs::is_directory(folder, ec) &&
+        (made_dir.empty() || folder_of(folder) != folder_of(made_dir)))
+        throw std::runtime_error("--wav: no folder '" + folder.string() + "' for '" + path +
+                                 "' (Pd makes none: create it, or write the WAV in --out's)");
 }
 
 std::string find_pd_library(const std::string &given)

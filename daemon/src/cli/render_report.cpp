@@ -97,12 +97,15 @@ void write_notes_csv(std::ostream &out, const GesturePlan &plan, const MatchSumm
 }
 
 ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit,
-                       bool off_time, const char *unit)
+                       NoteList which, double end_s, const char *unit)
 {
+    const bool off_time = which == NoteList::off_time;
     ListedNotes listed_notes;
-    auto listed = [&](const NoteMatch &n) {
-        const bool is =
-            off_time ? n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms : n.strike_seq < 0;
+    // A note within kOffTime_ms of the end is at it: its strike may fall after it.
+    auto listed = [&](const NoteMatch &n, double time_s) {
+        const bool after = time_s > end_s - 1e-3 * kOffTime_ms;
+        const bool is = off_time ? n.strike_seq >= 0 && std::abs(n.error_ms) > kOffTime_ms
+                                 : n.strike_seq < 0 && after == (which == NoteList::after_end);
         listed_notes.count += is;
         return is;
     };
@@ -130,7 +133,7 @@ ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit
         out << " at " << t << " s" << move << ")";
     };
     for (size_t i = 0; i < plan.notes.size(); ++i) {
-        if (!listed(m.notes[i]))
+        if (!listed(m.notes[i], plan.notes[i].written_time_s()))
             continue;
         const PlannedNote &n = plan.notes[i];
         const PlannedNote *prev = nullptr;
@@ -151,7 +154,7 @@ ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit
         one(n.line, who, n.drum, n.written_time_s(), error(m.notes[i]) + move.str());
     }
     for (size_t i = 0; i < plan.foot_notes.size(); ++i)
-        if (listed(m.foot_notes[i]))
+        if (listed(m.foot_notes[i], plan.foot_notes[i].time_s))
             one(plan.foot_notes[i].line,
                 plan.foot_notes[i].side == Side::right ? "the right foot" : "the left foot",
                 plan.foot_notes[i].drum, plan.foot_notes[i].time_s, error(m.foot_notes[i]));

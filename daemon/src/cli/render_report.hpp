@@ -31,19 +31,23 @@ nlohmann::json performance_json(const PerformanceOptions &o, const Performance &
 
 constexpr double kOffTime_ms = 5.0; // docs/perform.md: a note is right within +-5 ms
 
-// The notes not struck (off_time false) or struck more than kOffTime_ms from
-// their time (true), hands' and feet's: how many, and "line L (the right hand
-// on crash at 7.43 s, from floor 1.2 m away 0.27 s before)" ("note N" for a MIDI
-// part's: unit) for the first few
-// in plan order (off time with the error: "..., +12.40 ms"); a hand's move into
-// the note is given when it came from another piece (most notes lost on a kit
-// asked the arm for a move it cannot make in the time).
+// Which notes notes_text lists: those not struck before the render's end, those
+// struck more than kOffTime_ms from their time, those at or after the end (a
+// --duration shorter than the score: never played, so not missed).
+enum class NoteList { missed, off_time, after_end };
+
+// The notes of `which` kind, hands' and feet's (end_s: the plan time at which the
+// render stopped): how many, and "line L (the right hand on crash at 7.43 s, from
+// floor 1.2 m away 0.27 s before)" ("note N" for a MIDI part's: unit) for the
+// first few in plan order (off time with the error: "..., +12.40 ms"); a hand's
+// move into the note is given when it came from another piece (most notes lost
+// on a kit asked the arm for a move it cannot make in the time).
 struct ListedNotes {
     long count = 0;
     std::string text;
 };
 ListedNotes notes_text(const GesturePlan &plan, const MatchSummary &m, const Kit &kit,
-                       bool off_time, const char *unit);
+                       NoteList which, double end_s, const char *unit);
 
 // The strikes of no note (a stick that met a piece on its way, a second
 // strike of a note): "seq 37 (the right hand on hihat at 4.89 s)" for the

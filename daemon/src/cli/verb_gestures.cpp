@@ -26,8 +26,8 @@ void gestures_usage(std::ostream &out)
            "\n"
            "The gesture database: one unit (a stroke of one stick tip, 250 Hz, strike\n"
            "marked) per grip x nuance x hand. Nuances: legato, tenuto, accent,\n"
-           "vertical_accent, staccato. Without --db the built-in units of the parametric\n"
-           "stroke model are used (docs/gestures.md).\n"
+           "vertical_accent, staccato, buzz. Without --db the built-in units of the\n"
+           "parametric stroke model are used (docs/gestures.md).\n"
            "\n"
            "  --list             print the units: samples, strike time, preparation height,\n"
            "                     impact speed\n"
@@ -125,15 +125,15 @@ int cmd_gestures(Args &args)
     io.left_stick = sticks.left_stick;
     io.right_stick = sticks.right_stick;
     const std::vector<GestureUnit> units = import_capture(import_path, g, n, h, io);
+    const std::string strokes =
+        std::to_string(units.size()) + (units.size() == 1 ? " stroke" : " strokes");
     if (stroke >= static_cast<int>(units.size()))
-        throw UsageError("--stroke " + std::to_string(stroke) + ": the capture has " +
-                         std::to_string(units.size()) + " strokes");
+        throw UsageError("--stroke " + std::to_string(stroke) + ": the capture has " + strokes);
     const GestureUnit &picked = stroke >= 0 ? units[stroke] : representative_unit(units);
     GestureUnit chosen = picked;
     chosen.dynamics = dynamics;
-    std::cout << import_path << ": " << units.size() << " strokes; importing stroke "
-              << (&picked - units.data()) << " (strike at "
-              << chosen.capture_time_s + chosen.strike_time_s() << " s, impact "
+    std::cout << import_path << ": " << strokes << "; importing stroke " << (&picked - units.data())
+              << " (strike at " << chosen.capture_time_s + chosen.strike_time_s() << " s, impact "
               << chosen.impact_speed_mps() << " m/s, preparation " << chosen.preparation_height_m()
               << " m)\n";
     db.add(chosen);

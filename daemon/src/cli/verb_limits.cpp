@@ -4,7 +4,9 @@
 #include "ictus/cli/verbs.hpp"
 #include "ictus/mocap/joint_limits.hpp"
 
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -68,6 +70,12 @@ int cmd_limits(Args &args)
         return 0;
     if (file.empty())
         throw UsageError("FILE is required (ictusd limits FILE)");
+    std::string ext = std::filesystem::path(file).extension().string();
+    for (char &c : ext)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".csv")
+        throw UsageError(file + ": limits are learned from a BVH capture's joint rotations; a "
+                                "marker or stick .csv capture has none (docs/mocap.md)");
     const BvhFile bvh = load_bvh(file, clip.scale, clip.skip, clip.force);
     if (bvh.motion.frames() < kMinLimitFrames) {
         const std::string what = file + ": " + std::to_string(bvh.motion.frames()) +

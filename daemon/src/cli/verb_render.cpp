@@ -394,8 +394,9 @@ bool parse_render_args(Args &args, RenderArgs &r)
         find_pd_binary(r.pd.pd);
         r.pd.library = find_pd_library(r.pd.library);
         r.wav = std::filesystem::absolute(r.wav).lexically_normal().string();
-        check_wav_path(r.wav);
-        check_pd_path("--out", std::filesystem::absolute(r.out_dir).lexically_normal().string());
+        const std::string out = std::filesystem::absolute(r.out_dir).lexically_normal().string();
+        check_wav_path(r.wav, out);
+        check_pd_path("--out", out);
         check_pd_path("--pd-lib", r.pd.library);
     }
     return true;
@@ -575,6 +576,9 @@ nlohmann::json render_summary(const Performance &perf, const RenderArgs &r, bool
 struct NoteCount {
     long notes = 0, missed = 0, off_time = 0;
     std::string first_missed, first_off_time; // where the first few were written
+    // Notes at or after the render's end (--duration, Ctrl-C): not played, not missed.
+    long after_end = 0;
+    std::string first_after_end;
     // The strikes (bounces aside) and those of no note: how many, the first few.
     long primary_strikes = 0, extra = 0;
     std::string first_extra;
@@ -673,11 +677,17 @@ NoteCount write_render_files(RenderFiles &files, const Performance &perf, const 
         const MatchSummary m =
             match_strikes(plan.notes, rec.log.strikes(), perf.plan_origin_s(), plan.foot_notes);
         count.notes = static_cast<long>(plan.notes.size() + plan.foot_notes.size());
-        count.missed = count.notes - m.matched_notes;
         // A MIDI part's notes are numbered as the file's note-ons, in time order.
         const char *unit = perf.options().score.midi_path.empty() ? "line" : "note";
-        count.first_missed = notes_text(plan, m, perf.options().kit, false, unit).text;
-        const ListedNotes off = notes_text(plan, m, perf.options().kit, true, unit);
+        const Kit &kit = perf.options().kit;
+        const double end_s = perf.time_s() - perf.plan_origin_s();
+        const ListedNotes missed = notes_text(plan, m, kit, NoteList::missed, end_s, unit);
+        count.missed = missed.count;
+        count.first_missed = missed.text;
+        const ListedNotes after = notes_text(plan, m, kit, NoteList::after_end, end_s, unit);
+        count.after_end = after.count;
+        count.first_after_end = after.text;
+        const ListedNotes off = notes_text(plan, m, kit, NoteList::off_time, end_s, unit);
         count.off_time = off.count;
         count.first_off_time = off.text;
         count.primary_strikes = m.primary_strikes;
@@ -739,10 +749,16 @@ void print_render_summary(const Performance &perf, const RenderArgs &r, bool sco
         std::cerr << "ictusd render: warning: " << count.missed << " of " << count.notes
                   << " notes of the score were not struck: " << count.first_missed
                   << " (strike_seq -1 in notes.csv"
-                  << (count.missed == count.notes
+                  << (count.missed == count.notes - count.after_end
                           ? "; is the drum within the sticks' reach? --drum-pos"
                           : "")
                   << ")\n";
+    if (score_mode && count.after_end > 0)
+        std::cerr << "ictusd render: warning: " << count.after_end << " of " << count.notes
+                  << " notes of the score come after the end of the render ("
+                  << (rec.interrupted ? "interrupted at " : "--duration ") << perf.time_s()
+                  << " s): " << count.first_after_end
+                  << " (not played: strike_seq -1 in notes.csv)\n";
     if (rec.passes > 0)
         std::cerr << "ictusd render: rehearsed " << rec.passes << " time(s), kept pass "
                   << rec.kept_pass << ": " << rec.leads

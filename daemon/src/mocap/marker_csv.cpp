@@ -367,6 +367,15 @@ class CsvParser
     // The clock: the median step (robust to dropped frames) within the
     // sampling bounds, the whole capture within kMaxCaptureDuration_s. Errors
     // point at the first row whose step, or whose time, is out of bounds.
+    // The likely fault behind a clock out of bounds: a time column's unit, or the
+    // rate that times a frame column (there is no unit to blame then).
+    std::string clock_hint(bool too_slow) const
+    {
+        if (time_column_ < 0)
+            return "; is rate_hz " + number_text(options_.rate_hz) + " the capture's frame rate?";
+        return too_slow ? "; a time column in ms or us?" : "; a time column in minutes or hours?";
+    }
+
     void check_time_bounds()
     {
         const std::vector<double> &t = capture_.time_s;
@@ -396,9 +405,7 @@ class CsvParser
                               ", " + number_text(kMaxSampleInterval_s) +
                               "] s (a capture at 2 Hz to 2 kHz) from the " + clock + ", got " +
                               number_text(median) + " s (this row: " + number_text(steps[i]) +
-                              " s after the previous" +
-                              (too_slow ? "; a time column in ms or us?)"
-                                        : "; a time column in minutes or hours?)"));
+                              " s after the previous" + clock_hint(too_slow) + ")");
         }
         const double duration = t.back() - t.front();
         if (duration > kMaxCaptureDuration_s) {

@@ -5,6 +5,7 @@
 
 #include "ictus/base/input_file.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -14,6 +15,29 @@
 namespace ictus::detail
 {
 
+namespace
+{
+// UTF-16 (a "Unicode" save on Windows, a spreadsheet's Unicode text): its byte order
+// mark, or, without one, each of the first characters a byte and a NUL in the same
+// order (a capture's text has no NUL, so at least two such pairs).
+bool utf16_text(const std::string &head)
+{
+    if (head.compare(0, 2, "\xFF\xFE") == 0 || head.compare(0, 2, "\xFE\xFF") == 0)
+        return true;
+    const std::size_t pairs = std::min<std::size_t>(head.size() / 2, 32);
+    if (pairs < 2)
+        return false;
+    for (const std::size_t nul : {std::size_t{0}, std::size_t{1}}) {
+        bool all = true;
+        for (std::size_t k = 0; all && k < pairs; ++k)
+            all = head[2 * k + nul] == '\0' && head[2 * k + 1 - nul] != '\0';
+        if (all)
+            return true;
+    }
+    return false;
+}
+} // namespace
+
 std::vector<std::string> read_lines(std::istream &in, const std::string &source_name,
                                     std::size_t max_bytes)
 {
@@ -22,9 +46,14 @@ std::vector<std::string> read_lines(std::istream &in, const std::string &source_
     std::size_t total = 0;
     char buffer[65536];
     bool pending_cr = false;
+    bool first = true;
     while (in) {
         in.read(buffer, sizeof buffer);
         const std::streamsize got = in.gcount();
+        if (first && utf16_text(std::string(buffer, static_cast<std::size_t>(got))))
+            throw MocapError(source_name, 1,
+                             "expected UTF-8 or ASCII text, got UTF-16 (save the file as UTF-8)");
+        first = false;
         total += static_cast<std::size_t>(got);
         if (total > max_bytes)
             throw MocapError(source_name, 0,

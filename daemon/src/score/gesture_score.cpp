@@ -128,7 +128,8 @@ HandNotes time_notes(const Score &score, const PerformerFrame &frame, const Plan
                     m << "this " << (s == 0 ? "kick" : "chick") << " comes "
                       << (written - foot_written_prev[s]) * 1000.0
                       << " ms after the previous one (line " << prev.line << "), faster than the "
-                      << (s == 0 ? "right foot plays its pedal" : "left foot plays the hi-hat's")
+                      << (s == 0 ? "right foot plays its pedal"
+                                 : "left foot plays the hi-hat's pedal")
                       << " (minimum " << min_s * 1000.0 << " ms)";
                     throw ScoreError(score.source, n.line, n.column, m.str());
                 }

@@ -65,22 +65,24 @@ NoteDrum note_drum(const Score &score, const ScoreNote &n, const PerformerFrame 
         if (d.cymbal)
             cymbals += (cymbals.empty() ? "" : ", ") + d.name;
     }
-    if (const std::string base = without_suffix(n.drum, "bell"); !base.empty()) {
+    // A bell's or a rim's piece is found as a note's is: by its name, else by its
+    // common spelling (`hi-hat-bell`, `floor-tom-rim`).
+    auto piece = [&](const std::string &base) {
+        if (base.empty())
+            return -1;
         const int i = find_drum(frame, base);
-        if (i >= 0 && frame.drums[static_cast<size_t>(i)].cymbal)
+        return i >= 0 ? i : find_drum(frame, standard_spelling(base));
+    };
+    if (const int i = piece(without_suffix(n.drum, "bell")); i >= 0) {
+        if (frame.drums[static_cast<size_t>(i)].cymbal)
             return {i, true};
-        if (i >= 0)
-            throw ScoreError(
-                score.source, n.drum_line, n.drum_column,
-                "drum '" + n.drum + "': a bell is a cymbal's, and '" + base +
-                    "' is not a cymbal (" +
-                    (cymbals.empty() ? "the kit has none" : "the kit's cymbals: " + cymbals) + ")");
+        throw ScoreError(
+            score.source, n.drum_line, n.drum_column,
+            "drum '" + n.drum + "': a bell is a cymbal's, and '" +
+                frame.drums[static_cast<size_t>(i)].name + "' is not a cymbal (" +
+                (cymbals.empty() ? "the kit has none" : "the kit's cymbals: " + cymbals) + ")");
     }
-    const std::string rim_of = without_suffix(n.drum, "rim");
-    int rim_i = rim_of.empty() ? -1 : find_drum(frame, rim_of);
-    if (!rim_of.empty() && rim_i < 0)
-        rim_i = find_drum(frame, standard_spelling(rim_of));
-    if (rim_i >= 0) {
+    if (const int rim_i = piece(without_suffix(n.drum, "rim")); rim_i >= 0) {
         const PerformerFrame::Drum &d = frame.drums[static_cast<size_t>(rim_i)];
         if (!d.cymbal && !d.foot)
             return {rim_i, false, true};

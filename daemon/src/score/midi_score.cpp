@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -707,10 +708,12 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
             continue;
         }
         const double beat = static_cast<double>(n.tick) / tpq;
-        if (beat > kMaxScoreBeats)
-            throw MidiFileError(source + ": note " + std::to_string(line) + " at beat " +
-                                std::to_string(beat) + ", past the score's " +
-                                std::to_string(kMaxScoreBeats));
+        if (beat > kMaxScoreBeats) {
+            std::ostringstream what; // the beat as written: 296827.5, not 296827.500000
+            what << source << ": note " << line << " at beat " << std::setprecision(15) << beat
+                 << " is past the score's limit of " << kMaxScoreBeats << " beats (docs/score.md)";
+            throw MidiFileError(what.str());
+        }
         const double t = map.time_at_beat(beat);
         const bool kick = n.note == kMidiAcousticBass || n.note == kMidiKick;
         if (kick || n.note == kMidiPedalHihat) {

@@ -18,35 +18,6 @@
 namespace ictus
 {
 
-namespace
-{
-// A message quotes the score's words as typed: control bytes in them (a NUL
-// cut the message short on a terminal, and in C strings) are shown as \xNN.
-std::string printable(const std::string &message)
-{
-    std::string out;
-    for (const char c : message) {
-        const auto u = static_cast<unsigned char>(c);
-        if ((u < 0x20 && c != '\t') || u == 0x7f) {
-            static const char hex[] = "0123456789abcdef";
-            out += "\\x";
-            out += hex[u >> 4];
-            out += hex[u & 15];
-        } else {
-            out += c;
-        }
-    }
-    return out;
-}
-} // namespace
-
-ScoreError::ScoreError(const std::string &source, int line, int column, const std::string &message)
-    : std::runtime_error(source + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
-                         printable(message)),
-      source_(source), line_(line), column_(column), message_(printable(message))
-{
-}
-
 const char *to_string(Grace grace)
 {
     switch (grace) {
