@@ -5,6 +5,7 @@ back over UDP (FUDI text, [netsend -u]):
     tick <logical_ms>;            every 2 ms of logical time ([metro 2] + [timer])
     fire <logical_ms> <strike>;   when a strike comes out of ictus-receive
     probe <logical_ms> <k>;       echo of a `probe k` sent to the FUDI port
+                                  (`quit` there ends pd: see quit_pd)
     plain <logical_ms> <seq>;     (optional) a strike parsed by a bare [oscparse]
     pose ... / reply ... / info ...;   the other outlets
 
@@ -26,6 +27,7 @@ import subprocess
 import threading
 import time
 
+from ictus_tools.checks import check
 from ictus_tools.oscpacket import now
 from ictus_tools.pdrun import PD, PD_ENV, Patch, free_udp_port, make_workdir  # noqa: F401
 
@@ -102,7 +104,9 @@ def fudi_records(items):
 
 def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=None,
                 control_msgs=(), listen_later=False, fudi_in_port=None, ballast=0):
-    """The real-time test patch (see the module doc). control_msgs go into
+    """The real-time test patch (see the module doc). pd quits after `seconds`: a
+    deadline only, for a test that ends pd by handshake (quit_pd, with
+    fudi_in_port) once it has what it waits for. control_msgs go into
     ictus-receive's inlet at 300 ms (after 'connect localhost ctl_port'). With
     listen_later, [ictus-receive] starts without a port and gets 'listen
     pd_port' at 300 ms."""
@@ -171,12 +175,15 @@ def build_patch(build, pd_port, report_port, seconds, ctl_port=None, plain_port=
         p.connect(m, 0, recv, 0)
     if fudi_in_port:
         # FUDI in: `probe K` is echoed at once as `probe <logical_ms> K` (the
-        # test's round trip), anything else goes into ictus-receive's inlet
+        # test's round trip), `quit` ends pd (the test's handshake is done),
+        # anything else goes into ictus-receive's inlet
         nr = p.obj("netreceive -u %d" % fudi_in_port)
-        rp = p.obj("route probe")
+        rp = p.obj("route probe quit")
         p.connect(nr, 0, rp, 0)
         stamped(rp, 0, "probe")
-        p.connect(rp, 1, recv, 0)
+        bye = p.msg("\\; pd quit")
+        p.connect(rp, 1, bye, 0)
+        p.connect(rp, 2, recv, 0)
     if ballast:
         p.obj("array define ictus-test-ballast %d" % ballast)
     end = p.obj("delay %d" % int(seconds * 1000))
@@ -207,6 +214,36 @@ def wait_for_ticks(listener, timeout=20.0, count=20):
             return True
         time.sleep(0.02)
     return False
+
+
+def wait_records(listener, pred, what, timeout=20.0, required=True):
+    """Handshake: the records once pred holds for them. At the deadline: a failed
+    check naming `what`, or (required=False) the records as they are, for the
+    test's own checks to say what is missing."""
+    t0 = time.time()
+    while True:
+        records = fudi_records(listener.snapshot())
+        if pred(records):
+            return records
+        if time.time() - t0 >= timeout:
+            check(not required, "%s within %g s" % (what, timeout))
+            return records
+        time.sleep(0.02)
+
+
+def quit_pd(proc, fudi_port, timeout=30.0):
+    """Ends pd by handshake (`quit` to the patch's FUDI port, sent again every
+    second until pd has exited or the deadline passed) and returns its log."""
+    t_end = time.time() + timeout
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        while True:
+            s.sendto(b"quit;\n", ("127.0.0.1", fudi_port))
+            try:
+                log, _ = proc.communicate(timeout=min(1.0, max(0.0, t_end - time.time())))
+                return log
+            except subprocess.TimeoutExpired:
+                if time.time() >= t_end:
+                    raise
 
 
 def unexplained_late(late_strikes, reported_ms, tolerance_ms):

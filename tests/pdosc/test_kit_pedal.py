@@ -17,7 +17,7 @@ from ictus_tools.oscpacket import bundle, message, now, strike, timetag
 from ictus_tools.pdrun import Patch, error_lines
 from ictus_tools.rtpd import Listener, free_udp_port, fudi_records, start_pd, wait_for_ticks
 
-SECONDS = 6.0
+SECONDS = 600.0  # pd's own deadline: the test kills pd when done
 HIHAT = 6
 # (seq, delay after the first send in s, the pedal sent first in the bundle or None)
 BUNDLES = [(1, 0.4, 0.0), (2, 0.7, None), (3, 1.0, 1.0), (4, 1.3, 0.5)]

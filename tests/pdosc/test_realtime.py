@@ -21,8 +21,9 @@ import struct
 import time
 
 from ictus_tools.oscpacket import bundle, message, now, strike, timetag, IMMEDIATE
-from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd,
-                              wait_for_ticks, unexplained_late, wall_of_logical)
+from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, quit_pd,
+                              start_pd, wait_for_ticks, wait_records, unexplained_late,
+                              wall_of_logical)
 from ictus_tools.checks import check, inconclusive
 from ictus_tools.pdrun import error_lines
 
@@ -35,7 +36,7 @@ build = os.path.abspath(args.build)
 N_STRIKES = 24
 LOOKAHEAD_S = 0.060
 SPACING_S = 0.045
-SECONDS = 6.0
+SECONDS = 600.0  # pd's own deadline: the test ends it by handshake (quit_pd)
 LATENCY_MS = 10.0
 LATE_OVERDUE_S = 1.0
 
@@ -112,7 +113,13 @@ try:
             control.append(ctl.recv(65536))
         except socket.timeout:
             pass
-    log, _ = proc.communicate(timeout=30)
+    # not required: the checks below say what is missing, if anything
+    wait_records(reports, lambda r: set(sent) | {late_seq} <= {int(a[10]) for _, a in r
+                                                                if a[0] == "fire"}
+                 and sum(a[0] == "pose" for _, a in r) >= 2
+                 and sum(a[0] == "reply" for _, a in r) >= 3,
+                 "every strike, pose and reply", timeout=30.0, required=False)
+    log = quit_pd(proc, fudi_port)
 finally:
     if proc.poll() is None:
         proc.kill()
