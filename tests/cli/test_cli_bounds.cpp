@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <random>
 #include <regex>
 #include <set>
 #include <thread>
@@ -516,4 +517,48 @@ TEST_CASE("ictusd render --drum-preset: the preset's head, recorded in render.js
     INFO(h.output);
     CHECK(h.status == 2);
     CHECK(h.output.find("--drum-preset: 'hihat' is a cymbal") != std::string::npos);
+}
+
+// --tempo was a clip's alone: with a score it was ignored without a word. Seeded tempi:
+// the notes (one beat each from the 1 s lead-in) at --tempo until the score's own
+// `tempo`, which wins from beat 0 when the score starts with it.
+TEST_CASE("ictusd render --tempo: a score's tempo until the score's own first `tempo`",
+          "[cli][bounds]")
+{
+    std::mt19937 rng(20261203);
+    for (int trial = 0; trial < 3; ++trial) {
+        const int tempo = std::uniform_int_distribution<int>(50, 200)(rng);
+        const int later = std::uniform_int_distribution<int>(50, 200)(rng);
+        const int before = std::uniform_int_distribution<int>(1, 3)(rng);
+        std::ostringstream score;
+        if (trial == 0)
+            score << "tempo " << later << "\n";
+        for (int k = 0; k < before; ++k)
+            score << (k % 2 ? "L" : "R") << "\n";
+        score << "tempo " << later << "\nR\nL\n";
+        const std::string file =
+            simtest::write_temp("tempo" + std::to_string(trial) + ".score", score.str());
+        const std::string dir = simtest::temp_path("tempo_out" + std::to_string(trial));
+        const Run r = ictusd("render --score " + file + " --tempo " + std::to_string(tempo) +
+                             " --bvh-rate 0 --tips-rate 0 --out " + dir);
+        INFO("--tempo " << tempo << ", then tempo " << later << " after " << before << " notes\n"
+                        << r.output);
+        REQUIRE(r.status == 0);
+        const double first = trial == 0 ? later : tempo;
+        std::vector<double> expect;
+        double t = 1.0;
+        for (int k = 0; k < before + 2; ++k) {
+            expect.push_back(t);
+            t += 60.0 / (k < before ? first : later);
+        }
+        std::ifstream in(dir + "/notes.csv");
+        std::string row;
+        std::getline(in, row); // the header
+        std::vector<double> got;
+        while (std::getline(in, row))
+            got.push_back(std::stod(row.substr(row.find(',') + 1)));
+        REQUIRE(got.size() == expect.size());
+        for (size_t k = 0; k < expect.size(); ++k)
+            CHECK(got[k] == Approx(expect[k]).margin(1e-6));
+    }
 }

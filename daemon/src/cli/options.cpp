@@ -348,9 +348,11 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.rebound_s = parse_number(a, value(), 0, 0.5);
     else if (a == "--lead-in")
         o.score.plan.lead_in_s = parse_number(a, value(), 0.2, 60);
-    else if (a == "--tempo")
+    else if (a == "--tempo") {
+        // a clip's playback tempo; a score's until its own first `tempo`
         o.tempo_bpm = parse_number(a, value(), 20, 400);
-    else if (a == "--clip-bpm")
+        o.score.start_tempo_bpm = o.tempo_bpm;
+    } else if (a == "--clip-bpm")
         o.clip_bpm = parse_number(a, value(), 20, 400);
     else if (parse_drum_option(a, args, o)) {
         // the drum or the kit
@@ -403,7 +405,7 @@ void load_midi_score(PerformanceOptions &o)
     std::vector<MidiDrum> drums;
     for (const KitDrum &d : o.kit.drums)
         drums.push_back({d.name, d.midi_note, true, {d.place_m.x(), d.place_m.y(), d.place_m.z()}});
-    MidiDrumPart part = load_midi_drum_part(path, drums);
+    MidiDrumPart part = load_midi_drum_part(path, drums, o.score.start_tempo_bpm);
     std::ostringstream line;
     long skipped = 0;
     for (const auto &[note, count] : part.skipped) {

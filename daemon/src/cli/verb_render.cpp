@@ -122,7 +122,8 @@ void render_usage(std::ostream &out)
            "  --step S            physics step (default 0.001)\n"
            "  --grip G            french | german (default: a score's first note's, else\n"
            "                      french)\n"
-           "  --tempo BPM         clip playback tempo (default 120; a score sets its own)\n"
+           "  --tempo BPM         a clip's playback tempo; a score's (or a MIDI file's)\n"
+           "                      until its own first tempo (default 120)\n"
            "  --clip-bpm BPM      tempo at which the clip plays at its own speed (default 120)\n"
            "  --drum-pos X,Y,Z    membrane centre, m (default: a clip's, where its fast strokes\n"
            "                      turn around (median); a score's, in front of the shoulders)\n"
@@ -518,7 +519,7 @@ MidiTimeline midi_timeline_of(const Performance &perf, const RenderArgs &r, bool
     const Score score =
         so.score ? *so.score
                  : parse_score(so.score_text.empty() ? default_score_text() : so.score_text,
-                               so.score_name);
+                               so.score_name, so.start_tempo_bpm);
     const double beat0_s = perf.plan_origin_s() + perf.plan()->score_start_s;
     double earliest_s = beat0_s;
     for (const StrikeEvent &e : log.strikes())

@@ -67,11 +67,10 @@ ScoreMode::ScoreMode(Performance &performance) : perf_(performance)
     db_ = std::make_unique<GestureDatabase>(
         so.gestures.empty() ? GestureDatabase::builtin() : GestureDatabase::load_json(so.gestures));
     builder_ = std::make_unique<ScoreBuilder>("osc");
-    score_ =
-        so.score
-            ? so.score
-            : std::make_shared<const Score>(parse_score(
-                  so.score_text.empty() ? default_score_text() : so.score_text, so.score_name));
+    score_ = so.score ? so.score
+                      : std::make_shared<const Score>(parse_score(
+                            so.score_text.empty() ? default_score_text() : so.score_text,
+                            so.score_name, so.start_tempo_bpm));
     if (!so.grip_given && !score_->notes.empty())
         o.character.grip = score_->notes.front().grip;
     score_first_bpm_ = score_->tempo.tempo_at_beat(0.0);

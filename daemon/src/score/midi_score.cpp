@@ -292,8 +292,9 @@ int drum_of(int note, const std::vector<MidiDrum> &drums)
     return best;
 }
 
-// The file's tempo map and meters on the score's beats (a quarter a beat).
-void add_timing(const Smf &smf, MidiDrumPart &part)
+// The file's tempo map (start_bpm before its first tempo event) and meters on the
+// score's beats (a quarter a beat).
+void add_timing(const Smf &smf, MidiDrumPart &part, double start_bpm)
 {
     const double tpq = smf.ticks_per_quarter;
     auto bpm_of = [&part](long us) {
@@ -305,7 +306,7 @@ void add_timing(const Smf &smf, MidiDrumPart &part)
     };
     // Of two tempo events at one tick, the later in the file wins (TempoMap::add), at
     // tick 0 too: the first of them played the whole part at the wrong tempo.
-    part.score.tempo = TempoMap(kDefaultTempoBpm);
+    part.score.tempo = TempoMap(start_bpm);
     for (const SmfTempo &t : smf.tempo) {
         const double bpm = bpm_of(t.us_per_quarter);
         part.score.tempo.add(static_cast<double>(t.tick) / tpq, bpm, bpm, 0.0);
@@ -646,11 +647,11 @@ void drop_notes(std::vector<ScoreNote> &notes, std::vector<HandNote> &hand_notes
 } // namespace
 
 MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
-                             const std::string &source)
+                             const std::string &source, double start_bpm)
 {
     MidiDrumPart part;
     part.score.source = source;
-    add_timing(smf, part);
+    add_timing(smf, part, start_bpm);
     part.channel = drum_channel(smf);
     const double tpq = smf.ticks_per_quarter;
     const TempoMap &map = part.score.tempo;
@@ -822,7 +823,8 @@ MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
     return part;
 }
 
-MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<MidiDrum> &drums)
+MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<MidiDrum> &drums,
+                                 double start_bpm)
 {
     InputFile in = open_input_file(path);
     if (in.is_folder)
@@ -831,7 +833,7 @@ MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<Midi
         throw MidiFileError(path + ": cannot be read" + in.reason_suffix());
     std::ostringstream bytes;
     bytes << in.stream.rdbuf();
-    MidiDrumPart part = drum_part_score(read_smf(bytes.str(), path), drums, path);
+    MidiDrumPart part = drum_part_score(read_smf(bytes.str(), path), drums, path, start_bpm);
     if (part.score.notes.empty())
         throw MidiFileError(path + ": no note the " + (drums.empty() ? "drum" : "kit") +
                             " can play (snares 38, 40, side stick 37, toms 41..50 and, on a kit "

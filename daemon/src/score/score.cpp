@@ -841,6 +841,19 @@ void ScoreBuilder::set_default_nuance(Nuance nuance)
     state_->statements.push_back(st);
 }
 
+void ScoreBuilder::set_start_tempo(double bpm)
+{
+    if (!(bpm >= 20.0 && bpm <= 400.0))
+        throw ScoreError(state_->source, 0, 0,
+                         "the starting tempo " + std::to_string(bpm) +
+                             " is out of range (20..400 bpm)");
+    Statement st;
+    st.kind = Kind::tempo;
+    st.start_bpm = bpm;
+    st.end_bpm = bpm;
+    state_->statements.push_back(st);
+}
+
 void ScoreBuilder::add_statement(const std::string &text)
 {
     const int line = ++state_->calls;

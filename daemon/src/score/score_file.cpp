@@ -99,9 +99,11 @@ ScoreError::ScoreError(const std::string &source, int line, int column, const st
 {
 }
 
-Score parse_score(const std::string &text, const std::string &source_name)
+Score parse_score(const std::string &text, const std::string &source_name, double start_bpm)
 {
     ScoreBuilder builder(source_name);
+    if (start_bpm != kDefaultTempoBpm)
+        builder.set_start_tempo(start_bpm);
     // A UTF-16 file (its byte order mark, as Windows' Notepad may write) would read as
     // one unknown statement of NULs: said for what it is.
     if (text.compare(0, 2, "\xFF\xFE") == 0 || text.compare(0, 2, "\xFE\xFF") == 0)

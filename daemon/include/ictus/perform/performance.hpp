@@ -44,6 +44,8 @@ struct ScorePerformOptions {
     std::string gestures; // gesture database JSON; empty: GestureDatabase::builtin()
     TrackMode mode = TrackMode::cartesian;
     bool grip_given = false; // else the character holds the sticks as the score's first note
+    // The score's tempo until its own first `tempo` statement (--tempo), bpm.
+    double start_tempo_bpm = kDefaultTempoBpm;
     PlanOptions plan;        // strike_depth_m below: the default here
     // The tip targets are sampled this far ahead of the plan's clock: the
     // controller's measured tracking lag (docs/perform.md), so that the

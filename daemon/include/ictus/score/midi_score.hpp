@@ -149,12 +149,14 @@ struct MidiDrumPart {
 // note; no drums: the one drum plays them all), cymbals to the kit's crash,
 // ride and hi-hat (42 closed, 46 open) when it has them, the rest skipped; velocity
 // v to dynamics v / 127; hands as docs/midi.md says; the tempo map and the
-// meters of the file, its quarter note the score's beat.
+// meters of the file, its quarter note the score's beat; before the file's first
+// tempo event, start_bpm (ictusd --tempo; a Standard MIDI File's own default is 120).
 MidiDrumPart drum_part_score(const Smf &smf, const std::vector<MidiDrum> &drums,
-                             const std::string &source);
+                             const std::string &source, double start_bpm = kDefaultTempoBpm);
 
 // Reads the file at `path` and converts it. Throws MidiFileError (also when
 // it cannot be read or holds no playable note).
-MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<MidiDrum> &drums);
+MidiDrumPart load_midi_drum_part(const std::string &path, const std::vector<MidiDrum> &drums,
+                                 double start_bpm = kDefaultTempoBpm);
 
 } // namespace ictus

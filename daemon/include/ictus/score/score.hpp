@@ -250,6 +250,10 @@ class ScoreBuilder
     // and error positions stay those of the statements received): what
     // /ictus/nuance does in score mode.
     void set_default_nuance(Nuance nuance);
+    // The tempo the score starts at until its own first `tempo` statement
+    // (ictusd --tempo), as a `tempo BPM` before the first statement would set
+    // it, not counted as a statement. Throws ScoreError outside 20..400 bpm.
+    void set_start_tempo(double bpm);
     int statements() const; // how many add_statement() calls so far
     // The tempo the statements so far start at (their beat 0): that of the
     // last `tempo` before the first note, roll or rest; the default (120 bpm)
@@ -261,7 +265,7 @@ class ScoreBuilder
     void reset(); // back to an empty score, errors forgotten
 
   private:
-    friend Score parse_score(const std::string &, const std::string &);
+    friend Score parse_score(const std::string &, const std::string &, double);
     struct State;
     std::unique_ptr<State> state_;
     // Parses `text` as line `line` and appends its statements (all or none).
@@ -270,8 +274,10 @@ class ScoreBuilder
 
 // Parses a whole score (a file's contents): statements separated by
 // newlines, ';' or ','; '#' starts a comment. Throws ScoreError at the first
-// fault, naming `source_name`, the line and the column.
-Score parse_score(const std::string &text, const std::string &source_name);
+// fault, naming `source_name`, the line and the column. The score starts at
+// start_bpm until its first `tempo` statement.
+Score parse_score(const std::string &text, const std::string &source_name,
+                  double start_bpm = kDefaultTempoBpm);
 // Whether a score's text holds a statement, faulty or not: false for an empty text or one
 // of blank lines and comments only (a score file with no notes, refused as one).
 bool score_text_has_statements(const std::string &text);
