@@ -562,3 +562,21 @@ TEST_CASE("ictusd render --tempo: a score's tempo until the score's own first `t
             CHECK(got[k] == Approx(expect[k]).margin(1e-6));
     }
 }
+
+// A refused score left its --out folder behind, created and empty; a folder that was
+// there before stays.
+TEST_CASE("ictusd render: a refused score leaves no --out folder of its own", "[cli][bounds]")
+{
+    const std::string file = simtest::write_temp("refused.score", "R legato\nQ nonsense\n");
+    const std::string dir = simtest::temp_path("refused_out");
+    std::filesystem::remove_all(dir);
+    const Run r = ictusd("render --score " + file + " --out " + dir);
+    INFO(r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find(":2:1: unknown statement 'Q'") != std::string::npos);
+    CHECK(!std::filesystem::exists(dir));
+    std::filesystem::create_directories(dir);
+    const Run again = ictusd("render --score " + file + " --out " + dir);
+    CHECK(again.status == 1);
+    CHECK(std::filesystem::is_directory(dir));
+}
