@@ -806,3 +806,44 @@ TEST_CASE("score: a text of blank lines and comments only holds no statement, as
                              "# c\nR legatto"})
         CHECK(score_text_has_statements(some));
 }
+
+// A CR in one /ictus/score string (a patch's text pasted from Windows, or an old Mac's)
+// did not separate statements as LF does; a '#' comment ran past the line break to the
+// end of the string. Seeded statements in one string, each line break LF, CRLF or CR,
+// some lines with a comment: the notes of the same statements one per line of a file.
+TEST_CASE("score: a line break in one statement string separates as in a file, CR too",
+          "[score][parser]")
+{
+    const std::vector<std::string> words = {"R legato",     "L accent 0.8", "R staccato pp",
+                                            "L 1/2",        "tempo 90",     "R+L tenuto f",
+                                            "rest 1/4",     "L legato mp",  "R vertical_accent ff",
+                                            "dynamics 0.3", "R 1/4",        "grip german"};
+    std::mt19937 rng(20261204);
+    for (int trial = 0; trial < 50; ++trial) {
+        std::string file, message;
+        const int n = std::uniform_int_distribution<int>(2, 9)(rng);
+        for (int k = 0; k < n; ++k) {
+            const std::string &w = words[rng() % words.size()];
+            file += w + "\n";
+            message += w;
+            if (rng() % 3 == 0)
+                message += " # a comment, R ff";
+            if (k + 1 < n)
+                message += std::vector<std::string>{"\n", "\r\n", "\r"}[rng() % 3];
+        }
+        INFO("trial " << trial << ": " << file);
+        const Score want = parse_score(file, "file");
+        ScoreBuilder b;
+        b.add_statement(message);
+        const Score got = b.finish();
+        REQUIRE(got.notes.size() == want.notes.size());
+        for (size_t i = 0; i < want.notes.size(); ++i) {
+            CHECK(got.notes[i].beat == want.notes[i].beat);
+            CHECK(got.notes[i].hand == want.notes[i].hand);
+            CHECK(got.notes[i].nuance == want.notes[i].nuance);
+            CHECK(got.notes[i].dynamics == want.notes[i].dynamics);
+            CHECK(got.notes[i].grip == want.notes[i].grip);
+        }
+        CHECK(got.tempo.time_at_beat(8.0) == want.tempo.time_at_beat(8.0));
+    }
+}

@@ -203,9 +203,14 @@ class LineParser
         size_t i = 0, counted = 0, continuations = 0;
         while (i < text.size()) {
             const char c = text[i];
-            if (c == '#')
-                break;
-            if (c == ',' || c == ';' || c == '\n') {
+            if (c == '#') { // a comment, to the end of its line within the text
+                while (i < text.size() && text[i] != '\n' && text[i] != '\r')
+                    ++i;
+                continue;
+            }
+            // a line break in a statement sent as one string (a CR, as Windows' or
+            // an old Mac's, too) separates statements as a newline does in a file
+            if (c == ',' || c == ';' || c == '\n' || c == '\r') {
                 flush();
                 ++i;
                 continue;
