@@ -97,7 +97,7 @@ void check_score(const Score &score)
         ICTUS_FUZZ_CHECK(c.start_bpm >= kMinTempoBpm && c.start_bpm <= kMaxTempoBpm &&
                              c.end_bpm >= kMinTempoBpm && c.end_bpm <= kMaxTempoBpm,
                          "tempo outside the limits");
-        ICTUS_FUZZ_CHECK(c.ramp_beats >= 0.0 && c.ramp_beats <= kMaxRampBeats,
+        ICTUS_FUZZ_CHECK(c.ramp_beats >= 0.0 && c.ramp_beats <= kMaxNoteBeats,
                          "ramp outside the limits");
     }
     const double duration = score.duration_s();

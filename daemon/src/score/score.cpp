@@ -455,10 +455,9 @@ class LineParser
                          "expected 'over BEATS' after the target tempo, got '" + over.text + "'");
                 const Token &len =
                     need(tk, i + 3, "tempo change needs the number of beats after 'over'");
+                // 1/32..kMaxNoteBeats, as every duration (a longer change: one ramp
+                // after another, docs/score.md)
                 st.ramp_beats = duration(len, "tempo change length");
-                if (st.ramp_beats > kMaxRampBeats)
-                    fail(len.column,
-                         "tempo change length " + len.text + " is out of range (1/32..1024 beats)");
                 i += 4;
             } else {
                 st.end_bpm = *st.start_bpm;

@@ -40,7 +40,6 @@ constexpr double kMinTempoBpm = 20.0;
 constexpr double kMaxTempoBpm = 400.0;
 constexpr double kMinNoteBeats = 1.0 / 32.0;
 constexpr double kMaxNoteBeats = 64.0;
-constexpr double kMaxRampBeats = 1024.0;
 constexpr double kMaxRadiusFraction = 0.95; // r/a: the bead must land on the head
 constexpr int kMaxRepeat = 1000;
 constexpr double kMaxHumanize = 4.0;   // `humanize AMOUNT`: 0..4
