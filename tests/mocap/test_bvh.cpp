@@ -620,6 +620,13 @@ TEST_CASE("BVH: values out of the physical bounds of a capture are refused at th
                             "expected a frame time in [0.0005, 0.5] s (a capture at 2 Hz to "
                             "2 kHz), got '60'");
         require_bound_error(minimal_bvh(18, "Frame Time: 1"), 18, "got '1'");
+        // a rate typed for the interval: said as such, with the interval it means
+        require_bound_error(minimal_bvh(18, "Frame Time: 30"), 18,
+                            "got '30' (a rate? Frame Time is seconds per frame: 30 Hz is "
+                            "0.0333333 s)");
+        require_error(minimal_bvh(18, "Frame Time: 120"), 18,
+                      "got '120' (a rate? Frame Time is seconds per frame: 120 Hz is "
+                      "0.00833333 s)");
         require_bound_error(minimal_bvh(18, "Frame Time: 0.0001"), 18, "got '0.0001'");
         require_bound_warning(minimal_bvh(18, "Frame Time: 60"), 18, "got '60'");
         // The bounds themselves are accepted.

@@ -88,9 +88,11 @@ class Cursor
         return rest;
     }
 
-    [[noreturn]] void fail(const std::string &expected, const std::string &got) const
+    [[noreturn]] void fail(const std::string &expected, const std::string &got,
+                           const std::string &note = "") const
     {
-        throw MocapError(source_, token_line_, "expected " + expected + ", got " + quote(got));
+        throw MocapError(source_, token_line_,
+                         "expected " + expected + ", got " + quote(got) + note);
     }
 
     int token_line() const { return token_line_; }
@@ -352,14 +354,23 @@ class BvhParser
             cursor_.fail("Frame Time:", frame);
         const std::string value_token = labelled_value("Time:", "a frame time");
         double frame_time = 0.0;
-        if (!detail::parse_double(value_token, frame_time) || !std::isfinite(frame_time) ||
-            frame_time < kMinFrameTimeS || frame_time > kMaxFrameTimeS)
-            cursor_.fail("a frame time in [1e-05, 60] s", value_token);
+        const bool number = detail::parse_double(value_token, frame_time) &&
+                            std::isfinite(frame_time) && frame_time > 0.0;
+        // A rate typed where the interval goes (`Frame Time: 30`, a capture's 2 Hz
+        // to 2 kHz) is said as such.
+        const double interval_if_rate = number ? 1.0 / frame_time : 0.0;
+        const std::string hint =
+            interval_if_rate >= kMinSampleInterval_s && interval_if_rate <= kMaxSampleInterval_s
+                ? " (a rate? Frame Time is seconds per frame: " + value_token + " Hz is " +
+                      number_text(interval_if_rate) + " s)"
+                : "";
+        if (!number || frame_time < kMinFrameTimeS || frame_time > kMaxFrameTimeS)
+            cursor_.fail("a frame time in [1e-05, 60] s", value_token, hint);
         if (frame_time < kMinSampleInterval_s || frame_time > kMaxSampleInterval_s)
             out_of_bounds(cursor_.token_line(), "frame time",
                           "expected a frame time in [" + number_text(kMinSampleInterval_s) + ", " +
                               number_text(kMaxSampleInterval_s) +
-                              "] s (a capture at 2 Hz to 2 kHz), got " + quote(value_token));
+                              "] s (a capture at 2 Hz to 2 kHz), got " + quote(value_token) + hint);
         const std::vector<std::string> extra = cursor_.rest_of_line("");
         if (!extra.empty())
             cursor_.fail("end of line after the frame time", extra.front());
