@@ -601,6 +601,13 @@ TEST_CASE("live: score statements over OSC wait at most kMaxPendingStatements, t
     clear.kind = CommandKind::score_clear;
     REQUIRE(perf.apply(clear));
     CHECK(perf.apply(c, &why));
+    // a faulty statement is refused with its error and counted too
+    Command bad = c;
+    std::snprintf(bad.text, sizeof bad.text, "R legatto");
+    why.clear();
+    CHECK_FALSE(perf.apply(bad, &why));
+    CHECK(why.find("legatto") != std::string::npos);
+    CHECK(perf.refused_statements() == 2);
 }
 
 TEST_CASE("live: a stop just after a stroke sends its stick to rest without striking again",

@@ -591,7 +591,12 @@ bool ScoreMode::score(const Command &c, std::string *why)
             begin_new_score();
         // Parsed now (an error names the statement and column); played at
         // the next /ictus/play. A score with a faulty statement never plays.
-        builder_->add_statement(c.text);
+        try {
+            builder_->add_statement(c.text);
+        } catch (const ScoreError &) {
+            ++perf_.refused_statements_; // faulty: answered with its error, counted
+            throw;
+        }
         return true;
     }
     // A new score; the selected nuance still applies to the statements that

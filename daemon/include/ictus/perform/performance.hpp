@@ -268,8 +268,8 @@ class Performance
     long whips() const { return whips_; }
     // Strikes held back whole (onset and release) by the runaway guard.
     long withheld_strikes() const { return withheld_; }
-    // Score statements over OSC (/ictus/score) refused: kMaxPendingStatements
-    // are waiting already (docs/osc.md).
+    // Score statements over OSC (/ictus/score) refused: faulty (each answered
+    // with its error), or kMaxPendingStatements are waiting already (docs/osc.md).
     long refused_statements() const { return refused_statements_; }
     // Statements (parsed; a line may hold several) a score received over OSC
     // may hold until /ictus/score/clear: what a play copies, and what the
