@@ -102,6 +102,41 @@ def recorder(p, tables, seconds, sr, wav_path, quit_extra=None):
     return trig
 
 
+def send_each_ms(p, target, messages, tail_ms=20):
+    """Adds: at load, each of `messages` (a message box's text) into target's left
+    inlet, one logical millisecond apart from 1 ms on; pd quits tail_ms after the
+    last (in batch pd the delays take no wall time)."""
+    lb = p.obj("loadbang")
+    for k, text in enumerate(messages):
+        d = p.obj("delay %d" % (1 + k))
+        m = p.msg(text)
+        p.connect(lb, 0, d, 0)
+        p.connect(d, 0, m, 0)
+        p.connect(m, 0, target, 0)
+    q = p.obj("delay %d" % (len(messages) + tail_ms))
+    qm = p.msg("\\; pd quit")
+    p.connect(lb, 0, q, 0)
+    p.connect(q, 0, qm, 0)
+
+
+def check_bad_messages(errors, name, bad):
+    """Of a run that sent the messages `bad` to [name] (send_each_ms): every error
+    line names `name` ("error: NAME: ..."), and each bad message `WORD REST` has one
+    starting "error: NAME: WORD " and ending "got: REST" ("got: bang" for a bare
+    WORD). Checks made with ictus_tools.checks.check; returns whether all held."""
+    check = checks.check
+    prefix = "error: %s: " % name
+    ok = check(all(e.startswith(prefix) for e in errors), "every error line names %s: others %s"
+               % (name, [e for e in errors if not e.startswith(prefix)][:4]))
+    for text in bad:
+        word, _, rest = text.partition(" ")
+        said = [e for e in errors if e.startswith(prefix + word + " ")
+                and e.rstrip().endswith("got: " + (rest or "bang"))]
+        ok = check(said, "'%s': an error line of %s naming %s and quoting it (%s)"
+                   % (text, name, word, said[:1])) and ok
+    return ok
+
+
 def run_pd(patch_text, libdir, sr=48000, extra_args=(), workdir=None, name="test.pd",
            timeout=120):
     """Writes the patch into workdir and runs pd on it; returns (returncode, stderr)."""

@@ -13,7 +13,8 @@ import os
 import random
 
 from ictus_tools.checks import check, keep_going, failed
-from ictus_tools.pdrun import Patch, error_lines, free_udp_port, run_pd, make_workdir
+from ictus_tools.pdrun import (Patch, check_bad_messages, error_lines, free_udp_port, run_pd,
+                               make_workdir, send_each_ms)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -40,28 +41,12 @@ p = Patch(declare="-path %s/ictus" % args.build)
 rec = p.obj("ictus-receive")
 state = p.obj("print connection")
 p.connect(rec, 4, state, 0)
-lb = p.obj("loadbang")
-for k, text in enumerate(BAD + [GOOD]):
-    d = p.obj("delay %d" % (1 + k))
-    m = p.msg(text)
-    p.connect(lb, 0, d, 0)
-    p.connect(d, 0, m, 0)
-    p.connect(m, 0, rec, 0)
-q = p.obj("delay %d" % (len(BAD) + 20))
-qm = p.msg("\\; pd quit")
-p.connect(lb, 0, q, 0)
-p.connect(q, 0, qm, 0)
+send_each_ms(p, rec, BAD + [GOOD])
 rc, log = run_pd(p.text(), os.path.join(args.build, "ictus"), workdir=make_workdir("ictus-rcv-bad-"))
 keep_going()
 errors = error_lines(log)
 check(rc == 0, "pd ran (exit %d)" % rc)
-foreign = [e for e in errors if not e.startswith("error: ictus-receive: ")]
-check(not foreign, "every error line names ictus-receive: others %s" % foreign[:4])
-for text in BAD:
-    word, _, rest = text.partition(" ")
-    said = [e for e in errors if e.startswith("error: ictus-receive: %s " % word)
-            and e.rstrip().endswith("got: " + (rest or "bang"))]
-    check(said, "'%s': an error line of ictus-receive quoting it (%s)" % (text, said[:1]))
+check_bad_messages(errors, "ictus-receive", BAD)
 check(len(errors) == len(BAD), "one error line per bad message (%d for %d)" % (len(errors), len(BAD)))
 check("connection: 1" in log, "'%s' connects" % GOOD)
 if failed():

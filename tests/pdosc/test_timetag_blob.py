@@ -15,7 +15,7 @@ import struct
 
 from ictus_tools.checks import check, keep_going, failed
 from ictus_tools.oscpacket import osc_string
-from ictus_tools.pdrun import Patch, run_pd, make_workdir
+from ictus_tools.pdrun import Patch, run_pd, make_workdir, send_each_ms
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -43,17 +43,8 @@ info = p.obj("print info")
 p.connect(tt, 0, parse, 0)
 p.connect(parse, 0, out, 0)
 p.connect(tt, 2, info, 0)
-lb = p.obj("loadbang")
-for k, (_, _, _, packet, _) in enumerate(cases):
-    d = p.obj("delay %d" % (1 + k))
-    m = p.msg("list " + " ".join(str(b) for b in packet))
-    p.connect(lb, 0, d, 0)
-    p.connect(d, 0, m, 0)
-    p.connect(m, 0, tt, 0)
-quit_ = p.obj("delay %d" % (len(cases) + 10))
-qm = p.msg("\\; pd quit")
-p.connect(lb, 0, quit_, 0)
-p.connect(quit_, 0, qm, 0)
+send_each_ms(p, tt, ["list " + " ".join(str(b) for b in packet)
+                     for _, _, _, packet, _ in cases], tail_ms=10)
 rc, log = run_pd(p.text(), os.path.join(args.build, "ictus"), workdir=make_workdir("ictus-blob-"))
 keep_going()
 check(rc == 0 and "ended prematurely" not in log,

@@ -11,7 +11,8 @@ import os
 import random
 
 from ictus_tools.checks import check, keep_going, failed
-from ictus_tools.pdrun import Patch, error_lines, run_pd, make_workdir
+from ictus_tools.pdrun import (Patch, check_bad_messages, error_lines, run_pd, make_workdir,
+                               send_each_ms)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -32,29 +33,14 @@ GOOD = ["loop 1", "loop 0", "open %s" % os.path.join(LIB, "ictus-midifile-exampl
 
 p = Patch(declare="-path %s" % LIB)
 mf = p.obj("ictus-midifile")
-lb = p.obj("loadbang")
 messages = [text for text, _ in BAD] + GOOD
 rng.shuffle(messages)
-for k, text in enumerate(messages):
-    d = p.obj("delay %d" % (1 + k))
-    m = p.msg(text)
-    p.connect(lb, 0, d, 0)
-    p.connect(d, 0, m, 0)
-    p.connect(m, 0, mf, 0)
-q = p.obj("delay %d" % (len(messages) + 20))
-qm = p.msg("\\; pd quit")
-p.connect(lb, 0, q, 0)
-p.connect(q, 0, qm, 0)
+send_each_ms(p, mf, messages)
 rc, log = run_pd(p.text(), LIB, workdir=make_workdir("ictus-midifile-bad-"))
 keep_going()
 errors = error_lines(log)
 check(rc == 0, "pd ran (exit %d)" % rc)
-foreign = [e for e in errors if not e.startswith("error: ictus-midifile: ")]
-check(not foreign, "every error line names ictus-midifile: others %s" % foreign[:4])
-for text, end in BAD:
-    said = [e for e in errors if e.startswith("error: ictus-midifile: %s " % text.split()[0])
-            and e.rstrip().endswith(end)]
-    check(said, "'%s': an error line of ictus-midifile ending '%s'" % (text, end))
+check_bad_messages(errors, "ictus-midifile", [text for text, _ in BAD])
 check(len(errors) == len(BAD), "one error line per bad message, none for %s (%d for %d)"
       % (GOOD, len(errors), len(BAD)))
 if failed():

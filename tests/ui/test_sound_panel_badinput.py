@@ -12,7 +12,8 @@ import os
 import random
 
 from ictus_tools.checks import check, keep_going, failed
-from ictus_tools.pdrun import Patch, error_lines, run_pd, make_workdir
+from ictus_tools.pdrun import (Patch, check_bad_messages, error_lines, run_pd, make_workdir,
+                               send_each_ms)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -36,28 +37,12 @@ panel = p.obj("ictus-sound-panel")
 out1, out2 = p.obj("print sent"), p.obj("print drum")
 p.connect(panel, 0, out1, 0)
 p.connect(panel, 1, out2, 0)
-lb = p.obj("loadbang")
-for k, text in enumerate(BAD):
-    d = p.obj("delay %d" % (1 + k))
-    m = p.msg(text)
-    p.connect(lb, 0, d, 0)
-    p.connect(d, 0, m, 0)
-    p.connect(m, 0, panel, 0)
-q = p.obj("delay %d" % (len(BAD) + 20))
-qm = p.msg("\\; pd quit")
-p.connect(lb, 0, q, 0)
-p.connect(q, 0, qm, 0)
+send_each_ms(p, panel, BAD)
 rc, log = run_pd(p.text(), LIB, workdir=make_workdir("ictus-panel-bad-"))
 keep_going()
 errors = error_lines(log)
 check(rc == 0, "pd ran (exit %d)" % rc)
-foreign = [e for e in errors if not e.startswith("error: ictus-sound-panel: ")]
-check(not foreign, "every error line names ictus-sound-panel: others %s" % foreign[:4])
-for text in BAD:
-    word, _, rest = text.partition(" ")
-    said = [e for e in errors if e.startswith("error: ictus-sound-panel: %s " % word)
-            and e.rstrip().endswith("got: " + (rest or "bang"))]
-    check(said, "'%s': an error line of the panel naming %s and quoting it" % (text, word))
+check_bad_messages(errors, "ictus-sound-panel", BAD)
 sent = [l for l in log.splitlines() if l.startswith(("sent:", "drum:"))]
 check(not sent, "nothing sent for them: %s" % sent[:3])
 if failed():
