@@ -80,7 +80,7 @@ def test_patch(build, pd_port, daemon_port, ctl_port, wav):
              "#X obj 600 1120 print strike",                                # 14
              "#X obj 20 1120 print test",                                   # 15
              "#X msg 20 1150 ready",                                        # 16
-             "#X obj 900 1000 r render-kit-3",                              # 17
+             "#X obj 900 1000 r live-kit-3",                                # 17
              "#X obj 900 1030 print kit3",                                  # 18
              "#X obj 900 1060 route preset",                                # 19
              "#X obj 900 1090 print drum0-preset",                          # 20

@@ -11,7 +11,8 @@ velocity the documented curve of the strike's speed in strikes.csv. The kit mess
 that table's too, and so are performance.mid's of `ictusd render` of the same score. Then MIDI
 in with the kit ('in' ticked, `note G V`): each General MIDI note
 plays the kit's drum of that note (the strike list to ictus-kit, and a kit drum's hit line on
-render-kit-hit), 46 with the pedal open before it, 36 as the right foot, 44 the left foot;
+live-kit-hit: the main patch's is [ictus-kit live-kit]), 46 with the pedal open before it, 36
+as the right foot, 44 the left foot;
 `note N V G` as [ictus-midifile] sends it: G on the kit's drum, the hand from N; a note the kit
 has no drum of (60; 45, a tom `full` lacks) plays nothing.
 
@@ -104,7 +105,7 @@ def test_patch(build, pd_port, daemon_port, ctl_port):
              "#X obj 600 1090 print strike",                                # 12
              "#X obj 800 1000 r \\$0-kit",                                  # 13
              "#X obj 800 1030 print kit",                                   # 14
-             "#X obj 900 1000 r render-kit-hit",                            # 15
+             "#X obj 900 1000 r live-kit-hit",                              # 15
              "#X obj 900 1030 print kithit",                                # 16
              "#X obj 1000 1000 r \\$0-midi-in",                             # 17
              "#X obj 1000 1030 print midiin",                               # 18
@@ -257,7 +258,7 @@ def main():
     kithits = [l for l in lines.printed if l.startswith("kithit: ")]
     check(len(kithits) >= 1 and any(int(float(l.split()[2])) == drum_of["crash"]
                                     for l in kithits[-8:]),
-          "MIDI in's strikes reach the kit's drums (render-kit-hit): %s" % kithits[-8:])
+          "MIDI in's strikes reach the kit's drums (live-kit-hit): %s" % kithits[-8:])
     bad = uitest.error_lines("\n".join(lines.printed))
     check(not bad, "no error lines from pd: %s" % bad)
     print("PASS")

@@ -33,8 +33,10 @@ to the nearest limit (1e30 was taken as 0).
 [ictus-kit-drum N] (a kit's drum in ictus-render.pd and ictus-kit.pd, docs/pd-osc.md): N a whole
 number 1..7; out of range or not whole it is clamped (drum min(7, max(1, int N))), a symbol or no
 N takes drum 1, extra arguments are said, each naming ictus-kit-drum (9, foo and -1 were taken
-without a word, and [ictus-kit-drum 9] played the hit lines of a drum 9 no kit has). Checked by
-sound: the drum the clamp names sounds for its hit line, the bad number's does not.
+without a word, and [ictus-kit-drum 9] played the hit lines of a drum 9 no kit has). NAME, the
+prefix of its names (NAME-hit, NAME-N, throw~ NAME-l / -r): without it, or a number, it is
+render-kit (the render's, what it was before it took a NAME), said. Checked by sound: the drum
+the clamp names sounds for its hit line on the prefix's names, the bad number's does not.
 
     PYTHONPATH=python python3 tests/pdosc/test_abstraction_args.py --build build
 """
@@ -297,28 +299,40 @@ def kit_drum_args(build):
             return min(7, max(1, int(float(arg.split()[0]))))
         except (ValueError, IndexError):
             return 1
-    # (arguments, error lines expected)
-    cases = [("9", ["ictus-kit-drum: N must be a whole number 1..7 (clamped) - got: 9"]),
-             ("-1", ["ictus-kit-drum: N must be a whole number 1..7 (clamped) - got: -1"]),
-             ("2.5", ["ictus-kit-drum: N must be a whole number 1..7 (clamped) - got: 2.5"]),
-             ("foo", ["ictus-kit-drum: N must be a number 1..7 - using 1 - got: foo"]),
-             ("", ["ictus-kit-drum: takes N (the kit's drum 1..7) - using: 1"]),
-             ("3 4", ["ictus-kit-drum: takes one argument N - extra arguments ignored - got: 4"]),
-             ("5", [])]
+    no_name = ("ictus-kit-drum: takes N NAME (NAME-hit NAME-1..7 NAME-l NAME-r) - no NAME - "
+               "using: render-kit")
+    # (arguments, error lines expected, the names' prefix it must use)
+    cases = [("9 render-kit",
+              ["ictus-kit-drum: N must be a whole number 1..7 (clamped) - got: 9"], "render-kit"),
+             ("-1 kitx", ["ictus-kit-drum: N must be a whole number 1..7 (clamped) - got: -1"],
+              "kitx"),
+             ("2.5 render-kit",
+              ["ictus-kit-drum: N must be a whole number 1..7 (clamped) - got: 2.5"], "render-kit"),
+             ("foo render-kit", ["ictus-kit-drum: N must be a number 1..7 - using 1 - got: foo"],
+              "render-kit"),
+             ("", [no_name, "ictus-kit-drum: takes N (the kit's drum 1..7) - using: 1"],
+              "render-kit"),
+             ("3", [no_name], "render-kit"),
+             ("3 4", ["ictus-kit-drum: NAME must be a symbol (the kit's name) - using render-kit"
+                      " - got: 4"], "render-kit"),
+             ("3 kitx 4", ["ictus-kit-drum: takes two arguments N NAME - extra arguments ignored"
+                           " - got: 4"], "kitx"),
+             ("5 render-kit", [], "render-kit"),
+             ("6 kitx", [], "kitx")]
     work = make_workdir("ictus-pdosc-args-")
-    for arg, errors in cases:
+    for arg, errors, prefix in cases:
         want = clamped(arg)
-        other = 9 if arg == "9" else (want % 7) + 1  # a drum this one must not play
+        other = 9 if arg.startswith("9") else (want % 7) + 1  # a drum this one must not play
         peaks = []
         for drum in (want, other):
             p = Patch()
             p.obj("ictus-kit-drum %s" % arg)
-            p.obj("r render-kit-%d" % drum)  # a receiver for drum 9's messages too
-            catch = p.obj("catch~ ictus-render-kit-l")
+            p.obj("r %s-%d" % (prefix, drum))  # a receiver for drum 9's messages too
+            catch = p.obj("catch~ %s-l" % prefix)
             wav = os.path.join(work, "kit-%d.wav" % drum)
             trig = recorder(p, [(catch, 0, "k")], SECONDS, SR, wav)
-            m = p.msg("\\; render-kit-%d dsp 1 \\; render-kit-hit 1 %d 0 3 0.3 0 10 0.01 1 0 0"
-                      % (drum, drum))
+            m = p.msg("\\; %s-%d dsp 1 \\; %s-hit 1 %d 0 3 0.3 0 10 0.01 1 0 0"
+                      % (prefix, drum, prefix, drum))
             p.connect(trig, 2, m, 0)
             rc, log = run_pd(p.text(), os.path.join(build, "ictus"), sr=SR, workdir=work)
             check(rc == 0, "pd ran (rc %d)" % rc)
@@ -327,8 +341,8 @@ def kit_drum_args(build):
             check(lines == ["error: " + e for e in errors],
                   "[ictus-kit-drum %s]: error lines %s (got %s)" % (arg, errors, lines))
         check(peaks[0] > 1e-4 and peaks[1] == 0.0,
-              "[ictus-kit-drum %s] plays drum %d (peak %.3g) and not drum %d (peak %.3g)"
-              % (arg, want, peaks[0], other, peaks[1]))
+              "[ictus-kit-drum %s] plays drum %d of %s (peak %.3g) and not drum %d (peak %.3g)"
+              % (arg, want, prefix, peaks[0], other, peaks[1]))
 
 
 def main():

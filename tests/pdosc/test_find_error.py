@@ -29,7 +29,7 @@ build = os.path.abspath(args.build)
 CASES = [
     ("ictus-sound clips", "ictus-sound bogus", None,
      "error: ictus-sound: model must be one of"),
-    ("ictus-kit-drum 2", "ictus-kit-drum 9", None, "error: ictus-kit-drum"),
+    ("ictus-kit-drum 2 render-kit", "ictus-kit-drum 9 render-kit", None, "error: ictus-kit-drum"),
     ("ictus-sound synth", "ictus-sound modal", "volume 5",
      "error: ictus-sound: volume must be in 0..1 (clamped) - got: 5"),
     ("ictus-receive 0", "ictus-receive 70000", None, "error: ictus-receive"),

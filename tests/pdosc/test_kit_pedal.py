@@ -1,7 +1,7 @@
 """A hi-hat's pedal live (docs/osc.md, /ictus/kit/pedal; docs/pd-osc.md, "[ictus-kit]"), in the
 real pd in real time: bundles as ictusd sends them, /ictus/kit/pedal first and the /ictus/strike
 it goes before, one timetag. [ictus-receive] must hold the pedal to the timetag like the strike,
-and [ictus-kit] give it to the drum (render-kit-6 openness X): each pedal reaches the drum at
+and [ictus-kit test-kit] give it to the drum (test-kit-6 openness X): each pedal reaches the drum at
 its strike's logical time, before the strike, with its openness; a strike without a pedal
 brings none.
 
@@ -24,15 +24,15 @@ BUNDLES = [(1, 0.4, 0.0), (2, 0.7, None), (3, 1.0, 1.0), (4, 1.3, 0.5)]
 
 
 def build(build_dir, pd_port, report_port):
-    """[ictus-receive] -> [route kit] -> [ictus-kit]'s kit inlet; the strikes and what
-    render-kit-6 receives reported with their logical time (ms since load)."""
+    """[ictus-receive] -> [route kit] -> [ictus-kit test-kit]'s kit inlet; the strikes and what
+    test-kit-6 receives reported with their logical time (ms since load)."""
     p = Patch(declare="-path %s/ictus" % build_dir)
     recv = p.obj("ictus-receive %d" % pd_port)
     rk = p.obj("route kit")
-    kit = p.obj("ictus-kit")
+    kit = p.obj("ictus-kit test-kit")
     p.connect(recv, 2, rk, 0)
     p.connect(rk, 0, kit, 1)
-    drum = p.obj("r render-kit-%d" % HIHAT)
+    drum = p.obj("r test-kit-%d" % HIHAT)
     lb = p.obj("loadbang")
     t = p.obj("t b b b")
     p.connect(lb, 0, t, 0)
