@@ -31,7 +31,7 @@ std::string after_name(const std::string &message)
     return colon == std::string::npos ? ": " + message : message.substr(colon);
 }
 
-constexpr int kGivenRadius = 1, kGivenTension = 2, kGivenDensity = 4;
+constexpr int kGivenRadius = 1, kGivenTension = 2, kGivenDensity = 4, kGivenPreset = 8;
 
 // --drum-preset NAME: the head of a preset (membrane_presets.h) in the physics and the
 // sound; a --drum-radius, --drum-tension or --drum-density given too wins over it.
@@ -241,6 +241,7 @@ static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptio
         o.drum_given |= kGivenDensity;
     } else if (a == "--drum-preset") {
         apply_drum_preset(a, value(), o);
+        o.drum_given |= kGivenPreset;
     } else if (a == "--stick-tip") {
         const std::string v = value();
         if (!is_stick_tip(v))
@@ -390,8 +391,26 @@ void OutputFile::close()
         throw std::runtime_error("--out: error writing '" + path_ + "' (disk full?)");
 }
 
+// A kit's first drum has the kit's head and sound (docs/kit.md, "Playing it"): the one
+// drum's options would be dropped, or half kept, by their place before or after --kit.
+static void check_kit_drum_options(const PerformanceOptions &o)
+{
+    if (o.kit.empty())
+        return;
+    const char *option = (o.drum_given & kGivenPreset)    ? "--drum-preset"
+                         : (o.drum_given & kGivenRadius)  ? "--drum-radius"
+                         : (o.drum_given & kGivenTension) ? "--drum-tension"
+                                                          : nullptr;
+    if (option)
+        throw UsageError(std::string(option) +
+                         ": the kit's drums have their own heads and sounds (its first, '" +
+                         o.kit.drums.front().name + "', the " + o.kit.drums.front().preset +
+                         " preset's; docs/kit.md): give " + option + " without --kit");
+}
+
 void load_midi_score(PerformanceOptions &o)
 {
+    check_kit_drum_options(o);
     if (!o.mocap.empty() && !o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
     if (!o.mocap.empty() && !o.kit.empty())
