@@ -583,6 +583,49 @@ TEST_CASE("ictusd render: a sound option without --wav is refused, naming it", "
     }
 }
 
+// A score's options (render --help's "score mode") did nothing with --mocap, without a word:
+// the clip played to the same bytes with --humanize 4 --seed 7 as without. Each, with a
+// valid value, is a usage error (exit 2) naming it and --mocap, before --out is made; the
+// physics' and the drum's options still go with a clip.
+TEST_CASE("ictusd render --mocap: a score's option is refused, naming it", "[cli][bounds]")
+{
+    const std::string bvh = tiny_bvh();
+    const char *const given[][2] = {{"--humanize", "1"},
+                                    {"--seed", "7"},
+                                    {"--lead-in", "2"},
+                                    {"--mode", "joint"},
+                                    {"--strike-depth", "0.001"},
+                                    {"--strike-aim", "0.002"},
+                                    {"--move-margins", "0.1,0.1"},
+                                    {"--strike-aim-from", "1"},
+                                    {"--strike-aim-max", "0.003"},
+                                    {"--advance", "0.01"},
+                                    {"--ik-gain", "5"},
+                                    {"--ik-velocity-gain", "0.02"},
+                                    {"--ik-rotation-weight", "0.5"},
+                                    {"--ik-max-joint-speed", "30"},
+                                    {"--ik-limit-margin", "2"},
+                                    {"--rebound", "0.01"},
+                                    {"--rehearse", "1"}};
+    int n = 0;
+    for (const auto &g : given) {
+        const std::string dir = simtest::temp_path("mocap_score_opt" + std::to_string(n++));
+        const Run r = ictusd("render --mocap " + bvh + " --duration 0.05 " + g[0] + " " + g[1] +
+                             " --out " + dir);
+        INFO(g[0] << " -> " << r.status << "\n" << r.output);
+        CHECK(r.status == 2);
+        CHECK(r.output.find(std::string(g[0]) + ": a score's option") != std::string::npos);
+        CHECK(r.output.find("--mocap") != std::string::npos);
+        CHECK_FALSE(std::filesystem::exists(dir));
+    }
+    const Run ok = ictusd("render --mocap " + bvh +
+                          " --duration 0.05 --iterations 20 --sor-w 1.2 "
+                          "--grip german --drum-tension 2500 --out " +
+                          simtest::temp_path("mocap_score_opt_ok"));
+    INFO(ok.output);
+    CHECK(ok.status == 0);
+}
+
 // --tempo was a clip's alone: with a score it was ignored without a word. Seeded tempi:
 // the notes (one beat each from the 1 s lead-in) at --tempo until the score's own
 // `tempo`, which wins from beat 0 when the score starts with it.

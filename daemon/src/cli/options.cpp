@@ -6,6 +6,7 @@
 #include "ictus/score/midi_score.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -266,6 +267,26 @@ static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptio
 bool parse_performance_option(const std::string &a, Args &args, PerformanceOptions &o,
                               double &duration)
 {
+    static const char *const score_options[] = {"--gestures",
+                                                "--mode",
+                                                "--strike-depth",
+                                                "--strike-aim",
+                                                "--move-margins",
+                                                "--strike-aim-from",
+                                                "--strike-aim-max",
+                                                "--advance",
+                                                "--ik-gain",
+                                                "--ik-velocity-gain",
+                                                "--ik-rotation-weight",
+                                                "--ik-max-joint-speed",
+                                                "--ik-limit-margin",
+                                                "--humanize",
+                                                "--seed",
+                                                "--rebound",
+                                                "--lead-in"};
+    if (o.score_option_given.empty() &&
+        std::find(std::begin(score_options), std::end(score_options), a) != std::end(score_options))
+        o.score_option_given = a;
     auto value = [&]() { return args.value(a); };
     if (a == "--mocap") {
         o.mocap = value();
@@ -416,6 +437,10 @@ void load_midi_score(PerformanceOptions &o)
     if (!o.mocap.empty() && !o.kit.empty())
         throw UsageError("--kit: a kit is played from a score (--score, --midi or the default "
                          "score), not with --mocap");
+    if (!o.mocap.empty() && !o.score_option_given.empty())
+        throw UsageError(o.score_option_given +
+                         ": a score's option (score mode: --score, --midi or the default "
+                         "score): with --mocap the clip plays in joint space without it");
     const std::string &path = o.score.midi_path;
     if (path.empty())
         return;

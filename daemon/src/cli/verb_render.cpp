@@ -84,7 +84,7 @@ void render_usage(std::ostream &out)
            "                      the deken package, ictus/ beside ictusd, or\n"
            "                      ../lib/pd-externals/ictus from it)\n"
            "\n"
-           "score mode (run and render):\n"
+           "score mode (run and render; refused with --mocap):\n"
            "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
            "  --midi FILE         a Standard MIDI File's drum part as the score: the General\n"
            "                      MIDI drum map's notes the kit has (docs/midi.md, MIDI in)\n"
@@ -334,6 +334,8 @@ bool parse_render_args(Args &args, RenderArgs &r)
     const bool go_on = walk_args(args, render_usage, [&](const std::string &a) {
         if (r.sound_option.empty() && (a.rfind("--wav-", 0) == 0 || a == "--pd" || a == "--pd-lib"))
             r.sound_option = a;
+        if (a == "--rehearse" && r.o.score_option_given.empty())
+            r.o.score_option_given = a; // a score's notes: refused with --mocap
         if (!dispatch_option(options, a, args) &&
             !parse_performance_option(a, args, r.o, r.duration))
             throw UsageError("unknown option '" + a + "' (see ictusd render --help)");
