@@ -519,6 +519,113 @@ TEST_CASE("ictusd render --drum-preset: the preset's head, recorded in render.js
     CHECK(h.output.find("--drum-preset: 'hihat' is a cymbal") != std::string::npos);
 }
 
+// With --kit the first drum's head and sound are the kit's (docs/kit.md): --drum-radius and
+// --drum-tension were dropped without a word, and --drum-preset kept or dropped by its place
+// before or after --kit (after it, render.json's drum said the preset while its head and the
+// kit's stayed the snare's). Refused in either order, a usage error (exit 2) naming both
+// options, before --out is made; seeded kits and values, --drum-pos still the kit's anchor.
+TEST_CASE("ictusd render --kit with --drum-preset, --drum-radius or --drum-tension is refused",
+          "[cli][bounds]")
+{
+    const char *const kits[] = {"standard", "standard-cymbals", "full", "standard-timpani",
+                                "timpani"};
+    const char *const presets[] = {"paper", "snare", "tom", "floor-tom", "timpani", "frame"};
+    std::mt19937 rng(20261202);
+    int n = 0;
+    for (const std::string option : {"--drum-preset", "--drum-radius", "--drum-tension"}) {
+        for (const bool kit_first : {true, false}) {
+            const std::string kit = std::string("--kit ") + kits[rng() % 5];
+            std::string value = presets[rng() % 6];
+            if (option == "--drum-radius")
+                value = std::to_string(0.1 + 0.01 * static_cast<double>(rng() % 20));
+            else if (option == "--drum-tension")
+                value = std::to_string(1000 + rng() % 4000);
+            const std::string drum = option + " " + value;
+            const std::string dir = simtest::temp_path("kit_drum" + std::to_string(n++));
+            const Run r = ictusd("render --out " + dir + " " +
+                                 (kit_first ? kit + " " + drum : drum + " " + kit));
+            INFO(kit << " " << drum << " -> " << r.status << "\n" << r.output);
+            CHECK(r.status == 2);
+            CHECK(r.output.find(option + ": ") != std::string::npos);
+            CHECK(r.output.find("--kit") != std::string::npos);
+            CHECK_FALSE(std::filesystem::exists(dir));
+        }
+    }
+    const std::string dir = simtest::temp_path("kit_drum_pos");
+    const Run ok = ictusd("render --kit standard --drum-pos 0,0.75,0.45 --drum-density 0.3 "
+                          "--duration 0.05 --out " +
+                          dir);
+    INFO(ok.output);
+    CHECK(ok.status == 0);
+}
+
+// The sound's options set the WAV that --wav FILE writes: without --wav they did nothing,
+// without a word (`--wav-bits 24` gave no WAV at all). Each alone and two together are a
+// usage error (exit 2) naming the first and --wav, before --out is made.
+TEST_CASE("ictusd render: a sound option without --wav is refused, naming it", "[cli][bounds]")
+{
+    const char *const given[][2] = {{"--wav-mix pickups", "--wav-mix"},
+                                    {"--wav-bits 24", "--wav-bits"},
+                                    {"--wav-gain -6", "--wav-gain"},
+                                    {"--wav-rate 44100", "--wav-rate"},
+                                    {"--pd pd", "--pd"},
+                                    {"--pd-lib .", "--pd-lib"},
+                                    {"--wav-rate 96000 --wav-bits 16", "--wav-rate"}};
+    int n = 0;
+    for (const auto &g : given) {
+        const std::string dir = simtest::temp_path("sound_no_wav" + std::to_string(n++));
+        const Run r = ictusd("render --duration 0.05 " + std::string(g[0]) + " --out " + dir);
+        INFO(g[0] << " -> " << r.status << "\n" << r.output);
+        CHECK(r.status == 2);
+        CHECK(r.output.find(std::string(g[1]) + ": ") != std::string::npos);
+        CHECK(r.output.find("--wav FILE") != std::string::npos);
+        CHECK_FALSE(std::filesystem::exists(dir));
+    }
+}
+
+// A score's options (render --help's "score mode") did nothing with --mocap, without a word:
+// the clip played to the same bytes with --humanize 4 --seed 7 as without. Each, with a
+// valid value, is a usage error (exit 2) naming it and --mocap, before --out is made; the
+// physics' and the drum's options still go with a clip.
+TEST_CASE("ictusd render --mocap: a score's option is refused, naming it", "[cli][bounds]")
+{
+    const std::string bvh = tiny_bvh();
+    const char *const given[][2] = {{"--humanize", "1"},
+                                    {"--seed", "7"},
+                                    {"--lead-in", "2"},
+                                    {"--mode", "joint"},
+                                    {"--strike-depth", "0.001"},
+                                    {"--strike-aim", "0.002"},
+                                    {"--move-margins", "0.1,0.1"},
+                                    {"--strike-aim-from", "1"},
+                                    {"--strike-aim-max", "0.003"},
+                                    {"--advance", "0.01"},
+                                    {"--ik-gain", "5"},
+                                    {"--ik-velocity-gain", "0.02"},
+                                    {"--ik-rotation-weight", "0.5"},
+                                    {"--ik-max-joint-speed", "30"},
+                                    {"--ik-limit-margin", "2"},
+                                    {"--rebound", "0.01"},
+                                    {"--rehearse", "1"}};
+    int n = 0;
+    for (const auto &g : given) {
+        const std::string dir = simtest::temp_path("mocap_score_opt" + std::to_string(n++));
+        const Run r = ictusd("render --mocap " + bvh + " --duration 0.05 " + g[0] + " " + g[1] +
+                             " --out " + dir);
+        INFO(g[0] << " -> " << r.status << "\n" << r.output);
+        CHECK(r.status == 2);
+        CHECK(r.output.find(std::string(g[0]) + ": a score's option") != std::string::npos);
+        CHECK(r.output.find("--mocap") != std::string::npos);
+        CHECK_FALSE(std::filesystem::exists(dir));
+    }
+    const Run ok = ictusd("render --mocap " + bvh +
+                          " --duration 0.05 --iterations 20 --sor-w 1.2 "
+                          "--grip german --drum-tension 2500 --out " +
+                          simtest::temp_path("mocap_score_opt_ok"));
+    INFO(ok.output);
+    CHECK(ok.status == 0);
+}
+
 // --tempo was a clip's alone: with a score it was ignored without a word. Seeded tempi:
 // the notes (one beat each from the 1 s lead-in) at --tempo until the score's own
 // `tempo`, which wins from beat 0 when the score starts with it.

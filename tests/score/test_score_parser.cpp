@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <fstream>
 #include <random>
@@ -486,6 +487,39 @@ TEST_CASE("score: a '+' written without its spaces is named as such, at the word
     require_error("R+X\n", 1, 1, "unknown statement 'R+X'");
     require_error("R +2\n", 1, 3, "dynamics +2 is out of range");
     CHECK(parse_score("R+L, l+r, R + L, tempo 1e+2, R\n", "t").notes.size() == 7);
+}
+
+TEST_CASE("score: two notes on one line without a separator are named as such, at the second",
+          "[score][parser][errors]")
+{
+    // "R L R L" said "unknown nuance 'L'": a limb's word after a note's options starts
+    // another note, which a ',' or a new line separates (or ' + ' joins on one beat).
+    // Seeded: a first note of any limb with some of its options, then a limb's word in
+    // any case; the column is counted here from the pieces written.
+    const char *const firsts[] = {"R", "L", "right", "left", "RF", "LF", "both", "R+L"};
+    // at most one of each kind: a nuance, dynamics, a duration
+    const char *const options[3][2] = {{"accent", "staccato"}, {"0.7", "ff"}, {"1/2", "beats 2"}};
+    const char *const limbs[] = {"R",          "L",         "right", "left", "RF", "LF",
+                                 "right-foot", "left-foot", "both",  "R+L",  "L+R"};
+    std::mt19937 rng(20261202);
+    for (int trial = 0; trial < 200; ++trial) {
+        std::string line = firsts[rng() % 8];
+        for (const auto &kind : options)
+            if (rng() % 2)
+                line += std::string(" ") + kind[rng() % 2];
+        line += std::string(1 + rng() % 2, ' ');
+        const size_t column = line.size() + 1;
+        std::string limb = limbs[rng() % 11];
+        for (char &c : limb)
+            if (rng() % 2)
+                c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        INFO(line + limb);
+        require_error(line + limb + " accent\n", 1, static_cast<int>(column),
+                      "'" + limb + "' starts another note: separate notes with ',' or a new line");
+    }
+    // Words that are not a limb's keep their errors.
+    require_error("R X\n", 1, 3, "unknown nuance 'X'");
+    require_error("R accent X\n", 1, 10, "unexpected 'X' in a note");
 }
 
 TEST_CASE("score: an error shows control bytes as hex escapes, a NUL included",

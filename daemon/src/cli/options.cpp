@@ -6,6 +6,7 @@
 #include "ictus/score/midi_score.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -31,7 +32,7 @@ std::string after_name(const std::string &message)
     return colon == std::string::npos ? ": " + message : message.substr(colon);
 }
 
-constexpr int kGivenRadius = 1, kGivenTension = 2, kGivenDensity = 4;
+constexpr int kGivenRadius = 1, kGivenTension = 2, kGivenDensity = 4, kGivenPreset = 8;
 
 // --drum-preset NAME: the head of a preset (membrane_presets.h) in the physics and the
 // sound; a --drum-radius, --drum-tension or --drum-density given too wins over it.
@@ -241,6 +242,7 @@ static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptio
         o.drum_given |= kGivenDensity;
     } else if (a == "--drum-preset") {
         apply_drum_preset(a, value(), o);
+        o.drum_given |= kGivenPreset;
     } else if (a == "--stick-tip") {
         const std::string v = value();
         if (!is_stick_tip(v))
@@ -265,6 +267,26 @@ static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptio
 bool parse_performance_option(const std::string &a, Args &args, PerformanceOptions &o,
                               double &duration)
 {
+    static const char *const score_options[] = {"--gestures",
+                                                "--mode",
+                                                "--strike-depth",
+                                                "--strike-aim",
+                                                "--move-margins",
+                                                "--strike-aim-from",
+                                                "--strike-aim-max",
+                                                "--advance",
+                                                "--ik-gain",
+                                                "--ik-velocity-gain",
+                                                "--ik-rotation-weight",
+                                                "--ik-max-joint-speed",
+                                                "--ik-limit-margin",
+                                                "--humanize",
+                                                "--seed",
+                                                "--rebound",
+                                                "--lead-in"};
+    if (o.score_option_given.empty() &&
+        std::find(std::begin(score_options), std::end(score_options), a) != std::end(score_options))
+        o.score_option_given = a;
     auto value = [&]() { return args.value(a); };
     if (a == "--mocap") {
         o.mocap = value();
@@ -390,13 +412,35 @@ void OutputFile::close()
         throw std::runtime_error("--out: error writing '" + path_ + "' (disk full?)");
 }
 
+// A kit's first drum has the kit's head and sound (docs/kit.md, "Playing it"): the one
+// drum's options would be dropped, or half kept, by their place before or after --kit.
+static void check_kit_drum_options(const PerformanceOptions &o)
+{
+    if (o.kit.empty())
+        return;
+    const char *option = (o.drum_given & kGivenPreset)    ? "--drum-preset"
+                         : (o.drum_given & kGivenRadius)  ? "--drum-radius"
+                         : (o.drum_given & kGivenTension) ? "--drum-tension"
+                                                          : nullptr;
+    if (option)
+        throw UsageError(std::string(option) +
+                         ": the kit's drums have their own heads and sounds (its first, '" +
+                         o.kit.drums.front().name + "', the " + o.kit.drums.front().preset +
+                         " preset's; docs/kit.md): give " + option + " without --kit");
+}
+
 void load_midi_score(PerformanceOptions &o)
 {
+    check_kit_drum_options(o);
     if (!o.mocap.empty() && !o.score.score_text.empty())
         throw UsageError("--score and --mocap are two motion sources: give one");
     if (!o.mocap.empty() && !o.kit.empty())
         throw UsageError("--kit: a kit is played from a score (--score, --midi or the default "
                          "score), not with --mocap");
+    if (!o.mocap.empty() && !o.score_option_given.empty())
+        throw UsageError(o.score_option_given +
+                         ": a score's option (score mode: --score, --midi or the default "
+                         "score): with --mocap the clip plays in joint space without it");
     const std::string &path = o.score.midi_path;
     if (path.empty())
         return;

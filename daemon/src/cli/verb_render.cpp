@@ -72,7 +72,7 @@ void render_usage(std::ostream &out)
            "                      docs/score.md, \"Rehearsal\")\n"
            "\n"
            "the sound (Pd in batch mode, as scripts/main.sh: patches/ictus-render.pd on the\n"
-           "drum of render.json; docs/main-job.md):\n"
+           "drum of render.json; docs/main-job.md; the options after --wav need it):\n"
            "  --wav FILE          render the strikes to FILE (Pd's log: DIR/pd.log)\n"
            "  --wav-mix M         stereo (default: the drum in the middle, the hands panned)\n"
            "                      | pickups (the membrane's two pickups)\n"
@@ -84,7 +84,7 @@ void render_usage(std::ostream &out)
            "                      the deken package, ictus/ beside ictusd, or\n"
            "                      ../lib/pd-externals/ictus from it)\n"
            "\n"
-           "score mode (run and render):\n"
+           "score mode (run and render; refused with --mocap):\n"
            "  --score FILE        score file (docs/score.md; default: the built-in score)\n"
            "  --midi FILE         a Standard MIDI File's drum part as the score: the General\n"
            "                      MIDI drum map's notes the kit has (docs/midi.md, MIDI in)\n"
@@ -267,6 +267,7 @@ struct RenderArgs {
     double progress_every = 2.0;
     int rehearse = 2; // rehearsal passes at most (docs/score.md, "Rehearsal")
     std::string wav;
+    std::string sound_option; // the first of --wav-mix .. --pd-lib given: they need --wav
     PdRenderOptions pd;
 };
 
@@ -331,6 +332,10 @@ bool parse_render_args(Args &args, RenderArgs &r)
 {
     const OptionTable options = render_options(r);
     const bool go_on = walk_args(args, render_usage, [&](const std::string &a) {
+        if (r.sound_option.empty() && (a.rfind("--wav-", 0) == 0 || a == "--pd" || a == "--pd-lib"))
+            r.sound_option = a;
+        if (a == "--rehearse" && r.o.score_option_given.empty())
+            r.o.score_option_given = a; // a score's notes: refused with --mocap
         if (!dispatch_option(options, a, args) &&
             !parse_performance_option(a, args, r.o, r.duration))
             throw UsageError("unknown option '" + a + "' (see ictusd render --help)");
@@ -340,6 +345,10 @@ bool parse_render_args(Args &args, RenderArgs &r)
     load_midi_score(r.o);
     if (r.out_dir.empty())
         throw UsageError("--out DIR is required");
+    if (r.wav.empty() && !r.sound_option.empty())
+        throw UsageError(r.sound_option +
+                         ": sets the WAV that --wav FILE writes; give --wav FILE too (e.g. "
+                         "--wav DIR/performance.wav)");
     if (r.duration > kMaxRenderSeconds) {
         std::ostringstream m;
         m << "--duration: render keeps its outputs in memory (about 0.6 MB a simulated second): "

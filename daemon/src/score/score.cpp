@@ -740,6 +740,11 @@ class LineParser
                                        "' in one note (for a duration write 'beats " + t.text +
                                        "' or N/D)");
                 st.dynamics = dynamics_value(t);
+            } else if (hand_word(t.lower) || foot_word(t.lower) || left_foot_word(t.lower) ||
+                       t.lower == "both" || t.lower == "r+l" || t.lower == "l+r") {
+                fail(t.column, "'" + t.text +
+                                   "' starts another note: separate notes with ',' or a new "
+                                   "line ('R, L'), or join notes on one beat with ' + ' ('R + L')");
             } else if (i == 1) {
                 fail(t.column, "unknown nuance '" + t.text + "' (valid: " + nuance_list() + ")");
             } else {

@@ -94,6 +94,9 @@ struct PerformanceOptions {
     // Which of --drum-radius, --drum-tension, --drum-density were given (bits 1, 2, 4):
     // they win over the preset's, whatever the order of the options.
     int drum_given = 0;
+    // The first score-mode option given (--humanize, --lead-in, ...): the command line
+    // refuses it with --mocap, whose clip would play without it.
+    std::string score_option_given;
     StrikeDetectorOptions strikes;
     ScorePerformOptions score; // score mode (no mocap)
     // The grip's firmness 0..1 (Scene's grip_spring()): the notes' default,
