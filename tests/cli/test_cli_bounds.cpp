@@ -593,7 +593,7 @@ TEST_CASE("ictusd render --mocap: a score's option is refused, naming it", "[cli
     const char *const given[][2] = {{"--humanize", "1"},
                                     {"--seed", "7"},
                                     {"--lead-in", "2"},
-                                    {"--mode", "joint"},
+                                    {"--mode", "cartesian"},
                                     {"--strike-depth", "0.001"},
                                     {"--strike-aim", "0.002"},
                                     {"--move-margins", "0.1,0.1"},
@@ -619,7 +619,7 @@ TEST_CASE("ictusd render --mocap: a score's option is refused, naming it", "[cli
         CHECK_FALSE(std::filesystem::exists(dir));
     }
     const Run ok = ictusd("render --mocap " + bvh +
-                          " --duration 0.05 --iterations 20 --sor-w 1.2 "
+                          " --duration 0.05 --iterations 20 --sor-w 1.2 --mode joint "
                           "--grip german --drum-tension 2500 --out " +
                           simtest::temp_path("mocap_score_opt_ok"));
     INFO(ok.output);

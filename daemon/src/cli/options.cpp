@@ -268,7 +268,6 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
                               double &duration)
 {
     static const char *const score_options[] = {"--gestures",
-                                                "--mode",
                                                 "--strike-depth",
                                                 "--strike-aim",
                                                 "--move-margins",
@@ -325,9 +324,12 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         o.score.score_name = o.score.midi_path;
     } else if (a == "--gestures")
         o.score.gestures = value();
-    else if (a == "--mode")
+    else if (a == "--mode") {
         o.score.mode = parse_track_mode(a, value());
-    else if (a == "--strike-depth")
+        // `--mode joint` is what a clip plays in: said of cartesian alone
+        if (o.score.mode != TrackMode::joint && o.score_option_given.empty())
+            o.score_option_given = a;
+    } else if (a == "--strike-depth")
         o.score.plan.strike_depth_m = parse_number(a, value(), -0.05, 0.05);
     else if (a == "--strike-aim")
         o.score.plan.strike_aim_s = parse_number(a, value(), 0.0, 0.01);
