@@ -431,7 +431,7 @@ static void check_kit_drum_options(const PerformanceOptions &o)
                          " preset's; docs/kit.md): give " + option + " without --kit");
 }
 
-void load_midi_score(PerformanceOptions &o)
+void check_performance_options(const PerformanceOptions &o)
 {
     check_kit_drum_options(o);
     if (!o.mocap.empty() && !o.score.score_text.empty())
@@ -443,6 +443,11 @@ void load_midi_score(PerformanceOptions &o)
         throw UsageError(o.score_option_given +
                          ": a score's option (score mode: --score, --midi or the default "
                          "score): with --mocap the clip plays in joint space without it");
+}
+
+void load_midi_score(PerformanceOptions &o)
+{
+    check_performance_options(o);
     const std::string &path = o.score.midi_path;
     if (path.empty())
         return;

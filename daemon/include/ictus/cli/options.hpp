@@ -74,7 +74,12 @@ MarkerCapture load_marker_csv(const std::string &path, const MarkerCsvOptions &o
 
 // run and render: the motion source, the character, the drum, score mode.
 // Returns false when `option` is not one of them.
-// The motion sources checked (UsageError: --mocap with --score, --midi or --kit), then
+// The options that do not go together (UsageError): --mocap with --score, --midi, --kit or
+// a score's option (--mode cartesian, --humanize, ...); --kit with --drum-preset,
+// --drum-radius or --drum-tension (the kit's drums have their own).
+void check_performance_options(const PerformanceOptions &options);
+
+// check_performance_options(), then
 // --midi FILE (options.score.midi_path): the file's drum part as the score
 // (score/midi_score.hpp), on the kit given (--kit) or the one drum; a line on
 // stderr counts the notes left out. Throws UsageError with --score or
