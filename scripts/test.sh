@@ -14,6 +14,9 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 
+# Each stage's start is printed with the seconds since this script began (bash's SECONDS).
+stage() { echo "== $1 (at ${SECONDS} s) =="; }
+
 bash scripts/deps.sh
 jobs=$(nproc 2>/dev/null || echo 2)
 test_jobs=$((jobs + 1))
@@ -41,7 +44,7 @@ wait_beside() { # NAME: waits for the build started beside the last suite
     tail -n 1 "$bg_log"
 }
 
-echo "== release build and tests (build/) =="
+stage "release build and tests (build/)"
 # the Python environment of the corpus tests (build/venv, PyPI; minutes on a clean clone,
 # mostly downloads), made while the release build compiles; they skip without it, or fail
 # under CI=true
@@ -56,10 +59,12 @@ wait "$venv_pid" || echo "test.sh: no build/venv (scripts/venv.sh failed)" >&2
 mkdir -p build-asan
 start_beside build-asan/test-sh-build.log bash scripts/build.sh "$root/build-asan" \
     -DCMAKE_BUILD_TYPE=Debug -DICTUS_SANITIZE=ON "${parts[@]}" -DICTUS_BUILD_BENCH=OFF
+echo "test.sh: release build done at ${SECONDS} s"
 (cd build && ctest --output-on-failure --no-tests=error -j "$test_jobs")
 
-echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests (build-asan/) =="
+stage "AddressSanitizer + UndefinedBehaviorSanitizer build and tests (build-asan/)"
 wait_beside AddressSanitizer
+echo "test.sh: AddressSanitizer build done at ${SECONDS} s"
 # The libFuzzer harnesses (clang): only they and the libraries they fuzz; each CTest run
 # replays its seed corpus (fuzz/corpus/) and fuzzes for ICTUS_FUZZ_SECONDS. docs/fuzzing.md.
 launcher=()
@@ -73,6 +78,8 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_BUILD_TYPE=R
 start_beside build-fuzz/test-sh-build.log cmake --build build-fuzz --target ictus_fuzz -j "$jobs"
 (cd build-asan && ctest --output-on-failure --no-tests=error -j "$test_jobs")
 
-echo "== libFuzzer harnesses, a short run each (build-fuzz/, clang) =="
+stage "libFuzzer harnesses, a short run each (build-fuzz/, clang)"
 wait_beside libFuzzer
+echo "test.sh: libFuzzer build done at ${SECONDS} s"
 (cd build-fuzz && ctest -L fuzz --output-on-failure --no-tests=error -j "$jobs")
+echo "test.sh: every stage passed in ${SECONDS} s"

@@ -387,15 +387,16 @@ TEST_CASE("ictusd run and render under a file-size limit: exit 1, a message, who
     }
 }
 
-TEST_CASE("ictusd render --score /dev/zero is refused within 1 s", "[cli][bounds]")
+TEST_CASE("ictusd render --score /dev/zero is refused at its 16 MiB bound, not read on",
+          "[cli][bounds]")
 {
+    // An endless file: read on, it would not end before the deadline (or would run out of
+    // the 3 GB of address space); refused at the bound, it ends with the error line.
     TempDir dir("zero");
     const std::string limit = kSanitized ? "" : "ulimit -v 3000000; ";
-    const auto t0 = std::chrono::steady_clock::now();
     Proc p({"/bin/sh", "-c",
             limit + "exec " + ICTUSD_PATH + " render --score /dev/zero --out " + (dir / "o")});
-    const int status = p.wait_exit(10.0);
-    CHECK(since(t0) < 1.0);
+    const int status = p.wait_exit(60.0);
     CHECK(status == 1);
     CHECK_THAT(p.output(), Catch::Contains("--score: '/dev/zero' is larger than 16 MiB"));
 }
