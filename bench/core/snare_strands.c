@@ -417,9 +417,18 @@ static strands *build(const cfg *c, double a)
         }
     }
     free(z);
-    /* Strands: modes to fmax, tension varying across the set by +-spread. */
+    /* Strands: modes to fmax, tension varying across the set by +-spread. With env BEND
+     * (N m^2, the strand's bending stiffness B), a stiff string: omega^2 = (T k^2 + B k^4)
+     * / mu, k = n pi / L, the same sine shapes (simply supported ends). */
+    const double bend = getenv("BEND") ? atof(getenv("BEND")) : 0.0;
     const double cw = sqrt(c->tension / c->mu);
     int nm = (int)(c->fmax * 2.0 * 2.0 * a / (cw * (1.0 - c->spread)));
+    if (bend > 0.0) { /* the largest k with omega(k) < 2 pi fmax at the lowest tension */
+        const double tb = c->tension * (1.0 - c->spread) / c->mu, bb = bend / c->mu,
+                     om = 2.0 * M_PI * c->fmax;
+        const double k2 = (-tb + sqrt(tb * tb + 4.0 * bb * om * om)) / (2.0 * bb);
+        nm = (int)(sqrt(k2) * 2.0 * a / M_PI) + 1;
+    }
     if (nm < 1)
         nm = 1;
     w->nm = nm;
@@ -437,7 +446,8 @@ static strands *build(const cfg *c, double a)
             (1.0 + (cnt > 1 ? c->spread * (2.0 * ((idx * 7) % cnt) / (cnt - 1) - 1.0) : 0));
         const double cs = sqrt(ten / c->mu), sig = log(1000.0) / c->t60;
         for (int q = 0; q < nm; q++) {
-            const double om = (q + 1) * M_PI * cs / Ls[s];
+            const double kq = (q + 1) * M_PI / Ls[s],
+                         om = kq * sqrt(cs * cs + bend / c->mu * kq * kq);
             const int i = s * nm + q;
             if (om < 2.0 * M_PI * c->fmax && om < 0.9 * M_PI * c->sr)
                 coeffs(om, sig, T, &w->sca[i], &w->scb[i], &w->sg[i], &w->sw2[i]);
