@@ -30,6 +30,30 @@
  *
  * SR Hz, FMAX Hz (head and strands), V m/s and MASS kg: the stick, at r/a STRIKE_R
  * (env, 0.3), with the tip TIP (env, contact~'s default). `off` lifts the wires.
+ * Env BEND (N m^2): the strands' bending stiffness (stiff strings). Env PRELOAD (N/m):
+ * the strands pressed onto the head, the snare side starting at its static equilibrium
+ * under it (preload()). NPMAX points in all.
+ *
+ * Grounded values (a real set: ~20 strands, each a close-wound steel coil; per strand):
+ *   wire d = 0.35 mm, coil D = 2.0 mm (mean Dm = 1.65 mm), pitch p = d (close-wound),
+ *   steel rho = 7850 kg/m^3, E = 207 GPa, G = 79.3 GPa.
+ *   mu = rho (pi d^2 / 4) (pi Dm / p) = 11.2 g/m (d 0.3-0.4, D 1.5-2.5 mm: 7-16 g/m).
+ *   T = 2 N (the coil's initial tension tau_i pi d^3 / (8 Dm) = 0.5-1.5 N for tau_i =
+ *   50-150 MPa, plus the strainer's stretch on an axial rate G d^4 / (8 Dm^3 N) = 35 N/m,
+ *   N = 0.33 m / p turns; range 1-3 N), so f1 = sqrt(T / mu) / (2 L) = 19 Hz (11-29 Hz).
+ *   B = 2 p EI GJ / (pi Dm (EI + GJ)) = 8.9e-6 N m^2 (the open coil: each turn's bending
+ *   and torsion under a moment, energy per turn; J = 2 I = pi d^4 / 32): the string
+ *   dispersion crosses to bending near 1.4 kHz. A locked tube (turns pressed together by
+ *   the initial tension) bounds it above: 0.13 N m^2.
+ *   Preload q0 = 2 T sin(theta) / L - mu g: the strand's pull where it leaves the head for
+ *   the strainer (wrap angle theta, an estimate: 5 / 10 / 20 deg) spread evenly along its
+ *   length, less its weight (the snare side faces down): 0.87 / 1.85 / 3.74 N/m.
+ *   S model strands stand for 20 / S real ones each: mu, T, B and q0 times 20 / S (f1 and
+ *   the dispersion unchanged). E.g. S = 8: mu 0.028, T 5, BEND 2.23e-5, PRELOAD 4.63:
+ *   SYM=1 TIP=wood STRIKE_R=0.2 BEND=2.23e-5 PRELOAD=4.63 bench_snare_strands strands
+ *   96000 10000 3.0 0.0138 8 30 0.028 5 0 0.07 0.5
+ * At 48 kHz the preloaded contacts chatter at the time step (a 48 kHz figure is not to
+ * be trusted with PRELOAD: check it at 96 and 192 kHz).
  * E.g. SYM=1 TIP=wood STRIKE_R=0.2 bench_snare_strands strands 48000 10000 3.0 0.0138
  * 8 12 0.003 34.14 0.1 0.07 0.5: strands of 3 g/m at 34.14 N, whose fundamental along
  * the diameter is 150 Hz (TENSION = MU (2 L f1)^2, L = 2a = 0.3556 m). */
@@ -52,7 +76,7 @@
 #define SHELL_DEPTH  0.1397
 static double K_LAW = 1.0e9; /* N/m^1.5, as snare_wires.c (env K_LAW) */
 #define PICK_R 0.5
-#define NPMAX  160
+#define NPMAX  400
 
 typedef struct strands {
     membrane_point point; /* first member */
@@ -63,10 +87,13 @@ typedef struct strands {
     double *q, *qv, *qf, *sca, *scb, *sg, *sw2; /* [S][nm] */
     double *phi;                                /* [NP][nm]: strand mode at its point */
     int *strand_of;
+    double phi_norm[64]; /* sqrt(2 / (mu L)) of each strand */
     double k_air, Kmm, *Kmw, *C; /* C: [NP][NP] gap compliance */
+    double *fl, ustat;           /* the preload on each strand mode; the head's static mean */
     double d[NPMAX], gap0;
     int engaged;
     long contact_samples, newton_fail;
+    long open_sum, open_n, open_events; /* points apart, summed over samples; openings */
     long newton_solves, newton_steps, active_sum; /* the cost: steps, gaps in them */
 } strands;
 
@@ -218,6 +245,7 @@ static void step(strands *w, double ub, double kb, double T, double extra[MEMBRA
         yf[p] = s;
     }
     const double ka = w->k_air;
+    uf -= w->ustat; /* the air sees the head's mean from its static state (the vent) */
     const double beta = ka / (2.0 + ka * (kb + w->Kmm)), alpha = beta * (w->gap0 + ub - uf);
     double fa = alpha;
     if (w->engaged) {
@@ -250,14 +278,14 @@ static void step(strands *w, double ub, double kb, double T, double extra[MEMBRA
             double f = 0.0;
             for (int p = s * w->P; p < (s + 1) * w->P; p++)
                 f += w->phi[(size_t)p * nm + k] * F[p];
-            const double x1 = w->qf[i] + w->sg[i] * f;
+            const double x1 = w->qf[i] + w->sg[i] * (f + w->fl[i]);
             w->qv[i] = 2.0 / T * (x1 - w->q[i]) - w->qv[i];
             w->q[i] = x1;
         }
-    double u1 = uf + w->Kmm * fa;
+    double u1 = uf + w->ustat + w->Kmm * fa;
     for (int p = 0; w->engaged && p < NP; p++)
         u1 -= w->Kmw[p] * F[p];
-    w->gap0 = (ub - kb * fa) - u1;
+    w->gap0 = (ub - kb * fa) - (u1 - w->ustat);
     for (int p = 0; w->engaged && p < NP; p++) { /* the new gaps, exactly */
         const double *ps = w->psi + (size_t)p * n, *ph = w->phi + (size_t)p * nm,
                      *q = w->q + (size_t)w->strand_of[p] * nm;
@@ -266,8 +294,12 @@ static void step(strands *w, double ub, double kb, double T, double extra[MEMBRA
             hs += ps[k] * w->x[k];
         for (int k = 0; k < nm; k++)
             ys += ph[k] * q[k];
+        if (w->d[p] > 0.0 && hs - ys <= 0.0)
+            w->open_events++;
         w->d[p] = hs - ys;
+        w->open_sum += w->d[p] <= 0.0;
     }
+    w->open_n += w->engaged;
     w->contact_samples += touching;
     membrane_point *pt = &w->point;
     pt->force_pending = -fa;
@@ -331,7 +363,7 @@ static void strands_free(strands *w)
     membrane_point_free_(&w->point); /* detached from the batter first */
     double *arrs[] = {w->x,    w->v,       w->xf,      w->ca,  w->cb,  w->g,   w->w2,
                       w->mean, w->pick[0], w->pick[1], w->psi, w->q,   w->qv,  w->qf,
-                      w->sca,  w->scb,     w->sg,      w->sw2, w->phi, w->Kmw, w->C};
+                      w->sca,  w->scb,     w->sg,      w->sw2, w->phi, w->Kmw, w->C, w->fl};
     for (size_t i = 0; i < sizeof(arrs) / sizeof(arrs[0]); i++)
         free(arrs[i]);
     free(w->strand_of);
@@ -354,6 +386,110 @@ static void coeffs(double om, double s, double T, double *ca, double *cb, double
     *ca = (2.0 / T - 0.5 * T * wm * wm + 2.0 * s) / D;
     *cb = 2.0 / D;
     *g = T / D;
+}
+
+/* The preload (env PRELOAD, N/m toward the head, on each strand evenly along its length):
+ * the strands pressed against the head by the strainer (the strands' pull over the snare
+ * beds, spread along them; the strands' weight, the snare side down, takes mu g off it).
+ * The snare side starts at its static equilibrium under it: head modes, strands and the
+ * gaps' Hertz forces, by Newton on d = d_load - Cs F(d), Cs the static compliance (the
+ * discrete one: 1/W^2 of the prewarped modes, so the state is exactly at rest). The air
+ * does not hold the static load (the shell's vent hole equalises the static pressure):
+ * it acts on the head's mean relative to its static state. */
+static void preload(strands *w, double q0, const double *Ls)
+{
+    const int NP = w->NP, nm = w->nm, n = w->n;
+    double *Cs = dz((size_t)NP * NP), dl[NPMAX], d[NPMAX], F[NPMAX], df[NPMAX], R[NPMAX];
+    static double J[NPMAX * NPMAX];
+    for (int s = 0; s < w->S; s++)
+        for (int q = 0; q < nm; q++) {
+            const int i = s * nm + q;
+            if (w->sg[i] == 0.0)
+                continue;
+            const double mu_l = w->phi_norm[s]; /* sqrt(2 / (mu L)) */
+            w->fl[i] = -q0 * mu_l * Ls[s] * (1.0 - cos((q + 1) * M_PI)) / ((q + 1) * M_PI);
+        }
+    for (int p = 0; p < NP; p++) {
+        dl[p] = 0.0;
+        const int s = w->strand_of[p];
+        for (int q = 0; q < nm; q++) {
+            const int i = s * nm + q;
+            if (w->sw2[i] > 0.0)
+                dl[p] -= w->phi[(size_t)p * nm + q] * w->fl[i] / w->sw2[i];
+        }
+        for (int r = 0; r < NP; r++) {
+            double c = 0.0;
+            for (int k = 0; k < n; k++)
+                if (w->w2[k] > 0.0)
+                    c += w->psi[(size_t)p * n + k] * w->psi[(size_t)r * n + k] / w->w2[k];
+            if (w->strand_of[r] == s)
+                for (int q = 0; q < nm; q++)
+                    if (w->sw2[s * nm + q] > 0.0)
+                        c += w->phi[(size_t)p * nm + q] * w->phi[(size_t)r * nm + q] /
+                             w->sw2[s * nm + q];
+            Cs[(size_t)p * NP + r] = c;
+        }
+        d[p] = dl[p] > 0.0 ? 1e-3 * dl[p] : 0.0;
+    }
+    int it;
+    double worst = 1.0;
+    for (it = 0; it < 500; it++) {
+        for (int p = 0; p < NP; p++) {
+            F[p] = d[p] > 0.0 ? K_LAW * d[p] * sqrt(d[p]) : 0.0;
+            df[p] = d[p] > 0.0 ? 1.5 * K_LAW * sqrt(d[p]) : 0.0;
+        }
+        worst = 0.0;
+        for (int p = 0; p < NP; p++) {
+            double cf = 0.0;
+            for (int r = 0; r < NP; r++)
+                cf += Cs[(size_t)p * NP + r] * F[r];
+            R[p] = d[p] - dl[p] + cf;
+            worst = fmax(worst, fabs(R[p]));
+        }
+        if (worst < 1e-16)
+            break;
+        for (int p = 0; p < NP; p++)
+            for (int r = 0; r < NP; r++)
+                J[p * NP + r] = Cs[(size_t)p * NP + r] * df[r] + (p == r);
+        if (!solve_linear(J, R, NP))
+            break;
+        for (int p = 0; p < NP; p++) { /* damped: a gap at most halves, or opens to 0 */
+            double nd = d[p] - R[p];
+            if (d[p] > 0.0 && nd < 0.5 * d[p])
+                nd = 0.5 * d[p];
+            d[p] = nd;
+        }
+    }
+    for (int k = 0; k < n; k++) {
+        double f = 0.0;
+        for (int p = 0; p < NP; p++)
+            f -= w->psi[(size_t)p * n + k] * F[p];
+        w->x[k] = w->w2[k] > 0.0 ? f / w->w2[k] : 0.0;
+        w->ustat += w->mean[k] * w->x[k];
+    }
+    for (int s = 0; s < w->S; s++)
+        for (int q = 0; q < nm; q++) {
+            const int i = s * nm + q;
+            double f = w->fl[i];
+            for (int p = s * w->P; p < (s + 1) * w->P; p++)
+                f += w->phi[(size_t)p * nm + q] * F[p];
+            w->q[i] = w->sw2[i] > 0.0 ? f / w->sw2[i] : 0.0;
+        }
+    double tot = 0.0, dmax = 0.0;
+    int touching = 0;
+    for (int p = 0; p < NP; p++) { /* the gaps, exactly as step() computes them */
+        double hs = 0.0, ys = 0.0;
+        for (int k = 0; k < n; k++)
+            hs += w->psi[(size_t)p * n + k] * w->x[k];
+        for (int q = 0; q < nm; q++)
+            ys += w->phi[(size_t)p * nm + q] * w->q[w->strand_of[p] * nm + q];
+        w->d[p] = hs - ys;
+        tot += F[p], dmax = fmax(dmax, w->d[p]), touching += w->d[p] > 0.0;
+    }
+    printf("preload %.3g N/m: static solve %d iterations (residual %.1e m), %d of %d points "
+           "pressing, %.3g N in all, deepest %.3g m, head's static mean %.3g m\n",
+           q0, it, worst, touching, NP, tot, dmax, w->ustat);
+    free(Cs);
 }
 
 static strands *build(const cfg *c, double a)
@@ -453,6 +589,7 @@ static strands *build(const cfg *c, double a)
                 coeffs(om, sig, T, &w->sca[i], &w->scb[i], &w->sg[i], &w->sw2[i]);
             for (int p = s * c->P; p < (s + 1) * c->P; p++) {
                 w->strand_of[p] = s;
+                w->phi_norm[s] = sqrt(2.0 / (c->mu * Ls[s]));
                 if (w->sg[i] != 0.0)
                     w->phi[(size_t)p * nm + q] =
                         sqrt(2.0 / (c->mu * Ls[s])) *
@@ -483,6 +620,9 @@ static strands *build(const cfg *c, double a)
     w->k_air = MEMBRANE_AIR_RHO * MEMBRANE_AIR_C * MEMBRANE_AIR_C * M_PI * a * a / SHELL_DEPTH;
     w->engaged = !c->off;
     w->point.ops = &st_ops;
+    w->fl = dz((size_t)c->S * nm);
+    if (w->engaged && getenv("PRELOAD") && atof(getenv("PRELOAD")) != 0.0)
+        preload(w, atof(getenv("PRELOAD")), Ls);
     return w;
 }
 
@@ -495,6 +635,8 @@ static double energy(const strands *w)
         e += 0.5 * (w->qv[i] * w->qv[i] + w->sw2[i] * w->q[i] * w->q[i]);
     for (int p = 0; w->engaged && p < w->NP; p++)
         e += pot(w->d[p]);
+    for (int i = 0; w->engaged && i < w->S * w->nm; i++)
+        e -= w->fl[i] * w->q[i]; /* the constant preload's potential */
     return e;
 }
 
@@ -600,6 +742,10 @@ int main(int argc, char **argv)
         printf("samples with a point pressing %ld, Newton failures %ld, largest energy growth "
                "per block after the stick left %.2e, cpu %.2f s for %.3f s\n",
                w->contact_samples, w->newton_fail, worst_gain, cpu, len / c.sr);
+    if (w && w->open_n)
+        printf("points apart: %.1f %% of point-samples, %ld openings (%.1f per point)\n",
+               100.0 * w->open_sum / ((double)w->open_n * w->NP), w->open_events,
+               (double)w->open_events / w->NP);
     if (w && w->newton_steps)
         printf("Newton: %ld solves, %.2f steps per solve, %.1f gaps active per step\n",
                w->newton_solves, (double)w->newton_steps / w->newton_solves,
