@@ -54,6 +54,19 @@
  *   96000 10000 3.0 0.0138 8 30 0.028 5 0 0.07 0.5
  * At 48 kHz the preloaded contacts chatter at the time step (a 48 kHz figure is not to
  * be trusted with PRELOAD: check it at 96 and 192 kHz).
+ *
+ * Measured 2026-12-02 (SYM=1 TIP=wood STRIKE_R=0.2, 13.8 g; 95 % point, share > 4 kHz;
+ * head modes to 10 kHz unless said; energy never grew; wires off 700 Hz):
+ *   grounded strings, no preload (f1 19 Hz): 800-1060 Hz with or without BEND (S 2, 8).
+ *   BEND + PRELOAD (theta 10 deg), S = 2 (10 strands a line): 1560 Hz at 96 and 192 kHz.
+ *   BEND + PRELOAD, S = 8, P = 30 (P = 50: the same): mf 8660 Hz 16.8 % (96 kHz), 7740
+ *   Hz 13.3 % (192 kHz); heads to 19.2 kHz: 15880 Hz 17.9 % (96), 13520 Hz 14.5 % (192);
+ *   ff 7120 / 7500 Hz (96 / 192 kHz); pp 920 Hz at 192 kHz (the preload holds the wires
+ *   on the head: 0.3 % of point-samples apart). S = 16, P = 24: mf 7360 Hz 9.9 % (96).
+ *   PRELOAD alone (S = 8): 5920 Hz 6.9 %; BEND alone: 1060 Hz 0.7 % (96 kHz).
+ *   theta 5 deg: mf 7160 / 7600 Hz, ff 3340 / 3040 Hz (96 / 192 kHz), pp 5600 / 3700 /
+ *   2480 Hz at 96 / 192 / 384 kHz (not converged); theta 20 deg: mf 4640 Hz (96 kHz).
+ *   Cost: S = 8, P = 30 at 48 kHz, 9.4 s of one core for 0.061 s (~150x real time).
  * E.g. SYM=1 TIP=wood STRIKE_R=0.2 bench_snare_strands strands 48000 10000 3.0 0.0138
  * 8 12 0.003 34.14 0.1 0.07 0.5: strands of 3 g/m at 34.14 N, whose fundamental along
  * the diameter is 150 Hz (TENSION = MU (2 L f1)^2, L = 2a = 0.3556 m). */
