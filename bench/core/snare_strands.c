@@ -60,7 +60,8 @@
  *   grounded strings, no preload (f1 19 Hz): 800-1060 Hz with or without BEND (S 2, 8).
  *   BEND + PRELOAD (theta 10 deg), S = 2 (10 strands a line): 1560 Hz at 96 and 192 kHz.
  *   BEND + PRELOAD, S = 8, P = 30 (P = 50: the same): mf 8660 Hz 16.8 % (96 kHz), 7740
- *   Hz 13.3 % (192 kHz), 8280 Hz 14.8 % (384 kHz); heads to 19.2 kHz: 15880 Hz 17.9 % (96), 13520 Hz 14.5 % (192);
+ *   Hz 13.3 % (192 kHz), 8280 Hz 14.8 % (384 kHz); heads to 19.2 kHz: 15880 Hz
+ *   17.9 % (96), 13520 Hz 14.5 % (192);
  *   ff 7120 / 7500 Hz (96 / 192 kHz); pp 920 Hz at 192 kHz (the preload holds the wires
  *   on the head: 0.3 % of point-samples apart). S = 16, P = 24: mf 7360 Hz 9.9 % (96).
  *   PRELOAD alone (S = 8): 5920 Hz 6.9 %; BEND alone: 1060 Hz 0.7 % (96 kHz).
