@@ -362,14 +362,16 @@ struct CommandSpec {
 };
 
 constexpr const char *kGrips[] = {"french", "german", nullptr};
-constexpr const char *kNuances[] = {"legato",   "tenuto", "accent", "vertical_accent",
-                                    "staccato", "buzz",   nullptr};
+// vertical-accent: the score's other spelling (docs/score.md), as the statement `nuance N`
+constexpr const char *kNuances[] = {"legato",          "tenuto",   "accent", "vertical_accent",
+                                    "vertical-accent", "staccato", "buzz",   nullptr};
 constexpr const char *kModes[] = {"joint", "cartesian", nullptr};
 
 // Why a score statement cannot be queued, or "" when it can. The score's own
 // syntax is the physics thread's business (its parser names the fault's
 // position); here only what would not survive the trip: the length of
-// Command::text and characters that would split the line or the log.
+// Command::text and control characters. A line break (LF, CR) separates
+// statements in one string as in a file (docs/score.md): the parser takes it.
 std::string score_statement_problem(const char *text, std::size_t length)
 {
     if (length == 0)
@@ -379,9 +381,9 @@ std::string score_statement_problem(const char *text, std::size_t length)
                std::to_string(Command::kMaxText - 1) + " (send one statement per message)";
     for (std::size_t i = 0; i < length; ++i) {
         const unsigned char ch = static_cast<unsigned char>(text[i]);
-        if ((ch < 0x20 && ch != '\t') || ch == 0x7f)
+        if ((ch < 0x20 && ch != '\t' && ch != '\n' && ch != '\r') || ch == 0x7f)
             return "score statement: control character " + std::to_string(ch) + " at column " +
-                   std::to_string(i + 1) + " (one line per message)";
+                   std::to_string(i + 1) + " (text, tabs and line breaks only)";
     }
     return "";
 }
