@@ -704,6 +704,73 @@ TEST_CASE("osc in: /ictus/nuance takes vertical-accent as the score statement do
     CHECK(server.counters().bad_values == 0);
 }
 
+// docs/osc.md gives each float's range, ends included; a float of OSC holds 0.01 as
+// 0.0099999998, and /ictus/drum/density 0.01 was refused as "expected 0.01 to 10, got
+// 0.01". Every ranged command at both ends of its range, as a client types them (oscsend
+// reads the text into a float), is taken, within the range; the next float beyond each
+// end is refused.
+TEST_CASE("osc in: every documented range takes its ends as a float of OSC holds them",
+          "[net][link]")
+{
+    ictus::OscServerOptions so;
+    so.port = 0;
+    ictus::OscServer server(so, nullptr);
+    const std::string port = std::to_string(server.port());
+    struct Range {
+        const char *address;
+        int floats;
+        double lo, hi; // docs/osc.md
+    };
+    const Range ranges[] = {
+        {"/ictus/tempo", 1, 20, 400},         {"/ictus/gains", 2, 0.05, 4},
+        {"/ictus/drum/radius", 1, 0.05, 1},   {"/ictus/drum/tension", 1, 10, 1e5},
+        {"/ictus/drum/density", 1, 0.01, 10}, {"/ictus/grip/firmness", 1, 0, 1},
+        {"/ictus/humanize", 1, 0, 4}};
+    auto text = [](double v) {
+        std::ostringstream o;
+        o.precision(9);
+        o << v;
+        return o.str();
+    };
+    auto send = [&](const Range &r, const std::string &value) {
+        std::vector<std::string> args = {"oscsend", "127.0.0.1", port, r.address,
+                                         std::string(static_cast<size_t>(r.floats), 'f')};
+        for (int i = 0; i < r.floats; ++i)
+            args.push_back(value);
+        REQUIRE(osctest::run(args) == 0);
+    };
+    auto popped = [&](ictus::Command &c) {
+        for (int i = 0; i < 100; ++i) {
+            if (server.pop_command(c))
+                return true;
+            std::this_thread::sleep_for(5ms);
+        }
+        return false;
+    };
+    unsigned long refused = 0;
+    for (const Range &r : ranges)
+        for (const double end : {r.lo, r.hi}) {
+            INFO(r.address << " " << end);
+            send(r, text(end));
+            ictus::Command c;
+            REQUIRE(popped(c));
+            // the end, to a float's precision, and never outside the range
+            CHECK(c.value == Approx(end).epsilon(1e-7));
+            CHECK((c.value >= r.lo && c.value <= r.hi));
+            if (r.floats == 2)
+                CHECK(c.value2 == c.value);
+            const float beyond =
+                std::nextafter(static_cast<float>(end), end == r.lo ? -1e30f : 1e30f);
+            send(r, text(beyond));
+            ++refused;
+            for (int i = 0; i < 100 && server.counters().bad_values < refused; ++i)
+                std::this_thread::sleep_for(5ms);
+            CHECK(server.counters().bad_values == refused);
+        }
+    ictus::Command c;
+    CHECK_FALSE(server.pop_command(c));
+}
+
 TEST_CASE("osc in: 10^5 random and malformed packets are counted, each answered or counted "
           "unanswered (the error-reply budget), the server keeps answering",
           "[net][link]")

@@ -476,8 +476,12 @@ std::string read_arguments(const Request &r, const CommandSpec &s, Command &cmd)
     double *const floats[2] = {&cmd.value, &cmd.value2};
     for (int i = 0; i < 2 && r.types[i] == 'f'; ++i) {
         *floats[i] = lo_arg_float(r.argv[i]);
-        if (!(std::isfinite(*floats[i]) && *floats[i] >= s.lo && *floats[i] <= s.hi))
+        // The range's ends as an OSC float can hold them: 0.01 arrives as
+        // 0.0099999998, and the documented end is taken (as the end itself).
+        const double lo = static_cast<float>(s.lo), hi = static_cast<float>(s.hi);
+        if (!(std::isfinite(*floats[i]) && *floats[i] >= lo && *floats[i] <= hi))
             return format_range(s, *floats[i]);
+        *floats[i] = std::clamp(*floats[i], s.lo, s.hi);
     }
     if (r.types[0] == 's') {
         const char *text = lo_arg_string(r.argv[0]);
