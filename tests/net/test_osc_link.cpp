@@ -584,7 +584,7 @@ TEST_CASE("osc in: score statements, score clear and the cartesian mode pass thr
         {{"/ictus/score", "ss", "R", "legato"}, "type tags: expected ,s, got ,ss"},
         {{"/ictus/score"}, "type tags: expected ,s, got none"},
         {{"/ictus/score/clear", "s", "all"}, "type tags: expected none, got ,s"},
-        {{"/ictus/mode", "s", "Cartesian"}, "mode: expected joint or cartesian, got 'Cartesian'"},
+        {{"/ictus/mode", "s", "cartesien"}, "mode: expected joint or cartesian, got 'cartesien'"},
     };
     for (const Bad &b : bad) {
         oscsend(b.args);
@@ -769,6 +769,55 @@ TEST_CASE("osc in: every documented range takes its ends as a float of OSC holds
         }
     ictus::Command c;
     CHECK_FALSE(server.pop_command(c));
+}
+
+// The score's words and the CLI's take any case (--grip German, `grip German`), but
+// /ictus/grip German, /ictus/mode Joint and /ictus/nuance Accent were refused. Seeded
+// casings of every word of the three: queued (and echoed) as the lower-case word.
+TEST_CASE("osc in: grip, mode and nuance take their words in any case", "[net][link]")
+{
+    Peer replies;
+    ictus::OscServerOptions so;
+    so.port = 0;
+    so.reply_url = "osc.udp://127.0.0.1:" + std::to_string(replies.port());
+    ictus::OscServer server(so, nullptr);
+    const std::string port = std::to_string(server.port());
+    struct Words {
+        const char *address;
+        std::vector<std::string> words;
+    };
+    const Words table[] = {
+        {"/ictus/grip", {"french", "german"}},
+        {"/ictus/mode", {"joint", "cartesian"}},
+        {"/ictus/nuance",
+         {"legato", "tenuto", "accent", "vertical_accent", "vertical-accent", "staccato", "buzz"}}};
+    std::mt19937 rng(20261203);
+    for (const Words &t : table)
+        for (const std::string &w : t.words) {
+            std::string cased = w;
+            for (char &ch : cased)
+                if (rng() % 2)
+                    ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+            if (cased == w)
+                cased[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(cased[0])));
+            INFO(t.address << " " << cased);
+            REQUIRE(osctest::run({"oscsend", "127.0.0.1", port, t.address, "s", cased}) == 0);
+            ictus::Command c;
+            bool popped = false;
+            for (int i = 0; i < 200 && !popped; ++i) {
+                popped = server.pop_command(c);
+                if (!popped)
+                    std::this_thread::sleep_for(5ms);
+            }
+            REQUIRE(popped);
+            CHECK(std::string(c.text) == w);
+            server.post_accepted(c);
+            Peer::Message m;
+            REQUIRE(replies.receive(m, 3000));
+            CHECK(m.path == "/ictus/reply");
+            CHECK(m.strings == std::vector<std::string>{t.address, w});
+        }
+    CHECK(server.counters().bad_values == 0);
 }
 
 TEST_CASE("osc in: 10^5 random and malformed packets are counted, each answered or counted "

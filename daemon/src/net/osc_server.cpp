@@ -14,11 +14,13 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <strings.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -401,7 +403,7 @@ std::string text_problem(const CommandSpec &s, const char *text, std::size_t len
     if (!s.words)
         return score_statement_problem(text, length);
     for (const char *const *w = s.words; *w; ++w)
-        if (std::strcmp(text, *w) == 0)
+        if (strcasecmp(text, *w) == 0) // any case, as the score's words and the CLI's
             return "";
     return std::string(s.what) + ": expected " + s.expected + ", got '" +
            std::string(text, std::min<std::size_t>(length, 40)) + "'";
@@ -492,6 +494,9 @@ std::string read_arguments(const Request &r, const CommandSpec &s, Command &cmd)
         if (!problem.empty())
             return problem;
         std::memcpy(cmd.text, text, length + 1); // fits: checked above
+        if (s.words) // a word in lower case: the physics and the echo see it so
+            for (std::size_t i = 0; i < length; ++i)
+                cmd.text[i] = static_cast<char>(std::tolower(static_cast<unsigned char>(text[i])));
     }
     return "";
 }
