@@ -790,3 +790,41 @@ TEST_CASE("ictusd: an option that is one of a few words takes them in any case",
         }
     }
 }
+
+// A score that parses but cannot be planned (a hand's two strokes closer than 40 ms, a drum
+// the performance lacks) was refused by render and by run --autoplay at once, exit 1; run
+// waiting for play started anyway and refused it only when play was pressed. Seeded such
+// scores: run refuses each at start, exit 1, with render's very line (file:line:column).
+TEST_CASE("ictusd run refuses at start a score that cannot be planned, as render does", "[cli]")
+{
+    std::mt19937 rng(20261202);
+    for (int trial = 0; trial < 6; ++trial) {
+        std::string text, extra;
+        if (trial % 3 == 2) {
+            text = "R\nL on tom" + std::to_string(1 + rng() % 2) + "\n"; // no kit
+        } else {
+            const int bpm = 200 + static_cast<int>(rng() % 201);
+            int d = 8;
+            while (60.0 / bpm / d >= 0.04)
+                d *= 2;
+            const char *hand = rng() % 2 ? "R" : "L";
+            text = "tempo " + std::to_string(bpm) + "\nbeats 1/" + std::to_string(d) + "\n" + hand +
+                   "\n" + hand + " accent\n";
+            if (trial % 3 == 1)
+                extra = " --kit standard";
+        }
+        const std::string score =
+            simtest::write_temp("unplannable-" + std::to_string(trial) + ".score", text);
+        const std::string out = simtest::write_temp("unplannable-out", "").substr(0) + "-dir";
+        std::filesystem::remove_all(out);
+        const Run render = ictusd("render --score " + score + extra + " --out " + out);
+        INFO(text << " render -> " << render.output);
+        REQUIRE(render.status == 1);
+        const std::string line = render.output.substr(render.output.find(score));
+        const Run run = ictusd("run --score " + score + extra + " --port 0 --duration 1");
+        INFO("run -> " << run.output);
+        CHECK(run.status == 1);
+        CHECK(run.output.find(line) != std::string::npos);
+        CHECK(run.output.find("commands on") == std::string::npos); // never listened
+    }
+}
