@@ -1,6 +1,9 @@
 // The real ictusd binary on bad input: captures out of physical bounds, zero
 // limbs, frame times and units refused at their line (exit 1), --force, and the
 // version of the program and each verb.
+#include "ictus/cli/args.hpp"
+#include "ictus/cli/options.hpp"
+#include "ictus/perform/performance.hpp"
 #include "support/cli_test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -11,6 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <random>
@@ -686,4 +690,141 @@ TEST_CASE("ictusd render: a refused score leaves no --out folder of its own", "[
     const Run again = ictusd("render --score " + file + " --out " + dir);
     CHECK(again.status == 1);
     CHECK(std::filesystem::is_directory(dir));
+}
+
+// The score's words are case-insensitive (docs/score.md) and so was --grip (French), but
+// every other option that is one of a few words refused a capital: --kit Standard,
+// --mode Joint, --drum-preset Snare, gestures --nuance Legato. Seeded casings of every
+// such option's words, on every verb that has it: taken as the lower-case word (the
+// value's error would come first; a misspelling still names the option), and the same
+// options parsed as the lower-case word's.
+TEST_CASE("ictusd: an option that is one of a few words takes them in any case", "[cli]")
+{
+    std::mt19937 rng(20261202);
+    auto any_case = [&](const std::string &w) {
+        std::string out = w;
+        for (char &c : out)
+            if (rng() % 2)
+                c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        if (out == w) // at least one capital
+            out[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(out[0])));
+        return out;
+    };
+    struct Words {
+        std::string verb, option;
+        std::vector<std::string> words;
+    };
+    const std::vector<Words> table = {
+        {"render", "--mode", {"joint", "cartesian"}},
+        {"render", "--grip", {"french", "german"}},
+        {"render",
+         "--kit",
+         {"standard", "standard-cymbals", "full", "standard-timpani", "timpani"}},
+        {"render",
+         "--drum-preset",
+         {"paper", "snare", "tom", "floor-tom", "timpani", "frame", "kick"}},
+        {"render", "--stick-tip", {"wood", "nylon", "felt"}},
+        {"render", "--sticks", {"fulcrum", "rigid"}},
+        {"render", "--wav-mix", {"stereo", "pickups"}},
+        {"track", "--mode", {"joint", "cartesian"}},
+        {"track", "--ik-start", {"simulated", "kinematic"}},
+        {"track", "--drum", {"auto"}},
+        {"track", "--stepper", {"quick", "direct"}},
+        {"track", "--limits", {"none", "euler", "quaternion"}},
+        {"track", "--smooth-kernel", {"butterworth", "gaussian"}},
+        {"track", "--units", {"mm", "m"}},
+        {"track", "--up", {"y", "z"}},
+        {"limits", "--smooth-kernel", {"butterworth", "gaussian"}}};
+    for (const Words &t : table)
+        for (const std::string &w : t.words) {
+            const std::string cased = any_case(w);
+            Run r = ictusd(t.verb + " " + t.option + " " + cased + " --not-an-option");
+            INFO(t.verb << " " << t.option << " " << cased << " -> " << r.output);
+            CHECK(r.status == 2);
+            CHECK(r.output.find("unknown option '--not-an-option'") != std::string::npos);
+            r = ictusd(t.verb + " " + t.option + " " + cased + "x --not-an-option");
+            CHECK(r.status == 2);
+            CHECK(r.output.find(t.option + ": ") != std::string::npos);
+        }
+    // gestures --import checks its words before it reads the capture (here: none).
+    const std::vector<std::string> nuances = {
+        "legato", "tenuto", "accent", "vertical_accent", "staccato", "buzz", "vertical-accent"};
+    for (const std::string &n : nuances) {
+        const std::string words = " --grip " + any_case(rng() % 2 ? "french" : "german") +
+                                  " --nuance " + any_case(n) + " --hand " +
+                                  any_case(rng() % 2 ? "left" : "right");
+        const Run r =
+            ictusd("gestures --import /nonexistent/take.csv --out /nonexistent/g.json" + words);
+        INFO(words << " -> " << r.output);
+        CHECK(r.status == 1); // the capture, not a word
+        CHECK(r.output.find("/nonexistent/take.csv") != std::string::npos);
+    }
+    // Parsed in the process: the same options as the lower-case word's.
+    auto parse = [](const std::string &option, const std::string &word) {
+        std::vector<std::string> items = {"render", option, word};
+        std::vector<char *> argv;
+        for (std::string &s : items)
+            argv.push_back(s.data());
+        ictus::cli::Args args(static_cast<int>(argv.size()), argv.data());
+        ictus::PerformanceOptions o;
+        double duration = 0.0;
+        const std::string a = args.next();
+        REQUIRE(ictus::cli::parse_performance_option(a, args, o, duration));
+        return o;
+    };
+    for (const Words &t : table) {
+        if (t.verb != "render" || t.option == "--wav-mix")
+            continue;
+        for (const std::string &w : t.words) {
+            const ictus::PerformanceOptions want = parse(t.option, w);
+            const ictus::PerformanceOptions got = parse(t.option, any_case(w));
+            INFO(t.option << " " << w);
+            CHECK(got.score.mode == want.score.mode);
+            CHECK(got.character.grip == want.character.grip);
+            CHECK(got.kit.name == want.kit.name);
+            CHECK(got.kit.drums.size() == want.kit.drums.size());
+            CHECK(got.drum_preset == want.drum_preset);
+            CHECK(got.scene.drum.stick_tip == want.scene.drum.stick_tip);
+            CHECK(got.scene.drum.radius_m == want.scene.drum.radius_m);
+            CHECK(got.scene.sticks == want.scene.sticks);
+        }
+    }
+}
+
+// A score that parses but cannot be planned (a hand's two strokes closer than 40 ms, a drum
+// the performance lacks) was refused by render and by run --autoplay at once, exit 1; run
+// waiting for play started anyway and refused it only when play was pressed. Seeded such
+// scores: run refuses each at start, exit 1, with render's very line (file:line:column).
+TEST_CASE("ictusd run refuses at start a score that cannot be planned, as render does", "[cli]")
+{
+    std::mt19937 rng(20261202);
+    for (int trial = 0; trial < 6; ++trial) {
+        std::string text, extra;
+        if (trial % 3 == 2) {
+            text = "R\nL on tom" + std::to_string(1 + rng() % 2) + "\n"; // no kit
+        } else {
+            const int bpm = 200 + static_cast<int>(rng() % 201);
+            int d = 8;
+            while (60.0 / bpm / d >= 0.04)
+                d *= 2;
+            const char *hand = rng() % 2 ? "R" : "L";
+            text = "tempo " + std::to_string(bpm) + "\nbeats 1/" + std::to_string(d) + "\n" + hand +
+                   "\n" + hand + " accent\n";
+            if (trial % 3 == 1)
+                extra = " --kit standard";
+        }
+        const std::string score =
+            simtest::write_temp("unplannable-" + std::to_string(trial) + ".score", text);
+        const std::string out = simtest::write_temp("unplannable-out", "").substr(0) + "-dir";
+        std::filesystem::remove_all(out);
+        const Run render = ictusd("render --score " + score + extra + " --out " + out);
+        INFO(text << " render -> " << render.output);
+        REQUIRE(render.status == 1);
+        const std::string line = render.output.substr(render.output.find(score));
+        const Run run = ictusd("run --score " + score + extra + " --port 0 --duration 1");
+        INFO("run -> " << run.output);
+        CHECK(run.status == 1);
+        CHECK(run.output.find(line) != std::string::npos);
+        CHECK(run.output.find("commands on") == std::string::npos); // never listened
+    }
 }

@@ -33,7 +33,7 @@ def render(out, *extra, environ=None):
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=environ or env)
 
 
-def pd_itself(out, wav, sr, *sends):
+def pd_itself(out, wav, sr, *sends, read=True):
     """pd run by the test on render's events.txt: the reference."""
     with open(os.path.join(out, "render.json")) as f:
         import json
@@ -46,7 +46,7 @@ def pd_itself(out, wav, sr, *sends):
             "-send", "render-seconds %.3f" % seconds]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=PD_ENV)
     check(proc.returncode == 0, "pd rendered the reference: %s" % proc.stderr[-1000:])
-    return read_wav_any(wav)
+    return read_wav_any(wav) if read else None
 
 
 # --- the default WAV, with progress lines --------------------------------------
@@ -81,6 +81,30 @@ ref, rsr, rbits, _ = pd_itself(out, os.path.join(work, "ref-b.wav"), 44100, "ren
                                "render-bits 16")
 check(sr == 44100 and bits == 16 and not is_float and rsr == sr and rbits == bits and
       np.array_equal(ref, x), "16-bit 44.1 kHz raw pickups, bit for bit pd's render")
+
+# --- the suffix's case ------------------------------------------------------------------
+# Pd writes a name ending in .wav or .WAV as given and adds .wav to any other (".Wav" too):
+# --wav TAKE.WAV was refused ("does not end in .wav"). Taken now, written under that name;
+# a mixed case, for which pd itself (run here) writes NAME.Wav.wav, refused before any output.
+import random
+rng = random.Random(20261202)
+out = os.path.join(work, "e")
+wav = os.path.join(out, "TAKE.WAV")
+proc = render(out, "--wav", wav, "--progress-every", "0")
+check(proc.returncode == 0 and os.path.isfile(wav) and not os.path.exists(wav + ".wav") and
+      read_wav_any(wav)[0].shape[0] > 0, "--wav TAKE.WAV: written under that name (%s)"
+      % proc.stderr.strip()[-300:])
+mixed = "".join(rng.choice((c.lower(), c.upper())) for c in "wav")
+while mixed in ("wav", "WAV"):
+    mixed = "".join(rng.choice((c.lower(), c.upper())) for c in "wav")
+pd_itself(out, os.path.join(work, "ref-e." + mixed), 48000, read=False)
+check(os.path.isfile(os.path.join(work, "ref-e.%s.wav" % mixed)),
+      "pd itself writes NAME.%s as NAME.%s.wav" % (mixed, mixed))
+bad = os.path.join(work, "f", "take." + mixed)
+proc = render(os.path.join(work, "f"), "--wav", bad)
+check(proc.returncode == 1 and bad in proc.stderr and "adds .wav" in proc.stderr and
+      not os.path.exists(os.path.join(work, "f")),
+      "--wav take.%s: exit 1 naming it, before any output (%s)" % (mixed, proc.stderr.strip()[-300:]))
 
 # --- errors ----------------------------------------------------------------------------
 no_pd = dict(env)

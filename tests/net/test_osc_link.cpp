@@ -4,6 +4,7 @@
 #include "ictus/net/osc_sender.hpp"
 #include "ictus/net/osc_server.hpp"
 #include "ictus/perform/tracker.hpp"
+#include "ictus/score/score.hpp"
 #include "support/osc_test_util.hpp"
 
 #include <catch2/catch.hpp>
@@ -577,13 +578,13 @@ TEST_CASE("osc in: score statements, score clear and the cartesian mode pass thr
         {{"/ictus/score", "s", longest + "R"}, "256 characters exceed the limit of 255"},
         {{"/ictus/score", "s", std::string(3000, 'L')}, "3000 characters exceed the limit of 255"},
         {{"/ictus/score", "s", ""}, "score statement: empty"},
-        {{"/ictus/score", "s", "R legato\nL accent"}, "control character 10 at column 9"},
+        {{"/ictus/score", "s", "R legato\x1bL accent"}, "control character 27 at column 9"},
         {{"/ictus/score", "i", "96"}, "type tags: expected ,s, got ,i"},
         {{"/ictus/score", "f", "0.8"}, "type tags: expected ,s, got ,f"},
         {{"/ictus/score", "ss", "R", "legato"}, "type tags: expected ,s, got ,ss"},
         {{"/ictus/score"}, "type tags: expected ,s, got none"},
         {{"/ictus/score/clear", "s", "all"}, "type tags: expected none, got ,s"},
-        {{"/ictus/mode", "s", "Cartesian"}, "mode: expected joint or cartesian, got 'Cartesian'"},
+        {{"/ictus/mode", "s", "cartesien"}, "mode: expected joint or cartesian, got 'cartesien'"},
     };
     for (const Bad &b : bad) {
         oscsend(b.args);
@@ -609,6 +610,214 @@ TEST_CASE("osc in: score statements, score clear and the cartesian mode pass thr
     CHECK(k.bad_values == 5);
     CHECK(k.oversized == 1);
     CHECK(k.errors_sent == 11);
+}
+
+// docs/score.md: statements are separated by line breaks "in a file and in one
+// /ictus/score string alike"; the parser took them, but the server refused any line
+// break as a control character, so a client's multi-line string never reached it.
+// Seeded statements joined by LF, CRLF or CR (some with a comment) go through the
+// server whole and give the notes of the same statements one per line of a file.
+TEST_CASE("osc in: a score statement string with line breaks passes whole and parses as the "
+          "same lines of a file",
+          "[net][link]")
+{
+    Peer replies;
+    ictus::OscServerOptions so;
+    so.port = 0;
+    so.reply_url = "osc.udp://127.0.0.1:" + std::to_string(replies.port());
+    ictus::OscServer server(so, nullptr);
+    const std::string port = std::to_string(server.port());
+    const std::vector<std::string> lines = {
+        "R legato", "L accent 0.8", "tempo 90",    "R+L tenuto f",      "rest 1/4",
+        "L 1/2",    "dynamics 0.3", "grip german", "R vertical-accent", "beats 1/2"};
+    std::mt19937 rng(20261202);
+    for (int trial = 0; trial < 20; ++trial) {
+        std::string file, message;
+        const int n = std::uniform_int_distribution<int>(2, 6)(rng);
+        for (int k = 0; k < n; ++k) {
+            const std::string &w = lines[rng() % lines.size()];
+            file += w + "\n";
+            message += w;
+            if (rng() % 3 == 0)
+                message += " # a comment";
+            if (k + 1 < n)
+                message += std::vector<std::string>{"\n", "\r\n", "\r"}[rng() % 3];
+        }
+        INFO("trial " << trial << ": " << file);
+        REQUIRE(osctest::run({"oscsend", "127.0.0.1", port, "/ictus/score", "s", message}) == 0);
+        ictus::Command c;
+        bool popped = false;
+        for (int i = 0; i < 600 && !popped; ++i) {
+            popped = server.pop_command(c);
+            if (!popped) {
+                Peer::Message m;
+                if (replies.receive(m, 5)) // an error reply: the statement was refused
+                    FAIL(m.path << " " << (m.strings.size() > 1 ? m.strings[1] : ""));
+            }
+        }
+        REQUIRE(popped);
+        CHECK(c.kind == ictus::CommandKind::score);
+        CHECK(std::string(c.text) == message);
+        server.post_accepted(c);
+        Peer::Message m;
+        REQUIRE(replies.receive(m, 3000));
+        CHECK(m.path == "/ictus/reply");
+
+        const ictus::Score want = ictus::parse_score(file, "file");
+        ictus::ScoreBuilder b;
+        b.add_statement(c.text);
+        const ictus::Score got = b.finish();
+        REQUIRE(got.notes.size() == want.notes.size());
+        for (size_t i = 0; i < want.notes.size(); ++i) {
+            CHECK(got.notes[i].beat == want.notes[i].beat);
+            CHECK(got.notes[i].hand == want.notes[i].hand);
+            CHECK(got.notes[i].nuance == want.notes[i].nuance);
+            CHECK(got.notes[i].dynamics == want.notes[i].dynamics);
+        }
+    }
+    CHECK(server.counters().score_lines == 20);
+}
+
+// docs/osc.md: /ictus/nuance N is "as the statement `nuance N`", which takes the
+// score's spelling vertical-accent too; the server refused it.
+TEST_CASE("osc in: /ictus/nuance takes vertical-accent as the score statement does", "[net][link]")
+{
+    ictus::OscServerOptions so;
+    so.port = 0;
+    ictus::OscServer server(so, nullptr);
+    const std::string port = std::to_string(server.port());
+    for (const char *word : {"vertical-accent", "vertical_accent"}) {
+        REQUIRE(osctest::run({"oscsend", "127.0.0.1", port, "/ictus/nuance", "s", word}) == 0);
+        ictus::Command c;
+        bool popped = false;
+        for (int i = 0; i < 200 && !popped; ++i) {
+            popped = server.pop_command(c);
+            if (!popped)
+                std::this_thread::sleep_for(5ms);
+        }
+        REQUIRE(popped);
+        CHECK(c.kind == ictus::CommandKind::nuance);
+        CHECK(ictus::nuance_from_string(c.text) == ictus::Nuance::vertical_accent);
+        CHECK(ictus::parse_score(std::string("nuance ") + word + "\nR", "t").notes.at(0).nuance ==
+              ictus::Nuance::vertical_accent);
+    }
+    CHECK(server.counters().bad_values == 0);
+}
+
+// docs/osc.md gives each float's range, ends included; a float of OSC holds 0.01 as
+// 0.0099999998, and /ictus/drum/density 0.01 was refused as "expected 0.01 to 10, got
+// 0.01". Every ranged command at both ends of its range, as a client types them (oscsend
+// reads the text into a float), is taken, within the range; the next float beyond each
+// end is refused.
+TEST_CASE("osc in: every documented range takes its ends as a float of OSC holds them",
+          "[net][link]")
+{
+    ictus::OscServerOptions so;
+    so.port = 0;
+    ictus::OscServer server(so, nullptr);
+    const std::string port = std::to_string(server.port());
+    struct Range {
+        const char *address;
+        int floats;
+        double lo, hi; // docs/osc.md
+    };
+    const Range ranges[] = {
+        {"/ictus/tempo", 1, 20, 400},         {"/ictus/gains", 2, 0.05, 4},
+        {"/ictus/drum/radius", 1, 0.05, 1},   {"/ictus/drum/tension", 1, 10, 1e5},
+        {"/ictus/drum/density", 1, 0.01, 10}, {"/ictus/grip/firmness", 1, 0, 1},
+        {"/ictus/humanize", 1, 0, 4}};
+    auto text = [](double v) {
+        std::ostringstream o;
+        o.precision(9);
+        o << v;
+        return o.str();
+    };
+    auto send = [&](const Range &r, const std::string &value) {
+        std::vector<std::string> args = {"oscsend", "127.0.0.1", port, r.address,
+                                         std::string(static_cast<size_t>(r.floats), 'f')};
+        for (int i = 0; i < r.floats; ++i)
+            args.push_back(value);
+        REQUIRE(osctest::run(args) == 0);
+    };
+    auto popped = [&](ictus::Command &c) {
+        for (int i = 0; i < 100; ++i) {
+            if (server.pop_command(c))
+                return true;
+            std::this_thread::sleep_for(5ms);
+        }
+        return false;
+    };
+    unsigned long refused = 0;
+    for (const Range &r : ranges)
+        for (const double end : {r.lo, r.hi}) {
+            INFO(r.address << " " << end);
+            send(r, text(end));
+            ictus::Command c;
+            REQUIRE(popped(c));
+            // the end, to a float's precision, and never outside the range
+            CHECK(c.value == Approx(end).epsilon(1e-7));
+            CHECK((c.value >= r.lo && c.value <= r.hi));
+            if (r.floats == 2)
+                CHECK(c.value2 == c.value);
+            const float beyond =
+                std::nextafter(static_cast<float>(end), end == r.lo ? -1e30f : 1e30f);
+            send(r, text(beyond));
+            ++refused;
+            for (int i = 0; i < 100 && server.counters().bad_values < refused; ++i)
+                std::this_thread::sleep_for(5ms);
+            CHECK(server.counters().bad_values == refused);
+        }
+    ictus::Command c;
+    CHECK_FALSE(server.pop_command(c));
+}
+
+// The score's words and the CLI's take any case (--grip German, `grip German`), but
+// /ictus/grip German, /ictus/mode Joint and /ictus/nuance Accent were refused. Seeded
+// casings of every word of the three: queued (and echoed) as the lower-case word.
+TEST_CASE("osc in: grip, mode and nuance take their words in any case", "[net][link]")
+{
+    Peer replies;
+    ictus::OscServerOptions so;
+    so.port = 0;
+    so.reply_url = "osc.udp://127.0.0.1:" + std::to_string(replies.port());
+    ictus::OscServer server(so, nullptr);
+    const std::string port = std::to_string(server.port());
+    struct Words {
+        const char *address;
+        std::vector<std::string> words;
+    };
+    const Words table[] = {
+        {"/ictus/grip", {"french", "german"}},
+        {"/ictus/mode", {"joint", "cartesian"}},
+        {"/ictus/nuance",
+         {"legato", "tenuto", "accent", "vertical_accent", "vertical-accent", "staccato", "buzz"}}};
+    std::mt19937 rng(20261203);
+    for (const Words &t : table)
+        for (const std::string &w : t.words) {
+            std::string cased = w;
+            for (char &ch : cased)
+                if (rng() % 2)
+                    ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+            if (cased == w)
+                cased[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(cased[0])));
+            INFO(t.address << " " << cased);
+            REQUIRE(osctest::run({"oscsend", "127.0.0.1", port, t.address, "s", cased}) == 0);
+            ictus::Command c;
+            bool popped = false;
+            for (int i = 0; i < 200 && !popped; ++i) {
+                popped = server.pop_command(c);
+                if (!popped)
+                    std::this_thread::sleep_for(5ms);
+            }
+            REQUIRE(popped);
+            CHECK(std::string(c.text) == w);
+            server.post_accepted(c);
+            Peer::Message m;
+            REQUIRE(replies.receive(m, 3000));
+            CHECK(m.path == "/ictus/reply");
+            CHECK(m.strings == std::vector<std::string>{t.address, w});
+        }
+    CHECK(server.counters().bad_values == 0);
 }
 
 TEST_CASE("osc in: 10^5 random and malformed packets are counted, each answered or counted "

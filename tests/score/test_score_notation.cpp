@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -302,4 +303,46 @@ TEST_CASE("score: the notation one statement at a time (a Pd message box) equals
     c.add_statement("beats 1/2");
     c.add_statement("roll double 3/4");
     CHECK_THROWS_WITH(c.finish(), Contains("osc:2:1: a roll of 0.75 beats"));
+}
+
+// `tempo 96 -> 140 over 4` as a newcomer types it, `tempo 96->140 over 4`, was refused
+// ("malformed number '96->140' for tempo"); '->' is now a word of its own with or without
+// spaces around it. Seeded tempo ramps and hairpins, each side of each '->' spaced or not:
+// the same beat times and dynamics as the spaced form; an error after a glued arrow is at
+// the column an editor counts.
+TEST_CASE("score: '->' needs no spaces around it, in tempo ramps and hairpins alike",
+          "[score][notation]")
+{
+    std::mt19937 rng(20261202);
+    const std::vector<std::string> words = {"pp", "p", "mp", "mf", "f", "ff", "0.1", "0.9"};
+    auto arrow = [&]() {
+        return std::string(rng() % 2 ? " " : "") + "->" + (rng() % 2 ? " " : "");
+    };
+    for (int trial = 0; trial < 40; ++trial) {
+        const int t0 = 40 + static_cast<int>(rng() % 300), t1 = 40 + static_cast<int>(rng() % 300);
+        const int b = 1 + static_cast<int>(rng() % 8);
+        const std::string d0 = words[rng() % words.size()], d1 = words[rng() % words.size()];
+        const bool from_current = rng() % 2;
+        auto score = [&](const std::string &a1, const std::string &a2) {
+            return "tempo " + std::to_string(t0) + a1 + std::to_string(t1) + " over " +
+                   std::to_string(b) + "\ndynamics " + (from_current ? std::string() : d0) + a2 +
+                   d1 + " over " + std::to_string(b) + "\nrepeat 8\nR, L\nend\n";
+        };
+        const std::string spaced = score(" -> ", from_current ? "-> " : " -> ");
+        const std::string glued =
+            score(arrow(), from_current ? "->" + std::string(rng() % 2 ? " " : "") : arrow());
+        INFO(glued);
+        const Score want = parse_score(spaced, "t.txt");
+        const Score got = parse_score(glued, "t.txt");
+        REQUIRE(got.notes.size() == want.notes.size());
+        for (size_t i = 0; i < want.notes.size(); ++i) {
+            CHECK(got.notes[i].beat == want.notes[i].beat);
+            CHECK(got.notes[i].dynamics == want.notes[i].dynamics);
+        }
+        for (double beat : {0.5, 1.0 * b, 7.5, 16.0})
+            CHECK(got.tempo.time_at_beat(beat) == want.tempo.time_at_beat(beat));
+    }
+    // 1:11 is the 5 of 500, counted by hand.
+    require_error("tempo 96->500 over 4\nR", 1, 11, "tempo 500 is out of range");
+    require_error("dynamics p->2 over 4\nR", 1, 13, "2");
 }

@@ -3,6 +3,7 @@
 
 #include "ictus/net/osc_sender.hpp" // OscError: a bad --target/--bind is a usage error
 
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cmath>
@@ -129,6 +130,14 @@ std::string Args::value(const std::string &option)
     return next();
 }
 
+std::string Args::word(const std::string &option)
+{
+    std::string w = value(option);
+    for (char &c : w)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return w;
+}
+
 bool dispatch_option(const OptionTable &table, const std::string &option, Args &args)
 {
     for (const Option &entry : table)
@@ -142,6 +151,11 @@ bool dispatch_option(const OptionTable &table, const std::string &option, Args &
 OptionHandler store_text(std::string &target)
 {
     return [&target](const std::string &option, Args &args) { target = args.value(option); };
+}
+
+OptionHandler store_word(std::string &target)
+{
+    return [&target](const std::string &option, Args &args) { target = args.word(option); };
 }
 
 OptionHandler store_flag(bool &target)

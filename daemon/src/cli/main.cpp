@@ -40,6 +40,9 @@ void usage(std::ostream &out)
            "  ictusd run --mocap ../shared/data/cmu/80_13.bvh --target osc.udp://127.0.0.1:9000\n"
            "  ictusd gestures --list\n"
            "\n"
+           "an option's value that is a word (--mode joint, --kit full) is taken in any\n"
+           "case, as the score's words are\n"
+           "\n"
            "exit status: 0 ok, 1 error in a file or the data, 2 usage error,\n"
            "             3 the simulation diverged (and was reset), 130 interrupted\n";
 }

@@ -75,12 +75,12 @@ bool parse_stick_csv_option(const std::string &a, Args &args, StickCsvOptions &o
     } else if (a == "--right-stick") {
         o.right_stick = args.value(a);
     } else if (a == "--units") {
-        const std::string v = args.value(a);
+        const std::string v = args.word(a);
         if (v != "mm" && v != "m")
             throw UsageError("--units: expected mm or m, got '" + v + "'");
         o.csv.units = v == "mm" ? MarkerCsvOptions::Units::mm : MarkerCsvOptions::Units::m;
     } else if (a == "--up") {
-        const std::string v = args.value(a);
+        const std::string v = args.word(a);
         if (v != "y" && v != "z")
             throw UsageError("--up: expected y or z, got '" + v + "'");
         o.csv.up = v == "z" ? MarkerCsvOptions::Up::z : MarkerCsvOptions::Up::y;
@@ -120,7 +120,7 @@ bool parse_clip_option(const std::string &a, Args &args, ClipOptions &clip)
             throw UsageError("--smooth-hz: expected a number >= 0 (0: off)");
     } else if (a == "--smooth-kernel") {
         try {
-            clip.filter.kernel = reference_kernel_from_string(args.value(a));
+            clip.filter.kernel = reference_kernel_from_string(args.word(a));
         } catch (const CharacterError &e) {
             throw UsageError(a + after_name(e.what()));
         }
@@ -228,6 +228,7 @@ std::string read_score_file(const std::string &path)
 static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptions &o)
 {
     auto value = [&]() { return args.value(a); };
+    auto word = [&]() { return args.word(a); };
     if (a == "--drum-pos") {
         o.scene.drum.center_m = parse_vec3(a, value(), -kMaxDrumDistance_m, kMaxDrumDistance_m);
         o.drum_auto = false;
@@ -241,15 +242,15 @@ static bool parse_drum_option(const std::string &a, Args &args, PerformanceOptio
         o.drum_density_kg_per_m2 = parse_number(a, value(), 0.01, 10);
         o.drum_given |= kGivenDensity;
     } else if (a == "--drum-preset") {
-        apply_drum_preset(a, value(), o);
+        apply_drum_preset(a, word(), o);
         o.drum_given |= kGivenPreset;
     } else if (a == "--stick-tip") {
-        const std::string v = value();
+        const std::string v = word();
         if (!is_stick_tip(v))
             throw UsageError("--stick-tip: expected wood, nylon or felt, got '" + v + "'");
         o.scene.drum.stick_tip = v;
     } else if (a == "--kit") {
-        const std::string v = value();
+        const std::string v = word();
         try {
             o.kit = kit_named(v);
         } catch (const PerformError &e) {
@@ -287,6 +288,7 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
         std::find(std::begin(score_options), std::end(score_options), a) != std::end(score_options))
         o.score_option_given = a;
     auto value = [&]() { return args.value(a); };
+    auto word = [&]() { return args.word(a); };
     if (a == "--mocap") {
         o.mocap = value();
         std::string ext = std::filesystem::path(o.mocap).extension().string();
@@ -305,7 +307,7 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
     else if (a == "--step")
         o.scene.step_s = parse_number(a, value(), 1e-5, 0.01);
     else if (a == "--grip") {
-        o.character.grip = parse_grip(a, value());
+        o.character.grip = parse_grip(a, word());
         o.score.grip_given = true;
     } else if (a == "--score") {
         // A score that cannot be read is a file error (exit 1), not a usage error.
@@ -325,7 +327,7 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
     } else if (a == "--gestures")
         o.score.gestures = value();
     else if (a == "--mode") {
-        o.score.mode = parse_track_mode(a, value());
+        o.score.mode = parse_track_mode(a, word());
         // `--mode joint` is what a clip plays in: said of cartesian alone
         if (o.score.mode != TrackMode::joint && o.score_option_given.empty())
             o.score_option_given = a;
@@ -381,7 +383,7 @@ bool parse_performance_option(const std::string &a, Args &args, PerformanceOptio
     else if (parse_drum_option(a, args, o)) {
         // the drum or the kit
     } else if (a == "--sticks") {
-        const std::string v = value();
+        const std::string v = word();
         if (v == "fulcrum")
             o.scene.sticks = StickMount::fulcrum;
         else if (v == "rigid")

@@ -66,12 +66,17 @@ void check_pd_path(const char *what, const std::string &path)
 
 void check_wav_path(const std::string &path, const std::string &made_dir)
 {
-    const std::string suffix = ".wav";
+    // The suffixes Pd's soundfiler keeps as given (d_soundfile_wave.c's
+    // wave_hasextension); to any other name, `.Wav` too, it adds .wav.
     const std::string name = fs::path(path).filename().string();
-    if (name.size() <= suffix.size() ||
-        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+    auto ends_in = [&name](const std::string &suffix) {
+        return name.size() > suffix.size() &&
+               name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+    };
+    if (!ends_in(".wav") && !ends_in(".WAV") && !ends_in(".wave") && !ends_in(".WAVE"))
         throw std::runtime_error("--wav: '" + path +
-                                 "' does not end in .wav: Pd writes a WAV file by that name");
+                                 "' does not end in .wav (or .WAV): Pd writes a WAV file by "
+                                 "that name, and to any other adds .wav");
     std::error_code ec;
     if (fs::is_directory(path, ec))
         throw std::runtime_error("--wav: '" + path + "' is a folder: give a file NAME.wav");

@@ -77,9 +77,9 @@ int cmd_gestures(Args &args)
                                  {"--import", store_text(import_path)},
                                  {"--db", store_text(db_path)},
                                  {"--out", store_text(out_path)},
-                                 {"--grip", store_text(grip)},
-                                 {"--nuance", store_text(nuance)},
-                                 {"--hand", store_text(hand)},
+                                 {"--grip", store_word(grip)},
+                                 {"--nuance", store_word(nuance)},
+                                 {"--hand", store_word(hand)},
                                  {"--stroke", store(stroke, parse_int, 0, 1000000)},
                                  {"--dynamics", store(dynamics, parse_number, 0.0, 1.0)}};
     const bool go_on = walk_args(args, gestures_usage, [&](const std::string &a) {

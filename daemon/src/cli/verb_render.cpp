@@ -302,7 +302,7 @@ OptionTable render_options(RenderArgs &r)
         {"--wav", store_text(r.wav)},
         {"--wav-mix",
          [&pd](const std::string &a, Args &args) {
-             pd.mix = args.value(a);
+             pd.mix = args.word(a);
              if (pd.mix != "stereo" && pd.mix != "pickups")
                  throw UsageError("--wav-mix: expected stereo or pickups, got '" + pd.mix + "'");
          }},

@@ -381,6 +381,10 @@ int cmd_run(Args &args)
     Performance perf(r.performance);
     // Waits for /ictus/play unless --autoplay (docs/osc.md, "Starting").
     if (!r.autoplay) {
+        // The score (--score, --midi, the built-in) is planned once now: one that
+        // cannot be played ends here, exit 1, as with --autoplay and in render.
+        if (perf.score_mode())
+            perf.check_score();
         Command stop;
         stop.kind = CommandKind::stop;
         perf.apply(stop);

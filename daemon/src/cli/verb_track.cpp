@@ -140,7 +140,7 @@ OptionTable ik_options(TrackArgs &t)
     return {
         {"--mode",
          [&t](const std::string &a, Args &args) {
-             t.mode = args.value(a);
+             t.mode = args.word(a);
              t.options.mode = parse_track_mode(a, t.mode);
          }},
         {"--ik-gain", store(ik.gain, parse_positive)},
@@ -149,7 +149,7 @@ OptionTable ik_options(TrackArgs &t)
         {"--ik-correction-limit", store(ik.correction_limit_m, parse_number)},
         {"--ik-start",
          [&ik](const std::string &a, Args &args) {
-             const std::string v = args.value(a);
+             const std::string v = args.word(a);
              if (v != "simulated" && v != "kinematic")
                  throw UsageError("--ik-start: expected simulated or kinematic, got '" + v + "'");
              ik.start_from_simulated = v == "simulated";
@@ -175,7 +175,7 @@ OptionTable scene_options(TrackArgs &t)
     return {
         {"--drum",
          [&t](const std::string &a, Args &args) {
-             const std::string v = args.value(a);
+             const std::string v = args.word(a);
              if (v == "auto")
                  return;
              try {
@@ -198,7 +198,7 @@ OptionTable scene_options(TrackArgs &t)
         {"--step", store(scene.step_s, parse_positive)},
         {"--stepper",
          [&scene](const std::string &a, Args &args) {
-             const std::string s = args.value(a);
+             const std::string s = args.word(a);
              if (s == "quick")
                  scene.stepper = Stepper::quick;
              else if (s == "direct")
@@ -236,7 +236,7 @@ OptionTable body_options(TrackArgs &t)
         {"--gains", store_text(t.gains_file)},
         {"--limits",
          [&t](const std::string &a, Args &args) {
-             t.limits_mode = args.value(a);
+             t.limits_mode = args.word(a);
              if (t.limits_mode != "none" && t.limits_mode != "euler" &&
                  t.limits_mode != "quaternion")
                  throw UsageError("--limits: expected none, euler or quaternion, got '" +

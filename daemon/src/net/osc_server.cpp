@@ -14,11 +14,13 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <strings.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -362,14 +364,16 @@ struct CommandSpec {
 };
 
 constexpr const char *kGrips[] = {"french", "german", nullptr};
-constexpr const char *kNuances[] = {"legato",   "tenuto", "accent", "vertical_accent",
-                                    "staccato", "buzz",   nullptr};
+// vertical-accent: the score's other spelling (docs/score.md), as the statement `nuance N`
+constexpr const char *kNuances[] = {"legato",          "tenuto",   "accent", "vertical_accent",
+                                    "vertical-accent", "staccato", "buzz",   nullptr};
 constexpr const char *kModes[] = {"joint", "cartesian", nullptr};
 
 // Why a score statement cannot be queued, or "" when it can. The score's own
 // syntax is the physics thread's business (its parser names the fault's
 // position); here only what would not survive the trip: the length of
-// Command::text and characters that would split the line or the log.
+// Command::text and control characters. A line break (LF, CR) separates
+// statements in one string as in a file (docs/score.md): the parser takes it.
 std::string score_statement_problem(const char *text, std::size_t length)
 {
     if (length == 0)
@@ -379,9 +383,9 @@ std::string score_statement_problem(const char *text, std::size_t length)
                std::to_string(Command::kMaxText - 1) + " (send one statement per message)";
     for (std::size_t i = 0; i < length; ++i) {
         const unsigned char ch = static_cast<unsigned char>(text[i]);
-        if ((ch < 0x20 && ch != '\t') || ch == 0x7f)
+        if ((ch < 0x20 && ch != '\t' && ch != '\n' && ch != '\r') || ch == 0x7f)
             return "score statement: control character " + std::to_string(ch) + " at column " +
-                   std::to_string(i + 1) + " (one line per message)";
+                   std::to_string(i + 1) + " (text, tabs and line breaks only)";
     }
     return "";
 }
@@ -399,7 +403,7 @@ std::string text_problem(const CommandSpec &s, const char *text, std::size_t len
     if (!s.words)
         return score_statement_problem(text, length);
     for (const char *const *w = s.words; *w; ++w)
-        if (std::strcmp(text, *w) == 0)
+        if (strcasecmp(text, *w) == 0) // any case, as the score's words and the CLI's
             return "";
     return std::string(s.what) + ": expected " + s.expected + ", got '" +
            std::string(text, std::min<std::size_t>(length, 40)) + "'";
@@ -474,8 +478,12 @@ std::string read_arguments(const Request &r, const CommandSpec &s, Command &cmd)
     double *const floats[2] = {&cmd.value, &cmd.value2};
     for (int i = 0; i < 2 && r.types[i] == 'f'; ++i) {
         *floats[i] = lo_arg_float(r.argv[i]);
-        if (!(std::isfinite(*floats[i]) && *floats[i] >= s.lo && *floats[i] <= s.hi))
+        // The range's ends as an OSC float can hold them: 0.01 arrives as
+        // 0.0099999998, and the documented end is taken (as the end itself).
+        const double lo = static_cast<float>(s.lo), hi = static_cast<float>(s.hi);
+        if (!(std::isfinite(*floats[i]) && *floats[i] >= lo && *floats[i] <= hi))
             return format_range(s, *floats[i]);
+        *floats[i] = std::clamp(*floats[i], s.lo, s.hi);
     }
     if (r.types[0] == 's') {
         const char *text = lo_arg_string(r.argv[0]);
@@ -486,6 +494,9 @@ std::string read_arguments(const Request &r, const CommandSpec &s, Command &cmd)
         if (!problem.empty())
             return problem;
         std::memcpy(cmd.text, text, length + 1); // fits: checked above
+        if (s.words) // a word in lower case: the physics and the echo see it so
+            for (std::size_t i = 0; i < length; ++i)
+                cmd.text[i] = static_cast<char>(std::tolower(static_cast<unsigned char>(text[i])));
     }
     return "";
 }

@@ -640,6 +640,13 @@ void Performance::start_score()
     score_->start_score();
 }
 
+void Performance::check_score() const
+{
+    if (!score_)
+        throw PerformError("play: not in score mode");
+    score_->check_score();
+}
+
 // ---- background work -----------------------------------------------------------
 
 bool Performance::submit(std::unique_ptr<Work> job, std::string *why)

@@ -185,6 +185,12 @@ void ScoreMode::start_score()
                  true);
 }
 
+void ScoreMode::check_score() const
+{
+    make_score_plan(score_, *db_, rig_->frame,
+                    perf_.options_.score.plan_for(rig_->tracker->mode()));
+}
+
 // ---- background work -----------------------------------------------------------
 
 std::unique_ptr<ScoreMode::Job> ScoreMode::plan_job(const Command &origin, Work::Kind kind)

@@ -55,6 +55,8 @@ class ScoreMode final : public PerformMode
     const KickPedal *kick_pedal() const { return feet_[0] ? &feet_[0]->pedal() : nullptr; }
     // Plans the current score and starts it now.
     void start_score();
+    // Plans the current score and drops the plan: throws what start_score() would.
+    void check_score() const;
 
   private:
     class Job;

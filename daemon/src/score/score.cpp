@@ -226,8 +226,13 @@ class LineParser
                 if ((static_cast<unsigned char>(text[counted]) & 0xC0) == 0x80)
                     ++continuations;
             t.column = static_cast<int>(i - continuations) + 1;
-            while (i < text.size() && !space_at(text, i) && text[i] != ',' && text[i] != ';' &&
-                   text[i] != '#')
+            // '->' is a word of its own, with or without spaces around it ('96->140')
+            if (text.compare(i, 2, "->") == 0) {
+                t.text = "->";
+                i += 2;
+            }
+            while (t.text != "->" && i < text.size() && !space_at(text, i) && text[i] != ',' &&
+                   text[i] != ';' && text[i] != '#' && text.compare(i, 2, "->") != 0)
                 t.text += text[i++];
             t.lower = t.text;
             for (char &ch : t.lower)

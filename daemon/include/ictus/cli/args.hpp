@@ -43,6 +43,9 @@ class Args
     const std::string &next() { return items_[at_++]; }
     // The value of `option` (the next item); UsageError "OPTION: missing value".
     std::string value(const std::string &option);
+    // The value of an option that is one of a few words (a mode, a kit, a preset,
+    // a nuance), lower-cased: any case is taken, as the score's words are.
+    std::string word(const std::string &option);
 
   private:
     std::vector<std::string> items_;
@@ -68,6 +71,7 @@ bool dispatch_option(const OptionTable &table, const std::string &option, Args &
 // the table): as it is, or read by one of the parsers above, e.g.
 // store(k, parse_positive), store(channel, parse_int, 1, 16).
 OptionHandler store_text(std::string &target);
+OptionHandler store_word(std::string &target); // Args::word
 template <typename T>
 OptionHandler store(T &target, T (*parse)(const std::string &, const std::string &))
 {

@@ -67,10 +67,10 @@ std::string find_pd_library(const std::string &given);
 // std::runtime_error "WHAT: 'path' has ...".
 void check_pd_path(const char *what, const std::string &path);
 
-// --wav's path: a file name ending in .wav (what Pd writes; none of render's
-// other outputs ends so), not a folder, in a folder that exists or is
-// `made_dir` (render's --out, made before Pd runs: Pd makes no folder), and
-// one Pd's messages carry (check_pd_path). std::runtime_error naming the path.
+// --wav's path: a file name ending in .wav or .WAV (or .wave, .WAVE: the names Pd
+// writes as given; none of render's other outputs ends so), not a folder, in a folder that exists
+// or is `made_dir` (render's --out, made before Pd runs: Pd makes no folder), and one Pd's messages
+// carry (check_pd_path). std::runtime_error naming the path.
 void check_wav_path(const std::string &path, const std::string &made_dir = "");
 
 // The path of `pd` (a name is looked up on PATH); std::runtime_error when

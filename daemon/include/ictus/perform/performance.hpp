@@ -207,6 +207,9 @@ class Performance
     // score mode). Throws PerformError (not in score mode, background work
     // under way), ScoreError / GestureError; on error nothing changes.
     void start_score();
+    // Plans the current score as start_score() would, and keeps nothing: a score
+    // that cannot be played throws here, before anyone presses play.
+    void check_score() const;
 
     // Background work. Finishing and planning a score and rebuilding the
     // character (a grip change; a clip after one) can take 100 ms or more.
