@@ -6,6 +6,7 @@
 #include "ictus/perform/tracker.hpp"
 #include "ictus/score/score.hpp"
 #include "support/osc_test_util.hpp"
+#include "support/score_test_util.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -403,14 +404,10 @@ TEST_CASE("osc in: oscsend drives the server, replies and errors go back over OS
     // The physics thread's part: take the next command and confirm it (the
     // server replies once the physics took it).
     auto pop = [&](ictus::Command &c) {
-        for (int i = 0; i < 200; ++i) {
-            if (server.pop_command(c)) {
-                server.post_accepted(c);
-                return true;
-            }
-            std::this_thread::sleep_for(5ms);
-        }
-        return false;
+        if (!osctest::poll_until([&] { return server.pop_command(c); }))
+            return false;
+        server.post_accepted(c);
+        return true;
     };
     ictus::Command c;
     DumpLine d;
@@ -516,14 +513,10 @@ TEST_CASE("osc in: score statements, score clear and the cartesian mode pass thr
     // The physics thread's part: take the next command and confirm it (the
     // server replies once the physics took it).
     auto pop = [&](ictus::Command &c) {
-        for (int i = 0; i < 200; ++i) {
-            if (server.pop_command(c)) {
-                server.post_accepted(c);
-                return true;
-            }
-            std::this_thread::sleep_for(5ms);
-        }
-        return false;
+        if (!osctest::poll_until([&] { return server.pop_command(c); }))
+            return false;
+        server.post_accepted(c);
+        return true;
     };
     auto reply = [&](Peer::Message &m) {
         REQUIRE(replies.receive(m, 3000));
@@ -634,28 +627,18 @@ TEST_CASE("osc in: a score statement string with line breaks passes whole and pa
     for (int trial = 0; trial < 20; ++trial) {
         std::string file, message;
         const int n = std::uniform_int_distribution<int>(2, 6)(rng);
-        for (int k = 0; k < n; ++k) {
-            const std::string &w = lines[rng() % lines.size()];
-            file += w + "\n";
-            message += w;
-            if (rng() % 3 == 0)
-                message += " # a comment";
-            if (k + 1 < n)
-                message += std::vector<std::string>{"\n", "\r\n", "\r"}[rng() % 3];
-        }
+        ictus_test::join_statements(rng, lines, n, " # a comment", file, message);
         INFO("trial " << trial << ": " << file);
         REQUIRE(osctest::run({"oscsend", "127.0.0.1", port, "/ictus/score", "s", message}) == 0);
         ictus::Command c;
-        bool popped = false;
-        for (int i = 0; i < 600 && !popped; ++i) {
-            popped = server.pop_command(c);
-            if (!popped) {
-                Peer::Message m;
-                if (replies.receive(m, 5)) // an error reply: the statement was refused
-                    FAIL(m.path << " " << (m.strings.size() > 1 ? m.strings[1] : ""));
-            }
-        }
-        REQUIRE(popped);
+        REQUIRE(osctest::poll_until([&] {
+            if (server.pop_command(c))
+                return true;
+            Peer::Message m;
+            if (replies.receive(m, 5)) // an error reply: the statement was refused
+                FAIL(m.path << " " << (m.strings.size() > 1 ? m.strings[1] : ""));
+            return false;
+        }));
         CHECK(c.kind == ictus::CommandKind::score);
         CHECK(std::string(c.text) == message);
         server.post_accepted(c);
@@ -663,17 +646,7 @@ TEST_CASE("osc in: a score statement string with line breaks passes whole and pa
         REQUIRE(replies.receive(m, 3000));
         CHECK(m.path == "/ictus/reply");
 
-        const ictus::Score want = ictus::parse_score(file, "file");
-        ictus::ScoreBuilder b;
-        b.add_statement(c.text);
-        const ictus::Score got = b.finish();
-        REQUIRE(got.notes.size() == want.notes.size());
-        for (size_t i = 0; i < want.notes.size(); ++i) {
-            CHECK(got.notes[i].beat == want.notes[i].beat);
-            CHECK(got.notes[i].hand == want.notes[i].hand);
-            CHECK(got.notes[i].nuance == want.notes[i].nuance);
-            CHECK(got.notes[i].dynamics == want.notes[i].dynamics);
-        }
+        ictus_test::check_same_notes(c.text, file);
     }
     CHECK(server.counters().score_lines == 20);
 }
@@ -689,13 +662,7 @@ TEST_CASE("osc in: /ictus/nuance takes vertical-accent as the score statement do
     for (const char *word : {"vertical-accent", "vertical_accent"}) {
         REQUIRE(osctest::run({"oscsend", "127.0.0.1", port, "/ictus/nuance", "s", word}) == 0);
         ictus::Command c;
-        bool popped = false;
-        for (int i = 0; i < 200 && !popped; ++i) {
-            popped = server.pop_command(c);
-            if (!popped)
-                std::this_thread::sleep_for(5ms);
-        }
-        REQUIRE(popped);
+        REQUIRE(osctest::poll_until([&] { return server.pop_command(c); }));
         CHECK(c.kind == ictus::CommandKind::nuance);
         CHECK(ictus::nuance_from_string(c.text) == ictus::Nuance::vertical_accent);
         CHECK(ictus::parse_score(std::string("nuance ") + word + "\nR", "t").notes.at(0).nuance ==
@@ -740,12 +707,7 @@ TEST_CASE("osc in: every documented range takes its ends as a float of OSC holds
         REQUIRE(osctest::run(args) == 0);
     };
     auto popped = [&](ictus::Command &c) {
-        for (int i = 0; i < 100; ++i) {
-            if (server.pop_command(c))
-                return true;
-            std::this_thread::sleep_for(5ms);
-        }
-        return false;
+        return osctest::poll_until([&] { return server.pop_command(c); });
     };
     unsigned long refused = 0;
     for (const Range &r : ranges)
@@ -763,8 +725,7 @@ TEST_CASE("osc in: every documented range takes its ends as a float of OSC holds
                 std::nextafter(static_cast<float>(end), end == r.lo ? -1e30f : 1e30f);
             send(r, text(beyond));
             ++refused;
-            for (int i = 0; i < 100 && server.counters().bad_values < refused; ++i)
-                std::this_thread::sleep_for(5ms);
+            osctest::poll_until([&] { return server.counters().bad_values >= refused; });
             CHECK(server.counters().bad_values == refused);
         }
     ictus::Command c;
@@ -803,13 +764,7 @@ TEST_CASE("osc in: grip, mode and nuance take their words in any case", "[net][l
             INFO(t.address << " " << cased);
             REQUIRE(osctest::run({"oscsend", "127.0.0.1", port, t.address, "s", cased}) == 0);
             ictus::Command c;
-            bool popped = false;
-            for (int i = 0; i < 200 && !popped; ++i) {
-                popped = server.pop_command(c);
-                if (!popped)
-                    std::this_thread::sleep_for(5ms);
-            }
-            REQUIRE(popped);
+            REQUIRE(osctest::poll_until([&] { return server.pop_command(c); }));
             CHECK(std::string(c.text) == w);
             server.post_accepted(c);
             Peer::Message m;

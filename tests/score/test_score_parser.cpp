@@ -856,28 +856,8 @@ TEST_CASE("score: a line break in one statement string separates as in a file, C
     for (int trial = 0; trial < 50; ++trial) {
         std::string file, message;
         const int n = std::uniform_int_distribution<int>(2, 9)(rng);
-        for (int k = 0; k < n; ++k) {
-            const std::string &w = words[rng() % words.size()];
-            file += w + "\n";
-            message += w;
-            if (rng() % 3 == 0)
-                message += " # a comment, R ff";
-            if (k + 1 < n)
-                message += std::vector<std::string>{"\n", "\r\n", "\r"}[rng() % 3];
-        }
+        ictus_test::join_statements(rng, words, n, " # a comment, R ff", file, message);
         INFO("trial " << trial << ": " << file);
-        const Score want = parse_score(file, "file");
-        ScoreBuilder b;
-        b.add_statement(message);
-        const Score got = b.finish();
-        REQUIRE(got.notes.size() == want.notes.size());
-        for (size_t i = 0; i < want.notes.size(); ++i) {
-            CHECK(got.notes[i].beat == want.notes[i].beat);
-            CHECK(got.notes[i].hand == want.notes[i].hand);
-            CHECK(got.notes[i].nuance == want.notes[i].nuance);
-            CHECK(got.notes[i].dynamics == want.notes[i].dynamics);
-            CHECK(got.notes[i].grip == want.notes[i].grip);
-        }
-        CHECK(got.tempo.time_at_beat(8.0) == want.tempo.time_at_beat(8.0));
+        ictus_test::check_same_notes(message, file);
     }
 }

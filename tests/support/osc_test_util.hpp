@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace osctest
@@ -148,6 +149,19 @@ class Child
     int fd_ = -1;
     std::string buffer_;
 };
+
+// Polls ready() every 5 ms until it holds or deadline_s of wall time pass (a server's
+// thread on a busy machine may be slow to take a packet): whether it held.
+template <class Ready> bool poll_until(Ready ready, double deadline_s = 10.0)
+{
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(deadline_s);
+    while (!ready()) {
+        if (std::chrono::steady_clock::now() > end)
+            return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return true;
+}
 
 // Runs a command to completion; its exit status.
 inline int run(const std::vector<std::string> &args)
