@@ -230,10 +230,11 @@ class LineParser
             if (text.compare(i, 2, "->") == 0) {
                 t.text = "->";
                 i += 2;
+            } else {
+                while (i < text.size() && !space_at(text, i) && text[i] != ',' && text[i] != ';' &&
+                       text[i] != '#' && text.compare(i, 2, "->") != 0)
+                    t.text += text[i++];
             }
-            while (t.text != "->" && i < text.size() && !space_at(text, i) && text[i] != ',' &&
-                   text[i] != ';' && text[i] != '#' && text.compare(i, 2, "->") != 0)
-                t.text += text[i++];
             t.lower = t.text;
             for (char &ch : t.lower)
                 ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
