@@ -33,7 +33,9 @@ ap.add_argument("--slow-load", action="store_true")
 args = ap.parse_args()
 build = os.path.abspath(args.build)
 
-N_STRIKES = 24
+HALF = 12  # strikes sent as planned per half, before and after 'latency 10'
+MAX_PER_HALF = 2 * HALF
+SENDER_SLACK_S = 0.020  # sent later than planned by more: this script stalled
 LOOKAHEAD_S = 0.060
 SPACING_S = 0.045
 SECONDS = 600.0  # pd's own deadline: the test ends it by handshake (quit_pd)
@@ -56,6 +58,7 @@ try:
     # ictus_timetag collects clock samples (every 2 ms)
     time.sleep(0.6)
     sent = {}  # seq -> (timetag_s, hand, velocity, r_over_a, theta, stick_mass_kg)
+    second_half = 1 << 30  # the first strike after 'latency 10' 
     probes = {}  # k -> wall time sent
 
     def probe():
@@ -66,9 +69,16 @@ try:
     for _ in range(20):
         probe()
         time.sleep(0.01)
-    t_next = now() + LOOKAHEAD_S
-    for seq in range(1, N_STRIKES + 1):
-        if seq == N_STRIKES // 2 + 1:
+    # Each half (latency 0, then latency 10) needs HALF strikes whose bundle left
+    # this script as planned, LOOKAHEAD_S before its time (within SENDER_SLACK_S):
+    # only those judge pd. A strike this script sent late (a loaded CI run stalled
+    # it 250 ms, and four strikes went out back to back after their time) must
+    # still fire at once and be reported late, but says nothing about pd's
+    # scheduling: another is sent in its place, MAX_PER_HALF strikes at most.
+    seq = 0
+    planned = set()  # the strikes whose bundle left as planned
+    for half in (0, 1):
+        if half:
             # from here on, an audio output latency of 10 ms is subtracted. Sent
             # when no strike is in flight: pd polls its sockets in the order
             # they opened, so after a stall a packet on another socket may be
@@ -77,19 +87,26 @@ try:
                 time.sleep(0.001)
             out.sendto(b"latency %g;\n" % LATENCY_MS, ("127.0.0.1", fudi_port))
             time.sleep(0.05)
-            t_next = now() + LOOKAHEAD_S
-        # send each bundle LOOKAHEAD_S before its time, as the daemon does
-        while now() < t_next - LOOKAHEAD_S:
-            time.sleep(0.0005)
-        hand, vel, ra, th = seq % 2, 0.5 + 0.25 * seq, 0.01 * seq, 7.0 * seq
-        mass = 0.01 + 0.001 * seq
-        out.sendto(bundle(timetag(t_next), strike(seq, hand, vel, ra, th, stick_mass_kg=mass,
-                                                          stick_tip=seq % 4)),
-                   ("127.0.0.1", pd_port))
-        sent[seq] = (t_next, hand, vel, ra, th, mass)
-        t_next += SPACING_S
-        time.sleep(0.005)
-        probe()
+            second_half = seq + 1
+        t_next = now() + LOOKAHEAD_S
+        for _ in range(MAX_PER_HALF):
+            if sum(1 for s in planned if (s >= second_half) == bool(half)) >= HALF:
+                break
+            seq += 1
+            # send each bundle LOOKAHEAD_S before its time, as the daemon does
+            while now() < t_next - LOOKAHEAD_S:
+                time.sleep(0.0005)
+            hand, vel, ra, th = seq % 2, 0.5 + 0.25 * seq, 0.01 * seq, 7.0 * seq
+            mass = 0.01 + 0.001 * seq
+            out.sendto(bundle(timetag(t_next), strike(seq, hand, vel, ra, th, stick_mass_kg=mass,
+                                                              stick_tip=seq % 4)),
+                       ("127.0.0.1", pd_port))
+            if now() - (t_next - LOOKAHEAD_S) <= SENDER_SLACK_S:
+                planned.add(seq)
+            sent[seq] = (t_next, hand, vel, ra, th, mass)
+            t_next += SPACING_S
+            time.sleep(0.005)
+            probe()
     time.sleep(0.2)
     # a bundle a second overdue: fires at once, counted as late. Pd's logical
     # clock may lag the wall clock on a loaded machine (a sanitizer build under
@@ -152,7 +169,7 @@ for seq, (tag, hand, vel, ra, th, mass) in sorted(sent.items()):
           and abs(fields[4] - mass) < 1e-7 and abs(fields[5] - 50.0) < 1e-3 and fields[6] == 0
           and fields[8] == seq and abs(fields[17] + 1.0) < 1e-6 and fields[18] == seq % 4,
           "strike %d fields in the documented order: %s" % (seq, fields))
-    latency_ms = LATENCY_MS if seq > N_STRIKES // 2 else 0.0
+    latency_ms = LATENCY_MS if seq >= second_half else 0.0
     errors_ms.append((offset + logical_ms / 1000.0 - tag) * 1000.0 + latency_ms)
     arrival_ms.append((t_arr - tag) * 1000.0)
 # the mapping is late by the reports' transit, in [0, rtt]: the error of each
@@ -167,22 +184,30 @@ lates = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "lat
 # lookahead on a loaded machine) is not on time by design: it fires at once and
 # is reported late with its lateness (docs/pd-osc.md). Each strike more than
 # 1 ms late must be one of those, the report's lateness its own error within
-# 1 ms; and most strikes must be on time, or the run judged too little: it is
-# inconclusive and CTest's command (ictus_tools.retry) runs it again.
+# 1 ms; and most of the strikes this script sent as planned must be on time, or
+# the run judged too little: it is inconclusive and CTest's command
+# (ictus_tools.retry) runs it again.
 judged = [max(e - rtt_ms, 0.0) if e > 0 else -e for e in errors_ms]
 late_strikes = [(seq, e) for seq, e, j in zip(sorted(sent), errors_ms, judged) if j > 1.0]
 unexplained = unexplained_late(late_strikes, [a[2] for a in lates], 1.0 + rtt_ms)
-on_time = [j for j in judged if j <= 1.0]
+on_time = [j for seq, j in zip(sorted(sent), judged) if seq in planned and j <= 1.0]
 worst = max(on_time) if on_time else float("inf")
 if late_strikes:
     print("strikes handled late and reported late (seq, ms): %s" % late_strikes)
+if len(planned) < len(sent):
+    print("strikes this script sent later than planned (not judged on time): %s"
+          % sorted(set(sent) - planned))
 check(not unexplained,
       "every strike starts at its timetag (minus 10 ms for the second half, after 'latency 10') "
-      "within 1 ms (worst %.3f ms, %d of %d), or was handled late and reported so (%d; "
-      "unexplained: %s)" % (worst, len(on_time), N_STRIKES, len(late_strikes), unexplained))
-if len(on_time) < N_STRIKES - 4:
+      "within 1 ms (worst %.3f ms, %d of the %d sent as planned), or was handled late and "
+      "reported so (%d; unexplained: %s)"
+      % (worst, len(on_time), len(planned), len(late_strikes), unexplained))
+if len(planned) < 2 * HALF:
+    inconclusive("this script sent only %d of %d strikes as planned: it stalled past the "
+                 "lookahead again and again; too few to judge" % (len(planned), len(sent)))
+if len(on_time) < 2 * HALF - 4:
     inconclusive("%d of %d strikes on time, the rest handled late and reported so: the machine "
-                 "stalled past the lookahead; too few to judge" % (len(on_time), N_STRIKES))
+                 "stalled past the lookahead; too few to judge" % (len(on_time), len(planned)))
 
 t_arr, a = fires.get(late_seq, (None, None))
 check(a is not None, "the late bundle fired")
