@@ -5,7 +5,7 @@
  * size is commonly tuned: T = sigma (2 pi a f / j)^2 for the wanted f. */
 #include "membrane_presets.h"
 
-#include <string.h>
+#include "ictus_name.h"
 
 /* The cymbals' energy cascade: 1, the rate of the in-plane stress's frequency shift
  * (docs/plates.md, "The cascade"). */
@@ -84,7 +84,7 @@ const membrane_preset *membrane_preset_at(int index)
 const membrane_preset *membrane_preset_find(const char *name)
 {
     for (int i = 0; name && i < PRESET_COUNT; i++)
-        if (strcmp(presets[i].name, name) == 0)
+        if (ictus_name_equal(presets[i].name, name))
             return &presets[i];
     return NULL;
 }

@@ -62,7 +62,7 @@ typedef struct membrane_preset {
 /* The presets, in the order the docs list them; count via membrane_preset_count(). */
 int membrane_preset_count(void);
 const membrane_preset *membrane_preset_at(int index);
-/* The preset named `name`, or NULL. */
+/* The preset named `name`, in any casing ("Snare", "SNARE"), or NULL. */
 const membrane_preset *membrane_preset_find(const char *name);
 /* "snare, tom, ...": the names, for error messages; the drums' alone (not the
  * plates), for what takes a drum. */

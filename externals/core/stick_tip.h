@@ -21,6 +21,8 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "ictus_name.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -56,11 +58,11 @@ static inline double stick_tip_hertz_k(double e1, double nu1, double e2, double 
 /* The table, in the order wood, nylon, felt (stick_tip.c). */
 extern const stick_tip stick_tips[STICK_TIP_COUNT];
 
-/* The tip called name, or NULL. */
+/* The tip called name, in any casing ("Wood", "WOOD"), or NULL. */
 static inline const stick_tip *stick_tip_find(const char *name)
 {
     for (int i = 0; name && i < STICK_TIP_COUNT; i++)
-        if (strcmp(stick_tips[i].name, name) == 0)
+        if (ictus_name_equal(stick_tips[i].name, name))
             return &stick_tips[i];
     return NULL;
 }

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "ictus_pd.h"
+#include "ictus_name.h"
 #include "membrane_presets.h"
 #include "snare_wires.h"
 #include "m_imp.h" /* obj_starttraverseoutlet: is the second outlet connected? */
@@ -130,9 +131,11 @@ static int membrane_tilde_set_wires(t_membrane_tilde *x, int on)
 static void membrane_tilde_wires(t_membrane_tilde *x, t_symbol *s, int argc, t_atom *argv)
 {
     (void)s;
+    /* on and off in any casing, as the presets' names */
     if (argc == 1 && argv[0].a_type == A_SYMBOL &&
-        (argv[0].a_w.w_symbol == gensym("on") || argv[0].a_w.w_symbol == gensym("off")))
-        membrane_tilde_set_wires(x, argv[0].a_w.w_symbol == gensym("on"));
+        (ictus_name_equal(argv[0].a_w.w_symbol->s_name, "on") ||
+         ictus_name_equal(argv[0].a_w.w_symbol->s_name, "off")))
+        membrane_tilde_set_wires(x, ictus_name_equal(argv[0].a_w.w_symbol->s_name, "on"));
     else if (argc == 1 && argv[0].a_type == A_FLOAT &&
              (argv[0].a_w.w_float == 0 || argv[0].a_w.w_float == 1))
         membrane_tilde_set_wires(x, argv[0].a_w.w_float == 1);

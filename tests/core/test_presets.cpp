@@ -4,6 +4,7 @@
 // follow the ratios Rossing measured on kettle-loaded heads (written out here).
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cctype>
 #include <cmath>
 #include <random>
 #include <string>
@@ -45,8 +46,19 @@ TEST_CASE("Every preset is found by its name, and the names line lists them all"
         REQUIRE(p);
         CHECK(std::string(p->name) == name);
         CHECK(names.find(name) != std::string::npos);
+        // any casing names the same preset, as ictusd's --drum-preset takes words
+        std::string upper = name, mixed = name;
+        for (size_t i = 0; i < upper.size(); ++i) {
+            upper[i] = static_cast<char>(std::toupper(static_cast<unsigned char>(upper[i])));
+            if (i % 2 == 0)
+                mixed[i] = upper[i];
+        }
+        CHECK(membrane_preset_find(upper.c_str()) == p);
+        CHECK(membrane_preset_find(mixed.c_str()) == p);
     }
     CHECK(membrane_preset_find("bongo") == nullptr);
+    CHECK(membrane_preset_find("snares") == nullptr);
+    CHECK(membrane_preset_find("snar") == nullptr);
     CHECK(membrane_preset_find(nullptr) == nullptr);
     CHECK(membrane_preset_at(10) == nullptr);
     // the drums' list leaves the plates out

@@ -72,6 +72,10 @@ TEST_CASE("Stick tips: the table follows its sources", "[core][stick_tip]")
     REQUIRE(nylon);
     REQUIRE(felt);
     CHECK(stick_tip_find("steel") == nullptr);
+    CHECK(stick_tip_find("Wood") == wood); // any casing
+    CHECK(stick_tip_find("NYLON") == nylon);
+    CHECK(stick_tip_find("fElT") == felt);
+    CHECK(stick_tip_find("woo") == nullptr);
     CHECK(stick_tip_find(nullptr) == nullptr);
     // Hertz, sphere of 7 mm on a Mylar half-space: 4.73e8 and 2.34e8 N/m^1.5
     // (Johnson eq. 4.22, computed by hand in docs/sound.md).
