@@ -47,6 +47,10 @@
  * `expect ADDRESS TAGS` makes messages to ADDRESS with other type tags
  * malformed, so that a fixed namespace reaches the patch only as specified.
  *
+ * `host NAME` answers whether [netreceive] could listen on NAME here: `host 1 NAME`
+ * or `host 0 NAME` on the info outlet (ictus-receive checks its HOST so, to name a bad
+ * one itself and listen on loopback instead).
+ *
  * Outlets, right to left: info (`late <ms_late> <count>` per late bundle,
  * `malformed <count> <reason>` per bad packet, `status ...` on request), the
  * delay (float, ms), the message bytes (list). */
@@ -54,6 +58,18 @@
 #include <stdint.h>
 #include <string.h>
 #include <time.h>
+
+#ifdef _WIN32
+#include <winsock2.h>
+#include <ws2tcpip.h>
+#define ictus_closesocket closesocket
+#else
+#include <netdb.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+#define ictus_closesocket close
+#endif
 
 #include "m_pd.h"
 
@@ -509,6 +525,61 @@ static void ictus_timetag_expect(t_ictus_timetag *x, t_symbol *s, int argc, t_at
         x->x_expect_count++;
 }
 
+/* Whether a UDP socket can listen on `name` here, as [netreceive] would: the name
+ * resolves (getaddrinfo, passive, as netreceive looks it up) to an address of this
+ * machine, which a socket binds (on port 0, any free one: the check never takes the port
+ * the patch asks for), or to a multicast group (netreceive joins it). A name looked up in
+ * DNS blocks as netreceive's own lookup then does. */
+static int ictus_timetag_host_usable(const char *name)
+{
+    struct addrinfo hints, *list = NULL, *a;
+    int usable = 0;
+    memset(&hints, 0, sizeof(hints));
+    hints.ai_family = AF_UNSPEC;
+    hints.ai_socktype = SOCK_DGRAM;
+    hints.ai_flags = AI_PASSIVE;
+    if (getaddrinfo(name, NULL, &hints, &list) != 0)
+        return 0;
+    for (a = list; a && !usable; a = a->ai_next) {
+        if (a->ai_family == AF_INET) {
+            const struct sockaddr_in *in = (const struct sockaddr_in *)a->ai_addr;
+            if ((ntohl(in->sin_addr.s_addr) >> 28) == 0xE) { /* 224.0.0.0/4 */
+                usable = 1;
+                break;
+            }
+        } else if (a->ai_family == AF_INET6) {
+            const struct sockaddr_in6 *in6 = (const struct sockaddr_in6 *)a->ai_addr;
+            if (IN6_IS_ADDR_MULTICAST(&in6->sin6_addr)) {
+                usable = 1;
+                break;
+            }
+        }
+        int fd = (int)socket(a->ai_family, a->ai_socktype, a->ai_protocol);
+        if (fd < 0)
+            continue;
+        usable = bind(fd, a->ai_addr, (int)a->ai_addrlen) == 0;
+        ictus_closesocket(fd);
+    }
+    freeaddrinfo(list);
+    return usable;
+}
+
+/* host NAME: `host 1 NAME` when [netreceive] can listen on NAME here, else `host 0 NAME`,
+ * on the info outlet. */
+static void ictus_timetag_host(t_ictus_timetag *x, t_symbol *s, int argc, t_atom *argv)
+{
+    t_atom answer[2];
+    (void)s;
+    if (argc != 1 || argv[0].a_type != A_SYMBOL) {
+        pd_error(x, "ictus_timetag: host needs one NAME (an interface's name or address); "
+                    "ignored");
+        return;
+    }
+    SETFLOAT(&answer[0], (t_float)ictus_timetag_host_usable(argv[0].a_w.w_symbol->s_name));
+    SETSYMBOL(&answer[1], argv[0].a_w.w_symbol);
+    outlet_anything(x->x_info_out, gensym("host"), 2, answer);
+}
+
 static void ictus_timetag_reset(t_ictus_timetag *x)
 {
     x->x_late_count = x->x_malformed_count = x->x_packet_count = 0;
@@ -563,4 +634,5 @@ ICTUS_EXPORT void ictus_timetag_setup(void)
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_reset, gensym("reset"), 0);
     class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_expect, gensym("expect"), A_GIMME,
                     0);
+    class_addmethod(ictus_timetag_class, (t_method)ictus_timetag_host, gensym("host"), A_GIMME, 0);
 }

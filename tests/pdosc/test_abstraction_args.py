@@ -11,8 +11,15 @@ mixed with a = 5, b = -4, and no later width message could bring it back).
 [ictus-receive PORT HOST] and its listen message (docs/pd-osc.md): a PORT that is not a whole
 number in 0..65535 is refused by name and nothing listens ([netreceive] took 70000 as 70000 mod
 65536 and bound port 4464 without a word, -5 and symbols said nothing or named [netreceive]); a
-HOST that is not a symbol falls back to loopback, said so; extra arguments are said. Read from
-the kernel's table of UDP sockets (/proc/net/udp) while pd runs, in real time.
+HOST that is not a symbol, or not one [netreceive] can listen on here (seeded random dotted
+words like 1.2.3, addresses of the documentation networks, a name that does not resolve), falls
+back to loopback, said so by ictus-receive (it was [netreceive]'s "listen failed: Cannot assign
+requested address", and nothing listened); extra arguments are said. Read from the kernel's
+table of UDP sockets (/proc/net/udp) while pd runs, in real time.
+
+[ictus-drum] and [ictus-midi] take no arguments (their help): any given is an error naming the
+abstraction and quoting it, and is ignored: the drum renders the same samples, the MIDI panel
+sends the same notes (they were taken without a word).
 
 [ictus-midifile CHANNEL] and its channel message (docs/midi.md): 0 or a whole 1..16; out of
 range clamped, a symbol refused, extra arguments said, each by name ([ictus-midifile foo] left an
@@ -42,6 +49,7 @@ the clamp names sounds for its hit line on the prefix's names, the bad number's 
 """
 import argparse
 import os
+import random
 import subprocess
 import time
 
@@ -115,6 +123,15 @@ def bound_ports():
 
 def receive_args(build):
     wrap, host5, extra, later, ok = (free_udp_port() for _ in range(5))
+    rng = random.Random(20261203)
+    # a.b.c is the IPv4 address a.b.0.c: a public unicast one (not loopback, a private or
+    # link-local network, nor a multicast group, which netreceive joins)
+    public = [a for a in range(1, 224) if a not in (10, 100, 127, 169, 172, 192)]
+    bad_hosts = ["%d.%d.%d" % (rng.choice(public), rng.randint(0, 255), rng.randint(1, 254)),
+                 "%s.%d" % (rng.choice(["192.0.2", "198.51.100", "203.0.113"]), rng.randint(1, 254)),
+                 "nosuchhost.invalid"]
+    host_line = ("ictus-receive: HOST must be an interface's name or address (127.0.0.1 or "
+                 "0.0.0.0) - using 127.0.0.1 - got: ")
     # (arguments or listen message, the port it must bind or None, error lines expected)
     cases = [
         ("%d" % (wrap + 65536), None, ["ictus-receive: PORT must be a whole number in 0..65535 "
@@ -130,6 +147,11 @@ def receive_args(build):
         ("listen", None, ["ictus-receive: listen needs a PORT in 0..65535 (0: stop)"]),
         ("%d" % ok, ok, []),
     ]
+    for host in bad_hosts:
+        port = free_udp_port()
+        cases.append(("%d %s" % (port, host), port, [host_line + host]))
+    port = free_udp_port()
+    cases.append(("listen %d %s" % (port, bad_hosts[0]), port, [host_line + bad_hosts[0]]))
     p = Patch()
     lb = p.obj("loadbang")
     for arg, _, _ in cases:
@@ -345,6 +367,49 @@ def kit_drum_args(build):
               % (arg, want, prefix, peaks[0], other, peaks[1]))
 
 
+def drum_midi_args(build):
+    rng = random.Random(20261203)
+    drum_args = ["5", "%d" % rng.randint(-9, 99), rng.choice(["foo", "snare", "Tom"]),
+                 "%g %s" % (rng.uniform(-5, 5), rng.choice(["a", "b"]))]
+    midi_args = ["20", "%d" % rng.randint(1, 16), rng.choice(["on", "in", "x"]) + " 3"]
+    p = Patch()
+    lb = p.obj("loadbang")
+    tables = []
+    for i, arg in enumerate([""] + drum_args):
+        d = p.obj("ictus-drum %s" % arg)
+        m = p.msg("1 2 0.3 0")
+        p.connect(lb, 0, m, 0)
+        p.connect(m, 0, d, 0)
+        tables.append((d, 0, "d%d" % i))
+    for i, arg in enumerate([""] + midi_args):
+        panel = p.obj("ictus-midi %s" % arg)
+        m = p.msg("on 1 \\, 1 2 0.3 0")
+        p.connect(lb, 0, m, 0)
+        p.connect(m, 0, panel, 0)
+        p.connect(panel, 0, p.obj("print midi%d" % i), 0)
+    work = make_workdir("ictus-pdosc-args-")
+    wav = os.path.join(work, "drums.wav")
+    recorder(p, tables, SECONDS, SR, wav)
+    rc, log = run_pd(p.text(), os.path.join(build, "ictus"), sr=SR, workdir=work)
+    check(rc == 0, "pd ran (rc %d)" % rc)
+    want = ["error: ictus-drum: takes no arguments - ignored - got: %s" % a for a in drum_args]
+    want += ["error: ictus-midi: takes no arguments - ignored - got: %s" % a for a in midi_args]
+    lines = [l for l in log.splitlines() if l.startswith("error:")]
+    check(sorted(lines) == sorted(want), "one error line per abstraction given arguments, quoting "
+          "them: %s (want %s)" % (lines, want))
+    y, _ = read_wav_float(wav)
+    check(np.abs(y[:, 0]).max() > 1e-4, "[ictus-drum] sounds")
+    for i, arg in enumerate(drum_args):
+        check(np.array_equal(y[:, i + 1], y[:, 0]),
+              "[ictus-drum %s] renders [ictus-drum]'s samples: the argument is ignored" % arg)
+    notes = [sorted(l.split(":", 1)[1] for l in log.splitlines() if l.startswith("midi%d:" % i))
+             for i in range(len(midi_args) + 1)]
+    check(len(notes[0]) == 1, "[ictus-midi] sends a note for the strike: %s" % notes[0])
+    for i, arg in enumerate(midi_args):
+        check(notes[i + 1] == notes[0],
+              "[ictus-midi %s] sends [ictus-midi]'s note %s: %s" % (arg, notes[0], notes[i + 1]))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", required=True)
@@ -356,6 +421,7 @@ def main():
     render_seconds(build)
     timetag_args(build)
     kit_drum_args(build)
+    drum_midi_args(build)
     if failed():
         raise SystemExit(1)
     print("ok")
