@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <random>
 #include <regex>
@@ -291,6 +292,14 @@ TEST_CASE("ictusd track: a stick-only capture runs in Cartesian mode, drum fitte
     std::ifstream js_none(dir_none + "/summary.json");
     CHECK(nlohmann::json::parse(js_none).at("limits") == "none");
 
+    // A stick named in another casing than the capture's (stick_l, stick_r) is that object.
+    const Run cased = ictusd("track --mode cartesian --quiet --mocap " + csv +
+                             " --units mm --up z --duration 0.3 --left-stick STICK_L "
+                             "--right-stick Stick_R --out " +
+                             dir_none + "_cased");
+    INFO(cased.output);
+    CHECK(cased.status == 0);
+
     // Bad stick options and drum values are usage errors naming the thing.
     Run bad = ictusd("track --mode cartesian --quiet --mocap " + csv +
                      " --units mm --up z --left-stick nope");
@@ -313,6 +322,46 @@ TEST_CASE("ictusd track: a stick-only capture runs in Cartesian mode, drum fitte
     CHECK(bad.output.find("--units") != std::string::npos);
     bad = ictusd("track --mode cartesian --quiet --mocap " + csv + " --up x");
     CHECK(bad.status == 2);
+}
+
+TEST_CASE("ictusd gestures --import: sticks named in another casing, and a level far from "
+          "the stroke's height said",
+          "[cli]")
+{
+    // Two sticks bouncing off the head (|sin|: a V at each strike), 12 cm, 2 strokes/s
+    // each, z up, mm, the objects named Stick_L and Stick_R.
+    std::ostringstream out;
+    out << "time,Stick_L.x,Stick_L.y,Stick_L.z,Stick_R.x,Stick_R.y,Stick_R.z\n";
+    for (int f = 0; f < 800; ++f) {
+        const double t = f / 200.0;
+        out << t;
+        for (int s = 0; s < 2; ++s)
+            out << ',' << (s == 0 ? 1150.0 : 850.0) << ",2000,"
+                << 700.0 + 120.0 * std::abs(std::sin(2 * M_PI * t + (s == 0 ? 0 : M_PI / 2)));
+        out << '\n';
+    }
+    const std::string csv = simtest::write_temp("bouncing_sticks.csv", out.str());
+    const std::string base = "gestures --import " + csv +
+                             " --units mm --up z --grip french --nuance legato --hand right "
+                             "--left-stick stick_l --right-stick STICK_R --out " +
+                             simtest::temp_path("cased_sticks.json");
+    const Run mf = ictusd(base);
+    INFO(mf.output);
+    REQUIRE(mf.status == 0);
+    CHECK(mf.output.find("importing stroke") != std::string::npos);
+    CHECK(mf.output.find("warning") == std::string::npos); // 12 cm: about the model's mf
+    // --dynamics 0 (ppp): the model's softest stroke rises 1.5 cm; played at mf this one
+    // rises its height x 0.36 x 0.6^1.3 / 0.015 (docs/gestures.md), and that is said.
+    const Run ppp = ictusd(base + " --dynamics 0");
+    INFO(ppp.output);
+    REQUIRE(ppp.status == 0);
+    std::smatch prep, rise;
+    REQUIRE(std::regex_search(ppp.output, prep, std::regex("preparation ([0-9.e-]+) m")));
+    REQUIRE(std::regex_search(ppp.output, rise,
+                              std::regex("warning: --dynamics 0: .* played at mf \\(0.6\\) it "
+                                         "will rise ([0-9.e-]+) m")));
+    CHECK(std::stod(rise[1]) ==
+          Approx(std::stod(prep[1]) * 0.36 * std::pow(0.6, 1.3) / 0.015).epsilon(1e-4));
 }
 
 TEST_CASE("ictusd track --gains overrides one joint and refuses bad files", "[cli]")

@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
+#include <vector>
 
 using namespace ictus;
 
@@ -432,7 +434,7 @@ TEST_CASE("instantiate: model units regenerated, imported units scaled, fallback
     for (int k = 0; k < fb.samples(); ++k)
         REQUIRE(fb.tip_m[k] == direct.tip_m[k]);
 
-    // An imported unit: heights scale by (d / d0)^1.3 (d clamped to 0.04 .. 1).
+    // An imported unit: heights scale by (d / d0)^1.3 above the model's floor (d = 0.087).
     GestureUnit imported = stroke_model(Grip::french, Nuance::legato, Side::right, 0.6);
     imported.source = "mine.csv";
     for (auto &p : imported.tip_m)
@@ -451,12 +453,49 @@ TEST_CASE("instantiate: model units regenerated, imported units scaled, fallback
     for (int step = 2; step <= 50; ++step) { // from d = 0.04, where the clamp ends
         const double v = db.instantiate(Grip::french, Nuance::legato, Side::right, step / 50.0)
                              .impact_speed_mps();
-        REQUIRE(v > previous);
+        if (step / 50.0 > 0.09) // above the floor, where every softer level is the floor's
+            REQUIRE(v > previous);
+        else
+            REQUIRE(v == Approx(previous == 0.0 ? v : previous));
         previous = v;
     }
     // Others fall back to the builtin.
     REQUIRE(db.find(Grip::french, Nuance::accent, Side::right) == nullptr);
     CHECK(db.instantiate(Grip::french, Nuance::accent, Side::right, 0.6).source == "model");
+}
+
+TEST_CASE("instantiate: an imported unit of level d0 played at d has the model's height at d, "
+          "down to level 0 (the model's softest stroke)",
+          "[gesture][db]")
+{
+    // A capture that is the model's legato at d0, imported as representing d0: played
+    // at d, its preparation height is the model's at d, max(1.5 cm, 0.36 m x d^1.3)
+    // (docs/gestures.md), whatever d0 and d, the floor's levels (d < 0.087) included.
+    std::mt19937 rng(20261203);
+    std::uniform_real_distribution<double> level(0.0, 1.0);
+    std::vector<std::pair<double, double>> cases = {
+        {0.0, 0.6}, {0.0, 1.0}, {0.0, 0.0}, {0.02, 0.6}, {0.04, 0.3}, {0.6, 0.0}, {1.0, 0.05}};
+    for (int k = 0; k < 40; ++k)
+        cases.emplace_back(level(rng) * (k % 2 ? 1.0 : 0.12), level(rng));
+    for (const auto &[d0, d] : cases) {
+        GestureUnit imported = stroke_model(Grip::french, Nuance::legato, Side::right, d0);
+        imported.source = "capture.csv";
+        GestureDatabase db;
+        db.add(imported);
+        const double expected = std::max(0.015, 0.36 * std::pow(d, 1.3));
+        INFO("d0 " << d0 << ", d " << d);
+        CHECK(db.instantiate(Grip::french, Nuance::legato, Side::right, d).preparation_height_m() ==
+              Approx(expected).epsilon(1e-9));
+    }
+    // Level 0 at mf: 12.3x the softest stroke's height (0.36 x 0.6^1.3 / 0.015), not the
+    // 34x (0.6 / 0.04)^1.3 of a level the model never plays.
+    GestureUnit ppp = stroke_model(Grip::french, Nuance::legato, Side::right, 0.0);
+    ppp.source = "capture.csv";
+    GestureDatabase db;
+    db.add(ppp);
+    CHECK(db.instantiate(Grip::french, Nuance::legato, Side::right, 0.6).preparation_height_m() /
+              ppp.preparation_height_m() ==
+          Approx(0.36 * std::pow(0.6, 1.3) / 0.015).epsilon(1e-9));
 }
 
 TEST_CASE("a unit with two periods: the downswing of the one before, the lift of the one after, "

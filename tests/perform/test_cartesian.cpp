@@ -12,6 +12,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cctype>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -228,6 +229,42 @@ TEST_CASE("stick-only: the sticks are found by name, or by the default names", "
                       Catch::Contains("same object"));
     c.tracks[1].name = "head";
     CHECK_THROWS_WITH(find_stick_tracks(c, "", ""), Catch::Contains("no right stick"));
+}
+
+TEST_CASE("stick-only: a stick named in another casing is its object, unless two are so named",
+          "[perform][cartesian]")
+{
+    MarkerCapture c = synthetic_strokes(0.1);
+    // Seeded random casings of the capture's own names, never the names as written.
+    std::mt19937 rng(20261203);
+    const auto recase = [&rng](const std::string &name) {
+        std::string out;
+        do {
+            out = name;
+            for (char &ch : out)
+                ch = static_cast<char>(rng() % 2 ? std::toupper(static_cast<unsigned char>(ch))
+                                                 : std::tolower(static_cast<unsigned char>(ch)));
+        } while (out == name);
+        return out;
+    };
+    for (int trial = 0; trial < 40; ++trial) {
+        const std::string left = recase("Left Stick"), right = recase("RightStick");
+        INFO(left << " / " << right);
+        CHECK(find_stick_tracks(c, left, right) == std::array<int, 2>{0, 1});
+        CHECK(find_stick_tracks(c, right, left) == std::array<int, 2>{1, 0});
+    }
+    // The name as written wins over another casing of it.
+    c.tracks.push_back(c.tracks[0]);
+    c.tracks.back().name = "LEFT STICK";
+    CHECK(find_stick_tracks(c, "LEFT STICK", "") == std::array<int, 2>{2, 1});
+    CHECK(find_stick_tracks(c, "Left Stick", "") == std::array<int, 2>{0, 1});
+    // Two objects in other casings: which one is meant is not guessed.
+    CHECK_THROWS_WITH(find_stick_tracks(c, "left stick", ""),
+                      Catch::Contains("--left-stick") && Catch::Contains("Left Stick, LEFT STICK"));
+    // No object in any casing: the error lists the capture's objects.
+    CHECK_THROWS_WITH(find_stick_tracks(c, "", "Right Stick"),
+                      Catch::Contains("--right-stick") &&
+                          Catch::Contains("objects: Left Stick, RightStick, LEFT STICK"));
 }
 
 TEST_CASE("stick-only: placement behind the sticks and the drum under the strokes",

@@ -45,11 +45,29 @@ std::array<int, 2> find_stick_tracks(const MarkerCapture &capture, const std::st
     const char *part[2] = {"left", "right"};
     for (int s = 0; s < 2; ++s) {
         if (!given[s].empty()) {
+            const std::string option = s == 0 ? "--left-stick" : "--right-stick";
+            // The name as written, else the one object that matches it in another casing:
+            // a capture's names are its maker's ("Stick_L", "STICK_L"), a user types one.
             found[s] = capture.find(given[s]);
+            if (found[s] < 0) {
+                std::vector<int> other; // the objects spelt so in another casing
+                for (size_t i = 0; i < capture.tracks.size(); ++i)
+                    if (lower(capture.tracks[i].name) == lower(given[s]))
+                        other.push_back(static_cast<int>(i));
+                if (other.size() > 1) {
+                    std::string spelt;
+                    for (int i : other)
+                        spelt += (spelt.empty() ? "" : ", ") + capture.tracks[i].name;
+                    throw CharacterError(option + ": no object '" + given[s] +
+                                         "' in the capture, and several in other casings (" +
+                                         spelt + "); give one as written");
+                }
+                if (other.size() == 1)
+                    found[s] = other[0];
+            }
             if (found[s] < 0)
-                throw CharacterError(std::string(s == 0 ? "--left-stick" : "--right-stick") +
-                                     ": no object '" + given[s] +
-                                     "' in the capture (objects: " + names + ")");
+                throw CharacterError(option + ": no object '" + given[s] +
+                                     "' in the capture, in any casing (objects: " + names + ")");
             continue;
         }
         for (size_t i = 0; i < capture.tracks.size() && found[s] < 0; ++i)

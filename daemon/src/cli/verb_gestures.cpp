@@ -38,7 +38,8 @@ void gestures_usage(std::ostream &out)
            "                     median impact speed to the database (IN, else the built-in)\n"
            "                     and write it to --out\n"
            "  --stroke K         import stroke K (0-based) instead of the median one\n"
-           "  --dynamics D       the level the captured strokes represent (default 0.6)\n"
+           "  --dynamics D       the level the captured strokes represent, 0 (ppp) .. 1 (fff)\n"
+           "                     (default 0.6)\n"
            "  --scale M, --skip-frames N   BVH reading (default 0.056444, 1)\n"
            "  --units mm|m, --up y|z, --rate HZ, --left-stick NAME, --right-stick NAME\n"
            "                     CSV reading (as ictusd track)\n"
@@ -136,6 +137,18 @@ int cmd_gestures(Args &args)
               << " (strike at " << chosen.capture_time_s + chosen.strike_time_s() << " s, impact "
               << chosen.impact_speed_mps() << " m/s, preparation " << chosen.preparation_height_m()
               << " m)\n";
+    // The unit's heights scale from --dynamics (docs/gestures.md, "Dynamics rule"): a level
+    // far from the model's for a stroke of that height is said, with what mf will make of it.
+    const double model_m = stroke_model(g, n, h, dynamics, chosen.period_s).preparation_height_m();
+    const double ratio = chosen.preparation_height_m() / model_m;
+    if (ratio > 3.0 || ratio < 1.0 / 3.0)
+        std::cerr << "ictusd gestures: warning: --dynamics " << dynamics << ": the stroke rises "
+                  << chosen.preparation_height_m() << " m, the model's " << to_string(n)
+                  << " at that level " << model_m << " m (" << ratio
+                  << "x); played at mf (0.6) it will rise "
+                  << chosen.preparation_height_m() * dynamics_height_level(0.6) /
+                         dynamics_height_level(dynamics)
+                  << " m\n";
     db.add(chosen);
     db.save_json(out_path);
     std::cout << "wrote " << db.units().size() << " units to " << out_path << "\n";

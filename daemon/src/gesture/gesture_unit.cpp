@@ -220,7 +220,7 @@ GestureUnit GestureDatabase::instantiate(Grip g, Nuance n, Side h, double dynami
     const double d = std::clamp(dynamics, 0.0, 1.0);
     // Heights (and with them vertical velocities) scale with the dynamics
     // rule; timing and the horizontal path are kept.
-    const double k = dynamics_height_factor(d) / dynamics_height_factor(u.dynamics);
+    const double k = dynamics_height_level(d) / dynamics_height_level(u.dynamics);
     for (auto &p : u.tip_m)
         p.y() *= k;
     u.dynamics = d;

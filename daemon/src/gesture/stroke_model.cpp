@@ -131,6 +131,11 @@ double height(const NuanceShape &s, double H, double H_lift, double D, double L,
 
 } // namespace
 
+double dynamics_height_level(double dynamics)
+{
+    return std::max(dynamics_height_factor(dynamics), kMinHeight_m / kLegatoHeightFff_m);
+}
+
 GestureUnit stroke_model(Grip g, Nuance n, Side h, double dynamics, double period_s)
 {
     return stroke_model(g, n, h, dynamics, period_s, period_s);

@@ -26,9 +26,11 @@ struct TipTrajectory {
 };
 
 // The tracked objects used as the left and right stick tips: `left`/`right`
-// when not empty (exact names), else the first object whose name, case-
-// insensitively, is stick_l / stick_r, or else contains "left" / "right".
-// Throws CharacterError naming the missing object and listing the names.
+// when not empty (the object of that exact name, else the one object of that
+// name in another casing; several such are an error naming them), else the
+// first object whose name, case-insensitively, is stick_l / stick_r, or else
+// contains "left" / "right". Throws CharacterError naming the missing object
+// and listing the names.
 std::array<int, 2> find_stick_tracks(const MarkerCapture &capture, const std::string &left,
                                      const std::string &right);
 
