@@ -4,7 +4,9 @@ A test builds a patch from a list of boxes and connections, runs
 `pd -nogui -nosound -batch -stderr`, and reads back what the patch wrote into a
 table (32-bit float WAV via soundfiler, see docs/externals.md)."""
 import atexit
+import fcntl
 import os
+import random
 import re
 import shutil
 import socket
@@ -62,13 +64,66 @@ class Patch:
         return "\n".join(self.lines) + "\n"
 
 
+# Ports the tests listen on are drawn from below the kernel's ephemeral range
+# (net.ipv4.ip_local_port_range), where the kernel never hands one to another
+# process's unbound socket, and each is reserved by a lock file held until this
+# process exits, so that tests running side by side never draw the same one.
+PORT_LOCK_DIR = os.path.join(tempfile.gettempdir(), "ictus-test-ports")
+_held_port_locks = []
+
+
+def _port_candidates():
+    try:
+        with open("/proc/sys/net/ipv4/ip_local_port_range") as f:
+            low, high = (int(v) for v in f.read().split())
+    except (OSError, ValueError):
+        low, high = 32768, 60999
+    if low - 20000 >= 2000:
+        return range(20000, low)
+    if 65535 - high >= 2000:
+        return range(high + 1, 65536)
+    return range(max(1024, low), high + 1)
+
+
+def _bindable(port, kind):
+    with socket.socket(socket.AF_INET, kind) as s:
+        try:
+            s.bind(("127.0.0.1", port))
+        except OSError:
+            return False
+    return True
+
+
+def free_port(kind=socket.SOCK_DGRAM):
+    """A port on 127.0.0.1 that is free (UDP, or TCP with kind=socket.SOCK_STREAM),
+    outside the ephemeral range and reserved for this process (see above)."""
+    if not os.path.isdir(PORT_LOCK_DIR):
+        os.makedirs(PORT_LOCK_DIR, exist_ok=True)
+        try:
+            os.chmod(PORT_LOCK_DIR, 0o1777)  # shared by every user's tests, as /tmp is
+        except OSError:
+            pass
+    candidates = _port_candidates()
+    rng = random.SystemRandom()
+    for _ in range(2000):
+        port = rng.choice(candidates)
+        fd = os.open(os.path.join(PORT_LOCK_DIR, "%d.lock" % port), os.O_CREAT | os.O_RDWR, 0o666)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue
+        if _bindable(port, kind):
+            _held_port_locks.append(fd)
+            return port
+        os.close(fd)
+    raise RuntimeError("no free port in %d..%d after 2000 tries"
+                       % (candidates[0], candidates[-1]))
+
+
 def free_udp_port():
-    """A UDP port on 127.0.0.1 that was free a moment ago."""
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
+    """A UDP port on 127.0.0.1 that is free and reserved for this process."""
+    return free_port(socket.SOCK_DGRAM)
 
 
 def recorder(p, tables, seconds, sr, wav_path, quit_extra=None):

@@ -45,6 +45,7 @@ class PdLines:
     def _read(self, stream):
         for line in stream:
             self.queue.put(line.rstrip("\n"))
+        self.queue.put(None)  # the process closed its output: it has ended
 
     def wait_for(self, pred, what, timeout=60):
         deadline = time.time() + timeout
@@ -53,10 +54,32 @@ class PdLines:
                 line = self.queue.get(timeout=0.2)
             except queue.Empty:
                 continue
+            if line is None:
+                self.queue.put(None)  # a later wait fails at once too
+                fail("%s: the process ended first (it printed, last lines: %s)"
+                     % (what, self.printed[-25:]))
             self.printed.append(line)
             if pred(line):
                 return line
         fail("%s within %g s (pd printed, last lines: %s)" % (what, timeout, self.printed[-25:]))
+
+    def next_line(self, timeout):
+        """The next line within `timeout` s, else "" (none yet); None once the process ended."""
+        try:
+            line = self.queue.get(timeout=timeout)
+        except queue.Empty:
+            return ""
+        if line is None:
+            self.queue.put(None)
+        else:
+            self.printed.append(line)
+        return line
+
+    def drain(self, timeout=30):
+        """After the process was stopped: every line it printed, up to its end (or the deadline)."""
+        deadline = time.time() + timeout
+        while time.time() < deadline and self.next_line(0.2) is not None:
+            pass
 
 
 def skip_or_fail(reason, missing_package=False):

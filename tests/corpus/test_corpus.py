@@ -26,6 +26,8 @@ import sys
 import tempfile
 import time
 
+from ictus_tools.pdrun import free_port
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 failures = []
@@ -141,15 +143,9 @@ def part_kill(py, build, work):
         complete(os.path.join(out, d)) for d in items(out)), "then all 6 items are complete")
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def part_cluster(py, build, work):
     bindir = os.path.dirname(py)
-    port = free_port()
+    port = free_port(socket.SOCK_STREAM)
     url = "tcp://127.0.0.1:%d" % port
     procs = []
     try:

@@ -26,7 +26,6 @@ import socket
 import subprocess
 import tempfile
 import time
-import queue
 
 from ictus_tools import e2e_util, uitest
 from ictus_tools.checks import check
@@ -168,11 +167,9 @@ def main():
         # score lasts 6 s, its longest gap 1.2 s), within 180 s
         start, last = time.time(), None
         while time.time() - start < 180 and (last is None or time.time() - last < 6.0):
-            try:
-                line = lines.queue.get(timeout=0.2)
-            except queue.Empty:
-                continue
-            lines.printed.append(line)
+            line = lines.next_line(0.2)
+            if line is None:
+                break  # pd ended: the checks below say what is missing
             w = line.split() or [""]
             if w[0] == "strike:":
                 strikes.append(int(float(w[9])))
@@ -192,9 +189,7 @@ def main():
             daemon.kill()
             daemon.wait()
         uitest.stop(pd)
-    time.sleep(0.5)  # what pd printed last, read by the thread
-    while not lines.queue.empty():
-        lines.printed.append(lines.queue.get())
+    lines.drain()  # what pd printed last
     with open(os.path.join(work, "strikes.csv")) as f:
         rows = {int(r["seq"]): r for r in csv.DictReader(f)}
     # the kit as published: each drum's note is the GM map's

@@ -28,6 +28,7 @@ import threading
 import time
 
 from ictus_tools import oscpacket as osc
+from ictus_tools.pdrun import free_udp_port
 
 DEFAULT_SCORE_STRIKES = 32  # the built-in score's notes (score.cpp, default_score_text)
 # Wall-clock deadlines allow a daemon four times slower than real time (a sanitizer build).
@@ -41,14 +42,6 @@ RSS_BOUND_MB = 16  # docs/osc.md: 10000 statements of ~250 bytes, twice (a play 
 def fail(text):
     print("FAIL: " + text)
     sys.exit(1)
-
-
-def free_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def parse_strings(data, pos):
@@ -127,7 +120,7 @@ class Listener:
 
 class Daemon:
     def __init__(self, ictusd, args, out_dir, listener, stderr):
-        self.port = free_port()
+        self.port = free_udp_port()
         self.out_dir = out_dir
         cmd = [ictusd, "run", "--port", str(self.port), "--pose-rate", "0", "--out", out_dir,
                "--target", "osc.udp://127.0.0.1:%d" % listener.port] + args

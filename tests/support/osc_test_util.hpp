@@ -9,16 +9,22 @@
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <random>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace osctest
@@ -43,18 +49,63 @@ inline const char *lo_arg_string(const lo_arg *a)
     return reinterpret_cast<const char *>(a);
 }
 
-// A port that was free a moment ago (bound to port 0 and closed).
-inline int free_udp_port()
+// Ports the tests listen on are drawn from below the kernel's ephemeral range
+// (net.ipv4.ip_local_port_range), where the kernel never hands one to another
+// process's unbound socket, and each is reserved by a lock file held until this
+// process exits, so that tests running side by side never draw the same one.
+// python/ictus_tools/pdrun.py draws from the same range with the same locks.
+inline std::pair<int, int> port_candidates()
 {
-    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+    int low = 32768, high = 60999;
+    if (FILE *f = std::fopen("/proc/sys/net/ipv4/ip_local_port_range", "r")) {
+        if (std::fscanf(f, "%d %d", &low, &high) != 2) {
+            low = 32768;
+            high = 60999;
+        }
+        std::fclose(f);
+    }
+    if (low - 20000 >= 2000)
+        return {20000, low - 1};
+    if (65535 - high >= 2000)
+        return {high + 1, 65535};
+    return {std::max(1024, low), high};
+}
+
+inline bool port_bindable(int port, int kind)
+{
+    const int fd = socket(AF_INET, kind | SOCK_CLOEXEC, 0);
     sockaddr_in sa{};
     sa.sin_family = AF_INET;
     sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    bind(fd, reinterpret_cast<sockaddr *>(&sa), sizeof sa);
-    socklen_t len = sizeof sa;
-    getsockname(fd, reinterpret_cast<sockaddr *>(&sa), &len);
+    sa.sin_port = htons(static_cast<uint16_t>(port));
+    const bool ok = bind(fd, reinterpret_cast<sockaddr *>(&sa), sizeof sa) == 0;
     close(fd);
-    return ntohs(sa.sin_port);
+    return ok;
+}
+
+// A UDP port on 127.0.0.1 that is free and reserved for this process (above).
+inline int free_udp_port()
+{
+    const char *tmp = std::getenv("TMPDIR");
+    const std::string dir = std::string(tmp && *tmp ? tmp : "/tmp") + "/ictus-test-ports";
+    if (mkdir(dir.c_str(), 0777) == 0)
+        chmod(dir.c_str(), 01777); // shared by every user's tests, as /tmp is
+    const auto [first, last] = port_candidates();
+    std::random_device rd;
+    std::mt19937 rng(rd());
+    std::uniform_int_distribution<int> pick(first, last);
+    for (int attempt = 0; attempt < 2000; ++attempt) {
+        const int port = pick(rng);
+        const std::string lock = dir + "/" + std::to_string(port) + ".lock";
+        const int fd = open(lock.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0666);
+        if (fd < 0)
+            continue;
+        if (flock(fd, LOCK_EX | LOCK_NB) == 0 && port_bindable(port, SOCK_DGRAM))
+            return port; // fd stays open: the reservation lasts as long as the process
+        close(fd);
+    }
+    std::fprintf(stderr, "osctest: no free UDP port in %d..%d after 2000 tries\n", first, last);
+    std::abort();
 }
 
 // Waits until something (a peer started as a child: oscdump -L PORT) has
