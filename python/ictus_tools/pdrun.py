@@ -68,7 +68,9 @@ class Patch:
 # (net.ipv4.ip_local_port_range), where the kernel never hands one to another
 # process's unbound socket, and each is reserved by a lock file held until this
 # process exits, so that tests running side by side never draw the same one.
-PORT_LOCK_DIR = os.path.join(tempfile.gettempdir(), "ictus-test-ports")
+# $TMPDIR, else /tmp: the same rule as the C++ twin (not tempfile's, which also reads TEMP
+# and TMP), so that both find the same reservations.
+PORT_LOCK_DIR = os.path.join(os.environ.get("TMPDIR") or "/tmp", "ictus-test-ports")
 _held_port_locks = []
 
 
