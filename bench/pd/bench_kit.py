@@ -89,7 +89,7 @@ def mode_counts():
     path = os.path.join(work, "count.pd")
     with open(path, "w") as f:
         f.write(bench.patch(0.01, kit(KIT, args.gap)))
-    err = subprocess.run(["pd", "-nogui", "-nosound", "-batch", "-stderr", "-r", str(args.sr),
+    err = subprocess.run(["pd", "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(args.sr),
                           "-open", path], capture_output=True, text=True, timeout=120).stderr
     counts = [int(m) for m in re.findall(r"membrane~ bench-kit-\d+: .*?, (\d+) modes,", err)]
     if len(counts) != len(KIT) or "error" in err.lower():

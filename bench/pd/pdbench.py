@@ -56,7 +56,7 @@ class Bench:
         for _ in range(self.runs):
             usage = resource.getrusage(resource.RUSAGE_CHILDREN)
             self.cpu_so_far = usage.ru_utime + usage.ru_stime  # not other children run before
-            proc = subprocess.Popen(["pd", "-nogui", "-nosound", "-batch", "-stderr", "-r",
+            proc = subprocess.Popen(["pd", "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r",
                                      str(self.sr), "-open", path], stdout=subprocess.PIPE,
                                     stderr=subprocess.PIPE, text=True)
             _, err = proc.communicate(timeout=1200)

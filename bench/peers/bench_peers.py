@@ -113,7 +113,7 @@ def pd_run(text, name, env=None):
     path = os.path.join(work, name + ".pd")
     with open(path, "w") as f:
         f.write(text)
-    cpu, out = run_cpu(["pd", "-nogui", "-nosound", "-batch", "-stderr", "-r", str(SR),
+    cpu, out = run_cpu(["pd", "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(SR),
                         "-open", path], env=env)
     if "error" in out.lower() or "couldn't" in out:
         raise SystemExit("%s: pd said:\n%s" % (name, out))

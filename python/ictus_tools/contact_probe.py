@@ -76,7 +76,7 @@ def main():
             f.write("%.3f hit 1 0 0 %.4f %.4f 0 0 0 0 0 %.6f %.5f;\n"
                     % (100.0 if i == 0 else 1000.0 * SPACING_S, v, a.ra, t, a.mass))
     wav, reports = os.path.join(work, "probe.wav"), os.path.join(work, "reports.txt")
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", "48000", "-path",
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", "48000", "-path",
            os.path.join(os.path.abspath(a.build), "ictus"), "-open",
            os.path.join(ROOT, "patches", "ictus-render.pd"), "-send", "render-file " + events,
            "-send", "render-out " + wav, "-send", "render-mix pickups", "-send", "render-gain -40", "-send",

@@ -159,7 +159,7 @@ def render_pd(build, events_path, wav_path, seconds, sr=48000, timeout=300, send
     """patches/ictus-render.pd in pd batch mode -> (samples [n, 2], sr, log).
     `sends`: messages sent to the patch before the events file (as -send, the way
     `ictusd render --wav` sends the drum), before DSP starts."""
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr), "-path",
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr), "-path",
            os.path.join(build, "ictus"), "-open", RENDER_PATCH]
     for message in sends:
         cmd += ["-send", message]

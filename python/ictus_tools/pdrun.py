@@ -1,8 +1,13 @@
 """Helpers for the tests that run the real pd binary in batch mode.
 
 A test builds a patch from a list of boxes and connections, runs
-`pd -nogui -nosound -batch -stderr`, and reads back what the patch wrote into a
-table (32-bit float WAV via soundfiler, see docs/externals.md)."""
+`pd -nogui -nosound -batch -nrt -stderr`, and reads back what the patch wrote into a
+table (32-bit float WAV via soundfiler, see docs/externals.md).
+
+Every batch pd of the tests and benchmarks runs with -nrt. As root (CI), pd takes
+SCHED_FIFO priority 6 unless told not to; a batch render never sleeps, so two of them
+held both cores at that priority, and a real-time test's pd, at the same priority, got no
+CPU for seconds (its reports stopped for 4 s, the round trip to it was 1.8 s)."""
 import atexit
 import fcntl
 import os
@@ -201,7 +206,7 @@ def run_pd(patch_text, libdir, sr=48000, extra_args=(), workdir=None, name="test
     path = os.path.join(workdir, name)
     with open(path, "w") as f:
         f.write(patch_text)
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr), "-path", libdir]
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr), "-path", libdir]
     cmd += list(extra_args) + ["-open", path]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=workdir,
                           env=PD_ENV)
@@ -307,7 +312,7 @@ GEM_NOISE = ("gem.conf", "libDeckLinkAPI")
 def open_patch(path, extra_args=(), timeout=60):
     """Opens a patch in pd batch mode, switches DSP on and quits: (exit status, the error
     lines of pd's output but Gem's start-up chatter)."""
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr"] + list(extra_args) + [
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr"] + list(extra_args) + [
         "-open", path, "-send", "pd dsp 1", "-send", "pd quit"]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=PD_ENV)
     log = proc.stdout + proc.stderr

@@ -27,7 +27,7 @@ import subprocess
 import threading
 import time
 
-from ictus_tools.checks import check
+from ictus_tools.checks import check, inconclusive
 from ictus_tools.oscpacket import now
 from ictus_tools.pdrun import PD, PD_ENV, Patch, free_udp_port, make_workdir  # noqa: F401
 
@@ -35,18 +35,42 @@ from ictus_tools.pdrun import PD, PD_ENV, Patch, free_udp_port, make_workdir  # 
 # Linux's SO_TIMESTAMPNS (= SCM_TIMESTAMPNS): the kernel's CLOCK_REALTIME arrival
 # stamp of each datagram, as a struct timespec in the ancillary data.
 SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
+# Linux's SO_RXQ_OVFL: the count of datagrams the kernel dropped on this socket because
+# its receive buffer was full, a uint32 in the ancillary data of each one read.
+SO_RXQ_OVFL = getattr(socket, "SO_RXQ_OVFL", 40)
+# Linux's SO_RCVBUFFORCE (root may exceed net.core.rmem_max).
+SO_RCVBUFFORCE = getattr(socket, "SO_RCVBUFFORCE", 33)
+# The reports' receive buffer: pd's ticks alone are 500 datagrams a second (about 1 KB of
+# buffer each, with the kernel's overhead), which the default 208 KB holds for 0.4 s of a
+# stalled reader. 8 MB holds 16 s.
+LISTENER_BUFFER = 8 << 20
 
 
 class Listener:
     """UDP socket that stamps every datagram with the wall clock on arrival
-    (the kernel's stamp where it gives one, else the clock when read)."""
+    (the kernel's stamp where it gives one, else the clock when read). Its
+    receive buffer is as large as the system lets it be, and `dropped` counts
+    the datagrams the kernel dropped on it all the same (a reader starved past
+    what the buffer holds): a test that misses a report checks it first
+    (reports_lost), since a lost report says nothing about pd."""
 
     def __init__(self):
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        try:
-            self.sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
-        except OSError:
-            pass  # no kernel stamps: read-time stamps, as before
+        for opt in (SO_RCVBUFFORCE, socket.SO_RCVBUF):
+            try:
+                self.sock.setsockopt(socket.SOL_SOCKET, opt, LISTENER_BUFFER)
+                break
+            except OSError:
+                continue  # not root: SO_RCVBUF, capped at net.core.rmem_max
+        self.buffer_bytes = self.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+        for opt in (SO_TIMESTAMPNS, SO_RXQ_OVFL):
+            try:
+                self.sock.setsockopt(socket.SOL_SOCKET, opt, 1)
+            except OSError:
+                pass  # no kernel stamps: read-time stamps; no drop count: 0
+        self.dropped = 0
+        self._parsed = 0  # items parsed into _records so far (records())
+        self._records = []
         self.sock.bind(("127.0.0.1", 0))
         self.sock.settimeout(0.2)
         self.port = self.sock.getsockname()[1]
@@ -59,26 +83,68 @@ class Listener:
     def _run(self):
         while self.running:
             try:
-                data, ancillary, _, _ = self.sock.recvmsg(65536, 64)
+                data, ancillary, _, _ = self.sock.recvmsg(65536, 128)
             except socket.timeout:
                 continue
             except OSError:
                 return
             t = now()
+            dropped = self.dropped
             for level, kind, payload in ancillary:
                 if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(payload) >= 16:
                     sec, nsec = struct.unpack("qq", payload[:16])
                     t = sec + nsec * 1e-9
+                elif level == socket.SOL_SOCKET and kind == SO_RXQ_OVFL and len(payload) >= 4:
+                    dropped = struct.unpack("I", payload[:4])[0]
             with self.lock:
                 self.items.append((t, data))
+                self.dropped = dropped
 
     def snapshot(self):
         with self.lock:
             return list(self.items)
 
+    def records(self):
+        """fudi_records() of every datagram so far, each parsed once: a test that polls
+        its reports every 20 ms would otherwise parse all of them each time, thousands of
+        ticks, holding the interpreter lock that the reading thread waits for."""
+        with self.lock:
+            new = self.items[self._parsed:]
+            self._parsed = len(self.items)
+        self._records.extend(fudi_records(new))
+        return list(self._records)
+
+    def lost(self):
+        """Datagrams the kernel dropped on this socket so far: /proc/net/udp's count for
+        it (complete), else the last count the ancillary data gave (those before the
+        last datagram read). After close(): the count at closing."""
+        if self.sock.fileno() < 0:
+            return self.dropped
+        try:
+            with open("/proc/net/udp") as f:
+                for line in f.readlines()[1:]:
+                    fields = line.split()
+                    if fields[1] == "0100007F:%04X" % self.port:
+                        return int(fields[-1])
+        except (OSError, IndexError, ValueError):
+            pass
+        with self.lock:
+            return self.dropped
+
+    def require_intact(self):
+        """Ends the test as inconclusive (checks.inconclusive: CTest's command runs it again)
+        when the kernel dropped any report: a report this process failed to read says
+        nothing of pd, and whatever the test finds missing may be one of them."""
+        n = self.lost()
+        if n:
+            inconclusive("this test's listener lost %d of pd's reports (the kernel dropped them: "
+                         "its reader was starved past a %d KB buffer); pd is not judged"
+                         % (n, self.buffer_bytes // 1024))
+
     def close(self):
         self.running = False
         self.thread.join()
+        self.dropped = self.lost()
         self.sock.close()
 
 
@@ -210,7 +276,7 @@ def wait_for_ticks(listener, timeout=20.0, count=20):
     """Waits until pd reports `count` ticks (it is up and its ports are open)."""
     t0 = time.time()
     while time.time() - t0 < timeout:
-        if sum(1 for _, a in fudi_records(listener.snapshot()) if a and a[0] == "tick") >= count:
+        if sum(1 for _, a in listener.records() if a and a[0] == "tick") >= count:
             return True
         time.sleep(0.02)
     return False
@@ -222,10 +288,12 @@ def wait_records(listener, pred, what, timeout=20.0, required=True):
     test's own checks to say what is missing."""
     t0 = time.time()
     while True:
-        records = fudi_records(listener.snapshot())
+        records = listener.records()
         if pred(records):
             return records
         if time.time() - t0 >= timeout:
+            if required:
+                listener.require_intact()
             check(not required, "%s within %g s" % (what, timeout))
             return records
         time.sleep(0.02)

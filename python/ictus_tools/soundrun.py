@@ -37,7 +37,7 @@ def write_events(path, strokes, head=()):
 
 
 def render(build, model, events, wav, seconds, sr=48000, timeout=120):
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr), "-path",
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr), "-path",
            os.path.join(build, "ictus"), "-open", RENDER, "-send", "render-model %s" % model,
            "-send", "render-file %s" % events, "-send", "render-out %s" % wav,
            "-send", "render-seconds %.6g" % seconds]

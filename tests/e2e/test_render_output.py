@@ -57,7 +57,7 @@ def events_file(name, hits):
 
 def render(events, tag, *sends, seconds=1.2):
     wav = os.path.join(work, tag + ".wav")
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(SR), "-path",
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(SR), "-path",
            os.path.join(build, "ictus"), "-open", u.RENDER_PATCH]
     for s in sends:
         cmd += ["-send", s]

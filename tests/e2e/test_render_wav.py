@@ -38,7 +38,7 @@ def pd_itself(out, wav, sr, *sends, read=True):
     with open(os.path.join(out, "render.json")) as f:
         import json
         seconds = float(json.load(f)["duration_s"]) + 1.5
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr), "-path",
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr), "-path",
            os.path.join(build, "ictus"), "-open", u.RENDER_PATCH]
     for s in u.drum_lines(os.path.join(out, "render.json")) + list(sends):
         cmd += ["-send", s]

@@ -214,7 +214,7 @@ with open(events, "w") as f:
     # <delay_ms> hit <hand> <drum> <bounce> <v m/s> <r/a> <theta> <force N> <impulse> <ms> <vt> <t s>
     f.write("%.3f hit 0 0 0 3 0.3 45 150 0.01 1.2 0.1 %.6f;\n" % (strike_ms, strike_ms / 1000))
 wav = os.path.join(work, "strike.wav")
-cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(sr)] + pd_path + [
+cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr)] + pd_path + [
     "-open", os.path.join(lib, "ictus-render.pd"), "-send", "render-file %s" % events,
     "-send", "render-out %s" % wav, "-send", "render-seconds 0.5"]
 proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, env=PD_ENV)

@@ -23,7 +23,7 @@ for name in ("membrane~-help.pd", "contact~-help.pd", "ictus-meta.pd"):
     # the copy beside the binaries with no search path (as Pd's help browser
     # opens it), and the source file with -path <build>
     for where, extra in ((path, []), (source, ["-path", build])):
-        cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr"] + extra + [
+        cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr"] + extra + [
             "-open", where, "-send", "pd dsp 1", "-send", "pd quit"]
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
         log = proc.stdout + proc.stderr

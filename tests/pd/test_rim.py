@@ -134,7 +134,7 @@ for zone in (0, 1):
         f.write("100.000 hit 1 0 0 3.0000 0.93000 0.00 25.000 0.060000 4.500 0.0000 0.100000 "
                 "0.03000 %d;\n" % zone)
     out = os.path.join(work, "ev%d.wav" % zone)
-    r = subprocess.run([shutil.which("pd") or "pd", "-nogui", "-nosound", "-batch", "-r",
+    r = subprocess.run([shutil.which("pd") or "pd", "-nogui", "-nosound", "-batch", "-nrt", "-r",
                         str(sr), "-path", lib, "-open", os.path.join(lib, "ictus-render.pd"),
                         "-send", "render-file " + ev, "-send", "render-out " + out,
                         "-send", "render-seconds 1", "-send", "render-mix pickups"],

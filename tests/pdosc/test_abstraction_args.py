@@ -238,7 +238,7 @@ def render_seconds(build):
         wav = os.path.join(work, "render.wav")
         if os.path.exists(wav):
             os.remove(wav)
-        cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(SR), "-path", lib,
+        cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(SR), "-path", lib,
                "-open", os.path.join(lib, "ictus-render.pd"), "-send", "render-file " + events,
                "-send", "render-out " + wav, "-send", "render-seconds 0.2",
                "-send", "render-seconds " + bad]
@@ -258,7 +258,7 @@ def render_seconds(build):
                                           "got: foo"),
                        ("render-gain 1e30", "gain_db 40")):
         wav = os.path.join(work, "render.wav")
-        cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", str(SR), "-path", lib,
+        cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(SR), "-path", lib,
                "-open", os.path.join(lib, "ictus-render.pd"), "-send", "render-file " + events,
                "-send", "render-out " + wav, "-send", "render-seconds 0.2", "-send", send]
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)

@@ -71,7 +71,7 @@ for good, bad, message, error_start in CASES:
         text = "\n".join(lines + connects) + "\n"
         with open(path, "w") as f:
             f.write(text)
-        cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-path", build, "-path",
+        cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path", build, "-path",
                os.path.join(build, "ictus"), path]
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV,
                               cwd=work)

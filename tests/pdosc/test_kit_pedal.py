@@ -15,7 +15,7 @@ import time
 from ictus_tools.checks import check
 from ictus_tools.oscpacket import bundle, message, now, strike, timetag
 from ictus_tools.pdrun import Patch, error_lines
-from ictus_tools.rtpd import Listener, free_udp_port, fudi_records, start_pd, wait_for_ticks
+from ictus_tools.rtpd import Listener, free_udp_port, start_pd, wait_for_ticks
 
 SECONDS = 600.0  # pd's own deadline: the test kills pd when done
 HIHAT = 6
@@ -82,17 +82,18 @@ def main():
             out.sendto(bundle(timetag(t0 + delay), *parts), ("127.0.0.1", pd_port))
         deadline = time.time() + 10.0
         while time.time() < deadline:
-            records = [a for _, a in fudi_records(reports.snapshot()) if a[0] != "tick"]
+            records = [a for _, a in reports.records() if a[0] != "tick"]
             if sum(a[0] == "fire" for a in records) >= len(BUNDLES):
                 break
             time.sleep(0.02)
         time.sleep(0.1)  # a pedal reported after its strike would come in now
-        records = [a for _, a in fudi_records(reports.snapshot()) if a[0] != "tick"]
+        records = [a for _, a in reports.records() if a[0] != "tick"]
     finally:
         out.close()
         proc.kill()
         log, _ = proc.communicate()
         reports.close()
+    reports.require_intact()
     check(not error_lines(log), "pd ran cleanly: %s" % error_lines(log))
     # The reports in pd's order: each pedal, then the strike it goes before, at one logical
     # time (a strike list: hand, velocity, r/a, theta, mass, force, bounce, drum, seq ...).

@@ -15,7 +15,7 @@ import struct
 import time
 
 from ictus_tools.oscpacket import bundle, message, now, osc_string, strike, timetag
-from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, quit_pd,
+from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, quit_pd,
                               start_pd, wait_for_ticks, wait_records, unexplained_late,
                               wall_of_logical)
 from ictus_tools.checks import check, inconclusive
@@ -82,7 +82,7 @@ def wait_for_malformed(done, timeout=HANDSHAKE_S):
     """Polls pd's reports until done(the `malformed` records so far), or the deadline."""
     t0 = time.time()
     while time.time() - t0 < timeout:
-        if done([a for _, a in fudi_records(reports.snapshot())
+        if done([a for _, a in reports.records()
                  if a[0] == "info" and len(a) > 3 and a[1] == "malformed"]):
             return True
         time.sleep(0.005)
@@ -136,7 +136,8 @@ finally:
         proc.communicate()
     reports.close()
 
-records = fudi_records(reports.snapshot())
+records = reports.records()
+reports.require_intact()
 print(log)
 check(proc.returncode == 0, "pd exited normally (%s)" % proc.returncode)
 malformed = [a for _, a in records if a[0] == "info" and len(a) > 1 and a[1] == "malformed"]

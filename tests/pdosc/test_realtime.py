@@ -21,7 +21,7 @@ import struct
 import time
 
 from ictus_tools.oscpacket import bundle, message, now, strike, timetag, IMMEDIATE
-from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, quit_pd,
+from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, quit_pd,
                               start_pd, wait_for_ticks, wait_records, unexplained_late,
                               wall_of_logical)
 from ictus_tools.checks import check, inconclusive
@@ -80,11 +80,13 @@ try:
     for half in (0, 1):
         if half:
             # from here on, an audio output latency of 10 ms is subtracted. Sent
-            # when no strike is in flight: pd polls its sockets in the order
-            # they opened, so after a stall a packet on another socket may be
-            # handled before an older strike.
-            while now() < t_next - SPACING_S + 0.05:
-                time.sleep(0.001)
+            # once pd has reported every strike so far fired (a handshake): pd
+            # polls its sockets in the order they opened, so after a stall of pd
+            # the latency could be handled before an older strike still queued,
+            # which then started 10 ms early (seen under a loaded ASan run).
+            wait_records(reports, lambda r: set(sent) <= {int(a[10]) for _, a in r
+                                                          if a[0] == "fire"},
+                         "the first half's %d strikes fired" % len(sent), timeout=30.0)
             out.sendto(b"latency %g;\n" % LATENCY_MS, ("127.0.0.1", fudi_port))
             time.sleep(0.05)
             second_half = seq + 1
@@ -143,7 +145,8 @@ finally:
         proc.communicate()
     reports.close()
 
-records = fudi_records(reports.snapshot())
+records = reports.records()
+reports.require_intact()
 with open(os.path.join(work, "reports.json"), "w") as f:  # kept with the work folder on failure
     json.dump({"records": records, "sent": sent, "probes": probes}, f)
 check(proc.returncode == 0 and not error_lines(log), "pd ran cleanly: %s" % error_lines(log))

@@ -65,6 +65,7 @@ def main():
                        ("127.0.0.1", pd_port))
         records = wait_records(reports, lambda r: sum(a[0] == "fire" for _, a in r) >= REAL,
                                "the %d real strikes fired" % REAL)
+        reports.require_intact()
         fires = {int(a[10]): a[2:] for _, a in records if a[0] == "fire"}
         check(sorted(fires) == sorted(sent), "exactly the real strikes fired: %s" % sorted(fires))
         for seq, (hand, vel, ra, th) in sorted(sent.items()):

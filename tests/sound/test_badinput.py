@@ -25,7 +25,7 @@ def run(model, items, head, seconds=0.6):
     ev = os.path.join(work, "ev-%s.txt" % model)
     wav = os.path.join(work, "out-%s.wav" % model)
     write_events(ev, items, head=head)
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-stderr", "-r", "48000", "-path",
+    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", "48000", "-path",
            os.path.join(build, "ictus"), "-open", RENDER, "-send", "render-model %s" % model,
            "-send", "render-file %s" % ev, "-send", "render-out %s" % wav,
            "-send", "render-seconds %g" % seconds]
@@ -40,7 +40,7 @@ def open_lines(name, body):
     path = os.path.join(work, name)
     with open(path, "w") as f:
         f.write("#N canvas 0 0 400 300 12;\n" + body)
-    proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-path",
+    proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path",
                            os.path.join(build, "ictus"), "-open", path, "-send", "pd quit"],
                           capture_output=True, text=True, timeout=60, env=PD_ENV)
     return proc.returncode, proc.stdout + proc.stderr
@@ -89,7 +89,7 @@ for f in ["ictus-sound-clips.pd", "ictus-sound-clips-voice.pd"] + errors_binary:
     shutil.copy(os.path.join(build, "ictus", f), lib)
 with open(os.path.join(lib, "t.pd"), "w") as f:
     f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound-clips;\n")
-proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-stderr", "-open",
+proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-open",
                        os.path.join(lib, "t.pd"), "-send", "pd quit"],
                       capture_output=True, text=True, timeout=60, env=PD_ENV)
 log = proc.stdout + proc.stderr

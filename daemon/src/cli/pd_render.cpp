@@ -148,13 +148,26 @@ namespace
 {
 
 // Pd's command line: batch mode, the render patch, and the drum, the mix
-// and the files as -send messages to it.
+// and the files as -send messages to it. -nrt: run as root, Pd takes SCHED_FIFO
+// (priority 6) unless told not to, and a batch render, which never waits, would then
+// hold a core against every ordinary process, a live Pd's equal-priority scheduler
+// included, for as long as it renders.
 std::vector<std::string> pd_command_line(const PdRenderOptions &o, const std::string &pd,
                                          const std::string &lib)
 {
-    std::vector<std::string> argv = {pd,       "-nogui",  "-nosound", "-nomidi",
-                                     "-batch", "-stderr", "-r",       std::to_string(o.sample_rate),
-                                     "-path",  lib,       "-open",    lib + "/ictus-render.pd"};
+    std::vector<std::string> argv = {pd,
+                                     "-nogui",
+                                     "-nosound",
+                                     "-nomidi",
+                                     "-batch",
+                                     "-nrt",
+                                     "-stderr",
+                                     "-r",
+                                     std::to_string(o.sample_rate),
+                                     "-path",
+                                     lib,
+                                     "-open",
+                                     lib + "/ictus-render.pd"};
     std::vector<std::string> sends;
     if (!o.preset.empty()) // first: radius, tension and density below win over it
         sends.push_back("render-drum preset " + o.preset);
