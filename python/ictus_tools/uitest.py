@@ -31,11 +31,13 @@ def stop(process, timeout_s=10):
 
 
 class PdLines:
-    """What a pd process prints, line by line, read by a thread (follow): wait_for(pred,
-    what, timeout) is a test's handshake, the next line that pred accepts within a deadline
-    (the test fails naming the last lines otherwise); `printed` holds every line waited over."""
+    """What a process prints (pd, or another: name it), line by line, read by a thread
+    (follow): wait_for(pred, what, timeout) is a test's handshake, the next line that pred
+    accepts within a deadline (the test fails naming the process and its last lines
+    otherwise); `printed` holds every line waited over."""
 
-    def __init__(self):
+    def __init__(self, name="pd"):
+        self.name = name
         self.queue = queue.Queue()
         self.printed = []
 
@@ -56,12 +58,13 @@ class PdLines:
                 continue
             if line is None:
                 self.queue.put(None)  # a later wait fails at once too
-                fail("%s: the process ended first (it printed, last lines: %s)"
-                     % (what, self.printed[-25:]))
+                fail("%s: %s ended first (it printed, last lines: %s)"
+                     % (what, self.name, self.printed[-25:]))
             self.printed.append(line)
             if pred(line):
                 return line
-        fail("%s within %g s (pd printed, last lines: %s)" % (what, timeout, self.printed[-25:]))
+        fail("%s within %g s (%s printed, last lines: %s)"
+             % (what, timeout, self.name, self.printed[-25:]))
 
     def next_line(self, timeout):
         """The next line within `timeout` s, else "" (none yet); None once the process ended."""

@@ -127,7 +127,7 @@ def main():
                                    "--duration", "%g" % (length_s + 4.0)],
                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                   env=env)
-        dlines = uitest.PdLines()
+        dlines = uitest.PdLines("ictusd")
         dlines.follow(daemon.stdout)
         dlines.wait_for(lambda l: "commands on 127.0.0.1:%d" % daemon_port in l,
                         "the daemon listening", 120)

@@ -77,3 +77,23 @@ TEST_CASE("free_udp_port: outside the ephemeral range, bindable, never twice, ne
     CHECK(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 0);
 }
+
+TEST_CASE("free_udp_port: a TMPDIR that does not exist yet is made, and the port reserved in it",
+          "[ports]")
+{
+    char base[] = "/tmp/ictus-ports-test-XXXXXX";
+    REQUIRE(mkdtemp(base) != nullptr);
+    const std::string tmpdir = std::string(base) + "/not/yet";
+    const char *old = std::getenv("TMPDIR");
+    const std::string saved = old ? old : "";
+    setenv("TMPDIR", tmpdir.c_str(), 1);
+    const int port = osctest::free_udp_port();
+    if (old)
+        setenv("TMPDIR", saved.c_str(), 1);
+    else
+        unsetenv("TMPDIR");
+    CHECK(port > 0);
+    CHECK(std::filesystem::exists(tmpdir + "/ictus-test-ports/" + std::to_string(port) + ".lock"));
+    std::error_code ignored;
+    std::filesystem::remove_all(base, ignored);
+}

@@ -20,9 +20,12 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <random>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -88,7 +91,9 @@ inline int free_udp_port()
 {
     const char *tmp = std::getenv("TMPDIR");
     const std::string dir = std::string(tmp && *tmp ? tmp : "/tmp") + "/ictus-test-ports";
-    if (mkdir(dir.c_str(), 0777) == 0)
+    std::error_code made;
+    // TMPDIR itself may not exist yet (Python's twin creates it too)
+    if (std::filesystem::create_directories(dir, made))
         chmod(dir.c_str(), 01777); // shared by every user's tests, as /tmp is
     const auto [first, last] = port_candidates();
     std::random_device rd;
@@ -98,8 +103,11 @@ inline int free_udp_port()
         const int port = pick(rng);
         const std::string lock = dir + "/" + std::to_string(port) + ".lock";
         const int fd = open(lock.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0666);
-        if (fd < 0)
-            continue;
+        if (fd < 0) {
+            std::fprintf(stderr, "osctest: cannot reserve UDP port %d: %s: %s\n", port,
+                         lock.c_str(), std::strerror(errno));
+            std::abort();
+        }
         if (flock(fd, LOCK_EX | LOCK_NB) == 0 && port_bindable(port, SOCK_DGRAM))
             return port; // fd stays open: the reservation lasts as long as the process
         close(fd);
