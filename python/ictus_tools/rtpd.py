@@ -49,10 +49,10 @@ LISTENER_BUFFER = 8 << 20
 class Listener:
     """UDP socket that stamps every datagram with the wall clock on arrival
     (the kernel's stamp where it gives one, else the clock when read). Its
-    receive buffer is as large as the system lets it be, and `dropped` counts
-    the datagrams the kernel dropped on it all the same (a reader starved past
-    what the buffer holds): a test that misses a report checks it first
-    (reports_lost), since a lost report says nothing about pd."""
+    receive buffer is as large as the system lets it be, and lost() counts the
+    datagrams the kernel dropped on it all the same (a reader starved past what
+    the buffer holds): a test calls require_intact() before it judges what is
+    missing, since a lost report says nothing about pd."""
 
     def __init__(self):
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
