@@ -38,7 +38,7 @@ wait_beside() { # NAME: waits for the build started beside the last suite
     # Its suite has ended: from now on nothing waits on it, so it builds at normal priority
     # (at nice 19 on a machine whose cores something else keeps busy it stalled for more
     # than 15 minutes). Raising a priority needs root (CAP_SYS_NICE); others keep nice 19.
-    renice -n 0 -g "$bg_pid" >/dev/null 2>&1 || true
+    renice 0 -g "$bg_pid" >/dev/null 2>&1 || true # absolute (busybox reads -n as a step)
     if ! wait "$bg_pid"; then
         cat "$bg_log" >&2
         echo "test.sh: the $1 build failed (its log above: $bg_log)" >&2

@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from ictus_tools.oscpacket import bundle, now, strike, timetag
-from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, fudi_records, start_pd,
+from ictus_tools.rtpd import (Listener, build_patch, free_udp_port, start_pd,
                               wait_for_ticks, wall_of_logical)
 
 ap = argparse.ArgumentParser()
@@ -65,7 +65,10 @@ def run_once():
             proc.kill()
             proc.communicate()
         reports.close()
-    rec = fudi_records(reports.snapshot())
+    rec = reports.records()
+    if reports.lost():
+        print("note: this script's listener lost %d of pd's reports (kernel drops): a strike "
+              "counted missing below may be one of them" % reports.lost())
     offset = wall_of_logical(rec, sr=args.sr)
     fire = {int(a[10]): (t, a[1]) for t, a in rec if a[0] == "fire"}
     plain = {int(a[2]): a[1] for t, a in rec if a[0] == "plain"}

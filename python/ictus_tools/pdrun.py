@@ -101,6 +101,24 @@ def _bindable(port, kind):
     return True
 
 
+def _open_lock(path):
+    """The lock file's descriptor, or None when this user cannot open it (another user's
+    lock file, read-only to us: flock works on a read-only descriptor, so that is tried
+    next; else the port is skipped)."""
+    try:
+        fd = os.open(path, os.O_CREAT | os.O_RDWR, 0o666)
+    except PermissionError:
+        try:
+            return os.open(path, os.O_RDONLY)
+        except OSError:
+            return None
+    try:
+        os.fchmod(fd, 0o666)  # every user's tests may lock it (the umask took bits off)
+    except OSError:
+        pass  # another user's file: it stays as it is
+    return fd
+
+
 def free_port(kind=socket.SOCK_DGRAM):
     """A port on 127.0.0.1 that is free (UDP, or TCP with kind=socket.SOCK_STREAM),
     outside the ephemeral range and reserved for this process (see above)."""
@@ -114,7 +132,9 @@ def free_port(kind=socket.SOCK_DGRAM):
     rng = random.SystemRandom()
     for _ in range(2000):
         port = rng.choice(candidates)
-        fd = os.open(os.path.join(PORT_LOCK_DIR, "%d.lock" % port), os.O_CREAT | os.O_RDWR, 0o666)
+        fd = _open_lock(os.path.join(PORT_LOCK_DIR, "%d.lock" % port))
+        if fd is None:
+            continue
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
@@ -124,8 +144,8 @@ def free_port(kind=socket.SOCK_DGRAM):
             _held_port_locks.append(fd)
             return port
         os.close(fd)
-    raise RuntimeError("no free port in %d..%d after 2000 tries"
-                       % (candidates[0], candidates[-1]))
+    raise RuntimeError("no free port in %d..%d after 2000 tries (lock files in %s)"
+                       % (candidates[0], candidates[-1], PORT_LOCK_DIR))
 
 
 def free_udp_port():

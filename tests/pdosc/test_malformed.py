@@ -79,13 +79,15 @@ def fired(records):
 
 
 def wait_for_malformed(done, timeout=HANDSHAKE_S):
-    """Polls pd's reports until done(the `malformed` records so far), or the deadline."""
+    """Polls pd's reports until done(the `malformed` records so far), or the deadline
+    (inconclusive then if this script's listener lost a report: the count may be it)."""
     t0 = time.time()
     while time.time() - t0 < timeout:
         if done([a for _, a in reports.records()
                  if a[0] == "info" and len(a) > 3 and a[1] == "malformed"]):
             return True
         time.sleep(0.005)
+    reports.require_intact()
     return False
 
 

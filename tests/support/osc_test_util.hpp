@@ -86,6 +86,20 @@ inline bool port_bindable(int port, int kind)
     return ok;
 }
 
+// The lock file's descriptor, or -1 (errno set) when this user cannot open it: another
+// user's lock file is read-only to us, and flock works on a read-only descriptor.
+inline int open_port_lock(const std::string &path)
+{
+    const int fd = open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+        fchmod(fd, 0666); // every user's tests may lock it (the umask took bits off)
+        return fd;
+    }
+    if (errno != EACCES && errno != EPERM)
+        return -1;
+    return open(path.c_str(), O_RDONLY | O_CLOEXEC);
+}
+
 // A UDP port on 127.0.0.1 that is free and reserved for this process (above).
 inline int free_udp_port()
 {
@@ -99,20 +113,23 @@ inline int free_udp_port()
     std::random_device rd;
     std::mt19937 rng(rd());
     std::uniform_int_distribution<int> pick(first, last);
+    int open_error = 0;
     for (int attempt = 0; attempt < 2000; ++attempt) {
         const int port = pick(rng);
         const std::string lock = dir + "/" + std::to_string(port) + ".lock";
-        const int fd = open(lock.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0666);
+        const int fd = open_port_lock(lock);
         if (fd < 0) {
-            std::fprintf(stderr, "osctest: cannot reserve UDP port %d: %s: %s\n", port,
-                         lock.c_str(), std::strerror(errno));
-            std::abort();
+            open_error = errno;
+            continue; // a port this user cannot reserve: another one
         }
         if (flock(fd, LOCK_EX | LOCK_NB) == 0 && port_bindable(port, SOCK_DGRAM))
             return port; // fd stays open: the reservation lasts as long as the process
         close(fd);
     }
-    std::fprintf(stderr, "osctest: no free UDP port in %d..%d after 2000 tries\n", first, last);
+    std::fprintf(stderr,
+                 "osctest: no free UDP port in %d..%d after 2000 tries (lock files in %s%s%s)\n",
+                 first, last, dir.c_str(), open_error ? ": " : "",
+                 open_error ? std::strerror(open_error) : "");
     std::abort();
 }
 
