@@ -154,14 +154,22 @@ def receive_args(build):
     cases.append(("listen %d %s" % (port, bad_hosts[0]), port, [host_line + bad_hosts[0]]))
     p = Patch()
     lb = p.obj("loadbang")
+    # [t b b]: the listen messages first, then a plain [netreceive] listens on `sentinel`,
+    # bound once every listen message has been handled (the handshake below)
+    sentinel = free_udp_port()
+    order = p.obj("t b b")
+    p.connect(lb, 0, order, 0)
     for arg, _, _ in cases:
         if arg.startswith("listen"):
             r = p.obj("ictus-receive")
             m = p.msg(arg)
-            p.connect(lb, 0, m, 0)
+            p.connect(order, 1, m, 0)
             p.connect(m, 0, r, 0)
         else:
             p.obj("ictus-receive %s" % arg)
+    last = p.msg("listen %d 127.0.0.1" % sentinel)  # IPv4: read in /proc/net/udp
+    p.connect(order, 0, last, 0)
+    p.connect(last, 0, p.obj("netreceive -u"), 0)
     stop = p.obj("delay 20000")
     quit_msg = p.msg("\\; pd quit")
     p.connect(lb, 0, stop, 0)
@@ -174,16 +182,19 @@ def receive_args(build):
                              os.path.join(build, "ictus"), "-open", path],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             env=PD_ENV)
-    # handshake: the last receiver is created and listening once its port is bound
+    # handshake: every receiver is created (the last one, `ok`, listens) and every listen
+    # message handled (the sentinel listens) once both ports are bound; `ok` alone was
+    # bound before the loadbang, and pd was ended before the listen messages' error lines
     deadline, ports = time.time() + 20, set()
     while time.time() < deadline and proc.poll() is None:
         ports = bound_ports()
-        if ok in ports:
+        if ok in ports and sentinel in ports:
             break
         time.sleep(0.05)
     proc.terminate()
     log = proc.communicate(timeout=20)[0]
-    check(ok in ports, "[ictus-receive %d] listens" % ok)
+    check(ok in ports and sentinel in ports, "[ictus-receive %d] listens, and the listen "
+          "messages were handled (the sentinel's %d is bound)" % (ok, sentinel))
     for arg, port, errors in cases:
         if port:
             check(port in ports, "[ictus-receive %s] listens on %d" % (arg, port))
