@@ -7,6 +7,7 @@
  * calls through membrane_point_ops (membrane_internal.h). */
 #define _POSIX_C_SOURCE 200112L
 #include "membrane_internal.h"
+#include "ictus_simd.h"
 
 #include <float.h>
 #include <math.h>
@@ -55,22 +56,9 @@ membrane *membrane_new(double sample_rate_hz)
     m->pick_r[0] = 0.5;
     m->pick_r[1] = 0.5;
     m->pick_theta[1] = 90.0;
-    membrane_use_generic_kernel_(m);
-#if defined(MEMBRANE_X86) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
-        m->kernel = membrane_kernel_avx2;
-        m->kernel_pair = membrane_kernel_pair_avx2;
-        m->tension_kernel = membrane_tension_kernel_avx2;
-        m->couplings_kernel = membrane_couplings_kernel_avx2;
-        m->energy_kernel = membrane_energy_kernel_avx2;
-    }
-#endif
-    /* ICTUS_MEMBRANE_KERNEL=generic picks the portable kernel on any machine, e.g.
-     * to benchmark it inside Pd (bench/peers); read when the object is made. */
-    const char *want = getenv("ICTUS_MEMBRANE_KERNEL");
-    if (want && strcmp(want, "generic") == 0)
-        membrane_use_generic_kernel_(m);
+    /* The widest kernels the CPU runs; ICTUS_MEMBRANE_KERNEL=generic or avx2 caps them,
+     * e.g. to benchmark one inside Pd (bench/peers); read when the object is made. */
+    membrane_use_kernel_(m, ictus_simd_level());
     if (membrane_reserve_strikes(m, STRIKE_QUEUE) != ICTUS_OK ||
         membrane_build_modes_(m, MEMBRANE_DEFAULT_MODES) != ICTUS_OK) {
         membrane_free(m);
@@ -106,18 +94,45 @@ void membrane_free(membrane *m)
     free(m);
 }
 
+void membrane_use_kernel_(membrane *m, int level)
+{
+    switch (level) {
+    case ICTUS_SIMD_AVX512:
+        m->kernel = membrane_kernel_avx512;
+        m->kernel_pair = membrane_kernel_pair_avx512;
+        m->tension_kernel = membrane_tension_kernel_avx512;
+        m->couplings_kernel = membrane_couplings_kernel_avx512;
+        m->energy_kernel = membrane_energy_kernel_avx512;
+        break;
+    case ICTUS_SIMD_AVX2:
+        m->kernel = membrane_kernel_avx2;
+        m->kernel_pair = membrane_kernel_pair_avx2;
+        m->tension_kernel = membrane_tension_kernel_avx2;
+        m->couplings_kernel = membrane_couplings_kernel_avx2;
+        m->energy_kernel = membrane_energy_kernel_avx2;
+        break;
+    default:
+        m->kernel = membrane_kernel_generic;
+        m->kernel_pair = membrane_kernel_pair_generic;
+        m->tension_kernel = membrane_tension_kernel_generic;
+        m->couplings_kernel = membrane_couplings_kernel_generic;
+        m->energy_kernel = membrane_energy_kernel_generic;
+        break;
+    }
+}
+
 void membrane_use_generic_kernel_(membrane *m)
 {
-    m->kernel = membrane_kernel_generic;
-    m->kernel_pair = membrane_kernel_pair_generic;
-    m->tension_kernel = membrane_tension_kernel_generic;
-    m->couplings_kernel = membrane_couplings_kernel_generic;
-    m->energy_kernel = membrane_energy_kernel_generic;
+    membrane_use_kernel_(m, ICTUS_SIMD_GENERIC);
 }
 
 const char *membrane_kernel_name(const membrane *m)
 {
-    return m->kernel == membrane_kernel_avx2 ? "avx2+fma" : "generic";
+    if (m->kernel == membrane_kernel_avx512)
+        return ictus_simd_name(ICTUS_SIMD_AVX512);
+    if (m->kernel == membrane_kernel_avx2)
+        return ictus_simd_name(ICTUS_SIMD_AVX2);
+    return ictus_simd_name(ICTUS_SIMD_GENERIC);
 }
 
 /* ---------------------------------------------------------------- pickups, strike point */

@@ -15,8 +15,8 @@
 #endif
 
 /* Arrays are padded to this many floats and aligned to 64 bytes so that the
- * kernels can run whole 8-wide vectors with no remainder loop. */
-#define MEMBRANE_PAD 16
+ * kernels can run whole pairs of 16-wide vectors with no remainder loop. */
+#define MEMBRANE_PAD 32
 
 /* Arguments of one sample of the modal update (see membrane_kernel.inc). */
 typedef struct membrane_kernel_args {
@@ -72,12 +72,22 @@ void membrane_tension_kernel_generic(membrane_tension_args *a);
 void membrane_tension_kernel_avx2(membrane_tension_args *a);
 void membrane_couplings_kernel_generic(membrane_tension_args *a);
 void membrane_couplings_kernel_avx2(membrane_tension_args *a);
+void membrane_kernel_avx512(membrane_kernel_args *a);
+void membrane_kernel_pair_avx512(membrane_kernel_args *a);
+void membrane_tension_kernel_avx512(membrane_tension_args *a);
+void membrane_couplings_kernel_avx512(membrane_tension_args *a);
 /* Energy (J) of modes 0 .. live-1 from the stored state: sum (h wm sc q)^2 + (sc p)^2, / 2. */
 double membrane_energy_kernel_generic(const float *q, const float *p, const float *wm,
                                       const float *sc, float h, int live);
 double membrane_energy_kernel_avx2(const float *q, const float *p, const float *wm, const float *sc,
                                    float h, int live);
+double membrane_energy_kernel_avx512(const float *q, const float *p, const float *wm,
+                                     const float *sc, float h, int live);
 
+/* Run the kernels of this level (ictus_simd.h): membrane_new() picks the widest the CPU
+ * runs; tests and benchmarks compare the others. A level this build or CPU lacks is not
+ * checked here: ask ictus_simd_level() first. */
+void membrane_use_kernel_(membrane *m, int level);
 /* Benchmarks only: run the portable kernel even on an AVX2 machine. */
 void membrane_use_generic_kernel_(membrane *m);
 

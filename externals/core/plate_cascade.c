@@ -2,6 +2,7 @@
  * nonlinear potential (plate_cascade.h; docs/plates.md, "The cascade"). */
 #include "plate_cascade.h"
 #include "bessel_internal.h"
+#include "ictus_simd.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -297,12 +298,9 @@ ictus_status plate_cascade_build(plate_cascade *c, const mode_table *t, int mode
         return ICTUS_ENOMEM;
     }
     c->modes = modes;
-    c->potential = plate_cascade_potential_generic;
-#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-        c->potential = plate_cascade_potential_avx2;
-#endif
+    /* AVX2 where the CPU runs it (ictus_simd_level(), which AVX-512 includes). */
+    c->potential = ictus_simd_level() >= ICTUS_SIMD_AVX2 ? plate_cascade_potential_avx2
+                                                         : plate_cascade_potential_generic;
     int at = 0;
     for (int a = 0; a < na; a++) {
         c->row[a] = at;

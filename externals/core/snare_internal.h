@@ -4,11 +4,11 @@
 #define ICTUS_SNARE_INTERNAL_H
 
 #define SNARE_RADII      4 /* wire segments in pairs at x / a = +-r_j */
-#define SNARE_KERNEL_PAD 8 /* each mode group padded to a multiple of 8 floats */
+#define SNARE_KERNEL_PAD 16 /* each mode group padded to a multiple of 16 floats (AVX-512) */
 
 /* The snare head's float state and coefficients: groups [0, n0) the (0, n) modes,
  * [n0, ne) the other even-m modes, [ne, n) the odd-m modes, each a multiple of
- * SNARE_KERNEL_PAD (padding all zero), 32-byte aligned. */
+ * SNARE_KERNEL_PAD (padding all zero), 64-byte aligned. */
 typedef struct snare_kernel_args {
     int n0, ne, n;
     float *x, *v, *xf;
@@ -36,5 +36,10 @@ void snare_kernel_free_avx2(snare_kernel_args *a, int wires, double *mean, doubl
 void snare_kernel_force_avx2(snare_kernel_args *a, double fa, const double Fe[SNARE_RADII],
                              const double Fo[SNARE_RADII], double two_over_t, double *pick_even,
                              double *pick_odd);
+void snare_kernel_free_avx512(snare_kernel_args *a, int wires, double *mean,
+                              double even[SNARE_RADII], double odd[SNARE_RADII]);
+void snare_kernel_force_avx512(snare_kernel_args *a, double fa, const double Fe[SNARE_RADII],
+                               const double Fo[SNARE_RADII], double two_over_t, double *pick_even,
+                               double *pick_odd);
 
 #endif

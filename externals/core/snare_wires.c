@@ -23,6 +23,7 @@
  * y1 = y_free + G F, G = 1 / (2M/T^2 + k_s/2 + c/T). */
 #include "snare_wires.h"
 #include "bessel_internal.h"
+#include "ictus_simd.h"
 #include "membrane_internal.h"
 #include "snare_internal.h"
 
@@ -85,14 +86,14 @@ struct snare_wires {
 static const membrane_point_ops air_ops;
 static void head_coefficients(snare_wires *w, double sr);
 
-/* n elements of size `size`, zeroed, 32-byte aligned (NULL when memory cannot be had).
+/* n elements of size `size`, zeroed, 64-byte aligned (NULL when memory cannot be had).
  * Allocates. */
 static void *alloc_aligned(int n, size_t size)
 {
     void *p = NULL;
     size_t bytes = size * (size_t)(n > 0 ? n : 1);
-    bytes = (bytes + 31) / 32 * 32;
-    if (posix_memalign(&p, 32, bytes) != 0)
+    bytes = (bytes + 63) / 64 * 64;
+    if (posix_memalign(&p, 64, bytes) != 0)
         return NULL;
     memset(p, 0, bytes);
     return p;
@@ -633,21 +634,21 @@ snare_wires *snare_wires_new(void)
     w->damping = 2.0 * w->mass_kg * log(1000.0) / WIRE_T60_S;
     w->k = WIRE_STIFFNESS;
     w->engaged = 1;
-    w->kfree = snare_kernel_free_generic;
-    w->kforce = snare_kernel_force_generic;
-#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    /* As the batter's kernel (membrane.c): the widest the CPU runs, or the one
+     * ICTUS_MEMBRANE_KERNEL caps it at. */
+    switch (ictus_simd_level()) {
+    case ICTUS_SIMD_AVX512:
+        w->kfree = snare_kernel_free_avx512;
+        w->kforce = snare_kernel_force_avx512;
+        break;
+    case ICTUS_SIMD_AVX2:
         w->kfree = snare_kernel_free_avx2;
         w->kforce = snare_kernel_force_avx2;
-    }
-#endif
-    /* As the batter's kernel (membrane.c): ICTUS_MEMBRANE_KERNEL=generic picks the
-     * portable one. */
-    const char *want = getenv("ICTUS_MEMBRANE_KERNEL");
-    if (want && strcmp(want, "generic") == 0) {
+        break;
+    default:
         w->kfree = snare_kernel_free_generic;
         w->kforce = snare_kernel_force_generic;
+        break;
     }
     w->air.point.ops = &air_ops;
     w->air.set = w;

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "ictus_simd.h"
 #include "signal_tools.hpp"
 
 namespace
@@ -423,18 +424,18 @@ TEST_CASE("Modes above 0.95 Nyquist are silent", "[core][membrane]")
     CHECK(tools::band_max(mag, bin, fs - f02, 1.0) < 1e-4 * ref);
 }
 
-extern "C" void membrane_use_generic_kernel_(membrane *m); // membrane_internal.h
+extern "C" void membrane_use_kernel_(membrane *m, int level); // membrane_internal.h
 
 TEST_CASE("Generic and run-time selected kernels agree", "[core][membrane]")
 {
-    // On an AVX2 machine the tests above ran the AVX2+FMA kernel; the portable one
-    // must give the same sound up to float rounding (FMA contraction differs): 100
-    // modes summed per sample in float, ~100 * FLT_EPSILON ~ 1e-5 of the peak, and
-    // the contact feeds that back; a wrong coefficient would be off by far more.
-    auto run = [](bool generic) {
+    // The tests above ran the widest kernel this CPU has (AVX-512 or AVX2+FMA); every
+    // copy must give the portable one's sound up to float rounding (FMA contraction
+    // and the sums' order differ): 100 modes summed per sample in float, ~100 *
+    // FLT_EPSILON ~ 1e-5 of the peak, and the contact feeds that back; a wrong
+    // coefficient or a lane left out would be off by far more.
+    auto run = [](int level) {
         membrane_ptr m(membrane_new(48000.0));
-        if (generic)
-            membrane_use_generic_kernel_(m.get());
+        membrane_use_kernel_(m.get(), level);
         membrane_set_modes(m.get(), 100);
         contact *c = contact_new();
         membrane_attach_contact(m.get(), c);
@@ -445,15 +446,23 @@ TEST_CASE("Generic and run-time selected kernels agree", "[core][membrane]")
         contact_free(c);
         return x;
     };
-    std::vector<float> a = run(false), b = run(true);
-    double peak = 0.0, diff = 0.0;
-    for (size_t i = 0; i < a.size(); i++) {
-        peak = std::max(peak, (double)std::fabs(a[i]));
-        diff = std::max(diff, (double)std::fabs(a[i] - b[i]));
+    const std::vector<float> b = run(ICTUS_SIMD_GENERIC);
+    for (int level : {ICTUS_SIMD_AVX2, ICTUS_SIMD_AVX512}) {
+        if (ictus_simd_level() < level) {
+            WARN("no " << ictus_simd_name((ictus_simd)level) << " on this CPU: not compared");
+            continue;
+        }
+        INFO("kernel " << ictus_simd_name((ictus_simd)level));
+        const std::vector<float> a = run(level);
+        double peak = 0.0, diff = 0.0;
+        for (size_t i = 0; i < a.size(); i++) {
+            peak = std::max(peak, (double)std::fabs(a[i]));
+            diff = std::max(diff, (double)std::fabs(a[i] - b[i]));
+        }
+        INFO("largest difference " << diff << " of peak " << peak);
+        REQUIRE(peak > 0.0);
+        CHECK(diff <= 1e-4 * peak);
     }
-    INFO("largest difference " << diff << " of peak " << peak);
-    REQUIRE(peak > 0.0);
-    CHECK(diff <= 1e-4 * peak);
 }
 
 TEST_CASE("Without the second output the first pickup is the same, bit for bit", "[core][membrane]")

@@ -2,14 +2,15 @@
 // coefficients at a new frequency factor, the points' couplings in the new coefficients
 // and the energy of the stored state, checked
 // against the midpoint rule's coefficients and the energy computed here in double, and
-// the AVX2+FMA copy against the portable one (bit for bit in float: the kernels keep
-// the scalar formulas' order and stop FMA contraction).
+// the AVX2+FMA and AVX-512 copies against the portable one (bit for bit in float: the
+// kernels keep the scalar formulas' order and stop FMA contraction).
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
 #include <random>
 #include <vector>
 
+#include "ictus_simd.h"
 extern "C" {
 #include "membrane_internal.h"
 }
@@ -75,15 +76,19 @@ void fill(head &h, unsigned seed)
     }
 }
 
-bool avx2_available()
-{
-#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__)
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-#else
-    return true; // elsewhere the "avx2" kernel is the portable one under another name
-#endif
-}
+// A wide copy of the kernels: its name and its three entry points.
+struct wide_kernels {
+    ictus_simd level;
+    double (*energy)(const float *, const float *, const float *, const float *, float, int);
+    void (*tension)(membrane_tension_args *);
+    void (*couplings)(membrane_tension_args *);
+};
+const wide_kernels kWide[] = {
+    {ICTUS_SIMD_AVX2, membrane_energy_kernel_avx2, membrane_tension_kernel_avx2,
+     membrane_couplings_kernel_avx2},
+    {ICTUS_SIMD_AVX512, membrane_energy_kernel_avx512, membrane_tension_kernel_avx512,
+     membrane_couplings_kernel_avx512},
+};
 
 double mode_energy(float h, float w, float sc, float q, float p)
 {
@@ -145,37 +150,42 @@ TEST_CASE("Tension rebuild: the midpoint rule's coefficients at g w0, each mode'
     }
 }
 
-TEST_CASE("Tension rebuild and energy: the AVX2 kernels agree with the portable ones",
+TEST_CASE("Tension rebuild and energy: the AVX2 and AVX-512 kernels agree with the portable ones",
           "[core][membrane][tension]")
 {
-    if (!avx2_available()) {
-        WARN("no AVX2+FMA on this CPU: nothing to compare");
-        return;
-    }
-    head x, y;
-    fill(x, 23);
-    fill(y, 23);
-    double ex = membrane_energy_kernel_generic(x.q, x.p, x.wm, x.sc, kH, kLive);
-    double ey = membrane_energy_kernel_avx2(y.q, y.p, y.wm, y.sc, kH, kLive);
-    double e = 0.0; // the live modes only, in double
-    for (int k = 0; k < kLive; k++)
-        e += 0.5 * mode_energy(kH, x.wm[k], x.sc[k], x.q[k], x.p[k]);
-    REQUIRE(e > 0.0);
-    CHECK(ex == Approx(e).epsilon(1e-6));
-    CHECK(ey == Approx(ex).epsilon(1e-12));
-    membrane_tension_args a = x.args(), b = y.args();
-    membrane_tension_kernel_generic(&a);
-    membrane_couplings_kernel_generic(&a);
-    membrane_tension_kernel_avx2(&b);
-    membrane_couplings_kernel_avx2(&b);
-    size_t differ = 0;
-    for (size_t i = 0; i < x.mem.all.size(); i++)
-        differ += std::memcmp(x.mem.all[i], y.mem.all[i], sizeof(float) * kCount) != 0;
-    CHECK(differ == 0);
-    for (int c = 0; c < 2; c++) {
-        CHECK(b.self_sum[c] == Approx(a.self_sum[c]).epsilon(1e-12));
-        for (int j = 0; j < 2; j++)
-            CHECK(b.pick_coupling[c][j] ==
-                  Approx(a.pick_coupling[c][j]).epsilon(1e-9).margin(1e-12));
+    const ictus_simd cpu = ictus_simd_level();
+    for (const wide_kernels &k : kWide) {
+        const char *name = ictus_simd_name(k.level);
+        if (cpu < k.level) {
+            WARN("no " << name << " on this CPU: that copy is not compared");
+            continue;
+        }
+        INFO("kernels: " << name);
+        head x, y;
+        fill(x, 23);
+        fill(y, 23);
+        double ex = membrane_energy_kernel_generic(x.q, x.p, x.wm, x.sc, kH, kLive);
+        double ey = k.energy(y.q, y.p, y.wm, y.sc, kH, kLive);
+        double e = 0.0; // the live modes only, in double
+        for (int m = 0; m < kLive; m++)
+            e += 0.5 * mode_energy(kH, x.wm[m], x.sc[m], x.q[m], x.p[m]);
+        REQUIRE(e > 0.0);
+        CHECK(ex == Approx(e).epsilon(1e-6));
+        CHECK(ey == Approx(ex).epsilon(1e-12));
+        membrane_tension_args a = x.args(), b = y.args();
+        membrane_tension_kernel_generic(&a);
+        membrane_couplings_kernel_generic(&a);
+        k.tension(&b);
+        k.couplings(&b);
+        size_t differ = 0;
+        for (size_t i = 0; i < x.mem.all.size(); i++)
+            differ += std::memcmp(x.mem.all[i], y.mem.all[i], sizeof(float) * kCount) != 0;
+        CHECK(differ == 0);
+        for (int c = 0; c < 2; c++) {
+            CHECK(b.self_sum[c] == Approx(a.self_sum[c]).epsilon(1e-12));
+            for (int j = 0; j < 2; j++)
+                CHECK(b.pick_coupling[c][j] ==
+                      Approx(a.pick_coupling[c][j]).epsilon(1e-9).margin(1e-12));
+        }
     }
 }
