@@ -94,31 +94,31 @@ void membrane_free(membrane *m)
     free(m);
 }
 
+/* Each instruction set's kernels, by ictus_simd level. */
+static const struct kernel_set {
+    void (*kernel)(membrane_kernel_args *);
+    void (*pair)(membrane_kernel_args *);
+    void (*tension)(membrane_tension_args *);
+    void (*couplings)(membrane_tension_args *);
+    double (*energy)(const float *, const float *, const float *, const float *, float, int);
+} kernel_sets[] = {
+    {membrane_kernel_generic, membrane_kernel_pair_generic, membrane_tension_kernel_generic,
+     membrane_couplings_kernel_generic, membrane_energy_kernel_generic},
+    {membrane_kernel_avx2, membrane_kernel_pair_avx2, membrane_tension_kernel_avx2,
+     membrane_couplings_kernel_avx2, membrane_energy_kernel_avx2},
+    {membrane_kernel_avx512, membrane_kernel_pair_avx512, membrane_tension_kernel_avx512,
+     membrane_couplings_kernel_avx512, membrane_energy_kernel_avx512},
+};
+
 void membrane_use_kernel_(membrane *m, int level)
 {
-    switch (level) {
-    case ICTUS_SIMD_AVX512:
-        m->kernel = membrane_kernel_avx512;
-        m->kernel_pair = membrane_kernel_pair_avx512;
-        m->tension_kernel = membrane_tension_kernel_avx512;
-        m->couplings_kernel = membrane_couplings_kernel_avx512;
-        m->energy_kernel = membrane_energy_kernel_avx512;
-        break;
-    case ICTUS_SIMD_AVX2:
-        m->kernel = membrane_kernel_avx2;
-        m->kernel_pair = membrane_kernel_pair_avx2;
-        m->tension_kernel = membrane_tension_kernel_avx2;
-        m->couplings_kernel = membrane_couplings_kernel_avx2;
-        m->energy_kernel = membrane_energy_kernel_avx2;
-        break;
-    default:
-        m->kernel = membrane_kernel_generic;
-        m->kernel_pair = membrane_kernel_pair_generic;
-        m->tension_kernel = membrane_tension_kernel_generic;
-        m->couplings_kernel = membrane_couplings_kernel_generic;
-        m->energy_kernel = membrane_energy_kernel_generic;
-        break;
-    }
+    const struct kernel_set *k =
+        &kernel_sets[level >= ICTUS_SIMD_GENERIC && level <= ICTUS_SIMD_AVX512 ? level : 0];
+    m->kernel = k->kernel;
+    m->kernel_pair = k->pair;
+    m->tension_kernel = k->tension;
+    m->couplings_kernel = k->couplings;
+    m->energy_kernel = k->energy;
 }
 
 void membrane_use_generic_kernel_(membrane *m)
@@ -128,10 +128,9 @@ void membrane_use_generic_kernel_(membrane *m)
 
 const char *membrane_kernel_name(const membrane *m)
 {
-    if (m->kernel == membrane_kernel_avx512)
-        return ictus_simd_name(ICTUS_SIMD_AVX512);
-    if (m->kernel == membrane_kernel_avx2)
-        return ictus_simd_name(ICTUS_SIMD_AVX2);
+    for (int level = ICTUS_SIMD_AVX512; level > ICTUS_SIMD_GENERIC; level--)
+        if (m->kernel == kernel_sets[level].kernel)
+            return ictus_simd_name((ictus_simd)level);
     return ictus_simd_name(ICTUS_SIMD_GENERIC);
 }
 

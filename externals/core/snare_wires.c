@@ -634,22 +634,14 @@ snare_wires *snare_wires_new(void)
     w->damping = 2.0 * w->mass_kg * log(1000.0) / WIRE_T60_S;
     w->k = WIRE_STIFFNESS;
     w->engaged = 1;
-    /* As the batter's kernel (membrane.c): the widest the CPU runs, or the one
-     * ICTUS_MEMBRANE_KERNEL caps it at. */
-    switch (ictus_simd_level()) {
-    case ICTUS_SIMD_AVX512:
-        w->kfree = snare_kernel_free_avx512;
-        w->kforce = snare_kernel_force_avx512;
-        break;
-    case ICTUS_SIMD_AVX2:
-        w->kfree = snare_kernel_free_avx2;
-        w->kforce = snare_kernel_force_avx2;
-        break;
-    default:
-        w->kfree = snare_kernel_free_generic;
-        w->kforce = snare_kernel_force_generic;
-        break;
-    }
+    /* As the batter's kernel (membrane.c): ictus_simd_level() picks the copy. */
+    static const snare_kernel_free_fn frees[] = {snare_kernel_free_generic, snare_kernel_free_avx2,
+                                                 snare_kernel_free_avx512};
+    static const snare_kernel_force_fn forces[] = {
+        snare_kernel_force_generic, snare_kernel_force_avx2, snare_kernel_force_avx512};
+    const ictus_simd level = ictus_simd_level();
+    w->kfree = frees[level];
+    w->kforce = forces[level];
     w->air.point.ops = &air_ops;
     w->air.set = w;
     return w;

@@ -2,8 +2,10 @@
 // block-size independence and strike timing.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "ictus_simd.h"
@@ -448,7 +450,7 @@ TEST_CASE("Generic and run-time selected kernels agree", "[core][membrane]")
     };
     const std::vector<float> b = run(ICTUS_SIMD_GENERIC);
     for (int level : {ICTUS_SIMD_AVX2, ICTUS_SIMD_AVX512}) {
-        if (ictus_simd_level() < level) {
+        if (ictus_simd_cpu() < level) {
             WARN("no " << ictus_simd_name((ictus_simd)level) << " on this CPU: not compared");
             continue;
         }
@@ -463,6 +465,38 @@ TEST_CASE("Generic and run-time selected kernels agree", "[core][membrane]")
         REQUIRE(peak > 0.0);
         CHECK(diff <= 1e-4 * peak);
     }
+}
+
+TEST_CASE("ICTUS_MEMBRANE_KERNEL chooses the kernel of the membranes made after it",
+          "[core][membrane]")
+{
+    // generic: the portable kernel anywhere; avx2: at most AVX2+FMA; avx512: the widest
+    // the CPU has; unset: the widest, except AVX2 on AMD family 19h (Zen 4 splits
+    // 512-bit operations in two), where AVX2 is the faster.
+    auto made_with = [](const char *value) {
+        if (value)
+            REQUIRE(setenv("ICTUS_MEMBRANE_KERNEL", value, 1) == 0);
+        else
+            unsetenv("ICTUS_MEMBRANE_KERNEL");
+        membrane_ptr m(membrane_new(48000.0));
+        unsetenv("ICTUS_MEMBRANE_KERNEL");
+        return std::string(membrane_kernel_name(m.get()));
+    };
+    const ictus_simd cpu = ictus_simd_cpu();
+    const std::string widest = ictus_simd_name(cpu);
+    const std::string at_most_avx2 = ictus_simd_name(cpu < ICTUS_SIMD_AVX2 ? cpu : ICTUS_SIMD_AVX2);
+    INFO("this CPU runs up to " << widest);
+    CHECK(made_with("generic") == "generic");
+    CHECK(made_with("avx2") == at_most_avx2);
+    CHECK(made_with("avx512") == widest);
+    CHECK(made_with("no-such-kernel") == made_with(nullptr));
+#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__)
+    __builtin_cpu_init();
+    const bool zen4_like = __builtin_cpu_is("amdfam19h");
+#else
+    const bool zen4_like = false;
+#endif
+    CHECK(made_with(nullptr) == (zen4_like ? at_most_avx2 : widest));
 }
 
 TEST_CASE("Without the second output the first pickup is the same, bit for bit", "[core][membrane]")

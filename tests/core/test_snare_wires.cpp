@@ -225,7 +225,7 @@ TEST_CASE("the snare head's portable, AVX2 and AVX-512 kernels play the same str
     REQUIRE(setenv("ICTUS_MEMBRANE_KERNEL", "generic", 1) == 0);
     std::vector<float> slow_off = stroke(true, false, 2.5), slow_on = stroke(true, true, 2.5);
     unsetenv("ICTUS_MEMBRANE_KERNEL");
-    const ictus_simd cpu = ictus_simd_level();
+    const ictus_simd cpu = ictus_simd_cpu();
     for (ictus_simd level : {ICTUS_SIMD_AVX2, ICTUS_SIMD_AVX512}) {
         const char *name = ictus_simd_name(level);
         if (cpu < level) {

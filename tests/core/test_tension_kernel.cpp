@@ -153,7 +153,7 @@ TEST_CASE("Tension rebuild: the midpoint rule's coefficients at g w0, each mode'
 TEST_CASE("Tension rebuild and energy: the AVX2 and AVX-512 kernels agree with the portable ones",
           "[core][membrane][tension]")
 {
-    const ictus_simd cpu = ictus_simd_level();
+    const ictus_simd cpu = ictus_simd_cpu();
     for (const wide_kernels &k : kWide) {
         const char *name = ictus_simd_name(k.level);
         if (cpu < k.level) {
