@@ -25,7 +25,7 @@ import tempfile
 import numpy as np
 
 from ictus_tools import ROOT
-from ictus_tools.pdrun import PD, PD_ENV, error_lines, read_wav_any
+from ictus_tools.pdrun import PD_BATCH, PD_ENV, error_lines, read_wav_any
 from ictus_tools.drumtone import mode_hz
 from ictus_tools.presets import preset_air_mass, preset_head
 
@@ -76,12 +76,12 @@ def main():
             f.write("%.3f hit 1 0 0 %.4f %.4f 0 0 0 0 0 %.6f %.5f;\n"
                     % (100.0 if i == 0 else 1000.0 * SPACING_S, v, a.ra, t, a.mass))
     wav, reports = os.path.join(work, "probe.wav"), os.path.join(work, "reports.txt")
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", "48000", "-path",
-           os.path.join(os.path.abspath(a.build), "ictus"), "-open",
-           os.path.join(ROOT, "patches", "ictus-render.pd"), "-send", "render-file " + events,
-           "-send", "render-out " + wav, "-send", "render-mix pickups", "-send", "render-gain -40", "-send",
-           "render-seconds %.3f" % (0.6 + SPACING_S * len(speeds)), "-send",
-           "render-reports " + reports]
+    cmd = PD_BATCH + ["-r", "48000", "-path", os.path.join(os.path.abspath(a.build), "ictus"),
+                      "-open", os.path.join(ROOT, "patches", "ictus-render.pd"), "-send",
+                      "render-file " + events, "-send", "render-out " + wav, "-send",
+                      "render-mix pickups", "-send", "render-gain -40", "-send",
+                      "render-seconds %.3f" % (0.6 + SPACING_S * len(speeds)), "-send",
+                      "render-reports " + reports]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=PD_ENV)
     errors = error_lines(proc.stdout + proc.stderr)
     if proc.returncode != 0 or errors:

@@ -36,7 +36,7 @@ import subprocess
 import numpy as np
 
 from ictus_tools import ROOT
-from ictus_tools.pdrun import PD, PD_ENV, read_wav_float
+from ictus_tools.pdrun import PD, PD_BATCH, PD_ENV, read_wav_float
 
 RENDER_PATCH = os.path.join(ROOT, "patches", "ictus-render.pd")
 MIN_GAP_S = 0.060   # strikes closer than this go to different passes
@@ -159,8 +159,7 @@ def render_pd(build, events_path, wav_path, seconds, sr=48000, timeout=300, send
     """patches/ictus-render.pd in pd batch mode -> (samples [n, 2], sr, log).
     `sends`: messages sent to the patch before the events file (as -send, the way
     `ictusd render --wav` sends the drum), before DSP starts."""
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr), "-path",
-           os.path.join(build, "ictus"), "-open", RENDER_PATCH]
+    cmd = PD_BATCH + ["-r", str(sr), "-path", os.path.join(build, "ictus"), "-open", RENDER_PATCH]
     for message in sends:
         cmd += ["-send", message]
     cmd += ["-send", "render-file %s" % os.path.abspath(events_path), "-send",

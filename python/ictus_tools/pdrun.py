@@ -23,6 +23,10 @@ import numpy as np
 from ictus_tools import checks
 
 PD = os.environ.get("ICTUS_PD", "pd")
+# pd rendering offline, as fast as the CPU allows: no GUI, no audio device, its messages on
+# stderr, and -nrt: run as root pd would otherwise take SCHED_FIFO even in batch mode, and
+# a render that never sleeps would starve every real-time pd beside it.
+PD_BATCH = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr"]
 # Under the ASan build, the sanitizer runtime to preload into pd (which is not
 # instrumented itself); python is left alone.
 PD_ENV = dict(os.environ)
@@ -226,7 +230,7 @@ def run_pd(patch_text, libdir, sr=48000, extra_args=(), workdir=None, name="test
     path = os.path.join(workdir, name)
     with open(path, "w") as f:
         f.write(patch_text)
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr), "-path", libdir]
+    cmd = PD_BATCH + ["-r", str(sr), "-path", libdir]
     cmd += list(extra_args) + ["-open", path]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=workdir,
                           env=PD_ENV)
@@ -332,7 +336,7 @@ GEM_NOISE = ("gem.conf", "libDeckLinkAPI")
 def open_patch(path, extra_args=(), timeout=60):
     """Opens a patch in pd batch mode, switches DSP on and quits: (exit status, the error
     lines of pd's output but Gem's start-up chatter)."""
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr"] + list(extra_args) + [
+    cmd = list(PD_BATCH) + list(extra_args) + [
         "-open", path, "-send", "pd dsp 1", "-send", "pd quit"]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=PD_ENV)
     log = proc.stdout + proc.stderr

@@ -8,7 +8,8 @@ import numpy as np
 
 from ictus_tools import ROOT
 from ictus_tools.checks import check
-from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float  # noqa: F401
+from ictus_tools.pdrun import (PD, PD_BATCH, PD_ENV, error_lines, make_workdir,  # noqa: F401
+                               read_wav_float)
 
 RENDER = os.path.join(ROOT, "patches", "sound", "ictus-sound-render.pd")
 MODELS = ("clips", "synth", "modal")
@@ -37,10 +38,9 @@ def write_events(path, strokes, head=()):
 
 
 def render(build, model, events, wav, seconds, sr=48000, timeout=120):
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr), "-path",
-           os.path.join(build, "ictus"), "-open", RENDER, "-send", "render-model %s" % model,
-           "-send", "render-file %s" % events, "-send", "render-out %s" % wav,
-           "-send", "render-seconds %.6g" % seconds]
+    cmd = PD_BATCH + ["-r", str(sr), "-path", os.path.join(build, "ictus"), "-open", RENDER,
+                      "-send", "render-model %s" % model, "-send", "render-file %s" % events,
+                      "-send", "render-out %s" % wav, "-send", "render-seconds %.6g" % seconds]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=PD_ENV)
     log = proc.stdout + proc.stderr
     check(proc.returncode == 0 and not error_lines(log),

@@ -13,7 +13,7 @@ import time
 from ictus_tools import ROOT as REPO  # noqa: F401 (uitest.REPO in the tests)
 from ictus_tools import oscpacket
 from ictus_tools.checks import fail
-from ictus_tools.pdrun import PD, PD_ENV, error_lines, free_udp_port  # noqa: F401
+from ictus_tools.pdrun import PD, PD_BATCH, PD_ENV, error_lines, free_udp_port  # noqa: F401
 
 SKIP = 77
 

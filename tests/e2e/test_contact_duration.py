@@ -174,10 +174,10 @@ def match_reports(strikes_t_ms, strikes_hand, reports):
 def render_with_reports(events_path, seconds, tag):
     wav = os.path.join(work, "%s.wav" % tag)
     reports = os.path.join(work, "%s-reports.txt" % tag)
-    cmd = [u.PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", "48000", "-path",
-           os.path.join(build, "ictus"), "-open", u.RENDER_PATCH,
-           "-send", "render-file %s" % events_path, "-send", "render-out %s" % wav,
-           "-send", "render-seconds %.3f" % seconds, "-send", "render-reports %s" % reports]
+    cmd = u.PD_BATCH + ["-r", "48000", "-path", os.path.join(build, "ictus"), "-open",
+                        u.RENDER_PATCH, "-send", "render-file %s" % events_path, "-send",
+                        "render-out %s" % wav, "-send", "render-seconds %.3f" % seconds, "-send",
+                        "render-reports %s" % reports]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=u.PD_ENV)
     log = proc.stdout + proc.stderr
     check(proc.returncode == 0 and not error_lines(log),

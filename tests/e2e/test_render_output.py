@@ -25,7 +25,7 @@ import numpy as np
 
 from ictus_tools import e2e_util as u
 from ictus_tools.checks import check
-from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_any
+from ictus_tools.pdrun import PD_BATCH, PD_ENV, error_lines, make_workdir, read_wav_any
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -57,8 +57,7 @@ def events_file(name, hits):
 
 def render(events, tag, *sends, seconds=1.2):
     wav = os.path.join(work, tag + ".wav")
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(SR), "-path",
-           os.path.join(build, "ictus"), "-open", u.RENDER_PATCH]
+    cmd = PD_BATCH + ["-r", str(SR), "-path", os.path.join(build, "ictus"), "-open", u.RENDER_PATCH]
     for s in sends:
         cmd += ["-send", s]
     cmd += ["-send", "render-file " + events, "-send", "render-out " + wav,

@@ -16,7 +16,7 @@ import numpy as np
 
 from ictus_tools import e2e_util as u
 from ictus_tools.checks import check
-from ictus_tools.pdrun import PD, PD_ENV, make_workdir, read_wav_any
+from ictus_tools.pdrun import PD_BATCH, PD_ENV, make_workdir, read_wav_any
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -38,8 +38,7 @@ def pd_itself(out, wav, sr, *sends, read=True):
     with open(os.path.join(out, "render.json")) as f:
         import json
         seconds = float(json.load(f)["duration_s"]) + 1.5
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr), "-path",
-           os.path.join(build, "ictus"), "-open", u.RENDER_PATCH]
+    cmd = PD_BATCH + ["-r", str(sr), "-path", os.path.join(build, "ictus"), "-open", u.RENDER_PATCH]
     for s in u.drum_lines(os.path.join(out, "render.json")) + list(sends):
         cmd += ["-send", s]
     cmd += ["-send", "render-file " + os.path.join(out, "events.txt"), "-send", "render-out " + wav,

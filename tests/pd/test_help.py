@@ -9,7 +9,7 @@ import subprocess
 
 from ictus_tools import ROOT
 from ictus_tools.checks import check
-from ictus_tools.pdrun import PD, PD_ENV, error_lines
+from ictus_tools.pdrun import PD_BATCH, PD_ENV, error_lines
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -23,7 +23,7 @@ for name in ("membrane~-help.pd", "contact~-help.pd", "ictus-meta.pd"):
     # the copy beside the binaries with no search path (as Pd's help browser
     # opens it), and the source file with -path <build>
     for where, extra in ((path, []), (source, ["-path", build])):
-        cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr"] + extra + [
+        cmd = list(PD_BATCH) + extra + [
             "-open", where, "-send", "pd dsp 1", "-send", "pd quit"]
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
         log = proc.stdout + proc.stderr

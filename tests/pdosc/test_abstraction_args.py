@@ -56,8 +56,8 @@ import time
 import numpy as np
 
 from ictus_tools.checks import check, keep_going, failed
-from ictus_tools.pdrun import (PD, PD_ENV, Patch, free_udp_port, make_workdir, read_wav_float,
-                                recorder, run_pd)
+from ictus_tools.pdrun import (PD, PD_BATCH, PD_ENV, Patch, free_udp_port, make_workdir,
+                               read_wav_float, recorder, run_pd)
 
 SR, SECONDS, A = 48000, 0.2, 0.1
 
@@ -249,10 +249,10 @@ def render_seconds(build):
         wav = os.path.join(work, "render.wav")
         if os.path.exists(wav):
             os.remove(wav)
-        cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(SR), "-path", lib,
-               "-open", os.path.join(lib, "ictus-render.pd"), "-send", "render-file " + events,
-               "-send", "render-out " + wav, "-send", "render-seconds 0.2",
-               "-send", "render-seconds " + bad]
+        cmd = PD_BATCH + ["-r", str(SR), "-path", lib, "-open",
+                          os.path.join(lib, "ictus-render.pd"), "-send", "render-file " + events,
+                          "-send", "render-out " + wav, "-send", "render-seconds 0.2", "-send",
+                          "render-seconds " + bad]
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
             rc, log = proc.returncode, proc.stdout + proc.stderr
@@ -269,9 +269,10 @@ def render_seconds(build):
                                           "got: foo"),
                        ("render-gain 1e30", "gain_db 40")):
         wav = os.path.join(work, "render.wav")
-        cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(SR), "-path", lib,
-               "-open", os.path.join(lib, "ictus-render.pd"), "-send", "render-file " + events,
-               "-send", "render-out " + wav, "-send", "render-seconds 0.2", "-send", send]
+        cmd = PD_BATCH + ["-r", str(SR), "-path", lib, "-open",
+                          os.path.join(lib, "ictus-render.pd"), "-send", "render-file " + events,
+                          "-send", "render-out " + wav, "-send", "render-seconds 0.2", "-send",
+                          send]
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
         log = proc.stdout + proc.stderr
         check(proc.returncode == 0 and line in log and "trigger:" not in log and "clip:" not in log,

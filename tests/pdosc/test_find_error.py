@@ -17,7 +17,7 @@ import subprocess
 import tempfile
 
 from ictus_tools.checks import check
-from ictus_tools.pdrun import PD, PD_ENV
+from ictus_tools.pdrun import PD_BATCH, PD_ENV
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -71,8 +71,7 @@ for good, bad, message, error_start in CASES:
         text = "\n".join(lines + connects) + "\n"
         with open(path, "w") as f:
             f.write(text)
-        cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path", build, "-path",
-               os.path.join(build, "ictus"), path]
+        cmd = PD_BATCH + ["-path", build, "-path", os.path.join(build, "ictus"), path]
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV,
                               cwd=work)
         log = proc.stdout + proc.stderr

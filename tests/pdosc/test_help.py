@@ -7,7 +7,7 @@ import os
 import subprocess
 
 from ictus_tools.checks import check
-from ictus_tools.pdrun import PD, PD_ENV, error_lines
+from ictus_tools.pdrun import PD_BATCH, PD_ENV, error_lines
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -18,8 +18,7 @@ for name, obj in (("ictus-receive-help.pd", "ictus-receive"), ("ictus-drum-help.
                   ("ictus_timetag-help.pd", "ictus_timetag"), ("ictus_error-help.pd", "ictus_error")):
     path = os.path.join(build, "ictus", name)
     check(os.path.isfile(path), "%s is in the library folder" % name)
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path", build, "-open", path,
-           "-send", "pd dsp 1", "-send", "pd quit"]
+    cmd = PD_BATCH + ["-path", build, "-open", path, "-send", "pd dsp 1", "-send", "pd quit"]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
     log = proc.stdout + proc.stderr
     bad = error_lines(log)

@@ -24,7 +24,7 @@ import numpy as np
 
 from ictus_tools import ROOT
 from ictus_tools.checks import check
-from ictus_tools.pdrun import PD, PD_ENV, error_lines, make_workdir, read_wav_float
+from ictus_tools.pdrun import PD_BATCH, PD_ENV, error_lines, make_workdir, read_wav_float
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -59,9 +59,9 @@ for sr in (44100, 48000):
         f.write("\n".join(lines) + "\n")
     wav = os.path.join(work, "out-%d.wav" % sr)
     seconds = round(times[-1] / 1000.0 + 0.3, 3)
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(sr), "-path",
-           os.path.join(build, "ictus"), "-open", render, "-send", "render-file %s" % events,
-           "-send", "render-out %s" % wav, "-send", "render-seconds %.3f" % seconds]
+    cmd = PD_BATCH + ["-r", str(sr), "-path", os.path.join(build, "ictus"), "-open", render,
+                      "-send", "render-file %s" % events, "-send", "render-out %s" % wav, "-send",
+                      "render-seconds %.3f" % seconds]
     reports = os.path.join(work, "reports-%d.txt" % sr)
     if with_mass:
         cmd += ["-send", "render-reports %s" % reports]
@@ -115,9 +115,9 @@ with open(events, "w") as f:
     f.write("10 hit 0 0 0 2 0.3 45;\n10 hit 1 0 0 2 0.3 45 100 0.01 1.2 0.1 0.02;\n")
 wav = os.path.join(work, "short.wav")
 reports = os.path.join(work, "short-reports.txt")
-cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path", os.path.join(build, "ictus"),
-       "-open", render, "-send", "render-file %s" % events, "-send", "render-out %s" % wav,
-       "-send", "render-seconds 0.2", "-send", "render-reports %s" % reports]
+cmd = PD_BATCH + ["-path", os.path.join(build, "ictus"), "-open", render, "-send",
+                  "render-file %s" % events, "-send", "render-out %s" % wav, "-send",
+                  "render-seconds 0.2", "-send", "render-reports %s" % reports]
 proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
 log = proc.stdout + proc.stderr
 with open(reports) as f:
@@ -129,9 +129,9 @@ check(proc.returncode == 0 and "error: ictus-render: a hit line needs 11 numbers
 
 # A missing events file is reported, naming it; the patch still writes and quits.
 wav = os.path.join(work, "missing.wav")
-cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path", os.path.join(build, "ictus"),
-       "-open", render, "-send", "render-file %s/nope.txt" % work, "-send", "render-out %s" % wav,
-       "-send", "render-seconds 0.1"]
+cmd = PD_BATCH + ["-path", os.path.join(build, "ictus"), "-open", render, "-send",
+                  "render-file %s/nope.txt" % work, "-send", "render-out %s" % wav, "-send",
+                  "render-seconds 0.1"]
 proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
 log = proc.stdout + proc.stderr
 check(proc.returncode == 0 and "nope.txt" in log and os.path.isfile(wav),

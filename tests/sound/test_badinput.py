@@ -12,7 +12,8 @@ import subprocess
 import numpy as np
 
 from ictus_tools.checks import check
-from ictus_tools.soundrun import PD, PD_ENV, RENDER, make_workdir, read_wav_float, write_events
+from ictus_tools.soundrun import (PD_BATCH, PD_ENV, RENDER, make_workdir, read_wav_float,
+                                  write_events)
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -25,10 +26,9 @@ def run(model, items, head, seconds=0.6):
     ev = os.path.join(work, "ev-%s.txt" % model)
     wav = os.path.join(work, "out-%s.wav" % model)
     write_events(ev, items, head=head)
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", "48000", "-path",
-           os.path.join(build, "ictus"), "-open", RENDER, "-send", "render-model %s" % model,
-           "-send", "render-file %s" % ev, "-send", "render-out %s" % wav,
-           "-send", "render-seconds %g" % seconds]
+    cmd = PD_BATCH + ["-r", "48000", "-path", os.path.join(build, "ictus"), "-open", RENDER,
+                      "-send", "render-model %s" % model, "-send", "render-file %s" % ev, "-send",
+                      "render-out %s" % wav, "-send", "render-seconds %g" % seconds]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
     x, _ = read_wav_float(wav)
     return proc.returncode, proc.stdout + proc.stderr, x
@@ -40,8 +40,8 @@ def open_lines(name, body):
     path = os.path.join(work, name)
     with open(path, "w") as f:
         f.write("#N canvas 0 0 400 300 12;\n" + body)
-    proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path",
-                           os.path.join(build, "ictus"), "-open", path, "-send", "pd quit"],
+    proc = subprocess.run(PD_BATCH + ["-path", os.path.join(build, "ictus"), "-open", path, "-send",
+                                      "pd quit"],
                           capture_output=True, text=True, timeout=60, env=PD_ENV)
     return proc.returncode, proc.stdout + proc.stderr
 
@@ -89,8 +89,7 @@ for f in ["ictus-sound-clips.pd", "ictus-sound-clips-voice.pd"] + errors_binary:
     shutil.copy(os.path.join(build, "ictus", f), lib)
 with open(os.path.join(lib, "t.pd"), "w") as f:
     f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound-clips;\n")
-proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-open",
-                       os.path.join(lib, "t.pd"), "-send", "pd quit"],
+proc = subprocess.run(PD_BATCH + ["-open", os.path.join(lib, "t.pd"), "-send", "pd quit"],
                       capture_output=True, text=True, timeout=60, env=PD_ENV)
 log = proc.stdout + proc.stderr
 print(log)

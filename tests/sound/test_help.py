@@ -8,7 +8,7 @@ import os
 import subprocess
 
 from ictus_tools.checks import check
-from ictus_tools.soundrun import PD, PD_ENV, error_lines, make_workdir
+from ictus_tools.soundrun import PD_BATCH, PD_ENV, error_lines, make_workdir
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--build", required=True)
@@ -20,8 +20,7 @@ for obj in ("ictus-sound", "ictus-sound-clips", "ictus-sound-synth", "ictus-soun
     name = obj + "-help.pd"
     path = os.path.join(build, "ictus", name)
     check(os.path.isfile(path), "%s is in the library folder" % name)
-    cmd = [PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path", build, "-open", path,
-           "-send", "pd dsp 1", "-send", "pd quit"]
+    cmd = PD_BATCH + ["-path", build, "-open", path, "-send", "pd dsp 1", "-send", "pd quit"]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=PD_ENV)
     log = proc.stdout + proc.stderr
     lines = [l for l in log.splitlines() if l.strip()]
@@ -42,8 +41,8 @@ for arg, report in (("", "model modal 2"), ("clips", "model clips 0"), ("synth",
     with open(patch, "w") as f:
         f.write("#N canvas 0 0 400 300 12;\n#X obj 10 10 ictus-sound %s;\n#X obj 10 60 print got;\n"
                 "#X connect 0 2 1 0;\n" % arg)
-    proc = subprocess.run([PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path",
-                           os.path.join(build, "ictus"), "-open", patch, "-send", "pd quit"],
+    proc = subprocess.run(PD_BATCH + ["-path", os.path.join(build, "ictus"), "-open", patch,
+                                      "-send", "pd quit"],
                           capture_output=True, text=True, timeout=60, env=PD_ENV)
     log = (proc.stdout + proc.stderr).strip()
     check(log == "got: " + report, "[ictus-sound %s] starts with %s (%s)" % (arg, report, log))

@@ -65,8 +65,8 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-midi-") as work:
                 "#X obj 10 70 ictus-midi;\n#X obj 10 260 print midi;\n#X obj 200 260 print midiin;\n"
                 "#X connect 0 0 1 0;\n#X connect 1 0 2 0;\n#X connect 2 0 3 0;\n#X connect 2 1 4 0;\n"
                 % " \\, ".join(msgs))
-    proc = subprocess.run([uitest.PD, "-nogui", "-nosound", "-nomidi", "-batch", "-nrt", "-stderr", "-path",
-                           os.path.join(build, "ictus"), "-open", patch, "-send", "pd quit"],
+    proc = subprocess.run(uitest.PD_BATCH + ["-nomidi", "-path", os.path.join(build, "ictus"),
+                                             "-open", patch, "-send", "pd quit"],
                           capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
 log = proc.stdout + proc.stderr
 check(not uitest.error_lines(log), "no error lines: %s" % uitest.error_lines(log))

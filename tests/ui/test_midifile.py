@@ -76,8 +76,8 @@ def run(patch_text, work, name):
     patch = os.path.join(work, name)
     with open(patch, "w") as f:
         f.write(patch_text)
-    proc = subprocess.run([uitest.PD, "-nogui", "-nosound", "-nomidi", "-batch", "-nrt", "-stderr", "-path",
-                           os.path.join(build, "ictus"), "-open", patch],
+    proc = subprocess.run(uitest.PD_BATCH + ["-nomidi", "-path", os.path.join(build, "ictus"),
+                                             "-open", patch],
                           capture_output=True, text=True, timeout=120, env=uitest.PD_ENV)
     return proc.stdout + proc.stderr
 

@@ -65,8 +65,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-osc-") as work:
                 "#X connect 2 0 3 0;\n#X connect 3 0 4 0;\n#X connect 5 0 4 0;\n"
                 "#X connect 1 0 6 0;\n#X connect 6 0 3 1;\n#X connect 1 0 7 0;\n#X connect 7 0 8 0;\n"
                 % (messages, port))
-    proc = subprocess.run([uitest.PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path",
-                           os.path.join(build, "ictus"), "-open", patch],
+    proc = subprocess.run(uitest.PD_BATCH + ["-path", os.path.join(build, "ictus"), "-open", patch],
                           capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
 log = proc.stdout + proc.stderr
 check(proc.returncode == 0 and not uitest.error_lines(log), "pd ran without error lines" + ("" if not log else ": " + log))

@@ -37,8 +37,7 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-readback-") as work:
                 "#X obj 200 460 print shown;\n"
                 "#X connect 0 0 1 0;\n#X connect 3 0 2 1;\n#X connect 2 0 4 0;\n"
                 "#X connect 2 1 5 0;\n" % " \\; ".join(STEPS))
-    proc = subprocess.run([uitest.PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path",
-                           os.path.join(build, "ictus"), "-open", patch],
+    proc = subprocess.run(uitest.PD_BATCH + ["-path", os.path.join(build, "ictus"), "-open", patch],
                           capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
 log = (proc.stdout + proc.stderr).splitlines()
 errors = uitest.error_lines("\n".join(l for l in log if not l.startswith("shown: ")))

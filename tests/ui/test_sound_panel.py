@@ -28,8 +28,8 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-sound-") as work:
                 "#X obj 10 70 ictus-sound-panel;\n#X obj 10 100 print snd;\n#X obj 200 100 print dmn;\n"
                 "#X connect 0 0 1 0;\n#X connect 1 0 2 0;\n#X connect 2 0 3 0;\n#X connect 2 1 4 0;\n"
                 % " \\, ".join("%s %s" % kv for kv in PRESET))
-    proc = subprocess.run([uitest.PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path",
-                           os.path.join(build, "ictus"), "-open", patch, "-send", "pd quit"],
+    proc = subprocess.run(uitest.PD_BATCH + ["-path", os.path.join(build, "ictus"), "-open", patch,
+                                             "-send", "pd quit"],
                           capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
 lines = [l.strip() for l in (proc.stdout + proc.stderr).splitlines() if l.strip()]
 print("\n".join(lines))
@@ -71,9 +71,8 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-sound-") as work:
                 "#X obj 200 140 print report;\n"
                 "#X connect 0 0 1 0;\n#X connect 1 0 2 0;\n#X connect 2 0 3 0;\n#X connect 3 2 2 0;\n"
                 "#X connect 0 0 4 0;\n#X connect 4 0 3 0;\n#X connect 3 2 5 0;\n" % preset)
-    proc = subprocess.run([uitest.PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path",
-                           os.path.join(build, "ictus"), "-open", patch, "-send", "pd dsp 1",
-                           "-send", "pd quit"],
+    proc = subprocess.run(uitest.PD_BATCH + ["-path", os.path.join(build, "ictus"), "-open", patch,
+                                             "-send", "pd dsp 1", "-send", "pd quit"],
                           capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
 log = proc.stdout + proc.stderr
 print(log)

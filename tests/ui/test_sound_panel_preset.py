@@ -61,9 +61,8 @@ def render(choose, work, tag):
                 "#X connect 8 0 4 0;\n#X connect 0 0 9 0;\n#X connect 9 0 10 0;\n"
                 "#X connect 10 1 11 0;\n#X connect 11 0 12 0;\n#X connect 10 0 13 0;\n"
                 % (choose, SR * 13 // 10, wav))
-    proc = subprocess.run([uitest.PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-r", str(SR),
-                           "-path", os.path.join(build, "ictus"), "-open", patch,
-                           "-send", "pd dsp 1"],
+    proc = subprocess.run(uitest.PD_BATCH + ["-r", str(SR), "-path", os.path.join(build, "ictus"),
+                                             "-open", patch, "-send", "pd dsp 1"],
                           capture_output=True, text=True, timeout=120, env=uitest.PD_ENV)
     lines = [l.strip() for l in (proc.stdout + proc.stderr).splitlines() if l.strip()]
     check(proc.returncode == 0, "%s: pd ran (exit %d)" % (tag, proc.returncode))

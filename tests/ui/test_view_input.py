@@ -40,8 +40,8 @@ with tempfile.TemporaryDirectory(prefix="ictus-ui-view-") as work:
                 "#X obj 10 70 r viewin;\n#X obj 10 100 ictus-view;\n#X obj 200 70 r case;\n"
                 "#X obj 200 100 print case;\n#X connect 0 0 1 0;\n#X connect 2 0 3 0;\n#X connect 4 0 5 0;\n"
                 % " ".join("\\; case %d \\; viewin %s" % (n, m) for n, (m, _) in enumerate(CASES)))
-    proc = subprocess.run([uitest.PD, "-nogui", "-nosound", "-batch", "-nrt", "-stderr", "-path",
-                           os.path.join(build, "ictus"), "-open", patch, "-send", "pd quit"],
+    proc = subprocess.run(uitest.PD_BATCH + ["-path", os.path.join(build, "ictus"), "-open", patch,
+                                             "-send", "pd quit"],
                           capture_output=True, text=True, timeout=60, env=uitest.PD_ENV)
 lines = [l.strip() for l in (proc.stdout + proc.stderr).splitlines()
          if l.strip().startswith(("ictus-view", "case:", "error", "verbose(1)"))]
