@@ -269,8 +269,9 @@ double ictus_bessel_zero(int m, int n);
 /* J_m(x) for integer m >= 0. */
 double ictus_bessel_j(int m, double x);
 
-/* Which modal kernel this instance runs: "avx2+fma" or "generic" (chosen at
- * membrane_new() from the CPU's features). For benchmarks and bug reports. */
+/* Which modal kernel this instance runs: "avx512", "avx2+fma" or "generic" (chosen at
+ * membrane_new() from the CPU's features and ICTUS_MEMBRANE_KERNEL: ictus_simd.h).
+ * For benchmarks and bug reports. */
 const char *membrane_kernel_name(const membrane *m);
 
 #ifdef __cplusplus

@@ -1,6 +1,6 @@
 /* AVX2 + FMA build of the modal kernel. This file alone is compiled with
  * -mavx2 -mfma (externals/core/CMakeLists.txt); membrane_new() only selects it
- * when __builtin_cpu_supports says the CPU has both. */
+ * when ictus_simd_level() says so (the CPU has both). */
 #define KERNEL_NAME      membrane_kernel_avx2
 #define KERNEL_PAIR_NAME membrane_kernel_pair_avx2
 #define KERNEL_TENSION_NAME membrane_tension_kernel_avx2

@@ -430,8 +430,8 @@ extern "C" void membrane_use_kernel_(membrane *m, int level); // membrane_intern
 
 TEST_CASE("Generic and run-time selected kernels agree", "[core][membrane]")
 {
-    // The tests above ran the widest kernel this CPU has (AVX-512 or AVX2+FMA); every
-    // copy must give the portable one's sound up to float rounding (FMA contraction
+    // The tests above ran the kernel chosen at run time (AVX-512 or AVX2+FMA); every
+    // copy this CPU runs must give the portable one's sound up to float rounding (FMA contraction
     // and the sums' order differ): 100 modes summed per sample in float, ~100 *
     // FLT_EPSILON ~ 1e-5 of the peak, and the contact feeds that back; a wrong
     // coefficient or a lane left out would be off by far more.
