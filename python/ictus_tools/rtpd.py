@@ -59,7 +59,9 @@ class Listener:
                 break
             except OSError:
                 continue  # not root: SO_RCVBUF, capped at net.core.rmem_max
-        self.buffer_bytes = self.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+        # Linux reports twice the size set (the other half is its bookkeeping, socket(7)):
+        # the half is what holds datagrams' worth, and what was asked for.
+        self.buffer_bytes = self.sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 2
         try:
             self.sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
         except OSError:
