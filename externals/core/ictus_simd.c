@@ -4,9 +4,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
+#define SIMD_X86 1
+#endif
+
 ictus_simd ictus_simd_cpu(void)
 {
-#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
+#ifdef SIMD_X86
     /* libgcc's checks include the OS's (XCR0): a CPU whose OS does not save the
      * registers reports the feature absent. */
     __builtin_cpu_init();
@@ -22,13 +26,12 @@ ictus_simd ictus_simd_cpu(void)
 }
 
 /* AMD family 19h with AVX-512 (Zen 4; Zen 3 has none) runs a 512-bit operation as two
- * 256-bit halves: there
- * the AVX-512 kernel measured 0.160 ns per mode-sample against AVX2's 0.149 on Zen 4
- * (docs/benchmarks.md), so AVX2 is preferred. */
+ * 256-bit halves: there the AVX-512 kernel measured 0.160 ns per mode-sample against
+ * AVX2's 0.149 (docs/benchmarks.md), so AVX2 is preferred. Called only where
+ * ictus_simd_cpu() found AVX-512, after its __builtin_cpu_init(). */
 static int halves_512(void)
 {
-#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__) && !defined(ICTUS_NO_AVX2)
-    __builtin_cpu_init();
+#ifdef SIMD_X86
     return __builtin_cpu_is("amdfam19h");
 #else
     return 0;
